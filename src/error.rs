@@ -1,0 +1,61 @@
+//! Typed errors. Everything a user wrote (scene, graph, OBJ, WGSL) is reported with `file:line:col`.
+
+use std::fmt;
+use std::path::{Path, PathBuf};
+
+/// A position in a user file, 1-based, printed as `path:line:col`.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct FileLoc {
+    pub path: PathBuf,
+    pub line: usize,
+    pub col: usize,
+}
+
+impl FileLoc {
+    pub fn new(path: impl AsRef<Path>, line: usize, col: usize) -> Self {
+        Self {
+            path: path.as_ref().to_path_buf(),
+            line,
+            col,
+        }
+    }
+}
+
+impl fmt::Display for FileLoc {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}:{}:{}", self.path.display(), self.line, self.col)
+    }
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    /// Something wrong at a known place in a user file.
+    #[error("{loc}: {message}")]
+    At { loc: FileLoc, message: String },
+    /// A file that cannot be read or written, or is wrong as a whole.
+    #[error("{}: {message}", path.display())]
+    File { path: PathBuf, message: String },
+    /// The GPU, its adapter or its limits.
+    #[error("GPU: {0}")]
+    Gpu(String),
+    /// Invalid input that has no single position (for example a mesh-wide check).
+    #[error("{0}")]
+    Invalid(String),
+}
+
+impl Error {
+    pub fn at(loc: FileLoc, message: impl Into<String>) -> Self {
+        Error::At {
+            loc,
+            message: message.into(),
+        }
+    }
+    pub fn file(path: impl AsRef<Path>, message: impl fmt::Display) -> Self {
+        Error::File {
+            path: path.as_ref().to_path_buf(),
+            message: message.to_string(),
+        }
+    }
+}
+
+pub type Result<T, E = Error> = std::result::Result<T, E>;

@@ -1,0 +1,183 @@
+//! WGSL loading: `#include "shared/x.wgsl"` expansion with a line map back to the original files,
+//! then naga parsing and validation, so every shader error names `file:line:col` before any
+//! pipeline is made.
+
+use std::path::{Path, PathBuf};
+
+use crate::error::{Error, FileLoc, Result};
+
+/// A validated WGSL kernel: the naga module (handed to wgpu as IR, parsed once), its validation
+/// info (used for reflection), and every file it was assembled from (for hot reload).
+pub struct Kernel {
+    /// Path relative to the WGSL root, e.g. `emit_slices.wgsl`.
+    pub name: String,
+    pub module: naga::Module,
+    pub info: naga::valid::ModuleInfo,
+    pub files: Vec<PathBuf>,
+}
+
+/// Expanded source plus, for each expanded line, the file and line it came from.
+struct Expanded {
+    text: String,
+    origin: Vec<(usize, usize)>, // (index into files, 1-based line)
+    files: Vec<PathBuf>,
+}
+
+fn expand(root: &Path, rel: &Path, out: &mut Expanded, from: Option<FileLoc>) -> Result<()> {
+    let path = root.join(rel);
+    if out.files.contains(&path) {
+        return Ok(()); // each include once: shared files carry no guards
+    }
+    let text = std::fs::read_to_string(&path).map_err(|e| match &from {
+        Some(loc) => Error::at(
+            loc.clone(),
+            format!("cannot include {}: {e}", path.display()),
+        ),
+        None => Error::file(&path, format!("cannot read WGSL: {e}")),
+    })?;
+    out.files.push(path.clone());
+    let file_index = out.files.len() - 1;
+    for (i, line) in text.lines().enumerate() {
+        let trimmed = line.trim_start();
+        if let Some(rest) = trimmed.strip_prefix("#include") {
+            let name = rest.trim().trim_matches('"');
+            let col = line.len() - trimmed.len() + 1;
+            if name.is_empty() || !rest.trim().starts_with('"') {
+                return Err(Error::at(
+                    FileLoc::new(&path, i + 1, col),
+                    "expected #include \"shared/name.wgsl\"",
+                ));
+            }
+            expand(
+                root,
+                Path::new(name),
+                out,
+                Some(FileLoc::new(&path, i + 1, col)),
+            )?;
+            continue;
+        }
+        out.text.push_str(line);
+        out.text.push('\n');
+        out.origin.push((file_index, i + 1));
+    }
+    Ok(())
+}
+
+impl Expanded {
+    fn locate(&self, line: u32, col: u32) -> FileLoc {
+        let (file, orig) = self
+            .origin
+            .get((line as usize).saturating_sub(1))
+            .copied()
+            .unwrap_or((0, line as usize));
+        FileLoc::new(&self.files[file], orig, col as usize)
+    }
+}
+
+/// The naga capabilities voltex kernels may use on any adapter it supports.
+pub fn capabilities() -> naga::valid::Capabilities {
+    naga::valid::Capabilities::empty()
+}
+
+/// Loads, expands and validates `root/rel`.
+pub fn load(root: &Path, rel: &str) -> Result<Kernel> {
+    let mut ex = Expanded {
+        text: String::new(),
+        origin: Vec::new(),
+        files: Vec::new(),
+    };
+    expand(root, Path::new(rel), &mut ex, None)?;
+    load_expanded(rel, ex)
+}
+
+/// Validates WGSL given as text (tests and tools); `path` is only used in messages.
+pub fn load_str(path: &Path, source: &str) -> Result<Kernel> {
+    let ex = Expanded {
+        text: source.to_string(),
+        origin: (1..=source.lines().count()).map(|l| (0, l)).collect(),
+        files: vec![path.to_path_buf()],
+    };
+    load_expanded(&path.display().to_string(), ex)
+}
+
+fn load_expanded(name: &str, ex: Expanded) -> Result<Kernel> {
+    let module = naga::front::wgsl::parse_str(&ex.text).map_err(|e| {
+        let loc = e.location(&ex.text);
+        let (line, col) = loc
+            .map(|l| (l.line_number, l.line_position))
+            .unwrap_or((1, 1));
+        Error::at(
+            ex.locate(line, col),
+            format!(
+                "WGSL parse error: {}",
+                first_line(&e.emit_to_string(&ex.text))
+            ),
+        )
+    })?;
+    let info = naga::valid::Validator::new(naga::valid::ValidationFlags::all(), capabilities())
+        .validate(&module)
+        .map_err(|e| {
+            let (line, col) = e
+                .location(&ex.text)
+                .map(|l| (l.line_number, l.line_position))
+                .unwrap_or((1, 1));
+            let mut msg = e.as_inner().to_string();
+            let mut src: &dyn std::error::Error = e.as_inner();
+            while let Some(next) = src.source() {
+                msg.push_str(": ");
+                msg.push_str(&next.to_string());
+                src = next;
+            }
+            Error::at(
+                ex.locate(line, col),
+                format!("WGSL validation error: {msg}"),
+            )
+        })?;
+    Ok(Kernel {
+        name: name.to_string(),
+        module,
+        info,
+        files: ex.files,
+    })
+}
+
+fn first_line(diagnostic: &str) -> String {
+    diagnostic
+        .lines()
+        .next()
+        .unwrap_or("")
+        .trim_start_matches("error: ")
+        .to_string()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn parse_error_names_the_included_file_and_line() {
+        let dir = std::env::temp_dir().join(format!("voltex-shader-{}", std::process::id()));
+        std::fs::create_dir_all(dir.join("shared")).unwrap();
+        std::fs::write(
+            dir.join("shared/a.wgsl"),
+            "fn a() -> f32 { return 1.0; }\nfn b() -> f32 { return 1.0 +; }\n",
+        )
+        .unwrap();
+        std::fs::write(
+            dir.join("k.wgsl"),
+            "// k\n#include \"shared/a.wgsl\"\n@compute @workgroup_size(1) fn main() {}\n",
+        )
+        .unwrap();
+        let err = load(&dir, "k.wgsl").err().unwrap().to_string();
+        assert!(err.contains("shared/a.wgsl:2:"), "{err}");
+        std::fs::write(dir.join("shared/a.wgsl"), "fn a() -> f32 { return 1.0; }\n").unwrap();
+        std::fs::write(
+            dir.join("k.wgsl"),
+            "#include \"shared/a.wgsl\"\nfn c() -> u32 { return a(); }\n",
+        )
+        .unwrap();
+        let err = load(&dir, "k.wgsl").err().unwrap().to_string();
+        assert!(err.contains("k.wgsl:2:"), "{err}");
+        std::fs::remove_dir_all(&dir).ok();
+    }
+}

@@ -1,0 +1,26 @@
+//! voltex: volumetric textures and hypertextures on wgpu.
+//!
+//! Data flow: scene file → [`scene`] → objects with base surfaces ([`mesh`]) → a [`graph`] of
+//! compute and raster passes built from `graphs/*.ron` and `wgsl/*.wgsl` → [`io`] (EXR, PNG).
+
+pub mod bake;
+pub mod cpu;
+pub mod error;
+pub mod gpu;
+pub mod graph;
+pub mod io;
+pub mod mesh;
+pub mod methods;
+pub mod metrics;
+pub mod scene;
+pub mod types;
+
+pub use error::{Error, FileLoc, Result};
+
+/// The project's root folder, where `wgsl/`, `graphs/` and `scenes/` live. `VOLTEX_ROOT` overrides
+/// it (for an installed binary).
+pub fn project_root() -> std::path::PathBuf {
+    std::env::var_os("VOLTEX_ROOT")
+        .map(Into::into)
+        .unwrap_or_else(|| std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")))
+}

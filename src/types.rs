@@ -1,0 +1,65 @@
+//! Structs shared with WGSL. Mirrored in `wgsl/shared/types.wgsl`; `tests/types_layout.rs` checks
+//! that sizes and field offsets agree (naga reflection against these Rust layouts).
+
+use bytemuck::{Pod, Zeroable};
+
+/// One base-surface vertex of a shell: the bottom `p` and top `p + h`, camera-relative (f32 after
+/// subtracting the camera position in f64). `w` components are 1.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct ShellVertex {
+    pub bottom: [f32; 4],
+    pub top: [f32; 4],
+}
+
+/// One prism: three welded vertex ids (shared edges are recognised by these ids), the texture
+/// coordinates of its corners (per corner, so uv seams need no duplicated positions) and its
+/// bounding sphere for the trivial reject.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct Prism {
+    /// xyz: vertex ids into the `ShellVertex` array; w: unused.
+    pub vertices: [u32; 4],
+    /// uv of corner 0 (xy) and corner 1 (zw).
+    pub uv01: [f32; 4],
+    /// uv of corner 2 (xy); zw unused.
+    pub uv2: [f32; 4],
+    /// camera-relative centre (xyz) and radius (w) of a sphere holding all six corners.
+    pub sphere: [f32; 4],
+}
+
+/// Per-object, per-frame parameters of view-aligned slicing.
+/// Plane `k` (0 = back-most) is `dot(plane_normal, x) = first_plane - k * spacing`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct SliceParams {
+    /// xyz: unit plane normal (the camera's forward direction); w: unused.
+    pub plane_normal: [f32; 4],
+    pub first_plane: f32,
+    pub spacing: f32,
+    pub plane_count: u32,
+    pub prism_count: u32,
+    /// Capacity of the slice-vertex buffer, in vertices.
+    pub vertex_capacity: u32,
+    pub _pad: [u32; 3],
+}
+
+/// One vertex of a slice polygon, triangulated as a fan into a triangle list.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct SliceVertex {
+    /// Camera-relative position (xyz); w holds the prism index (as f32 bits, `bitcast<u32>`).
+    pub position: [f32; 4],
+    /// Texel coordinates (s, t, w); w component unused.
+    pub uvw: [f32; 4],
+}
+
+/// Arguments of `draw_indirect`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct DrawIndirect {
+    pub vertex_count: u32,
+    pub instance_count: u32,
+    pub first_vertex: u32,
+    pub first_instance: u32,
+}
