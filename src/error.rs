@@ -59,3 +59,24 @@ impl Error {
 }
 
 pub type Result<T, E = Error> = std::result::Result<T, E>;
+
+/// Line and column (1-based) of byte `offset` in `source`.
+pub fn line_col(source: &str, offset: usize) -> (usize, usize) {
+    let before = &source[..offset.min(source.len())];
+    let line = before.matches('\n').count() + 1;
+    let col = before.rfind('\n').map(|i| offset - i).unwrap_or(offset + 1);
+    (line, col)
+}
+
+/// Position of the string literal `"text"` in a RON source (the first one at or after byte
+/// `from`), for errors found after parsing, when serde no longer knows where a value was.
+pub fn locate_literal(source: &str, text: &str, from: usize) -> Option<(usize, usize)> {
+    let needle = format!("\"{text}\"");
+    let start = from.min(source.len());
+    source[start..].find(&needle).map(|i| line_col(source, start + i))
+}
+
+/// Turns a ron error into `path:line:col: message`.
+pub fn ron_error(path: &Path, e: &ron::error::SpannedError) -> Error {
+    Error::at(FileLoc::new(path, e.span.start.line, e.span.start.col), e.code.to_string())
+}

@@ -63,3 +63,42 @@ pub struct DrawIndirect {
     pub first_vertex: u32,
     pub first_instance: u32,
 }
+
+/// Per-frame parameters (uniform `frame`). Positions are camera-relative, so `view_proj` has no
+/// translation.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct FrameParams {
+    pub view_proj: [[f32; 4]; 4],
+    /// xyz: unit camera forward; w: near plane distance.
+    pub forward: [f32; 4],
+    /// xyz: unit direction towards the light; w: ambient term.
+    pub light_dir: [f32; 4],
+    /// rgb: light colour times intensity.
+    pub light_color: [f32; 4],
+    /// rgb: linear background colour.
+    pub background: [f32; 4],
+    /// width, height, 1/width, 1/height.
+    pub viewport: [f32; 4],
+}
+
+/// Per-object draw parameters (uniform `object`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct ObjectParams {
+    /// rgb: base-surface colour.
+    pub base_color: [f32; 4],
+    /// World length over which a voxel's stored opacity is reached.
+    pub opacity_length: f32,
+    pub _pad: [f32; 3],
+}
+
+/// One corner of a base-surface triangle, for the opaque base pass (3 per triangle).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct BaseVertex {
+    /// Camera-relative position (xyz), w = 1.
+    pub position: [f32; 4],
+    /// Unit normal (xyz), w = 0.
+    pub normal: [f32; 4],
+}

@@ -1,1 +1,8 @@
+//! Device, shader loading and validation, reflection, timestamps.
+
+pub mod context;
+pub mod reflect;
 pub mod shader;
+pub mod timing;
+
+pub use context::GpuContext;

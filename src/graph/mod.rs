@@ -1,1 +1,277 @@
-//! (filled in by its owner)
+//! Render-graph files (`graphs/*.ron`): resources and passes naming WGSL files. Bindings come from
+//! the WGSL itself (naga reflection, by name); pass order from reads and writes; what a scene does
+//! not use is pruned ([`plan`]); [`exec`] records and runs a frame.
+
+pub mod exec;
+pub mod plan;
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use serde::Deserialize;
+
+use crate::error::{locate_literal, ron_error, Error, FileLoc, Result};
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GraphFile {
+    /// Resources that leave the frame (read back or presented); everything else is pruned if
+    /// nothing needed reads it.
+    pub outputs: Vec<String>,
+    #[serde(default)]
+    pub resources: BTreeMap<String, ResourceDecl>,
+    pub passes: Vec<PassDecl>,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum ResourceDecl {
+    Texture {
+        format: Format,
+        #[serde(default)]
+        size: TextureSize,
+        #[serde(default)]
+        clear: Option<Clear>,
+    },
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+pub enum Format {
+    Rgba8Unorm,
+    Rgba16Float,
+    Rgba32Float,
+    Depth32Float,
+}
+
+impl Format {
+    pub fn wgpu(self) -> wgpu::TextureFormat {
+        match self {
+            Format::Rgba8Unorm => wgpu::TextureFormat::Rgba8Unorm,
+            Format::Rgba16Float => wgpu::TextureFormat::Rgba16Float,
+            Format::Rgba32Float => wgpu::TextureFormat::Rgba32Float,
+            Format::Depth32Float => wgpu::TextureFormat::Depth32Float,
+        }
+    }
+    pub fn bytes_per_pixel(self) -> u64 {
+        match self {
+            Format::Rgba8Unorm | Format::Depth32Float => 4,
+            Format::Rgba16Float => 8,
+            Format::Rgba32Float => 16,
+        }
+    }
+}
+
+#[derive(Debug, Clone, Copy, Default, PartialEq, Deserialize)]
+pub enum TextureSize {
+    /// The scene's output size.
+    #[default]
+    Output,
+    Fixed(u32, u32),
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+pub enum Clear {
+    /// Linear RGBA.
+    Color(f32, f32, f32, f32),
+    Depth(f32),
+}
+
+/// Which instances a pass runs for.
+#[derive(Debug, Clone, Default, PartialEq, Deserialize)]
+pub enum Instances {
+    /// Once per frame.
+    #[default]
+    Frame,
+    /// Once per scene object matching the filter (see [`plan::OBJECT_FILTERS`]), back to front.
+    Objects(String),
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum PassDecl {
+    Compute {
+        name: String,
+        shader: String,
+        #[serde(default = "default_compute_entry")]
+        entry: String,
+        #[serde(default)]
+        instances: Instances,
+        /// Buffers zeroed before the pass (per instance).
+        #[serde(default)]
+        clear: Vec<String>,
+        dispatch: Dispatch,
+    },
+    Raster {
+        name: String,
+        shader: String,
+        #[serde(default = "default_vertex_entry")]
+        vertex: String,
+        #[serde(default = "default_fragment_entry")]
+        fragment: String,
+        #[serde(default)]
+        instances: Instances,
+        targets: Vec<Target>,
+        #[serde(default)]
+        depth: Option<DepthTarget>,
+        draw: Draw,
+    },
+}
+
+fn default_compute_entry() -> String {
+    "main".into()
+}
+fn default_vertex_entry() -> String {
+    "vs_main".into()
+}
+fn default_fragment_entry() -> String {
+    "fs_main".into()
+}
+
+impl PassDecl {
+    pub fn name(&self) -> &str {
+        match self {
+            PassDecl::Compute { name, .. } | PassDecl::Raster { name, .. } => name,
+        }
+    }
+    pub fn shader(&self) -> &str {
+        match self {
+            PassDecl::Compute { shader, .. } | PassDecl::Raster { shader, .. } => shader,
+        }
+    }
+    pub fn instances(&self) -> &Instances {
+        match self {
+            PassDecl::Compute { instances, .. } | PassDecl::Raster { instances, .. } => instances,
+        }
+    }
+    pub fn entry_points(&self) -> Vec<&str> {
+        match self {
+            PassDecl::Compute { entry, .. } => vec![entry],
+            PassDecl::Raster { vertex, fragment, .. } => vec![vertex, fragment],
+        }
+    }
+}
+
+/// A count: a number, or a name the runtime knows (`prisms`, `planes`, `base_vertices`,
+/// `width`, `height`).
+pub type Count = String;
+
+#[derive(Debug, Clone, Deserialize)]
+pub enum Dispatch {
+    /// Invocation counts per axis; workgroup counts follow from the kernel's workgroup size.
+    Threads(Count, Count, Count),
+    /// Workgroup counts per axis.
+    Groups(Count, Count, Count),
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Target {
+    pub resource: String,
+    #[serde(default)]
+    pub blend: Blend,
+}
+
+#[derive(Debug, Clone, Copy, Default, PartialEq, Deserialize)]
+pub enum Blend {
+    #[default]
+    Replace,
+    /// `src + dst * (1 - src.a)` on premultiplied colours: back-to-front compositing.
+    PremultipliedOver,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DepthTarget {
+    pub resource: String,
+    pub write: bool,
+    #[serde(default)]
+    pub compare: Compare,
+}
+
+#[derive(Debug, Clone, Copy, Default, PartialEq, Deserialize)]
+pub enum Compare {
+    #[default]
+    Less,
+    LessEqual,
+    Always,
+}
+
+impl Compare {
+    pub fn wgpu(self) -> wgpu::CompareFunction {
+        match self {
+            Compare::Less => wgpu::CompareFunction::Less,
+            Compare::LessEqual => wgpu::CompareFunction::LessEqual,
+            Compare::Always => wgpu::CompareFunction::Always,
+        }
+    }
+}
+
+#[derive(Debug, Clone, Deserialize)]
+pub enum Draw {
+    Vertices(Count),
+    /// Indirect draw from a buffer holding `DrawIndirect` arguments.
+    Indirect(String),
+}
+
+/// A parsed graph file with its source, so later checks can point at `file:line:col`.
+#[derive(Debug, Clone)]
+pub struct Graph {
+    pub path: PathBuf,
+    pub source: String,
+    pub file: GraphFile,
+}
+
+impl Graph {
+    pub fn load(path: &Path) -> Result<Self> {
+        let source = std::fs::read_to_string(path).map_err(|e| Error::file(path, format!("cannot read graph: {e}")))?;
+        Self::parse(path, source)
+    }
+
+    pub fn parse(path: &Path, source: String) -> Result<Self> {
+        let file: GraphFile = ron::Options::default()
+            .with_default_extension(ron::extensions::Extensions::IMPLICIT_SOME)
+            .from_str(&source)
+            .map_err(|e| ron_error(path, &e))?;
+        let graph = Self { path: path.to_path_buf(), source, file };
+        graph.check_names()?;
+        Ok(graph)
+    }
+
+    /// An error at the first occurrence of the string literal `text` (or the file start).
+    pub fn error_at(&self, text: &str, message: impl Into<String>) -> Error {
+        let (line, col) = locate_literal(&self.source, text, 0).unwrap_or((1, 1));
+        Error::at(FileLoc::new(&self.path, line, col), message)
+    }
+
+    fn check_names(&self) -> Result<()> {
+        let f = &self.file;
+        let mut seen = Vec::new();
+        for p in &f.passes {
+            if seen.contains(&p.name()) {
+                return Err(self.error_at(p.name(), format!("pass `{}` is declared twice", p.name())));
+            }
+            seen.push(p.name());
+            if let Instances::Objects(filter) = p.instances() {
+                if !plan::OBJECT_FILTERS.contains(&filter.as_str()) {
+                    return Err(self.error_at(
+                        filter,
+                        format!("unknown object filter `{filter}`; expected one of {:?}", plan::OBJECT_FILTERS),
+                    ));
+                }
+            }
+            if let PassDecl::Raster { targets, depth, .. } = p {
+                for t in targets.iter().map(|t| &t.resource).chain(depth.iter().map(|d| &d.resource)) {
+                    if !f.resources.contains_key(t) {
+                        return Err(self.error_at(t, format!("render target `{t}` is not a texture declared in `resources`")));
+                    }
+                }
+            }
+        }
+        for o in &f.outputs {
+            if !f.resources.contains_key(o) {
+                return Err(self.error_at(o, format!("output `{o}` is not declared in `resources`")));
+            }
+        }
+        Ok(())
+    }
+}

@@ -1,1 +1,4 @@
-//! (filled in by its owner)
+//! Host side of each method. Now: view-aligned prism slicing, and the opaque base surface.
+
+pub mod shell;
+pub mod view_slices;

@@ -35,3 +35,25 @@ struct DrawIndirect {
     first_vertex: u32,
     first_instance: u32,
 }
+
+struct FrameParams {
+    view_proj: mat4x4<f32>,
+    forward: vec4<f32>,
+    light_dir: vec4<f32>,
+    light_color: vec4<f32>,
+    background: vec4<f32>,
+    viewport: vec4<f32>,
+}
+
+struct ObjectParams {
+    base_color: vec4<f32>,
+    opacity_length: f32,
+    _pad0: f32,
+    _pad1: f32,
+    _pad2: f32,
+}
+
+struct BaseVertex {
+    position: vec4<f32>,
+    normal: vec4<f32>,
+}

@@ -1,0 +1,161 @@
+//! Headless GPU context: Vulkan first (software Vulkan, lavapipe, on machines without a GPU), wgpu's
+//! GL backend as fallback. Uncaptured wgpu errors are collected instead of panicking.
+
+use std::sync::{Arc, Mutex};
+
+use crate::error::{Error, Result};
+
+/// Features voltex uses when the adapter has them (none is required).
+pub const OPTIONAL_FEATURES: wgpu::Features = wgpu::Features::TIMESTAMP_QUERY
+    .union(wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS);
+
+pub struct GpuContext {
+    pub device: wgpu::Device,
+    pub queue: wgpu::Queue,
+    pub info: wgpu::AdapterInfo,
+    pub features: wgpu::Features,
+    pub limits: wgpu::Limits,
+    errors: Arc<Mutex<Vec<String>>>,
+}
+
+const NO_ADAPTER: &str = "no GPU adapter found: install software Vulkan \
+    (Debian/Ubuntu: `apt-get install mesa-vulkan-drivers`) or a GPU driver with Vulkan support";
+
+impl GpuContext {
+    /// Opens the first adapter: `WGPU_BACKEND` if set, else Vulkan, else GL.
+    pub fn new() -> Result<Self> {
+        let tries: Vec<wgpu::Backends> = match wgpu::Backends::from_env() {
+            Some(b) => vec![b],
+            None => vec![wgpu::Backends::VULKAN, wgpu::Backends::GL],
+        };
+        for backends in tries {
+            let mut desc = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
+            desc.backends = backends;
+            let instance = wgpu::Instance::new(desc);
+            let options = wgpu::RequestAdapterOptions {
+                power_preference: wgpu::PowerPreference::HighPerformance,
+                ..Default::default()
+            };
+            if let Ok(adapter) = pollster::block_on(instance.request_adapter(&options)) {
+                return Self::open(adapter);
+            }
+        }
+        Err(Error::Gpu(NO_ADAPTER.into()))
+    }
+
+    fn open(adapter: wgpu::Adapter) -> Result<Self> {
+        let info = adapter.get_info();
+        let features = adapter.features() & OPTIONAL_FEATURES;
+        let limits = adapter.limits();
+        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+            label: Some("voltex"),
+            required_features: features,
+            required_limits: limits.clone(),
+            experimental_features: wgpu::ExperimentalFeatures::disabled(),
+            memory_hints: wgpu::MemoryHints::Performance,
+            trace: wgpu::Trace::Off,
+        }))
+        .map_err(|e| Error::Gpu(format!("cannot open {} ({:?}): {e}", info.name, info.backend)))?;
+        let errors = Arc::new(Mutex::new(Vec::new()));
+        let sink = errors.clone();
+        device.on_uncaptured_error(Arc::new(move |e: wgpu::Error| {
+            sink.lock().unwrap().push(e.to_string());
+        }));
+        Ok(Self { device, queue, info, features, limits, errors })
+    }
+
+    /// One line naming the adapter, for metadata and reports.
+    pub fn adapter_line(&self) -> String {
+        format!("{} ({:?}, {} {})", self.info.name, self.info.backend, self.info.driver, self.info.driver_info)
+    }
+
+    pub fn has_timestamps(&self) -> bool {
+        self.features.contains(OPTIONAL_FEATURES)
+    }
+
+    /// Fails with the first wgpu error raised outside an error scope since the last call.
+    pub fn take_errors(&self) -> Result<()> {
+        let mut errors = self.errors.lock().unwrap();
+        if errors.is_empty() {
+            return Ok(());
+        }
+        let first = errors.remove(0);
+        errors.clear();
+        Err(Error::Gpu(first))
+    }
+
+    /// Runs `f` inside a validation error scope, turning wgpu validation errors into `Error::Gpu`.
+    pub fn scoped<T>(&self, what: &str, f: impl FnOnce() -> T) -> Result<T> {
+        let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let value = f();
+        match pollster::block_on(scope.pop()) {
+            None => Ok(value),
+            Some(e) => Err(Error::Gpu(format!("{what}: {e}"))),
+        }
+    }
+
+    pub fn wait(&self) -> Result<()> {
+        self.device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map(|_| ())
+            .map_err(|e| Error::Gpu(format!("waiting for the GPU: {e}")))
+    }
+
+    /// Copies a buffer back to the CPU (tests, timestamps, readback of images).
+    pub fn read_buffer(&self, buffer: &wgpu::Buffer, offset: u64, size: u64) -> Result<Vec<u8>> {
+        let staging = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("readback"),
+            size,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut enc = self.device.create_command_encoder(&Default::default());
+        enc.copy_buffer_to_buffer(buffer, offset, &staging, 0, size);
+        self.queue.submit([enc.finish()]);
+        self.map_read(&staging)
+    }
+
+    /// Maps a MAP_READ buffer after the queue is idle and returns its bytes.
+    pub fn map_read(&self, staging: &wgpu::Buffer) -> Result<Vec<u8>> {
+        let slice = staging.slice(..);
+        slice.map_async(wgpu::MapMode::Read, |_| {});
+        self.wait()?;
+        let bytes = slice
+            .get_mapped_range()
+            .map_err(|e| Error::Gpu(format!("mapping a readback buffer: {e}")))?
+            .to_vec();
+        staging.unmap();
+        self.take_errors()?;
+        Ok(bytes)
+    }
+
+    /// Text of `voltex info`.
+    pub fn describe(&self) -> String {
+        let l = &self.limits;
+        let mut s = String::new();
+        s += &format!("adapter:  {}\n", self.info.name);
+        s += &format!("type:     {:?}\n", self.info.device_type);
+        s += &format!("backend:  {:?}\n", self.info.backend);
+        s += &format!("driver:   {} {}\n", self.info.driver, self.info.driver_info);
+        s += "features voltex uses:\n";
+        for (name, f) in [
+            ("TIMESTAMP_QUERY (GPU timings)", wgpu::Features::TIMESTAMP_QUERY),
+            ("TIMESTAMP_QUERY_INSIDE_ENCODERS", wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS),
+        ] {
+            s += &format!("  {:<34} {}\n", name, if self.features.contains(f) { "yes" } else { "no" });
+        }
+        s += "limits:\n";
+        for (name, v) in [
+            ("max_texture_dimension_2d", l.max_texture_dimension_2d as u64),
+            ("max_texture_dimension_3d", l.max_texture_dimension_3d as u64),
+            ("max_buffer_size", l.max_buffer_size),
+            ("max_storage_buffer_binding_size", l.max_storage_buffer_binding_size as u64),
+            ("max_compute_workgroups_per_dimension", l.max_compute_workgroups_per_dimension as u64),
+            ("max_compute_invocations_per_workgroup", l.max_compute_invocations_per_workgroup as u64),
+            ("max_bind_groups", l.max_bind_groups as u64),
+        ] {
+            s += &format!("  {name:<38} {v}\n");
+        }
+        s
+    }
+}

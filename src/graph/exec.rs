@@ -1,0 +1,430 @@
+//! Executing a planned graph: graph textures, pipelines (specialised by `override` constants and
+//! cached), bind groups resolved by name, and one frame recorded into a single submission.
+
+use std::borrow::Cow;
+use std::collections::HashMap;
+
+use crate::error::{Error, Result};
+use crate::gpu::reflect::{self, BindingKind};
+use crate::gpu::timing::Timer;
+use crate::gpu::GpuContext;
+use crate::graph::plan::{self, Plan, PlannedPass};
+use crate::graph::{Blend, Clear, Dispatch, Draw, Graph, PassDecl, ResourceDecl, TextureSize};
+
+/// Resources, counts and override constants of one instance: the frame, or one object.
+#[derive(Default)]
+pub struct Inputs {
+    pub buffers: HashMap<String, wgpu::Buffer>,
+    pub views: HashMap<String, wgpu::TextureView>,
+    pub samplers: HashMap<String, wgpu::Sampler>,
+    pub counts: HashMap<String, u32>,
+    /// Values for WGSL `override` constants, by name.
+    pub constants: Vec<(String, f64)>,
+}
+
+/// Count names the runtime provides (per object or per frame).
+pub const COUNTS: &[&str] = &["prisms", "planes", "base_vertices", "width", "height"];
+
+enum Pipeline {
+    Compute(wgpu::ComputePipeline),
+    Render(wgpu::RenderPipeline),
+}
+
+struct Texture {
+    texture: wgpu::Texture,
+    view: wgpu::TextureView,
+    clear: Option<Clear>,
+}
+
+pub struct Executor {
+    pub plan: Plan,
+    graph: Graph,
+    textures: HashMap<String, Texture>,
+    modules: HashMap<String, wgpu::ShaderModule>,
+    layouts: Vec<(Vec<wgpu::BindGroupLayout>, wgpu::PipelineLayout)>,
+    pipelines: HashMap<(usize, String), Pipeline>,
+}
+
+impl Executor {
+    pub fn new(ctx: &GpuContext, graph: Graph, plan: Plan, size: (u32, u32)) -> Result<Self> {
+        let max2d = ctx.limits.max_texture_dimension_2d;
+        if size.0 > max2d || size.1 > max2d {
+            return Err(Error::Gpu(format!(
+                "output {}x{} is beyond this adapter's 2D texture limit of {max2d}",
+                size.0, size.1
+            )));
+        }
+        for p in &plan.passes {
+            check_counts(&graph, p)?;
+        }
+        let mut textures = HashMap::new();
+        for (name, decl) in &plan.textures {
+            let ResourceDecl::Texture { format, size: tsize, clear } = decl;
+            let (w, h) = match tsize {
+                TextureSize::Output => size,
+                TextureSize::Fixed(w, h) => (*w, *h),
+            };
+            let texture = ctx.device.create_texture(&wgpu::TextureDescriptor {
+                label: Some(name),
+                size: wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: format.wgpu(),
+                usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+                    | wgpu::TextureUsages::TEXTURE_BINDING
+                    | wgpu::TextureUsages::COPY_SRC,
+                view_formats: &[],
+            });
+            let view = texture.create_view(&Default::default());
+            textures.insert(name.clone(), Texture { texture, view, clear: *clear });
+        }
+        let mut modules = HashMap::new();
+        let mut layouts = Vec::new();
+        for p in &plan.passes {
+            let name = p.decl.shader().to_string();
+            if !modules.contains_key(&name) {
+                let module = ctx.scoped(&format!("shader {name}"), || {
+                    ctx.device.create_shader_module(wgpu::ShaderModuleDescriptor {
+                        label: Some(&name),
+                        source: wgpu::ShaderSource::Naga(Cow::Owned(p.kernel.module.clone())),
+                    })
+                })?;
+                modules.insert(name, module);
+            }
+            layouts.push(pass_layout(ctx, p));
+        }
+        Ok(Self { plan, graph, textures, modules, layouts, pipelines: HashMap::new() })
+    }
+
+    pub fn texture(&self, name: &str) -> Option<&wgpu::Texture> {
+        self.textures.get(name).map(|t| &t.texture)
+    }
+
+    /// Creates every pipeline the frame will use now, so that errors come before any work.
+    pub fn prepare(&mut self, ctx: &GpuContext, frame: &Inputs, objects: &[Inputs]) -> Result<()> {
+        for i in 0..self.plan.passes.len() {
+            for inst in instance_inputs(&self.plan.passes[i], frame, objects) {
+                self.pipeline(ctx, i, frame, inst)?;
+            }
+        }
+        Ok(())
+    }
+
+    fn pipeline(&mut self, ctx: &GpuContext, index: usize, frame: &Inputs, inst: &Inputs) -> Result<()> {
+        let pass = &self.plan.passes[index];
+        let mut constants: Vec<(&str, f64)> = Vec::new();
+        for (name, has_default) in reflect::overrides(&pass.kernel) {
+            let value = inst.constants.iter().chain(frame.constants.iter()).find(|(n, _)| *n == name);
+            match value {
+                Some((n, v)) => constants.push((n.as_str(), *v)),
+                None if has_default => {}
+                None => {
+                    return Err(self.graph.error_at(
+                        pass.decl.name(),
+                        format!("{}: override `{name}` has no default and no value from the scene", pass.decl.shader()),
+                    ))
+                }
+            }
+        }
+        let key = (index, format!("{constants:?}"));
+        if self.pipelines.contains_key(&key) {
+            return Ok(());
+        }
+        let module = &self.modules[pass.decl.shader()];
+        let layout = &self.layouts[index].1;
+        let options = wgpu::PipelineCompilationOptions { constants: &constants, zero_initialize_workgroup_memory: true };
+        let label = format!("{} ({})", pass.decl.name(), pass.decl.shader());
+        let pipeline = match &pass.decl {
+            PassDecl::Compute { entry, .. } => ctx.scoped(&label, || {
+                Pipeline::Compute(ctx.device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                    label: Some(&label),
+                    layout: Some(layout),
+                    module,
+                    entry_point: Some(entry),
+                    compilation_options: options.clone(),
+                    cache: None,
+                }))
+            })?,
+            PassDecl::Raster { vertex, fragment, targets, depth, .. } => {
+                let color: Vec<Option<wgpu::ColorTargetState>> = targets
+                    .iter()
+                    .map(|t| {
+                        Some(wgpu::ColorTargetState {
+                            format: self.textures[&t.resource].texture.format(),
+                            blend: match t.blend {
+                                Blend::Replace => None,
+                                Blend::PremultipliedOver => Some(wgpu::BlendState::PREMULTIPLIED_ALPHA_BLENDING),
+                            },
+                            write_mask: wgpu::ColorWrites::ALL,
+                        })
+                    })
+                    .collect();
+                let depth_stencil = depth.as_ref().map(|d| wgpu::DepthStencilState {
+                    format: self.textures[&d.resource].texture.format(),
+                    depth_write_enabled: Some(d.write),
+                    depth_compare: Some(d.compare.wgpu()),
+                    stencil: Default::default(),
+                    bias: Default::default(),
+                });
+                ctx.scoped(&label, || {
+                    Pipeline::Render(ctx.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                        label: Some(&label),
+                        layout: Some(layout),
+                        vertex: wgpu::VertexState {
+                            module,
+                            entry_point: Some(vertex),
+                            compilation_options: options.clone(),
+                            buffers: &[],
+                        },
+                        primitive: wgpu::PrimitiveState::default(),
+                        depth_stencil,
+                        multisample: Default::default(),
+                        fragment: Some(wgpu::FragmentState {
+                            module,
+                            entry_point: Some(fragment),
+                            compilation_options: options.clone(),
+                            targets: &color,
+                        }),
+                        multiview_mask: None,
+                        cache: None,
+                    }))
+                })?
+            }
+        };
+        self.pipelines.insert(key, pipeline);
+        Ok(())
+    }
+
+    /// Records and submits one frame.
+    pub fn run(&mut self, ctx: &GpuContext, frame: &Inputs, objects: &[Inputs], timer: &mut Timer) -> Result<()> {
+        self.prepare(ctx, frame, objects)?;
+        let mut encoder = ctx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
+        let mut written: Vec<String> = Vec::new();
+        for index in 0..self.plan.passes.len() {
+            self.record(ctx, index, frame, objects, &mut encoder, timer, &mut written)?;
+        }
+        timer.resolve(&mut encoder);
+        let commands = ctx.scoped("recording the frame", || encoder.finish())?;
+        ctx.queue.submit([commands]);
+        ctx.take_errors()
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn record(
+        &self,
+        ctx: &GpuContext,
+        index: usize,
+        frame: &Inputs,
+        objects: &[Inputs],
+        encoder: &mut wgpu::CommandEncoder,
+        timer: &mut Timer,
+        written: &mut Vec<String>,
+    ) -> Result<()> {
+        let pass = &self.plan.passes[index];
+        let instances = instance_inputs(pass, frame, objects);
+        let groups: Vec<Vec<wgpu::BindGroup>> =
+            instances.iter().map(|inst| self.bind_groups(ctx, index, frame, inst)).collect::<Result<_>>()?;
+        let pipeline_of = |inst: &Inputs| -> &Pipeline {
+            let kernel = &pass.kernel;
+            let constants: Vec<(&str, f64)> = reflect::overrides(kernel)
+                .into_iter()
+                .filter_map(|(name, _)| {
+                    inst.constants.iter().chain(frame.constants.iter()).find(|(n, _)| *n == name).map(|(n, v)| (n.as_str(), *v))
+                })
+                .collect();
+            &self.pipelines[&(index, format!("{constants:?}"))]
+        };
+        match &pass.decl {
+            PassDecl::Compute { name, entry, clear, dispatch, .. } => {
+                for inst in &instances {
+                    for b in clear {
+                        let buf = resolve_buffer(inst, frame, b).ok_or_else(|| plan::unknown_resource(&self.graph, name, b))?;
+                        encoder.clear_buffer(buf, 0, None);
+                    }
+                }
+                let wg = reflect::workgroup_size(&pass.kernel, entry).unwrap_or([1, 1, 1]);
+                let mut cpass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: Some(name),
+                    timestamp_writes: timer.compute(name),
+                });
+                for (inst, bgs) in instances.iter().zip(&groups) {
+                    let Pipeline::Compute(p) = pipeline_of(inst) else { unreachable!("compute pass") };
+                    let (counts, per_group) = match dispatch {
+                        Dispatch::Threads(x, y, z) => ([x, y, z], false),
+                        Dispatch::Groups(x, y, z) => ([x, y, z], true),
+                    };
+                    let mut g = [0u32; 3];
+                    for axis in 0..3 {
+                        let n = count(counts[axis], inst, frame);
+                        g[axis] = if per_group { n } else { n.div_ceil(wg[axis].max(1)) };
+                        if g[axis] > ctx.limits.max_compute_workgroups_per_dimension {
+                            return Err(Error::Gpu(format!(
+                                "pass {name}: {} workgroups on axis {axis} exceed the adapter's limit of {}",
+                                g[axis], ctx.limits.max_compute_workgroups_per_dimension
+                            )));
+                        }
+                    }
+                    if g.contains(&0) {
+                        continue;
+                    }
+                    cpass.set_pipeline(p);
+                    for (i, bg) in bgs.iter().enumerate() {
+                        cpass.set_bind_group(i as u32, bg, &[]);
+                    }
+                    cpass.dispatch_workgroups(g[0], g[1], g[2]);
+                }
+            }
+            PassDecl::Raster { name, targets, depth, draw, .. } => {
+                let load = |res: &str, written: &mut Vec<String>| {
+                    let first = !written.iter().any(|w| w == res);
+                    if first {
+                        written.push(res.to_string());
+                    }
+                    (first, self.textures[res].clear)
+                };
+                let color: Vec<Option<wgpu::RenderPassColorAttachment>> = targets
+                    .iter()
+                    .map(|t| {
+                        let (first, clear) = load(&t.resource, written);
+                        let load = match (first, clear) {
+                            (true, Some(Clear::Color(r, g, b, a))) => wgpu::LoadOp::Clear(wgpu::Color {
+                                r: r as f64,
+                                g: g as f64,
+                                b: b as f64,
+                                a: a as f64,
+                            }),
+                            (true, _) => wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                            _ => wgpu::LoadOp::Load,
+                        };
+                        Some(wgpu::RenderPassColorAttachment {
+                            view: &self.textures[&t.resource].view,
+                            depth_slice: None,
+                            resolve_target: None,
+                            ops: wgpu::Operations { load, store: wgpu::StoreOp::Store },
+                        })
+                    })
+                    .collect();
+                let depth_att = depth.as_ref().map(|d| {
+                    let (first, clear) = load(&d.resource, written);
+                    let load = match (first, clear) {
+                        (true, Some(Clear::Depth(v))) => wgpu::LoadOp::Clear(v),
+                        (true, _) => wgpu::LoadOp::Clear(1.0),
+                        _ => wgpu::LoadOp::Load,
+                    };
+                    wgpu::RenderPassDepthStencilAttachment {
+                        view: &self.textures[&d.resource].view,
+                        depth_ops: Some(wgpu::Operations { load, store: wgpu::StoreOp::Store }),
+                        stencil_ops: None,
+                    }
+                });
+                let mut rpass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                    label: Some(name),
+                    color_attachments: &color,
+                    depth_stencil_attachment: depth_att,
+                    timestamp_writes: timer.render(name),
+                    occlusion_query_set: None,
+                    multiview_mask: None,
+                });
+                for (inst, bgs) in instances.iter().zip(&groups) {
+                    let Pipeline::Render(p) = pipeline_of(inst) else { unreachable!("raster pass") };
+                    rpass.set_pipeline(p);
+                    for (i, bg) in bgs.iter().enumerate() {
+                        rpass.set_bind_group(i as u32, bg, &[]);
+                    }
+                    match draw {
+                        Draw::Vertices(n) => rpass.draw(0..count(n, inst, frame), 0..1),
+                        Draw::Indirect(b) => {
+                            let buf = resolve_buffer(inst, frame, b)
+                                .ok_or_else(|| plan::unknown_resource(&self.graph, name, b))?;
+                            rpass.draw_indirect(buf, 0);
+                        }
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn bind_groups(&self, ctx: &GpuContext, index: usize, frame: &Inputs, inst: &Inputs) -> Result<Vec<wgpu::BindGroup>> {
+        let pass = &self.plan.passes[index];
+        let (bgls, _) = &self.layouts[index];
+        let mut out = Vec::new();
+        for (group, bgl) in bgls.iter().enumerate() {
+            let mut entries = Vec::new();
+            for b in pass.bindings.iter().filter(|b| b.group as usize == group) {
+                let resource = match &b.kind {
+                    BindingKind::Uniform | BindingKind::Storage { .. } => {
+                        resolve_buffer(inst, frame, &b.name).map(|buf| buf.as_entire_binding())
+                    }
+                    BindingKind::Texture { .. } | BindingKind::StorageTexture { .. } => inst
+                        .views
+                        .get(&b.name)
+                        .or_else(|| frame.views.get(&b.name))
+                        .or_else(|| self.textures.get(&b.name).map(|t| &t.view))
+                        .map(wgpu::BindingResource::TextureView),
+                    BindingKind::Sampler => inst
+                        .samplers
+                        .get(&b.name)
+                        .or_else(|| frame.samplers.get(&b.name))
+                        .map(wgpu::BindingResource::Sampler),
+                };
+                let resource = resource.ok_or_else(|| plan::unknown_resource(&self.graph, pass.decl.name(), &b.name))?;
+                entries.push(wgpu::BindGroupEntry { binding: b.binding, resource });
+            }
+            let label = format!("{} group {group}", pass.decl.name());
+            out.push(ctx.scoped(&label, || {
+                ctx.device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some(&label), layout: bgl, entries: &entries })
+            })?);
+        }
+        Ok(out)
+    }
+}
+
+fn pass_layout(ctx: &GpuContext, pass: &PlannedPass) -> (Vec<wgpu::BindGroupLayout>, wgpu::PipelineLayout) {
+    let groups = pass.bindings.iter().map(|b| b.group + 1).max().unwrap_or(0);
+    let bgls: Vec<wgpu::BindGroupLayout> = (0..groups)
+        .map(|g| {
+            let entries: Vec<_> = pass.bindings.iter().filter(|b| b.group == g).map(reflect::layout_entry).collect();
+            ctx.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: None, entries: &entries })
+        })
+        .collect();
+    let refs: Vec<Option<&wgpu::BindGroupLayout>> = bgls.iter().map(Some).collect();
+    let layout = ctx.device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some(pass.decl.name()),
+        bind_group_layouts: &refs,
+        immediate_size: 0,
+    });
+    (bgls, layout)
+}
+
+fn instance_inputs<'a>(pass: &PlannedPass, frame: &'a Inputs, objects: &'a [Inputs]) -> Vec<&'a Inputs> {
+    match &pass.instances {
+        None => vec![frame],
+        Some(ids) => ids.iter().map(|&i| &objects[i]).collect(),
+    }
+}
+
+fn resolve_buffer<'a>(inst: &'a Inputs, frame: &'a Inputs, name: &str) -> Option<&'a wgpu::Buffer> {
+    inst.buffers.get(name).or_else(|| frame.buffers.get(name))
+}
+
+fn count(name: &str, inst: &Inputs, frame: &Inputs) -> u32 {
+    name.parse()
+        .ok()
+        .or_else(|| inst.counts.get(name).or_else(|| frame.counts.get(name)).copied())
+        .unwrap_or(0)
+}
+
+fn check_counts(graph: &Graph, pass: &PlannedPass) -> Result<()> {
+    match &pass.decl {
+        PassDecl::Compute { dispatch: Dispatch::Threads(x, y, z) | Dispatch::Groups(x, y, z), .. } => {
+            for c in [x, y, z] {
+                plan::check_count(graph, c, COUNTS)?;
+            }
+        }
+        PassDecl::Raster { draw: Draw::Vertices(n), .. } => plan::check_count(graph, n, COUNTS)?,
+        PassDecl::Raster { .. } => {}
+    }
+    Ok(())
+}

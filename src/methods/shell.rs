@@ -1,0 +1,84 @@
+//! Shells on the GPU side: camera-relative prism corners and bounding spheres, and the opaque
+//! base-surface triangles. Positions are made camera-relative in f64 before they become f32.
+
+use glam::DVec3;
+
+use crate::mesh::BaseSurface;
+use crate::types::{BaseVertex, Prism, ShellVertex};
+
+pub struct Shell {
+    pub vertices: Vec<ShellVertex>,
+    pub prisms: Vec<Prism>,
+}
+
+fn rel(p: DVec3, eye: DVec3) -> [f32; 4] {
+    let r = p - eye;
+    [r.x as f32, r.y as f32, r.z as f32, 1.0]
+}
+
+impl Shell {
+    pub fn new(surface: &BaseSurface, eye: DVec3) -> Self {
+        let vertices = surface
+            .positions
+            .iter()
+            .zip(&surface.heights)
+            .map(|(&p, &h)| ShellVertex { bottom: rel(p, eye), top: rel(p + h, eye) })
+            .collect();
+        let prisms = surface
+            .triangles
+            .iter()
+            .zip(&surface.corner_uvs)
+            .map(|(t, uv)| {
+                let corners: Vec<DVec3> = t
+                    .iter()
+                    .flat_map(|&i| {
+                        let p = surface.positions[i as usize] - eye;
+                        [p, p + surface.heights[i as usize]]
+                    })
+                    .collect();
+                let centre = corners.iter().sum::<DVec3>() / 6.0;
+                let radius = corners.iter().map(|c| c.distance(centre)).fold(0.0, f64::max);
+                Prism {
+                    vertices: [t[0], t[1], t[2], 0],
+                    uv01: [uv[0].x as f32, uv[0].y as f32, uv[1].x as f32, uv[1].y as f32],
+                    uv2: [uv[2].x as f32, uv[2].y as f32, 0.0, 0.0],
+                    // Grown by a relative epsilon so that f32 rounding never rejects a touching plane.
+                    sphere: [centre.x as f32, centre.y as f32, centre.z as f32, (radius * (1.0 + 1e-5) + 1e-6) as f32],
+                }
+            })
+            .collect();
+        Self { vertices, prisms }
+    }
+
+    /// Range of `dot(n, x)` over all corners.
+    pub fn depth_range(&self, n: [f32; 3]) -> (f64, f64) {
+        let mut lo = f64::INFINITY;
+        let mut hi = f64::NEG_INFINITY;
+        for v in &self.vertices {
+            for p in [v.bottom, v.top] {
+                let d = n[0] as f64 * p[0] as f64 + n[1] as f64 * p[1] as f64 + n[2] as f64 * p[2] as f64;
+                lo = lo.min(d);
+                hi = hi.max(d);
+            }
+        }
+        (lo, hi)
+    }
+}
+
+/// Triangle corners of the base surface with face normals, for the opaque base pass.
+pub fn base_vertices(surface: &BaseSurface, eye: DVec3) -> Vec<BaseVertex> {
+    let mut out = Vec::with_capacity(surface.triangles.len() * 3);
+    for t in &surface.triangles {
+        let p = t.map(|i| surface.positions[i as usize]);
+        let n = (p[1] - p[0]).cross(p[2] - p[0]).normalize_or_zero();
+        for (k, &i) in t.iter().enumerate() {
+            let h = surface.heights[i as usize].normalize_or_zero();
+            let normal = if h != DVec3::ZERO { h } else { n };
+            out.push(BaseVertex {
+                position: rel(p[k], eye),
+                normal: [normal.x as f32, normal.y as f32, normal.z as f32, 0.0],
+            });
+        }
+    }
+    out
+}

@@ -1,0 +1,67 @@
+//! Host side of view-aligned prism slicing (2002 paper): the plane sweep of one object and the
+//! buffers its kernels (`count_slices`, `scan_plane_offsets`, `emit_slices`) and `draw_slices` use.
+
+use crate::error::{Error, Result};
+use crate::methods::shell::Shell;
+use crate::types::{SliceParams, SliceVertex};
+
+/// The plane sweep: `planes` planes orthogonal to the view direction spanning the shell's depth
+/// range (clipped to the near plane), back to front, each in the middle of its slab.
+pub fn sweep(shell: &Shell, forward: [f32; 3], planes: u32, near: f64) -> SliceParams {
+    let (lo, hi) = shell.depth_range(forward);
+    let lo = lo.max(near);
+    let hi = hi.max(lo + 1e-9);
+    let spacing = (hi - lo) / planes as f64;
+    SliceParams {
+        plane_normal: [forward[0], forward[1], forward[2], 0.0],
+        first_plane: (hi - 0.5 * spacing) as f32,
+        spacing: spacing as f32,
+        plane_count: planes,
+        prism_count: shell.prisms.len() as u32,
+        vertex_capacity: 0,
+        _pad: [0; 3],
+    }
+}
+
+/// An upper bound of the slice vertices a sweep emits: per prism, the planes its depth range
+/// crosses, times 9 (a pentagon is 3 triangles). Allocating this, not planes x prisms x 9, keeps
+/// memory proportional to what is drawn.
+pub fn vertex_capacity(shell: &Shell, params: &SliceParams) -> u64 {
+    let n = [params.plane_normal[0] as f64, params.plane_normal[1] as f64, params.plane_normal[2] as f64];
+    let spacing = params.spacing as f64;
+    let first = params.first_plane as f64;
+    let mut total = 0u64;
+    for p in &shell.prisms {
+        let mut lo = f64::INFINITY;
+        let mut hi = f64::NEG_INFINITY;
+        for &v in &p.vertices[..3] {
+            let sv = &shell.vertices[v as usize];
+            for c in [sv.bottom, sv.top] {
+                let d = n[0] * c[0] as f64 + n[1] * c[1] as f64 + n[2] * c[2] as f64;
+                lo = lo.min(d);
+                hi = hi.max(d);
+            }
+        }
+        // Planes k with lo <= first - k*spacing <= hi, widened by one plane for f32 rounding.
+        let k_min = ((first - hi) / spacing).floor().max(0.0) as i64 - 1;
+        let k_max = (((first - lo) / spacing).ceil() as i64 + 1).min(params.plane_count as i64 - 1);
+        if k_max >= k_min.max(0) {
+            total += (k_max - k_min.max(0) + 1) as u64 * 9;
+        }
+    }
+    total
+}
+
+/// Checks that the slice-vertex buffer fits the adapter's limits.
+pub fn check_capacity(capacity: u64, max_binding: u64, object: &str, planes: u32) -> Result<()> {
+    let bytes = capacity * std::mem::size_of::<SliceVertex>() as u64;
+    if bytes > max_binding || capacity > u32::MAX as u64 {
+        return Err(Error::Gpu(format!(
+            "object `{object}`: {planes} planes need up to {:.1} MiB of slice vertices, beyond this adapter's \
+             storage-binding limit of {:.1} MiB; use fewer planes",
+            bytes as f64 / 1048576.0,
+            max_binding as f64 / 1048576.0
+        )));
+    }
+    Ok(())
+}

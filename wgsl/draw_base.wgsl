@@ -1,0 +1,35 @@
+// Draws a base surface opaque with depth, lit by the frame's light (vertex pulling, 3 per triangle).
+#include "shared/types.wgsl"
+
+@group(0) @binding(0) var<uniform> frame: FrameParams;
+@group(0) @binding(1) var<uniform> object: ObjectParams;
+@group(0) @binding(2) var<storage, read> base_vertices: array<BaseVertex>;
+
+struct VsOut {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) normal: vec3<f32>,
+    @location(1) rel: vec3<f32>,
+}
+
+@vertex
+fn vs_main(@builtin(vertex_index) index: u32) -> VsOut {
+    let v = base_vertices[index];
+    var out: VsOut;
+    out.clip = frame.view_proj * vec4<f32>(v.position.xyz, 1.0);
+    out.normal = v.normal.xyz;
+    out.rel = v.position.xyz;
+    return out;
+}
+
+@fragment
+fn fs_main(in: VsOut) -> @location(0) vec4<f32> {
+    var n = normalize(in.normal);
+    // Two-sided: light the side facing the camera.
+    if dot(n, in.rel) > 0.0 {
+        n = -n;
+    }
+    let ambient = frame.light_dir.w;
+    let diffuse = max(dot(n, frame.light_dir.xyz), 0.0);
+    let rgb = object.base_color.rgb * (ambient + (1.0 - ambient) * diffuse) * frame.light_color.rgb;
+    return vec4<f32>(rgb, 1.0);
+}
