@@ -1,0 +1,93 @@
+//! Atomic file writes: write a temporary file beside the target, fsync it, rename it over the
+//! target. A failed write removes the temporary file and leaves the target untouched.
+
+use std::fs;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
+
+use crate::{Error, Result};
+
+/// Distinguishes temporary files of concurrent writes within one process.
+static COUNTER: AtomicU64 = AtomicU64::new(0);
+
+/// The folder a file `path` would be written into (`.` for a bare file name).
+fn parent_dir(path: &Path) -> PathBuf {
+    match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => PathBuf::from("."),
+    }
+}
+
+/// Fails with [`Error::File`] naming `dir` unless it is an existing folder we can create files
+/// in. Called before rendering starts so that a bad output folder fails early. It probes by
+/// creating and removing a small hidden file, since permission bits alone lie (root, ACLs,
+/// read-only mounts).
+pub fn check_writable_dir(dir: &Path) -> Result<()> {
+    let meta = fs::metadata(dir).map_err(|e| {
+        Error::file(
+            dir,
+            format!("output folder does not exist or is unreadable: {e}"),
+        )
+    })?;
+    if !meta.is_dir() {
+        return Err(Error::file(dir, "output folder is not a folder"));
+    }
+    let probe = dir.join(format!(
+        ".voltex-probe-{}-{}",
+        std::process::id(),
+        COUNTER.fetch_add(1, Ordering::Relaxed)
+    ));
+    fs::OpenOptions::new()
+        .write(true)
+        .create_new(true)
+        .open(&probe)
+        .map_err(|e| Error::file(dir, format!("output folder is not writable: {e}")))?;
+    let _ = fs::remove_file(&probe);
+    Ok(())
+}
+
+/// Writes `path` atomically. `write` gets the path of a fresh temporary file in the same folder
+/// (`.NAME.tmp-PID-N`) and must write the whole content there. Then the temporary file is
+/// fsynced and renamed over `path`. On any error the temporary file is removed and `path` is left
+/// as it was. A missing or unwritable folder is an [`Error::File`] naming the folder, raised
+/// before anything is written; parent folders are never created.
+pub fn write_atomic(path: &Path, write: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
+    let dir = parent_dir(path);
+    let name = path
+        .file_name()
+        .ok_or_else(|| Error::file(path, "output path has no file name"))?;
+    check_writable_dir(&dir)?;
+    let tmp = dir.join(format!(
+        ".{}.tmp-{}-{}",
+        name.to_string_lossy(),
+        std::process::id(),
+        COUNTER.fetch_add(1, Ordering::Relaxed)
+    ));
+    let result = write(&tmp).and_then(|()| finish(&tmp, path, &dir));
+    if result.is_err() {
+        let _ = fs::remove_file(&tmp);
+    }
+    result
+}
+
+/// fsync the finished temporary file, rename it over the target, fsync the folder.
+fn finish(tmp: &Path, path: &Path, dir: &Path) -> Result<()> {
+    let file = fs::File::open(tmp)
+        .map_err(|e| Error::file(path, format!("writer produced no file: {e}")))?;
+    file.sync_all()
+        .map_err(|e| Error::file(path, format!("cannot flush to disk: {e}")))?;
+    drop(file);
+    fs::rename(tmp, path).map_err(|e| Error::file(path, format!("cannot replace file: {e}")))?;
+    // Make the rename itself durable; not all platforms can open a folder, so best effort.
+    if let Ok(d) = fs::File::open(dir) {
+        let _ = d.sync_all();
+    }
+    Ok(())
+}
+
+/// Writes `bytes` to `path` atomically.
+pub fn write_bytes(path: &Path, bytes: &[u8]) -> Result<()> {
+    write_atomic(path, |tmp| {
+        fs::write(tmp, bytes).map_err(|e| Error::file(path, format!("cannot write: {e}")))
+    })
+}
