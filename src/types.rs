@@ -101,4 +101,55 @@ pub struct BaseVertex {
     pub position: [f32; 4],
     /// Unit normal (xyz), w = 0.
     pub normal: [f32; 4],
+
+/// Parameters shared by the bake kernels (`bake_implicit.wgsl`, `bake_heightfield.wgsl`).
+/// Mirrored as `BakeParams` in `wgsl/shared/types.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct BakeParams {
+    /// xyz: volume resolution in voxels; w: number of shapes used (implicit bake only).
+    pub resolution: [u32; 4],
+    /// xyz: texel-space direction towards the light (normalized by the kernel); w: ambient in [0,1].
+    pub light: [f32; 4],
+}
+
+/// One implicit shape of a union, in texel space. Mirrored as `ImplicitShape` in
+/// `wgsl/shared/types.wgsl`. `kind` is one of the `cpu::bake::{SPHERE, TORUS, ...}` constants.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct ImplicitShape {
+    pub kind: u32,
+    /// Metaballs only: the range `first_ball..first_ball + ball_count` of the `balls` buffer.
+    pub first_ball: u32,
+    pub ball_count: u32,
+    pub _pad: u32,
+    /// xyz: centre (unused by metaballs and constant); w: unused.
+    pub center: [f32; 4],
+    /// Sphere: x radius. Torus: x major, y minor radius (axis along w). Ellipsoid: xyz radii.
+    /// Metaballs: x threshold.
+    pub params: [f32; 4],
+    /// rgb: albedo; a: opacity per opacity length.
+    pub color: [f32; 4],
+}
+
+/// A periodic Perlin height field. Mirrored as `HeightfieldParams` in `wgsl/shared/types.wgsl`.
+/// Height `h(s,t) = base + amplitude * (0.5 + 0.5 * fbm(s,t))`, fbm in [-1,1].
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct HeightfieldParams {
+    /// Lattice cells per tile along s and t of the first octave (>= 1).
+    pub frequency: u32,
+    /// Octaves (each doubles the frequency, halves the amplitude); clamped to 1..=16.
+    pub octaves: u32,
+    pub seed: u32,
+    pub _pad0: u32,
+    pub amplitude: f32,
+    pub base: f32,
+    /// Opacity per opacity length of the filled region.
+    pub opacity: f32,
+    pub _pad1: f32,
+    /// rgb: albedo at w = 0; a: unused.
+    pub color_low: [f32; 4],
+    /// rgb: albedo at w = base + amplitude (the highest possible height); a: unused.
+    pub color_high: [f32; 4],
 }

@@ -1,1 +1,3 @@
-//! (filled in by its owner)
+//! CPU twins of the WGSL kernels (same names, same f32 math) for tests and references.
+
+pub mod bake;

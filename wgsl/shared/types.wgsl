@@ -56,4 +56,35 @@ struct ObjectParams {
 struct BaseVertex {
     position: vec4<f32>,
     normal: vec4<f32>,
+
+// Bake kernels' parameters (twin: BakeParams in src/types.rs).
+// resolution: xyz voxels, w shape count; light: xyz texel-space direction towards the light, w ambient.
+struct BakeParams {
+    resolution: vec4<u32>,
+    light: vec4<f32>,
+}
+
+// One implicit shape (twin: ImplicitShape in src/types.rs); kind constants in bake_implicit.wgsl.
+struct ImplicitShape {
+    kind: u32,
+    first_ball: u32,
+    ball_count: u32,
+    _pad: u32,
+    center: vec4<f32>,
+    params: vec4<f32>,
+    color: vec4<f32>,
+}
+
+// Periodic Perlin height field (twin: HeightfieldParams in src/types.rs).
+struct HeightfieldParams {
+    frequency: u32,
+    octaves: u32,
+    seed: u32,
+    _pad0: u32,
+    amplitude: f32,
+    base: f32,
+    opacity: f32,
+    _pad1: f32,
+    color_low: vec4<f32>,
+    color_high: vec4<f32>,
 }
