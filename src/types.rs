@@ -101,6 +101,7 @@ pub struct BaseVertex {
     pub position: [f32; 4],
     /// Unit normal (xyz), w = 0.
     pub normal: [f32; 4],
+}
 
 /// Parameters shared by the bake kernels (`bake_implicit.wgsl`, `bake_heightfield.wgsl`).
 /// Mirrored as `BakeParams` in `wgsl/shared/types.wgsl`.

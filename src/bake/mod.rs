@@ -1,1 +1,151 @@
-//! (filled in by its owner)
+//! Host side of the bake kernels: a texel source becomes an RGBA texel volume (3D texture,
+//! premultiplied `rgba8unorm`, full mip chain), plus a normal volume when a per-pixel-lit object
+//! uses it. Only texels some object draws are baked, each (texel, lighting) pair once.
+
+use std::path::Path;
+
+use wgpu::util::DeviceExt;
+
+use crate::cpu::bake::PackedShapes;
+use crate::error::{Error, Result};
+use crate::gpu::kernel::ComputeKernel;
+use crate::gpu::GpuContext;
+use crate::graph::exec::Inputs;
+use crate::types::{BakeParams, HeightfieldParams};
+
+/// What a bake kernel evaluates.
+pub enum BakeSource {
+    Implicit(PackedShapes),
+    Heightfield(HeightfieldParams),
+}
+
+pub struct BakeRequest {
+    pub resolution: [u32; 3],
+    pub source: BakeSource,
+    /// Write unshaded albedo and a normal volume instead of baked shading.
+    pub per_pixel: bool,
+    /// Texel-space direction towards the light, and the ambient term.
+    pub light: [f32; 3],
+    pub ambient: f32,
+}
+
+pub struct Baked {
+    pub volume: wgpu::Texture,
+    /// The normal volume (1x1x1 when `per_pixel` is off: the binding exists, nothing is stored).
+    pub normals: wgpu::Texture,
+}
+
+pub fn mip_count(res: [u32; 3]) -> u32 {
+    32 - res.iter().max().copied().unwrap_or(1).max(1).leading_zeros()
+}
+
+fn mip_size(res: [u32; 3], level: u32) -> [u32; 3] {
+    res.map(|r| (r >> level).max(1))
+}
+
+/// Bytes a bake allocates on the GPU (volume with mips, plus normals at full resolution).
+pub fn bytes(res: [u32; 3], per_pixel: bool) -> u64 {
+    let volume: u64 = (0..mip_count(res)).map(|l| mip_size(res, l).iter().map(|&x| x as u64).product::<u64>() * 4).sum();
+    let normals = if per_pixel { res.iter().map(|&x| x as u64).product::<u64>() * 4 } else { 4 };
+    volume + normals
+}
+
+/// The bake kernels, loaded once and reused for every texel.
+pub struct Baker {
+    implicit: Option<ComputeKernel>,
+    heightfield: Option<ComputeKernel>,
+    downsample: Option<ComputeKernel>,
+    wgsl_root: std::path::PathBuf,
+}
+
+impl Baker {
+    pub fn new(wgsl_root: &Path) -> Self {
+        Self { implicit: None, heightfield: None, downsample: None, wgsl_root: wgsl_root.to_path_buf() }
+    }
+
+    fn kernel<'a>(slot: &'a mut Option<ComputeKernel>, ctx: &GpuContext, root: &Path, name: &str) -> Result<&'a mut ComputeKernel> {
+        if slot.is_none() {
+            *slot = Some(ComputeKernel::load(ctx, root, name)?);
+        }
+        Ok(slot.as_mut().unwrap())
+    }
+
+    pub fn bake(&mut self, ctx: &GpuContext, req: &BakeRequest) -> Result<Baked> {
+        let max3d = ctx.limits.max_texture_dimension_3d;
+        if req.resolution.iter().any(|&r| r == 0 || r > max3d) {
+            return Err(Error::Gpu(format!(
+                "texel resolution {:?} is beyond this adapter's 3D texture limit of {max3d}",
+                req.resolution
+            )));
+        }
+        let mips = mip_count(req.resolution);
+        let volume = volume_texture(ctx, "texel volume", req.resolution, mips, wgpu::TextureFormat::Rgba8Unorm);
+        let normals_res = if req.per_pixel { req.resolution } else { [1, 1, 1] };
+        let normals = volume_texture(ctx, "texel normals", normals_res, 1, wgpu::TextureFormat::Rgba8Snorm);
+        let params = crate::cpu::bake::bake_params(req.resolution, 0, req.light, req.ambient);
+        let mut inputs = Inputs::default();
+        inputs.constants.push(("per_pixel_lighting".into(), req.per_pixel as u32 as f64));
+        inputs.views.insert("volume".into(), level_view(&volume, 0));
+        inputs.views.insert("normals".into(), level_view(&normals, 0));
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        let root = self.wgsl_root.clone();
+        match &req.source {
+            BakeSource::Implicit(packed) => {
+                let params = BakeParams { resolution: [params.resolution[0], params.resolution[1], params.resolution[2], packed.shape_count], ..params };
+                inputs.buffers.insert("bake_params".into(), uniform(ctx, "bake_params", bytemuck::bytes_of(&params)));
+                inputs.buffers.insert("shapes".into(), storage(ctx, "shapes", bytemuck::cast_slice(&packed.shapes)));
+                inputs.buffers.insert("balls".into(), storage(ctx, "balls", bytemuck::cast_slice(&packed.balls)));
+                Self::kernel(&mut self.implicit, ctx, &root, "bake_implicit.wgsl")?.dispatch(ctx, &mut encoder, &inputs, req.resolution)?;
+            }
+            BakeSource::Heightfield(hf) => {
+                inputs.buffers.insert("bake_params".into(), uniform(ctx, "bake_params", bytemuck::bytes_of(&params)));
+                inputs.buffers.insert("heightfield".into(), uniform(ctx, "heightfield", bytemuck::bytes_of(hf)));
+                Self::kernel(&mut self.heightfield, ctx, &root, "bake_heightfield.wgsl")?.dispatch(ctx, &mut encoder, &inputs, req.resolution)?;
+            }
+        }
+        let down = Self::kernel(&mut self.downsample, ctx, &root, "downsample_volume.wgsl")?;
+        for level in 1..mips {
+            let mut mip = Inputs::default();
+            mip.views.insert("source".into(), level_view(&volume, level - 1));
+            mip.views.insert("destination".into(), level_view(&volume, level));
+            down.dispatch(ctx, &mut encoder, &mip, mip_size(req.resolution, level))?;
+        }
+        ctx.queue.submit([encoder.finish()]);
+        ctx.take_errors()?;
+        Ok(Baked { volume, normals })
+    }
+}
+
+fn volume_texture(ctx: &GpuContext, label: &str, res: [u32; 3], mips: u32, format: wgpu::TextureFormat) -> wgpu::Texture {
+    ctx.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some(label),
+        size: wgpu::Extent3d { width: res[0], height: res[1], depth_or_array_layers: res[2] },
+        mip_level_count: mips,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D3,
+        format,
+        usage: wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC,
+        view_formats: &[],
+    })
+}
+
+/// A view of one mip level.
+pub fn level_view(t: &wgpu::Texture, level: u32) -> wgpu::TextureView {
+    t.create_view(&wgpu::TextureViewDescriptor { base_mip_level: level, mip_level_count: Some(1), ..Default::default() })
+}
+
+pub fn uniform(ctx: &GpuContext, label: &str, bytes: &[u8]) -> wgpu::Buffer {
+    ctx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some(label),
+        contents: bytes,
+        usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+    })
+}
+
+pub fn storage(ctx: &GpuContext, label: &str, bytes: &[u8]) -> wgpu::Buffer {
+    ctx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some(label),
+        contents: bytes,
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
+    })
+}

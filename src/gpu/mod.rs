@@ -1,6 +1,7 @@
 //! Device, shader loading and validation, reflection, timestamps.
 
 pub mod context;
+pub mod kernel;
 pub mod reflect;
 pub mod shader;
 pub mod timing;

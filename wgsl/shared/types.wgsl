@@ -56,6 +56,7 @@ struct ObjectParams {
 struct BaseVertex {
     position: vec4<f32>,
     normal: vec4<f32>,
+}
 
 // Bake kernels' parameters (twin: BakeParams in src/types.rs).
 // resolution: xyz voxels, w shape count; light: xyz texel-space direction towards the light, w ambient.
