@@ -1,1 +1,158 @@
-fn main() {}
+//! The `voltex` command line: render, plan, info, bench.
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+use voltex::gpu::GpuContext;
+use voltex::render::{Blueprint, RenderOptions, Renderer};
+use voltex::{io, scene, Result};
+
+#[derive(Parser)]
+#[command(name = "voltex", version, about = "Volumetric textures and hypertextures on wgpu")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(clap::Args, Clone, Default)]
+struct Overrides {
+    /// Output size, e.g. 128x128 (default: the scene's).
+    #[arg(long, value_parser = parse_size)]
+    size: Option<(u32, u32)>,
+    /// Plane count for every ViewSlices object (default: the scene's).
+    #[arg(long)]
+    planes: Option<u32>,
+    /// Turn the bounding-sphere trivial reject off (for measurement).
+    #[arg(long)]
+    no_trivial_reject: bool,
+    /// Render graph file (default: graphs/frame.ron).
+    #[arg(long)]
+    graph: Option<PathBuf>,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Render a scene headless to EXR (linear, with metadata) and a tonemapped PNG.
+    Render {
+        scene: PathBuf,
+        /// Output EXR (default: out/<scene name>.exr); the PNG goes beside it.
+        #[arg(short, long)]
+        output: Option<PathBuf>,
+        #[command(flatten)]
+        overrides: Overrides,
+    },
+    /// Print the bakes, passes, pipelines and GPU memory a scene will use (no GPU needed).
+    Plan {
+        scene: PathBuf,
+        #[command(flatten)]
+        overrides: Overrides,
+    },
+    /// Print the adapter, backend, driver, the features voltex uses and limits.
+    Info,
+    /// Benchmark view-aligned slicing (the 2002 paper's Table 1 set-up) with GPU timestamps.
+    Bench {
+        /// Scenes to measure (default: torus_egg and terrain).
+        scenes: Vec<PathBuf>,
+        /// Plane counts.
+        #[arg(long, value_delimiter = ',', default_values_t = vec![250, 500, 1000])]
+        planes: Vec<u32>,
+        #[arg(long, value_parser = parse_size, default_value = "512x512")]
+        size: (u32, u32),
+        /// Timed frames per setting (after warm-up); the median is reported.
+        #[arg(long, default_value_t = 5)]
+        frames: usize,
+    },
+}
+
+fn parse_size(s: &str) -> std::result::Result<(u32, u32), String> {
+    let (w, h) = s.split_once('x').ok_or("expected WIDTHxHEIGHT, e.g. 512x512")?;
+    let w: u32 = w.parse().map_err(|_| "expected WIDTHxHEIGHT, e.g. 512x512")?;
+    let h: u32 = h.parse().map_err(|_| "expected WIDTHxHEIGHT, e.g. 512x512")?;
+    if w == 0 || h == 0 || w > 16384 || h > 16384 {
+        return Err("expected a size between 1x1 and 16384x16384".into());
+    }
+    Ok((w, h))
+}
+
+impl Overrides {
+    fn options(&self) -> Result<RenderOptions> {
+        if let Some(p) = self.planes {
+            if p == 0 || p > voltex::scene::MAX_PLANES {
+                return Err(voltex::Error::Invalid(format!(
+                    "--planes {p}: expected a plane count in 1..={}",
+                    voltex::scene::MAX_PLANES
+                )));
+            }
+        }
+        Ok(RenderOptions {
+            size: self.size,
+            graph: self.graph.clone(),
+            planes: self.planes,
+            trivial_reject: self.no_trivial_reject.then_some(false),
+        })
+    }
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Render { scene, output, overrides } => render(&scene, output, &overrides),
+        Command::Plan { scene, overrides } => plan(&scene, &overrides),
+        Command::Info => GpuContext::new().map(|ctx| print!("{}", ctx.describe())),
+        Command::Bench { scenes, planes, size, frames } => voltex::bench::run(&scenes, &planes, size, frames),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn plan(scene_path: &Path, overrides: &Overrides) -> Result<()> {
+    let scene = scene::load(scene_path)?;
+    let bp = Blueprint::new(&scene, &overrides.options()?)?;
+    print!("{}", bp.describe());
+    Ok(())
+}
+
+fn render(scene_path: &Path, output: Option<PathBuf>, overrides: &Overrides) -> Result<()> {
+    let opts = overrides.options()?;
+    let scene = scene::load(scene_path)?;
+    let exr_path = output.unwrap_or_else(|| {
+        let stem = scene_path.file_stem().unwrap_or_default();
+        PathBuf::from("out").join(stem).with_extension("exr")
+    });
+    let png_path = exr_path.with_extension("png");
+    // Fail before any GPU work if the output cannot be written.
+    let dir = match exr_path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    if !dir.exists() && dir == Path::new("out") {
+        std::fs::create_dir_all(&dir).map_err(|e| voltex::Error::file(&dir, e))?;
+    }
+    io::atomic::check_writable_dir(&dir)?;
+    let bp = Blueprint::new(&scene, &opts)?;
+    for o in &bp.objects {
+        for w in &o.object.report.warnings {
+            eprintln!("warning: {}: object `{}`: {w}", scene_path.display(), o.object.name);
+        }
+    }
+    let ctx = GpuContext::new()?;
+    let mut renderer = Renderer::new(&ctx, bp)?;
+    let frame = renderer.render(&ctx)?;
+    let metadata = renderer.metadata(&ctx, &frame);
+    let meta: Vec<(&str, String)> = metadata.iter().map(|(k, v)| (k.as_str(), v.clone())).collect();
+    io::exr::write(&exr_path, &frame.image, &meta)?;
+    io::png::write_tonemapped(&png_path, &frame.image)?;
+    let gpu = frame.gpu_ms().map(|t| format!("{t:.2} ms GPU")).unwrap_or_else(|| "no GPU timestamps".into());
+    println!("{} and {} ({}x{}, {gpu}, {})", exr_path.display(), png_path.display(), frame.image.width, frame.image.height, ctx.adapter_line());
+    for (pass, ms) in &frame.pass_times {
+        println!("  {pass:<20} {ms:>9.3} ms");
+    }
+    Ok(())
+}

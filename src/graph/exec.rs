@@ -37,7 +37,6 @@ struct Texture {
 }
 
 pub struct Executor {
-    pub plan: Plan,
     graph: Graph,
     textures: HashMap<String, Texture>,
     modules: HashMap<String, wgpu::ShaderModule>,
@@ -46,7 +45,7 @@ pub struct Executor {
 }
 
 impl Executor {
-    pub fn new(ctx: &GpuContext, graph: Graph, plan: Plan, size: (u32, u32)) -> Result<Self> {
+    pub fn new(ctx: &GpuContext, graph: Graph, plan: &Plan, size: (u32, u32)) -> Result<Self> {
         let max2d = ctx.limits.max_texture_dimension_2d;
         if size.0 > max2d || size.1 > max2d {
             return Err(Error::Gpu(format!(
@@ -94,7 +93,7 @@ impl Executor {
             }
             layouts.push(pass_layout(ctx, p));
         }
-        Ok(Self { plan, graph, textures, modules, layouts, pipelines: HashMap::new() })
+        Ok(Self { graph, textures, modules, layouts, pipelines: HashMap::new() })
     }
 
     pub fn texture(&self, name: &str) -> Option<&wgpu::Texture> {
@@ -102,17 +101,17 @@ impl Executor {
     }
 
     /// Creates every pipeline the frame will use now, so that errors come before any work.
-    pub fn prepare(&mut self, ctx: &GpuContext, frame: &Inputs, objects: &[Inputs]) -> Result<()> {
-        for i in 0..self.plan.passes.len() {
-            for inst in instance_inputs(&self.plan.passes[i], frame, objects) {
-                self.pipeline(ctx, i, frame, inst)?;
+    pub fn prepare(&mut self, ctx: &GpuContext, plan: &Plan, frame: &Inputs, objects: &[Inputs]) -> Result<()> {
+        for i in 0..plan.passes.len() {
+            for inst in instance_inputs(&plan.passes[i], frame, objects) {
+                self.pipeline(ctx, plan, i, frame, inst)?;
             }
         }
         Ok(())
     }
 
-    fn pipeline(&mut self, ctx: &GpuContext, index: usize, frame: &Inputs, inst: &Inputs) -> Result<()> {
-        let pass = &self.plan.passes[index];
+    fn pipeline(&mut self, ctx: &GpuContext, plan: &Plan, index: usize, frame: &Inputs, inst: &Inputs) -> Result<()> {
+        let pass = &plan.passes[index];
         let mut constants: Vec<(&str, f64)> = Vec::new();
         for (name, has_default) in reflect::overrides(&pass.kernel) {
             let value = inst.constants.iter().chain(frame.constants.iter()).find(|(n, _)| *n == name);
@@ -197,12 +196,12 @@ impl Executor {
     }
 
     /// Records and submits one frame.
-    pub fn run(&mut self, ctx: &GpuContext, frame: &Inputs, objects: &[Inputs], timer: &mut Timer) -> Result<()> {
-        self.prepare(ctx, frame, objects)?;
+    pub fn run(&mut self, ctx: &GpuContext, plan: &Plan, frame: &Inputs, objects: &[Inputs], timer: &mut Timer) -> Result<()> {
+        self.prepare(ctx, plan, frame, objects)?;
         let mut encoder = ctx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
         let mut written: Vec<String> = Vec::new();
-        for index in 0..self.plan.passes.len() {
-            self.record(ctx, index, frame, objects, &mut encoder, timer, &mut written)?;
+        for index in 0..plan.passes.len() {
+            self.record(ctx, plan, index, frame, objects, &mut encoder, timer, &mut written)?;
         }
         timer.resolve(&mut encoder);
         let commands = ctx.scoped("recording the frame", || encoder.finish())?;
@@ -214,6 +213,7 @@ impl Executor {
     fn record(
         &self,
         ctx: &GpuContext,
+        plan: &Plan,
         index: usize,
         frame: &Inputs,
         objects: &[Inputs],
@@ -221,10 +221,10 @@ impl Executor {
         timer: &mut Timer,
         written: &mut Vec<String>,
     ) -> Result<()> {
-        let pass = &self.plan.passes[index];
+        let pass = &plan.passes[index];
         let instances = instance_inputs(pass, frame, objects);
         let groups: Vec<Vec<wgpu::BindGroup>> =
-            instances.iter().map(|inst| self.bind_groups(ctx, index, frame, inst)).collect::<Result<_>>()?;
+            instances.iter().map(|inst| self.bind_groups(ctx, pass, index, frame, inst)).collect::<Result<_>>()?;
         let pipeline_of = |inst: &Inputs| -> &Pipeline {
             let kernel = &pass.kernel;
             let constants: Vec<(&str, f64)> = reflect::overrides(kernel)
@@ -346,8 +346,14 @@ impl Executor {
         Ok(())
     }
 
-    fn bind_groups(&self, ctx: &GpuContext, index: usize, frame: &Inputs, inst: &Inputs) -> Result<Vec<wgpu::BindGroup>> {
-        let pass = &self.plan.passes[index];
+    fn bind_groups(
+        &self,
+        ctx: &GpuContext,
+        pass: &PlannedPass,
+        index: usize,
+        frame: &Inputs,
+        inst: &Inputs,
+    ) -> Result<Vec<wgpu::BindGroup>> {
         let (bgls, _) = &self.layouts[index];
         let mut out = Vec::new();
         for (group, bgl) in bgls.iter().enumerate() {

@@ -65,3 +65,59 @@ pub fn check_capacity(capacity: u64, max_binding: u64, object: &str, planes: u32
     }
     Ok(())
 }
+
+/// Adds the buffers and counts of one sliced shell to `inputs` (the names the kernels use).
+pub fn add_inputs(
+    ctx: &crate::gpu::GpuContext,
+    inputs: &mut crate::graph::exec::Inputs,
+    shell: &Shell,
+    params: &SliceParams,
+    capacity: u64,
+    trivial_reject: bool,
+) {
+    use crate::bake::{storage, uniform};
+    let buffer = |label: &str, size: u64, extra: wgpu::BufferUsages| {
+        ctx.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(label),
+            size: size.max(16),
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC | extra,
+            mapped_at_creation: false,
+        })
+    };
+    let b = &mut inputs.buffers;
+    b.insert("slice_params".into(), uniform(ctx, "slice_params", bytemuck::bytes_of(params)));
+    b.insert("shell_vertices".into(), storage(ctx, "shell_vertices", bytemuck::cast_slice(&shell.vertices)));
+    b.insert("prisms".into(), storage(ctx, "prisms", bytemuck::cast_slice(&shell.prisms)));
+    b.insert("plane_cursors".into(), buffer("plane_cursors", params.plane_count as u64 * 4, wgpu::BufferUsages::empty()));
+    b.insert("draw_args".into(), buffer("draw_args", 16, wgpu::BufferUsages::INDIRECT));
+    let bytes = capacity * std::mem::size_of::<SliceVertex>() as u64;
+    b.insert("slice_vertices".into(), buffer("slice_vertices", bytes, wgpu::BufferUsages::empty()));
+    inputs.counts.insert("prisms".into(), shell.prisms.len() as u32);
+    inputs.counts.insert("planes".into(), params.plane_count);
+    inputs.constants.push(("trivial_reject".into(), trivial_reject as u32 as f64));
+}
+
+/// Reads back the triangle-list vertices of each plane after a frame (tests, debugging): after
+/// `emit_slices`, `plane_cursors[k]` is the end of plane k's range.
+pub fn read_back(
+    ctx: &crate::gpu::GpuContext,
+    inputs: &crate::graph::exec::Inputs,
+    plane_count: u32,
+) -> Result<Vec<Vec<SliceVertex>>> {
+    let args = ctx.read_buffer(&inputs.buffers["draw_args"], 0, 16)?;
+    let drawn = bytemuck::cast_slice::<u8, u32>(&args)[0] as usize;
+    let ends = ctx.read_buffer(&inputs.buffers["plane_cursors"], 0, plane_count as u64 * 4)?;
+    let ends: &[u32] = bytemuck::cast_slice(&ends);
+    let bytes = if drawn > 0 { ctx.read_buffer(&inputs.buffers["slice_vertices"], 0, drawn as u64 * 32)? } else { Vec::new() };
+    let all: &[SliceVertex] = bytemuck::cast_slice(&bytes);
+    let mut start = 0usize;
+    Ok(ends
+        .iter()
+        .map(|&end| {
+            let end = (end as usize).min(all.len());
+            let plane = all[start.min(end)..end].to_vec();
+            start = end;
+            plane
+        })
+        .collect())
+}

@@ -1,0 +1,226 @@
+//! The view-slicing kernels (count, scan, emit) on software Vulkan against their CPU twin
+//! (`cpu::slice_prisms`), on random shells and planes and on the hard cases.
+
+use std::collections::BTreeMap;
+use std::sync::OnceLock;
+
+use glam::{DVec2, DVec3};
+use voltex::cpu::slice_prisms;
+use voltex::gpu::timing::Timer;
+use voltex::gpu::GpuContext;
+use voltex::graph::exec::{Executor, Inputs};
+use voltex::graph::plan::{self, ObjectInfo};
+use voltex::graph::Graph;
+use voltex::mesh::BaseSurface;
+use voltex::methods::shell::Shell;
+use voltex::methods::view_slices;
+use voltex::types::{SliceParams, SliceVertex};
+
+fn ctx() -> &'static GpuContext {
+    static CTX: OnceLock<GpuContext> = OnceLock::new();
+    CTX.get_or_init(|| GpuContext::new().expect("a GPU adapter (software Vulkan: mesa-vulkan-drivers)"))
+}
+
+/// Runs the slicing kernels through the `slices_only` graph and reads the polygons back.
+fn gpu_slices(shell: &Shell, params: &SliceParams, trivial_reject: bool) -> Vec<Vec<SliceVertex>> {
+    let ctx = ctx();
+    let root = voltex::project_root();
+    let graph = Graph::load(&root.join("graphs/slices_only.ron")).unwrap();
+    let info = ObjectInfo { name: "shell".into(), filters: vec!["ViewSlices"], distance: 0.0 };
+    let plan = plan::plan(&graph, &root.join("wgsl"), &[info]).unwrap();
+    assert_eq!(plan.passes.len(), 3);
+    let mut exec = Executor::new(ctx, graph, &plan, (1, 1)).unwrap();
+    let mut params = *params;
+    let capacity = view_slices::vertex_capacity(shell, &params).max(3);
+    params.vertex_capacity = capacity as u32;
+    let mut inputs = Inputs::default();
+    view_slices::add_inputs(ctx, &mut inputs, shell, &params, capacity, trivial_reject);
+    let mut timer = Timer::new(ctx, 4);
+    exec.run(ctx, &plan, &Inputs::default(), std::slice::from_ref(&inputs), &mut timer).unwrap();
+    view_slices::read_back(ctx, &inputs, params.plane_count).unwrap()
+}
+
+/// Triangle-list vertices of one plane, grouped by prism (a prism emits one fan per plane).
+fn by_prism(plane: &[SliceVertex]) -> BTreeMap<u32, Vec<SliceVertex>> {
+    let mut out: BTreeMap<u32, Vec<SliceVertex>> = BTreeMap::new();
+    for v in plane {
+        out.entry(v.position[3].to_bits()).or_default().push(*v);
+    }
+    out
+}
+
+/// Compares GPU and CPU polygons plane by plane. Returns the number of polygons compared.
+/// A prism whose polygon differs in size is allowed only when one of its corners lies within
+/// `ambiguous` of the plane (where the GPU's fused multiply-adds may classify it differently).
+fn compare(shell: &Shell, params: &SliceParams, trivial_reject: bool, ambiguous: f32) -> usize {
+    let gpu = gpu_slices(shell, params, trivial_reject);
+    let cpu = slice_prisms::slice_all(&shell.vertices, &shell.prisms, params, trivial_reject);
+    assert_eq!(gpu.len(), cpu.len());
+    let n = glam::Vec3::from_slice(&params.plane_normal[..3]);
+    let mut compared = 0;
+    for (k, (g, c)) in gpu.iter().zip(&cpu).enumerate() {
+        let d = params.first_plane - k as f32 * params.spacing;
+        let (g, c) = (by_prism(g), by_prism(c));
+        let prisms: std::collections::BTreeSet<u32> = g.keys().chain(c.keys()).copied().collect();
+        for p in prisms {
+            let (gv, cv) = (g.get(&p).cloned().unwrap_or_default(), c.get(&p).cloned().unwrap_or_default());
+            if gv.len() != cv.len() {
+                let prism = &shell.prisms[p as usize];
+                let near = prism.vertices[..3].iter().any(|&v| {
+                    let sv = &shell.vertices[v as usize];
+                    [sv.bottom, sv.top]
+                        .iter()
+                        .any(|x| (n.dot(glam::Vec3::from_slice(&x[..3])) - d).abs() <= ambiguous)
+                });
+                assert!(near, "plane {k} prism {p}: GPU {} vertices, CPU {} vertices", gv.len(), cv.len());
+                continue;
+            }
+            for (a, b) in gv.iter().zip(&cv) {
+                for i in 0..3 {
+                    let tol = 1e-5 * (1.0 + b.position[i].abs());
+                    assert!((a.position[i] - b.position[i]).abs() <= tol, "plane {k} prism {p}: {a:?} vs {b:?}");
+                    assert!((a.uvw[i] - b.uvw[i]).abs() <= 1e-5, "plane {k} prism {p}: {a:?} vs {b:?}");
+                }
+                assert!(a.position.iter().chain(&a.uvw).all(|x| x.is_finite()));
+            }
+            compared += 1;
+        }
+    }
+    compared
+}
+
+fn rng(seed: &mut u64) -> f64 {
+    *seed ^= *seed << 13;
+    *seed ^= *seed >> 7;
+    *seed ^= *seed << 17;
+    (*seed >> 11) as f64 / (1u64 << 53) as f64
+}
+
+/// A jittered grid shell with random height vectors (outward-ish), welded.
+fn random_shell(seed: u64, cells: u32) -> BaseSurface {
+    let mut s = seed;
+    let n = cells + 1;
+    let mut positions = Vec::new();
+    let mut heights = Vec::new();
+    for j in 0..n {
+        for i in 0..n {
+            let p = DVec3::new(i as f64 + 0.3 * rng(&mut s), j as f64 + 0.3 * rng(&mut s), 0.4 * rng(&mut s));
+            positions.push(p);
+            heights.push(DVec3::new(0.3 * (rng(&mut s) - 0.5), 0.3 * (rng(&mut s) - 0.5), 0.3 + rng(&mut s)));
+        }
+    }
+    let mut triangles = Vec::new();
+    let mut corner_uvs = Vec::new();
+    let uv = |i: u32, j: u32| DVec2::new(i as f64 / cells as f64, j as f64 / cells as f64);
+    for j in 0..cells {
+        for i in 0..cells {
+            let a = j * n + i;
+            triangles.push([a, a + 1, a + n + 1]);
+            corner_uvs.push([uv(i, j), uv(i + 1, j), uv(i + 1, j + 1)]);
+            triangles.push([a, a + n + 1, a + n]);
+            corner_uvs.push([uv(i, j), uv(i + 1, j + 1), uv(i, j + 1)]);
+        }
+    }
+    BaseSurface { positions, heights, triangles, corner_uvs }
+}
+
+fn oblique_params(shell: &Shell, dir: DVec3, planes: u32) -> SliceParams {
+    let d = dir.normalize();
+    view_slices::sweep(shell, [d.x as f32, d.y as f32, d.z as f32], planes, f64::NEG_INFINITY)
+}
+
+#[test]
+fn random_shells_and_planes_match_the_cpu_twin() {
+    let mut total = 0;
+    for (seed, dir) in [(7u64, DVec3::new(0.3, 0.5, -1.0)), (99, DVec3::new(-1.0, 0.2, -0.1)), (1234, DVec3::new(0.0, 1.0, 0.3))] {
+        let surface = random_shell(seed, 8);
+        let shell = Shell::new(&surface, DVec3::new(4.0, -6.0, 5.0));
+        let params = oblique_params(&shell, dir, 48);
+        for reject in [true, false] {
+            total += compare(&shell, &params, reject, 1e-5);
+        }
+    }
+    assert!(total > 2000, "only {total} polygons compared");
+}
+
+/// One prism over the right triangle (0,0,0) (1,0,0) (0,1,0) with the given heights.
+fn unit_prism(heights: [DVec3; 3], base: [DVec3; 3]) -> Shell {
+    let surface = BaseSurface {
+        positions: base.to_vec(),
+        heights: heights.to_vec(),
+        triangles: vec![[0, 1, 2]],
+        corner_uvs: vec![[DVec2::ZERO, DVec2::X, DVec2::Y]],
+    };
+    Shell::new(&surface, DVec3::ZERO)
+}
+
+fn explicit_planes(n: [f32; 3], ds: &[f32]) -> Vec<SliceParams> {
+    ds.iter()
+        .map(|&d| SliceParams {
+            plane_normal: [n[0], n[1], n[2], 0.0],
+            first_plane: d,
+            spacing: 1.0,
+            plane_count: 1,
+            prism_count: 1,
+            vertex_capacity: 0,
+            _pad: [0; 3],
+        })
+        .collect()
+}
+
+#[test]
+fn hard_cases_match_the_cpu_twin_exactly() {
+    let base = [DVec3::ZERO, DVec3::X, DVec3::Y];
+    let up = [DVec3::Z; 3];
+    let cases: Vec<(&str, Shell, Vec<SliceParams>)> = vec![
+        // Axis-aligned planes keep every signed distance exact on both sides.
+        ("plane through a vertex", unit_prism(up, base), explicit_planes([1.0, 0.0, 0.0], &[1.0, 0.0])),
+        ("plane through an edge", unit_prism(up, base), explicit_planes([0.0, 1.0, 0.0], &[0.0])),
+        ("plane containing a normal edge", unit_prism(up, base), explicit_planes([1.0, 0.0, 0.0], &[0.0, 1.0])),
+        ("plane parallel to the base", unit_prism(up, base), explicit_planes([0.0, 0.0, 1.0], &[0.0, 0.5, 1.0])),
+        (
+            "zero-area triangle",
+            unit_prism(up, [DVec3::ZERO, DVec3::X, DVec3::new(2.0, 0.0, 0.0)]),
+            explicit_planes([1.0, 0.0, 0.0], &[0.5, 1.0]),
+        ),
+        (
+            "zero-length height vector",
+            unit_prism([DVec3::Z, DVec3::ZERO, DVec3::Z], base),
+            explicit_planes([0.0, 0.0, 1.0], &[0.0, 0.5]),
+        ),
+    ];
+    for (name, shell, planes) in cases {
+        for params in planes {
+            let gpu = gpu_slices(&shell, &params, true);
+            let cpu = slice_prisms::slice_all(&shell.vertices, &shell.prisms, &params, true);
+            assert_eq!(gpu.len(), 1);
+            assert_eq!(gpu[0].len(), cpu[0].len(), "{name}, d = {}: vertex counts", params.first_plane);
+            for (a, b) in gpu[0].iter().zip(&cpu[0]) {
+                assert!(a.position.iter().chain(&a.uvw).all(|x| x.is_finite()), "{name}: non-finite vertex");
+                for i in 0..3 {
+                    assert!((a.position[i] - b.position[i]).abs() <= 1e-6, "{name}: {a:?} vs {b:?}");
+                    assert!((a.uvw[i] - b.uvw[i]).abs() <= 1e-6, "{name}: {a:?} vs {b:?}");
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn slices_are_ordered_back_to_front_and_lie_on_their_planes() {
+    let surface = random_shell(5, 6);
+    let shell = Shell::new(&surface, DVec3::new(3.0, 3.0, 8.0));
+    let params = oblique_params(&shell, DVec3::new(0.2, -0.1, -1.0), 32);
+    let gpu = gpu_slices(&shell, &params, true);
+    let n = glam::Vec3::from_slice(&params.plane_normal[..3]);
+    let mut nonempty = 0;
+    for (k, plane) in gpu.iter().enumerate() {
+        let d = params.first_plane - k as f32 * params.spacing;
+        for v in plane {
+            let s = n.dot(glam::Vec3::from_slice(&v.position[..3])) - d;
+            assert!(s.abs() < 1e-3, "plane {k}: vertex {s} off its plane");
+        }
+        nonempty += (!plane.is_empty()) as usize;
+    }
+    assert!(nonempty > 20, "{nonempty} planes hit the shell");
+}

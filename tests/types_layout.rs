@@ -1,0 +1,61 @@
+//! Every struct in wgsl/shared/types.wgsl has the size and field offsets of its Rust twin in
+//! src/types.rs (naga computes the WGSL layout).
+
+use std::mem::{offset_of, size_of};
+
+use voltex::types::*;
+
+macro_rules! layout {
+    ($t:ty; $($f:ident),*) => {
+        (stringify!($t), size_of::<$t>(), vec![$(offset_of!($t, $f)),*])
+    };
+}
+
+#[test]
+fn wgsl_structs_match_rust() {
+    let source = std::fs::read_to_string(voltex::project_root().join("wgsl/shared/types.wgsl")).unwrap();
+    // A kernel using nothing still gets every struct type when they are used by a dummy global.
+    let kernel = voltex::gpu::shader::load_str(std::path::Path::new("types.wgsl"), &source).unwrap();
+    let rust = [
+        layout!(ShellVertex; bottom, top),
+        layout!(Prism; vertices, uv01, uv2, sphere),
+        layout!(SliceParams; plane_normal, first_plane, spacing, plane_count, prism_count, vertex_capacity),
+        layout!(SliceVertex; position, uvw),
+        layout!(DrawIndirect; vertex_count, instance_count, first_vertex, first_instance),
+        layout!(FrameParams; view_proj, forward, light_dir, light_color, background, viewport),
+        layout!(ObjectParams; base_color, opacity_length),
+        layout!(BaseVertex; position, normal),
+        layout!(BakeParams; resolution, light),
+        layout!(ImplicitShape; kind, first_ball, ball_count, _pad, center, params, color),
+        layout!(HeightfieldParams; frequency, octaves, seed, _pad0, amplitude, base, opacity, _pad1, color_low, color_high),
+    ];
+    let mut seen = 0;
+    for (_, ty) in kernel.module.types.iter() {
+        let naga::TypeInner::Struct { members, span } = &ty.inner else { continue };
+        let name = ty.name.clone().unwrap_or_default();
+        let (_, size, offsets) = rust.iter().find(|r| r.0 == name).unwrap_or_else(|| panic!("no Rust twin listed for {name}"));
+        assert_eq!(*span as usize, *size, "size of {name}");
+        let wgsl: Vec<usize> = members.iter().map(|m| m.offset as usize).take(offsets.len()).collect();
+        assert_eq!(&wgsl, offsets, "field offsets of {name}");
+        seen += 1;
+    }
+    assert_eq!(seen, rust.len(), "every listed struct is in types.wgsl");
+}
+
+#[test]
+fn every_kernel_validates() {
+    let root = voltex::project_root().join("wgsl");
+    let mut n = 0;
+    for entry in std::fs::read_dir(&root).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_some_and(|e| e == "wgsl") {
+            let name = path.file_name().unwrap().to_str().unwrap();
+            let k = voltex::gpu::shader::load(&root, name).unwrap_or_else(|e| panic!("{e}"));
+            assert!(!k.module.entry_points.is_empty(), "{name} has an entry point");
+            let first = std::fs::read_to_string(&path).unwrap();
+            assert!(first.starts_with("// "), "{name} starts with a one-line purpose comment");
+            n += 1;
+        }
+    }
+    assert!(n >= 9, "found {n} kernels");
+}
