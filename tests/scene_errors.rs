@@ -273,6 +273,12 @@ fn node_consistency() {
 }
 
 #[test]
+fn degenerate_camera() {
+    let l = "    camera: (eye: (0.0, 0.0, 2.0), target: (0.0, 0.0, 0.0)),";
+    assert_err("camup", &[(4, l)], "scene.ron", 4, 13, "not parallel");
+}
+
+#[test]
 fn example_scenes_load_and_flatten() {
     let root = voltex::project_root().join("scenes");
     let mut stack = vec![root];

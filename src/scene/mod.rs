@@ -71,3 +71,6 @@ fn located(path: &Path, e: ron::error::SpannedError) -> Error {
     };
     Error::at(FileLoc::new(path, pos.line, pos.col), msg)
 }
+
+#[cfg(test)]
+mod tests;

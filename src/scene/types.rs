@@ -13,7 +13,8 @@ pub struct Scene {
     #[serde(skip)]
     pub path: PathBuf,
     pub output: Output,
-    pub camera: Camera,
+    /// Marked so that `load` can report a degenerate view (eye = target, up along the view).
+    pub camera: Mark<Camera>,
     #[serde(default, deserialize_with = "v::color")]
     pub background: [f32; 3],
     #[serde(default = "default_ambient", deserialize_with = "v::unit_f32")]

@@ -178,6 +178,19 @@ pub(super) fn check(scene: &Scene, dir: &Path) -> Findings {
             },
         },
     };
+    let cam = &scene.camera;
+    let view = cam.target - cam.eye;
+    if view.length_squared() == 0.0 {
+        c.fail(
+            cam,
+            "expected a camera `target` different from its `eye`".into(),
+        );
+    } else if view.normalize().cross(cam.up.normalize()).length() < 1e-6 {
+        c.fail(
+            cam,
+            "expected a camera `up` that is not parallel to the view direction".into(),
+        );
+    }
     for n in &scene.nodes {
         c.node(n);
     }
