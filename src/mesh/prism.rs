@@ -73,19 +73,18 @@ pub fn check(s: &BaseSurface) -> PrismReport {
         return r;
     }
 
-    let mut degenerate = Vec::new();
-    let mut base_ok = vec![false; s.triangles.len()];
-    for t in 0..s.triangles.len() {
-        let [a, b, c] = s.triangles[t].map(|i| s.positions[i as usize]);
-        let area2 = (b - a).cross(c - a).length();
-        let longest = (b - a).length().max((c - b).length()).max((a - c).length());
-        // Smallest altitude = twice the area / longest edge.
-        if longest == 0.0 || area2 / longest < SLIVER * longest {
-            degenerate.push(t);
-        } else {
-            base_ok[t] = true;
-        }
-    }
+    // Smallest altitude = twice the area / longest edge.
+    let base_ok: Vec<bool> = s
+        .triangles
+        .iter()
+        .map(|tri| {
+            let [a, b, c] = tri.map(|i| s.positions[i as usize]);
+            let area2 = (b - a).cross(c - a).length();
+            let longest = (b - a).length().max((c - b).length()).max((a - c).length());
+            longest > 0.0 && area2 / longest >= SLIVER * longest
+        })
+        .collect();
+    let degenerate: Vec<usize> = (0..base_ok.len()).filter(|&t| !base_ok[t]).collect();
     if !degenerate.is_empty() {
         r.warnings.push(format!(
             "{} degenerate (zero-area or sliver) triangles: {}",

@@ -1,0 +1,121 @@
+//! The node tree flattened into world-space objects with their base surfaces.
+
+use super::types::{HeightScale, Method, Node, Scene, Surface};
+use crate::error::{Error, Result};
+use crate::mesh::prism::{self, PrismReport};
+use crate::mesh::{generate, BaseSurface, Mesh};
+use glam::{DMat4, DVec2};
+use std::sync::Arc;
+
+/// A node with a surface, in world space.
+#[derive(Debug, Clone)]
+pub struct SceneObject {
+    pub name: String,
+    pub surface: BaseSurface,
+    pub texel: Option<String>,
+    pub method: Option<Method>,
+    pub base_color: Option<[f32; 3]>,
+    /// Prism check of `surface` (no errors, else `objects()` fails); warnings for the user.
+    pub report: PrismReport,
+}
+
+impl Scene {
+    /// Flattens the node tree (child transform = parent * child) into objects, one per node with a
+    /// surface, in document order (depth first). Fails on the first object whose prisms are invalid.
+    pub fn objects(&self) -> Result<Vec<SceneObject>> {
+        let mut out = Vec::new();
+        for n in &self.nodes {
+            self.flatten(n, DMat4::IDENTITY, &mut out)?;
+        }
+        Ok(out)
+    }
+
+    fn flatten(&self, n: &Node, parent: DMat4, out: &mut Vec<SceneObject>) -> Result<()> {
+        let world = parent * n.transform.matrix();
+        if let Some(surface) = &n.surface {
+            let surface = self.base_surface(n, surface, &world)?;
+            let report = prism::check(&surface);
+            if !report.errors.is_empty() {
+                return Err(Error::Invalid(format!(
+                    "{}: object \"{}\": invalid prisms: {}",
+                    self.path.display(),
+                    n.name,
+                    report.errors.join("; ")
+                )));
+            }
+            out.push(SceneObject {
+                name: n.name.clone(),
+                surface,
+                texel: n.texel.as_ref().map(|t| t.value.clone()),
+                method: n.method.as_ref().map(|m| m.value.clone()),
+                base_color: n.base_color,
+                report,
+            });
+        }
+        for c in &n.children {
+            self.flatten(c, world, out)?;
+        }
+        Ok(())
+    }
+
+    fn base_surface(&self, n: &Node, surface: &Surface, world: &DMat4) -> Result<BaseSurface> {
+        let assets = &self.assets;
+        let missing = |what: &str, p: &str| {
+            Error::Invalid(format!("object \"{}\": {what} {p} was not loaded", n.name))
+        };
+        let mesh: Arc<Mesh> = match surface {
+            Surface::Plane {
+                size,
+                cells,
+                jitter,
+                seed,
+            } => Arc::new(generate::plane(*size, *cells, *jitter, *seed)),
+            Surface::Sphere { radius, segments } => Arc::new(generate::sphere(*radius, *segments)),
+            Surface::Torus {
+                major,
+                minor,
+                segments,
+                distortion,
+                seed,
+            } => Arc::new(generate::torus(
+                *major,
+                *minor,
+                *segments,
+                *distortion,
+                *seed,
+            )),
+            Surface::Obj { path } => assets
+                .meshes
+                .get(&assets.dir.join(&path.value))
+                .cloned()
+                .ok_or_else(|| missing("OBJ", &path.value))?,
+        };
+        let scale: Option<Vec<f64>> = match n.height.scale.as_deref() {
+            None => None,
+            Some(HeightScale::VertexAttribute) => Some(
+                mesh.attribute
+                    .as_ref()
+                    .ok_or_else(|| {
+                        Error::Invalid(format!("object \"{}\": no vertex attribute", n.name))
+                    })?
+                    .iter()
+                    .map(|a| a.clamp(0.0, 1.0))
+                    .collect(),
+            ),
+            Some(HeightScale::Texture { path, channel }) => {
+                let img = assets
+                    .images
+                    .get(&assets.dir.join(&path.value))
+                    .ok_or_else(|| missing("height texture", &path.value))?;
+                Some(
+                    mesh.vertex_uvs
+                        .iter()
+                        .map(|&uv| img.sample(uv, *channel as usize).clamp(0.0, 1.0))
+                        .collect(),
+                )
+            }
+        };
+        let base = mesh.to_base(n.height.length, scale.as_deref(), DVec2::from(n.uv_tiling));
+        Ok(base.transformed(world))
+    }
+}

@@ -1,0 +1,377 @@
+//! Scene file types. Every struct and enum denies unknown fields; value checks live in `values`.
+
+use super::values::{self as v, Mark};
+use glam::{DMat4, DQuat, DVec3, EulerRot};
+use serde::Deserialize;
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Scene {
+    /// The scene file (not in the file; set by `load`). Relative paths resolve against its folder.
+    #[serde(skip)]
+    pub path: PathBuf,
+    pub output: Output,
+    /// Marked so that `load` can report a degenerate view (eye = target, up along the view).
+    pub camera: Mark<Camera>,
+    #[serde(default, deserialize_with = "v::color")]
+    pub background: [f32; 3],
+    #[serde(default = "default_ambient", deserialize_with = "v::unit_f32")]
+    pub ambient: f32,
+    #[serde(default)]
+    pub lights: Vec<Light>,
+    #[serde(default)]
+    pub texels: BTreeMap<String, Texel>,
+    #[serde(default)]
+    pub nodes: Vec<Node>,
+    /// OBJ meshes and height images loaded and checked by `load`, by resolved path.
+    #[serde(skip)]
+    pub(super) assets: super::validate::Assets,
+}
+
+fn default_ambient() -> f32 {
+    0.2
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Output {
+    #[serde(deserialize_with = "v::output_size")]
+    pub width: u32,
+    #[serde(deserialize_with = "v::output_size")]
+    pub height: u32,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Camera {
+    #[serde(deserialize_with = "v::vec3")]
+    pub eye: DVec3,
+    #[serde(deserialize_with = "v::vec3")]
+    pub target: DVec3,
+    #[serde(default = "default_up", deserialize_with = "v::direction")]
+    pub up: DVec3,
+    /// Vertical field of view in degrees.
+    #[serde(default = "default_fov", deserialize_with = "v::fov")]
+    pub fov_y: f64,
+}
+
+fn default_up() -> DVec3 {
+    DVec3::Z
+}
+fn default_fov() -> f64 {
+    45.0
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum Light {
+    /// Light travelling along `direction` (world space, not normalised in the file).
+    Directional {
+        #[serde(deserialize_with = "v::direction")]
+        direction: DVec3,
+        #[serde(default = "white", deserialize_with = "v::light_color")]
+        color: [f32; 3],
+        #[serde(default = "one_f32", deserialize_with = "v::non_negative_f32")]
+        intensity: f32,
+    },
+}
+
+fn white() -> [f32; 3] {
+    [1.0; 3]
+}
+fn one_f32() -> f32 {
+    1.0
+}
+
+/// A pattern volume over texture space [0,1]^3 (s, t tile; w is height).
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Texel {
+    #[serde(deserialize_with = "v::resolution")]
+    pub resolution: [u32; 3],
+    /// World length over which a voxel's stored alpha is reached.
+    #[serde(
+        default = "default_opacity_length",
+        deserialize_with = "v::positive_f32"
+    )]
+    pub opacity_length: f32,
+    pub source: TexelSource,
+}
+
+fn default_opacity_length() -> f32 {
+    0.05
+}
+
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum TexelSource {
+    /// Union of implicit shapes (later shapes win where they overlap).
+    Implicit { shapes: Vec<Shape> },
+    /// Periodic Perlin height field: voxel filled where `w < base + amplitude * noise(s, t)`,
+    /// colour from `color_low` (w = 0) to `color_high` (w = 1).
+    PerlinHeight {
+        #[serde(deserialize_with = "v::frequency")]
+        frequency: u32,
+        #[serde(default = "one_u32", deserialize_with = "v::octaves")]
+        octaves: u32,
+        #[serde(deserialize_with = "v::finite_f32")]
+        amplitude: f32,
+        #[serde(deserialize_with = "v::finite_f32")]
+        base: f32,
+        #[serde(default)]
+        seed: u32,
+        #[serde(deserialize_with = "v::color")]
+        color_low: [f32; 3],
+        #[serde(deserialize_with = "v::color")]
+        color_high: [f32; 3],
+        #[serde(default = "one_f32", deserialize_with = "v::unit_f32")]
+        opacity: f32,
+    },
+    /// A uniform volume (analytic tests).
+    Constant {
+        #[serde(deserialize_with = "v::color")]
+        color: [f32; 3],
+        #[serde(default = "one_f32", deserialize_with = "v::unit_f32")]
+        opacity: f32,
+    },
+}
+
+fn one_u32() -> u32 {
+    1
+}
+
+/// Implicit shapes in texel space [0,1]^3; colours linear RGB in [0,1]; opacity in [0,1].
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum Shape {
+    Sphere {
+        #[serde(deserialize_with = "v::point_f32")]
+        center: [f32; 3],
+        #[serde(deserialize_with = "v::positive_f32")]
+        radius: f32,
+        #[serde(deserialize_with = "v::color")]
+        color: [f32; 3],
+        #[serde(default = "one_f32", deserialize_with = "v::unit_f32")]
+        opacity: f32,
+    },
+    /// Axis along w.
+    Torus {
+        #[serde(deserialize_with = "v::point_f32")]
+        center: [f32; 3],
+        #[serde(deserialize_with = "v::positive_f32")]
+        major: f32,
+        #[serde(deserialize_with = "v::positive_f32")]
+        minor: f32,
+        #[serde(deserialize_with = "v::color")]
+        color: [f32; 3],
+        #[serde(default = "one_f32", deserialize_with = "v::unit_f32")]
+        opacity: f32,
+    },
+    Ellipsoid {
+        #[serde(deserialize_with = "v::point_f32")]
+        center: [f32; 3],
+        #[serde(deserialize_with = "v::radii_f32")]
+        radii: [f32; 3],
+        #[serde(deserialize_with = "v::color")]
+        color: [f32; 3],
+        #[serde(default = "one_f32", deserialize_with = "v::unit_f32")]
+        opacity: f32,
+    },
+    /// Inside where `sum (radius_i / |x - center_i|)^2 >= threshold`.
+    Metaballs {
+        balls: Vec<Ball>,
+        #[serde(deserialize_with = "v::positive_f32")]
+        threshold: f32,
+        #[serde(deserialize_with = "v::color")]
+        color: [f32; 3],
+        #[serde(default = "one_f32", deserialize_with = "v::unit_f32")]
+        opacity: f32,
+    },
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Ball {
+    #[serde(deserialize_with = "v::point_f32")]
+    pub center: [f32; 3],
+    #[serde(deserialize_with = "v::positive_f32")]
+    pub radius: f32,
+}
+
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Node {
+    pub name: String,
+    #[serde(default)]
+    pub transform: Transform,
+    #[serde(default)]
+    pub surface: Option<Mark<Surface>>,
+    #[serde(default)]
+    pub height: Height,
+    /// Texture repeats over the surface's uv tile (u, v).
+    #[serde(default = "one2", deserialize_with = "v::positive2")]
+    pub uv_tiling: [f64; 2],
+    #[serde(default)]
+    pub texel: Option<Mark<String>>,
+    #[serde(default)]
+    pub method: Option<Mark<Method>>,
+    /// Draw the base surface opaque with this colour.
+    #[serde(default, deserialize_with = "v::opt_color")]
+    pub base_color: Option<[f32; 3]>,
+    #[serde(default)]
+    pub children: Vec<Node>,
+}
+
+fn one2() -> [f64; 2] {
+    [1.0; 2]
+}
+
+/// `translate * rotate * scale`; `rotate` is Euler XYZ in degrees.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Transform {
+    #[serde(default, deserialize_with = "v::vec3")]
+    pub translate: DVec3,
+    #[serde(default, deserialize_with = "v::vec3")]
+    pub rotate: DVec3,
+    #[serde(default = "one3", deserialize_with = "v::scale3")]
+    pub scale: DVec3,
+}
+
+fn one3() -> DVec3 {
+    DVec3::ONE
+}
+
+impl Default for Transform {
+    fn default() -> Self {
+        Transform {
+            translate: DVec3::ZERO,
+            rotate: DVec3::ZERO,
+            scale: DVec3::ONE,
+        }
+    }
+}
+
+impl Transform {
+    pub fn matrix(&self) -> DMat4 {
+        let r = self.rotate * std::f64::consts::PI / 180.0;
+        DMat4::from_scale_rotation_translation(
+            self.scale,
+            DQuat::from_euler(EulerRot::XYZ, r.x, r.y, r.z),
+            self.translate,
+        )
+    }
+}
+
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum Surface {
+    /// Grid in the xy plane centred at the origin, normal +z.
+    Plane {
+        #[serde(deserialize_with = "v::positive2")]
+        size: [f64; 2],
+        #[serde(deserialize_with = "v::cells")]
+        cells: [u32; 2],
+        /// Fraction of a cell by which interior vertices move.
+        #[serde(default, deserialize_with = "v::jitter")]
+        jitter: f64,
+        #[serde(default)]
+        seed: u32,
+    },
+    /// UV sphere around the origin; segments = (around z, pole to pole).
+    Sphere {
+        #[serde(deserialize_with = "v::positive")]
+        radius: f64,
+        #[serde(deserialize_with = "v::sphere_segments")]
+        segments: [u32; 2],
+    },
+    /// Torus around z; segments = (around z, around the tube).
+    Torus {
+        #[serde(deserialize_with = "v::positive")]
+        major: f64,
+        #[serde(deserialize_with = "v::positive")]
+        minor: f64,
+        #[serde(deserialize_with = "v::torus_segments")]
+        segments: [u32; 2],
+        #[serde(default, deserialize_with = "v::distortion")]
+        distortion: f64,
+        #[serde(default)]
+        seed: u32,
+    },
+    /// Wavefront OBJ, path relative to the scene file.
+    Obj { path: Mark<String> },
+}
+
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Height {
+    #[serde(default = "default_height", deserialize_with = "v::non_negative")]
+    pub length: f64,
+    #[serde(default)]
+    pub scale: Option<Mark<HeightScale>>,
+}
+
+fn default_height() -> f64 {
+    0.1
+}
+
+impl Default for Height {
+    fn default() -> Self {
+        Height {
+            length: default_height(),
+            scale: None,
+        }
+    }
+}
+
+/// Per-vertex factor in [0,1] on the height length.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum HeightScale {
+    /// OBJ only: the first colour channel of `v x y z r g b` lines.
+    VertexAttribute,
+    /// PNG (grey, grey+alpha, RGB, RGBA), sampled bilinearly with wrapping at the vertex uv
+    /// (before tiling); v = 0 is the bottom row.
+    Texture {
+        path: Mark<String>,
+        #[serde(default)]
+        channel: u32,
+    },
+}
+
+/// How a node's texel is rendered. New methods are new variants with their own struct.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum Method {
+    ViewSlices(ViewSlices),
+}
+
+/// View-aligned prism slicing (2002).
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ViewSlices {
+    /// Slicing planes across the scene's depth range.
+    #[serde(deserialize_with = "v::planes")]
+    pub planes: u32,
+    /// Skip prisms entirely outside the slab of a plane.
+    #[serde(default = "yes")]
+    pub trivial_reject: bool,
+    #[serde(default)]
+    pub lighting: Lighting,
+}
+
+fn yes() -> bool {
+    true
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum Lighting {
+    /// Colour as baked in the texel.
+    #[default]
+    Baked,
+    /// Shaded per pixel with the texel's normals and the scene lights.
+    PerPixel,
+}

@@ -1,0 +1,198 @@
+//! Checks that need the whole scene (texel names, node consistency, files on disk) and the loading
+//! of the files the scene refers to (OBJ meshes, height images).
+
+use super::image::HeightImage;
+use super::types::{HeightScale, Node, Scene, Surface};
+use super::values::Mark;
+use crate::error::Error;
+use crate::mesh::{obj, Mesh};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+/// Files a scene refers to, loaded once by `load`, by resolved path.
+#[derive(Debug, Clone, Default)]
+pub struct Assets {
+    pub dir: PathBuf,
+    pub meshes: BTreeMap<PathBuf, Arc<Mesh>>,
+    pub images: BTreeMap<PathBuf, Arc<HeightImage>>,
+}
+
+/// What the checks found: messages for marks (positioned by a second parse), and the first error
+/// that has its own position (inside an OBJ file, say).
+pub(super) struct Findings {
+    pub fail: BTreeMap<usize, String>,
+    pub other: Option<Error>,
+    pub assets: Assets,
+}
+
+struct Checker<'a> {
+    scene: &'a Scene,
+    f: Findings,
+}
+
+impl Checker<'_> {
+    fn fail<T>(&mut self, mark: &Mark<T>, msg: String) {
+        self.f.fail.entry(mark.seq).or_insert(msg);
+    }
+
+    fn other(&mut self, e: Error) {
+        self.f.other.get_or_insert(e);
+    }
+
+    fn mesh(&mut self, path: &Mark<String>) -> Option<Arc<Mesh>> {
+        let full = self.f.assets.dir.join(&path.value);
+        if let Some(m) = self.f.assets.meshes.get(&full) {
+            return Some(m.clone());
+        }
+        if !full.is_file() {
+            let msg = format!(
+                "expected an OBJ file, but {} does not exist",
+                full.display()
+            );
+            self.fail(path, msg);
+            return None;
+        }
+        match obj::load(&full) {
+            Ok(m) => {
+                let m = Arc::new(m);
+                self.f.assets.meshes.insert(full, m.clone());
+                Some(m)
+            }
+            Err(e) => {
+                self.other(e);
+                None
+            }
+        }
+    }
+
+    fn image(&mut self, path: &Mark<String>) -> Option<Arc<HeightImage>> {
+        let full = self.f.assets.dir.join(&path.value);
+        if let Some(m) = self.f.assets.images.get(&full) {
+            return Some(m.clone());
+        }
+        if !full.is_file() {
+            let msg = format!("expected a PNG file, but {} does not exist", full.display());
+            self.fail(path, msg);
+            return None;
+        }
+        match HeightImage::load(&full) {
+            Ok(m) => {
+                let m = Arc::new(m);
+                self.f.assets.images.insert(full, m.clone());
+                Some(m)
+            }
+            Err(e) => {
+                self.other(e);
+                None
+            }
+        }
+    }
+
+    fn node(&mut self, n: &Node) {
+        if let Some(m) = &n.method {
+            if n.texel.is_none() {
+                self.fail(
+                    m,
+                    format!("node \"{}\" has a method: expected a `texel`", n.name),
+                );
+            } else if n.surface.is_none() {
+                self.fail(
+                    m,
+                    format!("node \"{}\" has a method: expected a `surface`", n.name),
+                );
+            }
+        }
+        if let Some(t) = &n.texel {
+            if !self.scene.texels.contains_key(&t.value) {
+                let names: Vec<String> = self
+                    .scene
+                    .texels
+                    .keys()
+                    .map(|k| format!("\"{k}\""))
+                    .collect();
+                let expected = if names.is_empty() {
+                    "no texels are defined in `texels`".to_string()
+                } else {
+                    format!("expected one of {}", names.join(", "))
+                };
+                self.fail(t, format!("unknown texel \"{}\": {expected}", t.value));
+            }
+        }
+        let mut mesh = None;
+        if let Some(s) = &n.surface {
+            match &s.value {
+                Surface::Torus { major, minor, .. } if minor >= major => {
+                    self.fail(
+                        s,
+                        format!("expected a torus minor radius below the major radius ({major})"),
+                    );
+                }
+                Surface::Obj { path } => mesh = self.mesh(path),
+                _ => {}
+            }
+        }
+        if let Some(scale) = &n.height.scale {
+            match (&scale.value, n.surface.as_deref()) {
+                (_, None) => self.fail(scale, "a height scale needs a `surface`".into()),
+                (HeightScale::VertexAttribute, Some(Surface::Obj { path })) => {
+                    if mesh.as_ref().is_some_and(|m| m.attribute.is_none()) {
+                        let msg = format!(
+                            "{} has no vertex colours: expected `v x y z r g b` lines for VertexAttribute",
+                            path.value
+                        );
+                        self.fail(scale, msg);
+                    }
+                }
+                (HeightScale::VertexAttribute, Some(_)) => {
+                    self.fail(scale, "built-in surfaces have no vertex attribute: expected Texture(path: ..) or an Obj surface".into());
+                }
+                (HeightScale::Texture { path, channel }, Some(_)) => {
+                    if let Some(img) = self.image(path) {
+                        if *channel as usize >= img.channels {
+                            let msg = format!(
+                                "expected a channel in 0..{} ({} has {} channels)",
+                                img.channels, path.value, img.channels
+                            );
+                            self.fail(scale, msg);
+                        }
+                    }
+                }
+            }
+        }
+        for c in &n.children {
+            self.node(c);
+        }
+    }
+}
+
+pub(super) fn check(scene: &Scene, dir: &Path) -> Findings {
+    let mut c = Checker {
+        scene,
+        f: Findings {
+            fail: BTreeMap::new(),
+            other: None,
+            assets: Assets {
+                dir: dir.to_path_buf(),
+                ..Assets::default()
+            },
+        },
+    };
+    let cam = &scene.camera;
+    let view = cam.target - cam.eye;
+    if view.length_squared() == 0.0 {
+        c.fail(
+            cam,
+            "expected a camera `target` different from its `eye`".into(),
+        );
+    } else if view.normalize().cross(cam.up.normalize()).length() < 1e-6 {
+        c.fail(
+            cam,
+            "expected a camera `up` that is not parallel to the view direction".into(),
+        );
+    }
+    for n in &scene.nodes {
+        c.node(n);
+    }
+    c.f
+}

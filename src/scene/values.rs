@@ -1,0 +1,214 @@
+//! Checked scene values. Range checks run inside `Deserialize` so ron attaches the position of the
+//! offending value; [`Mark`] positions checks that need the whole scene (see `super::load`).
+
+use glam::DVec3;
+use serde::de::{Deserialize, Deserializer, Error};
+use std::cell::RefCell;
+use std::collections::BTreeMap;
+
+macro_rules! checked_f64 {
+    ($name:ident, $ok:expr, $what:literal) => {
+        #[derive(Clone, Copy)]
+        struct $name(f64);
+        impl<'de> Deserialize<'de> for $name {
+            fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+                let v = f64::deserialize(d)?;
+                let ok: fn(f64) -> bool = $ok;
+                if v.is_finite() && ok(v) {
+                    Ok($name(v))
+                } else {
+                    Err(D::Error::custom(format!(
+                        concat!("expected ", $what, ", found {}"),
+                        v
+                    )))
+                }
+            }
+        }
+    };
+}
+
+checked_f64!(Finite, |_| true, "a finite number");
+checked_f64!(Positive, |v| v > 0.0, "a positive finite number");
+checked_f64!(NonNegative, |v| v >= 0.0, "a finite number >= 0");
+checked_f64!(Unit, |v| (0.0..=1.0).contains(&v), "a number in [0, 1]");
+checked_f64!(NonZero, |v| v != 0.0, "a finite non-zero number");
+checked_f64!(
+    Jitter,
+    |v| (0.0..0.5).contains(&v),
+    "a jitter in [0, 0.5) (fraction of a cell)"
+);
+checked_f64!(
+    Distortion,
+    |v| (0.0..0.9).contains(&v),
+    "a distortion in [0, 0.9)"
+);
+checked_f64!(
+    FieldOfView,
+    |v| v > 0.0 && v < 180.0,
+    "a field of view in (0, 180) degrees"
+);
+
+macro_rules! checked_u32 {
+    ($name:ident, $lo:expr, $hi:expr, $what:literal) => {
+        #[derive(Clone, Copy)]
+        struct $name(u32);
+        impl<'de> Deserialize<'de> for $name {
+            fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+                let v = u32::deserialize(d)?;
+                if ($lo..=$hi).contains(&v) {
+                    Ok($name(v))
+                } else {
+                    Err(D::Error::custom(format!(
+                        concat!("expected ", $what, " in {}..={}, found {}"),
+                        $lo, $hi, v
+                    )))
+                }
+            }
+        }
+    };
+}
+
+checked_u32!(OutputSize, 1, 16384, "an output size");
+checked_u32!(PlaneCount, 1, 16384, "a plane count");
+checked_u32!(Resolution, 1, 1024, "a resolution");
+checked_u32!(Octaves, 1, 8, "an octave count");
+checked_u32!(Frequency, 1, 1024, "a frequency (lattice cells per tile)");
+checked_u32!(Cells, 1, 4096, "a cell count");
+checked_u32!(Around, 3, 4096, "a segment count");
+checked_u32!(PoleToPole, 2, 4096, "a segment count");
+
+// `deserialize_with` adapters: public types stay plain (f64, DVec3, [f32; 3], u32).
+macro_rules! adapter {
+    ($fn:ident, $ty:ty, $via:ty, $map:expr) => {
+        pub(super) fn $fn<'de, D: Deserializer<'de>>(d: D) -> Result<$ty, D::Error> {
+            let map: fn($via) -> $ty = $map;
+            <$via>::deserialize(d).map(map)
+        }
+    };
+}
+
+adapter!(positive, f64, Positive, |v| v.0);
+adapter!(non_negative, f64, NonNegative, |v| v.0);
+adapter!(jitter, f64, Jitter, |v| v.0);
+adapter!(distortion, f64, Distortion, |v| v.0);
+adapter!(fov, f64, FieldOfView, |v| v.0);
+adapter!(finite_f32, f32, Finite, |v| v.0 as f32);
+adapter!(positive_f32, f32, Positive, |v| v.0 as f32);
+adapter!(non_negative_f32, f32, NonNegative, |v| v.0 as f32);
+adapter!(unit_f32, f32, Unit, |v| v.0 as f32);
+adapter!(vec3, DVec3, [Finite; 3], |v| DVec3::new(
+    v[0].0, v[1].0, v[2].0
+));
+adapter!(scale3, DVec3, [NonZero; 3], |v| DVec3::new(
+    v[0].0, v[1].0, v[2].0
+));
+adapter!(positive2, [f64; 2], [Positive; 2], |v| [v[0].0, v[1].0]);
+adapter!(point_f32, [f32; 3], [Finite; 3], |v| v.map(|x| x.0 as f32));
+adapter!(radii_f32, [f32; 3], [Positive; 3], |v| v
+    .map(|x| x.0 as f32));
+adapter!(color, [f32; 3], [Unit; 3], |v| v.map(|x| x.0 as f32));
+adapter!(light_color, [f32; 3], [NonNegative; 3], |v| v
+    .map(|x| x.0 as f32));
+adapter!(opt_color, Option<[f32; 3]>, Option<[Unit; 3]>, |v| v
+    .map(|c| c.map(|x| x.0 as f32)));
+adapter!(output_size, u32, OutputSize, |v| v.0);
+adapter!(planes, u32, PlaneCount, |v| v.0);
+adapter!(resolution, [u32; 3], [Resolution; 3], |v| v.map(|x| x.0));
+adapter!(octaves, u32, Octaves, |v| v.0);
+adapter!(frequency, u32, Frequency, |v| v.0);
+adapter!(cells, [u32; 2], [Cells; 2], |v| v.map(|x| x.0));
+adapter!(sphere_segments, [u32; 2], (Around, PoleToPole), |v| [
+    v.0 .0, v.1 .0
+]);
+adapter!(torus_segments, [u32; 2], [Around; 2], |v| v.map(|x| x.0));
+
+/// A direction: finite and not zero.
+pub(super) fn direction<'de, D: Deserializer<'de>>(d: D) -> Result<DVec3, D::Error> {
+    let v = vec3(d)?;
+    if v.length_squared() > 0.0 {
+        Ok(v)
+    } else {
+        Err(D::Error::custom("expected a non-zero direction"))
+    }
+}
+
+/// Prefix of the ron message of a [`Mark`] failure; the mapping uses the span's end (where the
+/// value starts) for these and strips it.
+pub(super) const MARK_PREFIX: &str = "\u{1}mark:";
+
+/// Numbering of [`Mark`]s during one parse, and the messages to fail with (second pass).
+#[derive(Default)]
+pub(super) struct Marking {
+    next: usize,
+    pub fail: BTreeMap<usize, String>,
+}
+
+thread_local! {
+    static MARKING: RefCell<Option<Marking>> = const { RefCell::new(None) };
+}
+
+/// Runs `f` with a fresh numbering (and the given failures) active on this thread.
+pub(super) fn with_marking<T>(fail: BTreeMap<usize, String>, f: impl FnOnce() -> T) -> T {
+    struct Reset;
+    impl Drop for Reset {
+        fn drop(&mut self) {
+            MARKING.with(|m| *m.borrow_mut() = None);
+        }
+    }
+    MARKING.with(|m| *m.borrow_mut() = Some(Marking { next: 0, fail }));
+    let _reset = Reset;
+    f()
+}
+
+/// A value whose position in the scene file can be reported by a check made after parsing.
+///
+/// Parsing is deterministic, so the n-th mark of a first parse is the n-th mark of a second one;
+/// the second parse fails at the marks whose checks failed, and ron attaches the position.
+#[derive(Clone, PartialEq)]
+pub struct Mark<T> {
+    pub value: T,
+    pub(super) seq: usize,
+}
+
+impl<T> Mark<T> {
+    /// A value that was not read from a file (its checks report without a position).
+    pub fn new(value: T) -> Self {
+        Mark {
+            value,
+            seq: usize::MAX,
+        }
+    }
+}
+
+impl<T> std::ops::Deref for Mark<T> {
+    type Target = T;
+    fn deref(&self) -> &T {
+        &self.value
+    }
+}
+
+impl<T: std::fmt::Debug> std::fmt::Debug for Mark<T> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        self.value.fmt(f)
+    }
+}
+
+impl<'de, T: Deserialize<'de>> Deserialize<'de> for Mark<T> {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let (seq, fail) = MARKING.with(|m| match m.borrow_mut().as_mut() {
+            Some(m) => {
+                m.next += 1;
+                (m.next - 1, m.fail.get(&(m.next - 1)).cloned())
+            }
+            None => (usize::MAX, None),
+        });
+        // Fail before reading the value: ron's span then ends where the value starts.
+        if let Some(msg) = fail {
+            return Err(D::Error::custom(format!("{MARK_PREFIX}{msg}")));
+        }
+        Ok(Mark {
+            value: T::deserialize(d)?,
+            seq,
+        })
+    }
+}
