@@ -1,1 +1,3 @@
-//! (filled in by its owner)
+//! CPU twins of kernels whose math matters (f32 mirroring WGSL unless stated).
+
+pub mod slice_prisms;
