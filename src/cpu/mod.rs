@@ -1,3 +1,4 @@
-//! CPU twins of the WGSL kernels (same names, same f32 math) for tests and references.
+//! CPU twins of the kernels whose math matters; tests run both on the same inputs.
 
 pub mod bake;
+pub mod slice_prisms;

@@ -1,0 +1,48 @@
+// Writes every (plane, prism) slice polygon, fan-triangulated, at its plane's scanned offset: back to front.
+#include "shared/types.wgsl"
+#include "shared/slice_prism.wgsl"
+
+@group(0) @binding(0) var<uniform> slice_params: SliceParams;
+@group(0) @binding(1) var<storage, read> shell_vertices: array<ShellVertex>;
+@group(0) @binding(2) var<storage, read> prisms: array<Prism>;
+@group(0) @binding(3) var<storage, read_write> plane_cursors: array<atomic<u32>>;
+@group(0) @binding(4) var<storage, read_write> slice_vertices: array<SliceVertex>;
+
+// Skip prisms whose bounding sphere misses the plane before classifying their corners.
+override trivial_reject: bool = true;
+
+fn slice_vertex(poly: SlicePolygon, i: u32, index: u32) -> SliceVertex {
+    return SliceVertex(vec4<f32>(poly.pos[i], bitcast<f32>(index)), vec4<f32>(poly.uvw[i], 0.0));
+}
+
+// x: prism index, y: plane index (0 = back-most).
+@compute @workgroup_size(64)
+fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let index = gid.x;
+    let k = gid.y;
+    if (index >= slice_params.prism_count || k >= slice_params.plane_count) {
+        return;
+    }
+    let poly = slice_prism(index, k);
+    let n = fan_vertex_count(poly.count);
+    if (n == 0u) {
+        return;
+    }
+    let base = atomicAdd(&plane_cursors[k], n);
+    let capacity = min(slice_params.vertex_capacity, arrayLength(&slice_vertices));
+    // A polygon straddling the capacity is written as degenerate triangles below it, so the
+    // drawn range [0, vertex_count) never holds stale vertices.
+    let fits = base <= capacity && n <= capacity - base;
+    let v0 = slice_vertex(poly, 0u, index);
+    for (var f = 0u; f + 2u < poly.count; f++) {
+        for (var c = 0u; c < 3u; c++) {
+            let corner = select(f + c, 0u, c == 0u); // fan (0, f+1, f+2)
+            let at = base + 3u * f + c;
+            if (fits) {
+                slice_vertices[at] = slice_vertex(poly, corner, index);
+            } else if (at < capacity) {
+                slice_vertices[at] = v0;
+            }
+        }
+    }
+}
