@@ -15,7 +15,8 @@ use crate::graph::{Graph, ResourceDecl, TextureSize};
 use crate::io::Image;
 use crate::methods::shell::{self, Shell};
 use crate::methods::view_slices;
-use crate::scene::{Lighting, Method, Scene, SceneObject, TexelSource};
+use crate::cpu::bake::Shape as BakeShape;
+use crate::scene::{Light, Lighting, Method, Scene, SceneObject, Shape, TexelSource};
 use crate::types::{BaseVertex, FrameParams, ObjectParams, SliceParams, SliceVertex};
 
 /// Overrides of what the scene file says, from the command line or tests.
@@ -99,7 +100,7 @@ impl Blueprint {
             let base = object.base_color.map(|_| shell::base_vertices(&object.surface, eye));
             let (mut slicing, mut trivial_reject, mut per_pixel, mut bake) = (None, true, false, None);
             if let Some(Method::ViewSlices(vs)) = &object.method {
-                let planes = opts.planes.unwrap_or(*vs.planes);
+                let planes = opts.planes.unwrap_or(vs.planes);
                 trivial_reject = opts.trivial_reject.unwrap_or(vs.trivial_reject);
                 per_pixel = vs.lighting == Lighting::PerPixel;
                 let mut params = view_slices::sweep(&shell, f32v(forward), planes, near);
@@ -133,14 +134,16 @@ impl Blueprint {
         let proj = projection(cam.fov_y.to_radians(), size.0 as f64 / size.1 as f64, near, far);
         let light = scene.lights.first();
         let (light_dir, light_color) = match light {
-            Some(l) => (-l.direction().normalize(), l.color() * l.intensity()),
-            None => (DVec3::new(0.3, 0.4, 1.0).normalize(), DVec3::ONE),
+            Some(Light::Directional { direction, color, intensity }) => {
+                (-direction.normalize(), color.map(|c| c * intensity))
+            }
+            None => (DVec3::new(0.3, 0.4, 1.0).normalize(), [1.0; 3]),
         };
         let frame = FrameParams {
             view_proj: (proj * view).as_mat4().to_cols_array_2d(),
             forward: [forward.x as f32, forward.y as f32, forward.z as f32, near as f32],
             light_dir: [light_dir.x as f32, light_dir.y as f32, light_dir.z as f32, scene.ambient],
-            light_color: [light_color.x as f32, light_color.y as f32, light_color.z as f32, 1.0],
+            light_color: [light_color[0], light_color[1], light_color[2], 1.0],
             background: [scene.background[0], scene.background[1], scene.background[2], 1.0],
             viewport: [size.0 as f32, size.1 as f32, 1.0 / size.0 as f32, 1.0 / size.1 as f32],
         };
@@ -313,15 +316,26 @@ fn bake_index(scene: &Scene, texel: &str, per_pixel: bool, bakes: &mut Vec<BakeP
         .get(texel)
         .ok_or_else(|| Error::Invalid(format!("{}: unknown texel `{texel}`", scene.path.display())))?;
     let source = match &t.source {
-        TexelSource::Implicit { shapes } => BakeSource::Implicit(crate::cpu::bake::pack_shapes(
-            &shapes.iter().map(crate::scene::Shape::to_bake).collect::<Vec<_>>(),
-        )),
-        TexelSource::PerlinHeight { .. } => BakeSource::Heightfield(t.source.heightfield_params()),
-        TexelSource::Constant { color, opacity } => BakeSource::Implicit(crate::cpu::bake::pack_shapes(&[(
-            crate::cpu::bake::Shape::Constant,
-            *color,
-            *opacity,
-        )])),
+        TexelSource::Implicit { shapes } => {
+            BakeSource::Implicit(crate::cpu::bake::pack_shapes(&shapes.iter().map(bake_shape).collect::<Vec<_>>()))
+        }
+        TexelSource::PerlinHeight { frequency, octaves, amplitude, base, seed, color_low, color_high, opacity } => {
+            let c = |v: &[f32; 3]| [v[0], v[1], v[2], 0.0];
+            BakeSource::Heightfield(crate::types::HeightfieldParams {
+                frequency: *frequency,
+                octaves: *octaves,
+                seed: *seed,
+                amplitude: *amplitude,
+                base: *base,
+                opacity: *opacity,
+                color_low: c(color_low),
+                color_high: c(color_high),
+                ..Default::default()
+            })
+        }
+        TexelSource::Constant { color, opacity } => {
+            BakeSource::Implicit(crate::cpu::bake::pack_shapes(&[(BakeShape::Constant, *color, *opacity)]))
+        }
     };
     bakes.push(BakePlan {
         texel: texel.to_string(),
@@ -494,5 +508,25 @@ impl Renderer {
             m.push((format!("voltex_object_{}", o.object.name), method));
         }
         m
+    }
+}
+
+/// A scene shape as the bake kernels take it: (shape, albedo, opacity).
+fn bake_shape(s: &Shape) -> (BakeShape, [f32; 3], f32) {
+    match s {
+        Shape::Sphere { center, radius, color, opacity } => {
+            (BakeShape::Sphere { center: *center, radius: *radius }, *color, *opacity)
+        }
+        Shape::Torus { center, major, minor, color, opacity } => {
+            (BakeShape::Torus { center: *center, major: *major, minor: *minor }, *color, *opacity)
+        }
+        Shape::Ellipsoid { center, radii, color, opacity } => {
+            (BakeShape::Ellipsoid { center: *center, radii: *radii }, *color, *opacity)
+        }
+        Shape::Metaballs { balls, threshold, color, opacity } => (
+            BakeShape::Metaballs { balls: balls.iter().map(|b| (b.center, b.radius)).collect(), threshold: *threshold },
+            *color,
+            *opacity,
+        ),
     }
 }

@@ -14,6 +14,7 @@ use crate::error::{locate_literal, ron_error, Error, FileLoc, Result};
 
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
+#[serde(rename = "Graph")]
 pub struct GraphFile {
     /// Resources that leave the frame (read back or presented): graph textures, or buffers the
     /// runtime provides (e.g. `slice_vertices` in a debug graph). Passes that contribute to none

@@ -69,7 +69,7 @@ macro_rules! checked_u32 {
 }
 
 checked_u32!(OutputSize, 1, 16384, "an output size");
-checked_u32!(PlaneCount, 1, 16384, "a plane count");
+checked_u32!(PlaneCount, 1, super::MAX_PLANES, "a plane count");
 checked_u32!(Resolution, 1, 1024, "a resolution");
 checked_u32!(Octaves, 1, 8, "an octave count");
 checked_u32!(Frequency, 1, 1024, "a frequency (lattice cells per tile)");
