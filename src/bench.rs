@@ -23,22 +23,54 @@ pub fn default_scenes() -> Vec<PathBuf> {
 }
 
 pub fn run(scenes: &[PathBuf], planes: &[u32], size: (u32, u32), frames: usize) -> Result<()> {
-    let scenes = if scenes.is_empty() { default_scenes() } else { scenes.to_vec() };
+    let scenes = if scenes.is_empty() {
+        default_scenes()
+    } else {
+        scenes.to_vec()
+    };
     let ctx = GpuContext::new()?;
     println!("adapter: {}", ctx.adapter_line());
-    println!("{}x{}, median of {frames} frames after 2 warm-up frames; times in ms", size.0, size.1);
+    println!(
+        "{}x{}, median of {frames} frames after 2 warm-up frames; times in ms",
+        size.0, size.1
+    );
     println!(
         "{:<12} {:>6} {:>7} | {:>8} {:>8} {:>8} {:>8} {:>9} | {:>9} {:>9} | {:>9}",
-        "scene", "planes", "reject", "count", "emit", "slices", "draw", "gpu total", "wall", "fps(wall)", "cpu twin"
+        "scene",
+        "planes",
+        "reject",
+        "count",
+        "emit",
+        "slices",
+        "draw",
+        "gpu total",
+        "wall",
+        "fps(wall)",
+        "cpu twin"
     );
     for scene_path in &scenes {
         let scene = crate::scene::load(scene_path)?;
         for &n in planes {
             for reject in [true, false] {
-                let opts = RenderOptions { size: Some(size), planes: Some(n), trivial_reject: Some(reject), ..Default::default() };
+                let opts = RenderOptions {
+                    size: Some(size),
+                    planes: Some(n),
+                    trivial_reject: Some(reject),
+                    ..Default::default()
+                };
                 let row = measure(&ctx, &scene, &opts, frames)?;
-                let name = Path::new(scene_path).file_stem().unwrap_or_default().to_string_lossy().to_string();
-                let pass = |p: &str| row.passes.iter().find(|x| x.0 == p).map(|x| x.1).unwrap_or(f64::NAN);
+                let name = Path::new(scene_path)
+                    .file_stem()
+                    .unwrap_or_default()
+                    .to_string_lossy()
+                    .to_string();
+                let pass = |p: &str| {
+                    row.passes
+                        .iter()
+                        .find(|x| x.0 == p)
+                        .map(|x| x.1)
+                        .unwrap_or(f64::NAN)
+                };
                 println!(
                     "{:<12} {:>6} {:>7} | {:>8.3} {:>8.3} {:>8.3} {:>8.3} {:>9.3} | {:>9.2} {:>9.1} | {:>9.2}",
                     name,
@@ -66,7 +98,12 @@ struct Row {
     cpu_ms: f64,
 }
 
-fn measure(ctx: &GpuContext, scene: &crate::scene::Scene, opts: &RenderOptions, frames: usize) -> Result<Row> {
+fn measure(
+    ctx: &GpuContext,
+    scene: &crate::scene::Scene,
+    opts: &RenderOptions,
+    frames: usize,
+) -> Result<Row> {
     let bp = Blueprint::new(scene, opts)?;
     let mut r = Renderer::new(ctx, bp)?;
     for _ in 0..2 {
@@ -89,7 +126,12 @@ fn measure(ctx: &GpuContext, scene: &crate::scene::Scene, opts: &RenderOptions, 
     for o in r.blueprint.objects.iter().filter(|o| o.slicing.is_some()) {
         let (params, _) = o.slicing.unwrap();
         let t = Instant::now();
-        let out = crate::cpu::slice_prisms::slice_all(&o.shell.vertices, &o.shell.prisms, &params, o.trivial_reject);
+        let out = crate::cpu::slice_prisms::slice_all(
+            &o.shell.vertices,
+            &o.shell.prisms,
+            &params,
+            o.trivial_reject,
+        );
         cpu.push(t.elapsed().as_secs_f64() * 1e3);
         std::hint::black_box(out);
     }

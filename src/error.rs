@@ -73,10 +73,15 @@ pub fn line_col(source: &str, offset: usize) -> (usize, usize) {
 pub fn locate_literal(source: &str, text: &str, from: usize) -> Option<(usize, usize)> {
     let needle = format!("\"{text}\"");
     let start = from.min(source.len());
-    source[start..].find(&needle).map(|i| line_col(source, start + i))
+    source[start..]
+        .find(&needle)
+        .map(|i| line_col(source, start + i))
 }
 
 /// Turns a ron error into `path:line:col: message`.
 pub fn ron_error(path: &Path, e: &ron::error::SpannedError) -> Error {
-    Error::at(FileLoc::new(path, e.span.start.line, e.span.start.col), e.code.to_string())
+    Error::at(
+        FileLoc::new(path, e.span.start.line, e.span.start.col),
+        e.code.to_string(),
+    )
 }

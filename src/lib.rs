@@ -24,5 +24,5 @@ pub fn project_root() -> std::path::PathBuf {
         .map(Into::into)
         .unwrap_or_else(|| std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")))
 }
-pub mod render;
 pub mod bench;
+pub mod render;

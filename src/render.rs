@@ -6,6 +6,7 @@ use std::path::PathBuf;
 use glam::{DMat4, DVec3, DVec4};
 
 use crate::bake::{self, BakeRequest, BakeSource, Baker};
+use crate::cpu::bake::Shape as BakeShape;
 use crate::error::{Error, Result};
 use crate::gpu::timing::Timer;
 use crate::gpu::GpuContext;
@@ -15,7 +16,6 @@ use crate::graph::{Graph, ResourceDecl, TextureSize};
 use crate::io::Image;
 use crate::methods::shell::{self, Shell};
 use crate::methods::view_slices;
-use crate::cpu::bake::Shape as BakeShape;
 use crate::scene::{Light, Lighting, Method, Scene, SceneObject, Shape, TexelSource};
 use crate::types::{BaseVertex, FrameParams, ObjectParams, SliceParams, SliceVertex};
 
@@ -68,7 +68,9 @@ pub fn wgsl_root() -> PathBuf {
 
 impl Blueprint {
     pub fn new(scene: &Scene, opts: &RenderOptions) -> Result<Self> {
-        let size = opts.size.unwrap_or((scene.output.width, scene.output.height));
+        let size = opts
+            .size
+            .unwrap_or((scene.output.width, scene.output.height));
         let objects = scene.objects()?;
         let cam = &scene.camera;
         let eye = cam.eye;
@@ -97,8 +99,11 @@ impl Blueprint {
         let mut plans = Vec::new();
         for object in objects {
             let shell = Shell::new(&object.surface, eye);
-            let base = object.base_color.map(|_| shell::base_vertices(&object.surface, eye));
-            let (mut slicing, mut trivial_reject, mut per_pixel, mut bake) = (None, true, false, None);
+            let base = object
+                .base_color
+                .map(|_| shell::base_vertices(&object.surface, eye));
+            let (mut slicing, mut trivial_reject, mut per_pixel, mut bake) =
+                (None, true, false, None);
             if let Some(Method::ViewSlices(vs)) = &object.method {
                 let planes = opts.planes.unwrap_or(vs.planes);
                 trivial_reject = opts.trivial_reject.unwrap_or(vs.trivial_reject);
@@ -110,7 +115,15 @@ impl Blueprint {
                 let texel_name = object.texel.clone().unwrap_or_default();
                 bake = Some(bake_index(scene, &texel_name, per_pixel, &mut bakes)?);
             }
-            plans.push(ObjectPlan { object, shell, base, slicing, trivial_reject, per_pixel, bake });
+            plans.push(ObjectPlan {
+                object,
+                shell,
+                base,
+                slicing,
+                trivial_reject,
+                per_pixel,
+                bake,
+            });
         }
 
         let graph = Graph::load(opts.graph.as_deref().unwrap_or(&default_graph()))?;
@@ -124,28 +137,60 @@ impl Blueprint {
                 if o.base.is_some() {
                     filters.push("BaseSurface");
                 }
-                let centre = o.object.surface.positions.iter().sum::<DVec3>() / o.object.surface.positions.len().max(1) as f64;
-                ObjectInfo { name: o.object.name.clone(), filters, distance: (centre - eye).length() }
+                let centre = o.object.surface.positions.iter().sum::<DVec3>()
+                    / o.object.surface.positions.len().max(1) as f64;
+                ObjectInfo {
+                    name: o.object.name.clone(),
+                    filters,
+                    distance: (centre - eye).length(),
+                }
             })
             .collect();
         let plan = plan::plan(&graph, &wgsl_root(), &infos)?;
 
         let view = view_matrix(forward, cam.up);
-        let proj = projection(cam.fov_y.to_radians(), size.0 as f64 / size.1 as f64, near, far);
+        let proj = projection(
+            cam.fov_y.to_radians(),
+            size.0 as f64 / size.1 as f64,
+            near,
+            far,
+        );
         let light = scene.lights.first();
         let (light_dir, light_color) = match light {
-            Some(Light::Directional { direction, color, intensity }) => {
-                (-direction.normalize(), color.map(|c| c * intensity))
-            }
+            Some(Light::Directional {
+                direction,
+                color,
+                intensity,
+            }) => (-direction.normalize(), color.map(|c| c * intensity)),
             None => (DVec3::new(0.3, 0.4, 1.0).normalize(), [1.0; 3]),
         };
         let frame = FrameParams {
             view_proj: (proj * view).as_mat4().to_cols_array_2d(),
-            forward: [forward.x as f32, forward.y as f32, forward.z as f32, near as f32],
-            light_dir: [light_dir.x as f32, light_dir.y as f32, light_dir.z as f32, scene.ambient],
+            forward: [
+                forward.x as f32,
+                forward.y as f32,
+                forward.z as f32,
+                near as f32,
+            ],
+            light_dir: [
+                light_dir.x as f32,
+                light_dir.y as f32,
+                light_dir.z as f32,
+                scene.ambient,
+            ],
             light_color: [light_color[0], light_color[1], light_color[2], 1.0],
-            background: [scene.background[0], scene.background[1], scene.background[2], 1.0],
-            viewport: [size.0 as f32, size.1 as f32, 1.0 / size.0 as f32, 1.0 / size.1 as f32],
+            background: [
+                scene.background[0],
+                scene.background[1],
+                scene.background[2],
+                1.0,
+            ],
+            viewport: [
+                size.0 as f32,
+                size.1 as f32,
+                1.0 / size.0 as f32,
+                1.0 / size.1 as f32,
+            ],
         };
         for b in &mut bakes {
             // Baked shading treats the texel axes (s, t, w) as world (x, y, z): exact for a flat
@@ -153,7 +198,16 @@ impl Blueprint {
             b.request.light = [light_dir.x as f32, light_dir.y as f32, light_dir.z as f32];
             b.request.ambient = scene.ambient;
         }
-        Ok(Self { scene_path: scene.path.clone(), size, eye, frame, objects: plans, bakes, graph, plan })
+        Ok(Self {
+            scene_path: scene.path.clone(),
+            size,
+            eye,
+            frame,
+            objects: plans,
+            bakes,
+            graph,
+            plan,
+        })
     }
 
     /// Bytes of GPU memory the frame allocates, by item.
@@ -165,12 +219,26 @@ impl Blueprint {
                 TextureSize::Output => self.size,
                 TextureSize::Fixed(w, h) => (*w, *h),
             };
-            out.push((format!("texture {name} {w}x{h} {format:?}"), w as u64 * h as u64 * format.bytes_per_pixel()));
+            out.push((
+                format!("texture {name} {w}x{h} {format:?}"),
+                w as u64 * h as u64 * format.bytes_per_pixel(),
+            ));
         }
         for b in &self.bakes {
             let r = b.request.resolution;
             out.push((
-                format!("texel {} {}x{}x{} rgba8 + mips{}", b.texel, r[0], r[1], r[2], if b.request.per_pixel { " + normals" } else { "" }),
+                format!(
+                    "texel {} {}x{}x{} rgba8 + mips{}",
+                    b.texel,
+                    r[0],
+                    r[1],
+                    r[2],
+                    if b.request.per_pixel {
+                        " + normals"
+                    } else {
+                        ""
+                    }
+                ),
                 bake::bytes(r, b.request.per_pixel),
             ));
         }
@@ -178,14 +246,27 @@ impl Blueprint {
             let name = &o.object.name;
             let shell = (o.shell.vertices.len() * 32 + o.shell.prisms.len() * 64) as u64;
             if let Some((params, cap)) = &o.slicing {
-                out.push((format!("object {name}: shell ({} prisms)", o.shell.prisms.len()), shell));
                 out.push((
-                    format!("object {name}: slice vertices (capacity {cap}) + {} plane cursors", params.plane_count),
-                    cap * std::mem::size_of::<SliceVertex>() as u64 + params.plane_count as u64 * 4 + 16 + 48 + 32,
+                    format!("object {name}: shell ({} prisms)", o.shell.prisms.len()),
+                    shell,
+                ));
+                out.push((
+                    format!(
+                        "object {name}: slice vertices (capacity {cap}) + {} plane cursors",
+                        params.plane_count
+                    ),
+                    cap * std::mem::size_of::<SliceVertex>() as u64
+                        + params.plane_count as u64 * 4
+                        + 16
+                        + 48
+                        + 32,
                 ));
             }
             if let Some(base) = &o.base {
-                out.push((format!("object {name}: base triangles"), (base.len() * 32) as u64));
+                out.push((
+                    format!("object {name}: base triangles"),
+                    (base.len() * 32) as u64,
+                ));
             }
         }
         out
@@ -193,7 +274,12 @@ impl Blueprint {
 
     /// The text of `voltex plan`.
     pub fn describe(&self) -> String {
-        let mut s = format!("scene {}\noutput {}x{}\n\nbakes:\n", self.scene_path.display(), self.size.0, self.size.1);
+        let mut s = format!(
+            "scene {}\noutput {}x{}\n\nbakes:\n",
+            self.scene_path.display(),
+            self.size.0,
+            self.size.1
+        );
         if self.bakes.is_empty() {
             s += "  (none)\n";
         }
@@ -210,7 +296,11 @@ impl Blueprint {
                 r[1],
                 r[2],
                 bake::mip_count(r) - 1,
-                if b.request.per_pixel { "per-pixel (albedo + normals)" } else { "baked" }
+                if b.request.per_pixel {
+                    "per-pixel (albedo + normals)"
+                } else {
+                    "baked"
+                }
             );
         }
         s += "\nobjects:\n";
@@ -225,7 +315,11 @@ impl Blueprint {
                 ),
                 None => "base surface only".into(),
             };
-            s += &format!("  {:<16} {} triangles  {method}\n", o.object.name, o.shell.prisms.len());
+            s += &format!(
+                "  {:<16} {} triangles  {method}\n",
+                o.object.name,
+                o.shell.prisms.len()
+            );
             for w in &o.object.report.warnings {
                 s += &format!("    warning: {w}\n");
             }
@@ -237,9 +331,22 @@ impl Blueprint {
                 Some(ids) => format!("{} object(s)", ids.len()),
             };
             let pipelines = self.pipeline_variants(p);
-            s += &format!("  {:<20} {:<26} {:<12} pipelines: {}\n", p.decl.name(), p.decl.shader(), inst, pipelines.join(", "));
+            s += &format!(
+                "  {:<20} {:<26} {:<12} pipelines: {}\n",
+                p.decl.name(),
+                p.decl.shader(),
+                inst,
+                pipelines.join(", ")
+            );
         }
-        s += &format!("\nkernels compiled: {}\n", self.plan.kernels().into_iter().collect::<Vec<_>>().join(", "));
+        s += &format!(
+            "\nkernels compiled: {}\n",
+            self.plan
+                .kernels()
+                .into_iter()
+                .collect::<Vec<_>>()
+                .join(", ")
+        );
         if !self.plan.pruned.is_empty() {
             s += "\npruned:\n";
             for p in &self.plan.pruned {
@@ -251,19 +358,31 @@ impl Blueprint {
         for (what, bytes) in &mem {
             s += &format!("  {:>10.2} MiB  {what}\n", *bytes as f64 / 1048576.0);
         }
-        s += &format!("  {:>10.2} MiB  total\n", mem.iter().map(|m| m.1).sum::<u64>() as f64 / 1048576.0);
+        s += &format!(
+            "  {:>10.2} MiB  total\n",
+            mem.iter().map(|m| m.1).sum::<u64>() as f64 / 1048576.0
+        );
         s
     }
 
     fn pipeline_variants(&self, p: &plan::PlannedPass) -> Vec<String> {
-        let names: Vec<String> = crate::gpu::reflect::overrides(&p.kernel).into_iter().map(|o| o.0).collect();
+        let names: Vec<String> = crate::gpu::reflect::overrides(&p.kernel)
+            .into_iter()
+            .map(|o| o.0)
+            .collect();
         let mut variants: Vec<String> = match &p.instances {
             None => vec![String::new()],
-            Some(ids) => ids.iter().map(|&i| self.constants(&self.objects[i], &names)).collect(),
+            Some(ids) => ids
+                .iter()
+                .map(|&i| self.constants(&self.objects[i], &names))
+                .collect(),
         };
         variants.sort();
         variants.dedup();
-        variants.into_iter().map(|v| if v.is_empty() { "default".into() } else { v }).collect()
+        variants
+            .into_iter()
+            .map(|v| if v.is_empty() { "default".into() } else { v })
+            .collect()
     }
 
     fn constants(&self, o: &ObjectPlan, names: &[String]) -> String {
@@ -307,19 +426,35 @@ fn object_constants(o: &ObjectPlan) -> Vec<(String, f64)> {
     ]
 }
 
-fn bake_index(scene: &Scene, texel: &str, per_pixel: bool, bakes: &mut Vec<BakePlan>) -> Result<usize> {
-    if let Some(i) = bakes.iter().position(|b| b.texel == texel && b.request.per_pixel == per_pixel) {
+fn bake_index(
+    scene: &Scene,
+    texel: &str,
+    per_pixel: bool,
+    bakes: &mut Vec<BakePlan>,
+) -> Result<usize> {
+    if let Some(i) = bakes
+        .iter()
+        .position(|b| b.texel == texel && b.request.per_pixel == per_pixel)
+    {
         return Ok(i);
     }
-    let t = scene
-        .texels
-        .get(texel)
-        .ok_or_else(|| Error::Invalid(format!("{}: unknown texel `{texel}`", scene.path.display())))?;
+    let t = scene.texels.get(texel).ok_or_else(|| {
+        Error::Invalid(format!("{}: unknown texel `{texel}`", scene.path.display()))
+    })?;
     let source = match &t.source {
-        TexelSource::Implicit { shapes } => {
-            BakeSource::Implicit(crate::cpu::bake::pack_shapes(&shapes.iter().map(bake_shape).collect::<Vec<_>>()))
-        }
-        TexelSource::PerlinHeight { frequency, octaves, amplitude, base, seed, color_low, color_high, opacity } => {
+        TexelSource::Implicit { shapes } => BakeSource::Implicit(crate::cpu::bake::pack_shapes(
+            &shapes.iter().map(bake_shape).collect::<Vec<_>>(),
+        )),
+        TexelSource::PerlinHeight {
+            frequency,
+            octaves,
+            amplitude,
+            base,
+            seed,
+            color_low,
+            color_high,
+            opacity,
+        } => {
             let c = |v: &[f32; 3]| [v[0], v[1], v[2], 0.0];
             BakeSource::Heightfield(crate::types::HeightfieldParams {
                 frequency: *frequency,
@@ -333,13 +468,19 @@ fn bake_index(scene: &Scene, texel: &str, per_pixel: bool, bakes: &mut Vec<BakeP
                 ..Default::default()
             })
         }
-        TexelSource::Constant { color, opacity } => {
-            BakeSource::Implicit(crate::cpu::bake::pack_shapes(&[(BakeShape::Constant, *color, *opacity)]))
-        }
+        TexelSource::Constant { color, opacity } => BakeSource::Implicit(
+            crate::cpu::bake::pack_shapes(&[(BakeShape::Constant, *color, *opacity)]),
+        ),
     };
     bakes.push(BakePlan {
         texel: texel.to_string(),
-        request: BakeRequest { resolution: t.resolution, source, per_pixel, light: [0.0, 0.0, 1.0], ambient: 0.2 },
+        request: BakeRequest {
+            resolution: t.resolution,
+            source,
+            per_pixel,
+            light: [0.0, 0.0, 1.0],
+            ambient: 0.2,
+        },
         opacity_length: t.opacity_length,
     });
     Ok(bakes.len() - 1)
@@ -372,11 +513,20 @@ impl Renderer {
     pub fn new(ctx: &GpuContext, blueprint: Blueprint) -> Result<Self> {
         for o in &blueprint.objects {
             if let Some((p, cap)) = &o.slicing {
-                view_slices::check_capacity(*cap, ctx.limits.max_storage_buffer_binding_size, &o.object.name, p.plane_count)?;
+                view_slices::check_capacity(
+                    *cap,
+                    ctx.limits.max_storage_buffer_binding_size,
+                    &o.object.name,
+                    p.plane_count,
+                )?;
             }
         }
         let mut baker = Baker::new(&wgsl_root());
-        let baked: Vec<bake::Baked> = blueprint.bakes.iter().map(|b| baker.bake(ctx, &b.request)).collect::<Result<_>>()?;
+        let baked: Vec<bake::Baked> = blueprint
+            .bakes
+            .iter()
+            .map(|b| baker.bake(ctx, &b.request))
+            .collect::<Result<_>>()?;
         let sampler = ctx.device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("volume_sampler"),
             address_mode_u: wgpu::AddressMode::Repeat,
@@ -388,12 +538,24 @@ impl Renderer {
             ..Default::default()
         });
         let mut frame = Inputs::default();
-        frame.buffers.insert("frame".into(), bake::uniform(ctx, "frame", bytemuck::bytes_of(&blueprint.frame)));
+        frame.buffers.insert(
+            "frame".into(),
+            bake::uniform(ctx, "frame", bytemuck::bytes_of(&blueprint.frame)),
+        );
         frame.samplers.insert("volume_sampler".into(), sampler);
         frame.counts.insert("width".into(), blueprint.size.0);
         frame.counts.insert("height".into(), blueprint.size.1);
-        let objects = blueprint.objects.iter().map(|o| object_inputs(ctx, &blueprint, o, &baked)).collect();
-        let exec = Executor::new(ctx, blueprint.graph.clone(), &blueprint.plan, blueprint.size)?;
+        let objects = blueprint
+            .objects
+            .iter()
+            .map(|o| object_inputs(ctx, &blueprint, o, &baked))
+            .collect();
+        let exec = Executor::new(
+            ctx,
+            blueprint.graph.clone(),
+            &blueprint.plan,
+            blueprint.size,
+        )?;
         let timer = Timer::new(ctx, blueprint.plan.passes.len() as u32);
         let (w, h) = blueprint.size;
         let readback = ctx.device.create_buffer(&wgpu::BufferDescriptor {
@@ -402,9 +564,17 @@ impl Renderer {
             usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let mut r = Self { blueprint, exec, frame, objects, timer, readback };
+        let mut r = Self {
+            blueprint,
+            exec,
+            frame,
+            objects,
+            timer,
+            readback,
+        };
         // Pipelines now, so that a bad kernel fails before any frame.
-        r.exec.prepare(ctx, &r.blueprint.plan, &r.frame, &r.objects)?;
+        r.exec
+            .prepare(ctx, &r.blueprint.plan, &r.frame, &r.objects)?;
         ctx.wait()?;
         Ok(r)
     }
@@ -412,7 +582,13 @@ impl Renderer {
     /// Renders one frame and reads back the graph's first output as a linear HDR image.
     pub fn render(&mut self, ctx: &GpuContext) -> Result<Frame> {
         self.timer.reset();
-        self.exec.run(ctx, &self.blueprint.plan, &self.frame, &self.objects, &mut self.timer)?;
+        self.exec.run(
+            ctx,
+            &self.blueprint.plan,
+            &self.frame,
+            &self.objects,
+            &mut self.timer,
+        )?;
         let pass_times = self.timer.read(ctx)?;
         let image = self.read_output(ctx)?;
         Ok(Frame { image, pass_times })
@@ -421,16 +597,28 @@ impl Renderer {
     /// Renders without reading the image back (benchmarks); returns per-pass GPU times.
     pub fn render_timed(&mut self, ctx: &GpuContext) -> Result<Vec<(String, f64)>> {
         self.timer.reset();
-        self.exec.run(ctx, &self.blueprint.plan, &self.frame, &self.objects, &mut self.timer)?;
+        self.exec.run(
+            ctx,
+            &self.blueprint.plan,
+            &self.frame,
+            &self.objects,
+            &mut self.timer,
+        )?;
         ctx.wait()?;
         self.timer.read(ctx)
     }
 
     fn read_output(&self, ctx: &GpuContext) -> Result<Image> {
         let name = &self.blueprint.graph.file.outputs[0];
-        let texture = self.exec.texture(name).ok_or_else(|| Error::Invalid(format!("output `{name}` was pruned")))?;
+        let texture = self
+            .exec
+            .texture(name)
+            .ok_or_else(|| Error::Invalid(format!("output `{name}` was pruned")))?;
         if texture.format() != wgpu::TextureFormat::Rgba32Float {
-            return Err(self.blueprint.graph.error_at(name, format!("output `{name}` must be Rgba32Float to be read back")));
+            return Err(self.blueprint.graph.error_at(
+                name,
+                format!("output `{name}` must be Rgba32Float to be read back"),
+            ));
         }
         let (w, h) = self.blueprint.size;
         let mut enc = ctx.device.create_command_encoder(&Default::default());
@@ -438,23 +626,33 @@ impl Renderer {
             texture.as_image_copy(),
             wgpu::TexelCopyBufferInfo {
                 buffer: &self.readback,
-                layout: wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(padded_row(w)), rows_per_image: Some(h) },
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(padded_row(w)),
+                    rows_per_image: Some(h),
+                },
             },
-            wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
+            wgpu::Extent3d {
+                width: w,
+                height: h,
+                depth_or_array_layers: 1,
+            },
         );
         ctx.queue.submit([enc.finish()]);
         let bytes = ctx.map_read(&self.readback)?;
         let mut pixels = Vec::with_capacity((w * h) as usize);
         for y in 0..h as usize {
             let row = &bytes[y * padded_row(w) as usize..][..w as usize * 16];
-            pixels.extend(bytemuck::cast_slice::<u8, [f32; 4]>(row).iter().copied());
+            pixels.extend(bytemuck::pod_collect_to_vec::<u8, [f32; 4]>(row));
         }
         Image::from_pixels(w, h, pixels)
     }
 
     /// Slice polygons (triangle-list vertices per plane) of one object after the last frame.
     pub fn read_slices(&self, ctx: &GpuContext, object: usize) -> Result<Vec<Vec<SliceVertex>>> {
-        let (params, _) = self.blueprint.objects[object].slicing.ok_or_else(|| Error::Invalid("object is not sliced".into()))?;
+        let (params, _) = self.blueprint.objects[object]
+            .slicing
+            .ok_or_else(|| Error::Invalid("object is not sliced".into()))?;
         view_slices::read_back(ctx, &self.objects[object], params.plane_count)
     }
 }
@@ -463,23 +661,57 @@ fn padded_row(w: u32) -> u32 {
     (w * 16).div_ceil(256) * 256
 }
 
-fn object_inputs(ctx: &GpuContext, bp: &Blueprint, o: &ObjectPlan, baked: &[bake::Baked]) -> Inputs {
+fn object_inputs(
+    ctx: &GpuContext,
+    bp: &Blueprint,
+    o: &ObjectPlan,
+    baked: &[bake::Baked],
+) -> Inputs {
     let mut inputs = Inputs::default();
-    inputs.constants.push(("per_pixel_lighting".into(), o.per_pixel as u32 as f64));
+    inputs
+        .constants
+        .push(("per_pixel_lighting".into(), o.per_pixel as u32 as f64));
     let opacity_length = o.bake.map(|b| bp.bakes[b].opacity_length).unwrap_or(1.0);
     let c = o.object.base_color.unwrap_or([0.0; 3]);
-    let params = ObjectParams { base_color: [c[0], c[1], c[2], 1.0], opacity_length, _pad: [0.0; 3] };
-    inputs.buffers.insert("object".into(), bake::uniform(ctx, "object", bytemuck::bytes_of(&params)));
-    inputs.counts.insert("prisms".into(), o.shell.prisms.len() as u32);
+    let params = ObjectParams {
+        base_color: [c[0], c[1], c[2], 1.0],
+        opacity_length,
+        _pad: [0.0; 3],
+    };
+    inputs.buffers.insert(
+        "object".into(),
+        bake::uniform(ctx, "object", bytemuck::bytes_of(&params)),
+    );
+    inputs
+        .counts
+        .insert("prisms".into(), o.shell.prisms.len() as u32);
     if let Some(base) = &o.base {
-        inputs.buffers.insert("base_vertices".into(), bake::storage(ctx, "base_vertices", bytemuck::cast_slice(base)));
-        inputs.counts.insert("base_vertices".into(), base.len() as u32);
+        inputs.buffers.insert(
+            "base_vertices".into(),
+            bake::storage(ctx, "base_vertices", bytemuck::cast_slice(base)),
+        );
+        inputs
+            .counts
+            .insert("base_vertices".into(), base.len() as u32);
     }
     if let Some((params, capacity)) = &o.slicing {
-        view_slices::add_inputs(ctx, &mut inputs, &o.shell, params, *capacity, o.trivial_reject);
+        view_slices::add_inputs(
+            ctx,
+            &mut inputs,
+            &o.shell,
+            params,
+            *capacity,
+            o.trivial_reject,
+        );
         if let Some(b) = o.bake {
-            inputs.views.insert("volume".into(), baked[b].volume.create_view(&Default::default()));
-            inputs.views.insert("normals".into(), baked[b].normals.create_view(&Default::default()));
+            inputs.views.insert(
+                "volume".into(),
+                baked[b].volume.create_view(&Default::default()),
+            );
+            inputs.views.insert(
+                "normals".into(),
+                baked[b].normals.create_view(&Default::default()),
+            );
         }
     }
     inputs
@@ -489,7 +721,10 @@ impl Renderer {
     /// EXR metadata: scene, methods and their quality knobs, adapter, GPU time.
     pub fn metadata(&self, ctx: &GpuContext, frame: &Frame) -> Vec<(String, String)> {
         let mut m = vec![
-            ("voltex_scene".to_string(), self.blueprint.scene_path.display().to_string()),
+            (
+                "voltex_scene".to_string(),
+                self.blueprint.scene_path.display().to_string(),
+            ),
             ("voltex_adapter".to_string(), ctx.adapter_line()),
         ];
         if let Some(t) = frame.gpu_ms() {
@@ -514,17 +749,57 @@ impl Renderer {
 /// A scene shape as the bake kernels take it: (shape, albedo, opacity).
 fn bake_shape(s: &Shape) -> (BakeShape, [f32; 3], f32) {
     match s {
-        Shape::Sphere { center, radius, color, opacity } => {
-            (BakeShape::Sphere { center: *center, radius: *radius }, *color, *opacity)
-        }
-        Shape::Torus { center, major, minor, color, opacity } => {
-            (BakeShape::Torus { center: *center, major: *major, minor: *minor }, *color, *opacity)
-        }
-        Shape::Ellipsoid { center, radii, color, opacity } => {
-            (BakeShape::Ellipsoid { center: *center, radii: *radii }, *color, *opacity)
-        }
-        Shape::Metaballs { balls, threshold, color, opacity } => (
-            BakeShape::Metaballs { balls: balls.iter().map(|b| (b.center, b.radius)).collect(), threshold: *threshold },
+        Shape::Sphere {
+            center,
+            radius,
+            color,
+            opacity,
+        } => (
+            BakeShape::Sphere {
+                center: *center,
+                radius: *radius,
+            },
+            *color,
+            *opacity,
+        ),
+        Shape::Torus {
+            center,
+            major,
+            minor,
+            color,
+            opacity,
+        } => (
+            BakeShape::Torus {
+                center: *center,
+                major: *major,
+                minor: *minor,
+            },
+            *color,
+            *opacity,
+        ),
+        Shape::Ellipsoid {
+            center,
+            radii,
+            color,
+            opacity,
+        } => (
+            BakeShape::Ellipsoid {
+                center: *center,
+                radii: *radii,
+            },
+            *color,
+            *opacity,
+        ),
+        Shape::Metaballs {
+            balls,
+            threshold,
+            color,
+            opacity,
+        } => (
+            BakeShape::Metaballs {
+                balls: balls.iter().map(|b| (b.center, b.radius)).collect(),
+                threshold: *threshold,
+            },
             *color,
             *opacity,
         ),

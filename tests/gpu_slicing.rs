@@ -18,7 +18,9 @@ use voltex::types::{SliceParams, SliceVertex};
 
 fn ctx() -> &'static GpuContext {
     static CTX: OnceLock<GpuContext> = OnceLock::new();
-    CTX.get_or_init(|| GpuContext::new().expect("a GPU adapter (software Vulkan: mesa-vulkan-drivers)"))
+    CTX.get_or_init(|| {
+        GpuContext::new().expect("a GPU adapter (software Vulkan: mesa-vulkan-drivers)")
+    })
 }
 
 /// Runs the slicing kernels through the `slices_only` graph and reads the polygons back.
@@ -26,7 +28,11 @@ fn gpu_slices(shell: &Shell, params: &SliceParams, trivial_reject: bool) -> Vec<
     let ctx = ctx();
     let root = voltex::project_root();
     let graph = Graph::load(&root.join("graphs/slices_only.ron")).unwrap();
-    let info = ObjectInfo { name: "shell".into(), filters: vec!["ViewSlices"], distance: 0.0 };
+    let info = ObjectInfo {
+        name: "shell".into(),
+        filters: vec!["ViewSlices"],
+        distance: 0.0,
+    };
     let plan = plan::plan(&graph, &root.join("wgsl"), &[info]).unwrap();
     assert_eq!(plan.passes.len(), 3);
     let mut exec = Executor::new(ctx, graph, &plan, (1, 1)).unwrap();
@@ -36,7 +42,14 @@ fn gpu_slices(shell: &Shell, params: &SliceParams, trivial_reject: bool) -> Vec<
     let mut inputs = Inputs::default();
     view_slices::add_inputs(ctx, &mut inputs, shell, &params, capacity, trivial_reject);
     let mut timer = Timer::new(ctx, 4);
-    exec.run(ctx, &plan, &Inputs::default(), std::slice::from_ref(&inputs), &mut timer).unwrap();
+    exec.run(
+        ctx,
+        &plan,
+        &Inputs::default(),
+        std::slice::from_ref(&inputs),
+        &mut timer,
+    )
+    .unwrap();
     view_slices::read_back(ctx, &inputs, params.plane_count).unwrap()
 }
 
@@ -63,7 +76,10 @@ fn compare(shell: &Shell, params: &SliceParams, trivial_reject: bool, ambiguous:
         let (g, c) = (by_prism(g), by_prism(c));
         let prisms: std::collections::BTreeSet<u32> = g.keys().chain(c.keys()).copied().collect();
         for p in prisms {
-            let (gv, cv) = (g.get(&p).cloned().unwrap_or_default(), c.get(&p).cloned().unwrap_or_default());
+            let (gv, cv) = (
+                g.get(&p).cloned().unwrap_or_default(),
+                c.get(&p).cloned().unwrap_or_default(),
+            );
             if gv.len() != cv.len() {
                 let prism = &shell.prisms[p as usize];
                 let near = prism.vertices[..3].iter().any(|&v| {
@@ -72,14 +88,25 @@ fn compare(shell: &Shell, params: &SliceParams, trivial_reject: bool, ambiguous:
                         .iter()
                         .any(|x| (n.dot(glam::Vec3::from_slice(&x[..3])) - d).abs() <= ambiguous)
                 });
-                assert!(near, "plane {k} prism {p}: GPU {} vertices, CPU {} vertices", gv.len(), cv.len());
+                assert!(
+                    near,
+                    "plane {k} prism {p}: GPU {} vertices, CPU {} vertices",
+                    gv.len(),
+                    cv.len()
+                );
                 continue;
             }
             for (a, b) in gv.iter().zip(&cv) {
                 for i in 0..3 {
                     let tol = 1e-5 * (1.0 + b.position[i].abs());
-                    assert!((a.position[i] - b.position[i]).abs() <= tol, "plane {k} prism {p}: {a:?} vs {b:?}");
-                    assert!((a.uvw[i] - b.uvw[i]).abs() <= 1e-5, "plane {k} prism {p}: {a:?} vs {b:?}");
+                    assert!(
+                        (a.position[i] - b.position[i]).abs() <= tol,
+                        "plane {k} prism {p}: {a:?} vs {b:?}"
+                    );
+                    assert!(
+                        (a.uvw[i] - b.uvw[i]).abs() <= 1e-5,
+                        "plane {k} prism {p}: {a:?} vs {b:?}"
+                    );
                 }
                 assert!(a.position.iter().chain(&a.uvw).all(|x| x.is_finite()));
             }
@@ -104,9 +131,17 @@ fn random_shell(seed: u64, cells: u32) -> BaseSurface {
     let mut heights = Vec::new();
     for j in 0..n {
         for i in 0..n {
-            let p = DVec3::new(i as f64 + 0.3 * rng(&mut s), j as f64 + 0.3 * rng(&mut s), 0.4 * rng(&mut s));
+            let p = DVec3::new(
+                i as f64 + 0.3 * rng(&mut s),
+                j as f64 + 0.3 * rng(&mut s),
+                0.4 * rng(&mut s),
+            );
             positions.push(p);
-            heights.push(DVec3::new(0.3 * (rng(&mut s) - 0.5), 0.3 * (rng(&mut s) - 0.5), 0.3 + rng(&mut s)));
+            heights.push(DVec3::new(
+                0.3 * (rng(&mut s) - 0.5),
+                0.3 * (rng(&mut s) - 0.5),
+                0.3 + rng(&mut s),
+            ));
         }
     }
     let mut triangles = Vec::new();
@@ -121,18 +156,32 @@ fn random_shell(seed: u64, cells: u32) -> BaseSurface {
             corner_uvs.push([uv(i, j), uv(i + 1, j + 1), uv(i, j + 1)]);
         }
     }
-    BaseSurface { positions, heights, triangles, corner_uvs }
+    BaseSurface {
+        positions,
+        heights,
+        triangles,
+        corner_uvs,
+    }
 }
 
 fn oblique_params(shell: &Shell, dir: DVec3, planes: u32) -> SliceParams {
     let d = dir.normalize();
-    view_slices::sweep(shell, [d.x as f32, d.y as f32, d.z as f32], planes, f64::NEG_INFINITY)
+    view_slices::sweep(
+        shell,
+        [d.x as f32, d.y as f32, d.z as f32],
+        planes,
+        f64::NEG_INFINITY,
+    )
 }
 
 #[test]
 fn random_shells_and_planes_match_the_cpu_twin() {
     let mut total = 0;
-    for (seed, dir) in [(7u64, DVec3::new(0.3, 0.5, -1.0)), (99, DVec3::new(-1.0, 0.2, -0.1)), (1234, DVec3::new(0.0, 1.0, 0.3))] {
+    for (seed, dir) in [
+        (7u64, DVec3::new(0.3, 0.5, -1.0)),
+        (99, DVec3::new(-1.0, 0.2, -0.1)),
+        (1234, DVec3::new(0.0, 1.0, 0.3)),
+    ] {
         let surface = random_shell(seed, 8);
         let shell = Shell::new(&surface, DVec3::new(4.0, -6.0, 5.0));
         let params = oblique_params(&shell, dir, 48);
@@ -174,10 +223,26 @@ fn hard_cases_match_the_cpu_twin_exactly() {
     let up = [DVec3::Z; 3];
     let cases: Vec<(&str, Shell, Vec<SliceParams>)> = vec![
         // Axis-aligned planes keep every signed distance exact on both sides.
-        ("plane through a vertex", unit_prism(up, base), explicit_planes([1.0, 0.0, 0.0], &[1.0, 0.0])),
-        ("plane through an edge", unit_prism(up, base), explicit_planes([0.0, 1.0, 0.0], &[0.0])),
-        ("plane containing a normal edge", unit_prism(up, base), explicit_planes([1.0, 0.0, 0.0], &[0.0, 1.0])),
-        ("plane parallel to the base", unit_prism(up, base), explicit_planes([0.0, 0.0, 1.0], &[0.0, 0.5, 1.0])),
+        (
+            "plane through a vertex",
+            unit_prism(up, base),
+            explicit_planes([1.0, 0.0, 0.0], &[1.0, 0.0]),
+        ),
+        (
+            "plane through an edge",
+            unit_prism(up, base),
+            explicit_planes([0.0, 1.0, 0.0], &[0.0]),
+        ),
+        (
+            "plane containing a normal edge",
+            unit_prism(up, base),
+            explicit_planes([1.0, 0.0, 0.0], &[0.0, 1.0]),
+        ),
+        (
+            "plane parallel to the base",
+            unit_prism(up, base),
+            explicit_planes([0.0, 0.0, 1.0], &[0.0, 0.5, 1.0]),
+        ),
         (
             "zero-area triangle",
             unit_prism(up, [DVec3::ZERO, DVec3::X, DVec3::new(2.0, 0.0, 0.0)]),
@@ -194,12 +259,26 @@ fn hard_cases_match_the_cpu_twin_exactly() {
             let gpu = gpu_slices(&shell, &params, true);
             let cpu = slice_prisms::slice_all(&shell.vertices, &shell.prisms, &params, true);
             assert_eq!(gpu.len(), 1);
-            assert_eq!(gpu[0].len(), cpu[0].len(), "{name}, d = {}: vertex counts", params.first_plane);
+            assert_eq!(
+                gpu[0].len(),
+                cpu[0].len(),
+                "{name}, d = {}: vertex counts",
+                params.first_plane
+            );
             for (a, b) in gpu[0].iter().zip(&cpu[0]) {
-                assert!(a.position.iter().chain(&a.uvw).all(|x| x.is_finite()), "{name}: non-finite vertex");
+                assert!(
+                    a.position.iter().chain(&a.uvw).all(|x| x.is_finite()),
+                    "{name}: non-finite vertex"
+                );
                 for i in 0..3 {
-                    assert!((a.position[i] - b.position[i]).abs() <= 1e-6, "{name}: {a:?} vs {b:?}");
-                    assert!((a.uvw[i] - b.uvw[i]).abs() <= 1e-6, "{name}: {a:?} vs {b:?}");
+                    assert!(
+                        (a.position[i] - b.position[i]).abs() <= 1e-6,
+                        "{name}: {a:?} vs {b:?}"
+                    );
+                    assert!(
+                        (a.uvw[i] - b.uvw[i]).abs() <= 1e-6,
+                        "{name}: {a:?} vs {b:?}"
+                    );
                 }
             }
         }

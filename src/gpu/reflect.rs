@@ -8,16 +8,28 @@ use crate::gpu::shader::Kernel;
 #[derive(Clone, Debug, PartialEq)]
 pub enum BindingKind {
     Uniform,
-    Storage { read_only: bool },
-    Texture { dim: wgpu::TextureViewDimension, depth: bool },
-    StorageTexture { dim: wgpu::TextureViewDimension, format: wgpu::TextureFormat, write_only: bool },
+    Storage {
+        read_only: bool,
+    },
+    Texture {
+        dim: wgpu::TextureViewDimension,
+        depth: bool,
+    },
+    StorageTexture {
+        dim: wgpu::TextureViewDimension,
+        format: wgpu::TextureFormat,
+        write_only: bool,
+    },
     Sampler,
 }
 
 impl BindingKind {
     /// Whether a pass with this binding writes the bound resource (for pass ordering).
     pub fn writes(&self) -> bool {
-        matches!(self, BindingKind::Storage { read_only: false } | BindingKind::StorageTexture { .. })
+        matches!(
+            self,
+            BindingKind::Storage { read_only: false } | BindingKind::StorageTexture { .. }
+        )
     }
 }
 
@@ -40,7 +52,9 @@ pub fn bindings(kernel: &Kernel, entry_points: &[&str]) -> Result<Vec<Binding>> 
             .iter()
             .enumerate()
             .find(|(_, e)| e.name == *ep_name)
-            .ok_or_else(|| Error::Invalid(format!("{}: no entry point `{ep_name}`", kernel.name)))?;
+            .ok_or_else(|| {
+                Error::Invalid(format!("{}: no entry point `{ep_name}`", kernel.name))
+            })?;
         let stage = match ep.stage {
             naga::ShaderStage::Vertex => wgpu::ShaderStages::VERTEX,
             naga::ShaderStage::Fragment => wgpu::ShaderStages::FRAGMENT,
@@ -53,12 +67,22 @@ pub fn bindings(kernel: &Kernel, entry_points: &[&str]) -> Result<Vec<Binding>> 
                 continue;
             }
             let name = var.name.clone().unwrap_or_default();
-            if let Some(b) = out.iter_mut().find(|b| b.group == rb.group && b.binding == rb.binding) {
+            if let Some(b) = out
+                .iter_mut()
+                .find(|b| b.group == rb.group && b.binding == rb.binding)
+            {
                 b.visibility |= stage;
                 continue;
             }
-            let kind = kind_of(module, var).map_err(|m| Error::Invalid(format!("{}: `{name}`: {m}", kernel.name)))?;
-            out.push(Binding { name, group: rb.group, binding: rb.binding, kind, visibility: stage });
+            let kind = kind_of(module, var)
+                .map_err(|m| Error::Invalid(format!("{}: `{name}`: {m}", kernel.name)))?;
+            out.push(Binding {
+                name,
+                group: rb.group,
+                binding: rb.binding,
+                kind,
+                visibility: stage,
+            });
         }
     }
     out.sort_by_key(|b| (b.group, b.binding));
@@ -73,7 +97,11 @@ fn kind_of(module: &naga::Module, var: &naga::GlobalVariable) -> Result<BindingK
         },
         naga::AddressSpace::Handle => match &module.types[var.ty].inner {
             naga::TypeInner::Sampler { .. } => BindingKind::Sampler,
-            naga::TypeInner::Image { dim, arrayed, class } => {
+            naga::TypeInner::Image {
+                dim,
+                arrayed,
+                class,
+            } => {
                 let dim = view_dim(*dim, *arrayed);
                 match class {
                     naga::ImageClass::Sampled { .. } => BindingKind::Texture { dim, depth: false },
@@ -83,7 +111,9 @@ fn kind_of(module: &naga::Module, var: &naga::GlobalVariable) -> Result<BindingK
                         format: texture_format(*format)?,
                         write_only: !access.contains(naga::StorageAccess::LOAD),
                     },
-                    naga::ImageClass::External => return Err("external textures are not supported".into()),
+                    naga::ImageClass::External => {
+                        return Err("external textures are not supported".into())
+                    }
                 }
             }
             other => return Err(format!("unsupported handle type {other:?}")),
@@ -115,7 +145,11 @@ fn texture_format(f: naga::StorageFormat) -> Result<wgpu::TextureFormat, String>
         S::R32Float => T::R32Float,
         S::R32Uint => T::R32Uint,
         S::Rg32Float => T::Rg32Float,
-        other => return Err(format!("storage format {other:?} is not supported by voltex")),
+        other => {
+            return Err(format!(
+                "storage format {other:?} is not supported by voltex"
+            ))
+        }
     })
 }
 
@@ -128,7 +162,9 @@ pub fn layout_entry(b: &Binding) -> wgpu::BindGroupLayoutEntry {
             min_binding_size: None,
         },
         BindingKind::Storage { read_only } => wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Storage { read_only: *read_only },
+            ty: wgpu::BufferBindingType::Storage {
+                read_only: *read_only,
+            },
             has_dynamic_offset: false,
             min_binding_size: None,
         },
@@ -141,7 +177,11 @@ pub fn layout_entry(b: &Binding) -> wgpu::BindGroupLayoutEntry {
             view_dimension: *dim,
             multisampled: false,
         },
-        BindingKind::StorageTexture { dim, format, write_only } => wgpu::BindingType::StorageTexture {
+        BindingKind::StorageTexture {
+            dim,
+            format,
+            write_only,
+        } => wgpu::BindingType::StorageTexture {
             access: if *write_only {
                 wgpu::StorageTextureAccess::WriteOnly
             } else {
@@ -152,7 +192,12 @@ pub fn layout_entry(b: &Binding) -> wgpu::BindGroupLayoutEntry {
         },
         BindingKind::Sampler => wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
     };
-    wgpu::BindGroupLayoutEntry { binding: b.binding, visibility: b.visibility, ty, count: None }
+    wgpu::BindGroupLayoutEntry {
+        binding: b.binding,
+        visibility: b.visibility,
+        ty,
+        count: None,
+    }
 }
 
 /// Names of the `override` constants a module declares, with whether each has a default.
@@ -167,5 +212,10 @@ pub fn overrides(kernel: &Kernel) -> Vec<(String, bool)> {
 
 /// Workgroup size of a compute entry point.
 pub fn workgroup_size(kernel: &Kernel, entry_point: &str) -> Option<[u32; 3]> {
-    kernel.module.entry_points.iter().find(|e| e.name == entry_point).map(|e| e.workgroup_size)
+    kernel
+        .module
+        .entry_points
+        .iter()
+        .find(|e| e.name == entry_point)
+        .map(|e| e.workgroup_size)
 }

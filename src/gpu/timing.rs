@@ -16,7 +16,12 @@ impl Timer {
     pub fn new(ctx: &GpuContext, passes: u32) -> Self {
         let capacity = passes.max(1) * 2;
         if !ctx.has_timestamps() {
-            return Self { set: None, resolve: None, labels: Vec::new(), capacity };
+            return Self {
+                set: None,
+                resolve: None,
+                labels: Vec::new(),
+                capacity,
+            };
         }
         let set = ctx.device.create_query_set(&wgpu::QuerySetDescriptor {
             label: Some("pass timestamps"),
@@ -29,7 +34,12 @@ impl Timer {
             usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
             mapped_at_creation: false,
         });
-        Self { set: Some(set), resolve: Some(resolve), labels: Vec::new(), capacity }
+        Self {
+            set: Some(set),
+            resolve: Some(resolve),
+            labels: Vec::new(),
+            capacity,
+        }
     }
 
     pub fn reset(&mut self) {
@@ -48,19 +58,21 @@ impl Timer {
     }
 
     pub fn compute(&mut self, label: &str) -> Option<wgpu::ComputePassTimestampWrites<'_>> {
-        self.next(label).map(|(query_set, i)| wgpu::ComputePassTimestampWrites {
-            query_set,
-            beginning_of_pass_write_index: Some(i),
-            end_of_pass_write_index: Some(i + 1),
-        })
+        self.next(label)
+            .map(|(query_set, i)| wgpu::ComputePassTimestampWrites {
+                query_set,
+                beginning_of_pass_write_index: Some(i),
+                end_of_pass_write_index: Some(i + 1),
+            })
     }
 
     pub fn render(&mut self, label: &str) -> Option<wgpu::RenderPassTimestampWrites<'_>> {
-        self.next(label).map(|(query_set, i)| wgpu::RenderPassTimestampWrites {
-            query_set,
-            beginning_of_pass_write_index: Some(i),
-            end_of_pass_write_index: Some(i + 1),
-        })
+        self.next(label)
+            .map(|(query_set, i)| wgpu::RenderPassTimestampWrites {
+                query_set,
+                beginning_of_pass_write_index: Some(i),
+                end_of_pass_write_index: Some(i + 1),
+            })
     }
 
     pub fn resolve(&self, encoder: &mut wgpu::CommandEncoder) {
@@ -73,18 +85,25 @@ impl Timer {
 
     /// Per-pass durations in milliseconds, in submission order (after the frame was submitted).
     pub fn read(&self, ctx: &GpuContext) -> Result<Vec<(String, f64)>> {
-        let Some(buf) = &self.resolve else { return Ok(Vec::new()) };
+        let Some(buf) = &self.resolve else {
+            return Ok(Vec::new());
+        };
         if self.labels.is_empty() {
             return Ok(Vec::new());
         }
         let bytes = ctx.read_buffer(buf, 0, self.labels.len() as u64 * 16)?;
-        let ticks: &[u64] = bytemuck::cast_slice(&bytes);
+        let ticks: Vec<u64> = bytemuck::pod_collect_to_vec(&bytes);
         let period = ctx.queue.get_timestamp_period() as f64;
         Ok(self
             .labels
             .iter()
             .enumerate()
-            .map(|(i, l)| (l.clone(), ticks[2 * i + 1].saturating_sub(ticks[2 * i]) as f64 * period * 1e-6))
+            .map(|(i, l)| {
+                (
+                    l.clone(),
+                    ticks[2 * i + 1].saturating_sub(ticks[2 * i]) as f64 * period * 1e-6,
+                )
+            })
             .collect())
     }
 }

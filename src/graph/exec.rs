@@ -58,14 +58,22 @@ impl Executor {
         }
         let mut textures = HashMap::new();
         for (name, decl) in &plan.textures {
-            let ResourceDecl::Texture { format, size: tsize, clear } = decl;
+            let ResourceDecl::Texture {
+                format,
+                size: tsize,
+                clear,
+            } = decl;
             let (w, h) = match tsize {
                 TextureSize::Output => size,
                 TextureSize::Fixed(w, h) => (*w, *h),
             };
             let texture = ctx.device.create_texture(&wgpu::TextureDescriptor {
                 label: Some(name),
-                size: wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
+                size: wgpu::Extent3d {
+                    width: w,
+                    height: h,
+                    depth_or_array_layers: 1,
+                },
                 mip_level_count: 1,
                 sample_count: 1,
                 dimension: wgpu::TextureDimension::D2,
@@ -76,7 +84,14 @@ impl Executor {
                 view_formats: &[],
             });
             let view = texture.create_view(&Default::default());
-            textures.insert(name.clone(), Texture { texture, view, clear: *clear });
+            textures.insert(
+                name.clone(),
+                Texture {
+                    texture,
+                    view,
+                    clear: *clear,
+                },
+            );
         }
         let mut modules = HashMap::new();
         let mut layouts = Vec::new();
@@ -84,16 +99,23 @@ impl Executor {
             let name = p.decl.shader().to_string();
             if !modules.contains_key(&name) {
                 let module = ctx.scoped(&format!("shader {name}"), || {
-                    ctx.device.create_shader_module(wgpu::ShaderModuleDescriptor {
-                        label: Some(&name),
-                        source: wgpu::ShaderSource::Naga(Cow::Owned(p.kernel.module.clone())),
-                    })
+                    ctx.device
+                        .create_shader_module(wgpu::ShaderModuleDescriptor {
+                            label: Some(&name),
+                            source: wgpu::ShaderSource::Naga(Cow::Owned(p.kernel.module.clone())),
+                        })
                 })?;
                 modules.insert(name, module);
             }
             layouts.push(pass_layout(ctx, p));
         }
-        Ok(Self { graph, textures, modules, layouts, pipelines: HashMap::new() })
+        Ok(Self {
+            graph,
+            textures,
+            modules,
+            layouts,
+            pipelines: HashMap::new(),
+        })
     }
 
     pub fn texture(&self, name: &str) -> Option<&wgpu::Texture> {
@@ -101,7 +123,13 @@ impl Executor {
     }
 
     /// Creates every pipeline the frame will use now, so that errors come before any work.
-    pub fn prepare(&mut self, ctx: &GpuContext, plan: &Plan, frame: &Inputs, objects: &[Inputs]) -> Result<()> {
+    pub fn prepare(
+        &mut self,
+        ctx: &GpuContext,
+        plan: &Plan,
+        frame: &Inputs,
+        objects: &[Inputs],
+    ) -> Result<()> {
         for i in 0..plan.passes.len() {
             for inst in instance_inputs(&plan.passes[i], frame, objects) {
                 self.pipeline(ctx, plan, i, frame, inst)?;
@@ -110,18 +138,32 @@ impl Executor {
         Ok(())
     }
 
-    fn pipeline(&mut self, ctx: &GpuContext, plan: &Plan, index: usize, frame: &Inputs, inst: &Inputs) -> Result<()> {
+    fn pipeline(
+        &mut self,
+        ctx: &GpuContext,
+        plan: &Plan,
+        index: usize,
+        frame: &Inputs,
+        inst: &Inputs,
+    ) -> Result<()> {
         let pass = &plan.passes[index];
         let mut constants: Vec<(&str, f64)> = Vec::new();
         for (name, has_default) in reflect::overrides(&pass.kernel) {
-            let value = inst.constants.iter().chain(frame.constants.iter()).find(|(n, _)| *n == name);
+            let value = inst
+                .constants
+                .iter()
+                .chain(frame.constants.iter())
+                .find(|(n, _)| *n == name);
             match value {
                 Some((n, v)) => constants.push((n.as_str(), *v)),
                 None if has_default => {}
                 None => {
                     return Err(self.graph.error_at(
                         pass.decl.name(),
-                        format!("{}: override `{name}` has no default and no value from the scene", pass.decl.shader()),
+                        format!(
+                            "{}: override `{name}` has no default and no value from the scene",
+                            pass.decl.shader()
+                        ),
                     ))
                 }
             }
@@ -132,20 +174,31 @@ impl Executor {
         }
         let module = &self.modules[pass.decl.shader()];
         let layout = &self.layouts[index].1;
-        let options = wgpu::PipelineCompilationOptions { constants: &constants, zero_initialize_workgroup_memory: true };
+        let options = wgpu::PipelineCompilationOptions {
+            constants: &constants,
+            zero_initialize_workgroup_memory: true,
+        };
         let label = format!("{} ({})", pass.decl.name(), pass.decl.shader());
         let pipeline = match &pass.decl {
             PassDecl::Compute { entry, .. } => ctx.scoped(&label, || {
-                Pipeline::Compute(ctx.device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                    label: Some(&label),
-                    layout: Some(layout),
-                    module,
-                    entry_point: Some(entry),
-                    compilation_options: options.clone(),
-                    cache: None,
-                }))
+                Pipeline::Compute(ctx.device.create_compute_pipeline(
+                    &wgpu::ComputePipelineDescriptor {
+                        label: Some(&label),
+                        layout: Some(layout),
+                        module,
+                        entry_point: Some(entry),
+                        compilation_options: options.clone(),
+                        cache: None,
+                    },
+                ))
             })?,
-            PassDecl::Raster { vertex, fragment, targets, depth, .. } => {
+            PassDecl::Raster {
+                vertex,
+                fragment,
+                targets,
+                depth,
+                ..
+            } => {
                 let color: Vec<Option<wgpu::ColorTargetState>> = targets
                     .iter()
                     .map(|t| {
@@ -153,7 +206,9 @@ impl Executor {
                             format: self.textures[&t.resource].texture.format(),
                             blend: match t.blend {
                                 Blend::Replace => None,
-                                Blend::PremultipliedOver => Some(wgpu::BlendState::PREMULTIPLIED_ALPHA_BLENDING),
+                                Blend::PremultipliedOver => {
+                                    Some(wgpu::BlendState::PREMULTIPLIED_ALPHA_BLENDING)
+                                }
                             },
                             write_mask: wgpu::ColorWrites::ALL,
                         })
@@ -167,27 +222,29 @@ impl Executor {
                     bias: Default::default(),
                 });
                 ctx.scoped(&label, || {
-                    Pipeline::Render(ctx.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                        label: Some(&label),
-                        layout: Some(layout),
-                        vertex: wgpu::VertexState {
-                            module,
-                            entry_point: Some(vertex),
-                            compilation_options: options.clone(),
-                            buffers: &[],
+                    Pipeline::Render(ctx.device.create_render_pipeline(
+                        &wgpu::RenderPipelineDescriptor {
+                            label: Some(&label),
+                            layout: Some(layout),
+                            vertex: wgpu::VertexState {
+                                module,
+                                entry_point: Some(vertex),
+                                compilation_options: options.clone(),
+                                buffers: &[],
+                            },
+                            primitive: wgpu::PrimitiveState::default(),
+                            depth_stencil,
+                            multisample: Default::default(),
+                            fragment: Some(wgpu::FragmentState {
+                                module,
+                                entry_point: Some(fragment),
+                                compilation_options: options.clone(),
+                                targets: &color,
+                            }),
+                            multiview_mask: None,
+                            cache: None,
                         },
-                        primitive: wgpu::PrimitiveState::default(),
-                        depth_stencil,
-                        multisample: Default::default(),
-                        fragment: Some(wgpu::FragmentState {
-                            module,
-                            entry_point: Some(fragment),
-                            compilation_options: options.clone(),
-                            targets: &color,
-                        }),
-                        multiview_mask: None,
-                        cache: None,
-                    }))
+                    ))
                 })?
             }
         };
@@ -196,12 +253,32 @@ impl Executor {
     }
 
     /// Records and submits one frame.
-    pub fn run(&mut self, ctx: &GpuContext, plan: &Plan, frame: &Inputs, objects: &[Inputs], timer: &mut Timer) -> Result<()> {
+    pub fn run(
+        &mut self,
+        ctx: &GpuContext,
+        plan: &Plan,
+        frame: &Inputs,
+        objects: &[Inputs],
+        timer: &mut Timer,
+    ) -> Result<()> {
         self.prepare(ctx, plan, frame, objects)?;
-        let mut encoder = ctx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
+        let mut encoder = ctx
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("frame"),
+            });
         let mut written: Vec<String> = Vec::new();
         for index in 0..plan.passes.len() {
-            self.record(ctx, plan, index, frame, objects, &mut encoder, timer, &mut written)?;
+            self.record(
+                ctx,
+                plan,
+                index,
+                frame,
+                objects,
+                &mut encoder,
+                timer,
+                &mut written,
+            )?;
         }
         timer.resolve(&mut encoder);
         let commands = ctx.scoped("recording the frame", || encoder.finish())?;
@@ -223,23 +300,36 @@ impl Executor {
     ) -> Result<()> {
         let pass = &plan.passes[index];
         let instances = instance_inputs(pass, frame, objects);
-        let groups: Vec<Vec<wgpu::BindGroup>> =
-            instances.iter().map(|inst| self.bind_groups(ctx, pass, index, frame, inst)).collect::<Result<_>>()?;
+        let groups: Vec<Vec<wgpu::BindGroup>> = instances
+            .iter()
+            .map(|inst| self.bind_groups(ctx, pass, index, frame, inst))
+            .collect::<Result<_>>()?;
         let pipeline_of = |inst: &Inputs| -> &Pipeline {
             let kernel = &pass.kernel;
             let constants: Vec<(&str, f64)> = reflect::overrides(kernel)
                 .into_iter()
                 .filter_map(|(name, _)| {
-                    inst.constants.iter().chain(frame.constants.iter()).find(|(n, _)| *n == name).map(|(n, v)| (n.as_str(), *v))
+                    inst.constants
+                        .iter()
+                        .chain(frame.constants.iter())
+                        .find(|(n, _)| *n == name)
+                        .map(|(n, v)| (n.as_str(), *v))
                 })
                 .collect();
             &self.pipelines[&(index, format!("{constants:?}"))]
         };
         match &pass.decl {
-            PassDecl::Compute { name, entry, clear, dispatch, .. } => {
+            PassDecl::Compute {
+                name,
+                entry,
+                clear,
+                dispatch,
+                ..
+            } => {
                 for inst in &instances {
                     for b in clear {
-                        let buf = resolve_buffer(inst, frame, b).ok_or_else(|| plan::unknown_resource(&self.graph, name, b))?;
+                        let buf = resolve_buffer(inst, frame, b)
+                            .ok_or_else(|| plan::unknown_resource(&self.graph, name, b))?;
                         encoder.clear_buffer(buf, 0, None);
                     }
                 }
@@ -249,7 +339,9 @@ impl Executor {
                     timestamp_writes: timer.compute(name),
                 });
                 for (inst, bgs) in instances.iter().zip(&groups) {
-                    let Pipeline::Compute(p) = pipeline_of(inst) else { unreachable!("compute pass") };
+                    let Pipeline::Compute(p) = pipeline_of(inst) else {
+                        unreachable!("compute pass")
+                    };
                     let (counts, per_group) = match dispatch {
                         Dispatch::Threads(x, y, z) => ([x, y, z], false),
                         Dispatch::Groups(x, y, z) => ([x, y, z], true),
@@ -257,7 +349,11 @@ impl Executor {
                     let mut g = [0u32; 3];
                     for axis in 0..3 {
                         let n = count(counts[axis], inst, frame);
-                        g[axis] = if per_group { n } else { n.div_ceil(wg[axis].max(1)) };
+                        g[axis] = if per_group {
+                            n
+                        } else {
+                            n.div_ceil(wg[axis].max(1))
+                        };
                         if g[axis] > ctx.limits.max_compute_workgroups_per_dimension {
                             return Err(Error::Gpu(format!(
                                 "pass {name}: {} workgroups on axis {axis} exceed the adapter's limit of {}",
@@ -275,7 +371,13 @@ impl Executor {
                     cpass.dispatch_workgroups(g[0], g[1], g[2]);
                 }
             }
-            PassDecl::Raster { name, targets, depth, draw, .. } => {
+            PassDecl::Raster {
+                name,
+                targets,
+                depth,
+                draw,
+                ..
+            } => {
                 let load = |res: &str, written: &mut Vec<String>| {
                     let first = !written.iter().any(|w| w == res);
                     if first {
@@ -288,12 +390,14 @@ impl Executor {
                     .map(|t| {
                         let (first, clear) = load(&t.resource, written);
                         let load = match (first, clear) {
-                            (true, Some(Clear::Color(r, g, b, a))) => wgpu::LoadOp::Clear(wgpu::Color {
-                                r: r as f64,
-                                g: g as f64,
-                                b: b as f64,
-                                a: a as f64,
-                            }),
+                            (true, Some(Clear::Color(r, g, b, a))) => {
+                                wgpu::LoadOp::Clear(wgpu::Color {
+                                    r: r as f64,
+                                    g: g as f64,
+                                    b: b as f64,
+                                    a: a as f64,
+                                })
+                            }
                             (true, _) => wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
                             _ => wgpu::LoadOp::Load,
                         };
@@ -301,7 +405,10 @@ impl Executor {
                             view: &self.textures[&t.resource].view,
                             depth_slice: None,
                             resolve_target: None,
-                            ops: wgpu::Operations { load, store: wgpu::StoreOp::Store },
+                            ops: wgpu::Operations {
+                                load,
+                                store: wgpu::StoreOp::Store,
+                            },
                         })
                     })
                     .collect();
@@ -314,7 +421,10 @@ impl Executor {
                     };
                     wgpu::RenderPassDepthStencilAttachment {
                         view: &self.textures[&d.resource].view,
-                        depth_ops: Some(wgpu::Operations { load, store: wgpu::StoreOp::Store }),
+                        depth_ops: Some(wgpu::Operations {
+                            load,
+                            store: wgpu::StoreOp::Store,
+                        }),
                         stencil_ops: None,
                     }
                 });
@@ -327,7 +437,9 @@ impl Executor {
                     multiview_mask: None,
                 });
                 for (inst, bgs) in instances.iter().zip(&groups) {
-                    let Pipeline::Render(p) = pipeline_of(inst) else { unreachable!("raster pass") };
+                    let Pipeline::Render(p) = pipeline_of(inst) else {
+                        unreachable!("raster pass")
+                    };
                     rpass.set_pipeline(p);
                     for (i, bg) in bgs.iter().enumerate() {
                         rpass.set_bind_group(i as u32, bg, &[]);
@@ -375,36 +487,63 @@ impl Executor {
                         .or_else(|| frame.samplers.get(&b.name))
                         .map(wgpu::BindingResource::Sampler),
                 };
-                let resource = resource.ok_or_else(|| plan::unknown_resource(&self.graph, pass.decl.name(), &b.name))?;
-                entries.push(wgpu::BindGroupEntry { binding: b.binding, resource });
+                let resource = resource.ok_or_else(|| {
+                    plan::unknown_resource(&self.graph, pass.decl.name(), &b.name)
+                })?;
+                entries.push(wgpu::BindGroupEntry {
+                    binding: b.binding,
+                    resource,
+                });
             }
             let label = format!("{} group {group}", pass.decl.name());
             out.push(ctx.scoped(&label, || {
-                ctx.device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some(&label), layout: bgl, entries: &entries })
+                ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some(&label),
+                    layout: bgl,
+                    entries: &entries,
+                })
             })?);
         }
         Ok(out)
     }
 }
 
-fn pass_layout(ctx: &GpuContext, pass: &PlannedPass) -> (Vec<wgpu::BindGroupLayout>, wgpu::PipelineLayout) {
+fn pass_layout(
+    ctx: &GpuContext,
+    pass: &PlannedPass,
+) -> (Vec<wgpu::BindGroupLayout>, wgpu::PipelineLayout) {
     let groups = pass.bindings.iter().map(|b| b.group + 1).max().unwrap_or(0);
     let bgls: Vec<wgpu::BindGroupLayout> = (0..groups)
         .map(|g| {
-            let entries: Vec<_> = pass.bindings.iter().filter(|b| b.group == g).map(reflect::layout_entry).collect();
-            ctx.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: None, entries: &entries })
+            let entries: Vec<_> = pass
+                .bindings
+                .iter()
+                .filter(|b| b.group == g)
+                .map(reflect::layout_entry)
+                .collect();
+            ctx.device
+                .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                    label: None,
+                    entries: &entries,
+                })
         })
         .collect();
     let refs: Vec<Option<&wgpu::BindGroupLayout>> = bgls.iter().map(Some).collect();
-    let layout = ctx.device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-        label: Some(pass.decl.name()),
-        bind_group_layouts: &refs,
-        immediate_size: 0,
-    });
+    let layout = ctx
+        .device
+        .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some(pass.decl.name()),
+            bind_group_layouts: &refs,
+            immediate_size: 0,
+        });
     (bgls, layout)
 }
 
-fn instance_inputs<'a>(pass: &PlannedPass, frame: &'a Inputs, objects: &'a [Inputs]) -> Vec<&'a Inputs> {
+fn instance_inputs<'a>(
+    pass: &PlannedPass,
+    frame: &'a Inputs,
+    objects: &'a [Inputs],
+) -> Vec<&'a Inputs> {
     match &pass.instances {
         None => vec![frame],
         Some(ids) => ids.iter().map(|&i| &objects[i]).collect(),
@@ -418,18 +557,29 @@ fn resolve_buffer<'a>(inst: &'a Inputs, frame: &'a Inputs, name: &str) -> Option
 fn count(name: &str, inst: &Inputs, frame: &Inputs) -> u32 {
     name.parse()
         .ok()
-        .or_else(|| inst.counts.get(name).or_else(|| frame.counts.get(name)).copied())
+        .or_else(|| {
+            inst.counts
+                .get(name)
+                .or_else(|| frame.counts.get(name))
+                .copied()
+        })
         .unwrap_or(0)
 }
 
 fn check_counts(graph: &Graph, pass: &PlannedPass) -> Result<()> {
     match &pass.decl {
-        PassDecl::Compute { dispatch: Dispatch::Threads(x, y, z) | Dispatch::Groups(x, y, z), .. } => {
+        PassDecl::Compute {
+            dispatch: Dispatch::Threads(x, y, z) | Dispatch::Groups(x, y, z),
+            ..
+        } => {
             for c in [x, y, z] {
                 plan::check_count(graph, c, COUNTS)?;
             }
         }
-        PassDecl::Raster { draw: Draw::Vertices(n), .. } => plan::check_count(graph, n, COUNTS)?,
+        PassDecl::Raster {
+            draw: Draw::Vertices(n),
+            ..
+        } => plan::check_count(graph, n, COUNTS)?,
         PassDecl::Raster { .. } => {}
     }
     Ok(())

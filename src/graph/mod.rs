@@ -148,7 +148,9 @@ impl PassDecl {
     pub fn entry_points(&self) -> Vec<&str> {
         match self {
             PassDecl::Compute { entry, .. } => vec![entry],
-            PassDecl::Raster { vertex, fragment, .. } => vec![vertex, fragment],
+            PassDecl::Raster {
+                vertex, fragment, ..
+            } => vec![vertex, fragment],
         }
     }
 }
@@ -225,7 +227,8 @@ pub struct Graph {
 
 impl Graph {
     pub fn load(path: &Path) -> Result<Self> {
-        let source = std::fs::read_to_string(path).map_err(|e| Error::file(path, format!("cannot read graph: {e}")))?;
+        let source = std::fs::read_to_string(path)
+            .map_err(|e| Error::file(path, format!("cannot read graph: {e}")))?;
         Self::parse(path, source)
     }
 
@@ -234,7 +237,11 @@ impl Graph {
             .with_default_extension(ron::extensions::Extensions::IMPLICIT_SOME)
             .from_str(&source)
             .map_err(|e| ron_error(path, &e))?;
-        let graph = Self { path: path.to_path_buf(), source, file };
+        let graph = Self {
+            path: path.to_path_buf(),
+            source,
+            file,
+        };
         graph.check_names()?;
         Ok(graph)
     }
@@ -250,27 +257,42 @@ impl Graph {
         let mut seen = Vec::new();
         for p in &f.passes {
             if seen.contains(&p.name()) {
-                return Err(self.error_at(p.name(), format!("pass `{}` is declared twice", p.name())));
+                return Err(
+                    self.error_at(p.name(), format!("pass `{}` is declared twice", p.name()))
+                );
             }
             seen.push(p.name());
             if let Instances::Objects(filter) = p.instances() {
                 if !plan::OBJECT_FILTERS.contains(&filter.as_str()) {
                     return Err(self.error_at(
                         filter,
-                        format!("unknown object filter `{filter}`; expected one of {:?}", plan::OBJECT_FILTERS),
+                        format!(
+                            "unknown object filter `{filter}`; expected one of {:?}",
+                            plan::OBJECT_FILTERS
+                        ),
                     ));
                 }
             }
             if let PassDecl::Raster { targets, depth, .. } = p {
-                for t in targets.iter().map(|t| &t.resource).chain(depth.iter().map(|d| &d.resource)) {
+                for t in targets
+                    .iter()
+                    .map(|t| &t.resource)
+                    .chain(depth.iter().map(|d| &d.resource))
+                {
                     if !f.resources.contains_key(t) {
-                        return Err(self.error_at(t, format!("render target `{t}` is not a texture declared in `resources`")));
+                        return Err(self.error_at(
+                            t,
+                            format!("render target `{t}` is not a texture declared in `resources`"),
+                        ));
                     }
                 }
             }
         }
         if f.outputs.is_empty() {
-            return Err(Error::at(FileLoc::new(&self.path, 1, 1), "expected at least one name in `outputs`"));
+            return Err(Error::at(
+                FileLoc::new(&self.path, 1, 1),
+                "expected at least one name in `outputs`",
+            ));
         }
         Ok(())
     }

@@ -49,8 +49,9 @@ pub fn plan(graph: &Graph, wgsl_root: &Path, objects: &[ObjectInfo]) -> Result<P
         let instances = match decl.instances() {
             Instances::Frame => None,
             Instances::Objects(filter) => {
-                let mut ids: Vec<usize> =
-                    (0..objects.len()).filter(|&i| objects[i].filters.contains(&filter.as_str())).collect();
+                let mut ids: Vec<usize> = (0..objects.len())
+                    .filter(|&i| objects[i].filters.contains(&filter.as_str()))
+                    .collect();
                 if ids.is_empty() {
                     pruned.push(format!("pass {}: no object matches {filter}", decl.name()));
                     continue;
@@ -65,7 +66,11 @@ pub fn plan(graph: &Graph, wgsl_root: &Path, objects: &[ObjectInfo]) -> Result<P
                 if !wgsl_root.join(decl.shader()).is_file() {
                     return Err(graph.error_at(
                         decl.shader(),
-                        format!("shader `{}` not found in {}", decl.shader(), wgsl_root.display()),
+                        format!(
+                            "shader `{}` not found in {}",
+                            decl.shader(),
+                            wgsl_root.display()
+                        ),
                     ));
                 }
                 let k = Arc::new(shader::load(wgsl_root, decl.shader())?);
@@ -76,12 +81,22 @@ pub fn plan(graph: &Graph, wgsl_root: &Path, objects: &[ObjectInfo]) -> Result<P
         let bindings = reflect::bindings(&kernel, &decl.entry_points())
             .map_err(|e| graph.error_at(decl.name(), format!("pass `{}`: {e}", decl.name())))?;
         let (reads, writes) = accesses(decl, &bindings);
-        candidates.push(PlannedPass { decl: decl.clone(), kernel, bindings, reads, writes, instances });
+        candidates.push(PlannedPass {
+            decl: decl.clone(),
+            kernel,
+            bindings,
+            reads,
+            writes,
+            instances,
+        });
     }
     let ordered = order(graph, candidates)?;
     let mut passes = live(&graph.file.outputs, ordered, &mut pruned);
     passes.shrink_to_fit();
-    let used: BTreeSet<&String> = passes.iter().flat_map(|p| p.reads.iter().chain(p.writes.iter())).collect();
+    let used: BTreeSet<&String> = passes
+        .iter()
+        .flat_map(|p| p.reads.iter().chain(p.writes.iter()))
+        .collect();
     let mut textures = BTreeMap::new();
     for (name, decl) in &graph.file.resources {
         if used.contains(name) {
@@ -90,7 +105,11 @@ pub fn plan(graph: &Graph, wgsl_root: &Path, objects: &[ObjectInfo]) -> Result<P
             pruned.push(format!("resource {name}: no kept pass uses it"));
         }
     }
-    Ok(Plan { passes, textures, pruned })
+    Ok(Plan {
+        passes,
+        textures,
+        pruned,
+    })
 }
 
 /// Resources a pass reads and writes: from reflection, render targets, indirect arguments and clears.
@@ -101,13 +120,24 @@ fn accesses(decl: &PassDecl, bindings: &[Binding]) -> (BTreeSet<String>, BTreeSe
         if b.kind.writes() {
             writes.insert(b.name.clone());
         }
-        if !matches!(b.kind, reflect::BindingKind::StorageTexture { write_only: true, .. }) {
+        if !matches!(
+            b.kind,
+            reflect::BindingKind::StorageTexture {
+                write_only: true,
+                ..
+            }
+        ) {
             reads.insert(b.name.clone());
         }
     }
     match decl {
         PassDecl::Compute { clear, .. } => writes.extend(clear.iter().cloned()),
-        PassDecl::Raster { targets, depth, draw, .. } => {
+        PassDecl::Raster {
+            targets,
+            depth,
+            draw,
+            ..
+        } => {
             for t in targets {
                 writes.insert(t.resource.clone());
                 if t.blend != crate::graph::Blend::Replace {
@@ -138,9 +168,15 @@ fn order(graph: &Graph, passes: Vec<PlannedPass>) -> Result<Vec<PlannedPass>> {
             if i == j {
                 continue;
             }
-            let writes_together = i < j && passes[i].writes.iter().any(|r| passes[j].writes.contains(r));
-            let reads_result =
-                passes[i].writes.iter().any(|r| passes[j].reads.contains(r) && !passes[j].writes.contains(r));
+            let writes_together = i < j
+                && passes[i]
+                    .writes
+                    .iter()
+                    .any(|r| passes[j].writes.contains(r));
+            let reads_result = passes[i]
+                .writes
+                .iter()
+                .any(|r| passes[j].reads.contains(r) && !passes[j].writes.contains(r));
             if writes_together || reads_result {
                 deps[j].insert(i);
             }
@@ -156,7 +192,10 @@ fn order(graph: &Graph, passes: Vec<PlannedPass>) -> Result<Vec<PlannedPass>> {
                 order.push(j);
             }
             None => {
-                let stuck: Vec<&str> = (0..n).filter(|&j| !done[j]).map(|j| passes[j].decl.name()).collect();
+                let stuck: Vec<&str> = (0..n)
+                    .filter(|&j| !done[j])
+                    .map(|j| passes[j].decl.name())
+                    .collect();
                 return Err(graph.error_at(
                     stuck[0],
                     format!("passes {stuck:?} depend on each other through their reads and writes"),
@@ -165,11 +204,18 @@ fn order(graph: &Graph, passes: Vec<PlannedPass>) -> Result<Vec<PlannedPass>> {
         }
     }
     let mut slots: Vec<Option<PlannedPass>> = passes.into_iter().map(Some).collect();
-    Ok(order.into_iter().map(|j| slots[j].take().unwrap()).collect())
+    Ok(order
+        .into_iter()
+        .map(|j| slots[j].take().unwrap())
+        .collect())
 }
 
 /// Keeps the passes that contribute to an output, walking back from the outputs.
-fn live(outputs: &[String], passes: Vec<PlannedPass>, pruned: &mut Vec<String>) -> Vec<PlannedPass> {
+fn live(
+    outputs: &[String],
+    passes: Vec<PlannedPass>,
+    pruned: &mut Vec<String>,
+) -> Vec<PlannedPass> {
     let mut needed: BTreeSet<String> = outputs.iter().cloned().collect();
     let mut keep = vec![false; passes.len()];
     for (i, p) in passes.iter().enumerate().rev() {
@@ -183,7 +229,10 @@ fn live(outputs: &[String], passes: Vec<PlannedPass>, pruned: &mut Vec<String>) 
         .zip(keep)
         .filter_map(|(p, k)| {
             if !k {
-                pruned.push(format!("pass {}: nothing it writes reaches an output", p.decl.name()));
+                pruned.push(format!(
+                    "pass {}: nothing it writes reaches an output",
+                    p.decl.name()
+                ));
             }
             k.then_some(p)
         })
@@ -202,7 +251,10 @@ pub fn check_count(graph: &Graph, count: &str, known: &[&str]) -> Result<()> {
     if count.parse::<u32>().is_ok() || known.contains(&count) {
         return Ok(());
     }
-    Err(graph.error_at(count, format!("unknown count `{count}`; expected a number or one of {known:?}")))
+    Err(graph.error_at(
+        count,
+        format!("unknown count `{count}`; expected a number or one of {known:?}"),
+    ))
 }
 
 pub fn unknown_resource(graph: &Graph, pass: &str, name: &str) -> Error {

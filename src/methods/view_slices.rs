@@ -27,7 +27,11 @@ pub fn sweep(shell: &Shell, forward: [f32; 3], planes: u32, near: f64) -> SliceP
 /// crosses, times 9 (a pentagon is 3 triangles). Allocating this, not planes x prisms x 9, keeps
 /// memory proportional to what is drawn.
 pub fn vertex_capacity(shell: &Shell, params: &SliceParams) -> u64 {
-    let n = [params.plane_normal[0] as f64, params.plane_normal[1] as f64, params.plane_normal[2] as f64];
+    let n = [
+        params.plane_normal[0] as f64,
+        params.plane_normal[1] as f64,
+        params.plane_normal[2] as f64,
+    ];
     let spacing = params.spacing as f64;
     let first = params.first_plane as f64;
     let mut total = 0u64;
@@ -80,21 +84,50 @@ pub fn add_inputs(
         ctx.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some(label),
             size: size.max(16),
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC | extra,
+            usage: wgpu::BufferUsages::STORAGE
+                | wgpu::BufferUsages::COPY_DST
+                | wgpu::BufferUsages::COPY_SRC
+                | extra,
             mapped_at_creation: false,
         })
     };
     let b = &mut inputs.buffers;
-    b.insert("slice_params".into(), uniform(ctx, "slice_params", bytemuck::bytes_of(params)));
-    b.insert("shell_vertices".into(), storage(ctx, "shell_vertices", bytemuck::cast_slice(&shell.vertices)));
-    b.insert("prisms".into(), storage(ctx, "prisms", bytemuck::cast_slice(&shell.prisms)));
-    b.insert("plane_cursors".into(), buffer("plane_cursors", params.plane_count as u64 * 4, wgpu::BufferUsages::empty()));
-    b.insert("draw_args".into(), buffer("draw_args", 16, wgpu::BufferUsages::INDIRECT));
+    b.insert(
+        "slice_params".into(),
+        uniform(ctx, "slice_params", bytemuck::bytes_of(params)),
+    );
+    b.insert(
+        "shell_vertices".into(),
+        storage(ctx, "shell_vertices", bytemuck::cast_slice(&shell.vertices)),
+    );
+    b.insert(
+        "prisms".into(),
+        storage(ctx, "prisms", bytemuck::cast_slice(&shell.prisms)),
+    );
+    b.insert(
+        "plane_cursors".into(),
+        buffer(
+            "plane_cursors",
+            params.plane_count as u64 * 4,
+            wgpu::BufferUsages::empty(),
+        ),
+    );
+    b.insert(
+        "draw_args".into(),
+        buffer("draw_args", 16, wgpu::BufferUsages::INDIRECT),
+    );
     let bytes = capacity * std::mem::size_of::<SliceVertex>() as u64;
-    b.insert("slice_vertices".into(), buffer("slice_vertices", bytes, wgpu::BufferUsages::empty()));
-    inputs.counts.insert("prisms".into(), shell.prisms.len() as u32);
+    b.insert(
+        "slice_vertices".into(),
+        buffer("slice_vertices", bytes, wgpu::BufferUsages::empty()),
+    );
+    inputs
+        .counts
+        .insert("prisms".into(), shell.prisms.len() as u32);
     inputs.counts.insert("planes".into(), params.plane_count);
-    inputs.constants.push(("trivial_reject".into(), trivial_reject as u32 as f64));
+    inputs
+        .constants
+        .push(("trivial_reject".into(), trivial_reject as u32 as f64));
 }
 
 /// Reads back the triangle-list vertices of each plane after a frame (tests, debugging): after
@@ -105,15 +138,19 @@ pub fn read_back(
     plane_count: u32,
 ) -> Result<Vec<Vec<SliceVertex>>> {
     let args = ctx.read_buffer(&inputs.buffers["draw_args"], 0, 16)?;
-    let drawn = bytemuck::cast_slice::<u8, u32>(&args)[0] as usize;
+    let drawn = bytemuck::pod_read_unaligned::<u32>(&args[..4]) as usize;
     let ends = ctx.read_buffer(&inputs.buffers["plane_cursors"], 0, plane_count as u64 * 4)?;
-    let ends: &[u32] = bytemuck::cast_slice(&ends);
-    let bytes = if drawn > 0 { ctx.read_buffer(&inputs.buffers["slice_vertices"], 0, drawn as u64 * 32)? } else { Vec::new() };
-    let all: &[SliceVertex] = bytemuck::cast_slice(&bytes);
+    let ends: Vec<u32> = bytemuck::pod_collect_to_vec(&ends);
+    let bytes = if drawn > 0 {
+        ctx.read_buffer(&inputs.buffers["slice_vertices"], 0, drawn as u64 * 32)?
+    } else {
+        Vec::new()
+    };
+    let all: Vec<SliceVertex> = bytemuck::pod_collect_to_vec(&bytes);
     let mut start = 0usize;
     Ok(ends
-        .iter()
-        .map(|&end| {
+        .into_iter()
+        .map(|end| {
             let end = (end as usize).min(all.len());
             let plane = all[start.min(end)..end].to_vec();
             start = end;
