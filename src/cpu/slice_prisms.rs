@@ -19,7 +19,8 @@ pub enum EdgeClass {
     Below,
 }
 
-/// One slice polygon: up to five vertices in order around the prism.
+/// One slice polygon: up to five vertices in order around the prism, in the sense of its base
+/// triangle; `position.w` holds the prism index as f32 bits.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Polygon {
     pub vertices: [SliceVertex; 5],

@@ -19,7 +19,7 @@ struct PrismCorners {
     sphere: vec4<f32>,
 }
 
-// Up to five vertices in order around the prism (sides visited 0-1, 1-2, 2-0).
+// Up to five vertices in order around the prism, in the sense of its base triangle 0-1-2.
 struct SlicePolygon {
     count: u32,
     pos: array<vec3<f32>, 5>,
