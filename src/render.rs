@@ -68,10 +68,18 @@ pub fn wgsl_root() -> PathBuf {
 
 impl Blueprint {
     pub fn new(scene: &Scene, opts: &RenderOptions) -> Result<Self> {
+        Self::with_objects(scene, scene.objects()?, opts)
+    }
+
+    /// Like [`Blueprint::new`] with the scene's objects given (tests alter their surfaces).
+    pub fn with_objects(
+        scene: &Scene,
+        objects: Vec<SceneObject>,
+        opts: &RenderOptions,
+    ) -> Result<Self> {
         let size = opts
             .size
             .unwrap_or((scene.output.width, scene.output.height));
-        let objects = scene.objects()?;
         let cam = &scene.camera;
         let eye = cam.eye;
         let forward = (cam.target - cam.eye).normalize_or_zero();

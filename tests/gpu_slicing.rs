@@ -303,3 +303,65 @@ fn slices_are_ordered_back_to_front_and_lie_on_their_planes() {
     }
     assert!(nonempty > 20, "{nonempty} planes hit the shell");
 }
+
+/// Polygon edges of one plane as (a, b) bit patterns, from the fan triangles of each prism.
+fn polygon_edges(plane: &[SliceVertex]) -> Vec<([u32; 3], [u32; 3], u32, f32, f32)> {
+    let key = |v: &SliceVertex| [v.position[0].to_bits(), v.position[1].to_bits(), v.position[2].to_bits()];
+    let mut out = Vec::new();
+    for (prism, verts) in by_prism(plane) {
+        // Fan (0, i, i+1): the polygon is v0, then the second vertex of each triangle, then the last.
+        let mut poly: Vec<SliceVertex> = vec![verts[0]];
+        for tri in verts.chunks(3) {
+            poly.push(tri[1]);
+        }
+        poly.push(verts[verts.len() - 1]);
+        for i in 0..poly.len() {
+            let (a, b) = (&poly[i], &poly[(i + 1) % poly.len()]);
+            out.push((key(a), key(b), prism, a.uvw[2], b.uvw[2]));
+        }
+    }
+    out
+}
+
+/// On a closed shell, every polygon edge crossing a lateral face is shared, bit for bit, by the
+/// neighbouring prism's polygon (no crack, no overlap); the others lie on the top or bottom face.
+#[test]
+fn closed_shells_have_watertight_slices() {
+    for surface in ["Sphere(radius: 1.0, segments: (12, 6))", "Torus(major: 1.0, minor: 0.4, segments: (16, 8), distortion: 0.15, seed: 2)"] {
+        let src = format!(
+            r#"Scene(output: (width: 64, height: 64), camera: (eye: (0.4, -3.0, 1.7), target: (0.0, 0.0, 0.0)),
+            texels: {{ "fog": (resolution: (4, 4, 4), source: Constant(color: (1.0, 1.0, 1.0))) }},
+            nodes: [(name: "shell", surface: {surface}, height: (length: 0.2), texel: "fog", method: ViewSlices(planes: 64))])"#
+        );
+        let scene = voltex::scene::parse(&src, std::path::Path::new("closed.ron")).unwrap();
+        let objects = scene.objects().unwrap();
+        let eye = scene.camera.eye;
+        let forward = (scene.camera.target - eye).normalize();
+        let shell = Shell::new(&objects[0].surface, eye);
+        let params = view_slices::sweep(&shell, [forward.x as f32, forward.y as f32, forward.z as f32], 64, 0.0);
+        let gpu = gpu_slices(&shell, &params, true);
+        let (mut shared, mut caps) = (0, 0);
+        for (k, plane) in gpu.iter().enumerate() {
+            let edges = polygon_edges(plane);
+            for (i, (a, b, prism, wa, wb)) in edges.iter().enumerate() {
+                if a == b {
+                    continue;
+                }
+                let twins: Vec<u32> = edges
+                    .iter()
+                    .enumerate()
+                    .filter(|(j, e)| *j != i && ((e.0 == *b && e.1 == *a) || (e.0 == *a && e.1 == *b)))
+                    .map(|(_, e)| e)
+                    .map(|e| e.2)
+                    .collect();
+                let on_cap = |w: f32| w.abs() < 1e-5 || (w - 1.0).abs() < 1e-5;
+                match twins.as_slice() {
+                    [other] if *other != *prism => shared += 1,
+                    [] if on_cap(*wa) && on_cap(*wb) && (wa - wb).abs() < 1e-5 => caps += 1,
+                    _ => panic!("{surface}: plane {k} prism {prism}: edge shared by {twins:?} (w {wa}, {wb})"),
+                }
+            }
+        }
+        assert!(shared > 500 && caps > 100, "{surface}: {shared} shared edges, {caps} cap edges");
+    }
+}

@@ -6,8 +6,9 @@ use std::sync::{Arc, Mutex};
 use crate::error::{Error, Result};
 
 /// Features voltex uses when the adapter has them (none is required).
-pub const OPTIONAL_FEATURES: wgpu::Features =
-    wgpu::Features::TIMESTAMP_QUERY.union(wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS);
+pub const OPTIONAL_FEATURES: wgpu::Features = wgpu::Features::TIMESTAMP_QUERY
+    .union(wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS)
+    .union(wgpu::Features::FLOAT32_BLENDABLE);
 
 pub struct GpuContext {
     pub device: wgpu::Device,
@@ -85,7 +86,7 @@ impl GpuContext {
     }
 
     pub fn has_timestamps(&self) -> bool {
-        self.features.contains(OPTIONAL_FEATURES)
+        self.features.contains(wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS)
     }
 
     /// Fails with the first wgpu error raised outside an error scope since the last call.
@@ -162,6 +163,7 @@ impl GpuContext {
                 "TIMESTAMP_QUERY_INSIDE_ENCODERS",
                 wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS,
             ),
+            ("FLOAT32_BLENDABLE (f32 accumulation)", wgpu::Features::FLOAT32_BLENDABLE),
         ] {
             s += &format!(
                 "  {:<34} {}\n",

@@ -11,9 +11,12 @@ pub enum BindingKind {
     Storage {
         read_only: bool,
     },
+    /// `filtered`: sampled through a sampler somewhere in the module (else only loaded, which
+    /// also accepts unfilterable formats such as Rgba32Float).
     Texture {
         dim: wgpu::TextureViewDimension,
         depth: bool,
+        filtered: bool,
     },
     StorageTexture {
         dim: wgpu::TextureViewDimension,
@@ -45,6 +48,7 @@ pub struct Binding {
 /// Bindings used by the given entry points, merged across stages, sorted by (group, binding).
 pub fn bindings(kernel: &Kernel, entry_points: &[&str]) -> Result<Vec<Binding>> {
     let module = &kernel.module;
+    let sampled = sampled_globals(module);
     let mut out: Vec<Binding> = Vec::new();
     for ep_name in entry_points {
         let (index, ep) = module
@@ -74,7 +78,7 @@ pub fn bindings(kernel: &Kernel, entry_points: &[&str]) -> Result<Vec<Binding>> 
                 b.visibility |= stage;
                 continue;
             }
-            let kind = kind_of(module, var)
+            let kind = kind_of(module, var, sampled.contains(&handle))
                 .map_err(|m| Error::Invalid(format!("{}: `{name}`: {m}", kernel.name)))?;
             out.push(Binding {
                 name,
@@ -89,7 +93,23 @@ pub fn bindings(kernel: &Kernel, entry_points: &[&str]) -> Result<Vec<Binding>> 
     Ok(out)
 }
 
-fn kind_of(module: &naga::Module, var: &naga::GlobalVariable) -> Result<BindingKind, String> {
+/// Globals used as the image of a sampling expression.
+fn sampled_globals(module: &naga::Module) -> Vec<naga::Handle<naga::GlobalVariable>> {
+    let functions = module.functions.iter().map(|(_, f)| f).chain(module.entry_points.iter().map(|e| &e.function));
+    let mut out = Vec::new();
+    for f in functions {
+        for (_, e) in f.expressions.iter() {
+            if let naga::Expression::ImageSample { image, .. } = e {
+                if let naga::Expression::GlobalVariable(g) = f.expressions[*image] {
+                    out.push(g);
+                }
+            }
+        }
+    }
+    out
+}
+
+fn kind_of(module: &naga::Module, var: &naga::GlobalVariable, filtered: bool) -> Result<BindingKind, String> {
     Ok(match var.space {
         naga::AddressSpace::Uniform => BindingKind::Uniform,
         naga::AddressSpace::Storage { access } => BindingKind::Storage {
@@ -104,8 +124,8 @@ fn kind_of(module: &naga::Module, var: &naga::GlobalVariable) -> Result<BindingK
             } => {
                 let dim = view_dim(*dim, *arrayed);
                 match class {
-                    naga::ImageClass::Sampled { .. } => BindingKind::Texture { dim, depth: false },
-                    naga::ImageClass::Depth { .. } => BindingKind::Texture { dim, depth: true },
+                    naga::ImageClass::Sampled { .. } => BindingKind::Texture { dim, depth: false, filtered },
+                    naga::ImageClass::Depth { .. } => BindingKind::Texture { dim, depth: true, filtered },
                     naga::ImageClass::Storage { format, access } => BindingKind::StorageTexture {
                         dim,
                         format: texture_format(*format)?,
@@ -168,11 +188,11 @@ pub fn layout_entry(b: &Binding) -> wgpu::BindGroupLayoutEntry {
             has_dynamic_offset: false,
             min_binding_size: None,
         },
-        BindingKind::Texture { dim, depth } => wgpu::BindingType::Texture {
+        BindingKind::Texture { dim, depth, filtered } => wgpu::BindingType::Texture {
             sample_type: if *depth {
                 wgpu::TextureSampleType::Depth
             } else {
-                wgpu::TextureSampleType::Float { filterable: true }
+                wgpu::TextureSampleType::Float { filterable: *filtered }
             },
             view_dimension: *dim,
             multisampled: false,

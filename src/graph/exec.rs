@@ -56,6 +56,17 @@ impl Executor {
         for p in &plan.passes {
             check_counts(&graph, p)?;
         }
+        let blended: Vec<&str> = plan
+            .passes
+            .iter()
+            .filter_map(|p| match &p.decl {
+                PassDecl::Raster { targets, .. } => Some(targets),
+                _ => None,
+            })
+            .flatten()
+            .filter(|t| t.blend != Blend::Replace)
+            .map(|t| t.resource.as_str())
+            .collect();
         let mut textures = HashMap::new();
         for (name, decl) in &plan.textures {
             let ResourceDecl::Texture {
@@ -77,7 +88,7 @@ impl Executor {
                 mip_level_count: 1,
                 sample_count: 1,
                 dimension: wgpu::TextureDimension::D2,
-                format: format.wgpu(),
+                format: texture_format(ctx, &graph, name, format.wgpu(), &blended),
                 usage: wgpu::TextureUsages::RENDER_ATTACHMENT
                     | wgpu::TextureUsages::TEXTURE_BINDING
                     | wgpu::TextureUsages::COPY_SRC,
@@ -506,6 +517,28 @@ impl Executor {
         }
         Ok(out)
     }
+}
+
+/// The format of a graph texture: as declared, except that a blended Rgba32Float target falls
+/// back to Rgba16Float (with a warning) on adapters without FLOAT32_BLENDABLE.
+fn texture_format(
+    ctx: &GpuContext,
+    graph: &Graph,
+    name: &str,
+    format: wgpu::TextureFormat,
+    blended: &[&str],
+) -> wgpu::TextureFormat {
+    if format == wgpu::TextureFormat::Rgba32Float
+        && blended.contains(&name)
+        && !ctx.features.contains(wgpu::Features::FLOAT32_BLENDABLE)
+    {
+        eprintln!(
+            "warning: {}: `{name}` blends in Rgba16Float: the adapter lacks FLOAT32_BLENDABLE",
+            graph.path.display()
+        );
+        return wgpu::TextureFormat::Rgba16Float;
+    }
+    format
 }
 
 fn pass_layout(

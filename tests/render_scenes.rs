@@ -1,0 +1,141 @@
+//! Rendering on software Vulkan: a golden image per example scene, the analytic flat shell (a
+//! constant volume over a plane must equal the box it encloses), brightness that does not depend
+//! on the plane count, and no seams along prism edges.
+
+mod common;
+
+use std::path::Path;
+use std::sync::{Mutex, OnceLock};
+
+use common::golden::{check_golden, Threshold};
+use glam::DVec3;
+use voltex::gpu::GpuContext;
+use voltex::io::Image;
+use voltex::render::{Blueprint, RenderOptions, Renderer};
+use voltex::scene::{self, Scene};
+
+/// One device for the whole test binary; renders are serialised (two cores, one lavapipe).
+fn ctx() -> &'static Mutex<GpuContext> {
+    static CTX: OnceLock<Mutex<GpuContext>> = OnceLock::new();
+    CTX.get_or_init(|| Mutex::new(GpuContext::new().expect("a GPU adapter (software Vulkan: mesa-vulkan-drivers)")))
+}
+
+fn render_blueprint(bp: Blueprint) -> Image {
+    let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
+    let mut r = Renderer::new(&ctx, bp).unwrap();
+    let frame = r.render(&ctx).unwrap();
+    assert_eq!(voltex::metrics::count_nonfinite(&frame.image), 0, "no NaN or infinity in any pixel");
+    frame.image
+}
+
+fn render(scene: &Scene, opts: RenderOptions) -> Image {
+    render_blueprint(Blueprint::new(scene, &opts).unwrap())
+}
+
+fn example(name: &str) -> Scene {
+    scene::load(&voltex::project_root().join("scenes/view_slices").join(name)).unwrap()
+}
+
+const TEST_SIZE: Option<(u32, u32)> = Some((128, 128));
+
+#[test]
+fn golden_torus_egg() {
+    let img = render(&example("torus_egg.ron"), RenderOptions { size: TEST_SIZE, ..Default::default() });
+    check_golden("view_slices_torus_egg", &img, Threshold::Flip(0.01));
+}
+
+#[test]
+fn golden_terrain() {
+    let img = render(&example("terrain.ron"), RenderOptions { size: TEST_SIZE, ..Default::default() });
+    check_golden("view_slices_terrain", &img, Threshold::Flip(0.01));
+}
+
+#[test]
+fn golden_sphere_balls() {
+    let img = render(&example("sphere_balls.ron"), RenderOptions { size: TEST_SIZE, ..Default::default() });
+    check_golden("view_slices_sphere_balls", &img, Threshold::Flip(0.01));
+}
+
+#[test]
+fn golden_flat_box() {
+    let img = render(&example("flat_box.ron"), RenderOptions { size: TEST_SIZE, ..Default::default() });
+    check_golden("view_slices_flat_box", &img, Threshold::Flip(0.01));
+}
+
+/// A constant volume (colour c, opacity a per length L) on a flat 2x2 plane with equal height
+/// vectors of length `h`, seen from straight above.
+fn slab_scene(cells: u32, planes: u32, eye: (f64, f64, f64)) -> Scene {
+    let src = format!(
+        r#"#![enable(implicit_some)]
+Scene(
+    output: (width: 128, height: 128),
+    camera: (eye: ({}, {}, {}), target: (0.0, 0.0, 0.25), up: (0.0, 1.0, 0.0), fov_y: 40.0),
+    background: (0.1, 0.2, 0.3),
+    ambient: 1.0,
+    texels: {{ "fog": (resolution: (8, 8, 8), opacity_length: 0.4, source: Constant(color: (0.8, 0.6, 0.4), opacity: 0.6)) }},
+    nodes: [(
+        name: "slab",
+        surface: Plane(size: (2.0, 2.0), cells: ({cells}, {cells})),
+        height: (length: 0.5),
+        texel: "fog",
+        method: ViewSlices(planes: {planes}),
+    )],
+)"#,
+        eye.0, eye.1, eye.2
+    );
+    scene::parse(&src, Path::new("slab.ron")).unwrap()
+}
+
+/// Pixel (x, y) centre's unit ray direction for a camera looking straight down -z with +y up.
+fn ray(x: u32, y: u32, size: u32, fov_y_deg: f64) -> DVec3 {
+    let t = (fov_y_deg.to_radians() * 0.5).tan();
+    let u = ((x as f64 + 0.5) / size as f64 * 2.0 - 1.0) * t;
+    let v = (1.0 - (y as f64 + 0.5) / size as f64 * 2.0) * t;
+    DVec3::new(u, v, -1.0).normalize()
+}
+
+#[test]
+fn flat_shell_equals_the_box_it_encloses() {
+    let img = render(&slab_scene(4, 64, (0.0, 0.0, 3.0)), RenderOptions::default());
+    // The volume is stored as rgba8: compare with the quantised opacity and premultiplied colour
+    // (values chosen away from rounding ties).
+    let a = (0.6f64 * 255.0).round() / 255.0;
+    let colour = [0.8, 0.6, 0.4].map(|c: f64| (c * 0.6 * 255.0).round() / 255.0 / a);
+    let background = [0.1, 0.2, 0.3];
+    let mut checked = 0;
+    let mut worst: f64 = 0.0;
+    for y in 0..128 {
+        for x in 0..128 {
+            let d = ray(x, y, 128, 40.0);
+            // Where the ray crosses the top (z = 0.5) and bottom (z = 0) planes of the slab.
+            let top = DVec3::new(0.0, 0.0, 3.0) + d * (2.5 / -d.z);
+            let bottom = DVec3::new(0.0, 0.0, 3.0) + d * (3.0 / -d.z);
+            if [top, bottom].iter().any(|p| p.x.abs() > 0.95 || p.y.abs() > 0.95) {
+                continue; // enters or leaves through a side: not the analytic case
+            }
+            let path = 0.5 / -d.z;
+            let transmittance = (1.0 - a).powf(path / 0.4);
+            let p = img.get(x, y);
+            for c in 0..3 {
+                let expected = colour[c] * (1.0 - transmittance) + background[c] * transmittance;
+                let err = (p[c] as f64 - expected).abs() / expected;
+                worst = worst.max(err);
+            }
+            checked += 1;
+        }
+    }
+    assert!(checked > 4000, "{checked} pixels checked");
+    assert!(worst < 0.01, "worst relative error {worst} against the analytic slab");
+}
+
+fn mean(img: &Image) -> f64 {
+    img.pixels.iter().map(|p| (p[0] + p[1] + p[2]) as f64).sum::<f64>() / img.pixels.len() as f64
+}
+
+#[test]
+fn plane_count_changes_error_not_brightness() {
+    let eye = (0.4, -1.8, 2.4);
+    let coarse = mean(&render(&slab_scene(4, 24, eye), RenderOptions::default()));
+    let fine = mean(&render(&slab_scene(4, 192, eye), RenderOptions::default()));
+    assert!((coarse - fine).abs() / fine < 0.01, "mean brightness {coarse} with 24 planes, {fine} with 192");
+}
