@@ -54,7 +54,7 @@ impl Executor {
             )));
         }
         for p in &plan.passes {
-            check_counts(&graph, p)?;
+            check_counts(&graph, &p.decl)?;
         }
         let blended: Vec<&str> = plan
             .passes
@@ -599,8 +599,10 @@ fn count(name: &str, inst: &Inputs, frame: &Inputs) -> u32 {
         .unwrap_or(0)
 }
 
-fn check_counts(graph: &Graph, pass: &PlannedPass) -> Result<()> {
-    match &pass.decl {
+/// Checks the dispatch and draw counts of a pass against [`COUNTS`] (called by the planner, so
+/// `voltex plan` reports them without a GPU).
+pub fn check_counts(graph: &Graph, decl: &PassDecl) -> Result<()> {
+    match decl {
         PassDecl::Compute {
             dispatch: Dispatch::Threads(x, y, z) | Dispatch::Groups(x, y, z),
             ..

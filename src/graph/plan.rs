@@ -46,6 +46,7 @@ pub fn plan(graph: &Graph, wgsl_root: &Path, objects: &[ObjectInfo]) -> Result<P
     let mut candidates = Vec::new();
     let mut pruned = Vec::new();
     for decl in &graph.file.passes {
+        super::exec::check_counts(graph, decl)?;
         let instances = match decl.instances() {
             Instances::Frame => None,
             Instances::Objects(filter) => {
@@ -159,25 +160,32 @@ fn accesses(decl: &PassDecl, bindings: &[Binding]) -> (BTreeSet<String>, BTreeSe
 }
 
 /// Orders passes so that every reader of a resource runs after its writers; writers of the same
-/// resource keep their declaration order (blending passes). Ties keep declaration order.
+/// resource keep their declaration order (blending passes) unless reads and writes already order
+/// them the other way. Ties keep declaration order.
 fn order(graph: &Graph, passes: Vec<PlannedPass>) -> Result<Vec<PlannedPass>> {
     let n = passes.len();
     let mut deps: Vec<BTreeSet<usize>> = vec![BTreeSet::new(); n];
     for j in 0..n {
         for i in 0..n {
-            if i == j {
-                continue;
-            }
-            let writes_together = i < j
+            let reads_result = i != j
                 && passes[i]
                     .writes
                     .iter()
-                    .any(|r| passes[j].writes.contains(r));
-            let reads_result = passes[i]
+                    .any(|r| passes[j].reads.contains(r) && !passes[j].writes.contains(r));
+            if reads_result {
+                deps[j].insert(i);
+            }
+        }
+    }
+    // Declaration order among writers of a resource is a preference: an edge that would close a
+    // cycle (e.g. a blending pass declared before the pass whose depth it reads) is left out.
+    for j in 0..n {
+        for i in 0..j {
+            let writes_together = passes[i]
                 .writes
                 .iter()
-                .any(|r| passes[j].reads.contains(r) && !passes[j].writes.contains(r));
-            if writes_together || reads_result {
+                .any(|r| passes[j].writes.contains(r));
+            if writes_together && !reaches(&deps, i, j) {
                 deps[j].insert(i);
             }
         }
@@ -192,8 +200,9 @@ fn order(graph: &Graph, passes: Vec<PlannedPass>) -> Result<Vec<PlannedPass>> {
                 order.push(j);
             }
             None => {
+                // Name only the passes on a cycle, not those merely waiting for one.
                 let stuck: Vec<&str> = (0..n)
-                    .filter(|&j| !done[j])
+                    .filter(|&j| !done[j] && deps[j].iter().any(|&i| reaches(&deps, i, j)))
                     .map(|j| passes[j].decl.name())
                     .collect();
                 return Err(graph.error_at(
@@ -208,6 +217,21 @@ fn order(graph: &Graph, passes: Vec<PlannedPass>) -> Result<Vec<PlannedPass>> {
         .into_iter()
         .map(|j| slots[j].take().unwrap())
         .collect())
+}
+
+/// Whether pass `to` depends, directly or not, on pass `from` (`to` == `from` counts).
+fn reaches(deps: &[BTreeSet<usize>], to: usize, from: usize) -> bool {
+    let mut seen = vec![false; deps.len()];
+    let mut stack = vec![to];
+    while let Some(k) = stack.pop() {
+        if k == from {
+            return true;
+        }
+        if !std::mem::replace(&mut seen[k], true) {
+            stack.extend(deps[k].iter().copied());
+        }
+    }
+    false
 }
 
 /// Keeps the passes that contribute to an output, walking back from the outputs.

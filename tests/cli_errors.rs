@@ -1,0 +1,629 @@
+//! Bad input through the real `voltex` binary: every error names the file (and `line:col` where
+//! there is one), exits with status 1 (no panic, no signal) and leaves no output or temporary
+//! file behind. Plus the success case and `voltex plan`.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+const BIN: &str = env!("CARGO_BIN_EXE_voltex");
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn flat_box() -> String {
+    std::fs::read_to_string(root().join("scenes/view_slices/flat_box.ron")).unwrap()
+}
+
+/// A fresh folder with an empty `out/` inside.
+fn temp_dir(test: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("voltex-cli-{}-{test}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(d.join("out")).unwrap();
+    d
+}
+
+/// Runs `voltex ARGS` with `VOLTEX_ROOT` (this checkout unless given: the shared target folder may
+/// hold a binary built elsewhere, and the compiled-in root would then be another checkout).
+fn voltex(args: &[&str], voltex_root: Option<&Path>) -> Output {
+    let mut cmd = Command::new(BIN);
+    cmd.args(args)
+        .env("VOLTEX_ROOT", voltex_root.unwrap_or(&root()));
+    if std::env::var_os("XDG_RUNTIME_DIR").is_none() {
+        cmd.env("XDG_RUNTIME_DIR", std::env::temp_dir());
+    }
+    cmd.output().unwrap()
+}
+
+/// `voltex render SCENE -o DIR/out/out.exr --size 64x64 EXTRA...`.
+fn render(dir: &Path, scene: &Path, extra: &[&str], voltex_root: Option<&Path>) -> Output {
+    let out = dir.join("out/out.exr");
+    let mut args = vec![
+        "render",
+        scene.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--size",
+        "64x64",
+    ];
+    args.extend_from_slice(extra);
+    voltex(&args, voltex_root)
+}
+
+/// 1-based `line:col` of the first occurrence of `needle` in `text`.
+fn line_col(text: &str, needle: &str) -> String {
+    let at = text
+        .find(needle)
+        .unwrap_or_else(|| panic!("{needle:?} not in the text"));
+    let before = &text[..at];
+    let line = before.matches('\n').count() + 1;
+    let col = at - before.rfind('\n').map(|i| i + 1).unwrap_or(0) + 1;
+    format!("{line}:{col}")
+}
+
+fn stderr(out: &Output) -> String {
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+fn entries(dir: &Path) -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    v.sort();
+    v
+}
+
+/// Exit status 1, no panic, stderr contains every string of `words`, and `dir/out` is empty.
+#[track_caller]
+fn assert_fails(out: &Output, dir: &Path, words: &[&str]) {
+    let err = stderr(out);
+    assert_eq!(
+        out.status.code(),
+        Some(1),
+        "expected exit status 1; stderr:\n{err}"
+    );
+    assert!(!err.contains("panicked"), "panic:\n{err}");
+    assert!(err.starts_with("error: "), "stderr:\n{err}");
+    for w in words {
+        assert!(err.contains(w), "expected {w:?} in stderr:\n{err}");
+    }
+    let left = entries(&dir.join("out"));
+    assert!(left.is_empty(), "files left in the output folder: {left:?}");
+}
+
+/// Writes `text` as `dir/scene.ron`, renders it and expects an error at `scene.ron:LOC`
+/// (`LOC` = the position of `at` in `text`, or any `line:col` when `at` is empty).
+#[track_caller]
+fn assert_scene_error(test: &str, text: &str, at: &str, words: &[&str]) {
+    let dir = temp_dir(test);
+    let scene = dir.join("scene.ron");
+    std::fs::write(&scene, text).unwrap();
+    let out = render(&dir, &scene, &[], None);
+    let prefix = format!("error: {}:", scene.display());
+    let mut all = vec![prefix.as_str()];
+    let loc;
+    if !at.is_empty() {
+        loc = format!("{}:{}: ", scene.display(), line_col(text, at));
+        all.push(&loc);
+    } else {
+        let err = stderr(&out);
+        let rest = err.strip_prefix(&prefix).unwrap_or_else(|| panic!("{err}"));
+        let pos: Vec<&str> = rest.splitn(3, ':').collect();
+        assert!(
+            pos.len() == 3 && pos[0].parse::<u32>().is_ok() && pos[1].parse::<u32>().is_ok(),
+            "expected line:col after the path: {err}"
+        );
+    }
+    all.extend_from_slice(words);
+    assert_fails(&out, &dir, &all);
+}
+
+fn replaced(text: &str, from: &str, to: &str) -> String {
+    assert!(text.contains(from), "{from:?} not in the scene");
+    text.replacen(from, to, 1)
+}
+
+// ---- scene errors ----
+
+#[test]
+fn truncated_ron() {
+    let text = flat_box();
+    let cut = &text[..text.find("nodes:").unwrap() + 12];
+    assert_scene_error("truncated", cut, "", &[]);
+}
+
+#[test]
+fn malformed_ron() {
+    let text = replaced(&flat_box(), "fov_y: 40.0)", "fov_y: 40.0");
+    assert_scene_error("malformed", &text, "", &[]);
+}
+
+#[test]
+fn unknown_field() {
+    let text = replaced(&flat_box(), "ambient: 1.0,", "ambient: 1.0, glow: 2.0,");
+    assert_scene_error("field", &text, "glow", &["glow", "camera", "nodes"]);
+}
+
+#[test]
+fn unknown_method_variant() {
+    let text = replaced(&flat_box(), "ViewSlices(planes", "RayMarch(planes");
+    assert_scene_error("method", &text, "RayMarch", &["RayMarch", "ViewSlices"]);
+}
+
+#[test]
+fn nan() {
+    let text = replaced(&flat_box(), "ambient: 1.0", "ambient: NaN");
+    assert_scene_error("nan", &text, "NaN", &["NaN"]);
+    let text = replaced(&flat_box(), "fov_y: 40.0", "fov_y: inf");
+    assert_scene_error("inf", &text, "inf", &[]);
+}
+
+#[test]
+fn plane_counts_out_of_range() {
+    let text = replaced(&flat_box(), "planes: 256", "planes: 0");
+    assert_scene_error("planes0", &text, "0, lighting", &["plane count"]);
+    let text = replaced(&flat_box(), "planes: 256", "planes: 100000");
+    assert_scene_error("planes_big", &text, "100000", &["plane count", "100000"]);
+}
+
+#[test]
+fn output_size_out_of_range() {
+    let text = replaced(&flat_box(), "width: 128", "width: 100000");
+    let dir = temp_dir("width");
+    let scene = dir.join("scene.ron");
+    std::fs::write(&scene, &text).unwrap();
+    // No --size: the scene's size counts.
+    let out = voltex(
+        &[
+            "render",
+            scene.to_str().unwrap(),
+            "-o",
+            dir.join("out/out.exr").to_str().unwrap(),
+        ],
+        None,
+    );
+    let loc = format!("{}:{}: ", scene.display(), line_col(&text, "100000"));
+    assert_fails(&out, &dir, &[&loc, "100000"]);
+}
+
+#[test]
+fn texel_resolution_too_large() {
+    let text = replaced(
+        &flat_box(),
+        "resolution: (8, 8, 8)",
+        "resolution: (8, 2048, 8)",
+    );
+    assert_scene_error("resolution", &text, "2048", &["2048"]);
+}
+
+#[test]
+fn unknown_texel() {
+    let text = replaced(&flat_box(), "texel: \"fog\"", "texel: \"smoke\"");
+    assert_scene_error("texel", &text, "\"smoke\"", &["smoke", "fog"]);
+}
+
+#[test]
+fn missing_obj_file() {
+    let text = replaced(
+        &flat_box(),
+        "Plane(size: (2.0, 2.0), cells: (4, 4))",
+        "Obj(path: \"missing.obj\")",
+    );
+    assert_scene_error("obj_missing", &text, "\"missing.obj\"", &["missing.obj"]);
+}
+
+#[test]
+fn obj_face_index_out_of_range() {
+    let dir = temp_dir("obj_face");
+    let obj = dir.join("tri.obj");
+    std::fs::write(&obj, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 7\n").unwrap();
+    let text = replaced(
+        &flat_box(),
+        "Plane(size: (2.0, 2.0), cells: (4, 4))",
+        "Obj(path: \"tri.obj\")",
+    );
+    let scene = dir.join("scene.ron");
+    std::fs::write(&scene, text).unwrap();
+    let out = render(&dir, &scene, &[], None);
+    let loc = format!("error: {}:5:7: ", obj.display());
+    assert_fails(&out, &dir, &[&loc, "7"]);
+}
+
+#[test]
+fn degenerate_obj_is_an_error_or_a_warning() {
+    // All three corners on a line: no area, no normal.
+    let dir = temp_dir("obj_degenerate");
+    std::fs::write(dir.join("line.obj"), "v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n").unwrap();
+    let text = replaced(
+        &flat_box(),
+        "Plane(size: (2.0, 2.0), cells: (4, 4))",
+        "Obj(path: \"line.obj\")",
+    );
+    let scene = dir.join("scene.ron");
+    std::fs::write(&scene, text).unwrap();
+    let out = render(&dir, &scene, &[], None);
+    let err = stderr(&out);
+    assert!(!err.contains("panicked"), "{err}");
+    // Today: warnings naming the degenerate triangles, and an empty image.
+    if out.status.code() == Some(0) {
+        assert!(
+            err.contains("warning:") && err.contains("degenerate"),
+            "{err}"
+        );
+    } else {
+        assert_fails(&out, &dir, &["line.obj"]);
+    }
+}
+
+#[test]
+fn missing_scene_file() {
+    let dir = temp_dir("no_scene");
+    let scene = dir.join("nope.ron");
+    let out = render(&dir, &scene, &[], None);
+    assert_fails(&out, &dir, &[&format!("error: {}", scene.display())]);
+}
+
+// ---- command-line errors ----
+
+#[test]
+fn missing_output_folder() {
+    let dir = temp_dir("no_out_dir");
+    let scene = root().join("scenes/view_slices/flat_box.ron");
+    let out = voltex(
+        &[
+            "render",
+            scene.to_str().unwrap(),
+            "-o",
+            "/nonexistent/dir/x.exr",
+            "--size",
+            "64x64",
+        ],
+        None,
+    );
+    assert_fails(&out, &dir, &["/nonexistent/dir", "does not exist"]);
+    assert!(!Path::new("/nonexistent/dir").exists());
+}
+
+#[test]
+fn output_folder_is_a_file() {
+    let dir = temp_dir("out_is_file");
+    let file = dir.join("plain");
+    std::fs::write(&file, "x").unwrap();
+    let scene = root().join("scenes/view_slices/flat_box.ron");
+    let target = file.join("x.exr");
+    let out = voltex(
+        &[
+            "render",
+            scene.to_str().unwrap(),
+            "-o",
+            target.to_str().unwrap(),
+        ],
+        None,
+    );
+    assert_fails(&out, &dir, &[file.to_str().unwrap()]);
+    assert_eq!(std::fs::read_to_string(&file).unwrap(), "x");
+}
+
+#[test]
+fn bad_size_and_planes_options() {
+    let dir = temp_dir("options");
+    let scene = root().join("scenes/view_slices/flat_box.ron");
+    for size in ["0x5", "5x0", "100000x64", "64", "axb"] {
+        let out = voltex(
+            &[
+                "render",
+                scene.to_str().unwrap(),
+                "-o",
+                dir.join("out/out.exr").to_str().unwrap(),
+                "--size",
+                size,
+            ],
+            None,
+        );
+        // Command-line syntax errors are clap's usage errors: status 2.
+        let err = stderr(&out);
+        assert_eq!(out.status.code(), Some(2), "--size {size}: {err}");
+        assert!(err.contains("--size"), "{err}");
+        assert!(!err.contains("panicked"), "{err}");
+        assert!(entries(&dir.join("out")).is_empty());
+    }
+    for planes in ["0", "100000"] {
+        let out = render(&dir, &scene, &["--planes", planes], None);
+        assert_fails(&out, &dir, &["--planes", planes]);
+    }
+}
+
+#[test]
+fn slice_buffer_beyond_the_storage_binding_limit() {
+    // terrain with 16384 planes needs ~1.2 GiB of slice vertices; most adapters bind at most
+    // 128 MiB or 2 GiB. Only checked where the limit is below that.
+    let info = voltex(&["info"], None);
+    if info.status.code() != Some(0) {
+        eprintln!("skipped: no GPU adapter");
+        return;
+    }
+    let text = String::from_utf8_lossy(&info.stdout).into_owned();
+    let limit: u64 = text
+        .lines()
+        .find(|l| {
+            l.trim_start()
+                .starts_with("max_storage_buffer_binding_size")
+        })
+        .and_then(|l| l.split_whitespace().last())
+        .and_then(|v| v.parse().ok())
+        .expect("voltex info prints max_storage_buffer_binding_size");
+    if limit > 1_100 << 20 {
+        eprintln!("skipped: binding limit {limit} is large enough");
+        return;
+    }
+    let dir = temp_dir("binding_limit");
+    let scene = root().join("scenes/view_slices/terrain.ron");
+    let out = render(&dir, &scene, &["--planes", "16384"], None);
+    assert_fails(&out, &dir, &["ground", "planes", "limit"]);
+}
+
+// ---- custom graphs and WGSL (VOLTEX_ROOT) ----
+
+fn copy_dir(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).unwrap();
+    for e in std::fs::read_dir(from).unwrap() {
+        let e = e.unwrap();
+        let target = to.join(e.file_name());
+        if e.file_type().unwrap().is_dir() {
+            copy_dir(&e.path(), &target);
+        } else {
+            std::fs::copy(e.path(), target).unwrap();
+        }
+    }
+}
+
+/// `dir/root` with copies of `wgsl/` and `graphs/`, to be passed as `VOLTEX_ROOT`.
+fn project_copy(dir: &Path) -> PathBuf {
+    let r = dir.join("root");
+    copy_dir(&root().join("wgsl"), &r.join("wgsl"));
+    copy_dir(&root().join("graphs"), &r.join("graphs"));
+    r
+}
+
+#[test]
+fn wgsl_parse_error_names_the_wgsl_file() {
+    let dir = temp_dir("wgsl_parse");
+    let r = project_copy(&dir);
+    let path = r.join("wgsl/composite.wgsl");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let broken = replaced(&text, "let c = textureLoad", "let c = = textureLoad");
+    std::fs::write(&path, &broken).unwrap();
+    let loc = line_col(&broken, "= textureLoad");
+    let scene = root().join("scenes/view_slices/flat_box.ron");
+    let out = render(&dir, &scene, &[], Some(&r));
+    assert_fails(
+        &out,
+        &dir,
+        &[&format!("error: {}:{loc}: ", path.display()), "WGSL"],
+    );
+    // `plan` compiles the kernels too and reports the same error.
+    let out = voltex(&["plan", scene.to_str().unwrap()], Some(&r));
+    assert_fails(&out, &dir, &[&format!("{}:{loc}: ", path.display())]);
+}
+
+#[test]
+fn wgsl_error_in_an_included_file_names_that_file() {
+    let dir = temp_dir("wgsl_include");
+    let r = project_copy(&dir);
+    let path = r.join("wgsl/shared/types.wgsl");
+    let mut text = std::fs::read_to_string(&path).unwrap();
+    text.push_str("\nfn broken( {}\n");
+    std::fs::write(&path, &text).unwrap();
+    let line = text.lines().count();
+    let scene = root().join("scenes/view_slices/flat_box.ron");
+    let out = render(&dir, &scene, &[], Some(&r));
+    assert_fails(&out, &dir, &[&format!("error: {}:{line}:", path.display())]);
+}
+
+#[test]
+fn graph_naming_a_missing_shader() {
+    let dir = temp_dir("graph_shader");
+    let graph = dir.join("g.ron");
+    let text = std::fs::read_to_string(root().join("graphs/frame.ron")).unwrap();
+    let text = replaced(&text, "\"composite.wgsl\"", "\"compost.wgsl\"");
+    std::fs::write(&graph, &text).unwrap();
+    let scene = root().join("scenes/view_slices/flat_box.ron");
+    let loc = format!(
+        "error: {}:{}: ",
+        graph.display(),
+        line_col(&text, "\"compost")
+    );
+    let out = render(&dir, &scene, &["--graph", graph.to_str().unwrap()], None);
+    assert_fails(&out, &dir, &[&loc, "compost.wgsl"]);
+    let out = voltex(
+        &[
+            "plan",
+            scene.to_str().unwrap(),
+            "--graph",
+            graph.to_str().unwrap(),
+        ],
+        None,
+    );
+    assert_fails(&out, &dir, &[&loc]);
+}
+
+#[test]
+fn missing_graph_file() {
+    let dir = temp_dir("graph_missing");
+    let graph = dir.join("nothere.ron");
+    let scene = root().join("scenes/view_slices/flat_box.ron");
+    let out = render(&dir, &scene, &["--graph", graph.to_str().unwrap()], None);
+    assert_fails(&out, &dir, &[graph.to_str().unwrap()]);
+}
+
+#[test]
+fn wgsl_global_nothing_provides() {
+    let dir = temp_dir("wgsl_global");
+    let r = project_copy(&dir);
+    let path = r.join("wgsl/composite.wgsl");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let text = replaced(
+        &text,
+        "var hdr: texture_2d<f32>;",
+        "var hdr: texture_2d<f32>;\n@group(0) @binding(7) var<storage, read> mystery: array<f32>;",
+    );
+    let text = replaced(
+        &text,
+        "return vec4<f32>(c.rgb",
+        "return mystery[0] * vec4<f32>(c.rgb",
+    );
+    std::fs::write(&path, &text).unwrap();
+    let graph = r.join("graphs/frame.ron");
+    let graph_text = std::fs::read_to_string(&graph).unwrap();
+    let loc = format!(
+        "error: {}:{}: ",
+        graph.display(),
+        line_col(&graph_text, "\"composite\"")
+    );
+    let scene = root().join("scenes/view_slices/flat_box.ron");
+    let out = render(&dir, &scene, &[], Some(&r));
+    assert_fails(&out, &dir, &[&loc, "`composite`", "`mystery`"]);
+}
+
+// ---- success ----
+
+#[test]
+fn render_writes_exr_and_png_with_metadata() {
+    let dir = temp_dir("ok");
+    let scene = root().join("scenes/view_slices/flat_box.ron");
+    let exr = dir.join("out/out.exr");
+    let out = voltex(
+        &[
+            "render",
+            scene.to_str().unwrap(),
+            "-o",
+            exr.to_str().unwrap(),
+            "--size",
+            "32x32",
+        ],
+        None,
+    );
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    assert_eq!(entries(&dir.join("out")), ["out.exr", "out.png"]);
+    let (image, meta) = voltex::io::exr::read(&exr).unwrap();
+    assert_eq!((image.width, image.height), (32, 32));
+    let keys: Vec<&str> = meta.iter().map(|(k, _)| k.as_str()).collect();
+    for k in ["voltex_adapter", "voltex_scene"] {
+        assert!(keys.contains(&k), "{k} not in {keys:?}");
+    }
+    assert!(
+        keys.iter().any(|k| k.starts_with("voltex_object_")),
+        "{keys:?}"
+    );
+    // Some fog is visible: the centre is not the black background.
+    let c = image.get(16, 16);
+    assert!(c[0] > 0.0 && c[3] > 0.0, "{c:?}");
+
+    // Rendering again over existing files replaces them, still nothing else in the folder.
+    let out = voltex(
+        &[
+            "render",
+            scene.to_str().unwrap(),
+            "-o",
+            exr.to_str().unwrap(),
+            "--size",
+            "16x16",
+        ],
+        None,
+    );
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    assert_eq!(entries(&dir.join("out")), ["out.exr", "out.png"]);
+    assert_eq!(voltex::io::exr::read(&exr).unwrap().0.width, 16);
+}
+
+#[test]
+fn failed_render_keeps_previous_output() {
+    let dir = temp_dir("keep");
+    std::fs::write(dir.join("out/out.exr"), "old").unwrap();
+    let text = replaced(&flat_box(), "texel: \"fog\"", "texel: \"smoke\"");
+    let scene = dir.join("scene.ron");
+    std::fs::write(&scene, text).unwrap();
+    let out = render(&dir, &scene, &[], None);
+    assert_eq!(out.status.code(), Some(1));
+    assert_eq!(entries(&dir.join("out")), ["out.exr"]);
+    assert_eq!(
+        std::fs::read_to_string(dir.join("out/out.exr")).unwrap(),
+        "old"
+    );
+}
+
+// ---- plan ----
+
+#[test]
+fn plan_prints_passes_pruning_and_memory_without_a_gpu() {
+    let scene = root().join("scenes/view_slices/flat_box.ron");
+    // Hide every Vulkan driver: `info` then fails, `plan` must not care.
+    let hide = |cmd: &mut Command| {
+        cmd.env("VOLTEX_ROOT", root())
+            .env("WGPU_BACKEND", "vulkan")
+            .env("VK_ICD_FILENAMES", "/nonexistent/icd.json")
+            .env("VK_DRIVER_FILES", "/nonexistent/icd.json");
+    };
+    let mut info = Command::new(BIN);
+    info.arg("info");
+    hide(&mut info);
+    let info = info.output().unwrap();
+    let mut cmd = Command::new(BIN);
+    cmd.args(["plan", scene.to_str().unwrap(), "--size", "64x48"]);
+    hide(&mut cmd);
+    let out = cmd.output().unwrap();
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let text = String::from_utf8_lossy(&out.stdout).into_owned();
+    if info.status.code() == Some(0) {
+        eprintln!("note: an adapter was still found; the no-GPU part is not proven here");
+    }
+    for s in [
+        "output 64x48",
+        "passes (in order):",
+        "pruned:",
+        "pass draw_base: no object matches BaseSurface",
+        "GPU memory:",
+        "total",
+    ] {
+        assert!(text.contains(s), "{s:?} not in:\n{text}");
+    }
+    let passes = text
+        .split("passes (in order):")
+        .nth(1)
+        .unwrap()
+        .split("\n\n")
+        .next()
+        .unwrap();
+    let order: Vec<&str> = passes
+        .lines()
+        .filter_map(|l| l.split_whitespace().next())
+        .collect();
+    assert_eq!(
+        order,
+        [
+            "count_slices",
+            "scan_plane_offsets",
+            "emit_slices",
+            "draw_slices",
+            "composite"
+        ]
+    );
+    let total = text
+        .lines()
+        .find(|l| l.trim_end().ends_with("MiB  total"))
+        .unwrap();
+    let mib: f64 = total.split_whitespace().next().unwrap().parse().unwrap();
+    assert!(mib > 0.0, "{total}");
+}
+
+#[test]
+fn plan_of_a_bad_scene_fails_like_render() {
+    let dir = temp_dir("plan_bad");
+    let text = replaced(&flat_box(), "ambient: 1.0", "ambient: NaN");
+    let scene = dir.join("scene.ron");
+    std::fs::write(&scene, &text).unwrap();
+    let out = voltex(&["plan", scene.to_str().unwrap()], None);
+    let loc = format!("{}:{}: ", scene.display(), line_col(&text, "NaN"));
+    assert_fails(&out, &dir, &[&loc]);
+}
