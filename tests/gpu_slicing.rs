@@ -305,8 +305,17 @@ fn slices_are_ordered_back_to_front_and_lie_on_their_planes() {
 }
 
 /// Polygon edges of one plane as (a, b) bit patterns, from the fan triangles of each prism.
-fn polygon_edges(plane: &[SliceVertex]) -> Vec<([u32; 3], [u32; 3], u32, f32, f32)> {
-    let key = |v: &SliceVertex| [v.position[0].to_bits(), v.position[1].to_bits(), v.position[2].to_bits()];
+/// (start bits, end bits, prism, w at start, w at end)
+type PolygonEdge = ([u32; 3], [u32; 3], u32, f32, f32);
+
+fn polygon_edges(plane: &[SliceVertex]) -> Vec<PolygonEdge> {
+    let key = |v: &SliceVertex| {
+        [
+            v.position[0].to_bits(),
+            v.position[1].to_bits(),
+            v.position[2].to_bits(),
+        ]
+    };
     let mut out = Vec::new();
     for (prism, verts) in by_prism(plane) {
         // Fan (0, i, i+1): the polygon is v0, then the second vertex of each triangle, then the last.
@@ -331,7 +340,10 @@ fn polygon_edges(plane: &[SliceVertex]) -> Vec<([u32; 3], [u32; 3], u32, f32, f3
 fn closed_shells_have_watertight_slices() {
     for (surface, allowed) in [
         ("Sphere(radius: 1.0, segments: (12, 6))", 0.0),
-        ("Torus(major: 1.0, minor: 0.4, segments: (16, 8), distortion: 0.15, seed: 2)", 0.002),
+        (
+            "Torus(major: 1.0, minor: 0.4, segments: (16, 8), distortion: 0.15, seed: 2)",
+            0.002,
+        ),
     ] {
         let src = format!(
             r#"Scene(output: (width: 64, height: 64), camera: (eye: (0.4, -3.0, 1.7), target: (0.0, 0.0, 0.0)),
@@ -343,7 +355,12 @@ fn closed_shells_have_watertight_slices() {
         let eye = scene.camera.eye;
         let forward = (scene.camera.target - eye).normalize();
         let shell = Shell::new(&objects[0].surface, eye);
-        let params = view_slices::sweep(&shell, [forward.x as f32, forward.y as f32, forward.z as f32], 64, 0.0);
+        let params = view_slices::sweep(
+            &shell,
+            [forward.x as f32, forward.y as f32, forward.z as f32],
+            64,
+            0.0,
+        );
         let gpu = gpu_slices(&shell, &params, true);
         let (mut shared, mut caps, mut unpaired) = (0, 0, 0);
         for (k, plane) in gpu.iter().enumerate() {
@@ -355,7 +372,9 @@ fn closed_shells_have_watertight_slices() {
                 let twins: Vec<u32> = edges
                     .iter()
                     .enumerate()
-                    .filter(|(j, e)| *j != i && ((e.0 == *b && e.1 == *a) || (e.0 == *a && e.1 == *b)))
+                    .filter(|(j, e)| {
+                        *j != i && ((e.0 == *b && e.1 == *a) || (e.0 == *a && e.1 == *b))
+                    })
                     .map(|(_, e)| e)
                     .map(|e| e.2)
                     .collect();
@@ -368,9 +387,17 @@ fn closed_shells_have_watertight_slices() {
                 }
             }
         }
-        eprintln!("{surface}: {shared} shared edges, {caps} cap edges, {unpaired} unpaired lateral edges");
-        assert!(shared > 500 && caps > 100, "{surface}: {shared} shared edges, {caps} cap edges");
+        eprintln!(
+            "{surface}: {shared} shared edges, {caps} cap edges, {unpaired} unpaired lateral edges"
+        );
+        assert!(
+            shared > 500 && caps > 100,
+            "{surface}: {shared} shared edges, {caps} cap edges"
+        );
         let fraction = unpaired as f64 / (shared + caps + unpaired) as f64;
-        assert!(fraction <= allowed, "{surface}: {unpaired} unpaired lateral edges ({fraction})");
+        assert!(
+            fraction <= allowed,
+            "{surface}: {unpaired} unpaired lateral edges ({fraction})"
+        );
     }
 }

@@ -38,6 +38,12 @@ impl GpuContext {
                 ..Default::default()
             };
             if let Ok(adapter) = pollster::block_on(instance.request_adapter(&options)) {
+                if adapter.get_info().backend == wgpu::Backend::Gl {
+                    eprintln!(
+                        "warning: no Vulkan adapter; using wgpu's GL backend, which lacks features voltex \
+                         needs (f32 render targets). Install software Vulkan: apt-get install mesa-vulkan-drivers"
+                    );
+                }
                 return Self::open(adapter);
             }
         }
@@ -86,7 +92,9 @@ impl GpuContext {
     }
 
     pub fn has_timestamps(&self) -> bool {
-        self.features.contains(wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS)
+        self.features.contains(
+            wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS,
+        )
     }
 
     /// Fails with the first wgpu error raised outside an error scope since the last call.
@@ -163,7 +171,10 @@ impl GpuContext {
                 "TIMESTAMP_QUERY_INSIDE_ENCODERS",
                 wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS,
             ),
-            ("FLOAT32_BLENDABLE (f32 accumulation)", wgpu::Features::FLOAT32_BLENDABLE),
+            (
+                "FLOAT32_BLENDABLE (f32 accumulation)",
+                wgpu::Features::FLOAT32_BLENDABLE,
+            ),
         ] {
             s += &format!(
                 "  {:<34} {}\n",
@@ -188,7 +199,7 @@ impl GpuContext {
             ("max_buffer_size", l.max_buffer_size),
             (
                 "max_storage_buffer_binding_size",
-                l.max_storage_buffer_binding_size as u64,
+                l.max_storage_buffer_binding_size,
             ),
             (
                 "max_compute_workgroups_per_dimension",

@@ -95,7 +95,11 @@ pub fn bindings(kernel: &Kernel, entry_points: &[&str]) -> Result<Vec<Binding>> 
 
 /// Globals used as the image of a sampling expression.
 fn sampled_globals(module: &naga::Module) -> Vec<naga::Handle<naga::GlobalVariable>> {
-    let functions = module.functions.iter().map(|(_, f)| f).chain(module.entry_points.iter().map(|e| &e.function));
+    let functions = module
+        .functions
+        .iter()
+        .map(|(_, f)| f)
+        .chain(module.entry_points.iter().map(|e| &e.function));
     let mut out = Vec::new();
     for f in functions {
         for (_, e) in f.expressions.iter() {
@@ -109,7 +113,11 @@ fn sampled_globals(module: &naga::Module) -> Vec<naga::Handle<naga::GlobalVariab
     out
 }
 
-fn kind_of(module: &naga::Module, var: &naga::GlobalVariable, filtered: bool) -> Result<BindingKind, String> {
+fn kind_of(
+    module: &naga::Module,
+    var: &naga::GlobalVariable,
+    filtered: bool,
+) -> Result<BindingKind, String> {
     Ok(match var.space {
         naga::AddressSpace::Uniform => BindingKind::Uniform,
         naga::AddressSpace::Storage { access } => BindingKind::Storage {
@@ -124,8 +132,16 @@ fn kind_of(module: &naga::Module, var: &naga::GlobalVariable, filtered: bool) ->
             } => {
                 let dim = view_dim(*dim, *arrayed);
                 match class {
-                    naga::ImageClass::Sampled { .. } => BindingKind::Texture { dim, depth: false, filtered },
-                    naga::ImageClass::Depth { .. } => BindingKind::Texture { dim, depth: true, filtered },
+                    naga::ImageClass::Sampled { .. } => BindingKind::Texture {
+                        dim,
+                        depth: false,
+                        filtered,
+                    },
+                    naga::ImageClass::Depth { .. } => BindingKind::Texture {
+                        dim,
+                        depth: true,
+                        filtered,
+                    },
                     naga::ImageClass::Storage { format, access } => BindingKind::StorageTexture {
                         dim,
                         format: texture_format(*format)?,
@@ -188,11 +204,17 @@ pub fn layout_entry(b: &Binding) -> wgpu::BindGroupLayoutEntry {
             has_dynamic_offset: false,
             min_binding_size: None,
         },
-        BindingKind::Texture { dim, depth, filtered } => wgpu::BindingType::Texture {
+        BindingKind::Texture {
+            dim,
+            depth,
+            filtered,
+        } => wgpu::BindingType::Texture {
             sample_type: if *depth {
                 wgpu::TextureSampleType::Depth
             } else {
-                wgpu::TextureSampleType::Float { filterable: *filtered }
+                wgpu::TextureSampleType::Float {
+                    filterable: *filtered,
+                }
             },
             view_dimension: *dim,
             multisampled: false,

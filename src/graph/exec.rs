@@ -108,15 +108,16 @@ impl Executor {
         let mut layouts = Vec::new();
         for p in &plan.passes {
             let name = p.decl.shader().to_string();
-            if !modules.contains_key(&name) {
-                let module = ctx.scoped(&format!("shader {name}"), || {
+            if let std::collections::hash_map::Entry::Vacant(slot) = modules.entry(name) {
+                let label = format!("shader {}", slot.key());
+                let module = ctx.scoped(&label, || {
                     ctx.device
                         .create_shader_module(wgpu::ShaderModuleDescriptor {
-                            label: Some(&name),
+                            label: Some(&label),
                             source: wgpu::ShaderSource::Naga(Cow::Owned(p.kernel.module.clone())),
                         })
                 })?;
-                modules.insert(name, module);
+                slot.insert(module);
             }
             layouts.push(pass_layout(ctx, p));
         }
