@@ -22,7 +22,15 @@ pub fn default_scenes() -> Vec<PathBuf> {
     vec![root.join("torus_egg.ron"), root.join("terrain.ron")]
 }
 
-pub fn run(scenes: &[PathBuf], planes: &[u32], size: (u32, u32), frames: usize) -> Result<()> {
+/// `reference_planes`: plane count of the converged image each row's error is measured against
+/// (a stand-in for the exact reference renderer, which does not exist yet).
+pub fn run(
+    scenes: &[PathBuf],
+    planes: &[u32],
+    size: (u32, u32),
+    frames: usize,
+    reference_planes: u32,
+) -> Result<()> {
     let scenes = if scenes.is_empty() {
         default_scenes()
     } else {
@@ -50,6 +58,10 @@ pub fn run(scenes: &[PathBuf], planes: &[u32], size: (u32, u32), frames: usize) 
     );
     for scene_path in &scenes {
         let scene = crate::scene::load(scene_path)?;
+        let reference = {
+            let opts = RenderOptions { size: Some(size), planes: Some(reference_planes), ..Default::default() };
+            Renderer::new(&ctx, Blueprint::new(&scene, &opts)?)?.render(&ctx)?.image
+        };
         for &n in planes {
             for reject in [true, false] {
                 let opts = RenderOptions {
@@ -58,7 +70,7 @@ pub fn run(scenes: &[PathBuf], planes: &[u32], size: (u32, u32), frames: usize) 
                     trivial_reject: Some(reject),
                     ..Default::default()
                 };
-                let row = measure(&ctx, &scene, &opts, frames)?;
+                let row = measure(&ctx, &scene, &opts, frames, &reference)?;
                 let name = Path::new(scene_path)
                     .file_stem()
                     .unwrap_or_default()
@@ -72,7 +84,7 @@ pub fn run(scenes: &[PathBuf], planes: &[u32], size: (u32, u32), frames: usize) 
                         .unwrap_or(f64::NAN)
                 };
                 println!(
-                    "{:<12} {:>6} {:>7} | {:>8.3} {:>8.3} {:>8.3} {:>8.3} {:>9.3} | {:>9.2} {:>9.1} | {:>9.2}",
+                    "{:<12} {:>6} {:>7} | {:>8.3} {:>8.3} {:>8.3} {:>8.3} {:>9.3} | {:>9.2} {:>9.1} | {:>9.2} | {:>8.4} {:>7.4}",
                     name,
                     n,
                     reject,
@@ -84,6 +96,8 @@ pub fn run(scenes: &[PathBuf], planes: &[u32], size: (u32, u32), frames: usize) 
                     row.wall_ms,
                     1000.0 / row.wall_ms,
                     row.cpu_ms,
+                    row.rel_rmse,
+                    row.flip,
                 );
             }
         }
@@ -96,6 +110,8 @@ struct Row {
     passes: Vec<(String, f64)>,
     wall_ms: f64,
     cpu_ms: f64,
+    rel_rmse: f64,
+    flip: f64,
 }
 
 fn measure(
@@ -103,12 +119,14 @@ fn measure(
     scene: &crate::scene::Scene,
     opts: &RenderOptions,
     frames: usize,
+    reference: &crate::io::Image,
 ) -> Result<Row> {
     let bp = Blueprint::new(scene, opts)?;
     let mut r = Renderer::new(ctx, bp)?;
-    for _ in 0..2 {
-        r.render_timed(ctx)?;
-    }
+    let image = r.render(ctx)?.image;
+    let rel_rmse = crate::metrics::relative_rmse(&image, reference)?;
+    let flip = crate::metrics::flip(&image, reference)?.mean;
+    r.render_timed(ctx)?; // second warm-up frame (the first rendered the image above)
     let mut per_pass: Vec<(String, Vec<f64>)> = Vec::new();
     let mut wall = Vec::new();
     for _ in 0..frames.max(1) {
@@ -139,5 +157,7 @@ fn measure(
         passes: per_pass.into_iter().map(|(n, v)| (n, median(v))).collect(),
         wall_ms: median(wall),
         cpu_ms: cpu.iter().sum(),
+        rel_rmse,
+        flip,
     })
 }

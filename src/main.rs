@@ -67,6 +67,9 @@ enum Command {
         /// Timed frames per setting (after warm-up); the median is reported.
         #[arg(long, default_value_t = 5)]
         frames: usize,
+        /// Plane count of the converged image that errors are measured against.
+        #[arg(long, default_value_t = 4000)]
+        reference_planes: u32,
     },
 }
 
@@ -120,7 +123,8 @@ fn main() -> ExitCode {
             planes,
             size,
             frames,
-        } => voltex::bench::run(&scenes, &planes, size, frames),
+            reference_planes,
+        } => voltex::bench::run(&scenes, &planes, size, frames, reference_planes),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

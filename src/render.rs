@@ -114,6 +114,12 @@ impl Blueprint {
                 (None, true, false, None);
             if let Some(Method::ViewSlices(vs)) = &object.method {
                 let planes = opts.planes.unwrap_or(vs.planes);
+                if planes == 0 || planes > crate::scene::MAX_PLANES {
+                    return Err(Error::Invalid(format!(
+                        "{planes} planes: expected a plane count in 1..={}",
+                        crate::scene::MAX_PLANES
+                    )));
+                }
                 trivial_reject = opts.trivial_reject.unwrap_or(vs.trivial_reject);
                 per_pixel = vs.lighting == Lighting::PerPixel;
                 let mut params = view_slices::sweep(&shell, f32v(forward), planes, near);
