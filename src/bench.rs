@@ -31,17 +31,10 @@ pub fn run(
     frames: usize,
     reference_planes: u32,
 ) -> Result<()> {
-    let scenes = if scenes.is_empty() {
-        default_scenes()
-    } else {
-        scenes.to_vec()
-    };
+    let scenes = if scenes.is_empty() { default_scenes() } else { scenes.to_vec() };
     let ctx = GpuContext::new()?;
     println!("adapter: {}", ctx.adapter_line());
-    println!(
-        "{}x{}, median of {frames} frames after 2 warm-up frames; times in ms",
-        size.0, size.1
-    );
+    println!("{}x{}, median of {frames} frames after 2 warm-up frames; times in ms", size.0, size.1);
     println!(
         "{:<12} {:>6} {:>7} | {:>8} {:>8} {:>8} {:>8} {:>9} | {:>9} {:>9} | {:>9}",
         "scene",
@@ -59,7 +52,8 @@ pub fn run(
     for scene_path in &scenes {
         let scene = crate::scene::load(scene_path)?;
         let reference = {
-            let opts = RenderOptions { size: Some(size), planes: Some(reference_planes), ..Default::default() };
+            let opts =
+                RenderOptions { size: Some(size), planes: Some(reference_planes), ..Default::default() };
             Renderer::new(&ctx, Blueprint::new(&scene, &opts)?)?.render(&ctx)?.image
         };
         for &n in planes {
@@ -71,18 +65,9 @@ pub fn run(
                     ..Default::default()
                 };
                 let row = measure(&ctx, &scene, &opts, frames, &reference)?;
-                let name = Path::new(scene_path)
-                    .file_stem()
-                    .unwrap_or_default()
-                    .to_string_lossy()
-                    .to_string();
-                let pass = |p: &str| {
-                    row.passes
-                        .iter()
-                        .find(|x| x.0 == p)
-                        .map(|x| x.1)
-                        .unwrap_or(f64::NAN)
-                };
+                let name =
+                    Path::new(scene_path).file_stem().unwrap_or_default().to_string_lossy().to_string();
+                let pass = |p: &str| row.passes.iter().find(|x| x.0 == p).map(|x| x.1).unwrap_or(f64::NAN);
                 println!(
                     "{:<12} {:>6} {:>7} | {:>8.3} {:>8.3} {:>8.3} {:>8.3} {:>9.3} | {:>9.2} {:>9.1} | {:>9.2} | {:>8.4} {:>7.4}",
                     name,

@@ -13,11 +13,7 @@ pub struct FileLoc {
 
 impl FileLoc {
     pub fn new(path: impl AsRef<Path>, line: usize, col: usize) -> Self {
-        Self {
-            path: path.as_ref().to_path_buf(),
-            line,
-            col,
-        }
+        Self { path: path.as_ref().to_path_buf(), line, col }
     }
 }
 
@@ -45,16 +41,10 @@ pub enum Error {
 
 impl Error {
     pub fn at(loc: FileLoc, message: impl Into<String>) -> Self {
-        Error::At {
-            loc,
-            message: message.into(),
-        }
+        Error::At { loc, message: message.into() }
     }
     pub fn file(path: impl AsRef<Path>, message: impl fmt::Display) -> Self {
-        Error::File {
-            path: path.as_ref().to_path_buf(),
-            message: message.to_string(),
-        }
+        Error::File { path: path.as_ref().to_path_buf(), message: message.to_string() }
     }
 }
 
@@ -73,15 +63,10 @@ pub fn line_col(source: &str, offset: usize) -> (usize, usize) {
 pub fn locate_literal(source: &str, text: &str, from: usize) -> Option<(usize, usize)> {
     let needle = format!("\"{text}\"");
     let start = from.min(source.len());
-    source[start..]
-        .find(&needle)
-        .map(|i| line_col(source, start + i))
+    source[start..].find(&needle).map(|i| line_col(source, start + i))
 }
 
 /// Turns a ron error into `path:line:col: message`.
 pub fn ron_error(path: &Path, e: &ron::error::SpannedError) -> Error {
-    Error::at(
-        FileLoc::new(path, e.span.start.line, e.span.start.col),
-        e.code.to_string(),
-    )
+    Error::at(FileLoc::new(path, e.span.start.line, e.span.start.col), e.code.to_string())
 }

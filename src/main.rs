@@ -10,11 +10,7 @@ use voltex::render::{Blueprint, RenderOptions, Renderer};
 use voltex::{io, scene, Result};
 
 #[derive(Parser)]
-#[command(
-    name = "voltex",
-    version,
-    about = "Volumetric textures and hypertextures on wgpu"
-)]
+#[command(name = "voltex", version, about = "Volumetric textures and hypertextures on wgpu")]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -74,15 +70,9 @@ enum Command {
 }
 
 fn parse_size(s: &str) -> std::result::Result<(u32, u32), String> {
-    let (w, h) = s
-        .split_once('x')
-        .ok_or("expected WIDTHxHEIGHT, e.g. 512x512")?;
-    let w: u32 = w
-        .parse()
-        .map_err(|_| "expected WIDTHxHEIGHT, e.g. 512x512")?;
-    let h: u32 = h
-        .parse()
-        .map_err(|_| "expected WIDTHxHEIGHT, e.g. 512x512")?;
+    let (w, h) = s.split_once('x').ok_or("expected WIDTHxHEIGHT, e.g. 512x512")?;
+    let w: u32 = w.parse().map_err(|_| "expected WIDTHxHEIGHT, e.g. 512x512")?;
+    let h: u32 = h.parse().map_err(|_| "expected WIDTHxHEIGHT, e.g. 512x512")?;
     if w == 0 || h == 0 || w > 16384 || h > 16384 {
         return Err("expected a size between 1x1 and 16384x16384".into());
     }
@@ -111,20 +101,12 @@ impl Overrides {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
-        Command::Render {
-            scene,
-            output,
-            overrides,
-        } => render(&scene, output, &overrides),
+        Command::Render { scene, output, overrides } => render(&scene, output, &overrides),
         Command::Plan { scene, overrides } => plan(&scene, &overrides),
         Command::Info => GpuContext::new().map(|ctx| print!("{}", ctx.describe())),
-        Command::Bench {
-            scenes,
-            planes,
-            size,
-            frames,
-            reference_planes,
-        } => voltex::bench::run(&scenes, &planes, size, frames, reference_planes),
+        Command::Bench { scenes, planes, size, frames, reference_planes } => {
+            voltex::bench::run(&scenes, &planes, size, frames, reference_planes)
+        }
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -162,27 +144,17 @@ fn render(scene_path: &Path, output: Option<PathBuf>, overrides: &Overrides) -> 
     let bp = Blueprint::new(&scene, &opts)?;
     for o in &bp.objects {
         for w in &o.object.report.warnings {
-            eprintln!(
-                "warning: {}: object `{}`: {w}",
-                scene_path.display(),
-                o.object.name
-            );
+            eprintln!("warning: {}: object `{}`: {w}", scene_path.display(), o.object.name);
         }
     }
     let ctx = GpuContext::new()?;
     let mut renderer = Renderer::new(&ctx, bp)?;
     let frame = renderer.render(&ctx)?;
     let metadata = renderer.metadata(&ctx, &frame);
-    let meta: Vec<(&str, String)> = metadata
-        .iter()
-        .map(|(k, v)| (k.as_str(), v.clone()))
-        .collect();
+    let meta: Vec<(&str, String)> = metadata.iter().map(|(k, v)| (k.as_str(), v.clone())).collect();
     io::exr::write(&exr_path, &frame.image, &meta)?;
     io::png::write_tonemapped(&png_path, &frame.image)?;
-    let gpu = frame
-        .gpu_ms()
-        .map(|t| format!("{t:.2} ms GPU"))
-        .unwrap_or_else(|| "no GPU timestamps".into());
+    let gpu = frame.gpu_ms().map(|t| format!("{t:.2} ms GPU")).unwrap_or_else(|| "no GPU timestamps".into());
     println!(
         "{} and {} ({}x{}, {gpu}, {})",
         exr_path.display(),

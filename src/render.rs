@@ -72,14 +72,8 @@ impl Blueprint {
     }
 
     /// Like [`Blueprint::new`] with the scene's objects given (tests alter their surfaces).
-    pub fn with_objects(
-        scene: &Scene,
-        objects: Vec<SceneObject>,
-        opts: &RenderOptions,
-    ) -> Result<Self> {
-        let size = opts
-            .size
-            .unwrap_or((scene.output.width, scene.output.height));
+    pub fn with_objects(scene: &Scene, objects: Vec<SceneObject>, opts: &RenderOptions) -> Result<Self> {
+        let size = opts.size.unwrap_or((scene.output.width, scene.output.height));
         let cam = &scene.camera;
         let eye = cam.eye;
         let forward = (cam.target - cam.eye).normalize_or_zero();
@@ -107,11 +101,8 @@ impl Blueprint {
         let mut plans = Vec::new();
         for object in objects {
             let shell = Shell::new(&object.surface, eye);
-            let base = object
-                .base_color
-                .map(|_| shell::base_vertices(&object.surface, eye));
-            let (mut slicing, mut trivial_reject, mut per_pixel, mut bake) =
-                (None, true, false, None);
+            let base = object.base_color.map(|_| shell::base_vertices(&object.surface, eye));
+            let (mut slicing, mut trivial_reject, mut per_pixel, mut bake) = (None, true, false, None);
             if let Some(Method::ViewSlices(vs)) = &object.method {
                 let planes = opts.planes.unwrap_or(vs.planes);
                 if planes == 0 || planes > crate::scene::MAX_PLANES {
@@ -129,15 +120,7 @@ impl Blueprint {
                 let texel_name = object.texel.clone().unwrap_or_default();
                 bake = Some(bake_index(scene, &texel_name, per_pixel, &mut bakes)?);
             }
-            plans.push(ObjectPlan {
-                object,
-                shell,
-                base,
-                slicing,
-                trivial_reject,
-                per_pixel,
-                bake,
-            });
+            plans.push(ObjectPlan { object, shell, base, slicing, trivial_reject, per_pixel, bake });
         }
 
         let graph = Graph::load(opts.graph.as_deref().unwrap_or(&default_graph()))?;
@@ -153,58 +136,27 @@ impl Blueprint {
                 }
                 let centre = o.object.surface.positions.iter().sum::<DVec3>()
                     / o.object.surface.positions.len().max(1) as f64;
-                ObjectInfo {
-                    name: o.object.name.clone(),
-                    filters,
-                    distance: (centre - eye).length(),
-                }
+                ObjectInfo { name: o.object.name.clone(), filters, distance: (centre - eye).length() }
             })
             .collect();
         let plan = plan::plan(&graph, &wgsl_root(), &infos)?;
 
         let view = view_matrix(forward, cam.up);
-        let proj = projection(
-            cam.fov_y.to_radians(),
-            size.0 as f64 / size.1 as f64,
-            near,
-            far,
-        );
+        let proj = projection(cam.fov_y.to_radians(), size.0 as f64 / size.1 as f64, near, far);
         let light = scene.lights.first();
         let (light_dir, light_color) = match light {
-            Some(Light::Directional {
-                direction,
-                color,
-                intensity,
-            }) => (-direction.normalize(), color.map(|c| c * intensity)),
+            Some(Light::Directional { direction, color, intensity }) => {
+                (-direction.normalize(), color.map(|c| c * intensity))
+            }
             None => (DVec3::new(0.3, 0.4, 1.0).normalize(), [1.0; 3]),
         };
         let frame = FrameParams {
             view_proj: (proj * view).as_mat4().to_cols_array_2d(),
-            forward: [
-                forward.x as f32,
-                forward.y as f32,
-                forward.z as f32,
-                near as f32,
-            ],
-            light_dir: [
-                light_dir.x as f32,
-                light_dir.y as f32,
-                light_dir.z as f32,
-                scene.ambient,
-            ],
+            forward: [forward.x as f32, forward.y as f32, forward.z as f32, near as f32],
+            light_dir: [light_dir.x as f32, light_dir.y as f32, light_dir.z as f32, scene.ambient],
             light_color: [light_color[0], light_color[1], light_color[2], 1.0],
-            background: [
-                scene.background[0],
-                scene.background[1],
-                scene.background[2],
-                1.0,
-            ],
-            viewport: [
-                size.0 as f32,
-                size.1 as f32,
-                1.0 / size.0 as f32,
-                1.0 / size.1 as f32,
-            ],
+            background: [scene.background[0], scene.background[1], scene.background[2], 1.0],
+            viewport: [size.0 as f32, size.1 as f32, 1.0 / size.0 as f32, 1.0 / size.1 as f32],
         };
         for b in &mut bakes {
             // Baked shading treats the texel axes (s, t, w) as world (x, y, z): exact for a flat
@@ -212,16 +164,7 @@ impl Blueprint {
             b.request.light = [light_dir.x as f32, light_dir.y as f32, light_dir.z as f32];
             b.request.ambient = scene.ambient;
         }
-        Ok(Self {
-            scene_path: scene.path.clone(),
-            size,
-            eye,
-            frame,
-            objects: plans,
-            bakes,
-            graph,
-            plan,
-        })
+        Ok(Self { scene_path: scene.path.clone(), size, eye, frame, objects: plans, bakes, graph, plan })
     }
 
     /// Bytes of GPU memory the frame allocates, by item.
@@ -247,11 +190,7 @@ impl Blueprint {
                     r[0],
                     r[1],
                     r[2],
-                    if b.request.per_pixel {
-                        " + normals"
-                    } else {
-                        ""
-                    }
+                    if b.request.per_pixel { " + normals" } else { "" }
                 ),
                 bake::bytes(r, b.request.per_pixel),
             ));
@@ -260,10 +199,7 @@ impl Blueprint {
             let name = &o.object.name;
             let shell = (o.shell.vertices.len() * 32 + o.shell.prisms.len() * 64) as u64;
             if let Some((params, cap)) = &o.slicing {
-                out.push((
-                    format!("object {name}: shell ({} prisms)", o.shell.prisms.len()),
-                    shell,
-                ));
+                out.push((format!("object {name}: shell ({} prisms)", o.shell.prisms.len()), shell));
                 out.push((
                     format!(
                         "object {name}: slice vertices (capacity {cap}) + {} plane cursors",
@@ -277,10 +213,7 @@ impl Blueprint {
                 ));
             }
             if let Some(base) = &o.base {
-                out.push((
-                    format!("object {name}: base triangles"),
-                    (base.len() * 32) as u64,
-                ));
+                out.push((format!("object {name}: base triangles"), (base.len() * 32) as u64));
             }
         }
         out
@@ -310,11 +243,7 @@ impl Blueprint {
                 r[1],
                 r[2],
                 bake::mip_count(r) - 1,
-                if b.request.per_pixel {
-                    "per-pixel (albedo + normals)"
-                } else {
-                    "baked"
-                }
+                if b.request.per_pixel { "per-pixel (albedo + normals)" } else { "baked" }
             );
         }
         s += "\nobjects:\n";
@@ -329,11 +258,7 @@ impl Blueprint {
                 ),
                 None => "base surface only".into(),
             };
-            s += &format!(
-                "  {:<16} {} triangles  {method}\n",
-                o.object.name,
-                o.shell.prisms.len()
-            );
+            s += &format!("  {:<16} {} triangles  {method}\n", o.object.name, o.shell.prisms.len());
             for w in &o.object.report.warnings {
                 s += &format!("    warning: {w}\n");
             }
@@ -355,11 +280,7 @@ impl Blueprint {
         }
         s += &format!(
             "\nkernels compiled: {}\n",
-            self.plan
-                .kernels()
-                .into_iter()
-                .collect::<Vec<_>>()
-                .join(", ")
+            self.plan.kernels().into_iter().collect::<Vec<_>>().join(", ")
         );
         if !self.plan.pruned.is_empty() {
             s += "\npruned:\n";
@@ -372,31 +293,19 @@ impl Blueprint {
         for (what, bytes) in &mem {
             s += &format!("  {:>10.2} MiB  {what}\n", *bytes as f64 / 1048576.0);
         }
-        s += &format!(
-            "  {:>10.2} MiB  total\n",
-            mem.iter().map(|m| m.1).sum::<u64>() as f64 / 1048576.0
-        );
+        s += &format!("  {:>10.2} MiB  total\n", mem.iter().map(|m| m.1).sum::<u64>() as f64 / 1048576.0);
         s
     }
 
     fn pipeline_variants(&self, p: &plan::PlannedPass) -> Vec<String> {
-        let names: Vec<String> = crate::gpu::reflect::overrides(&p.kernel)
-            .into_iter()
-            .map(|o| o.0)
-            .collect();
+        let names: Vec<String> = crate::gpu::reflect::overrides(&p.kernel).into_iter().map(|o| o.0).collect();
         let mut variants: Vec<String> = match &p.instances {
             None => vec![String::new()],
-            Some(ids) => ids
-                .iter()
-                .map(|&i| self.constants(&self.objects[i], &names))
-                .collect(),
+            Some(ids) => ids.iter().map(|&i| self.constants(&self.objects[i], &names)).collect(),
         };
         variants.sort();
         variants.dedup();
-        variants
-            .into_iter()
-            .map(|v| if v.is_empty() { "default".into() } else { v })
-            .collect()
+        variants.into_iter().map(|v| if v.is_empty() { "default".into() } else { v }).collect()
     }
 
     fn constants(&self, o: &ObjectPlan, names: &[String]) -> String {
@@ -440,21 +349,14 @@ fn object_constants(o: &ObjectPlan) -> Vec<(String, f64)> {
     ]
 }
 
-fn bake_index(
-    scene: &Scene,
-    texel: &str,
-    per_pixel: bool,
-    bakes: &mut Vec<BakePlan>,
-) -> Result<usize> {
-    if let Some(i) = bakes
-        .iter()
-        .position(|b| b.texel == texel && b.request.per_pixel == per_pixel)
-    {
+fn bake_index(scene: &Scene, texel: &str, per_pixel: bool, bakes: &mut Vec<BakePlan>) -> Result<usize> {
+    if let Some(i) = bakes.iter().position(|b| b.texel == texel && b.request.per_pixel == per_pixel) {
         return Ok(i);
     }
-    let t = scene.texels.get(texel).ok_or_else(|| {
-        Error::Invalid(format!("{}: unknown texel `{texel}`", scene.path.display()))
-    })?;
+    let t = scene
+        .texels
+        .get(texel)
+        .ok_or_else(|| Error::Invalid(format!("{}: unknown texel `{texel}`", scene.path.display())))?;
     let source = match &t.source {
         TexelSource::Implicit { shapes } => BakeSource::Implicit(crate::cpu::bake::pack_shapes(
             &shapes.iter().map(bake_shape).collect::<Vec<_>>(),
@@ -482,9 +384,9 @@ fn bake_index(
                 ..Default::default()
             })
         }
-        TexelSource::Constant { color, opacity } => BakeSource::Implicit(
-            crate::cpu::bake::pack_shapes(&[(BakeShape::Constant, *color, *opacity)]),
-        ),
+        TexelSource::Constant { color, opacity } => {
+            BakeSource::Implicit(crate::cpu::bake::pack_shapes(&[(BakeShape::Constant, *color, *opacity)]))
+        }
     };
     bakes.push(BakePlan {
         texel: texel.to_string(),
@@ -536,11 +438,8 @@ impl Renderer {
             }
         }
         let mut baker = Baker::new(&wgsl_root());
-        let baked: Vec<bake::Baked> = blueprint
-            .bakes
-            .iter()
-            .map(|b| baker.bake(ctx, &b.request))
-            .collect::<Result<_>>()?;
+        let baked: Vec<bake::Baked> =
+            blueprint.bakes.iter().map(|b| baker.bake(ctx, &b.request)).collect::<Result<_>>()?;
         let sampler = ctx.device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("volume_sampler"),
             address_mode_u: wgpu::AddressMode::Repeat,
@@ -552,24 +451,14 @@ impl Renderer {
             ..Default::default()
         });
         let mut frame = Inputs::default();
-        frame.buffers.insert(
-            "frame".into(),
-            bake::uniform(ctx, "frame", bytemuck::bytes_of(&blueprint.frame)),
-        );
+        frame
+            .buffers
+            .insert("frame".into(), bake::uniform(ctx, "frame", bytemuck::bytes_of(&blueprint.frame)));
         frame.samplers.insert("volume_sampler".into(), sampler);
         frame.counts.insert("width".into(), blueprint.size.0);
         frame.counts.insert("height".into(), blueprint.size.1);
-        let objects = blueprint
-            .objects
-            .iter()
-            .map(|o| object_inputs(ctx, &blueprint, o, &baked))
-            .collect();
-        let exec = Executor::new(
-            ctx,
-            blueprint.graph.clone(),
-            &blueprint.plan,
-            blueprint.size,
-        )?;
+        let objects = blueprint.objects.iter().map(|o| object_inputs(ctx, &blueprint, o, &baked)).collect();
+        let exec = Executor::new(ctx, blueprint.graph.clone(), &blueprint.plan, blueprint.size)?;
         let timer = Timer::new(ctx, blueprint.plan.passes.len() as u32);
         let (w, h) = blueprint.size;
         let readback = ctx.device.create_buffer(&wgpu::BufferDescriptor {
@@ -578,17 +467,9 @@ impl Renderer {
             usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let mut r = Self {
-            blueprint,
-            exec,
-            frame,
-            objects,
-            timer,
-            readback,
-        };
+        let mut r = Self { blueprint, exec, frame, objects, timer, readback };
         // Pipelines now, so that a bad kernel fails before any frame.
-        r.exec
-            .prepare(ctx, &r.blueprint.plan, &r.frame, &r.objects)?;
+        r.exec.prepare(ctx, &r.blueprint.plan, &r.frame, &r.objects)?;
         ctx.wait()?;
         Ok(r)
     }
@@ -596,13 +477,7 @@ impl Renderer {
     /// Renders one frame and reads back the graph's first output as a linear HDR image.
     pub fn render(&mut self, ctx: &GpuContext) -> Result<Frame> {
         self.timer.reset();
-        self.exec.run(
-            ctx,
-            &self.blueprint.plan,
-            &self.frame,
-            &self.objects,
-            &mut self.timer,
-        )?;
+        self.exec.run(ctx, &self.blueprint.plan, &self.frame, &self.objects, &mut self.timer)?;
         let pass_times = self.timer.read(ctx)?;
         let image = self.read_output(ctx)?;
         Ok(Frame { image, pass_times })
@@ -611,28 +486,20 @@ impl Renderer {
     /// Renders without reading the image back (benchmarks); returns per-pass GPU times.
     pub fn render_timed(&mut self, ctx: &GpuContext) -> Result<Vec<(String, f64)>> {
         self.timer.reset();
-        self.exec.run(
-            ctx,
-            &self.blueprint.plan,
-            &self.frame,
-            &self.objects,
-            &mut self.timer,
-        )?;
+        self.exec.run(ctx, &self.blueprint.plan, &self.frame, &self.objects, &mut self.timer)?;
         ctx.wait()?;
         self.timer.read(ctx)
     }
 
     fn read_output(&self, ctx: &GpuContext) -> Result<Image> {
         let name = &self.blueprint.graph.file.outputs[0];
-        let texture = self
-            .exec
-            .texture(name)
-            .ok_or_else(|| Error::Invalid(format!("output `{name}` was pruned")))?;
+        let texture =
+            self.exec.texture(name).ok_or_else(|| Error::Invalid(format!("output `{name}` was pruned")))?;
         if texture.format() != wgpu::TextureFormat::Rgba32Float {
-            return Err(self.blueprint.graph.error_at(
-                name,
-                format!("output `{name}` must be Rgba32Float to be read back"),
-            ));
+            return Err(self
+                .blueprint
+                .graph
+                .error_at(name, format!("output `{name}` must be Rgba32Float to be read back")));
         }
         let (w, h) = self.blueprint.size;
         let mut enc = ctx.device.create_command_encoder(&Default::default());
@@ -646,11 +513,7 @@ impl Renderer {
                     rows_per_image: Some(h),
                 },
             },
-            wgpu::Extent3d {
-                width: w,
-                height: h,
-                depth_or_array_layers: 1,
-            },
+            wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
         );
         ctx.queue.submit([enc.finish()]);
         let bytes = ctx.map_read(&self.readback)?;
@@ -675,57 +538,25 @@ fn padded_row(w: u32) -> u32 {
     (w * 16).div_ceil(256) * 256
 }
 
-fn object_inputs(
-    ctx: &GpuContext,
-    bp: &Blueprint,
-    o: &ObjectPlan,
-    baked: &[bake::Baked],
-) -> Inputs {
+fn object_inputs(ctx: &GpuContext, bp: &Blueprint, o: &ObjectPlan, baked: &[bake::Baked]) -> Inputs {
     let mut inputs = Inputs::default();
-    inputs
-        .constants
-        .push(("per_pixel_lighting".into(), o.per_pixel as u32 as f64));
+    inputs.constants.push(("per_pixel_lighting".into(), o.per_pixel as u32 as f64));
     let opacity_length = o.bake.map(|b| bp.bakes[b].opacity_length).unwrap_or(1.0);
     let c = o.object.base_color.unwrap_or([0.0; 3]);
-    let params = ObjectParams {
-        base_color: [c[0], c[1], c[2], 1.0],
-        opacity_length,
-        _pad: [0.0; 3],
-    };
-    inputs.buffers.insert(
-        "object".into(),
-        bake::uniform(ctx, "object", bytemuck::bytes_of(&params)),
-    );
-    inputs
-        .counts
-        .insert("prisms".into(), o.shell.prisms.len() as u32);
+    let params = ObjectParams { base_color: [c[0], c[1], c[2], 1.0], opacity_length, _pad: [0.0; 3] };
+    inputs.buffers.insert("object".into(), bake::uniform(ctx, "object", bytemuck::bytes_of(&params)));
+    inputs.counts.insert("prisms".into(), o.shell.prisms.len() as u32);
     if let Some(base) = &o.base {
-        inputs.buffers.insert(
-            "base_vertices".into(),
-            bake::storage(ctx, "base_vertices", bytemuck::cast_slice(base)),
-        );
         inputs
-            .counts
-            .insert("base_vertices".into(), base.len() as u32);
+            .buffers
+            .insert("base_vertices".into(), bake::storage(ctx, "base_vertices", bytemuck::cast_slice(base)));
+        inputs.counts.insert("base_vertices".into(), base.len() as u32);
     }
     if let Some((params, capacity)) = &o.slicing {
-        view_slices::add_inputs(
-            ctx,
-            &mut inputs,
-            &o.shell,
-            params,
-            *capacity,
-            o.trivial_reject,
-        );
+        view_slices::add_inputs(ctx, &mut inputs, &o.shell, params, *capacity, o.trivial_reject);
         if let Some(b) = o.bake {
-            inputs.views.insert(
-                "volume".into(),
-                baked[b].volume.create_view(&Default::default()),
-            );
-            inputs.views.insert(
-                "normals".into(),
-                baked[b].normals.create_view(&Default::default()),
-            );
+            inputs.views.insert("volume".into(), baked[b].volume.create_view(&Default::default()));
+            inputs.views.insert("normals".into(), baked[b].normals.create_view(&Default::default()));
         }
     }
     inputs
@@ -735,10 +566,7 @@ impl Renderer {
     /// EXR metadata: scene, methods and their quality knobs, adapter, GPU time.
     pub fn metadata(&self, ctx: &GpuContext, frame: &Frame) -> Vec<(String, String)> {
         let mut m = vec![
-            (
-                "voltex_scene".to_string(),
-                self.blueprint.scene_path.display().to_string(),
-            ),
+            ("voltex_scene".to_string(), self.blueprint.scene_path.display().to_string()),
             ("voltex_adapter".to_string(), ctx.adapter_line()),
         ];
         if let Some(t) = frame.gpu_ms() {
@@ -763,53 +591,16 @@ impl Renderer {
 /// A scene shape as the bake kernels take it: (shape, albedo, opacity).
 fn bake_shape(s: &Shape) -> (BakeShape, [f32; 3], f32) {
     match s {
-        Shape::Sphere {
-            center,
-            radius,
-            color,
-            opacity,
-        } => (
-            BakeShape::Sphere {
-                center: *center,
-                radius: *radius,
-            },
-            *color,
-            *opacity,
-        ),
-        Shape::Torus {
-            center,
-            major,
-            minor,
-            color,
-            opacity,
-        } => (
-            BakeShape::Torus {
-                center: *center,
-                major: *major,
-                minor: *minor,
-            },
-            *color,
-            *opacity,
-        ),
-        Shape::Ellipsoid {
-            center,
-            radii,
-            color,
-            opacity,
-        } => (
-            BakeShape::Ellipsoid {
-                center: *center,
-                radii: *radii,
-            },
-            *color,
-            *opacity,
-        ),
-        Shape::Metaballs {
-            balls,
-            threshold,
-            color,
-            opacity,
-        } => (
+        Shape::Sphere { center, radius, color, opacity } => {
+            (BakeShape::Sphere { center: *center, radius: *radius }, *color, *opacity)
+        }
+        Shape::Torus { center, major, minor, color, opacity } => {
+            (BakeShape::Torus { center: *center, major: *major, minor: *minor }, *color, *opacity)
+        }
+        Shape::Ellipsoid { center, radii, color, opacity } => {
+            (BakeShape::Ellipsoid { center: *center, radii: *radii }, *color, *opacity)
+        }
+        Shape::Metaballs { balls, threshold, color, opacity } => (
             BakeShape::Metaballs {
                 balls: balls.iter().map(|b| (b.center, b.radius)).collect(),
                 threshold: *threshold,

@@ -27,8 +27,7 @@ fn temp_dir(test: &str) -> PathBuf {
 /// hold a binary built elsewhere, and the compiled-in root would then be another checkout).
 fn voltex(args: &[&str], voltex_root: Option<&Path>) -> Output {
     let mut cmd = Command::new(BIN);
-    cmd.args(args)
-        .env("VOLTEX_ROOT", voltex_root.unwrap_or(&root()));
+    cmd.args(args).env("VOLTEX_ROOT", voltex_root.unwrap_or(&root()));
     if std::env::var_os("XDG_RUNTIME_DIR").is_none() {
         cmd.env("XDG_RUNTIME_DIR", std::env::temp_dir());
     }
@@ -38,23 +37,14 @@ fn voltex(args: &[&str], voltex_root: Option<&Path>) -> Output {
 /// `voltex render SCENE -o DIR/out/out.exr --size 64x64 EXTRA...`.
 fn render(dir: &Path, scene: &Path, extra: &[&str], voltex_root: Option<&Path>) -> Output {
     let out = dir.join("out/out.exr");
-    let mut args = vec![
-        "render",
-        scene.to_str().unwrap(),
-        "-o",
-        out.to_str().unwrap(),
-        "--size",
-        "64x64",
-    ];
+    let mut args = vec!["render", scene.to_str().unwrap(), "-o", out.to_str().unwrap(), "--size", "64x64"];
     args.extend_from_slice(extra);
     voltex(&args, voltex_root)
 }
 
 /// 1-based `line:col` of the first occurrence of `needle` in `text`.
 fn line_col(text: &str, needle: &str) -> String {
-    let at = text
-        .find(needle)
-        .unwrap_or_else(|| panic!("{needle:?} not in the text"));
+    let at = text.find(needle).unwrap_or_else(|| panic!("{needle:?} not in the text"));
     let before = &text[..at];
     let line = before.matches('\n').count() + 1;
     let col = at - before.rfind('\n').map(|i| i + 1).unwrap_or(0) + 1;
@@ -78,11 +68,7 @@ fn entries(dir: &Path) -> Vec<String> {
 #[track_caller]
 fn assert_fails(out: &Output, dir: &Path, words: &[&str]) {
     let err = stderr(out);
-    assert_eq!(
-        out.status.code(),
-        Some(1),
-        "expected exit status 1; stderr:\n{err}"
-    );
+    assert_eq!(out.status.code(), Some(1), "expected exit status 1; stderr:\n{err}");
     assert!(!err.contains("panicked"), "panic:\n{err}");
     assert!(err.starts_with("error: "), "stderr:\n{err}");
     for w in words {
@@ -174,26 +160,15 @@ fn output_size_out_of_range() {
     let scene = dir.join("scene.ron");
     std::fs::write(&scene, &text).unwrap();
     // No --size: the scene's size counts.
-    let out = voltex(
-        &[
-            "render",
-            scene.to_str().unwrap(),
-            "-o",
-            dir.join("out/out.exr").to_str().unwrap(),
-        ],
-        None,
-    );
+    let out =
+        voltex(&["render", scene.to_str().unwrap(), "-o", dir.join("out/out.exr").to_str().unwrap()], None);
     let loc = format!("{}:{}: ", scene.display(), line_col(&text, "100000"));
     assert_fails(&out, &dir, &[&loc, "100000"]);
 }
 
 #[test]
 fn texel_resolution_too_large() {
-    let text = replaced(
-        &flat_box(),
-        "resolution: (8, 8, 8)",
-        "resolution: (8, 2048, 8)",
-    );
+    let text = replaced(&flat_box(), "resolution: (8, 8, 8)", "resolution: (8, 2048, 8)");
     assert_scene_error("resolution", &text, "2048", &["2048"]);
 }
 
@@ -205,11 +180,7 @@ fn unknown_texel() {
 
 #[test]
 fn missing_obj_file() {
-    let text = replaced(
-        &flat_box(),
-        "Plane(size: (2.0, 2.0), cells: (4, 4))",
-        "Obj(path: \"missing.obj\")",
-    );
+    let text = replaced(&flat_box(), "Plane(size: (2.0, 2.0), cells: (4, 4))", "Obj(path: \"missing.obj\")");
     assert_scene_error("obj_missing", &text, "\"missing.obj\"", &["missing.obj"]);
 }
 
@@ -218,11 +189,7 @@ fn obj_face_index_out_of_range() {
     let dir = temp_dir("obj_face");
     let obj = dir.join("tri.obj");
     std::fs::write(&obj, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 7\n").unwrap();
-    let text = replaced(
-        &flat_box(),
-        "Plane(size: (2.0, 2.0), cells: (4, 4))",
-        "Obj(path: \"tri.obj\")",
-    );
+    let text = replaced(&flat_box(), "Plane(size: (2.0, 2.0), cells: (4, 4))", "Obj(path: \"tri.obj\")");
     let scene = dir.join("scene.ron");
     std::fs::write(&scene, text).unwrap();
     let out = render(&dir, &scene, &[], None);
@@ -235,11 +202,7 @@ fn degenerate_obj_is_an_error_or_a_warning() {
     // All three corners on a line: no area, no normal.
     let dir = temp_dir("obj_degenerate");
     std::fs::write(dir.join("line.obj"), "v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n").unwrap();
-    let text = replaced(
-        &flat_box(),
-        "Plane(size: (2.0, 2.0), cells: (4, 4))",
-        "Obj(path: \"line.obj\")",
-    );
+    let text = replaced(&flat_box(), "Plane(size: (2.0, 2.0), cells: (4, 4))", "Obj(path: \"line.obj\")");
     let scene = dir.join("scene.ron");
     std::fs::write(&scene, text).unwrap();
     let out = render(&dir, &scene, &[], None);
@@ -247,10 +210,7 @@ fn degenerate_obj_is_an_error_or_a_warning() {
     assert!(!err.contains("panicked"), "{err}");
     // Today: warnings naming the degenerate triangles, and an empty image.
     if out.status.code() == Some(0) {
-        assert!(
-            err.contains("warning:") && err.contains("degenerate"),
-            "{err}"
-        );
+        assert!(err.contains("warning:") && err.contains("degenerate"), "{err}");
     } else {
         assert_fails(&out, &dir, &["line.obj"]);
     }
@@ -270,17 +230,8 @@ fn missing_scene_file() {
 fn missing_output_folder() {
     let dir = temp_dir("no_out_dir");
     let scene = root().join("scenes/view_slices/flat_box.ron");
-    let out = voltex(
-        &[
-            "render",
-            scene.to_str().unwrap(),
-            "-o",
-            "/nonexistent/dir/x.exr",
-            "--size",
-            "64x64",
-        ],
-        None,
-    );
+    let out =
+        voltex(&["render", scene.to_str().unwrap(), "-o", "/nonexistent/dir/x.exr", "--size", "64x64"], None);
     assert_fails(&out, &dir, &["/nonexistent/dir", "does not exist"]);
     assert!(!Path::new("/nonexistent/dir").exists());
 }
@@ -292,15 +243,7 @@ fn output_folder_is_a_file() {
     std::fs::write(&file, "x").unwrap();
     let scene = root().join("scenes/view_slices/flat_box.ron");
     let target = file.join("x.exr");
-    let out = voltex(
-        &[
-            "render",
-            scene.to_str().unwrap(),
-            "-o",
-            target.to_str().unwrap(),
-        ],
-        None,
-    );
+    let out = voltex(&["render", scene.to_str().unwrap(), "-o", target.to_str().unwrap()], None);
     assert_fails(&out, &dir, &[file.to_str().unwrap()]);
     assert_eq!(std::fs::read_to_string(&file).unwrap(), "x");
 }
@@ -346,10 +289,7 @@ fn slice_buffer_beyond_the_storage_binding_limit() {
     let text = String::from_utf8_lossy(&info.stdout).into_owned();
     let limit: u64 = text
         .lines()
-        .find(|l| {
-            l.trim_start()
-                .starts_with("max_storage_buffer_binding_size")
-        })
+        .find(|l| l.trim_start().starts_with("max_storage_buffer_binding_size"))
         .and_then(|l| l.split_whitespace().last())
         .and_then(|v| v.parse().ok())
         .expect("voltex info prints max_storage_buffer_binding_size");
@@ -397,11 +337,7 @@ fn wgsl_parse_error_names_the_wgsl_file() {
     let loc = line_col(&broken, "= textureLoad");
     let scene = root().join("scenes/view_slices/flat_box.ron");
     let out = render(&dir, &scene, &[], Some(&r));
-    assert_fails(
-        &out,
-        &dir,
-        &[&format!("error: {}:{loc}: ", path.display()), "WGSL"],
-    );
+    assert_fails(&out, &dir, &[&format!("error: {}:{loc}: ", path.display()), "WGSL"]);
     // `plan` compiles the kernels too and reports the same error.
     let out = voltex(&["plan", scene.to_str().unwrap()], Some(&r));
     assert_fails(&out, &dir, &[&format!("{}:{loc}: ", path.display())]);
@@ -429,22 +365,10 @@ fn graph_naming_a_missing_shader() {
     let text = replaced(&text, "\"composite.wgsl\"", "\"compost.wgsl\"");
     std::fs::write(&graph, &text).unwrap();
     let scene = root().join("scenes/view_slices/flat_box.ron");
-    let loc = format!(
-        "error: {}:{}: ",
-        graph.display(),
-        line_col(&text, "\"compost")
-    );
+    let loc = format!("error: {}:{}: ", graph.display(), line_col(&text, "\"compost"));
     let out = render(&dir, &scene, &["--graph", graph.to_str().unwrap()], None);
     assert_fails(&out, &dir, &[&loc, "compost.wgsl"]);
-    let out = voltex(
-        &[
-            "plan",
-            scene.to_str().unwrap(),
-            "--graph",
-            graph.to_str().unwrap(),
-        ],
-        None,
-    );
+    let out = voltex(&["plan", scene.to_str().unwrap(), "--graph", graph.to_str().unwrap()], None);
     assert_fails(&out, &dir, &[&loc]);
 }
 
@@ -468,19 +392,11 @@ fn wgsl_global_nothing_provides() {
         "var hdr: texture_2d<f32>;",
         "var hdr: texture_2d<f32>;\n@group(0) @binding(7) var<storage, read> mystery: array<f32>;",
     );
-    let text = replaced(
-        &text,
-        "return vec4<f32>(c.rgb",
-        "return mystery[0] * vec4<f32>(c.rgb",
-    );
+    let text = replaced(&text, "return vec4<f32>(c.rgb", "return mystery[0] * vec4<f32>(c.rgb");
     std::fs::write(&path, &text).unwrap();
     let graph = r.join("graphs/frame.ron");
     let graph_text = std::fs::read_to_string(&graph).unwrap();
-    let loc = format!(
-        "error: {}:{}: ",
-        graph.display(),
-        line_col(&graph_text, "\"composite\"")
-    );
+    let loc = format!("error: {}:{}: ", graph.display(), line_col(&graph_text, "\"composite\""));
     let scene = root().join("scenes/view_slices/flat_box.ron");
     let out = render(&dir, &scene, &[], Some(&r));
     assert_fails(&out, &dir, &[&loc, "`composite`", "`mystery`"]);
@@ -493,17 +409,8 @@ fn render_writes_exr_and_png_with_metadata() {
     let dir = temp_dir("ok");
     let scene = root().join("scenes/view_slices/flat_box.ron");
     let exr = dir.join("out/out.exr");
-    let out = voltex(
-        &[
-            "render",
-            scene.to_str().unwrap(),
-            "-o",
-            exr.to_str().unwrap(),
-            "--size",
-            "32x32",
-        ],
-        None,
-    );
+    let out =
+        voltex(&["render", scene.to_str().unwrap(), "-o", exr.to_str().unwrap(), "--size", "32x32"], None);
     assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
     assert_eq!(entries(&dir.join("out")), ["out.exr", "out.png"]);
     let (image, meta) = voltex::io::exr::read(&exr).unwrap();
@@ -512,26 +419,14 @@ fn render_writes_exr_and_png_with_metadata() {
     for k in ["voltex_adapter", "voltex_scene"] {
         assert!(keys.contains(&k), "{k} not in {keys:?}");
     }
-    assert!(
-        keys.iter().any(|k| k.starts_with("voltex_object_")),
-        "{keys:?}"
-    );
+    assert!(keys.iter().any(|k| k.starts_with("voltex_object_")), "{keys:?}");
     // Some fog is visible: the centre is not the black background.
     let c = image.get(16, 16);
     assert!(c[0] > 0.0 && c[3] > 0.0, "{c:?}");
 
     // Rendering again over existing files replaces them, still nothing else in the folder.
-    let out = voltex(
-        &[
-            "render",
-            scene.to_str().unwrap(),
-            "-o",
-            exr.to_str().unwrap(),
-            "--size",
-            "16x16",
-        ],
-        None,
-    );
+    let out =
+        voltex(&["render", scene.to_str().unwrap(), "-o", exr.to_str().unwrap(), "--size", "16x16"], None);
     assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
     assert_eq!(entries(&dir.join("out")), ["out.exr", "out.png"]);
     assert_eq!(voltex::io::exr::read(&exr).unwrap().0.width, 16);
@@ -547,10 +442,7 @@ fn failed_render_keeps_previous_output() {
     let out = render(&dir, &scene, &[], None);
     assert_eq!(out.status.code(), Some(1));
     assert_eq!(entries(&dir.join("out")), ["out.exr"]);
-    assert_eq!(
-        std::fs::read_to_string(dir.join("out/out.exr")).unwrap(),
-        "old"
-    );
+    assert_eq!(std::fs::read_to_string(dir.join("out/out.exr")).unwrap(), "old");
 }
 
 // ---- plan ----
@@ -588,31 +480,10 @@ fn plan_prints_passes_pruning_and_memory_without_a_gpu() {
     ] {
         assert!(text.contains(s), "{s:?} not in:\n{text}");
     }
-    let passes = text
-        .split("passes (in order):")
-        .nth(1)
-        .unwrap()
-        .split("\n\n")
-        .next()
-        .unwrap();
-    let order: Vec<&str> = passes
-        .lines()
-        .filter_map(|l| l.split_whitespace().next())
-        .collect();
-    assert_eq!(
-        order,
-        [
-            "count_slices",
-            "scan_plane_offsets",
-            "emit_slices",
-            "draw_slices",
-            "composite"
-        ]
-    );
-    let total = text
-        .lines()
-        .find(|l| l.trim_end().ends_with("MiB  total"))
-        .unwrap();
+    let passes = text.split("passes (in order):").nth(1).unwrap().split("\n\n").next().unwrap();
+    let order: Vec<&str> = passes.lines().filter_map(|l| l.split_whitespace().next()).collect();
+    assert_eq!(order, ["count_slices", "scan_plane_offsets", "emit_slices", "draw_slices", "composite"]);
+    let total = text.lines().find(|l| l.trim_end().ends_with("MiB  total")).unwrap();
     let mib: f64 = total.split_whitespace().next().unwrap().parse().unwrap();
     assert!(mib > 0.0, "{total}");
 }

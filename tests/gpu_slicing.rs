@@ -18,9 +18,7 @@ use voltex::types::{SliceParams, SliceVertex};
 
 fn ctx() -> &'static GpuContext {
     static CTX: OnceLock<GpuContext> = OnceLock::new();
-    CTX.get_or_init(|| {
-        GpuContext::new().expect("a GPU adapter (software Vulkan: mesa-vulkan-drivers)")
-    })
+    CTX.get_or_init(|| GpuContext::new().expect("a GPU adapter (software Vulkan: mesa-vulkan-drivers)"))
 }
 
 /// Runs the slicing kernels through the `slices_only` graph and reads the polygons back.
@@ -28,11 +26,7 @@ fn gpu_slices(shell: &Shell, params: &SliceParams, trivial_reject: bool) -> Vec<
     let ctx = ctx();
     let root = voltex::project_root();
     let graph = Graph::load(&root.join("graphs/slices_only.ron")).unwrap();
-    let info = ObjectInfo {
-        name: "shell".into(),
-        filters: vec!["ViewSlices"],
-        distance: 0.0,
-    };
+    let info = ObjectInfo { name: "shell".into(), filters: vec!["ViewSlices"], distance: 0.0 };
     let plan = plan::plan(&graph, &root.join("wgsl"), &[info]).unwrap();
     assert_eq!(plan.passes.len(), 3);
     let mut exec = Executor::new(ctx, graph, &plan, (1, 1)).unwrap();
@@ -42,14 +36,7 @@ fn gpu_slices(shell: &Shell, params: &SliceParams, trivial_reject: bool) -> Vec<
     let mut inputs = Inputs::default();
     view_slices::add_inputs(ctx, &mut inputs, shell, &params, capacity, trivial_reject);
     let mut timer = Timer::new(ctx, 4);
-    exec.run(
-        ctx,
-        &plan,
-        &Inputs::default(),
-        std::slice::from_ref(&inputs),
-        &mut timer,
-    )
-    .unwrap();
+    exec.run(ctx, &plan, &Inputs::default(), std::slice::from_ref(&inputs), &mut timer).unwrap();
     view_slices::read_back(ctx, &inputs, params.plane_count).unwrap()
 }
 
@@ -76,10 +63,7 @@ fn compare(shell: &Shell, params: &SliceParams, trivial_reject: bool, ambiguous:
         let (g, c) = (by_prism(g), by_prism(c));
         let prisms: std::collections::BTreeSet<u32> = g.keys().chain(c.keys()).copied().collect();
         for p in prisms {
-            let (gv, cv) = (
-                g.get(&p).cloned().unwrap_or_default(),
-                c.get(&p).cloned().unwrap_or_default(),
-            );
+            let (gv, cv) = (g.get(&p).cloned().unwrap_or_default(), c.get(&p).cloned().unwrap_or_default());
             if gv.len() != cv.len() {
                 let prism = &shell.prisms[p as usize];
                 let near = prism.vertices[..3].iter().any(|&v| {
@@ -88,12 +72,7 @@ fn compare(shell: &Shell, params: &SliceParams, trivial_reject: bool, ambiguous:
                         .iter()
                         .any(|x| (n.dot(glam::Vec3::from_slice(&x[..3])) - d).abs() <= ambiguous)
                 });
-                assert!(
-                    near,
-                    "plane {k} prism {p}: GPU {} vertices, CPU {} vertices",
-                    gv.len(),
-                    cv.len()
-                );
+                assert!(near, "plane {k} prism {p}: GPU {} vertices, CPU {} vertices", gv.len(), cv.len());
                 continue;
             }
             for (a, b) in gv.iter().zip(&cv) {
@@ -103,10 +82,7 @@ fn compare(shell: &Shell, params: &SliceParams, trivial_reject: bool, ambiguous:
                         (a.position[i] - b.position[i]).abs() <= tol,
                         "plane {k} prism {p}: {a:?} vs {b:?}"
                     );
-                    assert!(
-                        (a.uvw[i] - b.uvw[i]).abs() <= 1e-5,
-                        "plane {k} prism {p}: {a:?} vs {b:?}"
-                    );
+                    assert!((a.uvw[i] - b.uvw[i]).abs() <= 1e-5, "plane {k} prism {p}: {a:?} vs {b:?}");
                 }
                 assert!(a.position.iter().chain(&a.uvw).all(|x| x.is_finite()));
             }
@@ -131,17 +107,9 @@ fn random_shell(seed: u64, cells: u32) -> BaseSurface {
     let mut heights = Vec::new();
     for j in 0..n {
         for i in 0..n {
-            let p = DVec3::new(
-                i as f64 + 0.3 * rng(&mut s),
-                j as f64 + 0.3 * rng(&mut s),
-                0.4 * rng(&mut s),
-            );
+            let p = DVec3::new(i as f64 + 0.3 * rng(&mut s), j as f64 + 0.3 * rng(&mut s), 0.4 * rng(&mut s));
             positions.push(p);
-            heights.push(DVec3::new(
-                0.3 * (rng(&mut s) - 0.5),
-                0.3 * (rng(&mut s) - 0.5),
-                0.3 + rng(&mut s),
-            ));
+            heights.push(DVec3::new(0.3 * (rng(&mut s) - 0.5), 0.3 * (rng(&mut s) - 0.5), 0.3 + rng(&mut s)));
         }
     }
     let mut triangles = Vec::new();
@@ -156,22 +124,12 @@ fn random_shell(seed: u64, cells: u32) -> BaseSurface {
             corner_uvs.push([uv(i, j), uv(i + 1, j + 1), uv(i, j + 1)]);
         }
     }
-    BaseSurface {
-        positions,
-        heights,
-        triangles,
-        corner_uvs,
-    }
+    BaseSurface { positions, heights, triangles, corner_uvs }
 }
 
 fn oblique_params(shell: &Shell, dir: DVec3, planes: u32) -> SliceParams {
     let d = dir.normalize();
-    view_slices::sweep(
-        shell,
-        [d.x as f32, d.y as f32, d.z as f32],
-        planes,
-        f64::NEG_INFINITY,
-    )
+    view_slices::sweep(shell, [d.x as f32, d.y as f32, d.z as f32], planes, f64::NEG_INFINITY)
 }
 
 #[test]
@@ -223,16 +181,8 @@ fn hard_cases_match_the_cpu_twin_exactly() {
     let up = [DVec3::Z; 3];
     let cases: Vec<(&str, Shell, Vec<SliceParams>)> = vec![
         // Axis-aligned planes keep every signed distance exact on both sides.
-        (
-            "plane through a vertex",
-            unit_prism(up, base),
-            explicit_planes([1.0, 0.0, 0.0], &[1.0, 0.0]),
-        ),
-        (
-            "plane through an edge",
-            unit_prism(up, base),
-            explicit_planes([0.0, 1.0, 0.0], &[0.0]),
-        ),
+        ("plane through a vertex", unit_prism(up, base), explicit_planes([1.0, 0.0, 0.0], &[1.0, 0.0])),
+        ("plane through an edge", unit_prism(up, base), explicit_planes([0.0, 1.0, 0.0], &[0.0])),
         (
             "plane containing a normal edge",
             unit_prism(up, base),
@@ -259,26 +209,12 @@ fn hard_cases_match_the_cpu_twin_exactly() {
             let gpu = gpu_slices(&shell, &params, true);
             let cpu = slice_prisms::slice_all(&shell.vertices, &shell.prisms, &params, true);
             assert_eq!(gpu.len(), 1);
-            assert_eq!(
-                gpu[0].len(),
-                cpu[0].len(),
-                "{name}, d = {}: vertex counts",
-                params.first_plane
-            );
+            assert_eq!(gpu[0].len(), cpu[0].len(), "{name}, d = {}: vertex counts", params.first_plane);
             for (a, b) in gpu[0].iter().zip(&cpu[0]) {
-                assert!(
-                    a.position.iter().chain(&a.uvw).all(|x| x.is_finite()),
-                    "{name}: non-finite vertex"
-                );
+                assert!(a.position.iter().chain(&a.uvw).all(|x| x.is_finite()), "{name}: non-finite vertex");
                 for i in 0..3 {
-                    assert!(
-                        (a.position[i] - b.position[i]).abs() <= 1e-6,
-                        "{name}: {a:?} vs {b:?}"
-                    );
-                    assert!(
-                        (a.uvw[i] - b.uvw[i]).abs() <= 1e-6,
-                        "{name}: {a:?} vs {b:?}"
-                    );
+                    assert!((a.position[i] - b.position[i]).abs() <= 1e-6, "{name}: {a:?} vs {b:?}");
+                    assert!((a.uvw[i] - b.uvw[i]).abs() <= 1e-6, "{name}: {a:?} vs {b:?}");
                 }
             }
         }
@@ -309,13 +245,7 @@ fn slices_are_ordered_back_to_front_and_lie_on_their_planes() {
 type PolygonEdge = ([u32; 3], [u32; 3], u32, f32, f32);
 
 fn polygon_edges(plane: &[SliceVertex]) -> Vec<PolygonEdge> {
-    let key = |v: &SliceVertex| {
-        [
-            v.position[0].to_bits(),
-            v.position[1].to_bits(),
-            v.position[2].to_bits(),
-        ]
-    };
+    let key = |v: &SliceVertex| [v.position[0].to_bits(), v.position[1].to_bits(), v.position[2].to_bits()];
     let mut out = Vec::new();
     for (prism, verts) in by_prism(plane) {
         // Fan (0, i, i+1): the polygon is v0, then the second vertex of each triangle, then the last.
@@ -340,10 +270,7 @@ fn polygon_edges(plane: &[SliceVertex]) -> Vec<PolygonEdge> {
 fn closed_shells_have_watertight_slices() {
     for (surface, allowed) in [
         ("Sphere(radius: 1.0, segments: (12, 6))", 0.0),
-        (
-            "Torus(major: 1.0, minor: 0.4, segments: (16, 8), distortion: 0.15, seed: 2)",
-            0.002,
-        ),
+        ("Torus(major: 1.0, minor: 0.4, segments: (16, 8), distortion: 0.15, seed: 2)", 0.002),
     ] {
         let src = format!(
             r#"Scene(output: (width: 64, height: 64), camera: (eye: (0.4, -3.0, 1.7), target: (0.0, 0.0, 0.0)),
@@ -355,12 +282,8 @@ fn closed_shells_have_watertight_slices() {
         let eye = scene.camera.eye;
         let forward = (scene.camera.target - eye).normalize();
         let shell = Shell::new(&objects[0].surface, eye);
-        let params = view_slices::sweep(
-            &shell,
-            [forward.x as f32, forward.y as f32, forward.z as f32],
-            64,
-            0.0,
-        );
+        let params =
+            view_slices::sweep(&shell, [forward.x as f32, forward.y as f32, forward.z as f32], 64, 0.0);
         let gpu = gpu_slices(&shell, &params, true);
         let (mut shared, mut caps, mut unpaired) = (0, 0, 0);
         for (k, plane) in gpu.iter().enumerate() {
@@ -372,9 +295,7 @@ fn closed_shells_have_watertight_slices() {
                 let twins: Vec<u32> = edges
                     .iter()
                     .enumerate()
-                    .filter(|(j, e)| {
-                        *j != i && ((e.0 == *b && e.1 == *a) || (e.0 == *a && e.1 == *b))
-                    })
+                    .filter(|(j, e)| *j != i && ((e.0 == *b && e.1 == *a) || (e.0 == *a && e.1 == *b)))
                     .map(|(_, e)| e)
                     .map(|e| e.2)
                     .collect();
@@ -383,21 +304,15 @@ fn closed_shells_have_watertight_slices() {
                     [other] if *other != *prism => shared += 1,
                     [] if on_cap(*wa) && on_cap(*wb) && (wa - wb).abs() < 1e-5 => caps += 1,
                     [] => unpaired += 1,
-                    _ => panic!("{surface}: plane {k} prism {prism}: edge shared by {twins:?} (w {wa}, {wb})"),
+                    _ => {
+                        panic!("{surface}: plane {k} prism {prism}: edge shared by {twins:?} (w {wa}, {wb})")
+                    }
                 }
             }
         }
-        eprintln!(
-            "{surface}: {shared} shared edges, {caps} cap edges, {unpaired} unpaired lateral edges"
-        );
-        assert!(
-            shared > 500 && caps > 100,
-            "{surface}: {shared} shared edges, {caps} cap edges"
-        );
+        eprintln!("{surface}: {shared} shared edges, {caps} cap edges, {unpaired} unpaired lateral edges");
+        assert!(shared > 500 && caps > 100, "{surface}: {shared} shared edges, {caps} cap edges");
         let fraction = unpaired as f64 / (shared + caps + unpaired) as f64;
-        assert!(
-            fraction <= allowed,
-            "{surface}: {unpaired} unpaired lateral edges ({fraction})"
-        );
+        assert!(fraction <= allowed, "{surface}: {unpaired} unpaired lateral edges ({fraction})");
     }
 }

@@ -87,11 +87,7 @@ fn objects(filters: &[&[&'static str]]) -> Vec<ObjectInfo> {
     filters
         .iter()
         .enumerate()
-        .map(|(i, f)| ObjectInfo {
-            name: format!("o{i}"),
-            filters: f.to_vec(),
-            distance: i as f64,
-        })
+        .map(|(i, f)| ObjectInfo { name: format!("o{i}"), filters: f.to_vec(), distance: i as f64 })
         .collect()
 }
 
@@ -100,19 +96,13 @@ fn names(p: &Plan) -> Vec<&str> {
 }
 
 fn pos(order: &[&str], name: &str) -> usize {
-    order
-        .iter()
-        .position(|n| *n == name)
-        .unwrap_or_else(|| panic!("{name} not in {order:?}"))
+    order.iter().position(|n| *n == name).unwrap_or_else(|| panic!("{name} not in {order:?}"))
 }
 
 #[track_caller]
 fn assert_err(e: voltex::Error, at: &str, words: &[&str]) {
     let msg = e.to_string();
-    assert!(
-        msg.starts_with(&format!("{at}: ")),
-        "expected an error at {at}, got: {msg}"
-    );
+    assert!(msg.starts_with(&format!("{at}: ")), "expected an error at {at}, got: {msg}");
     for w in words {
         assert!(msg.contains(w), "expected {w:?} in: {msg}");
     }
@@ -123,22 +113,10 @@ fn assert_err(e: voltex::Error, at: &str, words: &[&str]) {
 #[test]
 fn frame_graph_parses_and_plans() {
     let g = Graph::load(&root().join("graphs/frame.ron")).unwrap();
-    let p = plan(
-        &g,
-        &wgsl_root(),
-        &objects(&[&["ViewSlices", "BaseSurface"]]),
-    )
-    .unwrap();
+    let p = plan(&g, &wgsl_root(), &objects(&[&["ViewSlices", "BaseSurface"]])).unwrap();
     assert_eq!(
         names(&p),
-        [
-            "draw_base",
-            "count_slices",
-            "scan_plane_offsets",
-            "emit_slices",
-            "draw_slices",
-            "composite"
-        ]
+        ["draw_base", "count_slices", "scan_plane_offsets", "emit_slices", "draw_slices", "composite"]
     );
     assert!(p.pruned.is_empty(), "{:?}", p.pruned);
 }
@@ -149,11 +127,7 @@ fn malformed_ron_is_reported_at_line_col() {
     // Drop the closing parenthesis of the composite pass's target tuple.
     let broken = text.replacen("(resource: \"linear\")]", "(resource: \"linear\"]", 1);
     assert_ne!(broken, text);
-    let line = broken
-        .lines()
-        .position(|l| l.contains("(resource: \"linear\"]"))
-        .unwrap()
-        + 1;
+    let line = broken.lines().position(|l| l.contains("(resource: \"linear\"]")).unwrap() + 1;
     let col = broken.lines().nth(line - 1).unwrap().find(']').unwrap() + 1;
     let e = parse(&broken).unwrap_err();
     assert_err(e, &format!("test.ron:{line}:{col}"), &[]);
@@ -168,11 +142,7 @@ fn unknown_pass_field_lists_expected_names() {
     let text = graph_text(&["linear"], "", &[&pass]);
     let line = text.lines().position(|l| l.contains("shadr")).unwrap() + 1;
     let e = parse(&text).unwrap_err();
-    assert_err(
-        e,
-        &format!("test.ron:{line}:13"),
-        &["shadr", "name", "shader", "targets", "draw"],
-    );
+    assert_err(e, &format!("test.ron:{line}:13"), &["shadr", "name", "shader", "targets", "draw"]);
 }
 
 #[test]
@@ -180,19 +150,9 @@ fn unknown_object_filter_is_reported_at_the_filter() {
     let pass = EMIT.replace("Objects(\"ViewSlices\")", "Objects(\"Spheres\")");
     let text = graph_text(&["linear"], "", &[COMPOSITE, &pass]);
     let line = text.lines().position(|l| l.contains("Spheres")).unwrap() + 1;
-    let col = text
-        .lines()
-        .nth(line - 1)
-        .unwrap()
-        .find("\"Spheres")
-        .unwrap()
-        + 1;
+    let col = text.lines().nth(line - 1).unwrap().find("\"Spheres").unwrap() + 1;
     let e = parse(&text).unwrap_err();
-    assert_err(
-        e,
-        &format!("test.ron:{line}:{col}"),
-        &["Spheres", "ViewSlices", "BaseSurface"],
-    );
+    assert_err(e, &format!("test.ron:{line}:{col}"), &["Spheres", "ViewSlices", "BaseSurface"]);
 }
 
 #[test]
@@ -200,19 +160,9 @@ fn undeclared_render_target_is_an_error() {
     let pass = COMPOSITE.replace("(resource: \"linear\")", "(resource: \"final\")");
     let text = graph_text(&["linear"], "", &[&pass]);
     let line = text.lines().position(|l| l.contains("\"final\"")).unwrap() + 1;
-    let col = text
-        .lines()
-        .nth(line - 1)
-        .unwrap()
-        .find("\"final\"")
-        .unwrap()
-        + 1;
+    let col = text.lines().nth(line - 1).unwrap().find("\"final\"").unwrap() + 1;
     let e = parse(&text).unwrap_err();
-    assert_err(
-        e,
-        &format!("test.ron:{line}:{col}"),
-        &["render target `final`", "resources"],
-    );
+    assert_err(e, &format!("test.ron:{line}:{col}"), &["render target `final`", "resources"]);
     // A depth target too.
     let pass = DRAW_BASE.replace("(resource: \"depth\"", "(resource: \"zbuf\"");
     let e = parse(&graph_text(&["linear"], "", &[&pass])).unwrap_err();
@@ -245,17 +195,12 @@ fn missing_shader_is_reported_at_the_graph() {
 
 #[test]
 fn missing_entry_point_names_the_pass() {
-    let pass = COMPOSITE.replace(
-        "shader: \"composite.wgsl\",",
-        "shader: \"composite.wgsl\", fragment: \"fs_nope\",",
-    );
+    let pass = COMPOSITE
+        .replace("shader: \"composite.wgsl\",", "shader: \"composite.wgsl\", fragment: \"fs_nope\",");
     let g = parse(&graph_text(&["linear"], "", &[&pass])).unwrap();
     let e = plan(&g, &wgsl_root(), &[]).err().unwrap();
     let msg = e.to_string();
-    assert!(
-        msg.starts_with("test.ron:") && msg.contains("composite") && msg.contains("fs_nope"),
-        "{msg}"
-    );
+    assert!(msg.starts_with("test.ron:") && msg.contains("composite") && msg.contains("fs_nope"), "{msg}");
 }
 
 #[test]
@@ -264,10 +209,7 @@ fn unknown_count_is_an_error_before_any_gpu_work() {
     let g = parse(&graph_text(&["linear"], "", &[&pass])).unwrap();
     let e = plan(&g, &wgsl_root(), &[]).err().unwrap();
     let msg = e.to_string();
-    assert!(
-        msg.starts_with("test.ron:") && msg.contains("`tree`") && msg.contains("prisms"),
-        "{msg}"
-    );
+    assert!(msg.starts_with("test.ron:") && msg.contains("`tree`") && msg.contains("prisms"), "{msg}");
 }
 
 // ---- order ----
@@ -278,28 +220,14 @@ fn order_follows_reads_and_writes_not_declaration() {
     // write `plane_cursors`, so their relative order is the declared one (by design).
     let shuffled = [COMPOSITE, DRAW_SLICES, COUNT, SCAN, EMIT, DRAW_BASE];
     let g = parse(&graph_text(&["linear"], "", &shuffled)).unwrap();
-    let p = plan(
-        &g,
-        &wgsl_root(),
-        &objects(&[&["ViewSlices"], &["ViewSlices", "BaseSurface"]]),
-    )
-    .unwrap();
+    let p = plan(&g, &wgsl_root(), &objects(&[&["ViewSlices"], &["ViewSlices", "BaseSurface"]])).unwrap();
     let order = names(&p);
     assert_eq!(order.len(), 6, "{order:?}");
-    let chain = [
-        "count_slices",
-        "scan_plane_offsets",
-        "emit_slices",
-        "draw_slices",
-        "composite",
-    ];
+    let chain = ["count_slices", "scan_plane_offsets", "emit_slices", "draw_slices", "composite"];
     for w in chain.windows(2) {
         assert!(pos(&order, w[0]) < pos(&order, w[1]), "{order:?}");
     }
-    assert!(
-        pos(&order, "draw_base") < pos(&order, "composite"),
-        "{order:?}"
-    );
+    assert!(pos(&order, "draw_base") < pos(&order, "composite"), "{order:?}");
     assert!(
         pos(&order, "draw_base") < pos(&order, "draw_slices"),
         "draw_slices reads the depth draw_base writes: {order:?}"
@@ -316,11 +244,7 @@ fn a_cycle_is_an_error_naming_the_passes() {
     let dir = temp_dir("cycle");
     let w = dir.join("wgsl");
     std::fs::create_dir_all(&w).unwrap();
-    for (file, read, write) in [
-        ("a.wgsl", "x", "y"),
-        ("b.wgsl", "y", "x"),
-        ("c.wgsl", "x", "z"),
-    ] {
+    for (file, read, write) in [("a.wgsl", "x", "y"), ("b.wgsl", "y", "x"), ("c.wgsl", "x", "z")] {
         std::fs::write(
             w.join(file),
             format!(
@@ -343,11 +267,7 @@ fn a_cycle_is_an_error_naming_the_passes() {
     let g = parse(text).unwrap();
     let e = plan(&g, &w, &[]).err().unwrap();
     let msg = e.to_string();
-    assert_err(
-        e,
-        "test.ron:4:23",
-        &["pass_a", "pass_b", "depend on each other"],
-    );
+    assert_err(e, "test.ron:4:23", &["pass_a", "pass_b", "depend on each other"]);
     // pass_c only waits for the cycle; it is not part of it.
     assert!(!msg.contains("pass_c"), "{msg}");
 }
@@ -359,16 +279,9 @@ fn slicing_passes_are_pruned_without_view_slices_objects() {
     let g = Graph::load(&root().join("graphs/frame.ron")).unwrap();
     let p = plan(&g, &wgsl_root(), &objects(&[&["BaseSurface"]])).unwrap();
     assert_eq!(names(&p), ["draw_base", "composite"]);
-    for pass in [
-        "count_slices",
-        "scan_plane_offsets",
-        "emit_slices",
-        "draw_slices",
-    ] {
+    for pass in ["count_slices", "scan_plane_offsets", "emit_slices", "draw_slices"] {
         assert!(
-            p.pruned
-                .iter()
-                .any(|l| l.contains(pass) && l.contains("ViewSlices")),
+            p.pruned.iter().any(|l| l.contains(pass) && l.contains("ViewSlices")),
             "{pass}: {:?}",
             p.pruned
         );
@@ -390,28 +303,17 @@ fn passes_and_resources_reaching_no_output_are_pruned() {
     );
     let g = parse(&text).unwrap();
     let p = plan(&g, &wgsl_root(), &objects(&[&["ViewSlices"]])).unwrap();
-    assert_eq!(
-        names(&p),
-        ["count_slices", "scan_plane_offsets", "emit_slices"]
-    );
+    assert_eq!(names(&p), ["count_slices", "scan_plane_offsets", "emit_slices"]);
     for pass in ["draw_slices", "composite"] {
         assert!(
-            p.pruned
-                .iter()
-                .any(|l| l == &format!("pass {pass}: nothing it writes reaches an output")),
+            p.pruned.iter().any(|l| l == &format!("pass {pass}: nothing it writes reaches an output")),
             "{pass}: {:?}",
             p.pruned
         );
     }
     assert!(p.textures.is_empty(), "{:?}", p.textures.keys());
     for r in ["hdr", "depth", "linear", "unused"] {
-        assert!(
-            p.pruned
-                .iter()
-                .any(|l| l.starts_with(&format!("resource {r}:"))),
-            "{r}: {:?}",
-            p.pruned
-        );
+        assert!(p.pruned.iter().any(|l| l.starts_with(&format!("resource {r}:"))), "{r}: {:?}", p.pruned);
     }
 }
 
@@ -426,9 +328,7 @@ fn unused_texture_is_pruned_in_the_full_frame() {
     let p = plan(&g, &wgsl_root(), &objects(&[&["ViewSlices"]])).unwrap();
     assert!(!p.textures.contains_key("spare"));
     assert!(p.textures.contains_key("hdr") && p.textures.contains_key("linear"));
-    assert!(p
-        .pruned
-        .contains(&"resource spare: no kept pass uses it".to_string()));
+    assert!(p.pruned.contains(&"resource spare: no kept pass uses it".to_string()));
 }
 
 // ---- a new pass in RON + WGSL only ----
@@ -489,15 +389,7 @@ fn new_pass_from_ron_and_wgsl_is_planned_with_reflected_bindings() {
         &["final"],
         "\n        \"final\": Texture(format: Rgba8Unorm),",
         // Declared first: order comes from `linear`.
-        &[
-            POST_PASS,
-            DRAW_BASE,
-            COUNT,
-            SCAN,
-            EMIT,
-            DRAW_SLICES,
-            COMPOSITE,
-        ],
+        &[POST_PASS, DRAW_BASE, COUNT, SCAN, EMIT, DRAW_SLICES, COMPOSITE],
     );
     let g = parse(&text).unwrap();
     let p = plan(&g, &wgsl, &objects(&[&["ViewSlices"]])).unwrap();
@@ -505,11 +397,7 @@ fn new_pass_from_ron_and_wgsl_is_planned_with_reflected_bindings() {
     assert_eq!(order.last(), Some(&"invert"), "{order:?}");
     assert!(order.contains(&"composite"), "{order:?}");
     let inv = p.passes.last().unwrap();
-    let b: Vec<(&str, u32)> = inv
-        .bindings
-        .iter()
-        .map(|b| (b.name.as_str(), b.binding))
-        .collect();
+    let b: Vec<(&str, u32)> = inv.bindings.iter().map(|b| (b.name.as_str(), b.binding)).collect();
     assert_eq!(b, [("linear", 0), ("frame", 3)]);
     assert!(inv.reads.contains("linear") && inv.writes.contains("final"));
     assert!(p.textures.contains_key("final") && p.textures.contains_key("linear"));
@@ -523,23 +411,16 @@ fn new_pass_from_ron_and_wgsl_is_planned_with_reflected_bindings() {
     );
     let p = plan(&parse(&text).unwrap(), &wgsl, &objects(&[&["ViewSlices"]])).unwrap();
     assert!(!names(&p).contains(&"invert"));
-    assert!(p
-        .pruned
-        .contains(&"pass invert: nothing it writes reaches an output".to_string()));
-    assert!(p
-        .pruned
-        .contains(&"resource final: no kept pass uses it".to_string()));
+    assert!(p.pruned.contains(&"pass invert: nothing it writes reaches an output".to_string()));
+    assert!(p.pruned.contains(&"resource final: no kept pass uses it".to_string()));
 }
 
 #[test]
 fn broken_wgsl_is_reported_at_its_line_col() {
     let broken = POST.replace("let c = textureLoad", "let c = = textureLoad");
     let wgsl = wgsl_copy("broken", &[("invert.wgsl", &broken)]);
-    let text = graph_text(
-        &["final"],
-        "\n        \"final\": Texture(format: Rgba8Unorm),",
-        &[COMPOSITE, POST_PASS],
-    );
+    let text =
+        graph_text(&["final"], "\n        \"final\": Texture(format: Rgba8Unorm),", &[COMPOSITE, POST_PASS]);
     let e = plan(&parse(&text).unwrap(), &wgsl, &[]).err().unwrap();
     let at = format!("{}:15:13", wgsl.join("invert.wgsl").display());
     assert_err(e, &at, &["WGSL"]);

@@ -81,10 +81,7 @@ fn exr_roundtrip_keeps_pixels_and_metadata() {
     let meta = [
         ("method", "prism-slicing".to_string()),
         ("quality: slices per prism", "64".to_string()),
-        (
-            "adapter",
-            "llvmpipe (LLVM 17, 256 bits) — Vulkan".to_string(),
-        ),
+        ("adapter", "llvmpipe (LLVM 17, 256 bits) — Vulkan".to_string()),
         ("GPU time (ms)", "12.5".to_string()),
     ];
     io::exr::write(&path, &img, &meta).unwrap();
@@ -132,9 +129,7 @@ fn exr_read_errors_are_file_errors() {
 
     // A luminance-only EXR has no R, G, B.
     let luma = dir.path("luma.exr");
-    let channels = exr::prelude::SpecificChannels::build()
-        .with_channel("Y")
-        .with_pixel_fn(|_| (0.5f32,));
+    let channels = exr::prelude::SpecificChannels::build().with_channel("Y").with_pixel_fn(|_| (0.5f32,));
     exr::prelude::WritableImage::write(&exr::prelude::Image::from_channels((2, 2), channels))
         .to_file(&luma)
         .unwrap();
@@ -176,10 +171,7 @@ fn png_tonemapped_and_rgba8_roundtrip() {
     let hp = dir.path("heat.png");
     io::png::write_rgba8(&hp, 4, 3, &heat).unwrap();
     assert_eq!(io::png::read_rgba8(&hp).unwrap(), (4, 3, heat.clone()));
-    assert!(matches!(
-        io::png::write_rgba8(&hp, 5, 3, &heat),
-        Err(Error::Invalid(_))
-    ));
+    assert!(matches!(io::png::write_rgba8(&hp, 5, 3, &heat), Err(Error::Invalid(_))));
     assert_eq!(dir.entries(), vec!["heat.png", "preview.png"]);
 
     let bad = dir.path("bad.png");
@@ -193,11 +185,7 @@ fn atomic_write_failure_leaves_target_untouched() {
     let target = dir.path("out.exr");
     fs::write(&target, "old content").unwrap();
     let err = atomic::write_atomic(&target, |tmp| {
-        assert_eq!(
-            tmp.parent(),
-            target.parent(),
-            "temporary file sits beside the target"
-        );
+        assert_eq!(tmp.parent(), target.parent(), "temporary file sits beside the target");
         fs::write(tmp, "half-writ").unwrap();
         Err(Error::Gpu("device lost".into()))
     })
@@ -207,10 +195,8 @@ fn atomic_write_failure_leaves_target_untouched() {
     assert_eq!(dir.entries(), vec!["out.exr"], "temporary file removed");
 
     // A writer that succeeds replaces the target.
-    atomic::write_atomic(&target, |tmp| {
-        fs::write(tmp, "new content").map_err(|e| Error::file(tmp, e))
-    })
-    .unwrap();
+    atomic::write_atomic(&target, |tmp| fs::write(tmp, "new content").map_err(|e| Error::file(tmp, e)))
+        .unwrap();
     assert_eq!(fs::read_to_string(&target).unwrap(), "new content");
 
     // A writer that "succeeds" without writing anything is an error, target kept.
@@ -232,14 +218,8 @@ fn missing_output_folder_fails_before_writing() {
     .unwrap_err();
     assert!(!called, "writer must not run");
     assert_file_error(err, &sub);
-    assert_file_error(
-        io::exr::write(&target, &Image::new(2, 2), &[]).unwrap_err(),
-        &sub,
-    );
-    assert_file_error(
-        io::png::write_tonemapped(&target, &Image::new(2, 2)).unwrap_err(),
-        &sub,
-    );
+    assert_file_error(io::exr::write(&target, &Image::new(2, 2), &[]).unwrap_err(), &sub);
+    assert_file_error(io::png::write_tonemapped(&target, &Image::new(2, 2)).unwrap_err(), &sub);
     assert!(dir.entries().is_empty(), "no folder was created");
 
     assert_file_error(atomic::check_writable_dir(&sub).unwrap_err(), &sub);
@@ -261,15 +241,10 @@ fn metrics_are_zero_for_identical_images_and_grow_with_error() {
 
     let small = perturbed(&img, 0.02);
     let large = perturbed(&img, 0.3);
-    let (r1, r2) = (
-        metrics::relative_rmse(&small, &img).unwrap(),
-        metrics::relative_rmse(&large, &img).unwrap(),
-    );
+    let (r1, r2) =
+        (metrics::relative_rmse(&small, &img).unwrap(), metrics::relative_rmse(&large, &img).unwrap());
     assert!(0.0 < r1 && r1 < r2, "relative RMSE {r1} then {r2}");
-    let (f1, f2) = (
-        metrics::flip(&small, &img).unwrap().mean,
-        metrics::flip(&large, &img).unwrap().mean,
-    );
+    let (f1, f2) = (metrics::flip(&small, &img).unwrap().mean, metrics::flip(&large, &img).unwrap().mean);
     assert!(0.0 < f1 && f1 < f2, "FLIP {f1} then {f2}");
     assert!(f1 < 0.1, "2% noise is a small FLIP error, got {f1}");
     assert!(metrics::max_abs_diff(&large, &img).unwrap() > 0.0);
@@ -282,11 +257,7 @@ fn flip_of_a_known_pair_is_in_a_sane_range() {
     let black = Image::filled(16, 16, [0.0, 0.0, 0.0, 1.0]);
     let white = Image::filled(16, 16, [100.0, 100.0, 100.0, 1.0]);
     let f = metrics::flip(&black, &white).unwrap();
-    assert!(
-        (0.6..=1.0).contains(&f.mean),
-        "black vs white mean FLIP {}",
-        f.mean
-    );
+    assert!((0.6..=1.0).contains(&f.mean), "black vs white mean FLIP {}", f.mean);
     assert!(f.map.iter().all(|v| (0.0..=1.0).contains(v)));
     // A red/green swap of a mid-grey-ish image: clearly visible but far from maximal.
     let a = Image::filled(16, 16, [0.4, 0.2, 0.2, 1.0]);
@@ -317,10 +288,8 @@ fn golden_harness_passes_fails_and_explains() {
     }
 
     let bad = perturbed(&img, 0.5);
-    let msg = std::panic::catch_unwind(|| {
-        check_golden("io_metrics_gradient", &bad, Threshold::Flip(0.01))
-    })
-    .expect_err("a perturbed image must fail");
+    let msg = std::panic::catch_unwind(|| check_golden("io_metrics_gradient", &bad, Threshold::Flip(0.01)))
+        .expect_err("a perturbed image must fail");
     let msg = msg.downcast_ref::<String>().unwrap();
     assert!(msg.contains("mean FLIP") && msg.contains("0.01"), "{msg}");
     for suffix in ["actual.png", "actual.exr", "diff.png"] {

@@ -26,11 +26,7 @@ fn render_blueprint(bp: Blueprint) -> Image {
     let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
     let mut r = Renderer::new(&ctx, bp).unwrap();
     let frame = r.render(&ctx).unwrap();
-    assert_eq!(
-        voltex::metrics::count_nonfinite(&frame.image),
-        0,
-        "no NaN or infinity in any pixel"
-    );
+    assert_eq!(voltex::metrics::count_nonfinite(&frame.image), 0, "no NaN or infinity in any pixel");
     frame.image
 }
 
@@ -46,49 +42,25 @@ const TEST_SIZE: Option<(u32, u32)> = Some((128, 128));
 
 #[test]
 fn golden_torus_egg() {
-    let img = render(
-        &example("torus_egg.ron"),
-        RenderOptions {
-            size: TEST_SIZE,
-            ..Default::default()
-        },
-    );
+    let img = render(&example("torus_egg.ron"), RenderOptions { size: TEST_SIZE, ..Default::default() });
     check_golden("view_slices_torus_egg", &img, Threshold::Flip(0.01));
 }
 
 #[test]
 fn golden_terrain() {
-    let img = render(
-        &example("terrain.ron"),
-        RenderOptions {
-            size: TEST_SIZE,
-            ..Default::default()
-        },
-    );
+    let img = render(&example("terrain.ron"), RenderOptions { size: TEST_SIZE, ..Default::default() });
     check_golden("view_slices_terrain", &img, Threshold::Flip(0.01));
 }
 
 #[test]
 fn golden_sphere_balls() {
-    let img = render(
-        &example("sphere_balls.ron"),
-        RenderOptions {
-            size: TEST_SIZE,
-            ..Default::default()
-        },
-    );
+    let img = render(&example("sphere_balls.ron"), RenderOptions { size: TEST_SIZE, ..Default::default() });
     check_golden("view_slices_sphere_balls", &img, Threshold::Flip(0.01));
 }
 
 #[test]
 fn golden_flat_box() {
-    let img = render(
-        &example("flat_box.ron"),
-        RenderOptions {
-            size: TEST_SIZE,
-            ..Default::default()
-        },
-    );
+    let img = render(&example("flat_box.ron"), RenderOptions { size: TEST_SIZE, ..Default::default() });
     check_golden("view_slices_flat_box", &img, Threshold::Flip(0.01));
 }
 
@@ -126,10 +98,7 @@ fn ray(x: u32, y: u32, size: u32, fov_y_deg: f64) -> DVec3 {
 
 #[test]
 fn flat_shell_equals_the_box_it_encloses() {
-    let img = render(
-        &slab_scene(4, 64, (0.0, 0.0, 3.0)),
-        RenderOptions::default(),
-    );
+    let img = render(&slab_scene(4, 64, (0.0, 0.0, 3.0)), RenderOptions::default());
     // The volume is stored as rgba8: compare with the quantised opacity and premultiplied colour
     // (values chosen away from rounding ties).
     let a = (0.6f64 * 255.0).round() / 255.0;
@@ -143,10 +112,7 @@ fn flat_shell_equals_the_box_it_encloses() {
             // Where the ray crosses the top (z = 0.5) and bottom (z = 0) planes of the slab.
             let top = DVec3::new(0.0, 0.0, 3.0) + d * (2.5 / -d.z);
             let bottom = DVec3::new(0.0, 0.0, 3.0) + d * (3.0 / -d.z);
-            if [top, bottom]
-                .iter()
-                .any(|p| p.x.abs() > 0.95 || p.y.abs() > 0.95)
-            {
+            if [top, bottom].iter().any(|p| p.x.abs() > 0.95 || p.y.abs() > 0.95) {
                 continue; // enters or leaves through a side: not the analytic case
             }
             let path = 0.5 / -d.z;
@@ -161,18 +127,11 @@ fn flat_shell_equals_the_box_it_encloses() {
         }
     }
     assert!(checked > 4000, "{checked} pixels checked");
-    assert!(
-        worst < 0.01,
-        "worst relative error {worst} against the analytic slab"
-    );
+    assert!(worst < 0.01, "worst relative error {worst} against the analytic slab");
 }
 
 fn mean(img: &Image) -> f64 {
-    img.pixels
-        .iter()
-        .map(|p| (p[0] + p[1] + p[2]) as f64)
-        .sum::<f64>()
-        / img.pixels.len() as f64
+    img.pixels.iter().map(|p| (p[0] + p[1] + p[2]) as f64).sum::<f64>() / img.pixels.len() as f64
 }
 
 #[test]
@@ -180,8 +139,5 @@ fn plane_count_changes_error_not_brightness() {
     let eye = (0.4, -1.8, 2.4);
     let coarse = mean(&render(&slab_scene(4, 24, eye), RenderOptions::default()));
     let fine = mean(&render(&slab_scene(4, 192, eye), RenderOptions::default()));
-    assert!(
-        (coarse - fine).abs() / fine < 0.01,
-        "mean brightness {coarse} with 24 planes, {fine} with 192"
-    );
+    assert!((coarse - fine).abs() / fine < 0.01, "mean brightness {coarse} with 24 planes, {fine} with 192");
 }

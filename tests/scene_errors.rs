@@ -52,14 +52,7 @@ fn load(test: &str, text: &str, files: &[(&str, &str)]) -> (PathBuf, voltex::Res
 
 /// Asserts the error is at `file:line:col` and mentions `word`.
 #[track_caller]
-fn assert_err(
-    test: &str,
-    lines: &[(usize, &str)],
-    file: &str,
-    line: usize,
-    col: usize,
-    word: &str,
-) {
+fn assert_err(test: &str, lines: &[(usize, &str)], file: &str, line: usize, col: usize, word: &str) {
     assert_err_files(test, &with_lines(lines), &[], file, line, col, word)
 }
 
@@ -74,16 +67,10 @@ fn assert_err_files(
     word: &str,
 ) {
     let (path, r) = load(test, text, files);
-    let e = r
-        .err()
-        .unwrap_or_else(|| panic!("{test}: expected an error"))
-        .to_string();
+    let e = r.err().unwrap_or_else(|| panic!("{test}: expected an error")).to_string();
     let want = format!("{}:{line}:{col}: ", path.with_file_name(file).display());
     assert!(e.starts_with(&want), "{test}: want {want}..., got {e}");
-    assert!(
-        e.to_lowercase().contains(&word.to_lowercase()),
-        "{test}: want `{word}` in {e}"
-    );
+    assert!(e.to_lowercase().contains(&word.to_lowercase()), "{test}: want `{word}` in {e}");
 }
 
 #[test]
@@ -102,24 +89,9 @@ fn missing_scene_file() {
 
 #[test]
 fn malformed_and_truncated() {
-    assert_err(
-        "comma",
-        &[(3, "    output: (width: 64 height: 64),")],
-        "scene.ron",
-        3,
-        24,
-        "expected",
-    );
+    assert_err("comma", &[(3, "    output: (width: 64 height: 64),")], "scene.ron", 3, 24, "expected");
     let truncated: String = BASE.lines().take(12).map(|l| format!("{l}\n")).collect();
-    assert_err_files(
-        "truncated",
-        &truncated,
-        &[],
-        "scene.ron",
-        12,
-        35,
-        "expected the rest",
-    );
+    assert_err_files("truncated", &truncated, &[], "scene.ron", 12, 35, "expected the rest");
 }
 
 #[test]
@@ -137,93 +109,37 @@ fn unknown_method_variant() {
 #[test]
 fn non_finite_numbers() {
     let l = "    camera: (eye: (0.0, NaN, 2.0), target: (0.0, 0.0, 0.0), fov_y: 40.0),";
-    assert_err(
-        "nan",
-        &[(4, l)],
-        "scene.ron",
-        4,
-        25,
-        "expected a finite number",
-    );
+    assert_err("nan", &[(4, l)], "scene.ron", 4, 25, "expected a finite number");
     let l = "            height: (length: inf),";
-    assert_err(
-        "inf",
-        &[(12, l)],
-        "scene.ron",
-        12,
-        30,
-        "expected a finite number",
-    );
+    assert_err("inf", &[(12, l)], "scene.ron", 12, 30, "expected a finite number");
 }
 
 #[test]
 fn plane_counts() {
     let l = "            method: ViewSlices(planes: 0),";
-    assert_err(
-        "planes0",
-        &[(14, l)],
-        "scene.ron",
-        14,
-        40,
-        "expected a plane count in 1..=16384",
-    );
+    assert_err("planes0", &[(14, l)], "scene.ron", 14, 40, "expected a plane count in 1..=16384");
     let l = "            method: ViewSlices(planes: 100000),";
-    assert_err(
-        "planes1e5",
-        &[(14, l)],
-        "scene.ron",
-        14,
-        40,
-        "expected a plane count",
-    );
+    assert_err("planes1e5", &[(14, l)], "scene.ron", 14, 40, "expected a plane count");
 }
 
 #[test]
 fn output_sizes() {
     let l = "    output: (width: 0, height: 64),";
-    assert_err(
-        "width0",
-        &[(3, l)],
-        "scene.ron",
-        3,
-        21,
-        "expected an output size in 1..=16384",
-    );
+    assert_err("width0", &[(3, l)], "scene.ron", 3, 21, "expected an output size in 1..=16384");
     let l = "    output: (width: 64, height: 100000),";
-    assert_err(
-        "height1e5",
-        &[(3, l)],
-        "scene.ron",
-        3,
-        33,
-        "expected an output size",
-    );
+    assert_err("height1e5", &[(3, l)], "scene.ron", 3, 33, "expected an output size");
 }
 
 #[test]
 fn missing_obj_file() {
     let l = r#"            surface: Obj(path: "missing.obj"),"#;
-    assert_err(
-        "noobj",
-        &[(11, l)],
-        "scene.ron",
-        11,
-        32,
-        "expected an OBJ file",
-    );
+    assert_err("noobj", &[(11, l)], "scene.ron", 11, 32, "expected an OBJ file");
 }
 
 #[test]
 fn unknown_texel_name() {
     let l = r#"            texel: "x","#;
-    assert_err(
-        "texel",
-        &[(13, l)],
-        "scene.ron",
-        13,
-        20,
-        "expected one of \"t\"",
-    );
+    assert_err("texel", &[(13, l)], "scene.ron", 13, 20, "expected one of \"t\"");
 }
 
 #[test]
@@ -231,45 +147,16 @@ fn obj_face_index_out_of_range() {
     let l = r#"            surface: Obj(path: "mesh.obj"),"#;
     let obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 7\n";
     let text = with_lines(&[(11, l)]);
-    assert_err_files(
-        "objindex",
-        &text,
-        &[("mesh.obj", obj)],
-        "mesh.obj",
-        4,
-        7,
-        "expected 1..=3",
-    );
+    assert_err_files("objindex", &text, &[("mesh.obj", obj)], "mesh.obj", 4, 7, "expected 1..=3");
 }
 
 #[test]
 fn node_consistency() {
     let l = "            height: (length: 0.1, scale: VertexAttribute),";
-    assert_err(
-        "vattr",
-        &[(12, l)],
-        "scene.ron",
-        12,
-        42,
-        "built-in surfaces have no vertex attribute",
-    );
-    assert_err(
-        "notexel",
-        &[(13, "")],
-        "scene.ron",
-        14,
-        21,
-        "expected a `texel`",
-    );
+    assert_err("vattr", &[(12, l)], "scene.ron", 12, 42, "built-in surfaces have no vertex attribute");
+    assert_err("notexel", &[(13, "")], "scene.ron", 14, 21, "expected a `texel`");
     let l = r#"            height: (length: 0.1, scale: Texture(path: "h.png")),"#;
-    assert_err(
-        "nopng",
-        &[(12, l)],
-        "scene.ron",
-        12,
-        56,
-        "expected a PNG file",
-    );
+    assert_err("nopng", &[(12, l)], "scene.ron", 12, 56, "expected a PNG file");
 }
 
 #[test]
@@ -293,12 +180,7 @@ fn example_scenes_load_and_flatten() {
                 let objects = s.objects().unwrap_or_else(|e| panic!("{e}"));
                 assert!(!objects.is_empty(), "{}", p.display());
                 for o in &objects {
-                    assert!(
-                        o.report.warnings.is_empty(),
-                        "{}: {:?}",
-                        p.display(),
-                        o.report
-                    );
+                    assert!(o.report.warnings.is_empty(), "{}: {:?}", p.display(), o.report);
                 }
                 count += 1;
             }

@@ -13,11 +13,9 @@ macro_rules! layout {
 
 #[test]
 fn wgsl_structs_match_rust() {
-    let source =
-        std::fs::read_to_string(voltex::project_root().join("wgsl/shared/types.wgsl")).unwrap();
+    let source = std::fs::read_to_string(voltex::project_root().join("wgsl/shared/types.wgsl")).unwrap();
     // A kernel using nothing still gets every struct type when they are used by a dummy global.
-    let kernel =
-        voltex::gpu::shader::load_str(std::path::Path::new("types.wgsl"), &source).unwrap();
+    let kernel = voltex::gpu::shader::load_str(std::path::Path::new("types.wgsl"), &source).unwrap();
     let rust = [
         layout!(ShellVertex; bottom, top),
         layout!(Prism; vertices, uv01, uv2, sphere),
@@ -37,16 +35,10 @@ fn wgsl_structs_match_rust() {
             continue;
         };
         let name = ty.name.clone().unwrap_or_default();
-        let (_, size, offsets) = rust
-            .iter()
-            .find(|r| r.0 == name)
-            .unwrap_or_else(|| panic!("no Rust twin listed for {name}"));
+        let (_, size, offsets) =
+            rust.iter().find(|r| r.0 == name).unwrap_or_else(|| panic!("no Rust twin listed for {name}"));
         assert_eq!(*span as usize, *size, "size of {name}");
-        let wgsl: Vec<usize> = members
-            .iter()
-            .map(|m| m.offset as usize)
-            .take(offsets.len())
-            .collect();
+        let wgsl: Vec<usize> = members.iter().map(|m| m.offset as usize).take(offsets.len()).collect();
         assert_eq!(&wgsl, offsets, "field offsets of {name}");
         seen += 1;
     }
@@ -62,15 +54,9 @@ fn every_kernel_validates() {
         if path.extension().is_some_and(|e| e == "wgsl") {
             let name = path.file_name().unwrap().to_str().unwrap();
             let k = voltex::gpu::shader::load(&root, name).unwrap_or_else(|e| panic!("{e}"));
-            assert!(
-                !k.module.entry_points.is_empty(),
-                "{name} has an entry point"
-            );
+            assert!(!k.module.entry_points.is_empty(), "{name} has an entry point");
             let first = std::fs::read_to_string(&path).unwrap();
-            assert!(
-                first.starts_with("// "),
-                "{name} starts with a one-line purpose comment"
-            );
+            assert!(first.starts_with("// "), "{name} starts with a one-line purpose comment");
             n += 1;
         }
     }

@@ -36,13 +36,7 @@ pub struct Baked {
 }
 
 pub fn mip_count(res: [u32; 3]) -> u32 {
-    32 - res
-        .iter()
-        .max()
-        .copied()
-        .unwrap_or(1)
-        .max(1)
-        .leading_zeros()
+    32 - res.iter().max().copied().unwrap_or(1).max(1).leading_zeros()
 }
 
 fn mip_size(res: [u32; 3], level: u32) -> [u32; 3] {
@@ -51,14 +45,9 @@ fn mip_size(res: [u32; 3], level: u32) -> [u32; 3] {
 
 /// Bytes a bake allocates on the GPU (volume with mips, plus normals at full resolution).
 pub fn bytes(res: [u32; 3], per_pixel: bool) -> u64 {
-    let volume: u64 = (0..mip_count(res))
-        .map(|l| mip_size(res, l).iter().map(|&x| x as u64).product::<u64>() * 4)
-        .sum();
-    let normals = if per_pixel {
-        res.iter().map(|&x| x as u64).product::<u64>() * 4
-    } else {
-        4
-    };
+    let volume: u64 =
+        (0..mip_count(res)).map(|l| mip_size(res, l).iter().map(|&x| x as u64).product::<u64>() * 4).sum();
+    let normals = if per_pixel { res.iter().map(|&x| x as u64).product::<u64>() * 4 } else { 4 };
     volume + normals
 }
 
@@ -72,12 +61,7 @@ pub struct Baker {
 
 impl Baker {
     pub fn new(wgsl_root: &Path) -> Self {
-        Self {
-            implicit: None,
-            heightfield: None,
-            downsample: None,
-            wgsl_root: wgsl_root.to_path_buf(),
-        }
+        Self { implicit: None, heightfield: None, downsample: None, wgsl_root: wgsl_root.to_path_buf() }
     }
 
     fn kernel<'a>(
@@ -101,34 +85,15 @@ impl Baker {
             )));
         }
         let mips = mip_count(req.resolution);
-        let volume = volume_texture(
-            ctx,
-            "texel volume",
-            req.resolution,
-            mips,
-            wgpu::TextureFormat::Rgba8Unorm,
-        );
-        let normals_res = if req.per_pixel {
-            req.resolution
-        } else {
-            [1, 1, 1]
-        };
-        let normals = volume_texture(
-            ctx,
-            "texel normals",
-            normals_res,
-            1,
-            wgpu::TextureFormat::Rgba8Snorm,
-        );
+        let volume =
+            volume_texture(ctx, "texel volume", req.resolution, mips, wgpu::TextureFormat::Rgba8Unorm);
+        let normals_res = if req.per_pixel { req.resolution } else { [1, 1, 1] };
+        let normals = volume_texture(ctx, "texel normals", normals_res, 1, wgpu::TextureFormat::Rgba8Snorm);
         let params = crate::cpu::bake::bake_params(req.resolution, 0, req.light, req.ambient);
         let mut inputs = Inputs::default();
-        inputs
-            .constants
-            .push(("per_pixel_lighting".into(), req.per_pixel as u32 as f64));
+        inputs.constants.push(("per_pixel_lighting".into(), req.per_pixel as u32 as f64));
         inputs.views.insert("volume".into(), level_view(&volume, 0));
-        inputs
-            .views
-            .insert("normals".into(), level_view(&normals, 0));
+        inputs.views.insert("normals".into(), level_view(&normals, 0));
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
         let root = self.wgsl_root.clone();
         match &req.source {
@@ -142,18 +107,15 @@ impl Baker {
                     ],
                     ..params
                 };
-                inputs.buffers.insert(
-                    "bake_params".into(),
-                    uniform(ctx, "bake_params", bytemuck::bytes_of(&params)),
-                );
-                inputs.buffers.insert(
-                    "shapes".into(),
-                    storage(ctx, "shapes", bytemuck::cast_slice(&packed.shapes)),
-                );
-                inputs.buffers.insert(
-                    "balls".into(),
-                    storage(ctx, "balls", bytemuck::cast_slice(&packed.balls)),
-                );
+                inputs
+                    .buffers
+                    .insert("bake_params".into(), uniform(ctx, "bake_params", bytemuck::bytes_of(&params)));
+                inputs
+                    .buffers
+                    .insert("shapes".into(), storage(ctx, "shapes", bytemuck::cast_slice(&packed.shapes)));
+                inputs
+                    .buffers
+                    .insert("balls".into(), storage(ctx, "balls", bytemuck::cast_slice(&packed.balls)));
                 Self::kernel(&mut self.implicit, ctx, &root, "bake_implicit.wgsl")?.dispatch(
                     ctx,
                     &mut encoder,
@@ -162,25 +124,25 @@ impl Baker {
                 )?;
             }
             BakeSource::Heightfield(hf) => {
-                inputs.buffers.insert(
-                    "bake_params".into(),
-                    uniform(ctx, "bake_params", bytemuck::bytes_of(&params)),
-                );
-                inputs.buffers.insert(
-                    "heightfield".into(),
-                    uniform(ctx, "heightfield", bytemuck::bytes_of(hf)),
-                );
-                Self::kernel(&mut self.heightfield, ctx, &root, "bake_heightfield.wgsl")?
-                    .dispatch(ctx, &mut encoder, &inputs, req.resolution)?;
+                inputs
+                    .buffers
+                    .insert("bake_params".into(), uniform(ctx, "bake_params", bytemuck::bytes_of(&params)));
+                inputs
+                    .buffers
+                    .insert("heightfield".into(), uniform(ctx, "heightfield", bytemuck::bytes_of(hf)));
+                Self::kernel(&mut self.heightfield, ctx, &root, "bake_heightfield.wgsl")?.dispatch(
+                    ctx,
+                    &mut encoder,
+                    &inputs,
+                    req.resolution,
+                )?;
             }
         }
         let down = Self::kernel(&mut self.downsample, ctx, &root, "downsample_volume.wgsl")?;
         for level in 1..mips {
             let mut mip = Inputs::default();
-            mip.views
-                .insert("source".into(), level_view(&volume, level - 1));
-            mip.views
-                .insert("destination".into(), level_view(&volume, level));
+            mip.views.insert("source".into(), level_view(&volume, level - 1));
+            mip.views.insert("destination".into(), level_view(&volume, level));
             down.dispatch(ctx, &mut encoder, &mip, mip_size(req.resolution, level))?;
         }
         ctx.queue.submit([encoder.finish()]);
@@ -198,11 +160,7 @@ fn volume_texture(
 ) -> wgpu::Texture {
     ctx.device.create_texture(&wgpu::TextureDescriptor {
         label: Some(label),
-        size: wgpu::Extent3d {
-            width: res[0],
-            height: res[1],
-            depth_or_array_layers: res[2],
-        },
+        size: wgpu::Extent3d { width: res[0], height: res[1], depth_or_array_layers: res[2] },
         mip_level_count: mips,
         sample_count: 1,
         dimension: wgpu::TextureDimension::D3,
@@ -224,21 +182,17 @@ pub fn level_view(t: &wgpu::Texture, level: u32) -> wgpu::TextureView {
 }
 
 pub fn uniform(ctx: &GpuContext, label: &str, bytes: &[u8]) -> wgpu::Buffer {
-    ctx.device
-        .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some(label),
-            contents: bytes,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-        })
+    ctx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some(label),
+        contents: bytes,
+        usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+    })
 }
 
 pub fn storage(ctx: &GpuContext, label: &str, bytes: &[u8]) -> wgpu::Buffer {
-    ctx.device
-        .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some(label),
-            contents: bytes,
-            usage: wgpu::BufferUsages::STORAGE
-                | wgpu::BufferUsages::COPY_DST
-                | wgpu::BufferUsages::COPY_SRC,
-        })
+    ctx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some(label),
+        contents: bytes,
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
+    })
 }

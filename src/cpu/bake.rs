@@ -95,12 +95,7 @@ pub fn perlin_periodic(p: [f32; 2], period: u32, seed: u32) -> (f32, [f32; 2]) {
 }
 
 /// Fractal sum of periodic Perlin octaves, normalized to [-1,1]: (value, gradient).
-pub fn perlin_fbm_periodic(
-    p: [f32; 2],
-    frequency: u32,
-    octaves: u32,
-    seed: u32,
-) -> (f32, [f32; 2]) {
+pub fn perlin_fbm_periodic(p: [f32; 2], frequency: u32, octaves: u32, seed: u32) -> (f32, [f32; 2]) {
     let (mut value, mut grad) = (0.0, [0.0, 0.0]);
     let (mut amplitude, mut total) = (1.0f32, 0.0f32);
     let mut period = frequency.max(1);
@@ -129,21 +124,11 @@ pub fn gradient_normal(g: V3) -> V3 {
 /// `albedo * (ambient + (1 - ambient) * max(N.L, 0))`, `light` = (direction to the light, ambient).
 pub fn shade_lambert(albedo: V3, normal: V3, light: [f32; 4]) -> V3 {
     let l = gradient_normal(xyz(light));
-    scale(
-        albedo,
-        light[3] + (1.0 - light[3]) * dot(normal, l).max(0.0),
-    )
+    scale(albedo, light[3] + (1.0 - light[3]) * dot(normal, l).max(0.0))
 }
 
 /// Lambert plus a white Blinn-Phong highlight; `view` points towards the eye.
-pub fn shade_phong(
-    albedo: V3,
-    normal: V3,
-    light: [f32; 4],
-    view: V3,
-    specular: f32,
-    shininess: f32,
-) -> V3 {
+pub fn shade_phong(albedo: V3, normal: V3, light: [f32; 4], view: V3, specular: f32, shininess: f32) -> V3 {
     let l = gradient_normal(xyz(light));
     let h = gradient_normal(add(l, gradient_normal(view)));
     let lit = if dot(normal, l) > 0.0 { 1.0 } else { 0.0 };
@@ -156,11 +141,8 @@ pub fn shade_phong(
 /// Ellipsoid distance bound `k0 (k0 - 1) / k1`: exact on the axes, good near the surface.
 pub fn ellipsoid_distance(q: V3, radii: V3) -> f32 {
     let k0 = length([q[0] / radii[0], q[1] / radii[1], q[2] / radii[2]]);
-    let k1 = length([
-        q[0] / (radii[0] * radii[0]),
-        q[1] / (radii[1] * radii[1]),
-        q[2] / (radii[2] * radii[2]),
-    ]);
+    let k1 =
+        length([q[0] / (radii[0] * radii[0]), q[1] / (radii[1] * radii[1]), q[2] / (radii[2] * radii[2])]);
     if k1 < 1.0e-12 {
         return -radii[0].min(radii[1].min(radii[2]));
     }
@@ -241,11 +223,7 @@ fn finish(
 ) -> [f32; 4] {
     let coverage = (0.5 - d / voxel_size).clamp(0.0, 1.0);
     let alpha = (opacity * coverage).clamp(0.0, 1.0);
-    let rgb = if per_pixel {
-        albedo
-    } else {
-        shade_lambert(albedo, normal, light)
-    };
+    let rgb = if per_pixel { albedo } else { shade_lambert(albedo, normal, light) };
     let rgb = rgb.map(|c| c.clamp(0.0, 1.0) * alpha);
     [rgb[0], rgb[1], rgb[2], alpha]
 }
@@ -279,15 +257,7 @@ pub fn bake_implicit_voxel(
         shape_distance(shape, balls, add(p, o)) - shape_distance(shape, balls, sub(p, o))
     };
     let normal = gradient_normal([axis(0), axis(1), axis(2)]);
-    let rgba = finish(
-        xyz(shape.color),
-        shape.color[3],
-        normal,
-        best_d,
-        voxel_size,
-        params.light,
-        per_pixel,
-    );
+    let rgba = finish(xyz(shape.color), shape.color[3], normal, best_d, voxel_size, params.light, per_pixel);
     (rgba, normal)
 }
 
@@ -296,11 +266,7 @@ pub fn bake_implicit_voxel(
 /// `(h, dh/ds, dh/dt)` with `h = base + amplitude * (0.5 + 0.5 * fbm)`.
 pub fn heightfield_sample(hf: &HeightfieldParams, st: [f32; 2]) -> [f32; 3] {
     let (v, g) = perlin_fbm_periodic(st, hf.frequency, hf.octaves, hf.seed);
-    [
-        hf.base + hf.amplitude * (0.5 + 0.5 * v),
-        0.5 * hf.amplitude * g[0],
-        0.5 * hf.amplitude * g[1],
-    ]
+    [hf.base + hf.amplitude * (0.5 + 0.5 * v), 0.5 * hf.amplitude * g[0], 0.5 * hf.amplitude * g[1]]
 }
 
 /// One voxel of `bake_heightfield.wgsl`: (premultiplied rgba, outward normal).
@@ -318,15 +284,7 @@ pub fn bake_heightfield_voxel(
     let top = (hf.base + hf.amplitude).max(1.0e-6);
     let f = (p[2] / top).clamp(0.0, 1.0);
     let albedo = [0, 1, 2].map(|i| hf.color_low[i] + (hf.color_high[i] - hf.color_low[i]) * f);
-    let rgba = finish(
-        albedo,
-        hf.opacity,
-        normal,
-        d,
-        voxel_size,
-        params.light,
-        per_pixel,
-    );
+    let rgba = finish(albedo, hf.opacity, normal, d, voxel_size, params.light, per_pixel);
     (rgba, normal)
 }
 
@@ -396,13 +354,7 @@ pub fn bake_implicit_volume(
         normals.push([n[0], n[1], n[2], 0.0]);
         c
     });
-    (
-        rgba,
-        Volume {
-            size,
-            texels: normals,
-        },
-    )
+    (rgba, Volume { size, texels: normals })
 }
 
 pub fn bake_heightfield_volume(
@@ -417,13 +369,7 @@ pub fn bake_heightfield_volume(
         normals.push([n[0], n[1], n[2], 0.0]);
         c
     });
-    (
-        rgba,
-        Volume {
-            size,
-            texels: normals,
-        },
-    )
+    (rgba, Volume { size, texels: normals })
 }
 
 fn xyz_u(v: [u32; 4]) -> [u32; 3] {
@@ -475,10 +421,8 @@ pub fn pack_shapes(shapes: &[(Shape, V3, f32)]) -> PackedShapes {
         shape_count: shapes.len() as u32,
     };
     for (shape, albedo, opacity) in shapes {
-        let mut s = ImplicitShape {
-            color: [albedo[0], albedo[1], albedo[2], *opacity],
-            ..Default::default()
-        };
+        let mut s =
+            ImplicitShape { color: [albedo[0], albedo[1], albedo[2], *opacity], ..Default::default() };
         let c = |v: &V3| [v[0], v[1], v[2], 0.0];
         match shape {
             Shape::Sphere { center, radius } => {
@@ -486,11 +430,7 @@ pub fn pack_shapes(shapes: &[(Shape, V3, f32)]) -> PackedShapes {
                 s.center = c(center);
                 s.params[0] = *radius;
             }
-            Shape::Torus {
-                center,
-                major,
-                minor,
-            } => {
+            Shape::Torus { center, major, minor } => {
                 s.kind = TORUS;
                 s.center = c(center);
                 s.params[0] = *major;
@@ -506,9 +446,7 @@ pub fn pack_shapes(shapes: &[(Shape, V3, f32)]) -> PackedShapes {
                 s.first_ball = packed.balls.len() as u32;
                 s.ball_count = balls.len() as u32;
                 s.params[0] = *threshold;
-                packed
-                    .balls
-                    .extend(balls.iter().map(|(p, r)| [p[0], p[1], p[2], *r]));
+                packed.balls.extend(balls.iter().map(|(p, r)| [p[0], p[1], p[2], *r]));
             }
             Shape::Constant => s.kind = CONSTANT,
         }

@@ -11,18 +11,8 @@ fn close(a: f32, b: f32, tol: f32) -> bool {
 /// A 16^3 volume with one sphere centred on voxel (8,8,8).
 fn sphere_scene(radius: f32, light: V3, ambient: f32) -> (BakeParams, PackedShapes) {
     let c = 8.5 / 16.0;
-    let packed = pack_shapes(&[(
-        Shape::Sphere {
-            center: [c, c, c],
-            radius,
-        },
-        RED,
-        0.9,
-    )]);
-    (
-        bake_params([16; 3], packed.shape_count, light, ambient),
-        packed,
-    )
+    let packed = pack_shapes(&[(Shape::Sphere { center: [c, c, c], radius }, RED, 0.9)]);
+    (bake_params([16; 3], packed.shape_count, light, ambient), packed)
 }
 
 #[test]
@@ -63,14 +53,7 @@ fn sphere_far_outside_is_empty_and_surface_half_covered() {
 fn sphere_wraps_across_the_s_seam() {
     // Sphere at s = 0.99, radius 0.05: voxel s = 0.01 (i = 0 of 50) is 0.02 away through the seam,
     // mirroring voxel s = 0.97 (i = 48) on the near side.
-    let packed = pack_shapes(&[(
-        Shape::Sphere {
-            center: [0.99, 0.51, 0.51],
-            radius: 0.05,
-        },
-        RED,
-        1.0,
-    )]);
+    let packed = pack_shapes(&[(Shape::Sphere { center: [0.99, 0.51, 0.51], radius: 0.05 }, RED, 1.0)]);
     let params = bake_params([50; 3], 1, [0.0, 0.0, 1.0], 1.0);
     let (a, na) = bake_implicit_voxel(&params, &packed.shapes, &packed.balls, [0, 25, 25], false);
     let (b, nb) = bake_implicit_voxel(&params, &packed.shapes, &packed.balls, [48, 25, 25], false);
@@ -85,67 +68,25 @@ fn sphere_wraps_across_the_s_seam() {
 #[test]
 fn torus_ellipsoid_metaballs_distances() {
     let packed = pack_shapes(&[
-        (
-            Shape::Torus {
-                center: [0.5, 0.5, 0.5],
-                major: 0.3,
-                minor: 0.1,
-            },
-            RED,
-            1.0,
-        ),
-        (
-            Shape::Ellipsoid {
-                center: [0.5, 0.5, 0.5],
-                radii: [0.2, 0.1, 0.05],
-            },
-            RED,
-            1.0,
-        ),
-        (
-            Shape::Metaballs {
-                balls: vec![([0.5, 0.5, 0.5], 0.2)],
-                threshold: 0.5,
-            },
-            RED,
-            1.0,
-        ),
+        (Shape::Torus { center: [0.5, 0.5, 0.5], major: 0.3, minor: 0.1 }, RED, 1.0),
+        (Shape::Ellipsoid { center: [0.5, 0.5, 0.5], radii: [0.2, 0.1, 0.05] }, RED, 1.0),
+        (Shape::Metaballs { balls: vec![([0.5, 0.5, 0.5], 0.2)], threshold: 0.5 }, RED, 1.0),
     ]);
     let [torus, ellipsoid, meta] = [0, 1, 2].map(|i| packed.shapes[i]);
     let balls = &packed.balls;
     // Torus: tube centre at distance -minor, ring centre at major - minor.
-    assert!(close(
-        shape_distance(&torus, balls, [0.8, 0.5, 0.5]),
-        -0.1,
-        1e-6
-    ));
-    assert!(close(
-        shape_distance(&torus, balls, [0.5, 0.5, 0.5]),
-        0.2,
-        1e-6
-    ));
+    assert!(close(shape_distance(&torus, balls, [0.8, 0.5, 0.5]), -0.1, 1e-6));
+    assert!(close(shape_distance(&torus, balls, [0.5, 0.5, 0.5]), 0.2, 1e-6));
     // Ellipsoid: exact along the axes.
-    assert!(close(
-        shape_distance(&ellipsoid, balls, [0.8, 0.5, 0.5]),
-        0.1,
-        1e-5
-    ));
-    assert!(close(
-        shape_distance(&ellipsoid, balls, [0.5, 0.5, 0.6]),
-        0.05,
-        1e-5
-    ));
+    assert!(close(shape_distance(&ellipsoid, balls, [0.8, 0.5, 0.5]), 0.1, 1e-5));
+    assert!(close(shape_distance(&ellipsoid, balls, [0.5, 0.5, 0.6]), 0.05, 1e-5));
     assert!(shape_distance(&ellipsoid, balls, [0.5, 0.5, 0.5]) < 0.0);
     // Metaballs: one ball, surface where (1 - x)^3 = 0.5 with x = (d/r)^2.
     let d_surf = 0.2 * (1.0 - 0.5f32.cbrt()).sqrt();
     let at = |d: f32| shape_distance(&meta, balls, [0.5 + d, 0.5, 0.5]);
     assert!(close(at(d_surf), 0.0, 1e-5), "{}", at(d_surf));
     assert!(at(d_surf - 0.01) < 0.0 && at(d_surf + 0.01) > 0.0);
-    assert!(
-        close(at(d_surf + 0.005), 0.005, 1e-3),
-        "{}",
-        at(d_surf + 0.005)
-    );
+    assert!(close(at(d_surf + 0.005), 0.005, 1e-3), "{}", at(d_surf + 0.005));
     assert!(at(0.3) > 1.0); // outside the support: no field, far
 }
 
@@ -153,31 +94,14 @@ fn torus_ellipsoid_metaballs_distances() {
 fn union_takes_the_nearest_shape() {
     let blue = [0.1, 0.2, 0.9];
     let packed = pack_shapes(&[
-        (
-            Shape::Sphere {
-                center: [0.25, 0.5, 0.5],
-                radius: 0.2,
-            },
-            RED,
-            1.0,
-        ),
-        (
-            Shape::Sphere {
-                center: [0.75, 0.5, 0.5],
-                radius: 0.2,
-            },
-            blue,
-            0.5,
-        ),
+        (Shape::Sphere { center: [0.25, 0.5, 0.5], radius: 0.2 }, RED, 1.0),
+        (Shape::Sphere { center: [0.75, 0.5, 0.5], radius: 0.2 }, blue, 0.5),
     ]);
     let params = bake_params([16; 3], 2, [0.0, 0.0, 1.0], 1.0);
     let (a, _) = bake_implicit_voxel(&params, &packed.shapes, &packed.balls, [4, 8, 8], false);
     let (b, _) = bake_implicit_voxel(&params, &packed.shapes, &packed.balls, [12, 8, 8], false);
     assert!(close(a[0], RED[0], 1e-6) && close(a[3], 1.0, 1e-6), "{a:?}");
-    assert!(
-        close(b[2], blue[2] * 0.5, 1e-6) && close(b[3], 0.5, 1e-6),
-        "{b:?}"
-    );
+    assert!(close(b[2], blue[2] * 0.5, 1e-6) && close(b[3], 0.5, 1e-6), "{b:?}");
     // shape_count limits the union even when the buffer holds more.
     let params = bake_params([16; 3], 1, [0.0, 0.0, 1.0], 1.0);
     let (b, _) = bake_implicit_voxel(&params, &packed.shapes, &packed.balls, [12, 8, 8], false);
@@ -214,10 +138,7 @@ fn empty_pack_has_bindable_buffers() {
 fn perlin_gradient_matches_finite_differences() {
     for (period, seed) in [(1u32, 0u32), (4, 7), (13, 12345)] {
         for k in 0..40 {
-            let p = [
-                (k as f32 * 0.1371 + 0.013) % 1.0,
-                (k as f32 * 0.2917 + 0.071) % 1.0,
-            ];
+            let p = [(k as f32 * 0.1371 + 0.013) % 1.0, (k as f32 * 0.2917 + 0.071) % 1.0];
             let (_, g) = perlin_periodic(p, period, seed);
             // Step of 1/500 lattice cell: truncation (~h^2 u'''/6) and f32 rounding both ~1e-5.
             let h = 0.002 / period as f32;
@@ -225,15 +146,11 @@ fn perlin_gradient_matches_finite_differences() {
                 let (mut a, mut b) = (p, p);
                 a[i] += h;
                 b[i] -= h;
-                (perlin_periodic(a, period, seed).0 - perlin_periodic(b, period, seed).0)
-                    / (2.0 * h)
+                (perlin_periodic(a, period, seed).0 - perlin_periodic(b, period, seed).0) / (2.0 * h)
             });
             let err = ((fd[0] - g[0]).powi(2) + (fd[1] - g[1]).powi(2)).sqrt();
             let norm = (g[0] * g[0] + g[1] * g[1]).sqrt().max(period as f32 * 0.05);
-            assert!(
-                err / norm < 1e-3,
-                "p {p:?} period {period}: {g:?} vs {fd:?}"
-            );
+            assert!(err / norm < 1e-3, "p {p:?} period {period}: {g:?} vs {fd:?}");
         }
     }
 }
@@ -248,10 +165,7 @@ fn perlin_is_periodic_and_bounded() {
             for shift in [[1.0, 0.0], [0.0, 1.0], [-1.0, 2.0]] {
                 let (w, h) = perlin_periodic([p[0] + shift[0], p[1] + shift[1]], period, seed);
                 assert!(close(v, w, 1e-4), "{v} {w}");
-                assert!(
-                    close(g[0], h[0], 1e-2 * period as f32)
-                        && close(g[1], h[1], 1e-2 * period as f32)
-                );
+                assert!(close(g[0], h[0], 1e-2 * period as f32) && close(g[1], h[1], 1e-2 * period as f32));
             }
         }
         let (v, _) = perlin_fbm_periodic(p, 2, 5, 3);
@@ -304,16 +218,10 @@ fn heightfield_fills_below_the_surface() {
         assert!((0.2..=0.6).contains(&h));
         let (below, n) = bake_heightfield_voxel(&params, &hf, [i, j, 0], false);
         let (above, _) = bake_heightfield_voxel(&params, &hf, [i, j, 63], false);
-        assert!(
-            close(below[3], 0.8, 1e-6) && above == [0.0; 4],
-            "{below:?} {above:?}"
-        );
+        assert!(close(below[3], 0.8, 1e-6) && above == [0.0; 4], "{below:?} {above:?}");
         assert!(n[2] > 0.0 && close(length(n), 1.0, 1e-5));
         // Colour by height: the bottom voxel is almost color_low (ambient 1 = unshaded).
-        assert!(
-            close(below[0], (0.2 + 0.7 * 0.5 / 64.0 / 0.6) * 0.8, 1e-5),
-            "{below:?}"
-        );
+        assert!(close(below[0], (0.2 + 0.7 * 0.5 / 64.0 / 0.6) * 0.8, 1e-5), "{below:?}");
         // Periodic: voxel i and the same point one tile over agree.
         let h2 = heightfield_sample(&hf, [st[0] + 1.0, st[1] - 1.0])[0];
         assert!(close(h, h2, 1e-5));
@@ -390,14 +298,8 @@ fn bake_kernels_validate_and_match_the_contract() {
     use naga::{AddressSpace, TypeInner};
     let root = crate::project_root().join("wgsl");
     let kernels: [(&str, &[&str]); 3] = [
-        (
-            "bake_implicit.wgsl",
-            &["bake_params", "shapes", "balls", "volume", "normals"],
-        ),
-        (
-            "bake_heightfield.wgsl",
-            &["bake_params", "heightfield", "volume", "normals"],
-        ),
+        ("bake_implicit.wgsl", &["bake_params", "shapes", "balls", "volume", "normals"]),
+        ("bake_heightfield.wgsl", &["bake_params", "heightfield", "volume", "normals"]),
         ("downsample_volume.wgsl", &["source", "destination"]),
     ];
     for (file, globals) in kernels {
@@ -437,10 +339,9 @@ fn bake_kernels_validate_and_match_the_contract() {
                         std::mem::offset_of!(BakeParams, light),
                     ],
                 ),
-                Some("ImplicitShape") => (
-                    std::mem::size_of::<ImplicitShape>(),
-                    vec![0, 4, 8, 12, 16, 32, 48],
-                ),
+                Some("ImplicitShape") => {
+                    (std::mem::size_of::<ImplicitShape>(), vec![0, 4, 8, 12, 16, 32, 48])
+                }
                 Some("HeightfieldParams") => (
                     std::mem::size_of::<HeightfieldParams>(),
                     vec![

@@ -66,11 +66,7 @@ fn dot(a: V3, b: V3) -> f32 {
 }
 
 fn lerp(a: V3, b: V3, t: f32) -> V3 {
-    [
-        a[0] * (1.0 - t) + b[0] * t,
-        a[1] * (1.0 - t) + b[1] * t,
-        a[2] * (1.0 - t) + b[2] * t,
-    ]
+    [a[0] * (1.0 - t) + b[0] * t, a[1] * (1.0 - t) + b[1] * t, a[2] * (1.0 - t) + b[2] * t]
 }
 
 /// `None` for vertex ids out of range (the GPU reads clamped garbage there; here it is no slice).
@@ -81,11 +77,7 @@ fn load_prism(vertices: &[ShellVertex], prism: &Prism) -> Option<PrismCorners> {
     Some(PrismCorners {
         bottom: [xyz(v0.bottom), xyz(v1.bottom), xyz(v2.bottom)],
         top: [xyz(v0.top), xyz(v1.top), xyz(v2.top)],
-        uv: [
-            [prism.uv01[0], prism.uv01[1]],
-            [prism.uv01[2], prism.uv01[3]],
-            [prism.uv2[0], prism.uv2[1]],
-        ],
+        uv: [[prism.uv01[0], prism.uv01[1]], [prism.uv01[2], prism.uv01[3]], [prism.uv2[0], prism.uv2[1]]],
         ids,
         sphere: prism.sphere,
     })
@@ -142,10 +134,7 @@ fn edge_point(pa: V3, ua: V3, sa: f32, pb: V3, ub: V3, sb: f32) -> EdgePoint {
     if den.abs() > MIN_DENOM {
         t = (sa / den).clamp(0.0, 1.0);
     }
-    EdgePoint {
-        pos: lerp(pa, pb, t),
-        uvw: lerp(ua, ub, t),
-    }
+    EdgePoint { pos: lerp(pa, pb, t), uvw: lerp(ua, ub, t) }
 }
 
 fn poly_push(poly: &mut SlicePolygon, p: EdgePoint) {
@@ -188,11 +177,7 @@ enum Cap {
 
 /// Mirrors WGSL `slice_polygon`; see the comment there for the walk, its order and the bound of 5.
 fn slice_polygon(c: &PrismCorners, n: V3, d: f32, trivial_reject: bool) -> SlicePolygon {
-    let mut poly = SlicePolygon {
-        count: 0,
-        pos: [[0.0; 3]; 5],
-        uvw: [[0.0; 3]; 5],
-    };
+    let mut poly = SlicePolygon { count: 0, pos: [[0.0; 3]; 5], uvw: [[0.0; 3]; 5] };
     if trivial_reject && (dot(n, xyz(c.sphere)) - d).abs() > c.sphere[3] {
         return poly;
     }

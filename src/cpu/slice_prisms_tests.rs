@@ -6,10 +6,7 @@ use super::*;
 type D3 = [f64; 3];
 
 fn sv(bottom: V3, top: V3) -> ShellVertex {
-    ShellVertex {
-        bottom: [bottom[0], bottom[1], bottom[2], 1.0],
-        top: [top[0], top[1], top[2], 1.0],
-    }
+    ShellVertex { bottom: [bottom[0], bottom[1], bottom[2], 1.0], top: [top[0], top[1], top[2], 1.0] }
 }
 
 /// A prism over `ids` with its corner uvs and a bounding sphere of its six corners.
@@ -52,11 +49,7 @@ fn dot64(a: D3, b: D3) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 fn cross64(a: D3, b: D3) -> D3 {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
+    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
 }
 fn normalize(a: V3) -> V3 {
     let l = len(a);
@@ -94,11 +87,7 @@ fn dist_to_segment(p: V3, a: V3, b: V3) -> f64 {
     let (p, a, b) = (d3(p), d3(a), d3(b));
     let ab = sub64(b, a);
     let l2 = dot64(ab, ab);
-    let t = if l2 > 0.0 {
-        (dot64(sub64(p, a), ab) / l2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
+    let t = if l2 > 0.0 { (dot64(sub64(p, a), ab) / l2).clamp(0.0, 1.0) } else { 0.0 };
     let q = [a[0] + t * ab[0], a[1] + t * ab[1], a[2] + t * ab[2]];
     let r = sub64(p, q);
     dot64(r, r).sqrt()
@@ -112,10 +101,7 @@ fn check_on_plane_and_edges(v: &[ShellVertex], p: &Prism, poly: &Polygon, n: V3,
     let b = |i: usize| xyz(v[ids[i] as usize].bottom);
     let t = |i: usize| xyz(v[ids[i] as usize].top);
     for q in poly.as_slice() {
-        assert!(
-            q.position.iter().chain(&q.uvw).all(|x| x.is_finite()),
-            "{poly:?}"
-        );
+        assert!(q.position.iter().chain(&q.uvw).all(|x| x.is_finite()), "{poly:?}");
         assert!(q.uvw[2] >= 0.0 && q.uvw[2] <= 1.0);
         let x = xyz(q.position);
         let scale = 1.0 + len(x) as f64;
@@ -135,17 +121,10 @@ fn check_on_plane_and_edges(v: &[ShellVertex], p: &Prism, poly: &Polygon, n: V3,
 /// Convex and simple in plane coordinates: all turns have one sign and they add up to one turn.
 fn check_convex(pts: &[V3], n: V3) {
     let n = d3(n);
-    let helper = if n[0].abs() < 0.9 {
-        [1.0, 0.0, 0.0]
-    } else {
-        [0.0, 1.0, 0.0]
-    };
+    let helper = if n[0].abs() < 0.9 { [1.0, 0.0, 0.0] } else { [0.0, 1.0, 0.0] };
     let e1 = cross64(n, helper);
     let e2 = cross64(n, e1);
-    let uv: Vec<[f64; 2]> = pts
-        .iter()
-        .map(|p| [dot64(d3(*p), e1), dot64(d3(*p), e2)])
-        .collect();
+    let uv: Vec<[f64; 2]> = pts.iter().map(|p| [dot64(d3(*p), e1), dot64(d3(*p), e2)]).collect();
     let m = uv.len();
     let mut sign = 0.0;
     let mut turning = 0.0;
@@ -160,10 +139,7 @@ fn check_convex(pts: &[V3], n: V3) {
         assert_eq!(cr.signum(), sign, "not convex: {pts:?}");
         turning += cr.atan2(u[0] * w[0] + u[1] * w[1]);
     }
-    assert!(
-        (turning.abs() - std::f64::consts::TAU).abs() < 1e-6,
-        "self-intersecting: {pts:?}"
-    );
+    assert!((turning.abs() - std::f64::consts::TAU).abs() < 1e-6, "self-intersecting: {pts:?}");
 }
 
 /// The plane through `x` with normal `n` (not necessarily unit), as (unit normal, d).
@@ -180,11 +156,7 @@ fn plane_parallel_to_base_gives_the_base_triangle_at_that_height() {
         assert_eq!(poly.len, 3);
         check_on_plane_and_edges(&v, &p, &poly, n, d);
         check_convex(&positions(&poly), n);
-        for (q, corner) in poly
-            .as_slice()
-            .iter()
-            .zip([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])
-        {
+        for (q, corner) in poly.as_slice().iter().zip([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]) {
             assert_eq!(q.position, [corner[0], corner[1], z, f32::from_bits(7)]);
             assert_eq!(q.uvw, [corner[0], corner[1], z, 0.0]);
         }
@@ -232,20 +204,9 @@ fn classify_follows_the_paper() {
     assert_eq!(classify(1.0, 1.0), EdgeClass::Below);
     assert_eq!(classify(-1.0, -1.0), EdgeClass::Below);
     // The prism-oriented rule agrees whenever the edge rises like its prism.
-    for (sb, st) in [
-        (-1.0, 1.0),
-        (2.0, 1.0),
-        (-2.0, -1.0),
-        (1.0, 2.0),
-        (-3.0, -4.0),
-        (0.0, 1.0),
-    ] {
+    for (sb, st) in [(-1.0, 1.0), (2.0, 1.0), (-2.0, -1.0), (1.0, 2.0), (-3.0, -4.0), (0.0, 1.0)] {
         let rising = st - sb >= 0.0;
-        assert_eq!(
-            classify_oriented(sb, st, rising),
-            classify(sb, st),
-            "{sb} {st}"
-        );
+        assert_eq!(classify_oriented(sb, st, rising), classify(sb, st), "{sb} {st}");
     }
     // Parallel edges: on either side of the plane the classes differ, so the sides are kept.
     assert_eq!(classify_oriented(-1.0, -1.0, true), EdgeClass::Above);
@@ -306,11 +267,7 @@ impl Rng {
     }
     fn unit(&mut self) -> V3 {
         loop {
-            let v = [
-                self.range(-1.0, 1.0),
-                self.range(-1.0, 1.0),
-                self.range(-1.0, 1.0),
-            ];
+            let v = [self.range(-1.0, 1.0), self.range(-1.0, 1.0), self.range(-1.0, 1.0)];
             if (0.01..1.0).contains(&dot(v, v)) {
                 return normalize(v);
             }
@@ -355,25 +312,12 @@ fn degenerate_prisms_give_no_nan_and_points_on_the_plane() {
         for _ in 0..300 {
             let n = rng.unit();
             let corner = v[(rng.next() * 3.0) as usize % 3];
-            let x = if rng.next() < 0.5 {
-                corner.bottom
-            } else {
-                corner.top
-            };
+            let x = if rng.next() < 0.5 { corner.bottom } else { corner.top };
             // Half through a corner exactly, half anywhere near the prism.
-            let d = if rng.next() < 0.5 {
-                dot(n, xyz(x))
-            } else {
-                dot(n, xyz(x)) + rng.range(-1.0, 1.0)
-            };
+            let d = if rng.next() < 0.5 { dot(n, xyz(x)) } else { dot(n, xyz(x)) + rng.range(-1.0, 1.0) };
             planes.push((n, d));
         }
-        for axis in [
-            [1.0, 0.0, 0.0],
-            [0.0, 1.0, 0.0],
-            [0.0, 0.0, 1.0],
-            [0.0, 0.0, -1.0],
-        ] {
+        for axis in [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [0.0, 0.0, -1.0]] {
             for d in [-0.5, 0.0, 0.5, 1.0] {
                 planes.push((axis, d));
             }
@@ -390,9 +334,7 @@ fn degenerate_prisms_give_no_nan_and_points_on_the_plane() {
 /// How many of the prism's nine edges the plane crosses by sign.
 fn crossings(v: &[ShellVertex], p: &Prism, n: V3, d: f32) -> usize {
     let s = |x: [f32; 4]| dot(n, xyz(x)) - d >= 0.0;
-    let sb: Vec<bool> = (0..3)
-        .map(|i| s(v[p.vertices[i] as usize].bottom))
-        .collect();
+    let sb: Vec<bool> = (0..3).map(|i| s(v[p.vertices[i] as usize].bottom)).collect();
     let st: Vec<bool> = (0..3).map(|i| s(v[p.vertices[i] as usize].top)).collect();
     (0..3)
         .map(|i| {
@@ -412,16 +354,8 @@ fn prisms_sharing_an_edge_get_bit_identical_points() {
         // heights' slopes along the view disagree in sign.
         let mut v = Vec::new();
         for (x, y) in [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0)] {
-            let b = [
-                x + rng.range(-0.2, 0.2),
-                y + rng.range(-0.2, 0.2),
-                rng.range(-0.2, 0.2),
-            ];
-            let h = [
-                rng.range(-0.3, 0.3),
-                rng.range(-0.3, 0.3),
-                rng.range(0.5, 1.0),
-            ];
+            let b = [x + rng.range(-0.2, 0.2), y + rng.range(-0.2, 0.2), rng.range(-0.2, 0.2)];
+            let h = [rng.range(-0.3, 0.3), rng.range(-0.3, 0.3), rng.range(0.5, 1.0)];
             v.push(sv(b, [b[0] + h[0], b[1] + h[1], b[2] + h[2]]));
         }
         let uv = [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]];
@@ -430,10 +364,7 @@ fn prisms_sharing_an_edge_get_bit_identical_points() {
         let shared: Vec<(V3, V3)> = [1usize, 2]
             .iter()
             .map(|&i| (xyz(v[i].bottom), xyz(v[i].top)))
-            .chain([
-                (xyz(v[1].bottom), xyz(v[2].bottom)),
-                (xyz(v[1].top), xyz(v[2].top)),
-            ])
+            .chain([(xyz(v[1].bottom), xyz(v[2].bottom)), (xyz(v[1].top), xyz(v[2].top))])
             .collect();
         for _ in 0..20 {
             let mut n = rng.unit();
@@ -453,10 +384,7 @@ fn prisms_sharing_an_edge_get_bit_identical_points() {
             }
             for (x, y) in [(&a, &b), (&b, &a)] {
                 for q in positions(x) {
-                    if shared
-                        .iter()
-                        .any(|(e0, e1)| dist_to_segment(q, *e0, *e1) < 1e-6)
-                    {
+                    if shared.iter().any(|(e0, e1)| dist_to_segment(q, *e0, *e1) < 1e-6) {
                         let bits = q.map(f32::to_bits);
                         assert!(
                             positions(y).iter().any(|r| r.map(f32::to_bits) == bits),
@@ -478,22 +406,14 @@ fn flat_shell(cells: u32, size: f32, h: f32) -> (Vec<ShellVertex>, Vec<Prism>) {
     let mut v = Vec::new();
     for j in 0..m {
         for i in 0..m {
-            let (x, y) = (
-                size * i as f32 / cells as f32,
-                size * j as f32 / cells as f32,
-            );
+            let (x, y) = (size * i as f32 / cells as f32, size * j as f32 / cells as f32);
             v.push(sv([x, y, 0.0], [x, y, h]));
         }
     }
     let mut prisms = Vec::new();
     for j in 0..cells {
         for i in 0..cells {
-            let (a, b, c, d) = (
-                j * m + i,
-                j * m + i + 1,
-                (j + 1) * m + i,
-                (j + 1) * m + i + 1,
-            );
+            let (a, b, c, d) = (j * m + i, j * m + i + 1, (j + 1) * m + i, (j + 1) * m + i + 1);
             let uv = [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]];
             prisms.push(prism(&v, [a, b, c], uv));
             prisms.push(prism(&v, [b, d, c], uv));
@@ -520,15 +440,10 @@ fn flat_shell_cross_section_area_at_30_degrees() {
         _pad: [0; 3],
     };
     let tris = &slice_all(&v, &prisms, &params, true)[0];
-    let total: f64 = tris
-        .chunks(3)
-        .map(|t| area(&t.iter().map(|q| xyz(q.position)).collect::<Vec<_>>()))
-        .sum();
+    let total: f64 =
+        tris.chunks(3).map(|t| area(&t.iter().map(|q| xyz(q.position)).collect::<Vec<_>>())).sum();
     let expect = (2.0 * h * size) as f64;
-    assert!(
-        (total - expect).abs() < 1e-4 * expect,
-        "area {total} vs {expect}"
-    );
+    assert!((total - expect).abs() < 1e-4 * expect, "area {total} vs {expect}");
     // The same by polygons, each convex.
     let mut by_poly = 0.0;
     for (i, p) in prisms.iter().enumerate() {
@@ -559,10 +474,7 @@ fn counts_scan_and_slices_agree_and_trivial_reject_changes_nothing() {
     let slices = slice_all(&v, &prisms, &params, true);
     assert_eq!(slices, slice_all(&v, &prisms, &params, false));
     let counts = plane_counts(&v, &prisms, &params, true);
-    assert_eq!(
-        counts,
-        slices.iter().map(|s| s.len() as u32).collect::<Vec<_>>()
-    );
+    assert_eq!(counts, slices.iter().map(|s| s.len() as u32).collect::<Vec<_>>());
     assert!(counts.iter().filter(|&&c| c > 0).count() > 50);
     let (offsets, args) = scan_plane_offsets(&counts, params.vertex_capacity);
     let total: u32 = counts.iter().sum();
@@ -581,44 +493,21 @@ fn counts_scan_and_slices_agree_and_trivial_reject_changes_nothing() {
 fn kernels_validate_and_declare_the_bound_globals() {
     let root = crate::project_root().join("wgsl");
     for (file, globals) in [
-        (
-            "count_slices.wgsl",
-            &["slice_params", "shell_vertices", "prisms", "plane_cursors"][..],
-        ),
-        (
-            "scan_plane_offsets.wgsl",
-            &["slice_params", "plane_cursors", "draw_args"][..],
-        ),
+        ("count_slices.wgsl", &["slice_params", "shell_vertices", "prisms", "plane_cursors"][..]),
+        ("scan_plane_offsets.wgsl", &["slice_params", "plane_cursors", "draw_args"][..]),
         (
             "emit_slices.wgsl",
-            &[
-                "slice_params",
-                "shell_vertices",
-                "prisms",
-                "plane_cursors",
-                "slice_vertices",
-            ][..],
+            &["slice_params", "shell_vertices", "prisms", "plane_cursors", "slice_vertices"][..],
         ),
     ] {
         let kernel = crate::gpu::shader::load(&root, file).unwrap_or_else(|e| panic!("{e}"));
-        let names: Vec<&str> = kernel
-            .module
-            .global_variables
-            .iter()
-            .filter_map(|(_, g)| g.name.as_deref())
-            .collect();
+        let names: Vec<&str> =
+            kernel.module.global_variables.iter().filter_map(|(_, g)| g.name.as_deref()).collect();
         for g in globals {
             assert!(names.contains(g), "{file} lacks {g}: {names:?}");
         }
-        let overrides: Vec<&str> = kernel
-            .module
-            .overrides
-            .iter()
-            .filter_map(|(_, o)| o.name.as_deref())
-            .collect();
-        assert_eq!(
-            overrides.contains(&"trivial_reject"),
-            file != "scan_plane_offsets.wgsl"
-        );
+        let overrides: Vec<&str> =
+            kernel.module.overrides.iter().filter_map(|(_, o)| o.name.as_deref()).collect();
+        assert_eq!(overrides.contains(&"trivial_reject"), file != "scan_plane_offsets.wgsl");
     }
 }

@@ -62,25 +62,13 @@ impl GpuContext {
             memory_hints: wgpu::MemoryHints::Performance,
             trace: wgpu::Trace::Off,
         }))
-        .map_err(|e| {
-            Error::Gpu(format!(
-                "cannot open {} ({:?}): {e}",
-                info.name, info.backend
-            ))
-        })?;
+        .map_err(|e| Error::Gpu(format!("cannot open {} ({:?}): {e}", info.name, info.backend)))?;
         let errors = Arc::new(Mutex::new(Vec::new()));
         let sink = errors.clone();
         device.on_uncaptured_error(Arc::new(move |e: wgpu::Error| {
             sink.lock().unwrap().push(e.to_string());
         }));
-        Ok(Self {
-            device,
-            queue,
-            info,
-            features,
-            limits,
-            errors,
-        })
+        Ok(Self { device, queue, info, features, limits, errors })
     }
 
     /// One line naming the adapter, for metadata and reports.
@@ -92,9 +80,8 @@ impl GpuContext {
     }
 
     pub fn has_timestamps(&self) -> bool {
-        self.features.contains(
-            wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS,
-        )
+        self.features
+            .contains(wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS)
     }
 
     /// Fails with the first wgpu error raised outside an error scope since the last call.
@@ -163,52 +150,20 @@ impl GpuContext {
         s += &format!("driver:   {} {}\n", self.info.driver, self.info.driver_info);
         s += "features voltex uses:\n";
         for (name, f) in [
-            (
-                "TIMESTAMP_QUERY (GPU timings)",
-                wgpu::Features::TIMESTAMP_QUERY,
-            ),
-            (
-                "TIMESTAMP_QUERY_INSIDE_ENCODERS",
-                wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS,
-            ),
-            (
-                "FLOAT32_BLENDABLE (f32 accumulation)",
-                wgpu::Features::FLOAT32_BLENDABLE,
-            ),
+            ("TIMESTAMP_QUERY (GPU timings)", wgpu::Features::TIMESTAMP_QUERY),
+            ("TIMESTAMP_QUERY_INSIDE_ENCODERS", wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS),
+            ("FLOAT32_BLENDABLE (f32 accumulation)", wgpu::Features::FLOAT32_BLENDABLE),
         ] {
-            s += &format!(
-                "  {:<34} {}\n",
-                name,
-                if self.features.contains(f) {
-                    "yes"
-                } else {
-                    "no"
-                }
-            );
+            s += &format!("  {:<34} {}\n", name, if self.features.contains(f) { "yes" } else { "no" });
         }
         s += "limits:\n";
         for (name, v) in [
-            (
-                "max_texture_dimension_2d",
-                l.max_texture_dimension_2d as u64,
-            ),
-            (
-                "max_texture_dimension_3d",
-                l.max_texture_dimension_3d as u64,
-            ),
+            ("max_texture_dimension_2d", l.max_texture_dimension_2d as u64),
+            ("max_texture_dimension_3d", l.max_texture_dimension_3d as u64),
             ("max_buffer_size", l.max_buffer_size),
-            (
-                "max_storage_buffer_binding_size",
-                l.max_storage_buffer_binding_size,
-            ),
-            (
-                "max_compute_workgroups_per_dimension",
-                l.max_compute_workgroups_per_dimension as u64,
-            ),
-            (
-                "max_compute_invocations_per_workgroup",
-                l.max_compute_invocations_per_workgroup as u64,
-            ),
+            ("max_storage_buffer_binding_size", l.max_storage_buffer_binding_size),
+            ("max_compute_workgroups_per_dimension", l.max_compute_workgroups_per_dimension as u64),
+            ("max_compute_invocations_per_workgroup", l.max_compute_invocations_per_workgroup as u64),
             ("max_bind_groups", l.max_bind_groups as u64),
         ] {
             s += &format!("  {name:<38} {v}\n");

@@ -27,30 +27,23 @@ impl ComputeKernel {
         let kernel = shader::load(wgsl_root, name)?;
         let bindings = reflect::bindings(&kernel, &["main"])?;
         if bindings.iter().any(|b| b.group != 0) {
-            return Err(Error::Invalid(format!(
-                "{name}: bake kernels bind everything in @group(0)"
-            )));
+            return Err(Error::Invalid(format!("{name}: bake kernels bind everything in @group(0)")));
         }
         let entries: Vec<_> = bindings.iter().map(reflect::layout_entry).collect();
-        let bgl = ctx
-            .device
-            .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                label: Some(name),
-                entries: &entries,
-            });
-        let layout = ctx
-            .device
-            .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                label: Some(name),
-                bind_group_layouts: &[Some(&bgl)],
-                immediate_size: 0,
-            });
+        let bgl = ctx.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some(name),
+            entries: &entries,
+        });
+        let layout = ctx.device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some(name),
+            bind_group_layouts: &[Some(&bgl)],
+            immediate_size: 0,
+        });
         let module = ctx.scoped(name, || {
-            ctx.device
-                .create_shader_module(wgpu::ShaderModuleDescriptor {
-                    label: Some(name),
-                    source: wgpu::ShaderSource::Naga(Cow::Owned(kernel.module.clone())),
-                })
+            ctx.device.create_shader_module(wgpu::ShaderModuleDescriptor {
+                label: Some(name),
+                source: wgpu::ShaderSource::Naga(Cow::Owned(kernel.module.clone())),
+            })
         })?;
         let workgroup = reflect::workgroup_size(&kernel, "main").unwrap_or([1, 1, 1]);
         Ok(Self {
@@ -76,28 +69,23 @@ impl ComputeKernel {
         let constants: Vec<(&str, f64)> = reflect::overrides(&self.kernel)
             .into_iter()
             .filter_map(|(n, _)| {
-                inputs
-                    .constants
-                    .iter()
-                    .find(|(m, _)| *m == n)
-                    .map(|(m, v)| (m.as_str(), *v))
+                inputs.constants.iter().find(|(m, _)| *m == n).map(|(m, v)| (m.as_str(), *v))
             })
             .collect();
         let key = format!("{constants:?}");
         if !self.pipelines.contains_key(&key) {
             let p = ctx.scoped(&self.name, || {
-                ctx.device
-                    .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                        label: Some(&self.name),
-                        layout: Some(&self.layout),
-                        module: &self.module,
-                        entry_point: Some("main"),
-                        compilation_options: wgpu::PipelineCompilationOptions {
-                            constants: &constants,
-                            zero_initialize_workgroup_memory: true,
-                        },
-                        cache: None,
-                    })
+                ctx.device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                    label: Some(&self.name),
+                    layout: Some(&self.layout),
+                    module: &self.module,
+                    entry_point: Some("main"),
+                    compilation_options: wgpu::PipelineCompilationOptions {
+                        constants: &constants,
+                        zero_initialize_workgroup_memory: true,
+                    },
+                    cache: None,
+                })
             })?;
             self.pipelines.insert(key.clone(), p);
         }
@@ -107,22 +95,13 @@ impl ComputeKernel {
                 BindingKind::Uniform | BindingKind::Storage { .. } => {
                     inputs.buffers.get(&b.name).map(|x| x.as_entire_binding())
                 }
-                BindingKind::Texture { .. } | BindingKind::StorageTexture { .. } => inputs
-                    .views
-                    .get(&b.name)
-                    .map(wgpu::BindingResource::TextureView),
-                BindingKind::Sampler => inputs
-                    .samplers
-                    .get(&b.name)
-                    .map(wgpu::BindingResource::Sampler),
+                BindingKind::Texture { .. } | BindingKind::StorageTexture { .. } => {
+                    inputs.views.get(&b.name).map(wgpu::BindingResource::TextureView)
+                }
+                BindingKind::Sampler => inputs.samplers.get(&b.name).map(wgpu::BindingResource::Sampler),
             }
-            .ok_or_else(|| {
-                Error::Invalid(format!("{}: nothing bound to `{}`", self.name, b.name))
-            })?;
-            entries.push(wgpu::BindGroupEntry {
-                binding: b.binding,
-                resource,
-            });
+            .ok_or_else(|| Error::Invalid(format!("{}: nothing bound to `{}`", self.name, b.name)))?;
+            entries.push(wgpu::BindGroupEntry { binding: b.binding, resource });
         }
         let group = ctx.scoped(&self.name, || {
             ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -137,9 +116,7 @@ impl ComputeKernel {
         });
         pass.set_pipeline(&self.pipelines[&key]);
         pass.set_bind_group(0, &group, &[]);
-        let g: Vec<u32> = (0..3)
-            .map(|i| threads[i].div_ceil(self.workgroup[i].max(1)))
-            .collect();
+        let g: Vec<u32> = (0..3).map(|i| threads[i].div_ceil(self.workgroup[i].max(1))).collect();
         pass.dispatch_workgroups(g[0], g[1], g[2]);
         Ok(())
     }

@@ -29,10 +29,7 @@ pub enum BindingKind {
 impl BindingKind {
     /// Whether a pass with this binding writes the bound resource (for pass ordering).
     pub fn writes(&self) -> bool {
-        matches!(
-            self,
-            BindingKind::Storage { read_only: false } | BindingKind::StorageTexture { .. }
-        )
+        matches!(self, BindingKind::Storage { read_only: false } | BindingKind::StorageTexture { .. })
     }
 }
 
@@ -56,9 +53,7 @@ pub fn bindings(kernel: &Kernel, entry_points: &[&str]) -> Result<Vec<Binding>> 
             .iter()
             .enumerate()
             .find(|(_, e)| e.name == *ep_name)
-            .ok_or_else(|| {
-                Error::Invalid(format!("{}: no entry point `{ep_name}`", kernel.name))
-            })?;
+            .ok_or_else(|| Error::Invalid(format!("{}: no entry point `{ep_name}`", kernel.name)))?;
         let stage = match ep.stage {
             naga::ShaderStage::Vertex => wgpu::ShaderStages::VERTEX,
             naga::ShaderStage::Fragment => wgpu::ShaderStages::FRAGMENT,
@@ -71,22 +66,13 @@ pub fn bindings(kernel: &Kernel, entry_points: &[&str]) -> Result<Vec<Binding>> 
                 continue;
             }
             let name = var.name.clone().unwrap_or_default();
-            if let Some(b) = out
-                .iter_mut()
-                .find(|b| b.group == rb.group && b.binding == rb.binding)
-            {
+            if let Some(b) = out.iter_mut().find(|b| b.group == rb.group && b.binding == rb.binding) {
                 b.visibility |= stage;
                 continue;
             }
             let kind = kind_of(module, var, sampled.contains(&handle))
                 .map_err(|m| Error::Invalid(format!("{}: `{name}`: {m}", kernel.name)))?;
-            out.push(Binding {
-                name,
-                group: rb.group,
-                binding: rb.binding,
-                kind,
-                visibility: stage,
-            });
+            out.push(Binding { name, group: rb.group, binding: rb.binding, kind, visibility: stage });
         }
     }
     out.sort_by_key(|b| (b.group, b.binding));
@@ -95,11 +81,8 @@ pub fn bindings(kernel: &Kernel, entry_points: &[&str]) -> Result<Vec<Binding>> 
 
 /// Globals used as the image of a sampling expression.
 fn sampled_globals(module: &naga::Module) -> Vec<naga::Handle<naga::GlobalVariable>> {
-    let functions = module
-        .functions
-        .iter()
-        .map(|(_, f)| f)
-        .chain(module.entry_points.iter().map(|e| &e.function));
+    let functions =
+        module.functions.iter().map(|(_, f)| f).chain(module.entry_points.iter().map(|e| &e.function));
     let mut out = Vec::new();
     for f in functions {
         for (_, e) in f.expressions.iter() {
@@ -113,43 +96,25 @@ fn sampled_globals(module: &naga::Module) -> Vec<naga::Handle<naga::GlobalVariab
     out
 }
 
-fn kind_of(
-    module: &naga::Module,
-    var: &naga::GlobalVariable,
-    filtered: bool,
-) -> Result<BindingKind, String> {
+fn kind_of(module: &naga::Module, var: &naga::GlobalVariable, filtered: bool) -> Result<BindingKind, String> {
     Ok(match var.space {
         naga::AddressSpace::Uniform => BindingKind::Uniform,
-        naga::AddressSpace::Storage { access } => BindingKind::Storage {
-            read_only: !access.contains(naga::StorageAccess::STORE),
-        },
+        naga::AddressSpace::Storage { access } => {
+            BindingKind::Storage { read_only: !access.contains(naga::StorageAccess::STORE) }
+        }
         naga::AddressSpace::Handle => match &module.types[var.ty].inner {
             naga::TypeInner::Sampler { .. } => BindingKind::Sampler,
-            naga::TypeInner::Image {
-                dim,
-                arrayed,
-                class,
-            } => {
+            naga::TypeInner::Image { dim, arrayed, class } => {
                 let dim = view_dim(*dim, *arrayed);
                 match class {
-                    naga::ImageClass::Sampled { .. } => BindingKind::Texture {
-                        dim,
-                        depth: false,
-                        filtered,
-                    },
-                    naga::ImageClass::Depth { .. } => BindingKind::Texture {
-                        dim,
-                        depth: true,
-                        filtered,
-                    },
+                    naga::ImageClass::Sampled { .. } => BindingKind::Texture { dim, depth: false, filtered },
+                    naga::ImageClass::Depth { .. } => BindingKind::Texture { dim, depth: true, filtered },
                     naga::ImageClass::Storage { format, access } => BindingKind::StorageTexture {
                         dim,
                         format: texture_format(*format)?,
                         write_only: !access.contains(naga::StorageAccess::LOAD),
                     },
-                    naga::ImageClass::External => {
-                        return Err("external textures are not supported".into())
-                    }
+                    naga::ImageClass::External => return Err("external textures are not supported".into()),
                 }
             }
             other => return Err(format!("unsupported handle type {other:?}")),
@@ -181,11 +146,7 @@ fn texture_format(f: naga::StorageFormat) -> Result<wgpu::TextureFormat, String>
         S::R32Float => T::R32Float,
         S::R32Uint => T::R32Uint,
         S::Rg32Float => T::Rg32Float,
-        other => {
-            return Err(format!(
-                "storage format {other:?} is not supported by voltex"
-            ))
-        }
+        other => return Err(format!("storage format {other:?} is not supported by voltex")),
     })
 }
 
@@ -198,32 +159,20 @@ pub fn layout_entry(b: &Binding) -> wgpu::BindGroupLayoutEntry {
             min_binding_size: None,
         },
         BindingKind::Storage { read_only } => wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Storage {
-                read_only: *read_only,
-            },
+            ty: wgpu::BufferBindingType::Storage { read_only: *read_only },
             has_dynamic_offset: false,
             min_binding_size: None,
         },
-        BindingKind::Texture {
-            dim,
-            depth,
-            filtered,
-        } => wgpu::BindingType::Texture {
+        BindingKind::Texture { dim, depth, filtered } => wgpu::BindingType::Texture {
             sample_type: if *depth {
                 wgpu::TextureSampleType::Depth
             } else {
-                wgpu::TextureSampleType::Float {
-                    filterable: *filtered,
-                }
+                wgpu::TextureSampleType::Float { filterable: *filtered }
             },
             view_dimension: *dim,
             multisampled: false,
         },
-        BindingKind::StorageTexture {
-            dim,
-            format,
-            write_only,
-        } => wgpu::BindingType::StorageTexture {
+        BindingKind::StorageTexture { dim, format, write_only } => wgpu::BindingType::StorageTexture {
             access: if *write_only {
                 wgpu::StorageTextureAccess::WriteOnly
             } else {
@@ -234,12 +183,7 @@ pub fn layout_entry(b: &Binding) -> wgpu::BindGroupLayoutEntry {
         },
         BindingKind::Sampler => wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
     };
-    wgpu::BindGroupLayoutEntry {
-        binding: b.binding,
-        visibility: b.visibility,
-        ty,
-        count: None,
-    }
+    wgpu::BindGroupLayoutEntry { binding: b.binding, visibility: b.visibility, ty, count: None }
 }
 
 /// Names of the `override` constants a module declares, with whether each has a default.
@@ -254,10 +198,5 @@ pub fn overrides(kernel: &Kernel) -> Vec<(String, bool)> {
 
 /// Workgroup size of a compute entry point.
 pub fn workgroup_size(kernel: &Kernel, entry_point: &str) -> Option<[u32; 3]> {
-    kernel
-        .module
-        .entry_points
-        .iter()
-        .find(|e| e.name == entry_point)
-        .map(|e| e.workgroup_size)
+    kernel.module.entry_points.iter().find(|e| e.name == entry_point).map(|e| e.workgroup_size)
 }

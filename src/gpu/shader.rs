@@ -29,10 +29,7 @@ fn expand(root: &Path, rel: &Path, out: &mut Expanded, from: Option<FileLoc>) ->
         return Ok(()); // each include once: shared files carry no guards
     }
     let text = std::fs::read_to_string(&path).map_err(|e| match &from {
-        Some(loc) => Error::at(
-            loc.clone(),
-            format!("cannot include {}: {e}", path.display()),
-        ),
+        Some(loc) => Error::at(loc.clone(), format!("cannot include {}: {e}", path.display())),
         None => Error::file(&path, format!("cannot read WGSL: {e}")),
     })?;
     out.files.push(path.clone());
@@ -48,12 +45,7 @@ fn expand(root: &Path, rel: &Path, out: &mut Expanded, from: Option<FileLoc>) ->
                     "expected #include \"shared/name.wgsl\"",
                 ));
             }
-            expand(
-                root,
-                Path::new(name),
-                out,
-                Some(FileLoc::new(&path, i + 1, col)),
-            )?;
+            expand(root, Path::new(name), out, Some(FileLoc::new(&path, i + 1, col)))?;
             continue;
         }
         out.text.push_str(line);
@@ -65,11 +57,8 @@ fn expand(root: &Path, rel: &Path, out: &mut Expanded, from: Option<FileLoc>) ->
 
 impl Expanded {
     fn locate(&self, line: u32, col: u32) -> FileLoc {
-        let (file, orig) = self
-            .origin
-            .get((line as usize).saturating_sub(1))
-            .copied()
-            .unwrap_or((0, line as usize));
+        let (file, orig) =
+            self.origin.get((line as usize).saturating_sub(1)).copied().unwrap_or((0, line as usize));
         FileLoc::new(&self.files[file], orig, col as usize)
     }
 }
@@ -81,11 +70,7 @@ pub fn capabilities() -> naga::valid::Capabilities {
 
 /// Loads, expands and validates `root/rel`.
 pub fn load(root: &Path, rel: &str) -> Result<Kernel> {
-    let mut ex = Expanded {
-        text: String::new(),
-        origin: Vec::new(),
-        files: Vec::new(),
-    };
+    let mut ex = Expanded { text: String::new(), origin: Vec::new(), files: Vec::new() };
     expand(root, Path::new(rel), &mut ex, None)?;
     load_expanded(rel, ex)
 }
@@ -103,24 +88,17 @@ pub fn load_str(path: &Path, source: &str) -> Result<Kernel> {
 fn load_expanded(name: &str, ex: Expanded) -> Result<Kernel> {
     let module = naga::front::wgsl::parse_str(&ex.text).map_err(|e| {
         let loc = e.location(&ex.text);
-        let (line, col) = loc
-            .map(|l| (l.line_number, l.line_position))
-            .unwrap_or((1, 1));
+        let (line, col) = loc.map(|l| (l.line_number, l.line_position)).unwrap_or((1, 1));
         Error::at(
             ex.locate(line, col),
-            format!(
-                "WGSL parse error: {}",
-                first_line(&e.emit_to_string(&ex.text))
-            ),
+            format!("WGSL parse error: {}", first_line(&e.emit_to_string(&ex.text))),
         )
     })?;
     let info = naga::valid::Validator::new(naga::valid::ValidationFlags::all(), capabilities())
         .validate(&module)
         .map_err(|e| {
-            let (line, col) = e
-                .location(&ex.text)
-                .map(|l| (l.line_number, l.line_position))
-                .unwrap_or((1, 1));
+            let (line, col) =
+                e.location(&ex.text).map(|l| (l.line_number, l.line_position)).unwrap_or((1, 1));
             let mut msg = e.as_inner().to_string();
             let mut src: &dyn std::error::Error = e.as_inner();
             while let Some(next) = src.source() {
@@ -128,26 +106,13 @@ fn load_expanded(name: &str, ex: Expanded) -> Result<Kernel> {
                 msg.push_str(&next.to_string());
                 src = next;
             }
-            Error::at(
-                ex.locate(line, col),
-                format!("WGSL validation error: {msg}"),
-            )
+            Error::at(ex.locate(line, col), format!("WGSL validation error: {msg}"))
         })?;
-    Ok(Kernel {
-        name: name.to_string(),
-        module,
-        info,
-        files: ex.files,
-    })
+    Ok(Kernel { name: name.to_string(), module, info, files: ex.files })
 }
 
 fn first_line(diagnostic: &str) -> String {
-    diagnostic
-        .lines()
-        .next()
-        .unwrap_or("")
-        .trim_start_matches("error: ")
-        .to_string()
+    diagnostic.lines().next().unwrap_or("").trim_start_matches("error: ").to_string()
 }
 
 #[cfg(test)]
@@ -171,11 +136,8 @@ mod tests {
         let err = load(&dir, "k.wgsl").err().unwrap().to_string();
         assert!(err.contains("shared/a.wgsl:2:"), "{err}");
         std::fs::write(dir.join("shared/a.wgsl"), "fn a() -> f32 { return 1.0; }\n").unwrap();
-        std::fs::write(
-            dir.join("k.wgsl"),
-            "#include \"shared/a.wgsl\"\nfn c() -> u32 { return a(); }\n",
-        )
-        .unwrap();
+        std::fs::write(dir.join("k.wgsl"), "#include \"shared/a.wgsl\"\nfn c() -> u32 { return a(); }\n")
+            .unwrap();
         let err = load(&dir, "k.wgsl").err().unwrap().to_string();
         assert!(err.contains("k.wgsl:2:"), "{err}");
         std::fs::remove_dir_all(&dir).ok();

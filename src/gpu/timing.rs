@@ -16,12 +16,7 @@ impl Timer {
     pub fn new(ctx: &GpuContext, passes: u32) -> Self {
         let capacity = passes.max(1) * 2;
         if !ctx.has_timestamps() {
-            return Self {
-                set: None,
-                resolve: None,
-                labels: Vec::new(),
-                capacity,
-            };
+            return Self { set: None, resolve: None, labels: Vec::new(), capacity };
         }
         let set = ctx.device.create_query_set(&wgpu::QuerySetDescriptor {
             label: Some("pass timestamps"),
@@ -34,12 +29,7 @@ impl Timer {
             usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
             mapped_at_creation: false,
         });
-        Self {
-            set: Some(set),
-            resolve: Some(resolve),
-            labels: Vec::new(),
-            capacity,
-        }
+        Self { set: Some(set), resolve: Some(resolve), labels: Vec::new(), capacity }
     }
 
     pub fn reset(&mut self) {
@@ -58,21 +48,19 @@ impl Timer {
     }
 
     pub fn compute(&mut self, label: &str) -> Option<wgpu::ComputePassTimestampWrites<'_>> {
-        self.next(label)
-            .map(|(query_set, i)| wgpu::ComputePassTimestampWrites {
-                query_set,
-                beginning_of_pass_write_index: Some(i),
-                end_of_pass_write_index: Some(i + 1),
-            })
+        self.next(label).map(|(query_set, i)| wgpu::ComputePassTimestampWrites {
+            query_set,
+            beginning_of_pass_write_index: Some(i),
+            end_of_pass_write_index: Some(i + 1),
+        })
     }
 
     pub fn render(&mut self, label: &str) -> Option<wgpu::RenderPassTimestampWrites<'_>> {
-        self.next(label)
-            .map(|(query_set, i)| wgpu::RenderPassTimestampWrites {
-                query_set,
-                beginning_of_pass_write_index: Some(i),
-                end_of_pass_write_index: Some(i + 1),
-            })
+        self.next(label).map(|(query_set, i)| wgpu::RenderPassTimestampWrites {
+            query_set,
+            beginning_of_pass_write_index: Some(i),
+            end_of_pass_write_index: Some(i + 1),
+        })
     }
 
     pub fn resolve(&self, encoder: &mut wgpu::CommandEncoder) {
@@ -98,12 +86,7 @@ impl Timer {
             .labels
             .iter()
             .enumerate()
-            .map(|(i, l)| {
-                (
-                    l.clone(),
-                    ticks[2 * i + 1].saturating_sub(ticks[2 * i]) as f64 * period * 1e-6,
-                )
-            })
+            .map(|(i, l)| (l.clone(), ticks[2 * i + 1].saturating_sub(ticks[2 * i]) as f64 * period * 1e-6))
             .collect())
     }
 }

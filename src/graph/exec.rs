@@ -69,22 +69,14 @@ impl Executor {
             .collect();
         let mut textures = HashMap::new();
         for (name, decl) in &plan.textures {
-            let ResourceDecl::Texture {
-                format,
-                size: tsize,
-                clear,
-            } = decl;
+            let ResourceDecl::Texture { format, size: tsize, clear } = decl;
             let (w, h) = match tsize {
                 TextureSize::Output => size,
                 TextureSize::Fixed(w, h) => (*w, *h),
             };
             let texture = ctx.device.create_texture(&wgpu::TextureDescriptor {
                 label: Some(name),
-                size: wgpu::Extent3d {
-                    width: w,
-                    height: h,
-                    depth_or_array_layers: 1,
-                },
+                size: wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
                 mip_level_count: 1,
                 sample_count: 1,
                 dimension: wgpu::TextureDimension::D2,
@@ -95,14 +87,7 @@ impl Executor {
                 view_formats: &[],
             });
             let view = texture.create_view(&Default::default());
-            textures.insert(
-                name.clone(),
-                Texture {
-                    texture,
-                    view,
-                    clear: *clear,
-                },
-            );
+            textures.insert(name.clone(), Texture { texture, view, clear: *clear });
         }
         let mut modules = HashMap::new();
         let mut layouts = Vec::new();
@@ -111,23 +96,16 @@ impl Executor {
             if let std::collections::hash_map::Entry::Vacant(slot) = modules.entry(name) {
                 let label = format!("shader {}", slot.key());
                 let module = ctx.scoped(&label, || {
-                    ctx.device
-                        .create_shader_module(wgpu::ShaderModuleDescriptor {
-                            label: Some(&label),
-                            source: wgpu::ShaderSource::Naga(Cow::Owned(p.kernel.module.clone())),
-                        })
+                    ctx.device.create_shader_module(wgpu::ShaderModuleDescriptor {
+                        label: Some(&label),
+                        source: wgpu::ShaderSource::Naga(Cow::Owned(p.kernel.module.clone())),
+                    })
                 })?;
                 slot.insert(module);
             }
             layouts.push(pass_layout(ctx, p));
         }
-        Ok(Self {
-            graph,
-            textures,
-            modules,
-            layouts,
-            pipelines: HashMap::new(),
-        })
+        Ok(Self { graph, textures, modules, layouts, pipelines: HashMap::new() })
     }
 
     pub fn texture(&self, name: &str) -> Option<&wgpu::Texture> {
@@ -161,11 +139,7 @@ impl Executor {
         let pass = &plan.passes[index];
         let mut constants: Vec<(&str, f64)> = Vec::new();
         for (name, has_default) in reflect::overrides(&pass.kernel) {
-            let value = inst
-                .constants
-                .iter()
-                .chain(frame.constants.iter())
-                .find(|(n, _)| *n == name);
+            let value = inst.constants.iter().chain(frame.constants.iter()).find(|(n, _)| *n == name);
             match value {
                 Some((n, v)) => constants.push((n.as_str(), *v)),
                 None if has_default => {}
@@ -193,24 +167,16 @@ impl Executor {
         let label = format!("{} ({})", pass.decl.name(), pass.decl.shader());
         let pipeline = match &pass.decl {
             PassDecl::Compute { entry, .. } => ctx.scoped(&label, || {
-                Pipeline::Compute(ctx.device.create_compute_pipeline(
-                    &wgpu::ComputePipelineDescriptor {
-                        label: Some(&label),
-                        layout: Some(layout),
-                        module,
-                        entry_point: Some(entry),
-                        compilation_options: options.clone(),
-                        cache: None,
-                    },
-                ))
+                Pipeline::Compute(ctx.device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                    label: Some(&label),
+                    layout: Some(layout),
+                    module,
+                    entry_point: Some(entry),
+                    compilation_options: options.clone(),
+                    cache: None,
+                }))
             })?,
-            PassDecl::Raster {
-                vertex,
-                fragment,
-                targets,
-                depth,
-                ..
-            } => {
+            PassDecl::Raster { vertex, fragment, targets, depth, .. } => {
                 let color: Vec<Option<wgpu::ColorTargetState>> = targets
                     .iter()
                     .map(|t| {
@@ -234,29 +200,27 @@ impl Executor {
                     bias: Default::default(),
                 });
                 ctx.scoped(&label, || {
-                    Pipeline::Render(ctx.device.create_render_pipeline(
-                        &wgpu::RenderPipelineDescriptor {
-                            label: Some(&label),
-                            layout: Some(layout),
-                            vertex: wgpu::VertexState {
-                                module,
-                                entry_point: Some(vertex),
-                                compilation_options: options.clone(),
-                                buffers: &[],
-                            },
-                            primitive: wgpu::PrimitiveState::default(),
-                            depth_stencil,
-                            multisample: Default::default(),
-                            fragment: Some(wgpu::FragmentState {
-                                module,
-                                entry_point: Some(fragment),
-                                compilation_options: options.clone(),
-                                targets: &color,
-                            }),
-                            multiview_mask: None,
-                            cache: None,
+                    Pipeline::Render(ctx.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                        label: Some(&label),
+                        layout: Some(layout),
+                        vertex: wgpu::VertexState {
+                            module,
+                            entry_point: Some(vertex),
+                            compilation_options: options.clone(),
+                            buffers: &[],
                         },
-                    ))
+                        primitive: wgpu::PrimitiveState::default(),
+                        depth_stencil,
+                        multisample: Default::default(),
+                        fragment: Some(wgpu::FragmentState {
+                            module,
+                            entry_point: Some(fragment),
+                            compilation_options: options.clone(),
+                            targets: &color,
+                        }),
+                        multiview_mask: None,
+                        cache: None,
+                    }))
                 })?
             }
         };
@@ -274,23 +238,11 @@ impl Executor {
         timer: &mut Timer,
     ) -> Result<()> {
         self.prepare(ctx, plan, frame, objects)?;
-        let mut encoder = ctx
-            .device
-            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                label: Some("frame"),
-            });
+        let mut encoder =
+            ctx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
         let mut written: Vec<String> = Vec::new();
         for index in 0..plan.passes.len() {
-            self.record(
-                ctx,
-                plan,
-                index,
-                frame,
-                objects,
-                &mut encoder,
-                timer,
-                &mut written,
-            )?;
+            self.record(ctx, plan, index, frame, objects, &mut encoder, timer, &mut written)?;
         }
         timer.resolve(&mut encoder);
         let commands = ctx.scoped("recording the frame", || encoder.finish())?;
@@ -331,13 +283,7 @@ impl Executor {
             &self.pipelines[&(index, format!("{constants:?}"))]
         };
         match &pass.decl {
-            PassDecl::Compute {
-                name,
-                entry,
-                clear,
-                dispatch,
-                ..
-            } => {
+            PassDecl::Compute { name, entry, clear, dispatch, .. } => {
                 for inst in &instances {
                     for b in clear {
                         let buf = resolve_buffer(inst, frame, b)
@@ -351,9 +297,7 @@ impl Executor {
                     timestamp_writes: timer.compute(name),
                 });
                 for (inst, bgs) in instances.iter().zip(&groups) {
-                    let Pipeline::Compute(p) = pipeline_of(inst) else {
-                        unreachable!("compute pass")
-                    };
+                    let Pipeline::Compute(p) = pipeline_of(inst) else { unreachable!("compute pass") };
                     let (counts, per_group) = match dispatch {
                         Dispatch::Threads(x, y, z) => ([x, y, z], false),
                         Dispatch::Groups(x, y, z) => ([x, y, z], true),
@@ -361,11 +305,7 @@ impl Executor {
                     let mut g = [0u32; 3];
                     for axis in 0..3 {
                         let n = count(counts[axis], inst, frame);
-                        g[axis] = if per_group {
-                            n
-                        } else {
-                            n.div_ceil(wg[axis].max(1))
-                        };
+                        g[axis] = if per_group { n } else { n.div_ceil(wg[axis].max(1)) };
                         if g[axis] > ctx.limits.max_compute_workgroups_per_dimension {
                             return Err(Error::Gpu(format!(
                                 "pass {name}: {} workgroups on axis {axis} exceed the adapter's limit of {}",
@@ -383,13 +323,7 @@ impl Executor {
                     cpass.dispatch_workgroups(g[0], g[1], g[2]);
                 }
             }
-            PassDecl::Raster {
-                name,
-                targets,
-                depth,
-                draw,
-                ..
-            } => {
+            PassDecl::Raster { name, targets, depth, draw, .. } => {
                 let load = |res: &str, written: &mut Vec<String>| {
                     let first = !written.iter().any(|w| w == res);
                     if first {
@@ -402,14 +336,12 @@ impl Executor {
                     .map(|t| {
                         let (first, clear) = load(&t.resource, written);
                         let load = match (first, clear) {
-                            (true, Some(Clear::Color(r, g, b, a))) => {
-                                wgpu::LoadOp::Clear(wgpu::Color {
-                                    r: r as f64,
-                                    g: g as f64,
-                                    b: b as f64,
-                                    a: a as f64,
-                                })
-                            }
+                            (true, Some(Clear::Color(r, g, b, a))) => wgpu::LoadOp::Clear(wgpu::Color {
+                                r: r as f64,
+                                g: g as f64,
+                                b: b as f64,
+                                a: a as f64,
+                            }),
                             (true, _) => wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
                             _ => wgpu::LoadOp::Load,
                         };
@@ -417,10 +349,7 @@ impl Executor {
                             view: &self.textures[&t.resource].view,
                             depth_slice: None,
                             resolve_target: None,
-                            ops: wgpu::Operations {
-                                load,
-                                store: wgpu::StoreOp::Store,
-                            },
+                            ops: wgpu::Operations { load, store: wgpu::StoreOp::Store },
                         })
                     })
                     .collect();
@@ -433,10 +362,7 @@ impl Executor {
                     };
                     wgpu::RenderPassDepthStencilAttachment {
                         view: &self.textures[&d.resource].view,
-                        depth_ops: Some(wgpu::Operations {
-                            load,
-                            store: wgpu::StoreOp::Store,
-                        }),
+                        depth_ops: Some(wgpu::Operations { load, store: wgpu::StoreOp::Store }),
                         stencil_ops: None,
                     }
                 });
@@ -449,9 +375,7 @@ impl Executor {
                     multiview_mask: None,
                 });
                 for (inst, bgs) in instances.iter().zip(&groups) {
-                    let Pipeline::Render(p) = pipeline_of(inst) else {
-                        unreachable!("raster pass")
-                    };
+                    let Pipeline::Render(p) = pipeline_of(inst) else { unreachable!("raster pass") };
                     rpass.set_pipeline(p);
                     for (i, bg) in bgs.iter().enumerate() {
                         rpass.set_bind_group(i as u32, bg, &[]);
@@ -499,13 +423,9 @@ impl Executor {
                         .or_else(|| frame.samplers.get(&b.name))
                         .map(wgpu::BindingResource::Sampler),
                 };
-                let resource = resource.ok_or_else(|| {
-                    plan::unknown_resource(&self.graph, pass.decl.name(), &b.name)
-                })?;
-                entries.push(wgpu::BindGroupEntry {
-                    binding: b.binding,
-                    resource,
-                });
+                let resource =
+                    resource.ok_or_else(|| plan::unknown_resource(&self.graph, pass.decl.name(), &b.name))?;
+                entries.push(wgpu::BindGroupEntry { binding: b.binding, resource });
             }
             let label = format!("{} group {group}", pass.decl.name());
             out.push(ctx.scoped(&label, || {
@@ -542,42 +462,26 @@ fn texture_format(
     format
 }
 
-fn pass_layout(
-    ctx: &GpuContext,
-    pass: &PlannedPass,
-) -> (Vec<wgpu::BindGroupLayout>, wgpu::PipelineLayout) {
+fn pass_layout(ctx: &GpuContext, pass: &PlannedPass) -> (Vec<wgpu::BindGroupLayout>, wgpu::PipelineLayout) {
     let groups = pass.bindings.iter().map(|b| b.group + 1).max().unwrap_or(0);
     let bgls: Vec<wgpu::BindGroupLayout> = (0..groups)
         .map(|g| {
-            let entries: Vec<_> = pass
-                .bindings
-                .iter()
-                .filter(|b| b.group == g)
-                .map(reflect::layout_entry)
-                .collect();
+            let entries: Vec<_> =
+                pass.bindings.iter().filter(|b| b.group == g).map(reflect::layout_entry).collect();
             ctx.device
-                .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                    label: None,
-                    entries: &entries,
-                })
+                .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: None, entries: &entries })
         })
         .collect();
     let refs: Vec<Option<&wgpu::BindGroupLayout>> = bgls.iter().map(Some).collect();
-    let layout = ctx
-        .device
-        .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some(pass.decl.name()),
-            bind_group_layouts: &refs,
-            immediate_size: 0,
-        });
+    let layout = ctx.device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some(pass.decl.name()),
+        bind_group_layouts: &refs,
+        immediate_size: 0,
+    });
     (bgls, layout)
 }
 
-fn instance_inputs<'a>(
-    pass: &PlannedPass,
-    frame: &'a Inputs,
-    objects: &'a [Inputs],
-) -> Vec<&'a Inputs> {
+fn instance_inputs<'a>(pass: &PlannedPass, frame: &'a Inputs, objects: &'a [Inputs]) -> Vec<&'a Inputs> {
     match &pass.instances {
         None => vec![frame],
         Some(ids) => ids.iter().map(|&i| &objects[i]).collect(),
@@ -591,12 +495,7 @@ fn resolve_buffer<'a>(inst: &'a Inputs, frame: &'a Inputs, name: &str) -> Option
 fn count(name: &str, inst: &Inputs, frame: &Inputs) -> u32 {
     name.parse()
         .ok()
-        .or_else(|| {
-            inst.counts
-                .get(name)
-                .or_else(|| frame.counts.get(name))
-                .copied()
-        })
+        .or_else(|| inst.counts.get(name).or_else(|| frame.counts.get(name)).copied())
         .unwrap_or(0)
 }
 
@@ -604,18 +503,12 @@ fn count(name: &str, inst: &Inputs, frame: &Inputs) -> u32 {
 /// `voltex plan` reports them without a GPU).
 pub fn check_counts(graph: &Graph, decl: &PassDecl) -> Result<()> {
     match decl {
-        PassDecl::Compute {
-            dispatch: Dispatch::Threads(x, y, z) | Dispatch::Groups(x, y, z),
-            ..
-        } => {
+        PassDecl::Compute { dispatch: Dispatch::Threads(x, y, z) | Dispatch::Groups(x, y, z), .. } => {
             for c in [x, y, z] {
                 plan::check_count(graph, c, COUNTS)?;
             }
         }
-        PassDecl::Raster {
-            draw: Draw::Vertices(n),
-            ..
-        } => plan::check_count(graph, n, COUNTS)?,
+        PassDecl::Raster { draw: Draw::Vertices(n), .. } => plan::check_count(graph, n, COUNTS)?,
         PassDecl::Raster { .. } => {}
     }
     Ok(())

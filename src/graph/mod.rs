@@ -148,9 +148,7 @@ impl PassDecl {
     pub fn entry_points(&self) -> Vec<&str> {
         match self {
             PassDecl::Compute { entry, .. } => vec![entry],
-            PassDecl::Raster {
-                vertex, fragment, ..
-            } => vec![vertex, fragment],
+            PassDecl::Raster { vertex, fragment, .. } => vec![vertex, fragment],
         }
     }
 }
@@ -237,11 +235,7 @@ impl Graph {
             .with_default_extension(ron::extensions::Extensions::IMPLICIT_SOME)
             .from_str(&source)
             .map_err(|e| ron_error(path, &e))?;
-        let graph = Self {
-            path: path.to_path_buf(),
-            source,
-            file,
-        };
+        let graph = Self { path: path.to_path_buf(), source, file };
         graph.check_names()?;
         Ok(graph)
     }
@@ -257,9 +251,7 @@ impl Graph {
         let mut seen = Vec::new();
         for p in &f.passes {
             if seen.contains(&p.name()) {
-                return Err(
-                    self.error_at(p.name(), format!("pass `{}` is declared twice", p.name()))
-                );
+                return Err(self.error_at(p.name(), format!("pass `{}` is declared twice", p.name())));
             }
             seen.push(p.name());
             if let Instances::Objects(filter) = p.instances() {
@@ -274,11 +266,7 @@ impl Graph {
                 }
             }
             if let PassDecl::Raster { targets, depth, .. } = p {
-                for t in targets
-                    .iter()
-                    .map(|t| &t.resource)
-                    .chain(depth.iter().map(|d| &d.resource))
-                {
+                for t in targets.iter().map(|t| &t.resource).chain(depth.iter().map(|d| &d.resource)) {
                     if !f.resources.contains_key(t) {
                         return Err(self.error_at(
                             t,
@@ -289,10 +277,7 @@ impl Graph {
             }
         }
         if f.outputs.is_empty() {
-            return Err(Error::at(
-                FileLoc::new(&self.path, 1, 1),
-                "expected at least one name in `outputs`",
-            ));
+            return Err(Error::at(FileLoc::new(&self.path, 1, 1), "expected at least one name in `outputs`"));
         }
         Ok(())
     }

@@ -50,9 +50,8 @@ pub fn plan(graph: &Graph, wgsl_root: &Path, objects: &[ObjectInfo]) -> Result<P
         let instances = match decl.instances() {
             Instances::Frame => None,
             Instances::Objects(filter) => {
-                let mut ids: Vec<usize> = (0..objects.len())
-                    .filter(|&i| objects[i].filters.contains(&filter.as_str()))
-                    .collect();
+                let mut ids: Vec<usize> =
+                    (0..objects.len()).filter(|&i| objects[i].filters.contains(&filter.as_str())).collect();
                 if ids.is_empty() {
                     pruned.push(format!("pass {}: no object matches {filter}", decl.name()));
                     continue;
@@ -67,11 +66,7 @@ pub fn plan(graph: &Graph, wgsl_root: &Path, objects: &[ObjectInfo]) -> Result<P
                 if !wgsl_root.join(decl.shader()).is_file() {
                     return Err(graph.error_at(
                         decl.shader(),
-                        format!(
-                            "shader `{}` not found in {}",
-                            decl.shader(),
-                            wgsl_root.display()
-                        ),
+                        format!("shader `{}` not found in {}", decl.shader(), wgsl_root.display()),
                     ));
                 }
                 let k = Arc::new(shader::load(wgsl_root, decl.shader())?);
@@ -82,22 +77,12 @@ pub fn plan(graph: &Graph, wgsl_root: &Path, objects: &[ObjectInfo]) -> Result<P
         let bindings = reflect::bindings(&kernel, &decl.entry_points())
             .map_err(|e| graph.error_at(decl.name(), format!("pass `{}`: {e}", decl.name())))?;
         let (reads, writes) = accesses(decl, &bindings);
-        candidates.push(PlannedPass {
-            decl: decl.clone(),
-            kernel,
-            bindings,
-            reads,
-            writes,
-            instances,
-        });
+        candidates.push(PlannedPass { decl: decl.clone(), kernel, bindings, reads, writes, instances });
     }
     let ordered = order(graph, candidates)?;
     let mut passes = live(&graph.file.outputs, ordered, &mut pruned);
     passes.shrink_to_fit();
-    let used: BTreeSet<&String> = passes
-        .iter()
-        .flat_map(|p| p.reads.iter().chain(p.writes.iter()))
-        .collect();
+    let used: BTreeSet<&String> = passes.iter().flat_map(|p| p.reads.iter().chain(p.writes.iter())).collect();
     let mut textures = BTreeMap::new();
     for (name, decl) in &graph.file.resources {
         if used.contains(name) {
@@ -106,11 +91,7 @@ pub fn plan(graph: &Graph, wgsl_root: &Path, objects: &[ObjectInfo]) -> Result<P
             pruned.push(format!("resource {name}: no kept pass uses it"));
         }
     }
-    Ok(Plan {
-        passes,
-        textures,
-        pruned,
-    })
+    Ok(Plan { passes, textures, pruned })
 }
 
 /// Resources a pass reads and writes: from reflection, render targets, indirect arguments and clears.
@@ -121,24 +102,13 @@ fn accesses(decl: &PassDecl, bindings: &[Binding]) -> (BTreeSet<String>, BTreeSe
         if b.kind.writes() {
             writes.insert(b.name.clone());
         }
-        if !matches!(
-            b.kind,
-            reflect::BindingKind::StorageTexture {
-                write_only: true,
-                ..
-            }
-        ) {
+        if !matches!(b.kind, reflect::BindingKind::StorageTexture { write_only: true, .. }) {
             reads.insert(b.name.clone());
         }
     }
     match decl {
         PassDecl::Compute { clear, .. } => writes.extend(clear.iter().cloned()),
-        PassDecl::Raster {
-            targets,
-            depth,
-            draw,
-            ..
-        } => {
+        PassDecl::Raster { targets, depth, draw, .. } => {
             for t in targets {
                 writes.insert(t.resource.clone());
                 if t.blend != crate::graph::Blend::Replace {
@@ -181,10 +151,7 @@ fn order(graph: &Graph, passes: Vec<PlannedPass>) -> Result<Vec<PlannedPass>> {
     // cycle (e.g. a blending pass declared before the pass whose depth it reads) is left out.
     for j in 0..n {
         for i in 0..j {
-            let writes_together = passes[i]
-                .writes
-                .iter()
-                .any(|r| passes[j].writes.contains(r));
+            let writes_together = passes[i].writes.iter().any(|r| passes[j].writes.contains(r));
             if writes_together && !reaches(&deps, i, j) {
                 deps[j].insert(i);
             }
@@ -213,10 +180,7 @@ fn order(graph: &Graph, passes: Vec<PlannedPass>) -> Result<Vec<PlannedPass>> {
         }
     }
     let mut slots: Vec<Option<PlannedPass>> = passes.into_iter().map(Some).collect();
-    Ok(order
-        .into_iter()
-        .map(|j| slots[j].take().unwrap())
-        .collect())
+    Ok(order.into_iter().map(|j| slots[j].take().unwrap()).collect())
 }
 
 /// Whether pass `to` depends, directly or not, on pass `from` (`to` == `from` counts).
@@ -235,11 +199,7 @@ fn reaches(deps: &[BTreeSet<usize>], to: usize, from: usize) -> bool {
 }
 
 /// Keeps the passes that contribute to an output, walking back from the outputs.
-fn live(
-    outputs: &[String],
-    passes: Vec<PlannedPass>,
-    pruned: &mut Vec<String>,
-) -> Vec<PlannedPass> {
+fn live(outputs: &[String], passes: Vec<PlannedPass>, pruned: &mut Vec<String>) -> Vec<PlannedPass> {
     let mut needed: BTreeSet<String> = outputs.iter().cloned().collect();
     let mut keep = vec![false; passes.len()];
     for (i, p) in passes.iter().enumerate().rev() {
@@ -253,10 +213,7 @@ fn live(
         .zip(keep)
         .filter_map(|(p, k)| {
             if !k {
-                pruned.push(format!(
-                    "pass {}: nothing it writes reaches an output",
-                    p.decl.name()
-                ));
+                pruned.push(format!("pass {}: nothing it writes reaches an output", p.decl.name()));
             }
             k.then_some(p)
         })
@@ -275,15 +232,14 @@ pub fn check_count(graph: &Graph, count: &str, known: &[&str]) -> Result<()> {
     if count.parse::<u32>().is_ok() || known.contains(&count) {
         return Ok(());
     }
-    Err(graph.error_at(
-        count,
-        format!("unknown count `{count}`; expected a number or one of {known:?}"),
-    ))
+    Err(graph.error_at(count, format!("unknown count `{count}`; expected a number or one of {known:?}")))
 }
 
 pub fn unknown_resource(graph: &Graph, pass: &str, name: &str) -> Error {
     graph.error_at(
         pass,
-        format!("pass `{pass}` uses `{name}`, which is neither a graph resource nor one the runtime provides"),
+        format!(
+            "pass `{pass}` uses `{name}`, which is neither a graph resource nor one the runtime provides"
+        ),
     )
 }

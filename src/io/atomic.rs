@@ -23,20 +23,13 @@ fn parent_dir(path: &Path) -> PathBuf {
 /// creating and removing a small hidden file, since permission bits alone lie (root, ACLs,
 /// read-only mounts).
 pub fn check_writable_dir(dir: &Path) -> Result<()> {
-    let meta = fs::metadata(dir).map_err(|e| {
-        Error::file(
-            dir,
-            format!("output folder does not exist or is unreadable: {e}"),
-        )
-    })?;
+    let meta = fs::metadata(dir)
+        .map_err(|e| Error::file(dir, format!("output folder does not exist or is unreadable: {e}")))?;
     if !meta.is_dir() {
         return Err(Error::file(dir, "output folder is not a folder"));
     }
-    let probe = dir.join(format!(
-        ".voltex-probe-{}-{}",
-        std::process::id(),
-        COUNTER.fetch_add(1, Ordering::Relaxed)
-    ));
+    let probe =
+        dir.join(format!(".voltex-probe-{}-{}", std::process::id(), COUNTER.fetch_add(1, Ordering::Relaxed)));
     fs::OpenOptions::new()
         .write(true)
         .create_new(true)
@@ -53,9 +46,7 @@ pub fn check_writable_dir(dir: &Path) -> Result<()> {
 /// before anything is written; parent folders are never created.
 pub fn write_atomic(path: &Path, write: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
     let dir = parent_dir(path);
-    let name = path
-        .file_name()
-        .ok_or_else(|| Error::file(path, "output path has no file name"))?;
+    let name = path.file_name().ok_or_else(|| Error::file(path, "output path has no file name"))?;
     check_writable_dir(&dir)?;
     let tmp = dir.join(format!(
         ".{}.tmp-{}-{}",
@@ -72,10 +63,8 @@ pub fn write_atomic(path: &Path, write: impl FnOnce(&Path) -> Result<()>) -> Res
 
 /// fsync the finished temporary file, rename it over the target, fsync the folder.
 fn finish(tmp: &Path, path: &Path, dir: &Path) -> Result<()> {
-    let file = fs::File::open(tmp)
-        .map_err(|e| Error::file(path, format!("writer produced no file: {e}")))?;
-    file.sync_all()
-        .map_err(|e| Error::file(path, format!("cannot flush to disk: {e}")))?;
+    let file = fs::File::open(tmp).map_err(|e| Error::file(path, format!("writer produced no file: {e}")))?;
+    file.sync_all().map_err(|e| Error::file(path, format!("cannot flush to disk: {e}")))?;
     drop(file);
     fs::rename(tmp, path).map_err(|e| Error::file(path, format!("cannot replace file: {e}")))?;
     // Make the rename itself durable; not all platforms can open a folder, so best effort.

@@ -14,10 +14,7 @@ use crate::{Error, Result};
 
 /// Turns a string into EXR text (Latin-1); other characters become `?`.
 fn to_text(s: &str) -> Text {
-    let bytes = s
-        .chars()
-        .map(|c| u8::try_from(c as u32).unwrap_or(b'?'))
-        .collect();
+    let bytes = s.chars().map(|c| u8::try_from(c as u32).unwrap_or(b'?')).collect();
     Text::from_bytes_unchecked(bytes)
 }
 
@@ -25,19 +22,12 @@ fn to_text(s: &str) -> Text {
 /// standard attribute (`owner`, `comments`, …), which readers would parse as that attribute.
 fn check_key(key: &str) -> Result<Text> {
     if key.is_empty() || key.len() > 255 {
-        return Err(Error::Invalid(format!(
-            "EXR metadata key {key:?} must be 1 to 255 bytes long"
-        )));
+        return Err(Error::Invalid(format!("EXR metadata key {key:?} must be 1 to 255 bytes long")));
     }
-    let text = Text::new_or_none(key).ok_or_else(|| {
-        Error::Invalid(format!(
-            "EXR metadata key {key:?} has characters outside Latin-1"
-        ))
-    })?;
+    let text = Text::new_or_none(key)
+        .ok_or_else(|| Error::Invalid(format!("EXR metadata key {key:?} has characters outside Latin-1")))?;
     if text.as_slice().contains(&0) {
-        return Err(Error::Invalid(format!(
-            "EXR metadata key {key:?} contains NUL"
-        )));
+        return Err(Error::Invalid(format!("EXR metadata key {key:?} contains NUL")));
     }
     if standard_names::ALL.contains(&text.as_slice()) {
         return Err(Error::Invalid(format!(
@@ -61,19 +51,12 @@ pub fn write(path: &Path, image: &Image, metadata: &[(&str, String)]) -> Result<
         )));
     }
     if image.is_empty() {
-        return Err(Error::file(
-            path,
-            "cannot write an empty (0-pixel) EXR image",
-        ));
+        return Err(Error::file(path, "cannot write an empty (0-pixel) EXR image"));
     }
-    let mut attributes = LayerAttributes {
-        software_name: Some(to_text("voltex")),
-        ..LayerAttributes::default()
-    };
+    let mut attributes =
+        LayerAttributes { software_name: Some(to_text("voltex")), ..LayerAttributes::default() };
     for (key, value) in metadata {
-        attributes
-            .other
-            .insert(check_key(key)?, AttributeValue::Text(to_text(value)));
+        attributes.other.insert(check_key(key)?, AttributeValue::Text(to_text(value)));
     }
     let width = image.width as usize;
     let channels = x::SpecificChannels::rgba(|pos: x::Vec2<usize>| {
@@ -88,10 +71,7 @@ pub fn write(path: &Path, image: &Image, metadata: &[(&str, String)]) -> Result<
     );
     let exr_image = x::Image::from_layer(layer);
     write_atomic(path, |tmp| {
-        exr_image
-            .write()
-            .to_file(tmp)
-            .map_err(|e| Error::file(path, format!("cannot write EXR: {e}")))
+        exr_image.write().to_file(tmp).map_err(|e| Error::file(path, format!("cannot write EXR: {e}")))
     })
 }
 
@@ -115,12 +95,7 @@ pub fn read(path: &Path) -> Result<(Image, Vec<(String, String)>)> {
         .first_valid_layer()
         .all_attributes()
         .from_file(path)
-        .map_err(|e| {
-            Error::file(
-                path,
-                format!("cannot read as an EXR image with R, G, B channels: {e}"),
-            )
-        })?;
+        .map_err(|e| Error::file(path, format!("cannot read as an EXR image with R, G, B channels: {e}")))?;
     let mut metadata: Vec<(String, String)> = exr_image
         .attributes
         .other

@@ -25,11 +25,7 @@ impl Image {
 
     /// A `width` × `height` image with every pixel `value`.
     pub fn filled(width: u32, height: u32, value: [f32; 4]) -> Self {
-        Self {
-            width,
-            height,
-            pixels: vec![value; width as usize * height as usize],
-        }
+        Self { width, height, pixels: vec![value; width as usize * height as usize] }
     }
 
     /// An image whose pixel (x, y) is `f(x, y)`.
@@ -40,11 +36,7 @@ impl Image {
                 pixels.push(f(x, y));
             }
         }
-        Self {
-            width,
-            height,
-            pixels,
-        }
+        Self { width, height, pixels }
     }
 
     /// Wraps existing pixels; their count must be `width * height`.
@@ -56,21 +48,12 @@ impl Image {
                 pixels.len()
             )));
         }
-        Ok(Self {
-            width,
-            height,
-            pixels,
-        })
+        Ok(Self { width, height, pixels })
     }
 
     /// Index of pixel (x, y) in `pixels`. Panics when out of bounds (a programming error).
     pub fn index(&self, x: u32, y: u32) -> usize {
-        assert!(
-            x < self.width && y < self.height,
-            "pixel ({x}, {y}) outside {}x{}",
-            self.width,
-            self.height
-        );
+        assert!(x < self.width && y < self.height, "pixel ({x}, {y}) outside {}x{}", self.width, self.height);
         y as usize * self.width as usize + x as usize
     }
 
@@ -106,11 +89,7 @@ impl Image {
             .iter()
             .map(|p| {
                 let [r, g, b] = tonemap([p[0], p[1], p[2]]);
-                let a = if p[3].is_finite() {
-                    p[3].clamp(0.0, 1.0)
-                } else {
-                    0.0
-                };
+                let a = if p[3].is_finite() { p[3].clamp(0.0, 1.0) } else { 0.0 };
                 [quantize(r), quantize(g), quantize(b), quantize(a)]
             })
             .collect()

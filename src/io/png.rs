@@ -44,11 +44,7 @@ fn write_png(path: &Path, width: u32, height: u32, pixels: &[[u8; 4]], alpha: bo
         let file = File::create(tmp).map_err(|e| err(&e))?;
         let mut out = BufWriter::new(file);
         let mut encoder = ::png::Encoder::new(&mut out, width, height);
-        encoder.set_color(if alpha {
-            ::png::ColorType::Rgba
-        } else {
-            ::png::ColorType::Rgb
-        });
+        encoder.set_color(if alpha { ::png::ColorType::Rgba } else { ::png::ColorType::Rgb });
         encoder.set_depth(::png::BitDepth::Eight);
         encoder.set_source_srgb(::png::SrgbRenderingIntent::Perceptual);
         let mut writer = encoder.write_header().map_err(|e| err(&e))?;
@@ -66,27 +62,16 @@ pub fn read_rgba8(path: &Path) -> Result<(u32, u32, Vec<[u8; 4]>)> {
     let mut decoder = ::png::Decoder::new(BufReader::new(file));
     decoder.set_transformations(::png::Transformations::normalize_to_color8());
     let mut reader = decoder.read_info().map_err(|e| err(&e))?;
-    let size = reader
-        .output_buffer_size()
-        .ok_or_else(|| err(&"image too large"))?;
+    let size = reader.output_buffer_size().ok_or_else(|| err(&"image too large"))?;
     let mut buf = vec![0u8; size];
     let info = reader.next_frame(&mut buf).map_err(|e| err(&e))?;
     let buf = &buf[..info.buffer_size()];
     let (w, h) = (info.width, info.height);
     use ::png::ColorType as C;
     let pixels: Vec<[u8; 4]> = match info.color_type {
-        C::Rgba => buf
-            .chunks_exact(4)
-            .map(|c| [c[0], c[1], c[2], c[3]])
-            .collect(),
-        C::Rgb => buf
-            .chunks_exact(3)
-            .map(|c| [c[0], c[1], c[2], 255])
-            .collect(),
-        C::GrayscaleAlpha => buf
-            .chunks_exact(2)
-            .map(|c| [c[0], c[0], c[0], c[1]])
-            .collect(),
+        C::Rgba => buf.chunks_exact(4).map(|c| [c[0], c[1], c[2], c[3]]).collect(),
+        C::Rgb => buf.chunks_exact(3).map(|c| [c[0], c[1], c[2], 255]).collect(),
+        C::GrayscaleAlpha => buf.chunks_exact(2).map(|c| [c[0], c[0], c[0], c[1]]).collect(),
         C::Grayscale => buf.iter().map(|&g| [g, g, g, 255]).collect(),
         C::Indexed => return Err(err(&"palette was not expanded")),
     };

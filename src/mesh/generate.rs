@@ -50,10 +50,7 @@ pub fn plane(size: [f64; 2], cells: [u32; 2], jitter: f64, seed: u32) -> Mesh {
             triangles.push([a, c, d]);
         }
     }
-    let corner_uvs = triangles
-        .iter()
-        .map(|t| t.map(|k| uv(positions[k as usize])))
-        .collect();
+    let corner_uvs = triangles.iter().map(|t| t.map(|k| uv(positions[k as usize]))).collect();
     let n = positions.len();
     let mut m = Mesh {
         positions,
@@ -72,11 +69,7 @@ pub fn plane(size: [f64; 2], cells: [u32; 2], jitter: f64, seed: u32) -> Mesh {
 /// (one vertex each, triangle fans). Returns the mesh without normals.
 fn parametric(nu: usize, nv: usize, wrap_v: bool, pos: impl Fn(f64, f64) -> DVec3) -> Mesh {
     let mut positions = Vec::new();
-    let rows: Vec<usize> = if wrap_v {
-        (0..nv).collect()
-    } else {
-        (1..nv).collect()
-    };
+    let rows: Vec<usize> = if wrap_v { (0..nv).collect() } else { (1..nv).collect() };
     for &j in &rows {
         for i in 0..nu {
             positions.push(pos(i as f64 / nu as f64, j as f64 / nv as f64));
@@ -209,10 +202,7 @@ mod tests {
             let mid = (a + b + c) / 3.0;
             assert!(n.dot(mid - centre_of(mid)) > 0.0, "inward triangle {t:?}");
             for &i in t {
-                assert!(
-                    m.normals[i as usize].dot(n) > 0.0,
-                    "normal against face {t:?}"
-                );
+                assert!(m.normals[i as usize].dot(n) > 0.0, "normal against face {t:?}");
             }
         }
     }
@@ -243,10 +233,8 @@ mod tests {
             r * 1.0
         });
         // The seam triangle reaches u = 1.0 rather than wrapping back to 0.
-        let seam = m
-            .corner_uvs
-            .iter()
-            .any(|c| c.iter().any(|uv| uv.x == 1.0) && c.iter().any(|uv| uv.x < 1.0));
+        let seam =
+            m.corner_uvs.iter().any(|c| c.iter().any(|uv| uv.x == 1.0) && c.iter().any(|uv| uv.x < 1.0));
         assert!(seam);
     }
 

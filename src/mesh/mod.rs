@@ -43,16 +43,8 @@ impl BaseSurface {
     pub fn transformed(&self, m: &DMat4) -> BaseSurface {
         let flip = m.determinant() < 0.0;
         BaseSurface {
-            positions: self
-                .positions
-                .iter()
-                .map(|&p| m.transform_point3(p))
-                .collect(),
-            heights: self
-                .heights
-                .iter()
-                .map(|&h| m.transform_vector3(h))
-                .collect(),
+            positions: self.positions.iter().map(|&p| m.transform_point3(p)).collect(),
+            heights: self.heights.iter().map(|&h| m.transform_vector3(h)).collect(),
             triangles: if flip {
                 self.triangles.iter().map(|&[a, b, c]| [a, c, b]).collect()
             } else {
@@ -85,21 +77,13 @@ pub struct Mesh {
 impl Mesh {
     /// Height vectors = unit normal * `length` * `scale[i]`; uvs multiplied by `tiling`.
     pub fn to_base(&self, length: f64, scale: Option<&[f64]>, tiling: DVec2) -> BaseSurface {
-        let heights = self
-            .normals
-            .iter()
-            .enumerate()
-            .map(|(i, &n)| n * length * scale.map_or(1.0, |s| s[i]))
-            .collect();
+        let heights =
+            self.normals.iter().enumerate().map(|(i, &n)| n * length * scale.map_or(1.0, |s| s[i])).collect();
         BaseSurface {
             positions: self.positions.clone(),
             heights,
             triangles: self.triangles.clone(),
-            corner_uvs: self
-                .corner_uvs
-                .iter()
-                .map(|c| c.map(|uv| uv * tiling))
-                .collect(),
+            corner_uvs: self.corner_uvs.iter().map(|c| c.map(|uv| uv * tiling)).collect(),
         }
     }
 

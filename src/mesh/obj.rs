@@ -43,21 +43,13 @@ pub fn parse(text: &str, path: &Path) -> Result<Mesh> {
         let number = |&(col, w): &(usize, &str)| -> Result<f64> {
             match w.parse::<f64>() {
                 Ok(v) if v.is_finite() => Ok(v),
-                _ => Err(at(
-                    line_no,
-                    col,
-                    format!("expected a finite number, found `{w}`"),
-                )),
+                _ => Err(at(line_no, col, format!("expected a finite number, found `{w}`"))),
             }
         };
         match key {
             "v" => {
                 if args.len() < 3 {
-                    return Err(at(
-                        line_no,
-                        end_col,
-                        "expected `v x y z` (3 numbers)".into(),
-                    ));
+                    return Err(at(line_no, end_col, "expected `v x y z` (3 numbers)".into()));
                 }
                 let v: Vec<f64> = args.iter().map(number).collect::<Result<_>>()?;
                 positions.push(DVec3::new(v[0], v[1], v[2]));
@@ -75,11 +67,7 @@ pub fn parse(text: &str, path: &Path) -> Result<Mesh> {
             "vn" => normal_count += 1,
             "f" => {
                 if args.len() < 3 {
-                    return Err(at(
-                        line_no,
-                        end_col,
-                        "expected a face with at least 3 corners".into(),
-                    ));
+                    return Err(at(line_no, end_col, "expected a face with at least 3 corners".into()));
                 }
                 let mut corners = Vec::with_capacity(args.len());
                 for &(col, w) in &args {
@@ -90,11 +78,7 @@ pub fn parse(text: &str, path: &Path) -> Result<Mesh> {
                             None | Some("") => Ok(None),
                             Some(s) => {
                                 let i: i64 = s.parse().map_err(|_| {
-                                    at(
-                                        line_no,
-                                        col,
-                                        format!("expected a {what} index, found `{s}`"),
-                                    )
+                                    at(line_no, col, format!("expected a {what} index, found `{s}`"))
                                 })?;
                                 // OBJ indices are 1-based; negative ones count back from the end.
                                 let resolved = if i > 0 { i - 1 } else { count as i64 + i };
@@ -137,10 +121,11 @@ pub fn parse(text: &str, path: &Path) -> Result<Mesh> {
     }
 
     // Planar uv from the x, y bounds for corners without `vt`.
-    let (lo, hi) = positions.iter().fold(
-        (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)),
-        |(lo, hi), p| (lo.min(p.truncate()), hi.max(p.truncate())),
-    );
+    let (lo, hi) = positions
+        .iter()
+        .fold((DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)), |(lo, hi), p| {
+            (lo.min(p.truncate()), hi.max(p.truncate()))
+        });
     let extent = (hi - lo).max(DVec2::splat(1e-300));
     let corner_uvs = triangles
         .iter()
@@ -183,10 +168,7 @@ mod tests {
                     vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nvn 0 0 1\n\
                     f 1/1/1 2/2/1 3/3/1 4/4/1\nf -4 -2 -1\nf 1//1 2//1 3//1\nf 1/1 2/2 3/3\n";
         let m = parse(text, Path::new("m.obj")).unwrap();
-        assert_eq!(
-            m.triangles,
-            vec![[0, 1, 2], [0, 2, 3], [0, 2, 3], [0, 1, 2], [0, 1, 2]]
-        );
+        assert_eq!(m.triangles, vec![[0, 1, 2], [0, 2, 3], [0, 2, 3], [0, 1, 2], [0, 1, 2]]);
         assert_eq!(m.corner_uvs[1], [DVec2::ZERO, DVec2::ONE, DVec2::Y]);
         // No vt: planar uv from the x, y bounds.
         assert_eq!(m.corner_uvs[3], [DVec2::ZERO, DVec2::X, DVec2::ONE]);
@@ -197,22 +179,13 @@ mod tests {
     #[test]
     fn errors_have_positions() {
         let e = err("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n");
-        assert!(
-            e.starts_with("m.obj:4:7: vertex index 4 out of range"),
-            "{e}"
-        );
+        assert!(e.starts_with("m.obj:4:7: vertex index 4 out of range"), "{e}");
         let e = err("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 -4\n");
         assert!(e.starts_with("m.obj:4:7: vertex index -4"), "{e}");
         let e = err("v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1/1 2/2 3/1\n");
-        assert!(
-            e.starts_with("m.obj:5:9: texture coordinate index 2 out of range"),
-            "{e}"
-        );
+        assert!(e.starts_with("m.obj:5:9: texture coordinate index 2 out of range"), "{e}");
         let e = err("v 0 0 0\nv 1 x 0\n");
-        assert!(
-            e.starts_with("m.obj:2:5: expected a finite number, found `x`"),
-            "{e}"
-        );
+        assert!(e.starts_with("m.obj:2:5: expected a finite number, found `x`"), "{e}");
         let e = err("v 0 0 nan\n");
         assert!(e.starts_with("m.obj:1:7: expected a finite number"), "{e}");
         let e = err("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2\n");

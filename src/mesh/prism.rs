@@ -44,30 +44,20 @@ pub fn check(s: &BaseSurface) -> PrismReport {
         ));
         return r;
     }
-    if let Some(t) = s
-        .triangles
-        .iter()
-        .position(|t| t.iter().any(|&i| i as usize >= s.positions.len()))
-    {
-        r.errors
-            .push(format!("triangle {t} references a missing vertex"));
+    if let Some(t) = s.triangles.iter().position(|t| t.iter().any(|&i| i as usize >= s.positions.len())) {
+        r.errors.push(format!("triangle {t} references a missing vertex"));
         return r;
     }
     let bad_v: Vec<usize> = (0..s.positions.len())
         .filter(|&i| !s.positions[i].is_finite() || !s.heights[i].is_finite())
         .collect();
-    let bad_uv: Vec<usize> = (0..s.triangles.len())
-        .filter(|&t| s.corner_uvs[t].iter().any(|uv| !uv.is_finite()))
-        .collect();
+    let bad_uv: Vec<usize> =
+        (0..s.triangles.len()).filter(|&t| s.corner_uvs[t].iter().any(|uv| !uv.is_finite())).collect();
     if !bad_v.is_empty() {
-        r.errors.push(format!(
-            "non-finite position or height at vertices {}",
-            list(&bad_v)
-        ));
+        r.errors.push(format!("non-finite position or height at vertices {}", list(&bad_v)));
     }
     if !bad_uv.is_empty() {
-        r.errors
-            .push(format!("non-finite uv at triangles {}", list(&bad_uv)));
+        r.errors.push(format!("non-finite uv at triangles {}", list(&bad_uv)));
     }
     if !r.errors.is_empty() {
         return r;
@@ -93,9 +83,7 @@ pub fn check(s: &BaseSurface) -> PrismReport {
         ));
     }
 
-    let zero_h: Vec<usize> = (0..s.heights.len())
-        .filter(|&i| s.heights[i] == DVec3::ZERO)
-        .collect();
+    let zero_h: Vec<usize> = (0..s.heights.len()).filter(|&i| s.heights[i] == DVec3::ZERO).collect();
     if !zero_h.is_empty() {
         r.warnings.push(format!(
             "{} zero-length height vectors at vertices: {}",
@@ -111,10 +99,7 @@ pub fn check(s: &BaseSurface) -> PrismReport {
     for t in (0..s.triangles.len()).filter(|&t| base_ok[t]) {
         let n0 = s.face_normal(t);
         let ids = s.triangles[t].map(|i| i as usize);
-        if ids
-            .iter()
-            .any(|&i| s.heights[i] != DVec3::ZERO && s.heights[i].dot(n0) <= 0.0)
-        {
+        if ids.iter().any(|&i| s.heights[i] != DVec3::ZERO && s.heights[i].dot(n0) <= 0.0) {
             inward.push(t);
             continue;
         }
@@ -185,10 +170,7 @@ mod tests {
         let mut s = quad();
         s.heights[1] = -DVec3::Z * 0.1;
         let r = check(&s);
-        assert!(
-            r.errors[0].contains("inward") && r.errors[0].ends_with(": 0"),
-            "{r:?}"
-        );
+        assert!(r.errors[0].contains("inward") && r.errors[0].ends_with(": 0"), "{r:?}");
     }
 
     #[test]
@@ -198,12 +180,7 @@ mod tests {
         s.heights[2] = DVec3::new(-2.0, 0.0, 0.1);
         s.heights[3] = DVec3::new(2.0, 0.0, 0.1);
         let r = check(&s);
-        assert!(
-            r.errors
-                .iter()
-                .any(|e| e.contains("twisted") && e.ends_with(": 1")),
-            "{r:?}"
-        );
+        assert!(r.errors.iter().any(|e| e.contains("twisted") && e.ends_with(": 1")), "{r:?}");
     }
 
     #[test]
@@ -221,18 +198,12 @@ mod tests {
 
     #[test]
     fn list_truncates() {
-        assert_eq!(
-            list(&(0..13).collect::<Vec<_>>()),
-            "0, 1, 2, 3, 4, 5, 6, 7, 8, 9 and 3 more"
-        );
+        assert_eq!(list(&(0..13).collect::<Vec<_>>()), "0, 1, 2, 3, 4, 5, 6, 7, 8, 9 and 3 more");
     }
 
     #[test]
     fn sphere_contains_corners() {
         let (c, r) = bounding_sphere(quad().prism(0));
-        assert!(quad()
-            .prism(0)
-            .iter()
-            .all(|p| (*p - c).length() <= r + 1e-12));
+        assert!(quad().prism(0).iter().all(|p| (*p - c).length() <= r + 1e-12));
     }
 }

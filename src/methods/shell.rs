@@ -22,10 +22,7 @@ impl Shell {
             .positions
             .iter()
             .zip(&surface.heights)
-            .map(|(&p, &h)| ShellVertex {
-                bottom: rel(p, eye),
-                top: rel(p + h, eye),
-            })
+            .map(|(&p, &h)| ShellVertex { bottom: rel(p, eye), top: rel(p + h, eye) })
             .collect();
         let prisms = surface
             .triangles
@@ -40,18 +37,10 @@ impl Shell {
                     })
                     .collect();
                 let centre = corners.iter().sum::<DVec3>() / 6.0;
-                let radius = corners
-                    .iter()
-                    .map(|c| c.distance(centre))
-                    .fold(0.0, f64::max);
+                let radius = corners.iter().map(|c| c.distance(centre)).fold(0.0, f64::max);
                 Prism {
                     vertices: [t[0], t[1], t[2], 0],
-                    uv01: [
-                        uv[0].x as f32,
-                        uv[0].y as f32,
-                        uv[1].x as f32,
-                        uv[1].y as f32,
-                    ],
+                    uv01: [uv[0].x as f32, uv[0].y as f32, uv[1].x as f32, uv[1].y as f32],
                     uv2: [uv[2].x as f32, uv[2].y as f32, 0.0, 0.0],
                     // Grown by a relative epsilon so that f32 rounding never rejects a touching plane.
                     sphere: [
@@ -72,9 +61,7 @@ impl Shell {
         let mut hi = f64::NEG_INFINITY;
         for v in &self.vertices {
             for p in [v.bottom, v.top] {
-                let d = n[0] as f64 * p[0] as f64
-                    + n[1] as f64 * p[1] as f64
-                    + n[2] as f64 * p[2] as f64;
+                let d = n[0] as f64 * p[0] as f64 + n[1] as f64 * p[1] as f64 + n[2] as f64 * p[2] as f64;
                 lo = lo.min(d);
                 hi = hi.max(d);
             }

@@ -27,11 +27,7 @@ pub fn sweep(shell: &Shell, forward: [f32; 3], planes: u32, near: f64) -> SliceP
 /// crosses, times 9 (a pentagon is 3 triangles). Allocating this, not planes x prisms x 9, keeps
 /// memory proportional to what is drawn.
 pub fn vertex_capacity(shell: &Shell, params: &SliceParams) -> u64 {
-    let n = [
-        params.plane_normal[0] as f64,
-        params.plane_normal[1] as f64,
-        params.plane_normal[2] as f64,
-    ];
+    let n = [params.plane_normal[0] as f64, params.plane_normal[1] as f64, params.plane_normal[2] as f64];
     let spacing = params.spacing as f64;
     let first = params.first_plane as f64;
     let mut total = 0u64;
@@ -92,42 +88,19 @@ pub fn add_inputs(
         })
     };
     let b = &mut inputs.buffers;
-    b.insert(
-        "slice_params".into(),
-        uniform(ctx, "slice_params", bytemuck::bytes_of(params)),
-    );
-    b.insert(
-        "shell_vertices".into(),
-        storage(ctx, "shell_vertices", bytemuck::cast_slice(&shell.vertices)),
-    );
-    b.insert(
-        "prisms".into(),
-        storage(ctx, "prisms", bytemuck::cast_slice(&shell.prisms)),
-    );
+    b.insert("slice_params".into(), uniform(ctx, "slice_params", bytemuck::bytes_of(params)));
+    b.insert("shell_vertices".into(), storage(ctx, "shell_vertices", bytemuck::cast_slice(&shell.vertices)));
+    b.insert("prisms".into(), storage(ctx, "prisms", bytemuck::cast_slice(&shell.prisms)));
     b.insert(
         "plane_cursors".into(),
-        buffer(
-            "plane_cursors",
-            params.plane_count as u64 * 4,
-            wgpu::BufferUsages::empty(),
-        ),
+        buffer("plane_cursors", params.plane_count as u64 * 4, wgpu::BufferUsages::empty()),
     );
-    b.insert(
-        "draw_args".into(),
-        buffer("draw_args", 16, wgpu::BufferUsages::INDIRECT),
-    );
+    b.insert("draw_args".into(), buffer("draw_args", 16, wgpu::BufferUsages::INDIRECT));
     let bytes = capacity * std::mem::size_of::<SliceVertex>() as u64;
-    b.insert(
-        "slice_vertices".into(),
-        buffer("slice_vertices", bytes, wgpu::BufferUsages::empty()),
-    );
-    inputs
-        .counts
-        .insert("prisms".into(), shell.prisms.len() as u32);
+    b.insert("slice_vertices".into(), buffer("slice_vertices", bytes, wgpu::BufferUsages::empty()));
+    inputs.counts.insert("prisms".into(), shell.prisms.len() as u32);
     inputs.counts.insert("planes".into(), params.plane_count);
-    inputs
-        .constants
-        .push(("trivial_reject".into(), trivial_reject as u32 as f64));
+    inputs.constants.push(("trivial_reject".into(), trivial_reject as u32 as f64));
 }
 
 /// Reads back the triangle-list vertices of each plane after a frame (tests, debugging): after

@@ -20,9 +20,7 @@ fn check_sizes(actual: &Image, reference: &Image) -> Result<()> {
     }
     let n = actual.width as usize * actual.height as usize;
     if actual.pixels.len() != n || reference.pixels.len() != n {
-        return Err(Error::Invalid(
-            "image pixel count does not match its size".into(),
-        ));
+        return Err(Error::Invalid("image pixel count does not match its size".into()));
     }
     if n == 0 {
         return Err(Error::Invalid("cannot compare empty images".into()));
@@ -46,12 +44,7 @@ fn relative_sq(a: &[f32; 4], r: &[f32; 4]) -> f64 {
 /// result NaN (so any `<= threshold` check fails). Size mismatch is an error.
 pub fn relative_rmse(actual: &Image, reference: &Image) -> Result<f64> {
     check_sizes(actual, reference)?;
-    let sum: f64 = actual
-        .pixels
-        .iter()
-        .zip(&reference.pixels)
-        .map(|(a, r)| relative_sq(a, r))
-        .sum();
+    let sum: f64 = actual.pixels.iter().zip(&reference.pixels).map(|(a, r)| relative_sq(a, r)).sum();
     Ok((sum / actual.pixels.len() as f64).sqrt())
 }
 
@@ -91,11 +84,7 @@ pub fn flip(actual: &Image, reference: &Image) -> Result<FlipResult> {
 ///
 /// Computed by NVIDIA's reference C++ implementation (crate `nv-flip`) on 8-bit sRGB images,
 /// which is how LDR FLIP is defined; quantization differences below 1/255 are not seen.
-pub fn flip_with_ppd(
-    actual: &Image,
-    reference: &Image,
-    pixels_per_degree: f32,
-) -> Result<FlipResult> {
+pub fn flip_with_ppd(actual: &Image, reference: &Image, pixels_per_degree: f32) -> Result<FlipResult> {
     check_sizes(actual, reference)?;
     if !(pixels_per_degree.is_finite() && pixels_per_degree > 0.0) {
         return Err(Error::Invalid(format!(
@@ -103,11 +92,7 @@ pub fn flip_with_ppd(
         )));
     }
     let to_flip = |img: &Image| {
-        let rgb: Vec<u8> = img
-            .to_srgb8()
-            .iter()
-            .flat_map(|p| [p[0], p[1], p[2]])
-            .collect();
+        let rgb: Vec<u8> = img.to_srgb8().iter().flat_map(|p| [p[0], p[1], p[2]]).collect();
         nv_flip::FlipImageRgb8::with_data(img.width, img.height, &rgb)
     };
     let error = nv_flip::flip(to_flip(reference), to_flip(actual), pixels_per_degree);
@@ -125,11 +110,7 @@ pub fn diff_heatmap(map: &[f32], width: u32, height: u32) -> Vec<[u8; 4]> {
     (0..n)
         .map(|i| {
             let v = map.get(i).copied().unwrap_or(0.0);
-            let v = if v.is_finite() {
-                v.clamp(0.0, 1.0)
-            } else {
-                1.0
-            };
+            let v = if v.is_finite() { v.clamp(0.0, 1.0) } else { 1.0 };
             let k = (v * 255.0 + 0.5) as usize * 3;
             [lut[k], lut[k + 1], lut[k + 2], 255]
         })
@@ -155,11 +136,7 @@ pub fn max_abs_diff(actual: &Image, reference: &Image) -> Result<f64> {
 
 /// Number of pixels with at least one non-finite (NaN or ±∞) channel, alpha included.
 pub fn count_nonfinite(image: &Image) -> usize {
-    image
-        .pixels
-        .iter()
-        .filter(|p| p.iter().any(|v| !v.is_finite()))
-        .count()
+    image.pixels.iter().filter(|p| p.iter().any(|v| !v.is_finite())).count()
 }
 
 #[cfg(test)]

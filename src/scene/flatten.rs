@@ -60,30 +60,16 @@ impl Scene {
 
     fn base_surface(&self, n: &Node, surface: &Surface, world: &DMat4) -> Result<BaseSurface> {
         let assets = &self.assets;
-        let missing = |what: &str, p: &str| {
-            Error::Invalid(format!("object \"{}\": {what} {p} was not loaded", n.name))
-        };
+        let missing =
+            |what: &str, p: &str| Error::Invalid(format!("object \"{}\": {what} {p} was not loaded", n.name));
         let mesh: Arc<Mesh> = match surface {
-            Surface::Plane {
-                size,
-                cells,
-                jitter,
-                seed,
-            } => Arc::new(generate::plane(*size, *cells, *jitter, *seed)),
+            Surface::Plane { size, cells, jitter, seed } => {
+                Arc::new(generate::plane(*size, *cells, *jitter, *seed))
+            }
             Surface::Sphere { radius, segments } => Arc::new(generate::sphere(*radius, *segments)),
-            Surface::Torus {
-                major,
-                minor,
-                segments,
-                distortion,
-                seed,
-            } => Arc::new(generate::torus(
-                *major,
-                *minor,
-                *segments,
-                *distortion,
-                *seed,
-            )),
+            Surface::Torus { major, minor, segments, distortion, seed } => {
+                Arc::new(generate::torus(*major, *minor, *segments, *distortion, *seed))
+            }
             Surface::Obj { path } => assets
                 .meshes
                 .get(&assets.dir.join(&path.value))
@@ -95,9 +81,7 @@ impl Scene {
             Some(HeightScale::VertexAttribute) => Some(
                 mesh.attribute
                     .as_ref()
-                    .ok_or_else(|| {
-                        Error::Invalid(format!("object \"{}\": no vertex attribute", n.name))
-                    })?
+                    .ok_or_else(|| Error::Invalid(format!("object \"{}\": no vertex attribute", n.name)))?
                     .iter()
                     .map(|a| a.clamp(0.0, 1.0))
                     .collect(),

@@ -21,9 +21,7 @@ impl HeightImage {
         decoder.set_transformations(png::Transformations::EXPAND);
         let bad = |e: png::DecodingError| Error::file(path, format!("expected a PNG image: {e}"));
         let mut reader = decoder.read_info().map_err(bad)?;
-        let size = reader
-            .output_buffer_size()
-            .ok_or_else(|| Error::file(path, "PNG image too large"))?;
+        let size = reader.output_buffer_size().ok_or_else(|| Error::file(path, "PNG image too large"))?;
         let mut buf = vec![0; size];
         let info = reader.next_frame(&mut buf).map_err(bad)?;
         let channels = info.color_type.samples();
@@ -37,12 +35,7 @@ impl HeightImage {
                 .collect(),
             _ => buf[..n].iter().map(|&b| b as f32 / 255.0).collect(),
         };
-        Ok(HeightImage {
-            width: w,
-            height: h,
-            channels,
-            data,
-        })
+        Ok(HeightImage { width: w, height: h, channels, data })
     }
 
     fn texel(&self, x: i64, y: i64, channel: usize) -> f64 {
@@ -59,8 +52,7 @@ impl HeightImage {
         let (fx, fy) = (x - x0, y - y0);
         let (x0, y0) = (x0 as i64, y0 as i64);
         let top = self.texel(x0, y0, channel) * (1.0 - fx) + self.texel(x0 + 1, y0, channel) * fx;
-        let bottom =
-            self.texel(x0, y0 + 1, channel) * (1.0 - fx) + self.texel(x0 + 1, y0 + 1, channel) * fx;
+        let bottom = self.texel(x0, y0 + 1, channel) * (1.0 - fx) + self.texel(x0 + 1, y0 + 1, channel) * fx;
         top * (1.0 - fy) + bottom * fy
     }
 }
@@ -71,12 +63,7 @@ mod tests {
 
     #[test]
     fn bilinear_wraps() {
-        let img = HeightImage {
-            width: 2,
-            height: 1,
-            channels: 1,
-            data: vec![0.0, 1.0],
-        };
+        let img = HeightImage { width: 2, height: 1, channels: 1, data: vec![0.0, 1.0] };
         assert_eq!(img.sample(DVec2::new(0.25, 0.5), 0), 0.0);
         assert_eq!(img.sample(DVec2::new(0.75, 0.5), 0), 1.0);
         assert_eq!(img.sample(DVec2::new(0.5, 0.5), 0), 0.5);

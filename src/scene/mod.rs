@@ -38,8 +38,8 @@ pub fn load(path: &Path) -> Result<Scene> {
 
 /// Parses and checks scene text; `path` names it in errors and anchors relative file paths.
 pub fn parse(source: &str, path: &Path) -> Result<Scene> {
-    let mut scene: Scene = values::with_marking(BTreeMap::new(), || options().from_str(source))
-        .map_err(|e| located(path, e))?;
+    let mut scene: Scene =
+        values::with_marking(BTreeMap::new(), || options().from_str(source)).map_err(|e| located(path, e))?;
     scene.path = path.to_path_buf();
     let dir = path.parent().unwrap_or(Path::new(""));
     let found = validate::check(&scene, dir);

@@ -47,13 +47,7 @@ fn temp_dir(name: &str) -> PathBuf {
 #[test]
 fn spec_example_parses() {
     let s = parse(SPEC_EXAMPLE, Path::new("spec.ron")).unwrap();
-    assert_eq!(
-        s.output,
-        Output {
-            width: 512,
-            height: 512
-        }
-    );
+    assert_eq!(s.output, Output { width: 512, height: 512 });
     assert_eq!(s.camera.eye, DVec3::new(0.0, -3.4, 2.2));
     assert_eq!(s.texels["torus_egg"].resolution, [128; 3]);
     let o = s.objects().unwrap();
@@ -62,20 +56,10 @@ fn spec_example_parses() {
     assert_eq!(o[0].texel.as_deref(), Some("torus_egg"));
     assert_eq!(
         o[0].method,
-        Some(Method::ViewSlices(ViewSlices {
-            planes: 400,
-            trivial_reject: true,
-            lighting: Lighting::Baked
-        }))
+        Some(Method::ViewSlices(ViewSlices { planes: 400, trivial_reject: true, lighting: Lighting::Baked }))
     );
     // uv tiling applied to corners: the torus seam reaches u = 4.
-    let max_u = o[0]
-        .surface
-        .corner_uvs
-        .iter()
-        .flatten()
-        .map(|uv| uv.x)
-        .fold(0.0, f64::max);
+    let max_u = o[0].surface.corner_uvs.iter().flatten().map(|uv| uv.x).fold(0.0, f64::max);
     assert_eq!(max_u, 4.0);
 }
 
@@ -148,10 +132,7 @@ fn height_from_vertex_attribute_and_texture() {
     let mut enc = png::Encoder::new(std::io::BufWriter::new(file), 4, 1);
     enc.set_color(png::ColorType::Grayscale);
     enc.set_depth(png::BitDepth::Eight);
-    enc.write_header()
-        .unwrap()
-        .write_image_data(&[0, 255, 255, 0])
-        .unwrap();
+    enc.write_header().unwrap().write_image_data(&[0, 255, 255, 0]).unwrap();
 
     let text = r#"#![enable(implicit_some)]
 Scene(output: (width: 8, height: 8), camera: (eye: (0, -1, 0), target: (0, 0, 0)), nodes: [
@@ -164,12 +145,7 @@ Scene(output: (width: 8, height: 8), camera: (eye: (0, -1, 0), target: (0, 0, 0)
     let o = load(&path).unwrap().objects().unwrap();
     let h: Vec<f64> = o[0].surface.heights.iter().map(|h| h.z).collect();
     assert_eq!(h, vec![2.0, 1.0, 0.0, 0.5]);
-    assert_eq!(
-        o[0].report.warnings.len(),
-        1,
-        "one zero height: {:?}",
-        o[0].report
-    );
+    assert_eq!(o[0].report.warnings.len(), 1, "one zero height: {:?}", o[0].report);
     // Plane vertices at u = 0, 0.5, 1: wrapping makes u = 0 and 1 the mean of the end pixels.
     let h: Vec<f64> = o[1].surface.heights.iter().map(|h| h.z).collect();
     assert_eq!(h, vec![0.0, 1.0, 0.0, 0.0, 1.0, 0.0]);

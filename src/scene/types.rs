@@ -92,10 +92,7 @@ pub struct Texel {
     #[serde(deserialize_with = "v::resolution")]
     pub resolution: [u32; 3],
     /// World length over which a voxel's stored alpha is reached.
-    #[serde(
-        default = "default_opacity_length",
-        deserialize_with = "v::positive_f32"
-    )]
+    #[serde(default = "default_opacity_length", deserialize_with = "v::positive_f32")]
     pub opacity_length: f32,
     pub source: TexelSource,
 }
@@ -246,11 +243,7 @@ fn one3() -> DVec3 {
 
 impl Default for Transform {
     fn default() -> Self {
-        Transform {
-            translate: DVec3::ZERO,
-            rotate: DVec3::ZERO,
-            scale: DVec3::ONE,
-        }
+        Transform { translate: DVec3::ZERO, rotate: DVec3::ZERO, scale: DVec3::ONE }
     }
 }
 
@@ -319,10 +312,7 @@ fn default_height() -> f64 {
 
 impl Default for Height {
     fn default() -> Self {
-        Height {
-            length: default_height(),
-            scale: None,
-        }
+        Height { length: default_height(), scale: None }
     }
 }
 

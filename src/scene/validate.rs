@@ -46,10 +46,7 @@ impl Checker<'_> {
             return Some(m.clone());
         }
         if !full.is_file() {
-            let msg = format!(
-                "expected an OBJ file, but {} does not exist",
-                full.display()
-            );
+            let msg = format!("expected an OBJ file, but {} does not exist", full.display());
             self.fail(path, msg);
             return None;
         }
@@ -92,25 +89,14 @@ impl Checker<'_> {
     fn node(&mut self, n: &Node) {
         if let Some(m) = &n.method {
             if n.texel.is_none() {
-                self.fail(
-                    m,
-                    format!("node \"{}\" has a method: expected a `texel`", n.name),
-                );
+                self.fail(m, format!("node \"{}\" has a method: expected a `texel`", n.name));
             } else if n.surface.is_none() {
-                self.fail(
-                    m,
-                    format!("node \"{}\" has a method: expected a `surface`", n.name),
-                );
+                self.fail(m, format!("node \"{}\" has a method: expected a `surface`", n.name));
             }
         }
         if let Some(t) = &n.texel {
             if !self.scene.texels.contains_key(&t.value) {
-                let names: Vec<String> = self
-                    .scene
-                    .texels
-                    .keys()
-                    .map(|k| format!("\"{k}\""))
-                    .collect();
+                let names: Vec<String> = self.scene.texels.keys().map(|k| format!("\"{k}\"")).collect();
                 let expected = if names.is_empty() {
                     "no texels are defined in `texels`".to_string()
                 } else {
@@ -123,10 +109,7 @@ impl Checker<'_> {
         if let Some(s) = &n.surface {
             match &s.value {
                 Surface::Torus { major, minor, .. } if minor >= major => {
-                    self.fail(
-                        s,
-                        format!("expected a torus minor radius below the major radius ({major})"),
-                    );
+                    self.fail(s, format!("expected a torus minor radius below the major radius ({major})"));
                 }
                 Surface::Obj { path } => mesh = self.mesh(path),
                 _ => {}
@@ -172,24 +155,15 @@ pub(super) fn check(scene: &Scene, dir: &Path) -> Findings {
         f: Findings {
             fail: BTreeMap::new(),
             other: None,
-            assets: Assets {
-                dir: dir.to_path_buf(),
-                ..Assets::default()
-            },
+            assets: Assets { dir: dir.to_path_buf(), ..Assets::default() },
         },
     };
     let cam = &scene.camera;
     let view = cam.target - cam.eye;
     if view.length_squared() == 0.0 {
-        c.fail(
-            cam,
-            "expected a camera `target` different from its `eye`".into(),
-        );
+        c.fail(cam, "expected a camera `target` different from its `eye`".into());
     } else if view.normalize().cross(cam.up.normalize()).length() < 1e-6 {
-        c.fail(
-            cam,
-            "expected a camera `up` that is not parallel to the view direction".into(),
-        );
+        c.fail(cam, "expected a camera `up` that is not parallel to the view direction".into());
     }
     for n in &scene.nodes {
         c.node(n);

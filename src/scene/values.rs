@@ -17,10 +17,7 @@ macro_rules! checked_f64 {
                 if v.is_finite() && ok(v) {
                     Ok($name(v))
                 } else {
-                    Err(D::Error::custom(format!(
-                        concat!("expected ", $what, ", found {}"),
-                        v
-                    )))
+                    Err(D::Error::custom(format!(concat!("expected ", $what, ", found {}"), v)))
                 }
             }
         }
@@ -32,21 +29,9 @@ checked_f64!(Positive, |v| v > 0.0, "a positive finite number");
 checked_f64!(NonNegative, |v| v >= 0.0, "a finite number >= 0");
 checked_f64!(Unit, |v| (0.0..=1.0).contains(&v), "a number in [0, 1]");
 checked_f64!(NonZero, |v| v != 0.0, "a finite non-zero number");
-checked_f64!(
-    Jitter,
-    |v| (0.0..0.5).contains(&v),
-    "a jitter in [0, 0.5) (fraction of a cell)"
-);
-checked_f64!(
-    Distortion,
-    |v| (0.0..0.9).contains(&v),
-    "a distortion in [0, 0.9)"
-);
-checked_f64!(
-    FieldOfView,
-    |v| v > 0.0 && v < 180.0,
-    "a field of view in (0, 180) degrees"
-);
+checked_f64!(Jitter, |v| (0.0..0.5).contains(&v), "a jitter in [0, 0.5) (fraction of a cell)");
+checked_f64!(Distortion, |v| (0.0..0.9).contains(&v), "a distortion in [0, 0.9)");
+checked_f64!(FieldOfView, |v| v > 0.0 && v < 180.0, "a field of view in (0, 180) degrees");
 
 macro_rules! checked_u32 {
     ($name:ident, $lo:expr, $hi:expr, $what:literal) => {
@@ -96,30 +81,21 @@ adapter!(finite_f32, f32, Finite, |v| v.0 as f32);
 adapter!(positive_f32, f32, Positive, |v| v.0 as f32);
 adapter!(non_negative_f32, f32, NonNegative, |v| v.0 as f32);
 adapter!(unit_f32, f32, Unit, |v| v.0 as f32);
-adapter!(vec3, DVec3, [Finite; 3], |v| DVec3::new(
-    v[0].0, v[1].0, v[2].0
-));
-adapter!(scale3, DVec3, [NonZero; 3], |v| DVec3::new(
-    v[0].0, v[1].0, v[2].0
-));
+adapter!(vec3, DVec3, [Finite; 3], |v| DVec3::new(v[0].0, v[1].0, v[2].0));
+adapter!(scale3, DVec3, [NonZero; 3], |v| DVec3::new(v[0].0, v[1].0, v[2].0));
 adapter!(positive2, [f64; 2], [Positive; 2], |v| [v[0].0, v[1].0]);
 adapter!(point_f32, [f32; 3], [Finite; 3], |v| v.map(|x| x.0 as f32));
-adapter!(radii_f32, [f32; 3], [Positive; 3], |v| v
-    .map(|x| x.0 as f32));
+adapter!(radii_f32, [f32; 3], [Positive; 3], |v| v.map(|x| x.0 as f32));
 adapter!(color, [f32; 3], [Unit; 3], |v| v.map(|x| x.0 as f32));
-adapter!(light_color, [f32; 3], [NonNegative; 3], |v| v
-    .map(|x| x.0 as f32));
-adapter!(opt_color, Option<[f32; 3]>, Option<[Unit; 3]>, |v| v
-    .map(|c| c.map(|x| x.0 as f32)));
+adapter!(light_color, [f32; 3], [NonNegative; 3], |v| v.map(|x| x.0 as f32));
+adapter!(opt_color, Option<[f32; 3]>, Option<[Unit; 3]>, |v| v.map(|c| c.map(|x| x.0 as f32)));
 adapter!(output_size, u32, OutputSize, |v| v.0);
 adapter!(planes, u32, PlaneCount, |v| v.0);
 adapter!(resolution, [u32; 3], [Resolution; 3], |v| v.map(|x| x.0));
 adapter!(octaves, u32, Octaves, |v| v.0);
 adapter!(frequency, u32, Frequency, |v| v.0);
 adapter!(cells, [u32; 2], [Cells; 2], |v| v.map(|x| x.0));
-adapter!(sphere_segments, [u32; 2], (Around, PoleToPole), |v| [
-    v.0 .0, v.1 .0
-]);
+adapter!(sphere_segments, [u32; 2], (Around, PoleToPole), |v| [v.0 .0, v.1 .0]);
 adapter!(torus_segments, [u32; 2], [Around; 2], |v| v.map(|x| x.0));
 
 /// A direction: finite and not zero.
@@ -173,10 +149,7 @@ pub struct Mark<T> {
 impl<T> Mark<T> {
     /// A value that was not read from a file (its checks report without a position).
     pub fn new(value: T) -> Self {
-        Mark {
-            value,
-            seq: usize::MAX,
-        }
+        Mark { value, seq: usize::MAX }
     }
 }
 
@@ -206,9 +179,6 @@ impl<'de, T: Deserialize<'de>> Deserialize<'de> for Mark<T> {
         if let Some(msg) = fail {
             return Err(D::Error::custom(format!("{MARK_PREFIX}{msg}")));
         }
-        Ok(Mark {
-            value: T::deserialize(d)?,
-            seq,
-        })
+        Ok(Mark { value: T::deserialize(d)?, seq })
     }
 }

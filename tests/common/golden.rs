@@ -25,9 +25,7 @@ fn manifest_dir() -> PathBuf {
 
 /// Where the reference for `name` lives.
 pub fn golden_path(name: &str) -> PathBuf {
-    manifest_dir()
-        .join("tests/golden")
-        .join(format!("{name}.exr"))
+    manifest_dir().join("tests/golden").join(format!("{name}.exr"))
 }
 
 /// Where failure artefacts for `name` go.
@@ -42,10 +40,7 @@ fn update_requested() -> bool {
 /// Compares `actual` with the reference `tests/golden/NAME.exr` (see the module doc).
 pub fn check_golden(name: &str, actual: &Image, threshold: Threshold) {
     assert!(
-        !name.is_empty()
-            && name
-                .chars()
-                .all(|c| c.is_ascii_alphanumeric() || "-_.".contains(c)),
+        !name.is_empty() && name.chars().all(|c| c.is_ascii_alphanumeric() || "-_.".contains(c)),
         "golden name {name:?}: use letters, digits, '-', '_', '.'"
     );
     let path = golden_path(name);
@@ -65,8 +60,8 @@ pub fn check_golden(name: &str, actual: &Image, threshold: Threshold) {
             path.display()
         );
     }
-    let (reference, _) = voltex::io::exr::read(&path)
-        .unwrap_or_else(|e| panic!("golden {name}: cannot read reference: {e}"));
+    let (reference, _) =
+        voltex::io::exr::read(&path).unwrap_or_else(|e| panic!("golden {name}: cannot read reference: {e}"));
     if !actual.same_size(&reference) {
         let paths = write_failure(name, actual, None);
         panic!(
@@ -120,10 +115,7 @@ fn write_failure(name: &str, actual: &Image, map: Option<&[f32]>) -> String {
     if let Some(map) = map {
         let diff = dir.join(format!("{name}.diff.png"));
         let heat = metrics::diff_heatmap(map, actual.width, actual.height);
-        record(
-            &diff,
-            voltex::io::png::write_rgba8(&diff, actual.width, actual.height, &heat),
-        );
+        record(&diff, voltex::io::png::write_rgba8(&diff, actual.width, actual.height, &heat));
     }
     lines.join("\n")
 }
