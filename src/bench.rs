@@ -1,13 +1,19 @@
 //! `voltex bench`: the 2002 paper's Table 1 set-up on the current adapter. For each scene, plane
 //! count and trivial-reject setting: median GPU time per pass from timestamps after warm-up, wall
-//! time per frame, and the CPU twin doing the same classification and intersection.
+//! time per frame, the CPU twin doing the same classification and intersection, and the error
+//! against a converged render (many planes) of the same scene.
+//!
+//! Lavapipe returns near-zero compute timestamps once a render pass has run in the process, so
+//! the slicing kernels are timed first, alone (graph `slices_only.ron`), before any full frame.
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use crate::error::Result;
 use crate::gpu::GpuContext;
+use crate::io::Image;
 use crate::render::{Blueprint, RenderOptions, Renderer};
+use crate::scene::Scene;
 
 fn median(mut v: Vec<f64>) -> f64 {
     if v.is_empty() {
@@ -22,8 +28,25 @@ pub fn default_scenes() -> Vec<PathBuf> {
     vec![root.join("torus_egg.ron"), root.join("terrain.ron")]
 }
 
-/// `reference_planes`: plane count of the converged image each row's error is measured against
-/// (a stand-in for the exact reference renderer, which does not exist yet).
+/// One setting of the table.
+struct Setting {
+    scene: usize,
+    planes: u32,
+    reject: bool,
+}
+
+#[derive(Default)]
+struct Row {
+    /// Median GPU ms of the slicing kernels, timed alone.
+    slicing: Vec<(String, f64)>,
+    /// Median GPU ms of the raster passes of a full frame.
+    raster: Vec<(String, f64)>,
+    wall_ms: f64,
+    cpu_ms: f64,
+    rel_rmse: f64,
+    flip: f64,
+}
+
 pub fn run(
     scenes: &[PathBuf],
     planes: &[u32],
@@ -31,87 +54,96 @@ pub fn run(
     frames: usize,
     reference_planes: u32,
 ) -> Result<()> {
-    let scenes = if scenes.is_empty() { default_scenes() } else { scenes.to_vec() };
-    let ctx = GpuContext::new()?;
-    println!("adapter: {}", ctx.adapter_line());
-    println!("{}x{}, median of {frames} frames after 2 warm-up frames; times in ms", size.0, size.1);
-    println!(
-        "{:<12} {:>6} {:>7} | {:>8} {:>8} {:>8} {:>8} {:>9} | {:>9} {:>9} | {:>9}",
-        "scene",
-        "planes",
-        "reject",
-        "count",
-        "emit",
-        "slices",
-        "draw",
-        "gpu total",
-        "wall",
-        "fps(wall)",
-        "cpu twin"
-    );
-    for scene_path in &scenes {
-        let scene = crate::scene::load(scene_path)?;
-        let reference = {
-            let opts =
-                RenderOptions { size: Some(size), planes: Some(reference_planes), ..Default::default() };
-            Renderer::new(&ctx, Blueprint::new(&scene, &opts)?)?.render(&ctx)?.image
-        };
+    let paths = if scenes.is_empty() { default_scenes() } else { scenes.to_vec() };
+    let scenes: Vec<Scene> = paths.iter().map(|p| crate::scene::load(p)).collect::<Result<_>>()?;
+    let mut settings = Vec::new();
+    for scene in 0..scenes.len() {
         for &n in planes {
             for reject in [true, false] {
-                let opts = RenderOptions {
-                    size: Some(size),
-                    planes: Some(n),
-                    trivial_reject: Some(reject),
-                    ..Default::default()
-                };
-                let row = measure(&ctx, &scene, &opts, frames, &reference)?;
-                let name =
-                    Path::new(scene_path).file_stem().unwrap_or_default().to_string_lossy().to_string();
-                let pass = |p: &str| row.passes.iter().find(|x| x.0 == p).map(|x| x.1).unwrap_or(f64::NAN);
-                println!(
-                    "{:<12} {:>6} {:>7} | {:>8.3} {:>8.3} {:>8.3} {:>8.3} {:>9.3} | {:>9.2} {:>9.1} | {:>9.2} | {:>8.4} {:>7.4}",
-                    name,
-                    n,
-                    reject,
-                    pass("count_slices"),
-                    pass("emit_slices"),
-                    pass("count_slices") + pass("scan_plane_offsets") + pass("emit_slices"),
-                    pass("draw_slices"),
-                    row.passes.iter().map(|p| p.1).sum::<f64>(),
-                    row.wall_ms,
-                    1000.0 / row.wall_ms,
-                    row.cpu_ms,
-                    row.rel_rmse,
-                    row.flip,
-                );
+                settings.push(Setting { scene, planes: n, reject });
             }
         }
     }
-    println!("slices = count + scan + emit (classification and intersection); cpu twin = the same work on one CPU core");
+    let ctx = GpuContext::new()?;
+    let options = |s: &Setting, graph: Option<PathBuf>| RenderOptions {
+        size: Some(size),
+        planes: Some(s.planes),
+        trivial_reject: Some(s.reject),
+        graph,
+    };
+
+    // Phase 1: the slicing kernels alone, before any render pass runs in this process.
+    let slices_only = crate::project_root().join("graphs/slices_only.ron");
+    let mut rows: Vec<Row> = Vec::new();
+    for s in &settings {
+        let bp = Blueprint::new(&scenes[s.scene], &options(s, Some(slices_only.clone())))?;
+        let mut r = Renderer::new(&ctx, bp)?;
+        let (slicing, _) = timed(&ctx, &mut r, frames)?;
+        let mut cpu = Vec::new();
+        for o in &r.blueprint.objects {
+            let Some(params) = o.sweep else { continue };
+            let t = Instant::now();
+            let out = crate::cpu::slice_prisms::slice_all(&o.shell.vertices, &o.shell.prisms, &params, o.trivial_reject);
+            cpu.push(t.elapsed().as_secs_f64() * 1e3);
+            std::hint::black_box(out);
+        }
+        rows.push(Row { slicing, cpu_ms: cpu.iter().sum(), ..Default::default() });
+    }
+
+    // Phase 2: full frames, their raster passes and wall time, and the error of each setting.
+    let mut references: Vec<Option<Image>> = vec![None; scenes.len()];
+    for (s, row) in settings.iter().zip(&mut rows) {
+        if references[s.scene].is_none() {
+            let opts = RenderOptions { size: Some(size), planes: Some(reference_planes), ..Default::default() };
+            references[s.scene] = Some(Renderer::new(&ctx, Blueprint::new(&scenes[s.scene], &opts)?)?.render(&ctx)?.image);
+        }
+        let reference = references[s.scene].as_ref().unwrap();
+        let mut r = Renderer::new(&ctx, Blueprint::new(&scenes[s.scene], &options(s, None))?)?;
+        let image = r.render(&ctx)?.image;
+        row.rel_rmse = crate::metrics::relative_rmse(&image, reference)?;
+        row.flip = crate::metrics::flip(&image, reference)?.mean;
+        let (passes, wall) = timed(&ctx, &mut r, frames)?;
+        row.raster = passes.into_iter().filter(|p| p.0.starts_with("draw") || p.0 == "composite").collect();
+        row.wall_ms = wall;
+    }
+
+    println!("adapter: {}", ctx.adapter_line());
+    println!("{}x{}, median of {frames} frames after warm-up; times in ms", size.0, size.1);
+    println!("error: relative RMSE and mean FLIP against the same scene sliced with {reference_planes} planes");
+    println!(
+        "| scene | planes | reject | count | scan | emit | slicing | draw | composite | frame (wall) | fps | CPU twin | rel RMSE | FLIP |"
+    );
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+    for (s, row) in settings.iter().zip(&rows) {
+        let get = |v: &[(String, f64)], p: &str| v.iter().find(|x| x.0 == p).map(|x| x.1).unwrap_or(f64::NAN);
+        let slicing: f64 = row.slicing.iter().map(|p| p.1).sum();
+        let name = Path::new(&paths[s.scene]).file_stem().unwrap_or_default().to_string_lossy().to_string();
+        println!(
+            "| {name} | {} | {} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.1} | {:.2} | {:.1} | {:.4} | {:.4} |",
+            s.planes,
+            if s.reject { "on" } else { "off" },
+            get(&row.slicing, "count_slices"),
+            get(&row.slicing, "scan_plane_offsets"),
+            get(&row.slicing, "emit_slices"),
+            slicing,
+            get(&row.raster, "draw_slices"),
+            get(&row.raster, "composite"),
+            row.wall_ms,
+            1000.0 / row.wall_ms,
+            row.cpu_ms,
+            row.rel_rmse,
+            row.flip,
+        );
+    }
+    println!("slicing = count + scan + emit (classification and intersection, GPU timestamps, timed alone);");
+    println!("frame (wall) = submit to idle of a whole frame; CPU twin = the same slicing on one CPU core");
     Ok(())
 }
 
-struct Row {
-    passes: Vec<(String, f64)>,
-    wall_ms: f64,
-    cpu_ms: f64,
-    rel_rmse: f64,
-    flip: f64,
-}
-
-fn measure(
-    ctx: &GpuContext,
-    scene: &crate::scene::Scene,
-    opts: &RenderOptions,
-    frames: usize,
-    reference: &crate::io::Image,
-) -> Result<Row> {
-    let bp = Blueprint::new(scene, opts)?;
-    let mut r = Renderer::new(ctx, bp)?;
-    let image = r.render(ctx)?.image;
-    let rel_rmse = crate::metrics::relative_rmse(&image, reference)?;
-    let flip = crate::metrics::flip(&image, reference)?.mean;
-    r.render_timed(ctx)?; // second warm-up frame (the first rendered the image above)
+/// Renders warm-up frames, then `frames` timed ones: median GPU ms per pass and median wall ms.
+fn timed(ctx: &GpuContext, r: &mut Renderer, frames: usize) -> Result<(Vec<(String, f64)>, f64)> {
+    r.render_timed(ctx)?;
+    r.render_timed(ctx)?;
     let mut per_pass: Vec<(String, Vec<f64>)> = Vec::new();
     let mut wall = Vec::new();
     for _ in 0..frames.max(1) {
@@ -125,24 +157,5 @@ fn measure(
             }
         }
     }
-    let mut cpu = Vec::new();
-    for o in r.blueprint.objects.iter().filter(|o| o.slicing.is_some()) {
-        let (params, _) = o.slicing.unwrap();
-        let t = Instant::now();
-        let out = crate::cpu::slice_prisms::slice_all(
-            &o.shell.vertices,
-            &o.shell.prisms,
-            &params,
-            o.trivial_reject,
-        );
-        cpu.push(t.elapsed().as_secs_f64() * 1e3);
-        std::hint::black_box(out);
-    }
-    Ok(Row {
-        passes: per_pass.into_iter().map(|(n, v)| (n, median(v))).collect(),
-        wall_ms: median(wall),
-        cpu_ms: cpu.iter().sum(),
-        rel_rmse,
-        flip,
-    })
+    Ok((per_pass.into_iter().map(|(n, v)| (n, median(v))).collect(), median(wall)))
 }

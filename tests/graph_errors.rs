@@ -87,7 +87,7 @@ fn objects(filters: &[&[&'static str]]) -> Vec<ObjectInfo> {
     filters
         .iter()
         .enumerate()
-        .map(|(i, f)| ObjectInfo { name: format!("o{i}"), filters: f.to_vec(), distance: i as f64 })
+        .map(|(i, f)| ObjectInfo { name: format!("o{i}"), filters: f.to_vec(), distance: i as f64, order: 0 })
         .collect()
 }
 

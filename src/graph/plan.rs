@@ -21,6 +21,8 @@ pub struct ObjectInfo {
     pub filters: Vec<&'static str>,
     /// Distance of the object's centre from the camera: instances run back to front.
     pub distance: f64,
+    /// Order among instances at the same distance (the chunks of one sweep, back to front).
+    pub order: u32,
 }
 
 pub struct PlannedPass {
@@ -56,7 +58,10 @@ pub fn plan(graph: &Graph, wgsl_root: &Path, objects: &[ObjectInfo]) -> Result<P
                     pruned.push(format!("pass {}: no object matches {filter}", decl.name()));
                     continue;
                 }
-                ids.sort_by(|&a, &b| objects[b].distance.total_cmp(&objects[a].distance));
+                ids.sort_by(|&a, &b| {
+                    let (a, b) = (&objects[a], &objects[b]);
+                    b.distance.total_cmp(&a.distance).then(a.order.cmp(&b.order))
+                });
                 Some(ids)
             }
         };

@@ -23,14 +23,29 @@ pub fn sweep(shell: &Shell, forward: [f32; 3], planes: u32, near: f64) -> SliceP
     }
 }
 
-/// An upper bound of the slice vertices a sweep emits: per prism, the planes its depth range
-/// crosses, times 9 (a pentagon is 3 triangles). Allocating this, not planes x prisms x 9, keeps
-/// memory proportional to what is drawn.
-pub fn vertex_capacity(shell: &Shell, params: &SliceParams) -> u64 {
-    let n = [params.plane_normal[0] as f64, params.plane_normal[1] as f64, params.plane_normal[2] as f64];
+/// Slice-vertex budget of one chunk of a sweep: the storage-binding size every WebGPU adapter
+/// offers (128 MiB), so a chunk binds everywhere.
+pub const CHUNK_BYTES: u64 = 128 << 20;
+
+/// A run of consecutive planes of a sweep with its own buffers, sized to fit one binding.
+#[derive(Clone, Copy, Debug)]
+pub struct SliceChunk {
+    /// The chunk's planes (`first_plane` and `plane_count` of the chunk; the spacing of the sweep).
+    pub params: SliceParams,
+    /// Slice-vertex capacity (an upper bound of what the chunk emits).
+    pub capacity: u64,
+}
+
+/// Upper bound of the triangle-list vertices each plane of the sweep emits: per prism, 9 (a
+/// pentagon is 3 triangles) on every plane its depth range crosses. Allocating this, not
+/// planes x prisms x 9, keeps memory proportional to what is drawn.
+pub fn plane_bounds(shell: &Shell, params: &SliceParams) -> Vec<u64> {
+    let n = params.plane_normal.map(|x| x as f64);
     let spacing = params.spacing as f64;
     let first = params.first_plane as f64;
-    let mut total = 0u64;
+    let last = params.plane_count as i64 - 1;
+    // Difference array: +9 where a prism's plane range starts, -9 after it ends.
+    let mut diff = vec![0i64; params.plane_count as usize + 1];
     for p in &shell.prisms {
         let mut lo = f64::INFINITY;
         let mut hi = f64::NEG_INFINITY;
@@ -43,22 +58,77 @@ pub fn vertex_capacity(shell: &Shell, params: &SliceParams) -> u64 {
             }
         }
         // Planes k with lo <= first - k*spacing <= hi, widened by one plane for f32 rounding.
-        let k_min = ((first - hi) / spacing).floor().max(0.0) as i64 - 1;
-        let k_max = (((first - lo) / spacing).ceil() as i64 + 1).min(params.plane_count as i64 - 1);
-        if k_max >= k_min.max(0) {
-            total += (k_max - k_min.max(0) + 1) as u64 * 9;
+        let k_min = (((first - hi) / spacing).floor() as i64 - 1).max(0);
+        let k_max = (((first - lo) / spacing).ceil() as i64 + 1).min(last);
+        if k_max >= k_min {
+            diff[k_min as usize] += 9;
+            diff[k_max as usize + 1] -= 9;
         }
     }
-    total
+    let mut running = 0i64;
+    diff[..params.plane_count as usize]
+        .iter()
+        .map(|d| {
+            running += d;
+            running as u64
+        })
+        .collect()
 }
 
-/// Checks that the slice-vertex buffer fits the adapter's limits.
+/// Total slice-vertex capacity of a sweep (see [`plane_bounds`]).
+pub fn vertex_capacity(shell: &Shell, params: &SliceParams) -> u64 {
+    plane_bounds(shell, params).iter().sum()
+}
+
+/// Splits a sweep into chunks of consecutive planes whose vertex bound fits [`CHUNK_BYTES`],
+/// back to front.
+pub fn chunks(shell: &Shell, params: &SliceParams) -> Vec<SliceChunk> {
+    let budget = CHUNK_BYTES / std::mem::size_of::<SliceVertex>() as u64;
+    let bounds = plane_bounds(shell, params);
+    let mut out = Vec::new();
+    let (mut start, mut capacity) = (0usize, 0u64);
+    let close = |start: usize, end: usize, capacity: u64, out: &mut Vec<SliceChunk>| {
+        let mut p = *params;
+        p.first_plane = (params.first_plane as f64 - start as f64 * params.spacing as f64) as f32;
+        p.plane_count = (end - start) as u32;
+        p.vertex_capacity = capacity.max(3) as u32;
+        out.push(SliceChunk { params: p, capacity: capacity.max(3) });
+    };
+    for (k, &b) in bounds.iter().enumerate() {
+        if capacity + b > budget && k > start {
+            close(start, k, capacity, &mut out);
+            (start, capacity) = (k, 0);
+        }
+        capacity += b;
+    }
+    close(start, bounds.len(), capacity, &mut out);
+    out
+}
+
+/// Most slice-vertex memory one object may use (all chunks together).
+pub const MAX_SLICE_BYTES: u64 = 1 << 30;
+
+/// Checks a sweep's slice-vertex memory against [`MAX_SLICE_BYTES`].
+pub fn check_budget(chunks: &[SliceChunk], object: &str, planes: u32) -> Result<()> {
+    let bytes = chunks.iter().map(|c| c.capacity).sum::<u64>() * std::mem::size_of::<SliceVertex>() as u64;
+    if bytes > MAX_SLICE_BYTES {
+        return Err(Error::Invalid(format!(
+            "object `{object}`: {planes} planes need up to {:.0} MiB of slice vertices, beyond the limit of \
+             {} MiB per object; use fewer planes",
+            bytes as f64 / 1048576.0,
+            MAX_SLICE_BYTES >> 20
+        )));
+    }
+    Ok(())
+}
+
+/// Checks that a chunk's slice-vertex buffer fits the adapter's limits.
 pub fn check_capacity(capacity: u64, max_binding: u64, object: &str, planes: u32) -> Result<()> {
     let bytes = capacity * std::mem::size_of::<SliceVertex>() as u64;
     if bytes > max_binding || capacity > u32::MAX as u64 {
         return Err(Error::Gpu(format!(
-            "object `{object}`: {planes} planes need up to {:.1} MiB of slice vertices, beyond this adapter's \
-             storage-binding limit of {:.1} MiB; use fewer planes",
+            "object `{object}`: {planes} planes need up to {:.1} MiB of slice vertices in one binding, beyond \
+             this adapter's storage-binding limit of {:.1} MiB",
             bytes as f64 / 1048576.0,
             max_binding as f64 / 1048576.0
         )));

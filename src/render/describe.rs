@@ -1,0 +1,161 @@
+//! The text of `voltex plan`: bakes, objects, passes in order with their pipeline variants,
+//! what was pruned, and the GPU memory the frame allocates.
+
+use crate::bake::{self, BakeSource};
+use crate::graph::plan::PlannedPass;
+use crate::graph::{ResourceDecl, TextureSize};
+use crate::render::{object_constants, Blueprint, ObjectPlan};
+use crate::types::SliceVertex;
+
+impl Blueprint {
+    /// Bytes of GPU memory the frame allocates, by item.
+    pub fn memory(&self) -> Vec<(String, u64)> {
+        let mut out = Vec::new();
+        for (name, decl) in &self.plan.textures {
+            let ResourceDecl::Texture { format, size, .. } = decl;
+            let (w, h) = match size {
+                TextureSize::Output => self.size,
+                TextureSize::Fixed(w, h) => (*w, *h),
+            };
+            out.push((
+                format!("texture {name} {w}x{h} {format:?}"),
+                w as u64 * h as u64 * format.bytes_per_pixel(),
+            ));
+        }
+        for b in &self.bakes {
+            let r = b.request.resolution;
+            out.push((
+                format!(
+                    "texel {} {}x{}x{} rgba8 + mips{}",
+                    b.texel,
+                    r[0],
+                    r[1],
+                    r[2],
+                    if b.request.per_pixel { " + normals" } else { "" }
+                ),
+                bake::bytes(r, b.request.per_pixel),
+            ));
+        }
+        for o in &self.objects {
+            let name = &o.object.name;
+            let shell = (o.shell.vertices.len() * 32 + o.shell.prisms.len() * 64) as u64;
+            if let Some(sweep) = &o.sweep {
+                out.push((format!("object {name}: shell ({} prisms)", o.shell.prisms.len()), shell));
+                let cap: u64 = o.chunks.iter().map(|c| c.capacity).sum();
+                out.push((
+                    format!(
+                        "object {name}: slice vertices (capacity {cap} in {} chunk(s)) + {} plane cursors",
+                        o.chunks.len(),
+                        sweep.plane_count
+                    ),
+                    cap * std::mem::size_of::<SliceVertex>() as u64
+                        + sweep.plane_count as u64 * 4
+                        + o.chunks.len() as u64 * (16 + 48),
+                ));
+            }
+            if let Some(base) = &o.base {
+                out.push((format!("object {name}: base triangles"), (base.len() * 32) as u64));
+            }
+        }
+        out
+    }
+
+    /// The text of `voltex plan`.
+    pub fn describe(&self) -> String {
+        let mut s = format!(
+            "scene {}\noutput {}x{}\n\nbakes:\n",
+            self.scene_path.display(),
+            self.size.0,
+            self.size.1
+        );
+        if self.bakes.is_empty() {
+            s += "  (none)\n";
+        }
+        for b in &self.bakes {
+            let r = b.request.resolution;
+            let kind = match b.request.source {
+                BakeSource::Implicit(_) => "bake_implicit.wgsl",
+                BakeSource::Heightfield(_) => "bake_heightfield.wgsl",
+            };
+            s += &format!(
+                "  {:<16} {}x{}x{}  {kind} + downsample_volume.wgsl x{}  lighting {}\n",
+                b.texel,
+                r[0],
+                r[1],
+                r[2],
+                bake::mip_count(r) - 1,
+                if b.request.per_pixel { "per-pixel (albedo + normals)" } else { "baked" }
+            );
+        }
+        s += "\nobjects:\n";
+        for o in &self.objects {
+            let method = match &o.sweep {
+                Some(p) => format!(
+                    "ViewSlices planes {} spacing {:.4} trivial_reject {} lighting {}, {} chunk(s)",
+                    p.plane_count,
+                    p.spacing,
+                    o.trivial_reject,
+                    if o.per_pixel { "PerPixel" } else { "Baked" },
+                    o.chunks.len()
+                ),
+                None => "base surface only".into(),
+            };
+            s += &format!("  {:<16} {} triangles  {method}\n", o.object.name, o.shell.prisms.len());
+            for w in &o.object.report.warnings {
+                s += &format!("    warning: {w}\n");
+            }
+        }
+        s += "\npasses (in order):\n";
+        for p in &self.plan.passes {
+            let inst = match &p.instances {
+                None => "frame".to_string(),
+                Some(ids) => format!("{} instance(s)", ids.len()),
+            };
+            let pipelines = self.pipeline_variants(p);
+            s += &format!(
+                "  {:<20} {:<26} {:<12} pipelines: {}\n",
+                p.decl.name(),
+                p.decl.shader(),
+                inst,
+                pipelines.join(", ")
+            );
+        }
+        s += &format!(
+            "\nkernels compiled: {}\n",
+            self.plan.kernels().into_iter().collect::<Vec<_>>().join(", ")
+        );
+        if !self.plan.pruned.is_empty() {
+            s += "\npruned:\n";
+            for p in &self.plan.pruned {
+                s += &format!("  {p}\n");
+            }
+        }
+        s += "\nGPU memory:\n";
+        let mem = self.memory();
+        for (what, bytes) in &mem {
+            s += &format!("  {:>10.2} MiB  {what}\n", *bytes as f64 / 1048576.0);
+        }
+        s += &format!("  {:>10.2} MiB  total\n", mem.iter().map(|m| m.1).sum::<u64>() as f64 / 1048576.0);
+        s
+    }
+
+    fn pipeline_variants(&self, p: &PlannedPass) -> Vec<String> {
+        let names: Vec<String> = crate::gpu::reflect::overrides(&p.kernel).into_iter().map(|o| o.0).collect();
+        let mut variants: Vec<String> = match &p.instances {
+            None => vec![String::new()],
+            Some(ids) => ids.iter().map(|&i| self.constants(&self.objects[self.instances[i].0], &names)).collect(),
+        };
+        variants.sort();
+        variants.dedup();
+        variants.into_iter().map(|v| if v.is_empty() { "default".into() } else { v }).collect()
+    }
+
+    fn constants(&self, o: &ObjectPlan, names: &[String]) -> String {
+        object_constants(o)
+            .into_iter()
+            .filter(|(n, _)| names.contains(n))
+            .map(|(n, v)| format!("{n}={}", v != 0.0))
+            .collect::<Vec<_>>()
+            .join(" ")
+    }
+}

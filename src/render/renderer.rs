@@ -1,0 +1,192 @@
+//! GPU side of a blueprint: bakes, per-instance buffers, the graph executor, frames and readback.
+
+use crate::bake::{self, Baker};
+use crate::error::{Error, Result};
+use crate::gpu::timing::Timer;
+use crate::gpu::GpuContext;
+use crate::graph::exec::{Executor, Inputs};
+use crate::io::Image;
+use crate::methods::view_slices;
+use crate::render::{wgsl_root, Blueprint, ObjectPlan, Part};
+use crate::types::ObjectParams;
+
+/// A rendered frame.
+pub struct Frame {
+    pub image: Image,
+    /// Per-pass GPU time (ms) from timestamp queries; empty without TIMESTAMP_QUERY.
+    pub pass_times: Vec<(String, f64)>,
+}
+
+impl Frame {
+    pub fn gpu_ms(&self) -> Option<f64> {
+        (!self.pass_times.is_empty()).then(|| self.pass_times.iter().map(|p| p.1).sum())
+    }
+}
+
+/// GPU resources of a blueprint, ready to render frames.
+pub struct Renderer {
+    pub blueprint: Blueprint,
+    exec: Executor,
+    frame: Inputs,
+    objects: Vec<Inputs>,
+    timer: Timer,
+    readback: wgpu::Buffer,
+}
+
+impl Renderer {
+    pub fn new(ctx: &GpuContext, blueprint: Blueprint) -> Result<Self> {
+        for o in &blueprint.objects {
+            for c in &o.chunks {
+                let max = ctx.limits.max_storage_buffer_binding_size;
+                view_slices::check_capacity(c.capacity, max, &o.object.name, c.params.plane_count)?;
+            }
+        }
+        let mut baker = Baker::new(&wgsl_root());
+        let baked: Vec<bake::Baked> =
+            blueprint.bakes.iter().map(|b| baker.bake(ctx, &b.request)).collect::<Result<_>>()?;
+        let sampler = ctx.device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("volume_sampler"),
+            address_mode_u: wgpu::AddressMode::Repeat,
+            address_mode_v: wgpu::AddressMode::Repeat,
+            address_mode_w: wgpu::AddressMode::ClampToEdge,
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            mipmap_filter: wgpu::MipmapFilterMode::Linear,
+            ..Default::default()
+        });
+        let mut frame = Inputs::default();
+        frame
+            .buffers
+            .insert("frame".into(), bake::uniform(ctx, "frame", bytemuck::bytes_of(&blueprint.frame)));
+        frame.samplers.insert("volume_sampler".into(), sampler);
+        frame.counts.insert("width".into(), blueprint.size.0);
+        frame.counts.insert("height".into(), blueprint.size.1);
+        let objects = blueprint
+            .instances
+            .iter()
+            .map(|&(i, part)| instance_inputs(ctx, &blueprint, &blueprint.objects[i], part, &baked))
+            .collect();
+        let exec = Executor::new(ctx, blueprint.graph.clone(), &blueprint.plan, blueprint.size)?;
+        let timer = Timer::new(ctx, blueprint.plan.passes.len() as u32);
+        let (w, h) = blueprint.size;
+        let readback = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("image readback"),
+            size: padded_row(w) as u64 * h as u64,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut r = Self { blueprint, exec, frame, objects, timer, readback };
+        // Pipelines now, so that a bad kernel fails before any frame.
+        r.exec.prepare(ctx, &r.blueprint.plan, &r.frame, &r.objects)?;
+        ctx.wait()?;
+        Ok(r)
+    }
+
+    /// Renders one frame and reads back the graph's first output as a linear HDR image.
+    pub fn render(&mut self, ctx: &GpuContext) -> Result<Frame> {
+        self.timer.reset();
+        self.exec.run(ctx, &self.blueprint.plan, &self.frame, &self.objects, &mut self.timer)?;
+        let pass_times = self.timer.read(ctx)?;
+        let image = self.read_output(ctx)?;
+        Ok(Frame { image, pass_times })
+    }
+
+    /// Renders without reading the image back (benchmarks); returns per-pass GPU times.
+    pub fn render_timed(&mut self, ctx: &GpuContext) -> Result<Vec<(String, f64)>> {
+        self.timer.reset();
+        self.exec.run(ctx, &self.blueprint.plan, &self.frame, &self.objects, &mut self.timer)?;
+        ctx.wait()?;
+        self.timer.read(ctx)
+    }
+
+    fn read_output(&self, ctx: &GpuContext) -> Result<Image> {
+        let name = &self.blueprint.graph.file.outputs[0];
+        let texture =
+            self.exec.texture(name).ok_or_else(|| Error::Invalid(format!("output `{name}` was pruned")))?;
+        if texture.format() != wgpu::TextureFormat::Rgba32Float {
+            return Err(self
+                .blueprint
+                .graph
+                .error_at(name, format!("output `{name}` must be Rgba32Float to be read back")));
+        }
+        let (w, h) = self.blueprint.size;
+        let mut enc = ctx.device.create_command_encoder(&Default::default());
+        enc.copy_texture_to_buffer(
+            texture.as_image_copy(),
+            wgpu::TexelCopyBufferInfo {
+                buffer: &self.readback,
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(padded_row(w)),
+                    rows_per_image: Some(h),
+                },
+            },
+            wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
+        );
+        ctx.queue.submit([enc.finish()]);
+        let bytes = ctx.map_read(&self.readback)?;
+        let mut pixels = Vec::with_capacity((w * h) as usize);
+        for y in 0..h as usize {
+            let row = &bytes[y * padded_row(w) as usize..][..w as usize * 16];
+            pixels.extend(bytemuck::pod_collect_to_vec::<u8, [f32; 4]>(row));
+        }
+        Image::from_pixels(w, h, pixels)
+    }
+}
+
+fn padded_row(w: u32) -> u32 {
+    (w * 16).div_ceil(256) * 256
+}
+
+/// Buffers, views, counts and constants of one graph instance.
+fn instance_inputs(ctx: &GpuContext, bp: &Blueprint, o: &ObjectPlan, part: Part, baked: &[bake::Baked]) -> Inputs {
+    let mut inputs = Inputs::default();
+    inputs.constants.push(("per_pixel_lighting".into(), o.per_pixel as u32 as f64));
+    let opacity_length = o.bake.map(|b| bp.bakes[b].opacity_length).unwrap_or(1.0);
+    let c = o.object.base_color.unwrap_or([0.0; 3]);
+    let params = ObjectParams { base_color: [c[0], c[1], c[2], 1.0], opacity_length, _pad: [0.0; 3] };
+    inputs.buffers.insert("object".into(), bake::uniform(ctx, "object", bytemuck::bytes_of(&params)));
+    match part {
+        Part::Base => {
+            let base = o.base.as_deref().unwrap_or_default();
+            inputs.buffers.insert("base_vertices".into(), bake::storage(ctx, "base_vertices", bytemuck::cast_slice(base)));
+            inputs.counts.insert("base_vertices".into(), base.len() as u32);
+        }
+        Part::Slices(chunk) => {
+            let c = &o.chunks[chunk];
+            view_slices::add_inputs(ctx, &mut inputs, &o.shell, &c.params, c.capacity, o.trivial_reject);
+            if let Some(b) = o.bake {
+                inputs.views.insert("volume".into(), baked[b].volume.create_view(&Default::default()));
+                inputs.views.insert("normals".into(), baked[b].normals.create_view(&Default::default()));
+            }
+        }
+    }
+    inputs
+}
+
+impl Renderer {
+    /// EXR metadata: scene, methods and their quality knobs, adapter, GPU time.
+    pub fn metadata(&self, ctx: &GpuContext, frame: &Frame) -> Vec<(String, String)> {
+        let mut m = vec![
+            ("voltex_scene".to_string(), self.blueprint.scene_path.display().to_string()),
+            ("voltex_adapter".to_string(), ctx.adapter_line()),
+        ];
+        if let Some(t) = frame.gpu_ms() {
+            m.push(("voltex_gpu_ms".into(), format!("{t:.3}")));
+        }
+        for o in &self.blueprint.objects {
+            let method = match &o.sweep {
+                Some(p) => format!(
+                    "ViewSlices(planes: {}, trivial_reject: {}, lighting: {})",
+                    p.plane_count,
+                    o.trivial_reject,
+                    if o.per_pixel { "PerPixel" } else { "Baked" }
+                ),
+                None => "BaseSurface".into(),
+            };
+            m.push((format!("voltex_object_{}", o.object.name), method));
+        }
+        m
+    }
+}
+

@@ -1,0 +1,85 @@
+//! Scene texels as bake requests: only texels some object draws, each (texel, lighting) once.
+
+use crate::bake::{BakeRequest, BakeSource};
+use crate::cpu::bake::{pack_shapes, Shape as BakeShape};
+use crate::error::{Error, Result};
+use crate::render::BakePlan;
+use crate::scene::{Scene, Shape, TexelSource};
+use crate::types::HeightfieldParams;
+
+/// Index of the bake for `texel` with the given lighting, added if new.
+pub(super) fn bake_index(scene: &Scene, texel: &str, per_pixel: bool, bakes: &mut Vec<BakePlan>) -> Result<usize> {
+    if let Some(i) = bakes.iter().position(|b| b.texel == texel && b.request.per_pixel == per_pixel) {
+        return Ok(i);
+    }
+    let t = scene
+        .texels
+        .get(texel)
+        .ok_or_else(|| Error::Invalid(format!("{}: unknown texel `{texel}`", scene.path.display())))?;
+    let source = match &t.source {
+        TexelSource::Implicit { shapes } => BakeSource::Implicit(pack_shapes(
+            &shapes.iter().map(bake_shape).collect::<Vec<_>>(),
+        )),
+        TexelSource::PerlinHeight {
+            frequency,
+            octaves,
+            amplitude,
+            base,
+            seed,
+            color_low,
+            color_high,
+            opacity,
+        } => {
+            let c = |v: &[f32; 3]| [v[0], v[1], v[2], 0.0];
+            BakeSource::Heightfield(HeightfieldParams {
+                frequency: *frequency,
+                octaves: *octaves,
+                seed: *seed,
+                amplitude: *amplitude,
+                base: *base,
+                opacity: *opacity,
+                color_low: c(color_low),
+                color_high: c(color_high),
+                ..Default::default()
+            })
+        }
+        TexelSource::Constant { color, opacity } => {
+            BakeSource::Implicit(pack_shapes(&[(BakeShape::Constant, *color, *opacity)]))
+        }
+    };
+    bakes.push(BakePlan {
+        texel: texel.to_string(),
+        request: BakeRequest {
+            resolution: t.resolution,
+            source,
+            per_pixel,
+            light: [0.0, 0.0, 1.0],
+            ambient: 0.2,
+        },
+        opacity_length: t.opacity_length,
+    });
+    Ok(bakes.len() - 1)
+}
+
+/// A scene shape as the bake kernels take it: (shape, albedo, opacity).
+fn bake_shape(s: &Shape) -> (BakeShape, [f32; 3], f32) {
+    match s {
+        Shape::Sphere { center, radius, color, opacity } => {
+            (BakeShape::Sphere { center: *center, radius: *radius }, *color, *opacity)
+        }
+        Shape::Torus { center, major, minor, color, opacity } => {
+            (BakeShape::Torus { center: *center, major: *major, minor: *minor }, *color, *opacity)
+        }
+        Shape::Ellipsoid { center, radii, color, opacity } => {
+            (BakeShape::Ellipsoid { center: *center, radii: *radii }, *color, *opacity)
+        }
+        Shape::Metaballs { balls, threshold, color, opacity } => (
+            BakeShape::Metaballs {
+                balls: balls.iter().map(|b| (b.center, b.radius)).collect(),
+                threshold: *threshold,
+            },
+            *color,
+            *opacity,
+        ),
+    }
+}
