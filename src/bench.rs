@@ -83,7 +83,12 @@ pub fn run(
         for o in &r.blueprint.objects {
             let Some(params) = o.sweep else { continue };
             let t = Instant::now();
-            let out = crate::cpu::slice_prisms::slice_all(&o.shell.vertices, &o.shell.prisms, &params, o.trivial_reject);
+            let out = crate::cpu::slice_prisms::slice_all(
+                &o.shell.vertices,
+                &o.shell.prisms,
+                &params,
+                o.trivial_reject,
+            );
             cpu.push(t.elapsed().as_secs_f64() * 1e3);
             std::hint::black_box(out);
         }
@@ -94,8 +99,10 @@ pub fn run(
     let mut references: Vec<Option<Image>> = vec![None; scenes.len()];
     for (s, row) in settings.iter().zip(&mut rows) {
         if references[s.scene].is_none() {
-            let opts = RenderOptions { size: Some(size), planes: Some(reference_planes), ..Default::default() };
-            references[s.scene] = Some(Renderer::new(&ctx, Blueprint::new(&scenes[s.scene], &opts)?)?.render(&ctx)?.image);
+            let opts =
+                RenderOptions { size: Some(size), planes: Some(reference_planes), ..Default::default() };
+            references[s.scene] =
+                Some(Renderer::new(&ctx, Blueprint::new(&scenes[s.scene], &opts)?)?.render(&ctx)?.image);
         }
         let reference = references[s.scene].as_ref().unwrap();
         let mut r = Renderer::new(&ctx, Blueprint::new(&scenes[s.scene], &options(s, None))?)?;
@@ -109,7 +116,9 @@ pub fn run(
 
     println!("adapter: {}", ctx.adapter_line());
     println!("{}x{}, median of {frames} frames after warm-up; times in ms", size.0, size.1);
-    println!("error: relative RMSE and mean FLIP against the same scene sliced with {reference_planes} planes");
+    println!(
+        "error: relative RMSE and mean FLIP against the same scene sliced with {reference_planes} planes"
+    );
     println!(
         "| scene | planes | reject | count | scan | emit | slicing | draw | composite | frame (wall) | fps | CPU twin | rel RMSE | FLIP |"
     );

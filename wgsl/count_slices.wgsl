@@ -9,17 +9,21 @@
 
 // Skip prisms whose bounding sphere misses the plane before classifying their corners.
 override trivial_reject: bool = true;
+// Planes per thread (set by the host, which sizes the dispatch with it).
+override planes_per_thread: u32 = 32u;
 
-// x: prism index, y: plane index (0 = back-most).
+// x: prism index, y: block of planes (0 = back-most).
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
-    let index = gid.x;
-    let k = gid.y;
-    if (index >= slice_params.prism_count || k >= slice_params.plane_count) {
+    if (gid.x >= slice_params.prism_count) {
         return;
     }
-    let n = fan_vertex_count(slice_prism(index, k).count);
-    if (n > 0u) {
-        atomicAdd(&plane_cursors[k], n);
+    let c = load_prism(gid.x);
+    let range = plane_range(c, gid.y);
+    for (var k = range.x; k < range.y; k++) {
+        let n = fan_vertex_count(slice_prism(c, k).count);
+        if (n > 0u) {
+            atomicAdd(&plane_cursors[k], n);
+        }
     }
 }

@@ -10,20 +10,28 @@
 
 // Skip prisms whose bounding sphere misses the plane before classifying their corners.
 override trivial_reject: bool = true;
+// Planes per thread (set by the host, which sizes the dispatch with it).
+override planes_per_thread: u32 = 32u;
 
 fn slice_vertex(poly: SlicePolygon, i: u32, index: u32) -> SliceVertex {
     return SliceVertex(vec4<f32>(poly.pos[i], bitcast<f32>(index)), vec4<f32>(poly.uvw[i], 0.0));
 }
 
-// x: prism index, y: plane index (0 = back-most).
+// x: prism index, y: block of planes (0 = back-most).
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let index = gid.x;
-    let k = gid.y;
-    if (index >= slice_params.prism_count || k >= slice_params.plane_count) {
+    if (index >= slice_params.prism_count) {
         return;
     }
-    let poly = slice_prism(index, k);
+    let c = load_prism(index);
+    let range = plane_range(c, gid.y);
+    for (var k = range.x; k < range.y; k++) {
+        emit(slice_prism(c, k), k, index);
+    }
+}
+
+fn emit(poly: SlicePolygon, k: u32, index: u32) {
     let n = fan_vertex_count(poly.count);
     if (n == 0u) {
         return;

@@ -23,7 +23,7 @@ pub struct Inputs {
 }
 
 /// Count names the runtime provides (per object or per frame).
-pub const COUNTS: &[&str] = &["prisms", "planes", "base_vertices", "width", "height"];
+pub const COUNTS: &[&str] = &["prisms", "planes", "plane_blocks", "base_vertices", "width", "height"];
 
 enum Pipeline {
     Compute(wgpu::ComputePipeline),

@@ -23,6 +23,10 @@ pub fn sweep(shell: &Shell, forward: [f32; 3], planes: u32, near: f64) -> SliceP
     }
 }
 
+/// Planes one thread of `count_slices` / `emit_slices` loops over (WGSL override
+/// `planes_per_thread`; the dispatch's y size is the plane count divided by it).
+pub const PLANES_PER_THREAD: u32 = 32;
+
 /// Slice-vertex budget of one chunk of a sweep: the storage-binding size every WebGPU adapter
 /// offers (128 MiB), so a chunk binds everywhere.
 pub const CHUNK_BYTES: u64 = 128 << 20;
@@ -170,6 +174,8 @@ pub fn add_inputs(
     b.insert("slice_vertices".into(), buffer("slice_vertices", bytes, wgpu::BufferUsages::empty()));
     inputs.counts.insert("prisms".into(), shell.prisms.len() as u32);
     inputs.counts.insert("planes".into(), params.plane_count);
+    inputs.counts.insert("plane_blocks".into(), params.plane_count.div_ceil(PLANES_PER_THREAD));
+    inputs.constants.push(("planes_per_thread".into(), PLANES_PER_THREAD as f64));
     inputs.constants.push(("trivial_reject".into(), trivial_reject as u32 as f64));
 }
 

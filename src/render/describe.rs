@@ -143,7 +143,9 @@ impl Blueprint {
         let names: Vec<String> = crate::gpu::reflect::overrides(&p.kernel).into_iter().map(|o| o.0).collect();
         let mut variants: Vec<String> = match &p.instances {
             None => vec![String::new()],
-            Some(ids) => ids.iter().map(|&i| self.constants(&self.objects[self.instances[i].0], &names)).collect(),
+            Some(ids) => {
+                ids.iter().map(|&i| self.constants(&self.objects[self.instances[i].0], &names)).collect()
+            }
         };
         variants.sort();
         variants.dedup();

@@ -151,7 +151,12 @@ impl Blueprint {
                     Part::Slices(c) => c as u32,
                 };
                 instances.push((i, part));
-                infos.push(ObjectInfo { name: o.object.name.clone(), filters: vec![filter], distance, order });
+                infos.push(ObjectInfo {
+                    name: o.object.name.clone(),
+                    filters: vec![filter],
+                    distance,
+                    order,
+                });
             }
         }
         let plan = plan::plan(&graph, &wgsl_root(), &infos)?;
@@ -179,7 +184,17 @@ impl Blueprint {
             b.request.light = [light_dir.x as f32, light_dir.y as f32, light_dir.z as f32];
             b.request.ambient = scene.ambient;
         }
-        Ok(Self { scene_path: scene.path.clone(), size, eye, frame, objects: plans, instances, bakes, graph, plan })
+        Ok(Self {
+            scene_path: scene.path.clone(),
+            size,
+            eye,
+            frame,
+            objects: plans,
+            instances,
+            bakes,
+            graph,
+            plan,
+        })
     }
 }
 
@@ -214,4 +229,3 @@ fn object_constants(o: &ObjectPlan) -> Vec<(String, f64)> {
         ("per_pixel_lighting".into(), o.per_pixel as u32 as f64),
     ]
 }
-

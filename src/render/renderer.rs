@@ -139,7 +139,13 @@ fn padded_row(w: u32) -> u32 {
 }
 
 /// Buffers, views, counts and constants of one graph instance.
-fn instance_inputs(ctx: &GpuContext, bp: &Blueprint, o: &ObjectPlan, part: Part, baked: &[bake::Baked]) -> Inputs {
+fn instance_inputs(
+    ctx: &GpuContext,
+    bp: &Blueprint,
+    o: &ObjectPlan,
+    part: Part,
+    baked: &[bake::Baked],
+) -> Inputs {
     let mut inputs = Inputs::default();
     inputs.constants.push(("per_pixel_lighting".into(), o.per_pixel as u32 as f64));
     let opacity_length = o.bake.map(|b| bp.bakes[b].opacity_length).unwrap_or(1.0);
@@ -149,7 +155,10 @@ fn instance_inputs(ctx: &GpuContext, bp: &Blueprint, o: &ObjectPlan, part: Part,
     match part {
         Part::Base => {
             let base = o.base.as_deref().unwrap_or_default();
-            inputs.buffers.insert("base_vertices".into(), bake::storage(ctx, "base_vertices", bytemuck::cast_slice(base)));
+            inputs.buffers.insert(
+                "base_vertices".into(),
+                bake::storage(ctx, "base_vertices", bytemuck::cast_slice(base)),
+            );
             inputs.counts.insert("base_vertices".into(), base.len() as u32);
         }
         Part::Slices(chunk) => {
@@ -189,4 +198,3 @@ impl Renderer {
         m
     }
 }
-

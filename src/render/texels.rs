@@ -8,7 +8,12 @@ use crate::scene::{Scene, Shape, TexelSource};
 use crate::types::HeightfieldParams;
 
 /// Index of the bake for `texel` with the given lighting, added if new.
-pub(super) fn bake_index(scene: &Scene, texel: &str, per_pixel: bool, bakes: &mut Vec<BakePlan>) -> Result<usize> {
+pub(super) fn bake_index(
+    scene: &Scene,
+    texel: &str,
+    per_pixel: bool,
+    bakes: &mut Vec<BakePlan>,
+) -> Result<usize> {
     if let Some(i) = bakes.iter().position(|b| b.texel == texel && b.request.per_pixel == per_pixel) {
         return Ok(i);
     }
@@ -17,9 +22,9 @@ pub(super) fn bake_index(scene: &Scene, texel: &str, per_pixel: bool, bakes: &mu
         .get(texel)
         .ok_or_else(|| Error::Invalid(format!("{}: unknown texel `{texel}`", scene.path.display())))?;
     let source = match &t.source {
-        TexelSource::Implicit { shapes } => BakeSource::Implicit(pack_shapes(
-            &shapes.iter().map(bake_shape).collect::<Vec<_>>(),
-        )),
+        TexelSource::Implicit { shapes } => {
+            BakeSource::Implicit(pack_shapes(&shapes.iter().map(bake_shape).collect::<Vec<_>>()))
+        }
         TexelSource::PerlinHeight {
             frequency,
             octaves,

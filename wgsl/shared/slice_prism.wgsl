@@ -211,9 +211,27 @@ fn slice_polygon(c: PrismCorners, n: vec3<f32>, d: f32) -> SlicePolygon {
     return poly;
 }
 
-// The slice polygon of prism `index` with plane `k`.
-fn slice_prism(index: u32, k: u32) -> SlicePolygon {
-    return slice_polygon(load_prism(index), slice_params.plane_normal.xyz, plane_offset(k));
+// The slice polygon of prism corners `c` with plane `k`.
+fn slice_prism(c: PrismCorners, k: u32) -> SlicePolygon {
+    return slice_polygon(c, slice_params.plane_normal.xyz, plane_offset(k));
+}
+
+// Planes [x, y) a thread visits: its block of `planes_per_thread` planes, narrowed with the
+// trivial reject to those near the prism's bounding sphere (widened by one plane: the exact
+// per-plane sphere test in `slice_polygon` decides). Looping over planes in a thread, rather than
+// a thread per (plane, prism) pair, keeps the work proportional to the planes a prism meets.
+fn plane_range(c: PrismCorners, block: u32) -> vec2<u32> {
+    let first = block * planes_per_thread;
+    var range = vec2<u32>(first, min(first + planes_per_thread, slice_params.plane_count));
+    if (trivial_reject) {
+        let centre = dot(slice_params.plane_normal.xyz, c.sphere.xyz);
+        let lo = (slice_params.first_plane - (centre + c.sphere.w)) / slice_params.spacing - 1.0;
+        let hi = (slice_params.first_plane - (centre - c.sphere.w)) / slice_params.spacing + 2.0;
+        let k0 = u32(clamp(floor(lo), 0.0, f32(slice_params.plane_count)));
+        let k1 = u32(clamp(ceil(hi), 0.0, f32(slice_params.plane_count)));
+        range = vec2<u32>(max(range.x, k0), min(range.y, k1));
+    }
+    return range;
 }
 
 // Triangle-list vertices of a fan over a polygon of `count` points.
