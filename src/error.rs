@@ -58,6 +58,12 @@ pub fn line_col(source: &str, offset: usize) -> (usize, usize) {
     (line, col)
 }
 
+/// Byte offset of 1-based `line` and `col` in `source` (the inverse of [`line_col`]).
+pub fn offset_of(source: &str, line: usize, col: usize) -> usize {
+    let start: usize = source.split_inclusive('\n').take(line.saturating_sub(1)).map(str::len).sum();
+    (start + col.saturating_sub(1)).min(source.len())
+}
+
 /// Position of the string literal `"text"` in a RON source (the first one at or after byte
 /// `from`), for errors found after parsing, when serde no longer knows where a value was.
 pub fn locate_literal(source: &str, text: &str, from: usize) -> Option<(usize, usize)> {

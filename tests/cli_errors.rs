@@ -198,7 +198,7 @@ fn obj_face_index_out_of_range() {
 }
 
 #[test]
-fn degenerate_obj_is_an_error_or_a_warning() {
+fn degenerate_obj_is_an_error_at_its_node() {
     // All three corners on a line: no area, no normal.
     let dir = temp_dir("obj_degenerate");
     std::fs::write(dir.join("line.obj"), "v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n").unwrap();
@@ -208,12 +208,16 @@ fn degenerate_obj_is_an_error_or_a_warning() {
     let out = render(&dir, &scene, &[], None);
     let err = stderr(&out);
     assert!(!err.contains("panicked"), "{err}");
-    // Today: warnings naming the degenerate triangles, and an empty image.
-    if out.status.code() == Some(0) {
-        assert!(err.contains("warning:") && err.contains("degenerate"), "{err}");
-    } else {
-        assert_fails(&out, &dir, &["line.obj"]);
-    }
+    // Nothing could be drawn: an error at the node, not an empty image.
+    let loc = format!("error: {}:", scene.display());
+    assert_fails(&out, &dir, &[&loc, "\"box\"", "degenerate"]);
+    let rest = err.split(&loc).nth(1).unwrap_or("");
+    let mut parts = rest.splitn(3, ':');
+    let line = parts.next().and_then(|l| l.parse::<usize>().ok());
+    let col = parts.next().and_then(|c| c.parse::<usize>().ok());
+    let text = std::fs::read_to_string(&scene).unwrap();
+    let expected_line = text.lines().position(|l| l.contains("name: \"box\"")).map(|i| i + 1);
+    assert!(line.is_some() && line == expected_line && col.is_some(), "{err}");
 }
 
 #[test]
@@ -383,6 +387,9 @@ fn wgsl_global_nothing_provides() {
     let loc = format!("error: {}:{}: ", graph.display(), line_col(&graph_text, "\"composite\""));
     let scene = root().join("scenes/view_slices/flat_box.ron");
     let out = render(&dir, &scene, &[], Some(&r));
+    assert_fails(&out, &dir, &[&loc, "`composite`", "`mystery`"]);
+    // `plan` finds it too, without a GPU.
+    let out = voltex(&["plan", scene.to_str().unwrap()], Some(&r));
     assert_fails(&out, &dir, &[&loc, "`composite`", "`mystery`"]);
 }
 

@@ -75,6 +75,14 @@ pub fn check(s: &BaseSurface) -> PrismReport {
         })
         .collect();
     let degenerate: Vec<usize> = (0..base_ok.len()).filter(|&t| !base_ok[t]).collect();
+    if s.triangles.is_empty() || degenerate.len() == s.triangles.len() {
+        // Nothing could be drawn: an error rather than a silently empty image.
+        r.errors.push(format!(
+            "no usable triangle: all {} triangles are degenerate or missing",
+            s.triangles.len()
+        ));
+        return r;
+    }
     if !degenerate.is_empty() {
         r.warnings.push(format!(
             "{} degenerate (zero-area or sliver) triangles: {}",

@@ -160,6 +160,7 @@ impl Blueprint {
             }
         }
         let plan = plan::plan(&graph, &wgsl_root(), &infos)?;
+        check_bindings(&graph, &plan)?;
 
         let view = view_matrix(forward, cam.up);
         let proj = projection(cam.fov_y.to_radians(), size.0 as f64 / size.1 as f64, near, far);
@@ -196,6 +197,38 @@ impl Blueprint {
             plan,
         })
     }
+}
+
+/// Resources the runtime binds by name: per frame, and per instance (an object's base surface or
+/// one chunk of its slices).
+pub const FRAME_RESOURCES: &[&str] = &["frame", "volume_sampler"];
+pub const INSTANCE_RESOURCES: &[&str] = &[
+    "object",
+    "base_vertices",
+    "slice_params",
+    "shell_vertices",
+    "prisms",
+    "plane_cursors",
+    "draw_args",
+    "slice_vertices",
+    "volume",
+    "normals",
+];
+
+/// Every WGSL global a kept pass uses must name a graph texture or a runtime resource, so that
+/// `voltex plan` reports what `render` would.
+fn check_bindings(graph: &Graph, plan: &Plan) -> Result<()> {
+    for p in &plan.passes {
+        for b in &p.bindings {
+            let known = plan.textures.contains_key(&b.name)
+                || FRAME_RESOURCES.contains(&b.name.as_str())
+                || INSTANCE_RESOURCES.contains(&b.name.as_str());
+            if !known {
+                return Err(plan::unknown_resource(graph, p.decl.name(), &b.name));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Right-handed view rotation (the camera at the origin looks down -z in view space).

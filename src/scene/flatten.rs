@@ -1,7 +1,7 @@
 //! The node tree flattened into world-space objects with their base surfaces.
 
 use super::types::{HeightScale, Method, Node, Scene, Surface};
-use crate::error::{Error, Result};
+use crate::error::{Error, FileLoc, Result};
 use crate::mesh::prism::{self, PrismReport};
 use crate::mesh::{generate, BaseSurface, Mesh};
 use glam::{DMat4, DVec2};
@@ -36,12 +36,11 @@ impl Scene {
             let surface = self.base_surface(n, surface, &world)?;
             let report = prism::check(&surface);
             if !report.errors.is_empty() {
-                return Err(Error::Invalid(format!(
-                    "{}: object \"{}\": invalid prisms: {}",
-                    self.path.display(),
-                    n.name,
-                    report.errors.join("; ")
-                )));
+                let (line, col) = node_position(&self.source, &n.name);
+                return Err(Error::at(
+                    FileLoc::new(&self.path, line, col),
+                    format!("object \"{}\": invalid prisms: {}", n.name, report.errors.join("; ")),
+                ));
             }
             out.push(SceneObject {
                 name: n.name.clone(),
@@ -102,4 +101,18 @@ impl Scene {
         let base = mesh.to_base(n.height.length, scale.as_deref(), DVec2::from(n.uv_tiling));
         Ok(base.transformed(world))
     }
+}
+
+/// Position of the node named `name` (its `name: "..."` field), or the file start.
+fn node_position(source: &str, name: &str) -> (usize, usize) {
+    let mut from = 0;
+    while let Some((line, col)) = crate::error::locate_literal(source, name, from) {
+        let offset = crate::error::offset_of(source, line, col);
+        let before = source[..offset].trim_end();
+        if before.strip_suffix(':').is_some_and(|b| b.trim_end().ends_with("name")) {
+            return (line, col);
+        }
+        from = offset + 1;
+    }
+    (1, 1)
 }

@@ -55,6 +55,7 @@ pub fn parse(source: &str, path: &Path) -> Result<Scene> {
         return Err(e);
     }
     scene.assets = found.assets;
+    scene.source = source.to_string();
     Ok(scene)
 }
 

@@ -28,6 +28,9 @@ pub struct Scene {
     /// OBJ meshes and height images loaded and checked by `load`, by resolved path.
     #[serde(skip)]
     pub(super) assets: super::validate::Assets,
+    /// The file's text, to position errors found after parsing (e.g. by the prism checks).
+    #[serde(skip)]
+    pub(super) source: String,
 }
 
 fn default_ambient() -> f32 {
