@@ -43,6 +43,8 @@ struct Row {
     raster: Vec<(String, f64)>,
     wall_ms: f64,
     cpu_ms: f64,
+    /// Fragments the slices cover: their projected area in pixels, summed.
+    fragments: f64,
     rel_rmse: f64,
     flip: f64,
 }
@@ -80,6 +82,7 @@ pub fn run(
         let mut r = Renderer::new(&ctx, bp)?;
         let (slicing, _) = timed(&ctx, &mut r, frames)?;
         let mut cpu = Vec::new();
+        let mut fragments = 0.0;
         for o in &r.blueprint.objects {
             let Some(params) = o.sweep else { continue };
             let t = Instant::now();
@@ -90,9 +93,9 @@ pub fn run(
                 o.trivial_reject,
             );
             cpu.push(t.elapsed().as_secs_f64() * 1e3);
-            std::hint::black_box(out);
+            fragments += covered_pixels(&r.blueprint, &out);
         }
-        rows.push(Row { slicing, cpu_ms: cpu.iter().sum(), ..Default::default() });
+        rows.push(Row { slicing, cpu_ms: cpu.iter().sum(), fragments, ..Default::default() });
     }
 
     // Phase 2: full frames, their raster passes and wall time, and the error of each setting.
@@ -120,15 +123,15 @@ pub fn run(
         "error: relative RMSE and mean FLIP against the same scene sliced with {reference_planes} planes"
     );
     println!(
-        "| scene | planes | reject | count | scan | emit | slicing | draw | composite | frame (wall) | fps | CPU twin | rel RMSE | FLIP |"
+        "| scene | planes | reject | count | scan | emit | slicing | draw | Mfrag | Mfrag/s | composite | frame (wall) | fps | CPU twin | rel RMSE | FLIP |"
     );
-    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
     for (s, row) in settings.iter().zip(&rows) {
         let get = |v: &[(String, f64)], p: &str| v.iter().find(|x| x.0 == p).map(|x| x.1).unwrap_or(f64::NAN);
         let slicing: f64 = row.slicing.iter().map(|p| p.1).sum();
         let name = Path::new(&paths[s.scene]).file_stem().unwrap_or_default().to_string_lossy().to_string();
         println!(
-            "| {name} | {} | {} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.1} | {:.2} | {:.1} | {:.4} | {:.4} |",
+            "| {name} | {} | {} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.1} | {:.0} | {:.3} | {:.1} | {:.2} | {:.1} | {:.4} | {:.4} |",
             s.planes,
             if s.reject { "on" } else { "off" },
             get(&row.slicing, "count_slices"),
@@ -136,6 +139,8 @@ pub fn run(
             get(&row.slicing, "emit_slices"),
             slicing,
             get(&row.raster, "draw_slices"),
+            row.fragments * 1e-6,
+            row.fragments * 1e-3 / get(&row.raster, "draw_slices"),
             get(&row.raster, "composite"),
             row.wall_ms,
             1000.0 / row.wall_ms,
@@ -145,6 +150,9 @@ pub fn run(
         );
     }
     println!("slicing = count + scan + emit (classification and intersection, GPU timestamps, timed alone);");
+    println!(
+        "Mfrag = millions of fragments the slice polygons cover (projected area); Mfrag/s = Mfrag / draw;"
+    );
     println!("frame (wall) = submit to idle of a whole frame; CPU twin = the same slicing on one CPU core");
     Ok(())
 }
@@ -167,4 +175,27 @@ fn timed(ctx: &GpuContext, r: &mut Renderer, frames: usize) -> Result<(Vec<(Stri
         }
     }
     Ok((per_pass.into_iter().map(|(n, v)| (n, median(v))).collect(), median(wall)))
+}
+
+/// Pixels covered by slice triangles (their projected area, clipped to the viewport's bounds
+/// only by skipping triangles wholly outside): the fragments `draw_slices` shades.
+fn covered_pixels(bp: &Blueprint, planes: &[Vec<crate::types::SliceVertex>]) -> f64 {
+    let vp = glam::Mat4::from_cols_array_2d(&bp.frame.view_proj);
+    let (w, h) = (bp.size.0 as f32, bp.size.1 as f32);
+    let mut total = 0.0f64;
+    for tri in planes.iter().flat_map(|p| p.chunks_exact(3)) {
+        let q: [glam::Vec2; 3] = std::array::from_fn(|i| {
+            let v = &tri[i];
+            let c = vp * glam::Vec4::new(v.position[0], v.position[1], v.position[2], 1.0);
+            glam::Vec2::new((c.x / c.w * 0.5 + 0.5) * w, (c.y / c.w * 0.5 + 0.5) * h)
+        });
+        let outside = q.iter().all(|p| p.x < 0.0)
+            || q.iter().all(|p| p.x > w)
+            || q.iter().all(|p| p.y < 0.0)
+            || q.iter().all(|p| p.y > h);
+        if !outside {
+            total += 0.5 * ((q[1] - q[0]).perp_dot(q[2] - q[0])).abs() as f64;
+        }
+    }
+    total
 }

@@ -57,7 +57,6 @@ fn vs_main(@builtin(vertex_index) index: u32) -> VsOut {
 @fragment
 fn fs_main(in: VsOut) -> @location(0) vec4<f32> {
     let texel = textureSample(volume, volume_sampler, in.uvw);
-    let tex_normal = textureSample(normals, volume_sampler, in.uvw).xyz;
     // World length of this pixel's ray between two planes: spacing / cos(angle to the view axis).
     let ray = normalize(in.rel);
     let step = slice_params.spacing / max(dot(ray, frame.forward.xyz), 1e-4);
@@ -65,6 +64,7 @@ fn fs_main(in: VsOut) -> @location(0) vec4<f32> {
     let corrected = 1.0 - pow(1.0 - min(a, 0.999999), step / object.opacity_length);
     var rgb = texel.rgb * select(0.0, corrected / a, a > 1e-6);
     if per_pixel_lighting {
+        let tex_normal = textureSample(normals, volume_sampler, in.uvw).xyz;
         var n = in.n_s * tex_normal.x + in.n_t * tex_normal.y + in.n_w * tex_normal.z;
         n = select(-ray, normalize(n), dot(n, n) > 1e-20);
         let l = frame.light_dir.xyz;
