@@ -93,6 +93,15 @@ pub struct ObjectParams {
     pub _pad: [f32; 3],
 }
 
+/// Texel-to-world derivatives at a welded vertex, `dP/ds` and `dP/dt` (w unused), averaged over
+/// its triangles: per-pixel lighting interpolates them so normals vary smoothly across prisms.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct VertexFrame {
+    pub ds: [f32; 4],
+    pub dt: [f32; 4],
+}
+
 /// One corner of a base-surface triangle, for the opaque base pass (3 per triangle).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]

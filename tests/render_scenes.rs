@@ -59,6 +59,13 @@ fn golden_sphere_balls() {
 }
 
 #[test]
+fn golden_cloud_over_moss() {
+    let img =
+        render(&example("cloud_over_moss.ron"), RenderOptions { size: TEST_SIZE, ..Default::default() });
+    check_golden("view_slices_cloud_over_moss", &img, Threshold::Flip(0.01));
+}
+
+#[test]
 fn golden_flat_box() {
     let img = render(&example("flat_box.ron"), RenderOptions { size: TEST_SIZE, ..Default::default() });
     check_golden("view_slices_flat_box", &img, Threshold::Flip(0.01));

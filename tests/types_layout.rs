@@ -25,6 +25,7 @@ fn wgsl_structs_match_rust() {
         layout!(FrameParams; view_proj, forward, light_dir, light_color, background, viewport),
         layout!(ObjectParams; base_color, opacity_length),
         layout!(BaseVertex; position, normal),
+        layout!(VertexFrame; ds, dt),
         layout!(BakeParams; resolution, light),
         layout!(ImplicitShape; kind, first_ball, ball_count, _pad, center, params, color),
         layout!(HeightfieldParams; frequency, octaves, seed, _pad0, amplitude, base, opacity, _pad1, color_low, color_high),

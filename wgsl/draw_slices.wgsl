@@ -13,15 +13,33 @@ override per_pixel_lighting: bool = false;
 @group(0) @binding(6) var volume: texture_3d<f32>;
 @group(0) @binding(7) var normals: texture_3d<f32>;
 @group(0) @binding(8) var volume_sampler: sampler;
+@group(0) @binding(9) var<storage, read> vertex_frames: array<VertexFrame>;
 
 struct VsOut {
     @builtin(position) clip: vec4<f32>,
     @location(0) uvw: vec3<f32>,
     @location(1) rel: vec3<f32>,
-    // Columns of the inverse-transpose of the prism's texel-to-world Jacobian (up to scale).
-    @location(2) @interpolate(flat) n_s: vec3<f32>,
-    @location(3) @interpolate(flat) n_t: vec3<f32>,
-    @location(4) @interpolate(flat) n_w: vec3<f32>,
+    // Columns of the inverse-transpose of the texel-to-world Jacobian (up to scale) at this point.
+    @location(2) n_s: vec3<f32>,
+    @location(3) n_t: vec3<f32>,
+    @location(4) n_w: vec3<f32>,
+}
+
+// Barycentrics of p (in the triangle's plane) in the triangle q0 q1 q2; (1/3, 1/3, 1/3) if degenerate.
+fn barycentrics(p: vec3<f32>, q0: vec3<f32>, q1: vec3<f32>, q2: vec3<f32>) -> vec3<f32> {
+    let e1 = q1 - q0;
+    let e2 = q2 - q0;
+    let e = p - q0;
+    let d11 = dot(e1, e1);
+    let d12 = dot(e1, e2);
+    let d22 = dot(e2, e2);
+    let det = d11 * d22 - d12 * d12;
+    if (det <= 1e-12 * d11 * d22) {
+        return vec3<f32>(1.0 / 3.0);
+    }
+    let b1 = (d22 * dot(e, e1) - d12 * dot(e, e2)) / det;
+    let b2 = (d11 * dot(e, e2) - d12 * dot(e, e1)) / det;
+    return vec3<f32>(1.0 - b1 - b2, b1, b2);
 }
 
 @vertex
@@ -32,20 +50,22 @@ fn vs_main(@builtin(vertex_index) index: u32) -> VsOut {
     out.uvw = v.uvw.xyz;
     out.rel = v.position.xyz;
     if per_pixel_lighting {
+        // The Jacobian J = [dP/ds, dP/dt, dP/dw] interpolated from the prism's vertices at this
+        // point (barycentrics in the prism's cross-section at height w), so it is continuous
+        // across prism edges; normals transform with cofactor(J) = det(J) inverse(J)^T.
         let prism = prisms[bitcast<u32>(v.position.w)];
-        let a = shell_vertices[prism.vertices.x];
-        let b = shell_vertices[prism.vertices.y];
-        let c = shell_vertices[prism.vertices.z];
-        let e1 = b.bottom.xyz - a.bottom.xyz;
-        let e2 = c.bottom.xyz - a.bottom.xyz;
-        let d1 = prism.uv01.zw - prism.uv01.xy;
-        let d2 = prism.uv2.xy - prism.uv01.xy;
-        let det = d1.x * d2.y - d2.x * d1.y;
-        let inv = select(0.0, 1.0 / det, abs(det) > 1e-12);
-        let ds = (e1 * d2.y - e2 * d1.y) * inv;
-        let dt = (e2 * d1.x - e1 * d2.x) * inv;
-        let dw = ((a.top.xyz - a.bottom.xyz) + (b.top.xyz - b.bottom.xyz) + (c.top.xyz - c.bottom.xyz)) / 3.0;
-        // inverse(J)^T = cofactor(J) / det(J): normals transform with the cofactor matrix.
+        let ids = prism.vertices.xyz;
+        let a = shell_vertices[ids.x];
+        let b = shell_vertices[ids.y];
+        let c = shell_vertices[ids.z];
+        let w = v.uvw.z;
+        let bary = barycentrics(v.position.xyz, mix(a.bottom.xyz, a.top.xyz, w), mix(b.bottom.xyz, b.top.xyz, w), mix(c.bottom.xyz, c.top.xyz, w));
+        let fa = vertex_frames[ids.x];
+        let fb = vertex_frames[ids.y];
+        let fc = vertex_frames[ids.z];
+        let ds = bary.x * fa.ds.xyz + bary.y * fb.ds.xyz + bary.z * fc.ds.xyz;
+        let dt = bary.x * fa.dt.xyz + bary.y * fb.dt.xyz + bary.z * fc.dt.xyz;
+        let dw = bary.x * (a.top.xyz - a.bottom.xyz) + bary.y * (b.top.xyz - b.bottom.xyz) + bary.z * (c.top.xyz - c.bottom.xyz);
         let sign_j = select(-1.0, 1.0, dot(ds, cross(dt, dw)) >= 0.0);
         out.n_s = cross(dt, dw) * sign_j;
         out.n_t = cross(dw, ds) * sign_j;

@@ -4,7 +4,7 @@
 use glam::DVec3;
 
 use crate::mesh::BaseSurface;
-use crate::types::{BaseVertex, Prism, ShellVertex};
+use crate::types::{BaseVertex, Prism, ShellVertex, VertexFrame};
 
 pub struct Shell {
     pub vertices: Vec<ShellVertex>,
@@ -86,4 +86,29 @@ pub fn base_vertices(surface: &BaseSurface, eye: DVec3) -> Vec<BaseVertex> {
         }
     }
     out
+}
+
+/// Per welded vertex, `dP/ds` and `dP/dt` of its triangles (from their uv mapping), weighted by
+/// triangle area, for per-pixel lighting that is continuous across prism edges.
+pub fn vertex_frames(surface: &BaseSurface) -> Vec<VertexFrame> {
+    let n = surface.positions.len();
+    let mut sum = vec![(DVec3::ZERO, DVec3::ZERO); n];
+    for (t, uv) in surface.triangles.iter().zip(&surface.corner_uvs) {
+        let p = t.map(|i| surface.positions[i as usize]);
+        let (e1, e2) = (p[1] - p[0], p[2] - p[0]);
+        let (d1, d2) = (uv[1] - uv[0], uv[2] - uv[0]);
+        let det = d1.x * d2.y - d2.x * d1.y;
+        if det.abs() < 1e-20 {
+            continue; // no uv area: no texel directions to take from this triangle
+        }
+        let ds = (e1 * d2.y - e2 * d1.y) / det;
+        let dt = (e2 * d1.x - e1 * d2.x) / det;
+        let area = 0.5 * e1.cross(e2).length();
+        for &i in t {
+            sum[i as usize].0 += ds * area;
+            sum[i as usize].1 += dt * area;
+        }
+    }
+    let f = |v: DVec3| [v.x as f32, v.y as f32, v.z as f32, 0.0];
+    sum.into_iter().map(|(ds, dt)| VertexFrame { ds: f(ds), dt: f(dt) }).collect()
 }

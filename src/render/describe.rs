@@ -53,6 +53,12 @@ impl Blueprint {
                         + o.chunks.len() as u64 * (16 + 48),
                 ));
             }
+            if let Some(frames) = &o.frames {
+                out.push((
+                    format!("object {name}: vertex frames (per-pixel lighting)"),
+                    (frames.len() * 32) as u64,
+                ));
+            }
             if let Some(base) = &o.base {
                 out.push((format!("object {name}: base triangles"), (base.len() * 32) as u64));
             }

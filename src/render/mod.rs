@@ -18,7 +18,7 @@ use crate::graph::Graph;
 use crate::methods::shell::{self, Shell};
 use crate::methods::view_slices::{self, SliceChunk};
 use crate::scene::{Light, Lighting, Method, Scene, SceneObject};
-use crate::types::{BaseVertex, FrameParams, SliceParams};
+use crate::types::{BaseVertex, FrameParams, SliceParams, VertexFrame};
 
 /// Overrides of what the scene file says, from the command line or tests.
 #[derive(Debug, Clone, Default)]
@@ -39,6 +39,8 @@ pub struct ObjectPlan {
     pub chunks: Vec<SliceChunk>,
     pub trivial_reject: bool,
     pub per_pixel: bool,
+    /// Per-vertex texel frames for per-pixel lighting (only when it is on).
+    pub frames: Option<Vec<VertexFrame>>,
     /// Index into `Blueprint::bakes`.
     pub bake: Option<usize>,
 }
@@ -132,7 +134,18 @@ impl Blueprint {
                 let texel_name = object.texel.clone().unwrap_or_default();
                 bake = Some(texels::bake_index(scene, &texel_name, per_pixel, &mut bakes)?);
             }
-            plans.push(ObjectPlan { object, shell, base, sweep, chunks, trivial_reject, per_pixel, bake });
+            let frames = per_pixel.then(|| shell::vertex_frames(&object.surface));
+            plans.push(ObjectPlan {
+                object,
+                shell,
+                base,
+                sweep,
+                chunks,
+                trivial_reject,
+                per_pixel,
+                frames,
+                bake,
+            });
         }
 
         let graph = Graph::load(opts.graph.as_deref().unwrap_or(&default_graph()))?;
@@ -213,6 +226,7 @@ pub const INSTANCE_RESOURCES: &[&str] = &[
     "slice_vertices",
     "volume",
     "normals",
+    "vertex_frames",
 ];
 
 /// Every WGSL global a kept pass uses must name a graph texture or a runtime resource, so that

@@ -8,7 +8,7 @@ use crate::graph::exec::{Executor, Inputs};
 use crate::io::Image;
 use crate::methods::view_slices;
 use crate::render::{wgsl_root, Blueprint, ObjectPlan, Part};
-use crate::types::ObjectParams;
+use crate::types::{ObjectParams, VertexFrame};
 
 /// A rendered frame.
 pub struct Frame {
@@ -164,6 +164,12 @@ fn instance_inputs(
         Part::Slices(chunk) => {
             let c = &o.chunks[chunk];
             view_slices::add_inputs(ctx, &mut inputs, &o.shell, &c.params, c.capacity, o.trivial_reject);
+            // Bound even when unlit per pixel (the binding exists in the kernel): one entry then.
+            let frames = o.frames.as_deref().unwrap_or(&[VertexFrame { ds: [0.0; 4], dt: [0.0; 4] }]);
+            inputs.buffers.insert(
+                "vertex_frames".into(),
+                bake::storage(ctx, "vertex_frames", bytemuck::cast_slice(frames)),
+            );
             if let Some(b) = o.bake {
                 inputs.views.insert("volume".into(), baked[b].volume.create_view(&Default::default()));
                 inputs.views.insert("normals".into(), baked[b].normals.create_view(&Default::default()));

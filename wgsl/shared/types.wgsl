@@ -53,6 +53,11 @@ struct ObjectParams {
     _pad2: f32,
 }
 
+struct VertexFrame {
+    ds: vec4<f32>,
+    dt: vec4<f32>,
+}
+
 struct BaseVertex {
     position: vec4<f32>,
     normal: vec4<f32>,
