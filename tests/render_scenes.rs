@@ -148,3 +148,57 @@ fn plane_count_changes_error_not_brightness() {
     let fine = mean(&render(&slab_scene(4, 192, eye), RenderOptions::default()));
     assert!((coarse - fine).abs() / fine < 0.01, "mean brightness {coarse} with 24 planes, {fine} with 192");
 }
+
+/// Renders the slice polygons of one plane per object with the coverage debug graph: each pixel
+/// holds how many polygons cover it.
+fn coverage(scene: &Scene) -> Image {
+    let graph = voltex::project_root().join("graphs/slice_coverage.ron");
+    render(
+        scene,
+        RenderOptions { planes: Some(1), graph: Some(graph), size: Some((256, 256)), ..Default::default() },
+    )
+}
+
+/// Pixels covered twice (double blending), and cracks: uncovered pixels between covered ones that
+/// lie on a thin line of uncovered pixels (at most two uncovered neighbours), which tells a crack
+/// from a concave notch of the cross-section's boundary (open to the outside).
+fn seams(img: &Image) -> (usize, usize, usize) {
+    let (w, h) = (img.width, img.height);
+    let at = |x: u32, y: u32| img.get(x, y)[0];
+    let (mut covered, mut doubled, mut cracks) = (0, 0, 0);
+    for y in 1..h - 1 {
+        for x in 1..w - 1 {
+            let c = at(x, y);
+            covered += (c >= 1.0) as usize;
+            doubled += (c > 1.0) as usize;
+            let across =
+                (at(x - 1, y) >= 1.0 && at(x + 1, y) >= 1.0) || (at(x, y - 1) >= 1.0 && at(x, y + 1) >= 1.0);
+            let uncovered_neighbours =
+                (0..9).filter(|&i| i != 4 && at(x + i % 3 - 1, y + i / 3 - 1) == 0.0).count();
+            cracks += (c == 0.0 && across && uncovered_neighbours <= 2) as usize;
+        }
+    }
+    (covered, doubled, cracks)
+}
+
+/// "A constant-density volume on a closed mesh shows no seam pixels along prism edges": the
+/// polygons of a plane through closed shells cover each pixel of the cross-section exactly once.
+#[test]
+fn closed_shells_show_no_seam_pixels() {
+    for surface in [
+        "Sphere(radius: 1.0, segments: (24, 12))",
+        "Torus(major: 1.0, minor: 0.45, segments: (24, 12), distortion: 0.15, seed: 1)",
+    ] {
+        for eye in ["(0.3, -3.2, 1.6)", "(2.5, 1.0, 1.9)", "(0.01, 0.02, 3.4)"] {
+            let src = format!(
+                r#"Scene(output: (width: 256, height: 256), camera: (eye: {eye}, target: (0.0, 0.0, 0.0), fov_y: 45.0),
+                texels: {{ "fog": (resolution: (4, 4, 4), source: Constant(color: (1.0, 1.0, 1.0))) }},
+                nodes: [(name: "shell", surface: {surface}, height: (length: 0.3), texel: "fog", method: ViewSlices(planes: 1))])"#
+            );
+            let img = coverage(&scene::parse(&src, Path::new("closed.ron")).unwrap());
+            let (covered, doubled, cracks) = seams(&img);
+            assert!(covered > 3000, "{surface} from {eye}: the cross-section covers {covered} pixels");
+            assert_eq!((doubled, cracks), (0, 0), "{surface} from {eye}: pixels covered twice, cracks");
+        }
+    }
+}

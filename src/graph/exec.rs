@@ -187,6 +187,14 @@ impl Executor {
                                 Blend::PremultipliedOver => {
                                     Some(wgpu::BlendState::PREMULTIPLIED_ALPHA_BLENDING)
                                 }
+                                Blend::Add => {
+                                    let add = wgpu::BlendComponent {
+                                        src_factor: wgpu::BlendFactor::One,
+                                        dst_factor: wgpu::BlendFactor::One,
+                                        operation: wgpu::BlendOperation::Add,
+                                    };
+                                    Some(wgpu::BlendState { color: add, alpha: add })
+                                }
                             },
                             write_mask: wgpu::ColorWrites::ALL,
                         })

@@ -179,6 +179,8 @@ pub enum Blend {
     Replace,
     /// `src + dst * (1 - src.a)` on premultiplied colours: back-to-front compositing.
     PremultipliedOver,
+    /// `src + dst`: counting and accumulation (debug views).
+    Add,
 }
 
 #[derive(Debug, Clone, Deserialize)]
