@@ -18,10 +18,10 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (gid.x >= slice_params.prism_count) {
         return;
     }
-    let c = load_prism(gid.x);
-    let range = plane_range(c, gid.y);
+    var c = load_prism(gid.x);
+    let range = plane_range(&c, gid.y);
     for (var k = range.x; k < range.y; k++) {
-        let n = fan_vertex_count(slice_prism(c, k).count);
+        let n = fan_vertex_count(slice_prism(&c, k).count);
         if (n > 0u) {
             atomicAdd(&plane_cursors[k], n);
         }

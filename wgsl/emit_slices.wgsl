@@ -13,8 +13,8 @@ override trivial_reject: bool = true;
 // Planes per thread (set by the host, which sizes the dispatch with it).
 override planes_per_thread: u32 = 32u;
 
-fn slice_vertex(poly: SlicePolygon, i: u32, index: u32) -> SliceVertex {
-    return SliceVertex(vec4<f32>(poly.pos[i], bitcast<f32>(index)), vec4<f32>(poly.uvw[i], 0.0));
+fn slice_vertex(poly: ptr<function, SlicePolygon>, i: u32, index: u32) -> SliceVertex {
+    return SliceVertex(vec4<f32>((*poly).pos[i], bitcast<f32>(index)), vec4<f32>((*poly).uvw[i], 0.0));
 }
 
 // x: prism index, y: block of planes (0 = back-most).
@@ -24,15 +24,17 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (index >= slice_params.prism_count) {
         return;
     }
-    let c = load_prism(index);
-    let range = plane_range(c, gid.y);
+    var c = load_prism(index);
+    let range = plane_range(&c, gid.y);
     for (var k = range.x; k < range.y; k++) {
-        emit(slice_prism(c, k), k, index);
+        var poly = slice_prism(&c, k);
+        emit(&poly, k, index);
     }
 }
 
-fn emit(poly: SlicePolygon, k: u32, index: u32) {
-    let n = fan_vertex_count(poly.count);
+// Appends one polygon, fan-triangulated, to its plane's range.
+fn emit(poly: ptr<function, SlicePolygon>, k: u32, index: u32) {
+    let n = fan_vertex_count((*poly).count);
     if (n == 0u) {
         return;
     }
@@ -42,7 +44,7 @@ fn emit(poly: SlicePolygon, k: u32, index: u32) {
     // drawn range [0, vertex_count) never holds stale vertices.
     let fits = base <= capacity && n <= capacity - base;
     let v0 = slice_vertex(poly, 0u, index);
-    for (var f = 0u; f + 2u < poly.count; f++) {
+    for (var f = 0u; f + 2u < (*poly).count; f++) {
         for (var c = 0u; c < 3u; c++) {
             let corner = select(f + c, 0u, c == 0u); // fan (0, f+1, f+2)
             let at = base + 3u * f + c;

@@ -1,6 +1,8 @@
 // Plane/prism intersection of view-aligned slicing (2002 paper, Sec. 3-4, Fig. 4); CPU twin in
 // src/cpu/slice_prisms.rs, which mirrors these functions one to one.
-// The including kernel declares `slice_params`, `shell_vertices`, `prisms` and `trivial_reject`.
+// The including kernel declares `slice_params`, `shell_vertices`, `prisms`, `trivial_reject` and
+// `planes_per_thread`. Corners and polygons go by pointer: by-value copies of their arrays made
+// these kernels 4x slower on lavapipe.
 
 const EDGE_ABOVE: u32 = 0u; // a: the plane cuts the prolonged normal edge above its top
 const EDGE_WITHIN: u32 = 1u; // b: bottom and top lie on different sides of the plane
@@ -102,21 +104,21 @@ fn poly_push(poly: ptr<function, SlicePolygon>, p: EdgePoint) {
 }
 
 // Intersection of the upper (top) or lower (bottom) edge between corners i and j.
-fn side_edge_point(c: PrismCorners, s: array<f32, 3>, upper: bool, i: u32, j: u32) -> EdgePoint {
+fn side_edge_point(c: ptr<function, PrismCorners>, s: ptr<function, array<f32, 3>>, upper: bool, i: u32, j: u32) -> EdgePoint {
     var a = i;
     var b = j;
-    if (c.ids[j] < c.ids[i]) {
+    if ((*c).ids[j] < (*c).ids[i]) {
         a = j;
         b = i;
     }
     let w = select(0.0, 1.0, upper);
-    var pa = c.bottom[a];
-    var pb = c.bottom[b];
+    var pa = (*c).bottom[a];
+    var pb = (*c).bottom[b];
     if (upper) {
-        pa = c.top[a];
-        pb = c.top[b];
+        pa = (*c).top[a];
+        pb = (*c).top[b];
     }
-    return edge_point(pa, vec3<f32>(c.uv[a], w), s[a], pb, vec3<f32>(c.uv[b], w), s[b]);
+    return edge_point(pa, vec3<f32>((*c).uv[a], w), (*s)[a], pb, vec3<f32>((*c).uv[b], w), (*s)[b]);
 }
 
 const CAP_NONE: u32 = 0u;
@@ -145,17 +147,17 @@ const CAP_BOTTOM: u32 = 2u;
 // Degenerate output: consecutive repeated points are merged (also last vs first; a plane through a
 // corner reaches it from up to three edges); fewer than 3 points left give an empty polygon.
 // count_slices and emit_slices both use this function.
-fn slice_polygon(c: PrismCorners, n: vec3<f32>, d: f32) -> SlicePolygon {
+fn slice_polygon(c: ptr<function, PrismCorners>, n: vec3<f32>, d: f32) -> SlicePolygon {
     var poly: SlicePolygon;
     poly.count = 0u;
-    if (trivial_reject && abs(dot(n, c.sphere.xyz) - d) > c.sphere.w) {
+    if (trivial_reject && abs(dot(n, (*c).sphere.xyz) - d) > (*c).sphere.w) {
         return poly;
     }
     var sb: array<f32, 3>;
     var st: array<f32, 3>;
     for (var i = 0u; i < 3u; i++) {
-        sb[i] = dot(n, c.bottom[i]) - d;
-        st[i] = dot(n, c.top[i]) - d;
+        sb[i] = dot(n, (*c).bottom[i]) - d;
+        st[i] = dot(n, (*c).top[i]) - d;
     }
     let rising = ((st[0] - sb[0]) + (st[1] - sb[1])) + (st[2] - sb[2]) >= 0.0;
     var start = 0u;
@@ -171,9 +173,9 @@ fn slice_polygon(c: PrismCorners, n: vec3<f32>, d: f32) -> SlicePolygon {
         let i = (start + f) % 3u;
         let j = (i + 1u) % 3u;
         if (crossed(sb[i], st[i])) {
-            let ub = vec3<f32>(c.uv[i], 0.0);
-            let ut = vec3<f32>(c.uv[i], 1.0);
-            poly_push(&poly, edge_point(c.bottom[i], ub, sb[i], c.top[i], ut, st[i]));
+            let ub = vec3<f32>((*c).uv[i], 0.0);
+            let ut = vec3<f32>((*c).uv[i], 1.0);
+            poly_push(&poly, edge_point((*c).bottom[i], ub, sb[i], (*c).top[i], ut, st[i]));
             last_cap = CAP_NONE;
         }
         let upper = crossed(st[i], st[j]);
@@ -184,20 +186,20 @@ fn slice_polygon(c: PrismCorners, n: vec3<f32>, d: f32) -> SlicePolygon {
         }
         if (lower_first) {
             if (lower) {
-                poly_push(&poly, side_edge_point(c, sb, false, i, j));
+                poly_push(&poly, side_edge_point(c, &sb, false, i, j));
                 last_cap = CAP_BOTTOM;
             }
             if (upper) {
-                poly_push(&poly, side_edge_point(c, st, true, i, j));
+                poly_push(&poly, side_edge_point(c, &st, true, i, j));
                 last_cap = CAP_TOP;
             }
         } else {
             if (upper) {
-                poly_push(&poly, side_edge_point(c, st, true, i, j));
+                poly_push(&poly, side_edge_point(c, &st, true, i, j));
                 last_cap = CAP_TOP;
             }
             if (lower) {
-                poly_push(&poly, side_edge_point(c, sb, false, i, j));
+                poly_push(&poly, side_edge_point(c, &sb, false, i, j));
                 last_cap = CAP_BOTTOM;
             }
         }
@@ -212,7 +214,7 @@ fn slice_polygon(c: PrismCorners, n: vec3<f32>, d: f32) -> SlicePolygon {
 }
 
 // The slice polygon of prism corners `c` with plane `k`.
-fn slice_prism(c: PrismCorners, k: u32) -> SlicePolygon {
+fn slice_prism(c: ptr<function, PrismCorners>, k: u32) -> SlicePolygon {
     return slice_polygon(c, slice_params.plane_normal.xyz, plane_offset(k));
 }
 
@@ -220,13 +222,13 @@ fn slice_prism(c: PrismCorners, k: u32) -> SlicePolygon {
 // trivial reject to those near the prism's bounding sphere (widened by one plane: the exact
 // per-plane sphere test in `slice_polygon` decides). Looping over planes in a thread, rather than
 // a thread per (plane, prism) pair, keeps the work proportional to the planes a prism meets.
-fn plane_range(c: PrismCorners, block: u32) -> vec2<u32> {
+fn plane_range(c: ptr<function, PrismCorners>, block: u32) -> vec2<u32> {
     let first = block * planes_per_thread;
     var range = vec2<u32>(first, min(first + planes_per_thread, slice_params.plane_count));
     if (trivial_reject) {
-        let centre = dot(slice_params.plane_normal.xyz, c.sphere.xyz);
-        let lo = (slice_params.first_plane - (centre + c.sphere.w)) / slice_params.spacing - 1.0;
-        let hi = (slice_params.first_plane - (centre - c.sphere.w)) / slice_params.spacing + 2.0;
+        let centre = dot(slice_params.plane_normal.xyz, (*c).sphere.xyz);
+        let lo = (slice_params.first_plane - (centre + (*c).sphere.w)) / slice_params.spacing - 1.0;
+        let hi = (slice_params.first_plane - (centre - (*c).sphere.w)) / slice_params.spacing + 2.0;
         let k0 = u32(clamp(floor(lo), 0.0, f32(slice_params.plane_count)));
         let k1 = u32(clamp(ceil(hi), 0.0, f32(slice_params.plane_count)));
         range = vec2<u32>(max(range.x, k0), min(range.y, k1));
