@@ -17,7 +17,7 @@ use crate::graph::plan::{self, ObjectInfo, Plan};
 use crate::graph::Graph;
 use crate::methods::shell::{self, Shell};
 use crate::methods::view_slices::{self, SliceChunk};
-use crate::scene::{Light, Lighting, Method, Scene, SceneObject};
+use crate::scene::{Light, Lighting as LightingMode, Method, Scene, SceneObject};
 use crate::types::{BaseVertex, FrameParams, SliceParams, VertexFrame};
 
 /// Overrides of what the scene file says, from the command line or tests.
@@ -87,8 +87,45 @@ impl Blueprint {
     /// Like [`Blueprint::new`] with the scene's objects given (tests alter their surfaces).
     pub fn with_objects(scene: &Scene, objects: Vec<SceneObject>, opts: &RenderOptions) -> Result<Self> {
         let size = opts.size.unwrap_or((scene.output.width, scene.output.height));
+        let view = View::new(scene, &objects)?;
+        let light = Lighting::of(scene);
+        let mut bakes: Vec<BakePlan> = Vec::new();
+        let objects = objects
+            .into_iter()
+            .map(|o| ObjectPlan::new(scene, o, &view, &light, opts, &mut bakes))
+            .collect::<Result<Vec<_>>>()?;
+        let graph = Graph::load(opts.graph.as_deref().unwrap_or(&default_graph()))?;
+        let (instances, infos) = instances(&objects, view.eye);
+        let plan = plan::plan(&graph, &wgsl_root(), &infos)?;
+        check_bindings(&graph, &plan)?;
+        let frame = view.frame_params(scene, size, &light);
+        Ok(Self {
+            scene_path: scene.path.clone(),
+            size,
+            eye: view.eye,
+            frame,
+            objects,
+            instances,
+            bakes,
+            graph,
+            plan,
+        })
+    }
+}
+
+/// The camera, with the depth range of everything drawn for the projection's near and far planes.
+struct View {
+    eye: DVec3,
+    forward: DVec3,
+    up: DVec3,
+    fov_y: f64,
+    near: f64,
+    far: f64,
+}
+
+impl View {
+    fn new(scene: &Scene, objects: &[SceneObject]) -> Result<Self> {
         let cam = &scene.camera;
-        let eye = cam.eye;
         let forward = (cam.target - cam.eye).normalize_or_zero();
         if forward == DVec3::ZERO || forward.cross(cam.up).length_squared() < 1e-12 {
             return Err(Error::Invalid(format!(
@@ -96,120 +133,118 @@ impl Blueprint {
                 scene.path.display()
             )));
         }
-        let f32v = |v: DVec3| [v.x as f32, v.y as f32, v.z as f32];
-
-        // Depth range of everything drawn, for the projection's near and far planes.
         let mut far: f64 = 1e-3;
-        for o in &objects {
+        for o in objects {
             for (&p, &h) in o.surface.positions.iter().zip(&o.surface.heights) {
-                for q in [p, p + h] {
-                    far = far.max((q - eye).dot(forward));
-                }
+                far = far.max((p - cam.eye).dot(forward)).max((p + h - cam.eye).dot(forward));
             }
         }
         far *= 1.01;
         let near = (far * 1e-4).max(1e-6);
+        Ok(Self { eye: cam.eye, forward, up: cam.up, fov_y: cam.fov_y, near, far })
+    }
 
-        let mut bakes: Vec<BakePlan> = Vec::new();
-        let mut plans = Vec::new();
-        for object in objects {
-            let shell = Shell::new(&object.surface, eye);
-            let base = object.base_color.map(|_| shell::base_vertices(&object.surface, eye));
-            let (mut sweep, mut chunks, mut trivial_reject, mut per_pixel, mut bake) =
-                (None, Vec::new(), true, false, None);
-            if let Some(Method::ViewSlices(vs)) = &object.method {
-                let planes = opts.planes.unwrap_or(vs.planes);
-                if planes == 0 || planes > crate::scene::MAX_PLANES {
-                    return Err(Error::Invalid(format!(
-                        "{planes} planes: expected a plane count in 1..={}",
-                        crate::scene::MAX_PLANES
-                    )));
-                }
-                trivial_reject = opts.trivial_reject.unwrap_or(vs.trivial_reject);
-                per_pixel = vs.lighting == Lighting::PerPixel;
-                let params = view_slices::sweep(&shell, f32v(forward), planes, near);
-                chunks = view_slices::chunks(&shell, &params);
-                view_slices::check_budget(&chunks, &object.name, planes)?;
-                sweep = Some(params);
-                let texel_name = object.texel.clone().unwrap_or_default();
-                bake = Some(texels::bake_index(scene, &texel_name, per_pixel, &mut bakes)?);
-            }
-            let frames = per_pixel.then(|| shell::vertex_frames(&object.surface));
-            plans.push(ObjectPlan {
-                object,
-                shell,
-                base,
-                sweep,
-                chunks,
-                trivial_reject,
-                per_pixel,
-                frames,
-                bake,
-            });
+    fn forward_f32(&self) -> [f32; 3] {
+        self.forward.as_vec3().to_array()
+    }
+
+    fn frame_params(&self, scene: &Scene, size: (u32, u32), light: &Lighting) -> FrameParams {
+        let view = view_matrix(self.forward, self.up);
+        let proj = projection(self.fov_y.to_radians(), size.0 as f64 / size.1 as f64, self.near, self.far);
+        let (f, l, c, b) = (self.forward_f32(), light.direction, light.color, scene.background);
+        FrameParams {
+            view_proj: (proj * view).as_mat4().to_cols_array_2d(),
+            forward: [f[0], f[1], f[2], self.near as f32],
+            light_dir: [l[0], l[1], l[2], scene.ambient],
+            light_color: [c[0], c[1], c[2], 1.0],
+            background: [b[0], b[1], b[2], 1.0],
+            viewport: [size.0 as f32, size.1 as f32, 1.0 / size.0 as f32, 1.0 / size.1 as f32],
         }
+    }
+}
 
-        let graph = Graph::load(opts.graph.as_deref().unwrap_or(&default_graph()))?;
-        // Instances: base surfaces and slice chunks; back to front by object, chunks in order.
-        let mut instances = Vec::new();
-        let mut infos = Vec::new();
-        for (i, o) in plans.iter().enumerate() {
-            let positions = &o.object.surface.positions;
-            let centre = positions.iter().sum::<DVec3>() / positions.len().max(1) as f64;
-            let distance = (centre - eye).length();
-            let parts = o.base.iter().map(|_| Part::Base).chain((0..o.chunks.len()).map(Part::Slices));
-            for part in parts {
-                let filter = if part == Part::Base { "BaseSurface" } else { "ViewSlices" };
-                let order = match part {
-                    Part::Base => 0,
-                    Part::Slices(c) => c as u32,
-                };
-                instances.push((i, part));
-                infos.push(ObjectInfo {
-                    name: o.object.name.clone(),
-                    filters: vec![filter],
-                    distance,
-                    order,
-                });
-            }
-        }
-        let plan = plan::plan(&graph, &wgsl_root(), &infos)?;
-        check_bindings(&graph, &plan)?;
+/// The scene's first light (towards the light, colour times intensity) and ambient term.
+pub(crate) struct Lighting {
+    pub(crate) direction: [f32; 3],
+    color: [f32; 3],
+    pub(crate) ambient: f32,
+}
 
-        let view = view_matrix(forward, cam.up);
-        let proj = projection(cam.fov_y.to_radians(), size.0 as f64 / size.1 as f64, near, far);
-        let light = scene.lights.first();
-        let (light_dir, light_color) = match light {
+impl Lighting {
+    fn of(scene: &Scene) -> Self {
+        let (direction, color) = match scene.lights.first() {
             Some(Light::Directional { direction, color, intensity }) => {
                 (-direction.normalize(), color.map(|c| c * intensity))
             }
             None => (DVec3::new(0.3, 0.4, 1.0).normalize(), [1.0; 3]),
         };
-        let frame = FrameParams {
-            view_proj: (proj * view).as_mat4().to_cols_array_2d(),
-            forward: [forward.x as f32, forward.y as f32, forward.z as f32, near as f32],
-            light_dir: [light_dir.x as f32, light_dir.y as f32, light_dir.z as f32, scene.ambient],
-            light_color: [light_color[0], light_color[1], light_color[2], 1.0],
-            background: [scene.background[0], scene.background[1], scene.background[2], 1.0],
-            viewport: [size.0 as f32, size.1 as f32, 1.0 / size.0 as f32, 1.0 / size.1 as f32],
-        };
-        for b in &mut bakes {
-            // Baked shading treats the texel axes (s, t, w) as world (x, y, z): exact for a flat
-            // z-up base surface; PerPixel lighting is right everywhere.
-            b.request.light = [light_dir.x as f32, light_dir.y as f32, light_dir.z as f32];
-            b.request.ambient = scene.ambient;
-        }
-        Ok(Self {
-            scene_path: scene.path.clone(),
-            size,
-            eye,
-            frame,
-            objects: plans,
-            instances,
-            bakes,
-            graph,
-            plan,
-        })
+        Self { direction: direction.as_vec3().to_array(), color, ambient: scene.ambient }
     }
+}
+
+impl ObjectPlan {
+    fn new(
+        scene: &Scene,
+        object: SceneObject,
+        view: &View,
+        light: &Lighting,
+        opts: &RenderOptions,
+        bakes: &mut Vec<BakePlan>,
+    ) -> Result<Self> {
+        let shell = Shell::new(&object.surface, view.eye);
+        let base = object.base_color.map(|_| shell::base_vertices(&object.surface, view.eye));
+        let mut plan = ObjectPlan {
+            shell,
+            base,
+            sweep: None,
+            chunks: Vec::new(),
+            trivial_reject: true,
+            per_pixel: false,
+            frames: None,
+            bake: None,
+            object,
+        };
+        let Some(Method::ViewSlices(vs)) = &plan.object.method else { return Ok(plan) };
+        let planes = opts.planes.unwrap_or(vs.planes);
+        if planes == 0 || planes > crate::scene::MAX_PLANES {
+            return Err(Error::Invalid(format!(
+                "{planes} planes: expected a plane count in 1..={}",
+                crate::scene::MAX_PLANES
+            )));
+        }
+        plan.trivial_reject = opts.trivial_reject.unwrap_or(vs.trivial_reject);
+        plan.per_pixel = vs.lighting == LightingMode::PerPixel;
+        let sweep = view_slices::sweep(&plan.shell, view.forward_f32(), planes, view.near);
+        plan.chunks = view_slices::chunks(&plan.shell, &sweep);
+        view_slices::check_budget(&plan.chunks, &plan.object.name, planes)?;
+        plan.sweep = Some(sweep);
+        plan.frames = plan.per_pixel.then(|| shell::vertex_frames(&plan.object.surface));
+        let texel = plan.object.texel.clone().unwrap_or_default();
+        plan.bake = Some(texels::bake_index(scene, &texel, plan.per_pixel, light, bakes)?);
+        Ok(plan)
+    }
+}
+
+/// Graph instances: each object's base surface and slice chunks, with what the planner needs to
+/// know of them (filters; back to front by object, chunks in sweep order).
+fn instances(objects: &[ObjectPlan], eye: DVec3) -> (Vec<(usize, Part)>, Vec<ObjectInfo>) {
+    let mut instances = Vec::new();
+    let mut infos = Vec::new();
+    for (i, o) in objects.iter().enumerate() {
+        let positions = &o.object.surface.positions;
+        let centre = positions.iter().sum::<DVec3>() / positions.len().max(1) as f64;
+        let distance = (centre - eye).length();
+        let parts = o.base.iter().map(|_| Part::Base).chain((0..o.chunks.len()).map(Part::Slices));
+        for part in parts {
+            let (filter, order) = match part {
+                Part::Base => ("BaseSurface", 0),
+                Part::Slices(c) => ("ViewSlices", c as u32),
+            };
+            instances.push((i, part));
+            infos.push(ObjectInfo { name: o.object.name.clone(), filters: vec![filter], distance, order });
+        }
+    }
+    (instances, infos)
 }
 
 /// Resources the runtime binds by name: per frame, and per instance (an object's base surface or

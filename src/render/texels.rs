@@ -3,7 +3,7 @@
 use crate::bake::{BakeRequest, BakeSource};
 use crate::cpu::bake::{pack_shapes, Shape as BakeShape};
 use crate::error::{Error, Result};
-use crate::render::BakePlan;
+use crate::render::{BakePlan, Lighting};
 use crate::scene::{Scene, Shape, TexelSource};
 use crate::types::HeightfieldParams;
 
@@ -12,6 +12,7 @@ pub(super) fn bake_index(
     scene: &Scene,
     texel: &str,
     per_pixel: bool,
+    light: &Lighting,
     bakes: &mut Vec<BakePlan>,
 ) -> Result<usize> {
     if let Some(i) = bakes.iter().position(|b| b.texel == texel && b.request.per_pixel == per_pixel) {
@@ -58,8 +59,10 @@ pub(super) fn bake_index(
             resolution: t.resolution,
             source,
             per_pixel,
-            light: [0.0, 0.0, 1.0],
-            ambient: 0.2,
+            // Baked shading takes the texel axes (s, t, w) as world (x, y, z): exact for a flat
+            // z-up base surface; PerPixel lighting is right everywhere.
+            light: light.direction,
+            ambient: light.ambient,
         },
         opacity_length: t.opacity_length,
     });
