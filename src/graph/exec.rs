@@ -137,24 +137,16 @@ impl Executor {
         inst: &Inputs,
     ) -> Result<()> {
         let pass = &plan.passes[index];
-        let mut constants: Vec<(&str, f64)> = Vec::new();
-        for (name, has_default) in reflect::overrides(&pass.kernel) {
-            let value = inst.constants.iter().chain(frame.constants.iter()).find(|(n, _)| *n == name);
-            match value {
-                Some((n, v)) => constants.push((n.as_str(), *v)),
-                None if has_default => {}
-                None => {
-                    return Err(self.graph.error_at(
-                        pass.decl.name(),
-                        format!(
-                            "{}: override `{name}` has no default and no value from the scene",
-                            pass.decl.shader()
-                        ),
-                    ))
-                }
-            }
-        }
-        let key = (index, format!("{constants:?}"));
+        let constants = specialisation(pass, frame, inst).map_err(|name| {
+            self.graph.error_at(
+                pass.decl.name(),
+                format!(
+                    "{}: override `{name}` has no default and no value from the scene",
+                    pass.decl.shader()
+                ),
+            )
+        })?;
+        let key = (index, constants_key(&constants));
         if self.pipelines.contains_key(&key) {
             return Ok(());
         }
@@ -277,18 +269,8 @@ impl Executor {
             .map(|inst| self.bind_groups(ctx, pass, index, frame, inst))
             .collect::<Result<_>>()?;
         let pipeline_of = |inst: &Inputs| -> &Pipeline {
-            let kernel = &pass.kernel;
-            let constants: Vec<(&str, f64)> = reflect::overrides(kernel)
-                .into_iter()
-                .filter_map(|(name, _)| {
-                    inst.constants
-                        .iter()
-                        .chain(frame.constants.iter())
-                        .find(|(n, _)| *n == name)
-                        .map(|(n, v)| (n.as_str(), *v))
-                })
-                .collect();
-            &self.pipelines[&(index, format!("{constants:?}"))]
+            // `prepare` made every pipeline, so the specialisation is known to succeed here.
+            &self.pipelines[&(index, constants_key(&specialisation(pass, frame, inst).unwrap_or_default()))]
         };
         match &pass.decl {
             PassDecl::Compute { name, entry, clear, dispatch, .. } => {
@@ -468,6 +450,28 @@ fn texture_format(
         return wgpu::TextureFormat::Rgba16Float;
     }
     format
+}
+
+/// Values of the kernel's `override` constants for an instance (instance first, then frame);
+/// the name of one without a default that nobody sets as the error.
+fn specialisation<'a>(
+    pass: &PlannedPass,
+    frame: &'a Inputs,
+    inst: &'a Inputs,
+) -> std::result::Result<Vec<(&'a str, f64)>, String> {
+    let mut out = Vec::new();
+    for (name, has_default) in reflect::overrides(&pass.kernel) {
+        match inst.constants.iter().chain(&frame.constants).find(|(n, _)| *n == name) {
+            Some((n, v)) => out.push((n.as_str(), *v)),
+            None if !has_default => return Err(name),
+            None => {}
+        }
+    }
+    Ok(out)
+}
+
+fn constants_key(constants: &[(&str, f64)]) -> String {
+    format!("{constants:?}")
 }
 
 fn pass_layout(ctx: &GpuContext, pass: &PlannedPass) -> (Vec<wgpu::BindGroupLayout>, wgpu::PipelineLayout) {
