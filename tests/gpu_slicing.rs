@@ -58,6 +58,7 @@ fn compare(shell: &Shell, params: &SliceParams, trivial_reject: bool, ambiguous:
     assert_eq!(gpu.len(), cpu.len());
     let n = glam::Vec3::from_slice(&params.plane_normal[..3]);
     let mut compared = 0;
+    let mut worst: f32 = 0.0;
     for (k, (g, c)) in gpu.iter().zip(&cpu).enumerate() {
         let d = params.first_plane - k as f32 * params.spacing;
         let (g, c) = (by_prism(g), by_prism(c));
@@ -77,6 +78,7 @@ fn compare(shell: &Shell, params: &SliceParams, trivial_reject: bool, ambiguous:
             }
             for (a, b) in gv.iter().zip(&cv) {
                 for i in 0..3 {
+                    worst = worst.max((a.position[i] - b.position[i]).abs());
                     let tol = 1e-5 * (1.0 + b.position[i].abs());
                     assert!(
                         (a.position[i] - b.position[i]).abs() <= tol,
@@ -89,6 +91,7 @@ fn compare(shell: &Shell, params: &SliceParams, trivial_reject: bool, ambiguous:
             compared += 1;
         }
     }
+    eprintln!("{compared} polygons compared, largest position difference {worst:e}");
     compared
 }
 

@@ -133,6 +133,7 @@ fn flat_shell_equals_the_box_it_encloses() {
             checked += 1;
         }
     }
+    eprintln!("flat slab: worst relative error {worst:.5} over {checked} pixels");
     assert!(checked > 4000, "{checked} pixels checked");
     assert!(worst < 0.01, "worst relative error {worst} against the analytic slab");
 }
@@ -146,6 +147,7 @@ fn plane_count_changes_error_not_brightness() {
     let eye = (0.4, -1.8, 2.4);
     let coarse = mean(&render(&slab_scene(4, 24, eye), RenderOptions::default()));
     let fine = mean(&render(&slab_scene(4, 192, eye), RenderOptions::default()));
+    eprintln!("mean brightness: {coarse:.5} with 24 planes, {fine:.5} with 192");
     assert!((coarse - fine).abs() / fine < 0.01, "mean brightness {coarse} with 24 planes, {fine} with 192");
 }
 
@@ -197,6 +199,7 @@ fn closed_shells_show_no_seam_pixels() {
             );
             let img = coverage(&scene::parse(&src, Path::new("closed.ron")).unwrap());
             let (covered, doubled, cracks) = seams(&img);
+            eprintln!("{surface} from {eye}: {covered} pixels covered, {doubled} twice, {cracks} cracks");
             assert!(covered > 3000, "{surface} from {eye}: the cross-section covers {covered} pixels");
             assert_eq!((doubled, cracks), (0, 0), "{surface} from {eye}: pixels covered twice, cracks");
         }
