@@ -2,6 +2,8 @@
 //! there is one), exits with status 1 (no panic, no signal) and leaves no output or temporary
 //! file behind. Plus the success case and `voltex plan`.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -293,24 +295,11 @@ fn slice_memory_beyond_the_per_object_limit() {
 
 // ---- custom graphs and WGSL (VOLTEX_ROOT) ----
 
-fn copy_dir(from: &Path, to: &Path) {
-    std::fs::create_dir_all(to).unwrap();
-    for e in std::fs::read_dir(from).unwrap() {
-        let e = e.unwrap();
-        let target = to.join(e.file_name());
-        if e.file_type().unwrap().is_dir() {
-            copy_dir(&e.path(), &target);
-        } else {
-            std::fs::copy(e.path(), target).unwrap();
-        }
-    }
-}
-
 /// `dir/root` with copies of `wgsl/` and `graphs/`, to be passed as `VOLTEX_ROOT`.
 fn project_copy(dir: &Path) -> PathBuf {
     let r = dir.join("root");
-    copy_dir(&root().join("wgsl"), &r.join("wgsl"));
-    copy_dir(&root().join("graphs"), &r.join("graphs"));
+    common::copy_dir(&root().join("wgsl"), &r.join("wgsl"));
+    common::copy_dir(&root().join("graphs"), &r.join("graphs"));
     r
 }
 

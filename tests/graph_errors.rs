@@ -1,6 +1,8 @@
 //! Render-graph files through the library (no GPU): parse errors at `file:line:col`, pass order
 //! derived from reads and writes, pruning, and new passes added only in RON and WGSL.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 
 use voltex::graph::plan::{plan, ObjectInfo, Plan};
@@ -336,24 +338,11 @@ fn unused_texture_is_pruned_in_the_full_frame() {
 /// A copy of `wgsl/` with extra files.
 fn wgsl_copy(test: &str, extra: &[(&str, &str)]) -> PathBuf {
     let dir = temp_dir(test).join("wgsl");
-    copy_dir(&wgsl_root(), &dir);
+    common::copy_dir(&wgsl_root(), &dir);
     for (name, text) in extra {
         std::fs::write(dir.join(name), text).unwrap();
     }
     dir
-}
-
-fn copy_dir(from: &Path, to: &Path) {
-    std::fs::create_dir_all(to).unwrap();
-    for e in std::fs::read_dir(from).unwrap() {
-        let e = e.unwrap();
-        let target = to.join(e.file_name());
-        if e.file_type().unwrap().is_dir() {
-            copy_dir(&e.path(), &target);
-        } else {
-            std::fs::copy(e.path(), target).unwrap();
-        }
-    }
 }
 
 const POST: &str = r#"// Test post effect: inverts the linear image.
