@@ -99,6 +99,7 @@ impl Overrides {
 }
 
 fn main() -> ExitCode {
+    private_runtime_dir();
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Render { scene, output, overrides } => render(&scene, output, &overrides),
@@ -113,6 +114,23 @@ fn main() -> ExitCode {
         Err(e) => {
             eprintln!("error: {e}");
             ExitCode::FAILURE
+        }
+    }
+}
+
+/// Mesa prints "XDG_RUNTIME_DIR is invalid" on every device unless that variable names a private
+/// folder; give it one (before any thread starts) so users see only voltex's own messages.
+fn private_runtime_dir() {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::{DirBuilderExt, MetadataExt};
+        if std::env::var_os("XDG_RUNTIME_DIR").is_some_and(|d| Path::new(&d).is_dir()) {
+            return;
+        }
+        let uid = std::fs::metadata("/proc/self").map(|m| m.uid()).unwrap_or(0);
+        let dir = std::env::temp_dir().join(format!("voltex-runtime-{uid}"));
+        if std::fs::DirBuilder::new().mode(0o700).create(&dir).is_ok() || dir.is_dir() {
+            std::env::set_var("XDG_RUNTIME_DIR", &dir);
         }
     }
 }
