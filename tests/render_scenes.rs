@@ -205,3 +205,104 @@ fn closed_shells_show_no_seam_pixels() {
         }
     }
 }
+
+/// Two interpenetrating slabs (red and blue constant densities, tilted +-35 degrees about x):
+/// their slices are interleaved by depth, so the image matches front-to-back ray marching of the
+/// two media, and not compositing one object over the other.
+#[test]
+fn overlapping_objects_composite_plane_by_plane() {
+    let node = |name: &str, angle: f64, texel: &str| {
+        format!(
+            r#"(name: "{name}", transform: (rotate: ({angle}, 0.0, 0.0)), surface: Plane(size: (2.0, 2.0), cells: (4, 4)),
+                height: (length: 0.4), texel: "{texel}", method: ViewSlices(planes: 256))"#
+        )
+    };
+    let src = format!(
+        r#"Scene(output: (width: 96, height: 96), camera: (eye: (0.0, -3.0, 0.2), target: (0.0, 0.0, 0.2), fov_y: 40.0),
+        background: (0.1, 0.1, 0.1), ambient: 1.0,
+        texels: {{
+            "red": (resolution: (4, 4, 4), opacity_length: 0.3, source: Constant(color: (0.9, 0.2, 0.1), opacity: 0.6)),
+            "blue": (resolution: (4, 4, 4), opacity_length: 0.3, source: Constant(color: (0.1, 0.3, 0.9), opacity: 0.6)),
+        }},
+        nodes: [{}, {}])"#,
+        node("a", 35.0, "red"),
+        node("b", -35.0, "blue")
+    );
+    let scene = scene::parse(&src, Path::new("slabs.ron")).unwrap();
+    let bp = Blueprint::new(&scene, &RenderOptions::default()).unwrap();
+    let inv = glam::DMat4::from_cols_array_2d(&bp.frame.view_proj.map(|c| c.map(f64::from))).inverse();
+    // Each slab: origin, unit normal and in-plane axes from its base surface; the stored rgba8
+    // premultiplied colour and opacity, as the bake quantises them.
+    let a_q = (0.6f64 * 255.0).round() / 255.0;
+    let slabs: Vec<(DVec3, DVec3, DVec3, [f64; 3])> = bp
+        .objects
+        .iter()
+        .zip([[0.9, 0.2, 0.1], [0.1, 0.3, 0.9]])
+        .map(|(o, colour)| {
+            let s = &o.object.surface;
+            let origin = s.positions.iter().sum::<DVec3>() / s.positions.len() as f64 - bp.eye;
+            let n = s.heights[0].normalize();
+            let e1 = DVec3::X;
+            (origin, n, n.cross(e1), colour.map(|c: f64| (c * 0.6 * 255.0).round() / 255.0 / a_q))
+        })
+        .collect();
+    let layer = |s: &(DVec3, DVec3, DVec3, [f64; 3]), p: DVec3| {
+        let d = p - s.0;
+        let z = d.dot(s.1);
+        d.x.abs() <= 1.0 && d.dot(s.2).abs() <= 1.0 && (0.0..=0.4).contains(&z)
+    };
+    let img = render_blueprint(bp);
+    let step = 0.0005;
+    let keep = 1.0 - (1.0 - a_q).powf(step / 0.3);
+    let (mut err, mut err_unsorted, mut n) = (0.0, 0.0, 0);
+    for y in 0..96 {
+        for x in 0..96 {
+            let ndc =
+                glam::DVec4::new((x as f64 + 0.5) / 48.0 - 1.0, 1.0 - (y as f64 + 0.5) / 48.0, 0.5, 1.0);
+            let h = inv * ndc;
+            let dir = (h.truncate() / h.w).normalize();
+            // Front-to-back marching; also each slab alone, to composite them object over object.
+            let mut colour = [0.0; 3];
+            let mut t_all = 1.0;
+            let mut alone = [([0.0; 3], 1.0); 2];
+            let mut inside = [false; 2];
+            let mut t = 1.5;
+            while t < 4.5 {
+                let p = dir * t;
+                for (i, s) in slabs.iter().enumerate() {
+                    if layer(s, p) {
+                        inside[i] = true;
+                        let (seen, own) = (t_all * keep, alone[i].1 * keep);
+                        for ((total, single), emitted) in colour.iter_mut().zip(&mut alone[i].0).zip(s.3) {
+                            *total += seen * emitted;
+                            *single += own * emitted;
+                        }
+                        t_all *= 1.0 - keep;
+                        alone[i].1 *= 1.0 - keep;
+                    }
+                }
+                t += step;
+            }
+            if !(inside[0] && inside[1]) {
+                continue;
+            }
+            // Object over object, in the order the renderer used to draw them (a, then b over it).
+            let unsorted: Vec<f64> =
+                (0..3).map(|c| alone[1].0[c] + alone[1].1 * (alone[0].0[c] + alone[0].1 * 0.1)).collect();
+            let p = img.get(x, y);
+            for c in 0..3 {
+                let exact = colour[c] + t_all * 0.1;
+                err += (p[c] as f64 - exact).abs();
+                err_unsorted += (unsorted[c] - exact).abs();
+            }
+            n += 3;
+        }
+    }
+    let (err, err_unsorted) = (err / n as f64, err_unsorted / n as f64);
+    eprintln!(
+        "overlapping slabs: mean error {err:.4} over {} pixels; one object over the other: {err_unsorted:.4}",
+        n / 3
+    );
+    assert!(n > 3000, "{} pixels see both slabs", n / 3);
+    assert!(err < 0.01 && err_unsorted > 4.0 * err, "mean error {err}, object over object {err_unsorted}");
+}

@@ -1,9 +1,11 @@
-// Exclusive prefix sum of the per-plane slice vertex counts, in place, and the indirect draw arguments.
+// Exclusive prefix sum of the per-plane slice vertex counts, in place, and the indirect draw arguments (whole sweep and per plane).
 #include "shared/types.wgsl"
 
 @group(0) @binding(0) var<uniform> slice_params: SliceParams;
 @group(0) @binding(1) var<storage, read_write> plane_cursors: array<u32>;
 @group(0) @binding(2) var<storage, read_write> draw_args: DrawIndirect;
+// One draw per plane, for drawing the planes of overlapping objects interleaved by depth.
+@group(0) @binding(3) var<storage, read_write> plane_draws: array<DrawIndirect>;
 
 const SCAN_THREADS: u32 = 256u;
 
@@ -33,9 +35,13 @@ fn main(@builtin(local_invocation_index) lid: u32) {
         workgroupBarrier();
     }
     var running = partial_sums[lid] - sum;
+    let capacity = slice_params.vertex_capacity;
     for (var i = begin; i < end; i++) {
         let c = plane_cursors[i];
         plane_cursors[i] = running;
+        // What emit_slices writes of this plane below the capacity.
+        let first = min(running, capacity);
+        plane_draws[i] = DrawIndirect(min(c, capacity - first), 1u, first, 0u);
         running += c;
     }
     if (lid == SCAN_THREADS - 1u) {

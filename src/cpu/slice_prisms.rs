@@ -348,6 +348,25 @@ pub fn scan_plane_offsets(counts: &[u32], vertex_capacity: u32) -> (Vec<u32>, Dr
     (offsets, args)
 }
 
+/// Twin of the per-plane draw arguments of `scan_plane_offsets`: each plane's range of the vertex
+/// buffer, cut at the capacity.
+pub fn plane_draws(counts: &[u32], vertex_capacity: u32) -> Vec<DrawIndirect> {
+    let (offsets, _) = scan_plane_offsets(counts, vertex_capacity);
+    offsets
+        .iter()
+        .zip(counts)
+        .map(|(&o, &c)| {
+            let first = o.min(vertex_capacity);
+            DrawIndirect {
+                vertex_count: c.min(vertex_capacity - first),
+                instance_count: 1,
+                first_vertex: first,
+                first_instance: 0,
+            }
+        })
+        .collect()
+}
+
 #[cfg(test)]
 #[path = "slice_prisms_tests.rs"]
 mod tests;

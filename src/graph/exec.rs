@@ -20,6 +20,9 @@ pub struct Inputs {
     pub counts: HashMap<String, u32>,
     /// Values for WGSL `override` constants, by name.
     pub constants: Vec<(String, f64)>,
+    /// View depth of each plane of a slice sweep, back to front: draws of instances whose depth
+    /// ranges overlap are interleaved plane by plane (`Draw::DepthSorted`).
+    pub plane_depths: Vec<f64>,
 }
 
 /// Count names the runtime provides (per object or per frame).
@@ -364,18 +367,33 @@ impl Executor {
                     occlusion_query_set: None,
                     multiview_mask: None,
                 });
-                for (inst, bgs) in instances.iter().zip(&groups) {
-                    let Pipeline::Render(p) = pipeline_of(inst) else { unreachable!("raster pass") };
-                    rpass.set_pipeline(p);
-                    for (i, bg) in bgs.iter().enumerate() {
-                        rpass.set_bind_group(i as u32, bg, &[]);
+                // (instance, byte offset into the per-plane arguments or None for a whole draw).
+                let items: Vec<(usize, Option<u64>)> = match draw {
+                    Draw::DepthSorted { .. } => depth_sorted(&instances),
+                    _ => (0..instances.len()).map(|i| (i, None)).collect(),
+                };
+                let mut bound = None;
+                for (i, plane) in items {
+                    let inst = instances[i];
+                    if bound != Some(i) {
+                        let Pipeline::Render(p) = pipeline_of(inst) else { unreachable!("raster pass") };
+                        rpass.set_pipeline(p);
+                        for (g, bg) in groups[i].iter().enumerate() {
+                            rpass.set_bind_group(g as u32, bg, &[]);
+                        }
+                        bound = Some(i);
                     }
-                    match draw {
-                        Draw::Vertices(n) => rpass.draw(0..count(n, inst, frame), 0..1),
-                        Draw::Indirect(b) => {
-                            let buf = resolve_buffer(inst, frame, b)
-                                .ok_or_else(|| plan::unknown_resource(&self.graph, name, b))?;
-                            rpass.draw_indirect(buf, 0);
+                    let buffer = |b: &str| {
+                        resolve_buffer(inst, frame, b)
+                            .ok_or_else(|| plan::unknown_resource(&self.graph, name, b))
+                    };
+                    match (draw, plane) {
+                        (Draw::Vertices(n), _) => rpass.draw(0..count(n, inst, frame), 0..1),
+                        (Draw::Indirect(b), _) | (Draw::DepthSorted { whole: b, .. }, None) => {
+                            rpass.draw_indirect(buffer(b)?, 0)
+                        }
+                        (Draw::DepthSorted { per_plane, .. }, Some(offset)) => {
+                            rpass.draw_indirect(buffer(per_plane)?, offset)
                         }
                     }
                 }
@@ -468,6 +486,31 @@ fn specialisation<'a>(
         }
     }
     Ok(out)
+}
+
+/// Draw order of slice instances, back to front: an instance whose planes' depth range overlaps
+/// no other instance's is one whole draw; the planes of overlapping instances are interleaved by
+/// depth (ties keep instance order), each a draw of its own.
+fn depth_sorted(instances: &[&Inputs]) -> Vec<(usize, Option<u64>)> {
+    let range = |inst: &Inputs| {
+        let d = &inst.plane_depths;
+        (d.iter().copied().fold(f64::INFINITY, f64::min), d.iter().copied().fold(f64::NEG_INFINITY, f64::max))
+    };
+    let ranges: Vec<(f64, f64)> = instances.iter().map(|i| range(i)).collect();
+    let overlaps = |i: usize| {
+        (0..ranges.len()).any(|j| j != i && ranges[j].0 <= ranges[i].1 && ranges[i].0 <= ranges[j].1)
+    };
+    let stride = std::mem::size_of::<crate::types::DrawIndirect>() as u64;
+    let mut items: Vec<(f64, usize, Option<u64>)> = Vec::new();
+    for (i, inst) in instances.iter().enumerate() {
+        if overlaps(i) {
+            items.extend(inst.plane_depths.iter().enumerate().map(|(k, &d)| (d, i, Some(k as u64 * stride))));
+        } else {
+            items.push((ranges[i].1, i, None));
+        }
+    }
+    items.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
+    items.into_iter().map(|(_, i, plane)| (i, plane)).collect()
 }
 
 fn constants_key(constants: &[(&str, f64)]) -> String {

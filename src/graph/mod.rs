@@ -215,6 +215,14 @@ pub enum Draw {
     Vertices(Count),
     /// Indirect draw from a buffer holding `DrawIndirect` arguments.
     Indirect(String),
+    /// Slices of several instances composited back to front: an instance whose planes' depth
+    /// range overlaps no other's is drawn whole (`whole`, one `DrawIndirect`); the planes of
+    /// overlapping instances are drawn one by one (`per_plane`, one `DrawIndirect` per plane),
+    /// interleaved by depth.
+    DepthSorted {
+        whole: String,
+        per_plane: String,
+    },
 }
 
 /// A parsed graph file with its source, so later checks can point at `file:line:col`.

@@ -126,8 +126,15 @@ fn accesses(decl: &PassDecl, bindings: &[Binding]) -> (BTreeSet<String>, BTreeSe
                     writes.insert(d.resource.clone());
                 }
             }
-            if let Draw::Indirect(buf) = draw {
-                reads.insert(buf.clone());
+            match draw {
+                Draw::Indirect(buf) => {
+                    reads.insert(buf.clone());
+                }
+                Draw::DepthSorted { whole, per_plane } => {
+                    reads.insert(whole.clone());
+                    reads.insert(per_plane.clone());
+                }
+                Draw::Vertices(_) => {}
             }
         }
     }

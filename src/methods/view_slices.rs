@@ -170,6 +170,11 @@ pub fn add_inputs(
         buffer("plane_cursors", params.plane_count as u64 * 4, wgpu::BufferUsages::empty()),
     );
     b.insert("draw_args".into(), buffer("draw_args", 16, wgpu::BufferUsages::INDIRECT));
+    let per_plane = params.plane_count as u64 * std::mem::size_of::<crate::types::DrawIndirect>() as u64;
+    b.insert("plane_draws".into(), buffer("plane_draws", per_plane, wgpu::BufferUsages::INDIRECT));
+    inputs.plane_depths = (0..params.plane_count)
+        .map(|k| params.first_plane as f64 - k as f64 * params.spacing as f64)
+        .collect();
     let bytes = capacity * std::mem::size_of::<SliceVertex>() as u64;
     b.insert("slice_vertices".into(), buffer("slice_vertices", bytes, wgpu::BufferUsages::empty()));
     inputs.counts.insert("prisms".into(), shell.prisms.len() as u32);

@@ -258,6 +258,7 @@ pub const INSTANCE_RESOURCES: &[&str] = &[
     "prisms",
     "plane_cursors",
     "draw_args",
+    "plane_draws",
     "slice_vertices",
     "volume",
     "normals",
