@@ -37,6 +37,11 @@ fn gpu_slices(shell: &Shell, params: &SliceParams, trivial_reject: bool) -> Vec<
     view_slices::add_inputs(ctx, &mut inputs, shell, &params, capacity, trivial_reject);
     let mut timer = Timer::new(ctx, 4);
     exec.run(ctx, &plan, &Inputs::default(), std::slice::from_ref(&inputs), &mut timer).unwrap();
+    // The per-plane draw arguments agree with the CPU twin's scan.
+    let bytes = ctx.read_buffer(&inputs.buffers["plane_draws"], 0, params.plane_count as u64 * 16).unwrap();
+    let draws: Vec<voltex::types::DrawIndirect> = bytemuck::pod_collect_to_vec(&bytes);
+    let counts = slice_prisms::plane_counts(&shell.vertices, &shell.prisms, &params, trivial_reject);
+    assert_eq!(draws, slice_prisms::plane_draws(&counts, params.vertex_capacity));
     view_slices::read_back(ctx, &inputs, params.plane_count).unwrap()
 }
 
