@@ -306,3 +306,43 @@ fn overlapping_objects_composite_plane_by_plane() {
     assert!(n > 3000, "{} pixels see both slabs", n / 3);
     assert!(err < 0.01 && err_unsorted > 4.0 * err, "mean error {err}, object over object {err_unsorted}");
 }
+
+fn example_text(name: &str) -> String {
+    std::fs::read_to_string(voltex::project_root().join("scenes/view_slices").join(name)).unwrap()
+}
+
+/// Positions are made camera-relative in f64 before they reach f32 kernels: the torus_egg scene
+/// moved 1e5 away from the origin (camera too) renders as it does at the origin.
+#[test]
+fn scenes_far_from_the_origin_render_as_at_the_origin() {
+    let text = example_text("torus_egg.ron");
+    let moved = text
+        .replace(
+            "eye: (0.0, -4.6, 3.0), target: (0.0, 0.0, 0.0)",
+            "eye: (100000.0, 99995.4, 3.0), target: (100000.0, 100000.0, 0.0)",
+        )
+        .replace("translate: (0.0, 0.0, 0.0)", "translate: (100000.0, 100000.0, 0.0)");
+    assert_ne!(text, moved);
+    let opts = || RenderOptions { size: TEST_SIZE, ..Default::default() };
+    let here = render(&scene::parse(&text, Path::new("here.ron")).unwrap(), opts());
+    let far = render(&scene::parse(&moved, Path::new("far.ron")).unwrap(), opts());
+    let diff = voltex::metrics::max_abs_diff(&here, &far).unwrap();
+    eprintln!("torus_egg at 1e5 from the origin: max abs difference {diff:e}");
+    assert!(diff < 1e-3, "max abs difference {diff}");
+}
+
+/// A camera inside the shell: planes behind the near plane are skipped, the image is finite and
+/// shows the texels around the camera.
+#[test]
+fn camera_inside_the_shell() {
+    let text = example_text("torus_egg.ron").replace(
+        "eye: (0.0, -4.6, 3.0), target: (0.0, 0.0, 0.0)",
+        "eye: (1.62, 0.0, 0.0), target: (0.0, 1.0, 0.3)",
+    );
+    let img = render(
+        &scene::parse(&text, Path::new("inside.ron")).unwrap(),
+        RenderOptions { size: TEST_SIZE, ..Default::default() },
+    );
+    let lit = img.pixels.iter().filter(|p| p[0] > 0.2).count();
+    assert!(lit > 2000, "{lit} pixels show texels");
+}
