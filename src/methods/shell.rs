@@ -3,7 +3,7 @@
 
 use glam::DVec3;
 
-use crate::mesh::BaseSurface;
+use crate::mesh::{prism, BaseSurface};
 use crate::types::{BaseVertex, Prism, ShellVertex, VertexFrame};
 
 pub struct Shell {
@@ -28,27 +28,16 @@ impl Shell {
             .triangles
             .iter()
             .zip(&surface.corner_uvs)
-            .map(|(t, uv)| {
-                let corners: Vec<DVec3> = t
-                    .iter()
-                    .flat_map(|&i| {
-                        let p = surface.positions[i as usize] - eye;
-                        [p, p + surface.heights[i as usize]]
-                    })
-                    .collect();
-                let centre = corners.iter().sum::<DVec3>() / 6.0;
-                let radius = corners.iter().map(|c| c.distance(centre)).fold(0.0, f64::max);
+            .enumerate()
+            .map(|(t, (ids, uv))| {
+                let (centre, radius) = prism::bounding_sphere(surface.prism(t).map(|p| p - eye));
+                // Grown by a relative epsilon so that f32 rounding never rejects a touching plane.
+                let radius = radius * (1.0 + 1e-5) + 1e-6;
                 Prism {
-                    vertices: [t[0], t[1], t[2], 0],
+                    vertices: [ids[0], ids[1], ids[2], 0],
                     uv01: [uv[0].x as f32, uv[0].y as f32, uv[1].x as f32, uv[1].y as f32],
                     uv2: [uv[2].x as f32, uv[2].y as f32, 0.0, 0.0],
-                    // Grown by a relative epsilon so that f32 rounding never rejects a touching plane.
-                    sphere: [
-                        centre.x as f32,
-                        centre.y as f32,
-                        centre.z as f32,
-                        (radius * (1.0 + 1e-5) + 1e-6) as f32,
-                    ],
+                    sphere: [centre.x as f32, centre.y as f32, centre.z as f32, radius as f32],
                 }
             })
             .collect();
