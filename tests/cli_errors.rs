@@ -469,6 +469,18 @@ fn plan_prints_passes_pruning_and_memory_without_a_gpu() {
 }
 
 #[test]
+fn a_graph_that_samples_no_texel_bakes_nothing() {
+    let scene = root().join("scenes/view_slices/torus_egg.ron");
+    let graph = root().join("graphs/slices_only.ron");
+    let out = voltex(&["plan", scene.to_str().unwrap(), "--graph", graph.to_str().unwrap()], None);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("bakes:\n  (none)") && !text.contains("texel torus_egg"), "{text}");
+    let out = voltex(&["plan", scene.to_str().unwrap()], None);
+    assert!(String::from_utf8_lossy(&out.stdout).contains("texel torus_egg"));
+}
+
+#[test]
 fn plan_of_a_bad_scene_fails_like_render() {
     let dir = temp_dir("plan_bad");
     let text = replaced(&flat_box(), "ambient: 1.0", "ambient: NaN");

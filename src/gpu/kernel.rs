@@ -9,7 +9,7 @@ use crate::error::{Error, Result};
 use crate::gpu::reflect::{self, Binding, BindingKind};
 use crate::gpu::shader;
 use crate::gpu::GpuContext;
-use crate::graph::exec::Inputs;
+use crate::graph::exec::{override_values, Inputs};
 
 pub struct ComputeKernel {
     pub name: String,
@@ -66,12 +66,9 @@ impl ComputeKernel {
         inputs: &Inputs,
         threads: [u32; 3],
     ) -> Result<()> {
-        let constants: Vec<(&str, f64)> = reflect::overrides(&self.kernel)
-            .into_iter()
-            .filter_map(|(n, _)| {
-                inputs.constants.iter().find(|(m, _)| *m == n).map(|(m, v)| (m.as_str(), *v))
-            })
-            .collect();
+        let constants = override_values(&self.kernel, &[inputs]).map_err(|name| {
+            Error::Invalid(format!("{}: override `{name}` has no default and no value", self.name))
+        })?;
         let key = format!("{constants:?}");
         if !self.pipelines.contains_key(&key) {
             let p = ctx.scoped(&self.name, || {

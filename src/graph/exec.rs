@@ -470,22 +470,30 @@ fn texture_format(
     format
 }
 
-/// Values of the kernel's `override` constants for an instance (instance first, then frame);
-/// the name of one without a default that nobody sets as the error.
-fn specialisation<'a>(
-    pass: &PlannedPass,
-    frame: &'a Inputs,
-    inst: &'a Inputs,
+/// Values of a kernel's `override` constants, looked up by name in `sources` (first match wins);
+/// the name of one without a default that no source sets as the error.
+pub fn override_values<'a>(
+    kernel: &crate::gpu::shader::Kernel,
+    sources: &[&'a Inputs],
 ) -> std::result::Result<Vec<(&'a str, f64)>, String> {
     let mut out = Vec::new();
-    for (name, has_default) in reflect::overrides(&pass.kernel) {
-        match inst.constants.iter().chain(&frame.constants).find(|(n, _)| *n == name) {
+    for (name, has_default) in reflect::overrides(kernel) {
+        match sources.iter().flat_map(|s| &s.constants).find(|(n, _)| *n == name) {
             Some((n, v)) => out.push((n.as_str(), *v)),
             None if !has_default => return Err(name),
             None => {}
         }
     }
     Ok(out)
+}
+
+/// A pass's constants for an instance: the instance's values first, then the frame's.
+fn specialisation<'a>(
+    pass: &PlannedPass,
+    frame: &'a Inputs,
+    inst: &'a Inputs,
+) -> std::result::Result<Vec<(&'a str, f64)>, String> {
+    override_values(&pass.kernel, &[inst, frame])
 }
 
 /// Draw order of slice instances, back to front: an instance whose planes' depth range overlaps

@@ -90,7 +90,7 @@ impl Blueprint {
         let view = View::new(scene, &objects)?;
         let light = Lighting::of(scene);
         let mut bakes: Vec<BakePlan> = Vec::new();
-        let objects = objects
+        let mut objects = objects
             .into_iter()
             .map(|o| ObjectPlan::new(scene, o, &view, &light, opts, &mut bakes))
             .collect::<Result<Vec<_>>>()?;
@@ -98,6 +98,13 @@ impl Blueprint {
         let (instances, infos) = instances(&objects, view.eye);
         let plan = plan::plan(&graph, &wgsl_root(), &infos)?;
         check_bindings(&graph, &plan)?;
+        let samples_texels =
+            plan.passes.iter().flat_map(|p| &p.bindings).any(|b| b.name == "volume" || b.name == "normals");
+        if !samples_texels {
+            // A graph that samples no texel (the slicing debug graphs) bakes nothing.
+            bakes.clear();
+            objects.iter_mut().for_each(|o| o.bake = None);
+        }
         let frame = view.frame_params(scene, size, &light);
         Ok(Self {
             scene_path: scene.path.clone(),
