@@ -72,6 +72,7 @@ pub fn run(
         planes: Some(s.planes),
         trivial_reject: Some(s.reject),
         graph,
+        ..Default::default()
     };
 
     // Phase 1: the slicing kernels alone, before any render pass runs in this process.

@@ -6,7 +6,7 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 use voltex::gpu::GpuContext;
-use voltex::render::{Blueprint, RenderOptions, Renderer};
+use voltex::render::{Blueprint, MethodKind, RenderOptions, Renderer};
 use voltex::{io, scene, Result};
 
 #[derive(Parser)]
@@ -30,6 +30,18 @@ struct Overrides {
     /// Render graph file (default: graphs/frame.ron).
     #[arg(long)]
     graph: Option<PathBuf>,
+    /// Render every textured object with this method (its lighting mode is kept).
+    #[arg(long, value_enum)]
+    method: Option<MethodArg>,
+    /// Ray step (world units) for Reference objects (default: the scene's, else half a voxel).
+    #[arg(long)]
+    step: Option<f64>,
+}
+
+#[derive(clap::ValueEnum, Clone, Copy)]
+enum MethodArg {
+    ViewSlices,
+    Reference,
 }
 
 #[derive(Subcommand)]
@@ -89,11 +101,21 @@ impl Overrides {
                 )));
             }
         }
+        if let Some(s) = self.step {
+            if !(s.is_finite() && s > 0.0) {
+                return Err(voltex::Error::Invalid(format!("--step {s}: expected a positive world length")));
+            }
+        }
         Ok(RenderOptions {
             size: self.size,
             graph: self.graph.clone(),
             planes: self.planes,
             trivial_reject: self.no_trivial_reject.then_some(false),
+            method: self.method.map(|m| match m {
+                MethodArg::ViewSlices => MethodKind::ViewSlices,
+                MethodArg::Reference => MethodKind::Reference,
+            }),
+            step: self.step,
         })
     }
 }

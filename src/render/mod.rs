@@ -17,7 +17,7 @@ use crate::graph::plan::{self, ObjectInfo, Plan};
 use crate::graph::Graph;
 use crate::methods::shell::{self, Shell};
 use crate::methods::view_slices::{self, SliceChunk};
-use crate::scene::{Light, Lighting as LightingMode, Method, Scene, SceneObject};
+use crate::scene::{Light, Lighting as LightingMode, Method, Reference, Scene, SceneObject, ViewSlices};
 use crate::types::{BaseVertex, FrameParams, SliceParams, VertexFrame};
 
 /// Overrides of what the scene file says, from the command line or tests.
@@ -27,6 +27,47 @@ pub struct RenderOptions {
     pub graph: Option<PathBuf>,
     pub planes: Option<u32>,
     pub trivial_reject: Option<bool>,
+    /// Render every textured object with this method (keeping its lighting mode).
+    pub method: Option<MethodKind>,
+    /// Ray step for `Reference` objects (world units).
+    pub step: Option<f64>,
+}
+
+/// A method without its knobs, to switch every object to it (`--method`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum MethodKind {
+    ViewSlices,
+    Reference,
+}
+
+/// Plane count when an object is switched to view slicing from a method without planes.
+pub const DEFAULT_PLANES: u32 = 400;
+
+impl RenderOptions {
+    /// An object's method after the overrides: switched to `method` if given, knobs replaced.
+    pub fn apply(&self, method: &Method) -> Method {
+        let lighting = method.lighting();
+        let kind = self.method.unwrap_or(match method {
+            Method::ViewSlices(_) => MethodKind::ViewSlices,
+            Method::Reference(_) => MethodKind::Reference,
+        });
+        match (kind, method) {
+            (MethodKind::ViewSlices, Method::ViewSlices(vs)) => Method::ViewSlices(ViewSlices {
+                planes: self.planes.unwrap_or(vs.planes),
+                trivial_reject: self.trivial_reject.unwrap_or(vs.trivial_reject),
+                lighting,
+            }),
+            (MethodKind::ViewSlices, _) => Method::ViewSlices(ViewSlices {
+                planes: self.planes.unwrap_or(DEFAULT_PLANES),
+                trivial_reject: self.trivial_reject.unwrap_or(true),
+                lighting,
+            }),
+            (MethodKind::Reference, Method::Reference(r)) => {
+                Method::Reference(Reference { step: self.step.or(r.step), lighting })
+            }
+            (MethodKind::Reference, _) => Method::Reference(Reference { step: self.step, lighting }),
+        }
+    }
 }
 
 /// One object as the frame sees it.
@@ -211,15 +252,21 @@ impl ObjectPlan {
             bake: None,
             object,
         };
-        let Some(Method::ViewSlices(vs)) = &plan.object.method else { return Ok(plan) };
-        let planes = opts.planes.unwrap_or(vs.planes);
+        let Some(method) = plan.object.method.as_ref().map(|m| opts.apply(m)) else { return Ok(plan) };
+        let vs = match method {
+            Method::ViewSlices(vs) => vs,
+            Method::Reference(_) => {
+                return Err(Error::Invalid("the Reference method is not implemented yet".into()))
+            }
+        };
+        let planes = vs.planes;
         if planes == 0 || planes > crate::scene::MAX_PLANES {
             return Err(Error::Invalid(format!(
                 "{planes} planes: expected a plane count in 1..={}",
                 crate::scene::MAX_PLANES
             )));
         }
-        plan.trivial_reject = opts.trivial_reject.unwrap_or(vs.trivial_reject);
+        plan.trivial_reject = vs.trivial_reject;
         plan.per_pixel = vs.lighting == LightingMode::PerPixel;
         let sweep = view_slices::sweep(&plan.shell, view.forward_f32(), planes, view.near);
         plan.chunks = view_slices::chunks(&plan.shell, &sweep);

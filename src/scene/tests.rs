@@ -78,7 +78,7 @@ fn defaults() {
     let n = &s.nodes[0];
     assert_eq!((n.height.length, n.uv_tiling), (0.1, [1.0, 1.0]));
     assert_eq!(n.transform, Transform::default());
-    let Method::ViewSlices(v) = &n.method.as_ref().unwrap().value;
+    let Method::ViewSlices(v) = &n.method.as_ref().unwrap().value else { panic!("not ViewSlices") };
     assert!(v.trivial_reject && v.lighting == Lighting::Baked);
 }
 

@@ -339,6 +339,27 @@ pub enum HeightScale {
 #[serde(deny_unknown_fields)]
 pub enum Method {
     ViewSlices(ViewSlices),
+    Reference(Reference),
+}
+
+impl Method {
+    pub fn lighting(&self) -> Lighting {
+        match self {
+            Method::ViewSlices(m) => m.lighting,
+            Method::Reference(m) => m.lighting,
+        }
+    }
+}
+
+/// Exact ray casting through the prisms with a fine fixed step: the ground truth.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Reference {
+    /// Ray step in world units (default: half the object's smallest voxel extent).
+    #[serde(default, deserialize_with = "v::opt_positive")]
+    pub step: Option<f64>,
+    #[serde(default)]
+    pub lighting: Lighting,
 }
 
 /// View-aligned prism slicing (2002).

@@ -73,6 +73,7 @@ macro_rules! adapter {
 }
 
 adapter!(positive, f64, Positive, |v| v.0);
+adapter!(opt_positive, Option<f64>, Option<Positive>, |v| v.map(|x| x.0));
 adapter!(non_negative, f64, NonNegative, |v| v.0);
 adapter!(jitter, f64, Jitter, |v| v.0);
 adapter!(distortion, f64, Distortion, |v| v.0);
