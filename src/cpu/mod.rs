@@ -2,3 +2,5 @@
 
 pub mod bake;
 pub mod slice_prisms;
+pub mod prism_map;
+pub mod trace_reference;

@@ -70,6 +70,14 @@ impl Executor {
             .filter(|t| t.blend != Blend::Replace)
             .map(|t| t.resource.as_str())
             .collect();
+        // Textures some compute pass writes as storage textures.
+        let stored: Vec<&str> = plan
+            .passes
+            .iter()
+            .flat_map(|p| &p.bindings)
+            .filter(|b| matches!(b.kind, BindingKind::StorageTexture { .. }))
+            .map(|b| b.name.as_str())
+            .collect();
         let mut textures = HashMap::new();
         for (name, decl) in &plan.textures {
             let ResourceDecl::Texture { format, size: tsize, clear } = decl;
@@ -86,7 +94,12 @@ impl Executor {
                 format: texture_format(ctx, &graph, name, format.wgpu(), &blended),
                 usage: wgpu::TextureUsages::RENDER_ATTACHMENT
                     | wgpu::TextureUsages::TEXTURE_BINDING
-                    | wgpu::TextureUsages::COPY_SRC,
+                    | wgpu::TextureUsages::COPY_SRC
+                    | if stored.contains(&name.as_str()) {
+                        wgpu::TextureUsages::STORAGE_BINDING
+                    } else {
+                        wgpu::TextureUsages::empty()
+                    },
                 view_formats: &[],
             });
             let view = texture.create_view(&Default::default());
@@ -284,6 +297,16 @@ impl Executor {
                         encoder.clear_buffer(buf, 0, None);
                     }
                 }
+                // Graph textures a compute pass touches before any pass wrote them this frame start
+                // from their clear value (e.g. the depth buffer when no base surface is drawn).
+                for b in &pass.bindings {
+                    if self.textures.contains_key(&b.name) && !written.contains(&b.name) {
+                        written.push(b.name.clone());
+                        if !matches!(b.kind, BindingKind::StorageTexture { .. }) {
+                            self.clear_texture(encoder, &b.name);
+                        }
+                    }
+                }
                 let wg = reflect::workgroup_size(&pass.kernel, entry).unwrap_or([1, 1, 1]);
                 let mut cpass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                     label: Some(name),
@@ -400,6 +423,43 @@ impl Executor {
             }
         }
         Ok(())
+    }
+
+    /// Clears a graph texture to its declared clear value (transparent black or depth 1 if none).
+    fn clear_texture(&self, encoder: &mut wgpu::CommandEncoder, name: &str) {
+        let t = &self.textures[name];
+        let depth = t.texture.format().is_depth_stencil_format();
+        let color = match t.clear {
+            Some(Clear::Color(r, g, b, a)) => {
+                wgpu::Color { r: r as f64, g: g as f64, b: b as f64, a: a as f64 }
+            }
+            _ => wgpu::Color::TRANSPARENT,
+        };
+        let depth_value = match t.clear {
+            Some(Clear::Depth(v)) => v,
+            _ => 1.0,
+        };
+        let color_att = [Some(wgpu::RenderPassColorAttachment {
+            view: &t.view,
+            depth_slice: None,
+            resolve_target: None,
+            ops: wgpu::Operations { load: wgpu::LoadOp::Clear(color), store: wgpu::StoreOp::Store },
+        })];
+        encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("clear"),
+            color_attachments: if depth { &[] } else { &color_att },
+            depth_stencil_attachment: depth.then(|| wgpu::RenderPassDepthStencilAttachment {
+                view: &t.view,
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(depth_value),
+                    store: wgpu::StoreOp::Store,
+                }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
     }
 
     fn bind_groups(
