@@ -210,3 +210,13 @@ pub struct ReferenceObject {
     /// x: opacity length; y: ray step (world units); zw: unused.
     pub params: [f32; 4],
 }
+
+/// Per-pixel progress of the reference tracer between its dispatches (`reference_state`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct ReferenceState {
+    /// rgb: colour gathered so far; a: transmittance.
+    pub color: [f32; 4],
+    /// x: ray distance to resume from; y: 1 once started; z: 1 once finished.
+    pub resume: [f32; 4],
+}

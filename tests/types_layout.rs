@@ -33,6 +33,7 @@ fn wgsl_structs_match_rust() {
         layout!(ReferenceNode; min, max),
         layout!(ReferencePrism; vertices, uv01, uv2),
         layout!(ReferenceObject; resolution, atlas, params),
+        layout!(ReferenceState; color, resume),
     ];
     let mut seen = 0;
     for (_, ty) in kernel.module.types.iter() {

@@ -2,11 +2,18 @@
 #include "shared/types.wgsl"
 #include "shared/prism_map.wgsl"
 
-// Intervals held per window: a ray meeting more prisms is traced in several windows (see below).
+// Work per dispatch, in samples (a window's collection counts WINDOW_COST): the pass is dispatched
+// `reference_dispatches` times and each pixel resumes from `reference_state`. Lavapipe ends every
+// loop of an invocation after 65535 iterations in all, and real GPUs have watchdogs, so no single
+// dispatch may march a whole long ray.
+override samples_per_dispatch: u32 = 512u;
+const WINDOW_COST: u32 = 16u;
+// Intervals held per window: a ray meeting more prisms is traced in several windows.
 const MAX_SEGMENTS: u32 = 16u;
 const STACK_SIZE: u32 = 48u;
 const MIN_TRANSMITTANCE: f32 = 1e-4;
 const MAX_ALPHA: f32 = 0.999999;
+const FAR: f32 = 3.4e38;
 // Raster depth is coarse far from the camera: opaque surfaces from the depth buffer are moved
 // back by this relative margin (the Reference objects' own bases are hit exactly).
 const DEPTH_SLACK: f32 = 2e-3;
@@ -22,6 +29,7 @@ const DEPTH_SLACK: f32 = 2e-3;
 @group(0) @binding(8) var<storage, read> normal_atlas: array<u32>;
 @group(0) @binding(9) var depth: texture_depth_2d;
 @group(0) @binding(10) var reference_rgba: texture_storage_2d<rgba32float, write>;
+@group(0) @binding(11) var<storage, read_write> reference_state: array<ReferenceState>;
 
 // The intervals of the current window: the MAX_SEGMENTS earliest starts at or after the window's
 // start; `cut` is the earliest start that did not fit, so everything before it is complete.
@@ -34,8 +42,6 @@ var<private> t_opaque: f32;
 
 fn load_shape(index: u32) -> PrismShape {
     let ids = reference_prisms[index].vertices.xyz;
-    // Built whole: writing the arrays element by element in a loop miscompiles on lavapipe
-    // (the caller's loop ran once; tests/reference.rs pins it).
     let a = shell_vertices[ids.x];
     let b = shell_vertices[ids.y];
     let c = shell_vertices[ids.z];
@@ -47,30 +53,29 @@ fn load_shape(index: u32) -> PrismShape {
 }
 
 fn keep(prism: u32, t0: f32, t1: f32) {
-    if (t0 >= cut) {
-        return;
-    }
-    if (seg_count < MAX_SEGMENTS) {
-        seg_t0[seg_count] = t0;
-        seg_t1[seg_count] = t1;
-        seg_prism[seg_count] = prism;
-        seg_count += 1u;
-        return;
-    }
-    var latest = 0u;
-    for (var i = 1u; i < MAX_SEGMENTS; i++) {
-        if (seg_t0[i] > seg_t0[latest]) {
-            latest = i;
+    if (t0 < cut) {
+        if (seg_count < MAX_SEGMENTS) {
+            seg_t0[seg_count] = t0;
+            seg_t1[seg_count] = t1;
+            seg_prism[seg_count] = prism;
+            seg_count += 1u;
+        } else {
+            var latest = 0u;
+            for (var i = 1u; i < MAX_SEGMENTS; i++) {
+                if (seg_t0[i] > seg_t0[latest]) {
+                    latest = i;
+                }
+            }
+            if (t0 >= seg_t0[latest]) {
+                cut = t0;
+            } else {
+                cut = seg_t0[latest];
+                seg_t0[latest] = t0;
+                seg_t1[latest] = t1;
+                seg_prism[latest] = prism;
+            }
         }
     }
-    if (t0 >= seg_t0[latest]) {
-        cut = t0;
-        return;
-    }
-    cut = seg_t0[latest];
-    seg_t0[latest] = t0;
-    seg_t1[latest] = t1;
-    seg_prism[latest] = prism;
 }
 
 // The parts of the ray in [t_start, inf) inside prism `index` go to `keep`; a crossing of an
@@ -90,32 +95,28 @@ fn collect_prism(d: vec3<f32>, index: u32, t_start: f32) {
     var open = false;
     var start = 0.0;
     for (var k = 0u; k <= hits.count; k++) {
-        var t1 = 3.4e38;
-        if (k < hits.count) {
-            t1 = hits.t[k];
+        let t1 = select(FAR, hits.t[min(k, 7u)], k < hits.count);
+        if (t1 > t0) {
+            // Between consecutive crossings the ray is wholly inside or outside: test the middle.
+            var inside = false;
+            if (k < hits.count) {
+                inside = prism_inverse(d * (0.5 * (t0 + t1)), &shape).w >= 0.0;
+            }
+            if (inside && !open) {
+                open = true;
+                start = t0;
+            } else if (!inside && open) {
+                open = false;
+                keep(index, start, t0);
+            }
+            t0 = t1;
         }
-        if (t1 <= t0) {
-            continue;
-        }
-        // Between consecutive crossings the ray is wholly inside or outside: test the middle.
-        var inside = false;
-        if (k < hits.count) {
-            inside = prism_inverse(d * (0.5 * (t0 + t1)), &shape).w >= 0.0;
-        }
-        if (inside && !open) {
-            open = true;
-            start = t0;
-        } else if (!inside && open) {
-            open = false;
-            keep(index, start, t0);
-        }
-        t0 = t1;
     }
 }
 
-fn slab(o_inv: vec3<f32>, node: ReferenceNode) -> vec2<f32> {
-    let a = node.min.xyz * o_inv;
-    let b = node.max.xyz * o_inv;
+fn slab(inv: vec3<f32>, node: ReferenceNode) -> vec2<f32> {
+    let a = node.min.xyz * inv;
+    let b = node.max.xyz * inv;
     let lo = min(a, b);
     let hi = max(a, b);
     return vec2<f32>(max(max(lo.x, lo.y), lo.z), min(min(hi.x, hi.y), hi.z));
@@ -124,42 +125,29 @@ fn slab(o_inv: vec3<f32>, node: ReferenceNode) -> vec2<f32> {
 // Walks the BVH over prism bounds, collecting the intervals after t_start.
 fn collect(d: vec3<f32>, t_start: f32) {
     seg_count = 0u;
-    cut = 3.4e38;
-    { var nn = 0u; for (var q = 0u; q < 576u; q++) { nn += 1u; } seg_count = nn; return; }
-    if (reference_params.counts.x == 0u) {
-        return;
-    }
+    cut = FAR;
     let inv = 1.0 / d;
     var stack: array<u32, STACK_SIZE>;
-    var top = 1u;
+    var top = select(0u, 1u, reference_params.counts.x > 0u);
     stack[0] = 0u;
     while (top > 0u) {
         top -= 1u;
         let node = reference_nodes[stack[top]];
         let span = slab(inv, node);
-        if (span.x > span.y || span.y < t_start || span.x > min(t_opaque, cut)) {
-            continue;
-        }
-        let count = bitcast<u32>(node.min.w);
-        let first = bitcast<u32>(node.max.w);
-        if (count > 0u) {
-            for (var i = 0u; i < count; i++) {
-                collect_prism(d, first + i, t_start);
+        if (span.x <= span.y && span.y >= t_start && span.x <= min(t_opaque, cut)) {
+            let count = bitcast<u32>(node.min.w);
+            let first = bitcast<u32>(node.max.w);
+            if (count > 0u) {
+                for (var i = 0u; i < count; i++) {
+                    collect_prism(d, first + i, t_start);
+                }
+            } else if (top + 2u <= STACK_SIZE) {
+                stack[top] = first;
+                stack[top + 1u] = first + 1u;
+                top += 2u;
             }
-        } else if (top + 2u <= STACK_SIZE) {
-            stack[top] = first;
-            stack[top + 1u] = first + 1u;
-            top += 2u;
         }
     }
-}
-
-fn load_texel(offset: u32, pitch: u32, rows: u32, x: u32, y: u32, z: u32) -> vec4<f32> {
-    return unpack4x8unorm(texel_atlas[offset + (z * rows + y) * pitch + x]);
-}
-
-fn load_normal(offset: u32, pitch: u32, rows: u32, x: u32, y: u32, z: u32) -> vec4<f32> {
-    return unpack4x8snorm(normal_atlas[offset + (z * rows + y) * pitch + x]);
 }
 
 struct Axis {
@@ -171,9 +159,9 @@ struct Axis {
 fn axis(c: f32, n: u32, wrap: bool) -> Axis {
     let x = c * f32(n) - 0.5;
     let fl = floor(x);
+    let m = i32(n);
     var i0 = i32(fl);
     var i1 = i0 + 1;
-    let m = i32(n);
     if (wrap) {
         i0 = ((i0 % m) + m) % m;
         i1 = ((i1 % m) + m) % m;
@@ -197,22 +185,20 @@ fn sample_volume(object: ReferenceObject, uvw: vec3<f32>, normals: bool) -> vec4
         let x = select(ax.i0, ax.i1, (k & 1u) != 0u);
         let y = select(ay.i0, ay.i1, (k & 2u) != 0u);
         let z = select(az.i0, az.i1, (k & 4u) != 0u);
-        let wx = select(1.0 - ax.f, ax.f, (k & 1u) != 0u);
-        let wy = select(1.0 - ay.f, ay.f, (k & 2u) != 0u);
-        let wz = select(1.0 - az.f, az.f, (k & 4u) != 0u);
-        var v: vec4<f32>;
+        let weight = select(1.0 - ax.f, ax.f, (k & 1u) != 0u) * select(1.0 - ay.f, ay.f, (k & 2u) != 0u)
+            * select(1.0 - az.f, az.f, (k & 4u) != 0u);
+        let at = offset + (z * rows + y) * pitch + x;
         if (normals) {
-            v = load_normal(offset, pitch, rows, x, y, z);
+            out += unpack4x8snorm(normal_atlas[at]) * weight;
         } else {
-            v = load_texel(offset, pitch, rows, x, y, z);
+            out += unpack4x8unorm(texel_atlas[at]) * weight;
         }
-        out += v * (wx * wy * wz);
     }
     return out;
 }
 
 // Phong lighting exactly as draw_slices.wgsl does it, with the exact barycentrics.
-fn shade(object: ReferenceObject, index: u32, shape: ptr<function, PrismShape>, b: vec3<f32>, uvw: vec3<f32>, ray: vec3<f32>, albedo: vec3<f32>) -> vec3<f32> {
+fn shade(object: ReferenceObject, shape: ptr<function, PrismShape>, b: vec3<f32>, uvw: vec3<f32>, ray: vec3<f32>, albedo: vec3<f32>) -> vec3<f32> {
     let fa = vertex_frames[(*shape).ids[0]];
     let fb = vertex_frames[(*shape).ids[1]];
     let fc = vertex_frames[(*shape).ids[2]];
@@ -231,35 +217,36 @@ fn shade(object: ReferenceObject, index: u32, shape: ptr<function, PrismShape>, 
     return albedo * (ambient + (1.0 - ambient) * diffuse) + vec3<f32>(specular);
 }
 
-// Extinction (w) and extinction-weighted colour (xyz) at d t over the segments active in [a, b].
+// Extinction (w) and extinction-weighted colour (xyz) of prism `index` at x.
+fn segment_sample(index: u32, x: vec3<f32>, d: vec3<f32>) -> vec4<f32> {
+    let prism = reference_prisms[index];
+    let object = reference_objects[prism.vertices.w];
+    var shape = load_shape(index);
+    let inv = prism_inverse(x, &shape);
+    let st = inv.x * prism.uv01.xy + inv.y * prism.uv01.zw + inv.z * prism.uv2.xy;
+    let uvw = vec3<f32>(st, inv.w);
+    let texel = sample_volume(object, uvw, false);
+    let alpha = clamp(texel.a, 0.0, MAX_ALPHA);
+    var out = vec4<f32>(0.0);
+    if (inv.w >= 0.0 && alpha > 1e-6) {
+        var colour = texel.rgb / alpha;
+        if ((object.resolution.w & 1u) != 0u) {
+            colour = shade(object, &shape, inv.xyz, uvw, d, colour);
+        }
+        let sigma = -log(1.0 - alpha) / object.params.x;
+        out = vec4<f32>(colour * sigma, sigma);
+    }
+    return out;
+}
+
+// The sum over the intervals covering [a, b] (overlapping objects add their extinctions).
 fn sample_point(d: vec3<f32>, t: f32, a: f32, b: f32) -> vec4<f32> {
     let x = d * t;
     var acc = vec4<f32>(0.0);
     for (var i = 0u; i < seg_count; i++) {
-        if (!(seg_t0[i] <= a && seg_t1[i] >= b)) {
-            continue;
+        if (seg_t0[i] <= a && seg_t1[i] >= b) {
+            acc += segment_sample(seg_prism[i], x, d);
         }
-        let index = seg_prism[i];
-        let prism = reference_prisms[index];
-        let object = reference_objects[prism.vertices.w];
-        var shape = load_shape(index);
-        let inv = prism_inverse(x, &shape);
-        if (inv.w < 0.0) {
-            continue;
-        }
-        let st = inv.x * prism.uv01.xy + inv.y * prism.uv01.zw + inv.z * prism.uv2.xy;
-        let uvw = vec3<f32>(st, inv.w);
-        let texel = sample_volume(object, uvw, false);
-        let alpha = clamp(texel.a, 0.0, MAX_ALPHA);
-        if (alpha <= 1e-6) {
-            continue;
-        }
-        var colour = texel.rgb / alpha;
-        if ((object.resolution.w & 1u) != 0u) {
-            colour = shade(object, index, &shape, inv.xyz, uvw, d, colour);
-        }
-        let sigma = -log(1.0 - alpha) / object.params.x;
-        acc += vec4<f32>(colour * sigma, sigma);
     }
     return acc;
 }
@@ -267,7 +254,13 @@ fn sample_point(d: vec3<f32>, t: f32, a: f32, b: f32) -> vec4<f32> {
 @compute @workgroup_size(8, 8, 1)
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let size = vec2<u32>(frame.viewport.xy);
-    if (id.x >= size.x || id.y >= size.y) {
+    let pixel = id.y * size.x + id.x;
+    var state = ReferenceState(vec4<f32>(0.0, 0.0, 0.0, 1.0), vec4<f32>(0.0));
+    if (id.x < size.x && id.y < size.y) {
+        state = reference_state[pixel];
+    }
+    // resume: x where to go on, y 1 once started, z 1 once finished.
+    if (id.x >= size.x || id.y >= size.y || state.resume.z != 0.0) {
         return;
     }
     let sx = 2.0 * (f32(id.x) + 0.5) * frame.viewport.z - 1.0;
@@ -277,26 +270,32 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let cos_d = dot(d, forward);
     let near = reference_params.right.w;
     let far = reference_params.up.w;
+    var rgb = state.color.rgb;
+    var transmittance = state.color.a;
+    var t_start = state.resume.x;
+    if (state.resume.y == 0.0) {
+        rgb = vec3<f32>(0.0);
+        transmittance = 1.0;
+        t_start = near / cos_d;
+    }
     // Opaque surfaces already drawn (base surfaces) stop the ray.
     let z = textureLoad(depth, vec2<i32>(id.xy), 0);
-    t_opaque = 3.4e38;
+    t_opaque = FAR;
     if (z < 1.0) {
-        let view_depth = far * near / (far - z * (far - near));
-        t_opaque = view_depth / cos_d * (1.0 + DEPTH_SLACK);
+        t_opaque = far * near / (far - z * (far - near)) / cos_d * (1.0 + DEPTH_SLACK);
     }
-    var rgb = vec3<f32>(0.0);
-    var transmittance = 1.0;
-    var t_start = near / cos_d;
-    // Windows: each holds the next MAX_SEGMENTS intervals; the last one ends where no interval is left.
-    for (var window = 0u; window < 4096u; window++) {
+    var budget = samples_per_dispatch;
+    var finished = false;
+    // Each window holds the next MAX_SEGMENTS intervals and is marched from t_start to its cut.
+    while (!finished && budget >= WINDOW_COST) {
+        budget -= WINDOW_COST;
         collect(d, t_start);
-    textureStore(reference_rgba, vec2<i32>(id.xy), vec4<f32>(f32(seg_count))); return;
         let end = min(cut, t_opaque);
         var a = t_start;
-        while (a < end && transmittance >= MIN_TRANSMITTANCE) {
+        while (a < end && transmittance >= MIN_TRANSMITTANCE && budget > 0u) {
             // Next boundary after a: where an interval starts or ends, or the window's end.
             var b = end;
-            var step = 3.4e38;
+            var step = FAR;
             for (var i = 0u; i < seg_count; i++) {
                 if (seg_t0[i] > a) {
                     b = min(b, seg_t0[i]);
@@ -305,24 +304,40 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
                     step = min(step, reference_objects[reference_prisms[seg_prism[i]].vertices.w].params.y);
                 }
             }
-            if (step < 3.4e38) {
-                let n = max(ceil((b - a) / step), 1.0);
-                let h = (b - a) / n;
-                for (var k = 0.0; k < n && transmittance >= MIN_TRANSMITTANCE; k += 1.0) {
-                    let s = sample_point(d, a + (k + 0.5) * h, a, b);
+            var next = b;
+            if (step < FAR) {
+                // Whole steps over [a, b]; stopping early resumes at the last finished step.
+                let n = u32(max(ceil((b - a) / step), 1.0));
+                let h = (b - a) / f32(n);
+                var k = 0u;
+                while (k < n && transmittance >= MIN_TRANSMITTANCE && budget > 0u) {
+                    let s = sample_point(d, a + (f32(k) + 0.5) * h, a, b);
                     if (s.w > 0.0) {
                         let alpha = 1.0 - exp(-s.w * h);
                         rgb += s.xyz / s.w * alpha * transmittance;
                         transmittance *= 1.0 - alpha;
                     }
+                    k += 1u;
+                    budget -= 1u;
+                }
+                if (k < n) {
+                    next = a + f32(k) * h;
                 }
             }
-            a = b;
+            a = next;
         }
-        if (cut >= t_opaque || cut >= 3.4e38 || transmittance < MIN_TRANSMITTANCE) {
-            break;
+        if (transmittance < MIN_TRANSMITTANCE) {
+            finished = true;
+        } else if (a < end) {
+            t_start = a; // out of budget: resume here
+        } else if (cut >= t_opaque || cut >= FAR || cut <= t_start) {
+            // (cut <= t_start: more than MAX_SEGMENTS intervals start at one point; they are
+            // dropped rather than looping forever.)
+            finished = true;
+        } else {
+            t_start = cut;
         }
-        t_start = cut;
     }
+    reference_state[pixel] = ReferenceState(vec4<f32>(rgb, transmittance), vec4<f32>(t_start, 1.0, select(0.0, 1.0, finished), 0.0));
     textureStore(reference_rgba, vec2<i32>(id.xy), vec4<f32>(rgb * frame.light_color.rgb, 1.0 - transmittance));
 }

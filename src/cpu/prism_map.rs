@@ -142,8 +142,10 @@ pub fn barycentrics(x: DVec3, q: [DVec3; 3]) -> Option<[f64; 3]> {
     Some([1.0 - b1 - b2, b1, b2])
 }
 
-/// Tolerance on barycentrics and height for a point to count as inside a prism.
+/// Tolerance on barycentrics for a point to count as inside a prism.
 pub const INSIDE_EPS: f64 = 1e-9;
+/// Relative to the section cubic's coefficients, what counts as a root at w = 0 or 1.
+const ZERO_TOL: f64 = 1e-13;
 
 /// The inverse prism map: `(b, w)` with `x = sum_i b_i (p_i + w h_i)`, if `x` lies in the prism.
 ///
@@ -163,12 +165,14 @@ pub fn inverse(x: DVec3, p: &PrismCorners) -> Option<([f64; 3], f64)> {
     crit.sort_by(f64::total_cmp);
     cuts.extend(crit);
     cuts.push(1.0);
+    // Points on the bottom or top face give f(0) or f(1) = 0 up to rounding.
+    let tol = ZERO_TOL * c.iter().map(|v| v.abs()).sum::<f64>();
     for k in 0..cuts.len() - 1 {
         let (lo, hi) = (cuts[k], cuts[k + 1]);
         let (f_lo, f_hi) = (cubic(&c, lo), cubic(&c, hi));
-        let w = if f_lo == 0.0 {
+        let w = if f_lo.abs() <= tol {
             lo
-        } else if f_hi == 0.0 {
+        } else if f_hi.abs() <= tol {
             hi
         } else if (f_lo < 0.0) != (f_hi < 0.0) {
             bracketed_root(&c, lo, hi)
@@ -187,8 +191,7 @@ pub fn inverse(x: DVec3, p: &PrismCorners) -> Option<([f64; 3], f64)> {
 
 /// The parts of the ray `[t_min, t_max]` inside the prism, as `(t0, t1)` intervals in order.
 pub fn ray_intervals(d: DVec3, p: &PrismCorners, t_min: f64, t_max: f64) -> Vec<(f64, f64)> {
-    let mut cuts: Vec<f64> =
-        boundary_hits(d, p).into_iter().filter(|&t| t > t_min && t < t_max).collect();
+    let mut cuts: Vec<f64> = boundary_hits(d, p).into_iter().filter(|&t| t > t_min && t < t_max).collect();
     cuts.sort_by(f64::total_cmp);
     cuts.insert(0, t_min);
     cuts.push(t_max);
@@ -208,4 +211,98 @@ pub fn ray_intervals(d: DVec3, p: &PrismCorners, t_min: f64, t_max: f64) -> Vec<
         }
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn prism(bottom: [DVec3; 3], heights: [DVec3; 3]) -> PrismCorners {
+        PrismCorners { bottom, top: [0, 1, 2].map(|i| bottom[i] + heights[i]), ids: [0, 1, 2] }
+    }
+
+    fn forward(p: &PrismCorners, b: [f64; 3], w: f64) -> DVec3 {
+        (0..3).map(|i| (p.bottom[i] + (p.top[i] - p.bottom[i]) * w) * b[i]).sum()
+    }
+
+    /// Splayed, sheared and parallel height vectors (the last two make the cubic a quadratic or
+    /// a linear equation): the inverse recovers (b, w) everywhere inside.
+    #[test]
+    fn inverse_round_trips_including_degenerate_cubics() {
+        let base = [DVec3::new(0.0, 0.0, 0.0), DVec3::new(1.0, 0.1, 0.0), DVec3::new(0.2, 0.9, 0.05)];
+        let cases = [
+            [DVec3::new(-0.3, -0.2, 1.0), DVec3::new(0.4, -0.1, 0.8), DVec3::new(0.0, 0.5, 1.2)],
+            [DVec3::new(0.3, 0.1, 0.5); 3],
+            [DVec3::new(0.0, 0.0, 1.0), DVec3::new(0.0, 0.0, 1.0), DVec3::new(0.1, 0.0, 1.0)],
+            [DVec3::new(0.0, 0.0, 1e-4); 3],
+        ];
+        for (c, h) in cases.iter().enumerate() {
+            let p = prism(base, *h);
+            for &b in &[[1.0 / 3.0; 3], [0.8, 0.1, 0.1], [0.0, 0.5, 0.5], [0.05, 0.05, 0.9]] {
+                for &w in &[0.0, 0.01, 0.5, 0.99, 1.0] {
+                    let x = forward(&p, b, w);
+                    let (b2, w2) = inverse(x, &p).unwrap_or_else(|| panic!("case {c}: {b:?} {w} not found"));
+                    assert!((w2 - w).abs() < 1e-9, "case {c}: w {w2} for {w}");
+                    for i in 0..3 {
+                        assert!((b2[i] - b[i]).abs() < 1e-9, "case {c}: b {b2:?} for {b:?}");
+                    }
+                }
+            }
+            // Points outside: beyond the top, and beside an edge.
+            assert!(inverse(forward(&p, [1.0 / 3.0; 3], 1.2), &p).is_none(), "case {c}");
+            assert!(inverse(forward(&p, [-0.1, 0.6, 0.5], 0.5), &p).is_none(), "case {c}");
+        }
+    }
+
+    /// The intervals of rays through a right prism (a box-like wedge) are the exact chords.
+    #[test]
+    fn intervals_of_a_right_prism_are_its_chords() {
+        let p = prism(
+            [DVec3::new(-1.0, -1.0, 2.0), DVec3::new(1.0, -1.0, 2.0), DVec3::new(-1.0, 1.0, 2.0)],
+            [DVec3::new(0.0, 0.0, 1.0); 3],
+        );
+        // Straight down the z axis through the wedge: from z = 2 to z = 3.
+        let d = DVec3::new(-0.2, -0.3, 1.0).normalize();
+        let iv = ray_intervals(d, &p, 0.0, f64::INFINITY);
+        let t_bottom = 2.0 / d.z;
+        let t_top = 3.0 / d.z;
+        assert_eq!(iv.len(), 1);
+        assert!((iv[0].0 - t_bottom).abs() < 1e-12 && (iv[0].1 - t_top).abs() < 1e-12, "{iv:?}");
+        // Through a side: enters the bottom, leaves by the side x = -1 (at z = 1 / 0.45).
+        let d = DVec3::new(-0.45, 0.0, 1.0).normalize();
+        let iv = ray_intervals(d, &p, 0.0, f64::INFINITY);
+        assert_eq!(iv.len(), 1, "{iv:?}");
+        let (t_in, t_out) = (2.0 / d.z, 1.0 / 0.45 / d.z);
+        assert!((iv[0].0 - t_in).abs() < 1e-12 && (iv[0].1 - t_out).abs() < 1e-12, "{iv:?}");
+        // A ray that misses.
+        assert!(ray_intervals(DVec3::new(1.0, 0.0, 0.0), &p, 0.0, f64::INFINITY).is_empty());
+    }
+
+    /// A curved (twisted-free but non-planar) side patch: every reported hit lies on the patch.
+    #[test]
+    fn patch_hits_lie_on_the_patch() {
+        let (q00, q10) = (DVec3::new(-1.0, 0.0, 3.0), DVec3::new(1.0, 0.2, 3.0));
+        let (q01, q11) = (DVec3::new(-1.2, 0.5, 4.0), DVec3::new(1.0, -0.4, 4.2));
+        let mut found = 0;
+        for i in 0..40 {
+            for j in 0..40 {
+                let d = DVec3::new(-0.4 + 0.02 * i as f64, -0.3 + 0.02 * j as f64, 1.0).normalize();
+                for t in ray_patch(d, q00, q10, q01, q11).into_iter().flatten() {
+                    let x = d * t;
+                    // Closest point on the patch by dense search must be (nearly) x.
+                    let mut best = f64::INFINITY;
+                    for u in 0..=200 {
+                        for v in 0..=200 {
+                            let (u, v) = (u as f64 / 200.0, v as f64 / 200.0);
+                            let s = (q00 * (1.0 - u) + q10 * u) * (1.0 - v) + (q01 * (1.0 - u) + q11 * u) * v;
+                            best = best.min((s - x).length());
+                        }
+                    }
+                    assert!(best < 0.02, "hit {x:?} is {best} from the patch");
+                    found += 1;
+                }
+            }
+        }
+        assert!(found > 100, "{found} hits");
+    }
 }

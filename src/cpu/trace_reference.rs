@@ -138,8 +138,7 @@ pub fn trace_ray(view: &TraceView, objects: &[TraceObject], d: DVec3) -> [f64; 4
             }
         }
     }
-    let mut cuts: Vec<f64> =
-        segments.iter().flat_map(|s| [s.t0, s.t1]).map(|t| t.min(t_max)).collect();
+    let mut cuts: Vec<f64> = segments.iter().flat_map(|s| [s.t0, s.t1]).map(|t| t.min(t_max)).collect();
     cuts.sort_by(f64::total_cmp);
     cuts.dedup();
     let mut rgb = DVec3::ZERO;

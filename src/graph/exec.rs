@@ -26,7 +26,8 @@ pub struct Inputs {
 }
 
 /// Count names the runtime provides (per object or per frame).
-pub const COUNTS: &[&str] = &["prisms", "planes", "plane_blocks", "base_vertices", "width", "height"];
+pub const COUNTS: &[&str] =
+    &["prisms", "planes", "plane_blocks", "base_vertices", "width", "height", "reference_dispatches"];
 
 enum Pipeline {
     Compute(wgpu::ComputePipeline),
@@ -289,7 +290,7 @@ impl Executor {
             &self.pipelines[&(index, constants_key(&specialisation(pass, frame, inst).unwrap_or_default()))]
         };
         match &pass.decl {
-            PassDecl::Compute { name, entry, clear, dispatch, .. } => {
+            PassDecl::Compute { name, entry, clear, dispatch, repeat, .. } => {
                 for inst in &instances {
                     for b in clear {
                         let buf = resolve_buffer(inst, frame, b)
@@ -336,7 +337,9 @@ impl Executor {
                     for (i, bg) in bgs.iter().enumerate() {
                         cpass.set_bind_group(i as u32, bg, &[]);
                     }
-                    cpass.dispatch_workgroups(g[0], g[1], g[2]);
+                    for _ in 0..count(repeat, inst, frame) {
+                        cpass.dispatch_workgroups(g[0], g[1], g[2]);
+                    }
                 }
             }
             PassDecl::Raster { name, targets, depth, draw, .. } => {
@@ -448,7 +451,7 @@ impl Executor {
         encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("clear"),
             color_attachments: if depth { &[] } else { &color_att },
-            depth_stencil_attachment: depth.then(|| wgpu::RenderPassDepthStencilAttachment {
+            depth_stencil_attachment: depth.then_some(wgpu::RenderPassDepthStencilAttachment {
                 view: &t.view,
                 depth_ops: Some(wgpu::Operations {
                     load: wgpu::LoadOp::Clear(depth_value),
@@ -626,8 +629,12 @@ fn count(name: &str, inst: &Inputs, frame: &Inputs) -> u32 {
 /// `voltex plan` reports them without a GPU).
 pub fn check_counts(graph: &Graph, decl: &PassDecl) -> Result<()> {
     match decl {
-        PassDecl::Compute { dispatch: Dispatch::Threads(x, y, z) | Dispatch::Groups(x, y, z), .. } => {
-            for c in [x, y, z] {
+        PassDecl::Compute {
+            dispatch: Dispatch::Threads(x, y, z) | Dispatch::Groups(x, y, z),
+            repeat,
+            ..
+        } => {
+            for c in [x, y, z, repeat] {
                 plan::check_count(graph, c, COUNTS)?;
             }
         }

@@ -15,7 +15,9 @@ use crate::gpu::GpuContext;
 use crate::graph::exec::Inputs;
 use crate::methods::shell;
 use crate::render::{Blueprint, ObjectPlan};
-use crate::types::{ReferenceNode, ReferenceObject, ReferenceParams, ReferencePrism, ShellVertex, VertexFrame};
+use crate::types::{
+    ReferenceNode, ReferenceObject, ReferenceParams, ReferencePrism, ReferenceState, ShellVertex, VertexFrame,
+};
 
 /// Everything the reference kernel reads, for all Reference objects of a frame.
 pub struct ReferenceSet {
@@ -32,6 +34,36 @@ pub struct ReferenceSet {
     /// Atlas sizes in u32 words (at least 1: the bindings exist).
     pub atlas_words: u64,
     pub normal_words: u64,
+    /// Dispatches of the tracer per frame (each marches SAMPLES_PER_DISPATCH steps of a ray).
+    pub dispatches: u32,
+}
+
+/// Mirrors the default of `samples_per_dispatch` and `WINDOW_COST` in trace_reference.wgsl.
+const SAMPLES_PER_DISPATCH: f64 = 512.0;
+const WINDOW_COST: f64 = 16.0;
+const MAX_SEGMENTS: f64 = 16.0;
+/// More dispatches than this means a step far finer than the scene needs.
+pub const MAX_DISPATCHES: u32 = 20_000;
+
+/// A bound on the work along any ray through the object: a ray meets a shell in a few stretches
+/// (four, for a torus seen edge-on), each no longer than the shell's bounding diagonal.
+fn work_bound(o: &ObjectPlan, step: f64) -> f64 {
+    let s = &o.object.surface;
+    let mut lo = DVec3::splat(f64::INFINITY);
+    let mut hi = DVec3::splat(f64::NEG_INFINITY);
+    for (p, h) in s.positions.iter().zip(&s.heights) {
+        for q in [*p, *p + *h] {
+            lo = lo.min(q);
+            hi = hi.max(q);
+        }
+    }
+    let diagonal = (hi - lo).length();
+    let edges: f64 =
+        s.triangles.iter().map(|t| (s.positions[t[1] as usize] - s.positions[t[0] as usize]).length()).sum();
+    let edge = (edges / s.triangles.len().max(1) as f64).max(1e-12);
+    let path = 4.0 * diagonal;
+    let intervals = 2.0 * path / edge + 8.0;
+    path / step + intervals + WINDOW_COST * (intervals / MAX_SEGMENTS + 1.0)
 }
 
 /// Half the smallest world extent of a voxel over the object (height along w; `dP/ds`, `dP/dt`
@@ -58,8 +90,7 @@ pub fn default_step(o: &ObjectPlan, resolution: [u32; 3]) -> f64 {
     };
     let ds = mean(&|f| f.ds);
     let dt = mean(&|f| f.dt);
-    let extent =
-        (h / resolution[2] as f64).min(ds / resolution[0] as f64).min(dt / resolution[1] as f64);
+    let extent = (h / resolution[2] as f64).min(ds / resolution[0] as f64).min(dt / resolution[1] as f64);
     0.5 * extent.max(1e-9)
 }
 
@@ -87,7 +118,9 @@ pub fn build(
         copies: Vec::new(),
         atlas_words: 0,
         normal_words: 0,
+        dispatches: 1,
     };
+    let mut work = 0.0;
     let mut prisms = Vec::new();
     let mut boxes = Vec::new();
     for (k, &i) in members.iter().enumerate() {
@@ -118,6 +151,7 @@ pub fn build(
         let words = pitch as u64 * res[1] as u64 * res[2] as u64;
         let opaque = o.object.base_color.is_some();
         let step = o.reference_step.unwrap_or(1.0);
+        work += work_bound(o, step);
         set.table.push(ReferenceObject {
             resolution: [res[0], res[1], res[2], o.per_pixel as u32 | (opaque as u32) << 1],
             atlas: [set.atlas_words as u32, pitch, set.normal_words as u32, 0],
@@ -144,20 +178,28 @@ pub fn build(
             .collect();
     }
     set.params.counts = [set.nodes.len() as u32, set.prisms.len() as u32, set.table.len() as u32, 0];
+    set.dispatches = ((work / SAMPLES_PER_DISPATCH).ceil() + 1.0).min(u32::MAX as f64) as u32;
     set.atlas_words = set.atlas_words.max(1);
     set.normal_words = set.normal_words.max(1);
     set
 }
 
 impl ReferenceSet {
-    /// Checks the atlases against the adapter's storage-buffer limit.
+    /// Checks the atlases against the adapter's storage-buffer limit, and the dispatch count.
     pub fn check_limits(&self, max_binding: u64) -> Result<()> {
+        if self.dispatches > MAX_DISPATCHES {
+            return Err(Error::Invalid(format!(
+                "the Reference step is too fine for this scene: {} dispatches per frame (at most {MAX_DISPATCHES}); \
+                 use a larger `step`",
+                self.dispatches
+            )));
+        }
         for (what, words) in [("texel", self.atlas_words), ("normal", self.normal_words)] {
             if words * 4 > max_binding {
                 return Err(Error::Gpu(format!(
                     "the Reference objects' {what} volumes need {} MiB in one storage buffer, beyond this \
                      adapter's limit of {} MiB: use smaller texel resolutions or another method",
-                    words * 4 >> 20,
+                    (words * 4) >> 20,
                     max_binding >> 20
                 )));
             }
@@ -166,21 +208,43 @@ impl ReferenceSet {
     }
 
     /// Buffers of the reference instance; the atlases are filled from the bakes by `copy_volumes`.
-    pub fn add_inputs(&self, ctx: &GpuContext, inputs: &mut Inputs) {
+    pub fn add_inputs(&self, ctx: &GpuContext, inputs: &mut Inputs, size: (u32, u32)) {
+        inputs.counts.insert("reference_dispatches".into(), self.dispatches);
+        let state = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("reference_state"),
+            size: size.0 as u64 * size.1 as u64 * std::mem::size_of::<ReferenceState>() as u64,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        inputs.buffers.insert("reference_state".into(), state);
         use crate::bake::{storage, uniform};
         let b = &mut inputs.buffers;
-        b.insert("reference_params".into(), uniform(ctx, "reference_params", bytemuck::bytes_of(&self.params)));
+        b.insert(
+            "reference_params".into(),
+            uniform(ctx, "reference_params", bytemuck::bytes_of(&self.params)),
+        );
         let nodes = if self.nodes.is_empty() { vec![ReferenceNode::default()] } else { self.nodes.clone() };
         b.insert("reference_nodes".into(), storage(ctx, "reference_nodes", bytemuck::cast_slice(&nodes)));
-        b.insert("reference_prisms".into(), storage(ctx, "reference_prisms", bytemuck::cast_slice(&self.prisms)));
-        b.insert("reference_objects".into(), storage(ctx, "reference_objects", bytemuck::cast_slice(&self.table)));
-        b.insert("shell_vertices".into(), storage(ctx, "shell_vertices", bytemuck::cast_slice(&self.vertices)));
+        b.insert(
+            "reference_prisms".into(),
+            storage(ctx, "reference_prisms", bytemuck::cast_slice(&self.prisms)),
+        );
+        b.insert(
+            "reference_objects".into(),
+            storage(ctx, "reference_objects", bytemuck::cast_slice(&self.table)),
+        );
+        b.insert(
+            "shell_vertices".into(),
+            storage(ctx, "shell_vertices", bytemuck::cast_slice(&self.vertices)),
+        );
         b.insert("vertex_frames".into(), storage(ctx, "vertex_frames", bytemuck::cast_slice(&self.frames)));
         for (name, words) in [("texel_atlas", self.atlas_words), ("normal_atlas", self.normal_words)] {
             let buffer = ctx.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(name),
                 size: words * 4,
-                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
+                usage: wgpu::BufferUsages::STORAGE
+                    | wgpu::BufferUsages::COPY_DST
+                    | wgpu::BufferUsages::COPY_SRC,
                 mapped_at_creation: false,
             });
             b.insert(name.into(), buffer);

@@ -39,14 +39,15 @@ impl Blueprint {
         if let Some(r) = &self.reference {
             out.push((
                 format!(
-                    "reference: BVH ({} nodes), {} prisms, shells, texel atlas{}",
+                    "reference: BVH ({} nodes), {} prisms, shells, texel atlas{}, per-pixel state",
                     r.nodes.len(),
                     r.prisms.len(),
                     if r.normal_words > 1 { " + normal atlas" } else { "" }
                 ),
                 (r.nodes.len() * 32 + r.prisms.len() * 48 + r.vertices.len() * 32 + r.frames.len() * 32)
                     as u64
-                    + (r.atlas_words + r.normal_words) * 4,
+                    + (r.atlas_words + r.normal_words) * 4
+                    + self.size.0 as u64 * self.size.1 as u64 * 32,
             ));
         }
         for o in &self.objects {
@@ -110,8 +111,9 @@ impl Blueprint {
         for o in &self.objects {
             let method = match (&o.sweep, o.reference_step) {
                 (_, Some(step)) => format!(
-                    "Reference step {step:.6} lighting {}",
-                    if o.per_pixel { "PerPixel" } else { "Baked" }
+                    "Reference step {step:.6} lighting {}, {} dispatch(es) per frame",
+                    if o.per_pixel { "PerPixel" } else { "Baked" },
+                    self.reference.as_ref().map_or(0, |r| r.dispatches)
                 ),
                 (Some(p), _) => format!(
                     "ViewSlices planes {} spacing {:.4} trivial_reject {} lighting {}, {} chunk(s)",

@@ -15,8 +15,8 @@ use crate::bake::BakeRequest;
 use crate::error::{Error, Result};
 use crate::graph::plan::{self, ObjectInfo, Plan};
 use crate::graph::Graph;
-use crate::methods::shell::{self, Shell};
 use crate::methods::reference::{self, ReferenceSet};
+use crate::methods::shell::{self, Shell};
 use crate::methods::view_slices::{self, SliceChunk};
 use crate::scene::{Light, Lighting as LightingMode, Method, Reference, Scene, SceneObject, ViewSlices};
 use crate::types::{BaseVertex, FrameParams, ReferenceParams, SliceParams, VertexFrame};
@@ -174,7 +174,12 @@ impl Blueprint {
 }
 
 /// The BVH and tables of the frame's Reference objects.
-fn reference_set(objects: &[ObjectPlan], bakes: &[BakePlan], view: &View, size: (u32, u32)) -> Option<ReferenceSet> {
+fn reference_set(
+    objects: &[ObjectPlan],
+    bakes: &[BakePlan],
+    view: &View,
+    size: (u32, u32),
+) -> Option<ReferenceSet> {
     let members: Vec<usize> = (0..objects.len()).filter(|&i| objects[i].reference_step.is_some()).collect();
     if members.is_empty() {
         return None;
@@ -296,7 +301,8 @@ impl ObjectPlan {
                 let texel = plan.object.texel.clone().unwrap_or_default();
                 let bake = texels::bake_index(scene, &texel, plan.per_pixel, light, bakes)?;
                 plan.bake = Some(bake);
-                let step = r.step.unwrap_or_else(|| reference::default_step(&plan, bakes[bake].request.resolution));
+                let step =
+                    r.step.unwrap_or_else(|| reference::default_step(&plan, bakes[bake].request.resolution));
                 plan.reference_step = Some(step);
                 return Ok(plan);
             }
@@ -376,6 +382,7 @@ pub const INSTANCE_RESOURCES: &[&str] = &[
     "reference_objects",
     "texel_atlas",
     "normal_atlas",
+    "reference_state",
 ];
 
 /// Every WGSL global a kept pass uses must name a graph texture or a runtime resource, so that

@@ -183,7 +183,7 @@ fn instance_inputs(
         }
         Part::Reference => {
             if let Some(set) = &bp.reference {
-                set.add_inputs(ctx, &mut inputs);
+                set.add_inputs(ctx, &mut inputs, bp.size);
                 set.copy_volumes(ctx, &inputs, baked);
             }
         }

@@ -3,6 +3,8 @@
 
 // A point counts as inside a prism when its barycentrics are at least -INSIDE_EPS.
 const INSIDE_EPS: f32 = 1e-5;
+// Relative to the section cubic's coefficients, what counts as a root at w = 0 or 1.
+const ZERO_TOL: f32 = 1e-6;
 
 struct PrismShape {
     bottom: array<vec3<f32>, 3>,
@@ -20,18 +22,17 @@ fn quadratic_roots(c0: f32, c1: f32, c2: f32) -> Roots {
     var out: Roots;
     out.count = 0u;
     let disc = c1 * c1 - 4.0 * c2 * c0;
-    if (disc < 0.0) {
-        return out;
-    }
-    let sq = sqrt(disc);
-    let q = -0.5 * (c1 + select(-sq, sq, c1 >= 0.0));
-    if (c2 != 0.0) {
-        out.r[out.count] = q / c2;
-        out.count += 1u;
-    }
-    if (q != 0.0) {
-        out.r[out.count] = c0 / q;
-        out.count += 1u;
+    if (disc >= 0.0) {
+        let sq = sqrt(disc);
+        let q = -0.5 * (c1 + select(-sq, sq, c1 >= 0.0));
+        if (c2 != 0.0) {
+            out.r[out.count] = q / c2;
+            out.count += 1u;
+        }
+        if (q != 0.0) {
+            out.r[out.count] = c0 / q;
+            out.count += 1u;
+        }
     }
     return out;
 }
@@ -42,17 +43,13 @@ fn ray_triangle(d: vec3<f32>, a: vec3<f32>, b: vec3<f32>, c: vec3<f32>) -> f32 {
     let e2 = c - a;
     let p = cross(d, e2);
     let det = dot(e1, p);
-    if (det == 0.0) {
-        return -1.0;
-    }
     let s = -a;
     let u = dot(s, p) / det;
     let q = cross(s, e1);
     let v = dot(d, q) / det;
-    if (u < 0.0 || v < 0.0 || u + v > 1.0) {
-        return -1.0;
-    }
-    return dot(e2, q) / det;
+    // det = 0: the ray lies in the triangle's plane and only grazes the prism.
+    let hit = det != 0.0 && u >= 0.0 && v >= 0.0 && u + v <= 1.0;
+    return select(-1.0, dot(e2, q) / det, hit);
 }
 
 struct Hits {
@@ -146,17 +143,16 @@ fn section_cubic(x: vec3<f32>, p: ptr<function, PrismShape>) -> vec4<f32> {
     return vec4<f32>(dot(n0, r), dot(n1, r) - dot(n0, h0), dot(n2, r) - dot(n1, h0), -dot(n2, h0));
 }
 
-// Root in [lo, hi] given a sign change: Newton steps kept inside the bracket, else bisection.
+// Root in [lo, hi] given a sign change: Newton steps kept inside the bracket, else bisection
+// (24 halvings reach f32 precision on [0, 1]; Newton usually converges in a few steps).
 fn bracketed_root(c: vec4<f32>, lo_in: f32, hi_in: f32) -> f32 {
     var lo = lo_in;
     var hi = hi_in;
     var f_lo = cubic(c, lo);
     var w = 0.5 * (lo + hi);
-    for (var k = 0; k < 40; k++) {
+    var done = false;
+    for (var k = 0; k < 24 && !done; k++) {
         let f = cubic(c, w);
-        if (f == 0.0) {
-            return w;
-        }
         if ((f < 0.0) == (f_lo < 0.0)) {
             lo = w;
             f_lo = f;
@@ -169,10 +165,8 @@ fn bracketed_root(c: vec4<f32>, lo_in: f32, hi_in: f32) -> f32 {
         if (newton > lo && newton < hi) {
             next = newton;
         }
-        if (abs(next - w) <= 1e-7 * (1.0 + abs(w)) || hi - lo <= 1e-7) {
-            return next;
-        }
-        w = next;
+        done = f == 0.0 || abs(next - w) <= 1e-7 * (1.0 + abs(w)) || hi - lo <= 1e-7;
+        w = select(next, w, f == 0.0);
     }
     return w;
 }
@@ -186,12 +180,10 @@ fn section_barycentrics(x: vec3<f32>, q0: vec3<f32>, q1: vec3<f32>, q2: vec3<f32
     let d12 = dot(e1, e2);
     let d22 = dot(e2, e2);
     let det = d11 * d22 - d12 * d12;
-    if (det <= 1e-12 * d11 * d22 || det == 0.0) {
-        return vec3<f32>(-2.0);
-    }
     let b1 = (d22 * dot(e, e1) - d12 * dot(e, e2)) / det;
     let b2 = (d11 * dot(e, e2) - d12 * dot(e, e1)) / det;
-    return vec3<f32>(1.0 - b1 - b2, b1, b2);
+    let degenerate = det <= 1e-12 * d11 * d22 || det == 0.0;
+    return select(vec3<f32>(1.0 - b1 - b2, b1, b2), vec3<f32>(-2.0), degenerate);
 }
 
 // The inverse prism map: (b, w) with x = sum_i b_i (p_i + w h_i); w < 0 when x is outside.
@@ -222,19 +214,23 @@ fn prism_inverse(x: vec3<f32>, p: ptr<function, PrismShape>) -> vec4<f32> {
         n += 1u;
     }
     cuts[n] = 1.0;
+    // Points on the bottom or top face give f(0) or f(1) = 0 up to rounding.
+    let tol = ZERO_TOL * dot(abs(c), vec4<f32>(1.0));
+    var result = vec4<f32>(0.0, 0.0, 0.0, -1.0);
     for (var k = 0u; k < n; k++) {
         let lo = cuts[k];
         let hi = cuts[k + 1u];
         let f_lo = cubic(c, lo);
         let f_hi = cubic(c, hi);
         var w = -1.0;
-        if (f_lo == 0.0) {
+        if (abs(f_lo) <= tol) {
             w = lo;
-        } else if (f_hi == 0.0) {
+        } else if (abs(f_hi) <= tol) {
             w = hi;
         } else if ((f_lo < 0.0) != (f_hi < 0.0)) {
             w = bracketed_root(c, lo, hi);
-        } else {
+        }
+        if (w < 0.0) {
             continue;
         }
         let q0 = mix((*p).bottom[0], (*p).top[0], w);
@@ -242,8 +238,9 @@ fn prism_inverse(x: vec3<f32>, p: ptr<function, PrismShape>) -> vec4<f32> {
         let q2 = mix((*p).bottom[2], (*p).top[2], w);
         let b = section_barycentrics(x, q0, q1, q2);
         if (all(b >= vec3<f32>(-INSIDE_EPS))) {
-            return vec4<f32>(b, w);
+            result = vec4<f32>(b, w);
+            break;
         }
     }
-    return vec4<f32>(0.0, 0.0, 0.0, -1.0);
+    return result;
 }

@@ -118,3 +118,8 @@ struct ReferenceObject {
     atlas: vec4<u32>,
     params: vec4<f32>,
 }
+
+struct ReferenceState {
+    color: vec4<f32>,
+    resume: vec4<f32>,
+}
