@@ -9,6 +9,10 @@
 //! broken reference (unreadable, other size). Every scene is checked before the exit status says
 //! whether all passed. References are written only with `--update`, and only for new, regressed
 //! and other-size ones.
+//!
+//! `--jobs N` runs N scenes on threads sharing one [`GpuContext`]. wgpu errors raised outside an
+//! error scope are collected per device, so with N > 1 such an error may be reported on the
+//! scene that happened to look next; rerun the scene alone to be sure which one raised it.
 
 mod check;
 mod discover;
