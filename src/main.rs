@@ -34,7 +34,7 @@ struct Overrides {
     #[arg(long, value_enum)]
     method: Option<MethodArg>,
     /// Ray step (world units) for Reference objects (default: the scene's, else half a voxel).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     step: Option<f64>,
 }
 
