@@ -2,6 +2,7 @@
 
 use crate::bake::{self, Baker};
 use crate::error::{Error, Result};
+use crate::gpu::cache::{self, GpuCache};
 use crate::gpu::timing::Timer;
 use crate::gpu::GpuContext;
 use crate::graph::exec::{Executor, Inputs};
@@ -35,6 +36,12 @@ pub struct Renderer {
 
 impl Renderer {
     pub fn new(ctx: &GpuContext, blueprint: Blueprint) -> Result<Self> {
+        Self::with_cache(ctx, blueprint, &mut GpuCache::default())
+    }
+
+    /// Like [`Renderer::new`], taking shader modules, pipelines and bakes from `cache` where
+    /// nothing that defines them changed (the preview's hot reload).
+    pub fn with_cache(ctx: &GpuContext, blueprint: Blueprint, cache: &mut GpuCache) -> Result<Self> {
         for o in &blueprint.objects {
             for c in &o.chunks {
                 let max = ctx.limits.max_storage_buffer_binding_size;
@@ -45,8 +52,11 @@ impl Renderer {
             set.check_limits(ctx.limits.max_storage_buffer_binding_size)?;
         }
         let mut baker = Baker::new(&wgsl_root());
-        let baked: Vec<bake::Baked> =
-            blueprint.bakes.iter().map(|b| baker.bake(ctx, &b.request)).collect::<Result<_>>()?;
+        let baked: Vec<bake::Baked> = blueprint
+            .bakes
+            .iter()
+            .map(|b| cache.bake(cache::key(&b.request), || baker.bake(ctx, &b.request)))
+            .collect::<Result<_>>()?;
         let sampler = ctx.device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("volume_sampler"),
             address_mode_u: wgpu::AddressMode::Repeat,
@@ -69,7 +79,7 @@ impl Renderer {
             .iter()
             .map(|&(i, part)| instance_inputs(ctx, &blueprint, &blueprint.objects[i], part, &baked))
             .collect();
-        let exec = Executor::new(ctx, blueprint.graph.clone(), &blueprint.plan, blueprint.size)?;
+        let exec = Executor::new(ctx, blueprint.graph.clone(), &blueprint.plan, blueprint.size, cache)?;
         let timer = Timer::new(ctx, blueprint.plan.passes.len() as u32);
         let (w, h) = blueprint.size;
         let readback = ctx.device.create_buffer(&wgpu::BufferDescriptor {
@@ -80,7 +90,7 @@ impl Renderer {
         });
         let mut r = Self { blueprint, exec, frame, objects, timer, readback };
         // Pipelines now, so that a bad kernel fails before any frame.
-        r.exec.prepare(ctx, &r.blueprint.plan, &r.frame, &r.objects)?;
+        r.exec.prepare(ctx, &r.blueprint.plan, &r.frame, &r.objects, cache)?;
         ctx.wait()?;
         Ok(r)
     }
