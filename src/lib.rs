@@ -13,6 +13,7 @@ pub mod mesh;
 pub mod methods;
 pub mod metrics;
 pub mod pareto;
+pub mod regress;
 pub mod scene;
 pub mod types;
 

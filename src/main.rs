@@ -34,7 +34,7 @@ struct Overrides {
     #[arg(long, value_enum)]
     method: Option<MethodArg>,
     /// Ray step (world units) for Reference objects (default: the scene's, else half a voxel).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     step: Option<f64>,
 }
 
@@ -61,6 +61,8 @@ enum Command {
         #[command(flatten)]
         overrides: Overrides,
     },
+    /// Render every scene under a folder and compare it with its reference image (<stem>.ref.exr).
+    Regress(voltex::regress::Args),
     /// Print the adapter, backend, driver, the features voltex uses and limits.
     Info,
     /// Benchmark view-aligned slicing (the 2002 paper's Table 1 set-up) with GPU timestamps.
@@ -151,6 +153,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Render { scene, output, overrides } => render(&scene, output, &overrides),
         Command::Plan { scene, overrides } => plan(&scene, &overrides),
+        Command::Regress(args) => voltex::regress::command(&args),
         Command::Info => GpuContext::new().map(|ctx| print!("{}", ctx.describe())),
         Command::Bench { scenes, planes, size, frames, reference_planes } => {
             voltex::bench::run(&scenes, &planes, size, frames, reference_planes)

@@ -163,3 +163,60 @@ pub struct HeightfieldParams {
     /// rgb: albedo at w = base + amplitude (the highest possible height); a: unused.
     pub color_high: [f32; 4],
 }
+
+/// Camera of the reference tracer (uniform `reference_params`). A pixel's ray is
+/// `forward + sx right + sy up` with `sx, sy` in [-1, 1].
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct ReferenceParams {
+    /// xyz: camera right scaled by the half-width at unit distance; w: near plane distance.
+    pub right: [f32; 4],
+    /// xyz: camera up scaled by the half-height at unit distance; w: far plane distance.
+    pub up: [f32; 4],
+    /// x: BVH node count; y: prism count; z: object count; w: unused.
+    pub counts: [u32; 4],
+}
+
+/// A node of the BVH over prism bounds (obvhs's BVH2, flattened). Inner nodes have their children
+/// at `first` and `first + 1`; leaves hold the prisms `first..first + count`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct ReferenceNode {
+    /// xyz: box minimum (camera-relative); w: prism count as u32 bits (0 for inner nodes).
+    pub min: [f32; 4],
+    /// xyz: box maximum; w: `first` as u32 bits.
+    pub max: [f32; 4],
+}
+
+/// A prism of a Reference object, in BVH leaf order.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct ReferencePrism {
+    /// xyz: vertex ids into the frame's concatenated shell vertices; w: object index.
+    pub vertices: [u32; 4],
+    pub uv01: [f32; 4],
+    pub uv2: [f32; 4],
+}
+
+/// A Reference object: where its volume sits in the texel atlas, and its optical parameters.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct ReferenceObject {
+    /// xyz: volume resolution; w: flags (1: per-pixel lighting, 2: opaque base surface).
+    pub resolution: [u32; 4],
+    /// x: volume offset in the texel atlas (u32 words); y: row pitch (words); z: normal volume
+    /// offset in the normal atlas; w: unused.
+    pub atlas: [u32; 4],
+    /// x: opacity length; y: ray step (world units); zw: unused.
+    pub params: [f32; 4],
+}
+
+/// Per-pixel progress of the reference tracer between its dispatches (`reference_state`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct ReferenceState {
+    /// rgb: colour gathered so far; a: transmittance.
+    pub color: [f32; 4],
+    /// x: ray distance to resume from; y: 1 once started; z: 1 once finished.
+    pub resume: [f32; 4],
+}

@@ -413,6 +413,24 @@ fn render_writes_exr_and_png_with_metadata() {
 }
 
 #[test]
+fn render_with_the_reference_method() {
+    let dir = temp_dir("reference");
+    let scene = root().join("scenes/view_slices/flat_box.ron");
+    let out = render(&dir, &scene, &["--method", "reference", "--step", "0.01"], None);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let (image, meta) = voltex::io::exr::read(&dir.join("out/out.exr")).unwrap();
+    let method = meta.iter().find(|(k, _)| k == "voltex_object_box").map(|(_, v)| v.as_str());
+    assert_eq!(method, Some("Reference(step: 0.010000, lighting: Baked)"));
+    assert!(image.get(32, 32)[0] > 0.0);
+    // A step that is not a positive length, and one far too fine for the scene.
+    for (step, words) in [("-1", &["--step -1", "positive"][..]), ("1e-9", &["too fine", "step"][..])] {
+        let dir = temp_dir("reference-bad");
+        let out = render(&dir, &scene, &["--method", "reference", "--step", step], None);
+        assert_fails(&out, &dir, words);
+    }
+}
+
+#[test]
 fn failed_render_keeps_previous_output() {
     let dir = temp_dir("keep");
     std::fs::write(dir.join("out/out.exr"), "old").unwrap();

@@ -115,12 +115,25 @@ fn assert_err(e: voltex::Error, at: &str, words: &[&str]) {
 #[test]
 fn frame_graph_parses_and_plans() {
     let g = Graph::load(&root().join("graphs/frame.ron")).unwrap();
-    let p = plan(&g, &wgsl_root(), &objects(&[&["ViewSlices", "BaseSurface"]])).unwrap();
+    let p = plan(&g, &wgsl_root(), &objects(&[&["ViewSlices", "BaseSurface"], &["Reference"]])).unwrap();
     assert_eq!(
         names(&p),
-        ["draw_base", "count_slices", "scan_plane_offsets", "emit_slices", "draw_slices", "composite"]
+        [
+            "draw_base",
+            "count_slices",
+            "scan_plane_offsets",
+            "emit_slices",
+            "draw_slices",
+            "trace_reference",
+            "composite_reference",
+            "composite"
+        ]
     );
     assert!(p.pruned.is_empty(), "{:?}", p.pruned);
+    // Without Reference objects its passes and layer go.
+    let p = plan(&g, &wgsl_root(), &objects(&[&["ViewSlices", "BaseSurface"]])).unwrap();
+    assert!(!names(&p).contains(&"trace_reference"), "{:?}", names(&p));
+    assert!(p.pruned.iter().any(|r| r.contains("reference_rgba")), "{:?}", p.pruned);
 }
 
 #[test]

@@ -1,6 +1,7 @@
-//! `voltex pareto` through the real binary: a reduced sweep on a small scene writes the CSV (one
-//! row per setting, error falling with the plane count), the SVG with every point and the truth;
-//! bad input fails with status 1 before any rendering. No test asserts a duration.
+//! `voltex pareto` through the real binary: reduced sweeps on a small scene write the CSV (one
+//! row per setting, error falling with the plane count and rising with the ray step), the SVG
+//! with every point and the truth; bad input fails with status 1 before any rendering. No test
+//! asserts a duration.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -117,6 +118,39 @@ fn view_slices_sweep_writes_csv_svg_and_fronts() {
     assert_eq!(svg.matches(r#"class="point""#).count(), 4);
     assert!(svg.contains(">ViewSlices</text>"));
     assert!(out.join("truth.png").is_file());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn reference_truth_and_step_sweep() {
+    let dir = temp_dir("reference");
+    let out = dir.join("result");
+    let out_s = out.to_str().unwrap().to_string();
+    let scene = scene("torus_egg.ron");
+    let args =
+        [&scene, "--size", "40x40", "--frames", "1", "--planes", "16", "--steps", "8,32", "--out", &out_s];
+    let run = pareto(&args);
+    let log = text(&run);
+    println!("{log}");
+    assert_eq!(run.status.code(), Some(0), "{log}");
+    assert!(log.contains("truth: Reference, default step"), "{log}");
+    assert!(log.contains("Reference front:") && log.contains("ViewSlices front:"), "{log}");
+
+    let (header, rows) = read_csv(&out.join("pareto.csv"));
+    let col = |name: &str| header.iter().position(|h| h == name).unwrap();
+    let reference: Vec<&Vec<String>> = rows.iter().filter(|r| r[col("method")] == "Reference").collect();
+    assert_eq!(reference.len(), 2, "{rows:?}");
+    assert_eq!(rows.len(), 4, "ViewSlices at 16 planes, reject on and off, and two steps: {rows:?}");
+    let by = |k: &str| reference.iter().find(|r| r[col("knobs")] == k).unwrap_or_else(|| panic!("no {k}"));
+    let f = |k: &str, c: &str| by(k)[col(c)].parse::<f64>().unwrap();
+    let ratio = f("step=32x", "step") / f("step=8x", "step");
+    assert!((ratio - 4.0).abs() < 1e-3, "steps are multiples of one default step: {ratio}");
+    println!("Reference FLIP {:.4} at 8x, {:.4} at 32x", f("step=8x", "flip"), f("step=32x", "flip"));
+    assert!(f("step=32x", "flip") > f("step=8x", "flip"), "error should grow with the step");
+    assert!(by("step=8x")[col("passes")].contains("trace_reference="));
+    let svg = std::fs::read_to_string(out.join("pareto.svg")).unwrap();
+    assert_eq!(svg.matches(r#"class="point""#).count(), 4);
+    assert!(svg.contains(">Reference</text>") && svg.contains(">ViewSlices</text>"));
     let _ = std::fs::remove_dir_all(&dir);
 }
 

@@ -29,6 +29,11 @@ fn wgsl_structs_match_rust() {
         layout!(BakeParams; resolution, light),
         layout!(ImplicitShape; kind, first_ball, ball_count, _pad, center, params, color),
         layout!(HeightfieldParams; frequency, octaves, seed, _pad0, amplitude, base, opacity, _pad1, color_low, color_high),
+        layout!(ReferenceParams; right, up, counts),
+        layout!(ReferenceNode; min, max),
+        layout!(ReferencePrism; vertices, uv01, uv2),
+        layout!(ReferenceObject; resolution, atlas, params),
+        layout!(ReferenceState; color, resume),
     ];
     let mut seen = 0;
     for (_, ty) in kernel.module.types.iter() {

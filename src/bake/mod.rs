@@ -14,11 +14,13 @@ use crate::graph::exec::Inputs;
 use crate::types::{BakeParams, HeightfieldParams};
 
 /// What a bake kernel evaluates.
+#[derive(Debug)]
 pub enum BakeSource {
     Implicit(PackedShapes),
     Heightfield(HeightfieldParams),
 }
 
+#[derive(Debug)]
 pub struct BakeRequest {
     pub resolution: [u32; 3],
     pub source: BakeSource,
@@ -29,6 +31,7 @@ pub struct BakeRequest {
     pub ambient: f32,
 }
 
+#[derive(Clone)]
 pub struct Baked {
     pub volume: wgpu::Texture,
     /// The normal volume (1x1x1 when `per_pixel` is off: the binding exists, nothing is stored).

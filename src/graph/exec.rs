@@ -5,6 +5,7 @@ use std::borrow::Cow;
 use std::collections::HashMap;
 
 use crate::error::{Error, Result};
+use crate::gpu::cache::{self, GpuCache, Layout, Pipeline};
 use crate::gpu::reflect::{self, BindingKind};
 use crate::gpu::timing::Timer;
 use crate::gpu::GpuContext;
@@ -26,12 +27,8 @@ pub struct Inputs {
 }
 
 /// Count names the runtime provides (per object or per frame).
-pub const COUNTS: &[&str] = &["prisms", "planes", "plane_blocks", "base_vertices", "width", "height"];
-
-enum Pipeline {
-    Compute(wgpu::ComputePipeline),
-    Render(wgpu::RenderPipeline),
-}
+pub const COUNTS: &[&str] =
+    &["prisms", "planes", "plane_blocks", "base_vertices", "width", "height", "reference_dispatches"];
 
 struct Texture {
     texture: wgpu::Texture,
@@ -43,12 +40,20 @@ pub struct Executor {
     graph: Graph,
     textures: HashMap<String, Texture>,
     modules: HashMap<String, wgpu::ShaderModule>,
-    layouts: Vec<(Vec<wgpu::BindGroupLayout>, wgpu::PipelineLayout)>,
+    layouts: Vec<Layout>,
     pipelines: HashMap<(usize, String), Pipeline>,
 }
 
 impl Executor {
-    pub fn new(ctx: &GpuContext, graph: Graph, plan: &Plan, size: (u32, u32)) -> Result<Self> {
+    /// Graph textures, shader modules and layouts for a plan; modules and layouts come from
+    /// `cache` when their source and bindings are unchanged.
+    pub fn new(
+        ctx: &GpuContext,
+        graph: Graph,
+        plan: &Plan,
+        size: (u32, u32),
+        cache: &mut GpuCache,
+    ) -> Result<Self> {
         let max2d = ctx.limits.max_texture_dimension_2d;
         if size.0 > max2d || size.1 > max2d {
             return Err(Error::Gpu(format!(
@@ -70,6 +75,14 @@ impl Executor {
             .filter(|t| t.blend != Blend::Replace)
             .map(|t| t.resource.as_str())
             .collect();
+        // Textures some compute pass writes as storage textures.
+        let stored: Vec<&str> = plan
+            .passes
+            .iter()
+            .flat_map(|p| &p.bindings)
+            .filter(|b| matches!(b.kind, BindingKind::StorageTexture { .. }))
+            .map(|b| b.name.as_str())
+            .collect();
         let mut textures = HashMap::new();
         for (name, decl) in &plan.textures {
             let ResourceDecl::Texture { format, size: tsize, clear } = decl;
@@ -86,7 +99,12 @@ impl Executor {
                 format: texture_format(ctx, &graph, name, format.wgpu(), &blended),
                 usage: wgpu::TextureUsages::RENDER_ATTACHMENT
                     | wgpu::TextureUsages::TEXTURE_BINDING
-                    | wgpu::TextureUsages::COPY_SRC,
+                    | wgpu::TextureUsages::COPY_SRC
+                    | if stored.contains(&name.as_str()) {
+                        wgpu::TextureUsages::STORAGE_BINDING
+                    } else {
+                        wgpu::TextureUsages::empty()
+                    },
                 view_formats: &[],
             });
             let view = texture.create_view(&Default::default());
@@ -96,17 +114,20 @@ impl Executor {
         let mut layouts = Vec::new();
         for p in &plan.passes {
             let name = p.decl.shader().to_string();
-            if let std::collections::hash_map::Entry::Vacant(slot) = modules.entry(name) {
-                let label = format!("shader {}", slot.key());
-                let module = ctx.scoped(&label, || {
+            let label = format!("shader {name}");
+            let module = cache.module(p.kernel.source_hash, || {
+                ctx.scoped(&label, || {
                     ctx.device.create_shader_module(wgpu::ShaderModuleDescriptor {
                         label: Some(&label),
                         source: wgpu::ShaderSource::Naga(Cow::Owned(p.kernel.module.clone())),
                     })
-                })?;
-                slot.insert(module);
-            }
-            layouts.push(pass_layout(ctx, p));
+                })
+            })?;
+            modules.insert(name, module);
+            let entries: Vec<wgpu::BindGroupLayoutEntry> =
+                p.bindings.iter().map(reflect::layout_entry).collect();
+            let groups: Vec<u32> = p.bindings.iter().map(|b| b.group).collect();
+            layouts.push(cache.layout(cache::key(&(&entries, &groups)), || pass_layout(ctx, p)));
         }
         Ok(Self { graph, textures, modules, layouts, pipelines: HashMap::new() })
     }
@@ -122,10 +143,11 @@ impl Executor {
         plan: &Plan,
         frame: &Inputs,
         objects: &[Inputs],
+        cache: &mut GpuCache,
     ) -> Result<()> {
         for i in 0..plan.passes.len() {
             for inst in instance_inputs(&plan.passes[i], frame, objects) {
-                self.pipeline(ctx, plan, i, frame, inst)?;
+                self.pipeline(ctx, plan, i, frame, inst, cache)?;
             }
         }
         Ok(())
@@ -138,6 +160,7 @@ impl Executor {
         index: usize,
         frame: &Inputs,
         inst: &Inputs,
+        cache: &mut GpuCache,
     ) -> Result<()> {
         let pass = &plan.passes[index];
         let constants = specialisation(pass, frame, inst).map_err(|name| {
@@ -154,79 +177,93 @@ impl Executor {
             return Ok(());
         }
         let module = &self.modules[pass.decl.shader()];
-        let layout = &self.layouts[index].1;
+        let layout = &self.layouts[index].pipeline;
         let options = wgpu::PipelineCompilationOptions {
             constants: &constants,
             zero_initialize_workgroup_memory: true,
         };
         let label = format!("{} ({})", pass.decl.name(), pass.decl.shader());
-        let pipeline = match &pass.decl {
-            PassDecl::Compute { entry, .. } => ctx.scoped(&label, || {
-                Pipeline::Compute(ctx.device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                    label: Some(&label),
-                    layout: Some(layout),
-                    module,
-                    entry_point: Some(entry),
-                    compilation_options: options.clone(),
-                    cache: None,
-                }))
-            })?,
-            PassDecl::Raster { vertex, fragment, targets, depth, .. } => {
-                let color: Vec<Option<wgpu::ColorTargetState>> = targets
-                    .iter()
-                    .map(|t| {
-                        Some(wgpu::ColorTargetState {
-                            format: self.textures[&t.resource].texture.format(),
-                            blend: match t.blend {
-                                Blend::Replace => None,
-                                Blend::PremultipliedOver => {
-                                    Some(wgpu::BlendState::PREMULTIPLIED_ALPHA_BLENDING)
-                                }
-                                Blend::Add => {
-                                    let add = wgpu::BlendComponent {
-                                        src_factor: wgpu::BlendFactor::One,
-                                        dst_factor: wgpu::BlendFactor::One,
-                                        operation: wgpu::BlendOperation::Add,
-                                    };
-                                    Some(wgpu::BlendState { color: add, alpha: add })
-                                }
-                            },
-                            write_mask: wgpu::ColorWrites::ALL,
-                        })
-                    })
-                    .collect();
-                let depth_stencil = depth.as_ref().map(|d| wgpu::DepthStencilState {
-                    format: self.textures[&d.resource].texture.format(),
-                    depth_write_enabled: Some(d.write),
-                    depth_compare: Some(d.compare.wgpu()),
-                    stencil: Default::default(),
-                    bias: Default::default(),
-                });
-                ctx.scoped(&label, || {
-                    Pipeline::Render(ctx.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        let formats: Vec<wgpu::TextureFormat> = match &pass.decl {
+            PassDecl::Raster { targets, depth, .. } => targets
+                .iter()
+                .map(|t| &t.resource)
+                .chain(depth.iter().map(|d| &d.resource))
+                .map(|r| self.textures[r].texture.format())
+                .collect(),
+            PassDecl::Compute { .. } => Vec::new(),
+        };
+        // Everything that defines the pipeline: source, bindings, the pass (entries, blending,
+        // depth), target formats and specialisation.
+        let desc = cache::key(&(pass.kernel.source_hash, &pass.bindings, &pass.decl, &formats, &constants));
+        let pipeline = cache.pipeline(desc, || {
+            Ok(match &pass.decl {
+                PassDecl::Compute { entry, .. } => ctx.scoped(&label, || {
+                    Pipeline::Compute(ctx.device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
                         label: Some(&label),
                         layout: Some(layout),
-                        vertex: wgpu::VertexState {
-                            module,
-                            entry_point: Some(vertex),
-                            compilation_options: options.clone(),
-                            buffers: &[],
-                        },
-                        primitive: wgpu::PrimitiveState::default(),
-                        depth_stencil,
-                        multisample: Default::default(),
-                        fragment: Some(wgpu::FragmentState {
-                            module,
-                            entry_point: Some(fragment),
-                            compilation_options: options.clone(),
-                            targets: &color,
-                        }),
-                        multiview_mask: None,
+                        module,
+                        entry_point: Some(entry),
+                        compilation_options: options.clone(),
                         cache: None,
                     }))
-                })?
-            }
-        };
+                })?,
+                PassDecl::Raster { vertex, fragment, targets, depth, .. } => {
+                    let color: Vec<Option<wgpu::ColorTargetState>> = targets
+                        .iter()
+                        .map(|t| {
+                            Some(wgpu::ColorTargetState {
+                                format: self.textures[&t.resource].texture.format(),
+                                blend: match t.blend {
+                                    Blend::Replace => None,
+                                    Blend::PremultipliedOver => {
+                                        Some(wgpu::BlendState::PREMULTIPLIED_ALPHA_BLENDING)
+                                    }
+                                    Blend::Add => {
+                                        let add = wgpu::BlendComponent {
+                                            src_factor: wgpu::BlendFactor::One,
+                                            dst_factor: wgpu::BlendFactor::One,
+                                            operation: wgpu::BlendOperation::Add,
+                                        };
+                                        Some(wgpu::BlendState { color: add, alpha: add })
+                                    }
+                                },
+                                write_mask: wgpu::ColorWrites::ALL,
+                            })
+                        })
+                        .collect();
+                    let depth_stencil = depth.as_ref().map(|d| wgpu::DepthStencilState {
+                        format: self.textures[&d.resource].texture.format(),
+                        depth_write_enabled: Some(d.write),
+                        depth_compare: Some(d.compare.wgpu()),
+                        stencil: Default::default(),
+                        bias: Default::default(),
+                    });
+                    ctx.scoped(&label, || {
+                        Pipeline::Render(ctx.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                            label: Some(&label),
+                            layout: Some(layout),
+                            vertex: wgpu::VertexState {
+                                module,
+                                entry_point: Some(vertex),
+                                compilation_options: options.clone(),
+                                buffers: &[],
+                            },
+                            primitive: wgpu::PrimitiveState::default(),
+                            depth_stencil,
+                            multisample: Default::default(),
+                            fragment: Some(wgpu::FragmentState {
+                                module,
+                                entry_point: Some(fragment),
+                                compilation_options: options.clone(),
+                                targets: &color,
+                            }),
+                            multiview_mask: None,
+                            cache: None,
+                        }))
+                    })?
+                }
+            })
+        })?;
         self.pipelines.insert(key, pipeline);
         Ok(())
     }
@@ -240,7 +277,6 @@ impl Executor {
         objects: &[Inputs],
         timer: &mut Timer,
     ) -> Result<()> {
-        self.prepare(ctx, plan, frame, objects)?;
         let mut encoder =
             ctx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
         let mut written: Vec<String> = Vec::new();
@@ -276,12 +312,22 @@ impl Executor {
             &self.pipelines[&(index, constants_key(&specialisation(pass, frame, inst).unwrap_or_default()))]
         };
         match &pass.decl {
-            PassDecl::Compute { name, entry, clear, dispatch, .. } => {
+            PassDecl::Compute { name, entry, clear, dispatch, repeat, .. } => {
                 for inst in &instances {
                     for b in clear {
                         let buf = resolve_buffer(inst, frame, b)
                             .ok_or_else(|| plan::unknown_resource(&self.graph, name, b))?;
                         encoder.clear_buffer(buf, 0, None);
+                    }
+                }
+                // Graph textures a compute pass touches before any pass wrote them this frame start
+                // from their clear value (e.g. the depth buffer when no base surface is drawn).
+                for b in &pass.bindings {
+                    if self.textures.contains_key(&b.name) && !written.contains(&b.name) {
+                        written.push(b.name.clone());
+                        if !matches!(b.kind, BindingKind::StorageTexture { .. }) {
+                            self.clear_texture(encoder, &b.name);
+                        }
                     }
                 }
                 let wg = reflect::workgroup_size(&pass.kernel, entry).unwrap_or([1, 1, 1]);
@@ -313,7 +359,9 @@ impl Executor {
                     for (i, bg) in bgs.iter().enumerate() {
                         cpass.set_bind_group(i as u32, bg, &[]);
                     }
-                    cpass.dispatch_workgroups(g[0], g[1], g[2]);
+                    for _ in 0..count(repeat, inst, frame) {
+                        cpass.dispatch_workgroups(g[0], g[1], g[2]);
+                    }
                 }
             }
             PassDecl::Raster { name, targets, depth, draw, .. } => {
@@ -402,6 +450,43 @@ impl Executor {
         Ok(())
     }
 
+    /// Clears a graph texture to its declared clear value (transparent black or depth 1 if none).
+    fn clear_texture(&self, encoder: &mut wgpu::CommandEncoder, name: &str) {
+        let t = &self.textures[name];
+        let depth = t.texture.format().is_depth_stencil_format();
+        let color = match t.clear {
+            Some(Clear::Color(r, g, b, a)) => {
+                wgpu::Color { r: r as f64, g: g as f64, b: b as f64, a: a as f64 }
+            }
+            _ => wgpu::Color::TRANSPARENT,
+        };
+        let depth_value = match t.clear {
+            Some(Clear::Depth(v)) => v,
+            _ => 1.0,
+        };
+        let color_att = [Some(wgpu::RenderPassColorAttachment {
+            view: &t.view,
+            depth_slice: None,
+            resolve_target: None,
+            ops: wgpu::Operations { load: wgpu::LoadOp::Clear(color), store: wgpu::StoreOp::Store },
+        })];
+        encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("clear"),
+            color_attachments: if depth { &[] } else { &color_att },
+            depth_stencil_attachment: depth.then_some(wgpu::RenderPassDepthStencilAttachment {
+                view: &t.view,
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(depth_value),
+                    store: wgpu::StoreOp::Store,
+                }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+    }
+
     fn bind_groups(
         &self,
         ctx: &GpuContext,
@@ -410,7 +495,7 @@ impl Executor {
         frame: &Inputs,
         inst: &Inputs,
     ) -> Result<Vec<wgpu::BindGroup>> {
-        let (bgls, _) = &self.layouts[index];
+        let bgls = &self.layouts[index].groups;
         let mut out = Vec::new();
         for (group, bgl) in bgls.iter().enumerate() {
             let mut entries = Vec::new();
@@ -525,9 +610,9 @@ fn constants_key(constants: &[(&str, f64)]) -> String {
     format!("{constants:?}")
 }
 
-fn pass_layout(ctx: &GpuContext, pass: &PlannedPass) -> (Vec<wgpu::BindGroupLayout>, wgpu::PipelineLayout) {
-    let groups = pass.bindings.iter().map(|b| b.group + 1).max().unwrap_or(0);
-    let bgls: Vec<wgpu::BindGroupLayout> = (0..groups)
+fn pass_layout(ctx: &GpuContext, pass: &PlannedPass) -> Layout {
+    let count = pass.bindings.iter().map(|b| b.group + 1).max().unwrap_or(0);
+    let groups: Vec<wgpu::BindGroupLayout> = (0..count)
         .map(|g| {
             let entries: Vec<_> =
                 pass.bindings.iter().filter(|b| b.group == g).map(reflect::layout_entry).collect();
@@ -535,13 +620,13 @@ fn pass_layout(ctx: &GpuContext, pass: &PlannedPass) -> (Vec<wgpu::BindGroupLayo
                 .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: None, entries: &entries })
         })
         .collect();
-    let refs: Vec<Option<&wgpu::BindGroupLayout>> = bgls.iter().map(Some).collect();
-    let layout = ctx.device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+    let refs: Vec<Option<&wgpu::BindGroupLayout>> = groups.iter().map(Some).collect();
+    let pipeline = ctx.device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
         label: Some(pass.decl.name()),
         bind_group_layouts: &refs,
         immediate_size: 0,
     });
-    (bgls, layout)
+    Layout { groups, pipeline }
 }
 
 fn instance_inputs<'a>(pass: &PlannedPass, frame: &'a Inputs, objects: &'a [Inputs]) -> Vec<&'a Inputs> {
@@ -566,8 +651,12 @@ fn count(name: &str, inst: &Inputs, frame: &Inputs) -> u32 {
 /// `voltex plan` reports them without a GPU).
 pub fn check_counts(graph: &Graph, decl: &PassDecl) -> Result<()> {
     match decl {
-        PassDecl::Compute { dispatch: Dispatch::Threads(x, y, z) | Dispatch::Groups(x, y, z), .. } => {
-            for c in [x, y, z] {
+        PassDecl::Compute {
+            dispatch: Dispatch::Threads(x, y, z) | Dispatch::Groups(x, y, z),
+            repeat,
+            ..
+        } => {
+            for c in [x, y, z, repeat] {
                 plan::check_count(graph, c, COUNTS)?;
             }
         }

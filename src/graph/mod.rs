@@ -102,6 +102,10 @@ pub enum PassDecl {
         #[serde(default)]
         clear: Vec<String>,
         dispatch: Dispatch,
+        /// Dispatches per frame (a count name or number): kernels that resume their work from a
+        /// state buffer, so no single dispatch runs long (watchdogs, software loop limits).
+        #[serde(default = "one")]
+        repeat: String,
     },
     Raster {
         name: String,
@@ -117,6 +121,10 @@ pub enum PassDecl {
         depth: Option<DepthTarget>,
         draw: Draw,
     },
+}
+
+fn one() -> String {
+    "1".into()
 }
 
 fn default_compute_entry() -> String {

@@ -1,4 +1,5 @@
-//! Host side of each method. Now: view-aligned prism slicing, and the opaque base surface.
+//! Host side of each method. Now: view-aligned prism slicing, the reference ray caster, and the opaque base surface.
 
+pub mod reference;
 pub mod shell;
 pub mod view_slices;

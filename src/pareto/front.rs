@@ -1,9 +1,16 @@
 //! Pareto fronts of (time, error) points: a point is on the front when no other point is at least
 //! as fast and at least as accurate, and strictly better in one of the two. Both are minimised.
+//! Errors within [`ERROR_TOLERANCE`] of each other count as equal: renders that differ only in
+//! floating-point blending order (the trivial reject on or off) are ties, and the faster wins.
+
+/// Relative difference below which two errors are equal.
+pub const ERROR_TOLERANCE: f64 = 1e-3;
 
 /// `a` dominates `b`: no slower, no less accurate, strictly better in time or error.
 pub fn dominates(a: (f64, f64), b: (f64, f64)) -> bool {
-    a.0 <= b.0 && a.1 <= b.1 && (a.0 < b.0 || a.1 < b.1)
+    let no_worse = a.1 <= b.1 * (1.0 + ERROR_TOLERANCE);
+    let better = a.1 * (1.0 + ERROR_TOLERANCE) < b.1;
+    a.0 <= b.0 && no_worse && (a.0 < b.0 || better)
 }
 
 fn finite(p: (f64, f64)) -> bool {
@@ -43,6 +50,17 @@ mod tests {
         let p = [(1.0, 0.5), (4.0, 0.1), (2.0, 0.6), (5.0, 0.1), (2.0, 0.2)];
         assert_eq!(front(&p), [true, true, false, false, true]);
         assert_eq!(front_order(&p), [0, 4, 1]);
+    }
+
+    #[test]
+    fn errors_within_the_tolerance_are_ties() {
+        // The slower point is 1e-5 more accurate: noise, not a trade-off.
+        let p = [(10.0, 0.211959), (15.0, 0.211954)];
+        assert_eq!(front(&p), [true, false]);
+        // Same time, errors within the tolerance: both stay.
+        assert_eq!(front(&[(10.0, 0.2), (10.0, 0.20001)]), [true, true]);
+        // A real improvement is kept.
+        assert_eq!(front(&[(10.0, 0.2), (15.0, 0.19)]), [true, true]);
     }
 
     #[test]

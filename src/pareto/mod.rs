@@ -17,7 +17,7 @@ use std::str::FromStr;
 
 use crate::error::{Error, Result};
 use crate::gpu::GpuContext;
-use crate::io::atomic;
+use crate::io::{atomic, Image};
 use crate::render::{Blueprint, MethodKind, RenderOptions};
 use crate::scene::{Scene, MAX_PLANES};
 use report::Row;
@@ -177,42 +177,22 @@ pub fn sweep(scene: &Scene, args: &Args) -> Result<(Vec<Setting>, Vec<String>)> 
     for &m in &args.methods {
         match m {
             MethodKind::ViewSlices => settings.extend(view_slices(args)),
-            MethodKind::Reference => match reference_default_step(scene)? {
-                Some(step) => settings.extend(reference(args, step)),
-                None => notes.push("Reference: no textured object to step through".into()),
+            MethodKind::Reference => match reference_default_step(scene, args.size) {
+                Ok(Some(step)) => settings.extend(reference(args, step)),
+                Ok(None) => notes.push("Reference: not measured: no textured object".into()),
+                Err(e) => notes.push(format!("Reference: not measured: {e}")),
             },
         }
     }
     Ok((settings, notes))
 }
 
-/// The `Reference` method's default step for the scene: half the smallest voxel extent (world
-/// units, along `s`, `t` or `w`) over its textured objects. With several objects, the sweep
-/// scales this one step for all of them.
-pub fn reference_default_step(scene: &Scene) -> Result<Option<f64>> {
-    let mut best = f64::INFINITY;
-    for o in scene.objects()? {
-        let texel = o.texel.as_ref().and_then(|t| scene.texels.get(t));
-        let (Some(_), Some(texel)) = (&o.method, texel) else { continue };
-        let [rs, rt, rw] = texel.resolution.map(f64::from);
-        for h in &o.surface.heights {
-            if h.length() > 0.0 {
-                best = best.min(h.length() / rw);
-            }
-        }
-        for (tri, uv) in o.surface.triangles.iter().zip(&o.surface.corner_uvs) {
-            let p = tri.map(|i| o.surface.positions[i as usize]);
-            let (e1, e2, d1, d2) = (p[1] - p[0], p[2] - p[0], uv[1] - uv[0], uv[2] - uv[0]);
-            let det = d1.x * d2.y - d2.x * d1.y;
-            if det.abs() > 1e-12 {
-                // World length per unit of s and of t over this triangle.
-                let ds = (e1 * d2.y - e2 * d1.y) / det;
-                let dt = (e2 * d1.x - e1 * d2.x) / det;
-                best = best.min(ds.length() / rs).min(dt.length() / rt);
-            }
-        }
-    }
-    Ok((best.is_finite() && best > 0.0).then_some(0.5 * best))
+/// The `Reference` method's default step for the scene: the smallest of its textured objects'
+/// default steps (half the smallest voxel extent, see `methods::reference::default_step`).
+pub fn reference_default_step(scene: &Scene, size: (u32, u32)) -> Result<Option<f64>> {
+    let opts = RenderOptions { size: Some(size), method: Some(MethodKind::Reference), ..Default::default() };
+    let bp = Blueprint::new(scene, &opts)?;
+    Ok(bp.objects.iter().filter_map(|o| o.reference_step).min_by(f64::total_cmp))
 }
 
 pub fn run(args: &Args) -> Result<()> {
@@ -226,25 +206,14 @@ pub fn run(args: &Args) -> Result<()> {
     atomic::check_writable_dir(&out)?;
 
     let n = settings.len();
-    // Phase 1: compute passes alone, each setting on a fresh device where no render pass has run.
-    let mut compute: Vec<Option<measure::ComputeOnly>> = Vec::new();
-    for (i, (s, bp)) in settings.iter().zip(blueprints).enumerate() {
-        eprintln!("[{}/{n}] {} {}: compute passes", i + 1, s.method, s.knobs);
-        let timed = GpuContext::new().and_then(|ctx| measure::compute_passes(&ctx, bp, args.frames));
-        compute.push(timed.map_err(|e| note(&mut notes, s, &e)).ok());
-    }
-    // Phase 2: the truth, then whole frames for images and raster passes.
+    let load = report::load_average();
     let ctx = GpuContext::new()?;
     eprintln!("truth: {}", args.truth);
     let truth = measure::image(&ctx, Blueprint::new(&scene, &args.truth.options(args.size))?)?;
     let mut rows = Vec::new();
-    for (i, (s, compute)) in settings.into_iter().zip(compute).enumerate() {
-        let Some(compute) = compute else { continue };
-        eprintln!("[{}/{n}] {} {}: frames", i + 1, s.method, s.knobs);
-        let measured = Blueprint::new(&scene, &s.options)
-            .and_then(|bp| measure::full_frames(&ctx, bp, args.frames))
-            .and_then(|f| Row::new(s.clone(), compute, f, &truth));
-        match measured {
+    for (i, (s, bp)) in settings.into_iter().zip(blueprints).enumerate() {
+        eprintln!("[{}/{n}] {} {}", i + 1, s.method, s.knobs);
+        match measure_setting(&scene, args, &s, bp, &truth) {
             Ok(row) => rows.push(row),
             Err(e) => note(&mut notes, &s, &e),
         }
@@ -266,9 +235,19 @@ pub fn run(args: &Args) -> Result<()> {
     );
     atomic::write_bytes(&svg_path, report::chart(&rows, &title, ctx.has_timestamps()).as_bytes())?;
     crate::io::png::write_tonemapped(&out.join("truth.png"), &truth)?;
-    report::print_report(args, &ctx, &rows, &notes);
+    report::print_report(args, &ctx, &rows, &notes, load);
     println!("wrote {}, {} and truth.png", csv_path.display(), svg_path.display());
     Ok(())
+}
+
+/// Times one setting and measures its error. On a fresh device, so that no render pass has run
+/// on it when its compute passes are timed alone (phase 1); then whole frames (phase 2), right
+/// after, so both phases see the same machine load.
+fn measure_setting(scene: &Scene, args: &Args, s: &Setting, bp: Blueprint, truth: &Image) -> Result<Row> {
+    let ctx = GpuContext::new()?;
+    let compute = measure::compute_passes(&ctx, bp, args.frames)?;
+    let frames = measure::full_frames(&ctx, Blueprint::new(scene, &s.options)?, args.frames)?;
+    Row::new(s.clone(), compute, frames, truth)
 }
 
 /// The settings to measure, each with its blueprint (CPU only: planning fails early), and notes

@@ -157,19 +157,30 @@ fn timing_check(rows: &[Row]) -> String {
     line
 }
 
-pub(super) fn print_report(args: &Args, ctx: &GpuContext, rows: &[Row], notes: &[String]) {
+/// The 1-minute load average (Linux), to tell a quiet machine from a busy one: on a software
+/// adapter, GPU time is CPU time and other processes stretch it.
+pub(super) fn load_average() -> Option<f64> {
+    std::fs::read_to_string("/proc/loadavg").ok()?.split_whitespace().next()?.parse().ok()
+}
+
+pub(super) fn print_report(args: &Args, ctx: &GpuContext, rows: &[Row], notes: &[String], load: Option<f64>) {
     println!("pareto: {} at {}x{}, truth: {}", args.scene.display(), args.size.0, args.size.1, args.truth);
     println!("adapter: {}", ctx.adapter_line());
     if ctx.has_timestamps() {
         println!(
-            "GPU ms: per frame, the sum of each pass's median over {} frames after {} warm-up frames \
-             (compute passes timed alone, see README); wall ms: submit to idle",
+            "GPU ms: per frame, the sum of each pass's median over {} frames after warm-up ({} frames, \
+             1 when a frame takes over {} ms; compute passes timed alone, see README); wall ms: submit to idle",
             args.frames,
-            measure::WARM_UP_FRAMES
+            measure::WARM_UP_FRAMES,
+            measure::LONG_FRAME_MS
         );
         println!("{}", timing_check(rows));
     } else {
         println!("no GPU timestamps on this adapter: times are wall clock (submit to idle)");
+    }
+    let cores = std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1);
+    if let (Some(a), Some(b)) = (load, load_average()) {
+        println!("load average (1 min) at start {a:.2}, at end {b:.2}, on {cores} cores");
     }
     for n in notes {
         println!("{n}");

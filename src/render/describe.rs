@@ -36,6 +36,20 @@ impl Blueprint {
                 bake::bytes(r, b.request.per_pixel),
             ));
         }
+        if let Some(r) = &self.reference {
+            out.push((
+                format!(
+                    "reference: BVH ({} nodes), {} prisms, shells, texel atlas{}, per-pixel state",
+                    r.nodes.len(),
+                    r.prisms.len(),
+                    if r.normal_words > 1 { " + normal atlas" } else { "" }
+                ),
+                (r.nodes.len() * 32 + r.prisms.len() * 48 + r.vertices.len() * 32 + r.frames.len() * 32)
+                    as u64
+                    + (r.atlas_words + r.normal_words) * 4
+                    + self.size.0 as u64 * self.size.1 as u64 * 32,
+            ));
+        }
         for o in &self.objects {
             let name = &o.object.name;
             let shell = (o.shell.vertices.len() * 32 + o.shell.prisms.len() * 64) as u64;
@@ -95,8 +109,13 @@ impl Blueprint {
         }
         s += "\nobjects:\n";
         for o in &self.objects {
-            let method = match &o.sweep {
-                Some(p) => format!(
+            let method = match (&o.sweep, o.reference_step) {
+                (_, Some(step)) => format!(
+                    "Reference step {step:.6} lighting {}, {} dispatch(es) per frame",
+                    if o.per_pixel { "PerPixel" } else { "Baked" },
+                    self.reference.as_ref().map_or(0, |r| r.dispatches)
+                ),
+                (Some(p), _) => format!(
                     "ViewSlices planes {} spacing {:.4} trivial_reject {} lighting {}, {} chunk(s)",
                     p.plane_count,
                     p.spacing,
@@ -104,7 +123,7 @@ impl Blueprint {
                     if o.per_pixel { "PerPixel" } else { "Baked" },
                     o.chunks.len()
                 ),
-                None => "base surface only".into(),
+                (None, _) => "base surface only".into(),
             };
             s += &format!("  {:<16} {} triangles  {method}\n", o.object.name, o.shell.prisms.len());
             for w in &o.object.report.warnings {

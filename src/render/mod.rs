@@ -15,10 +15,11 @@ use crate::bake::BakeRequest;
 use crate::error::{Error, Result};
 use crate::graph::plan::{self, ObjectInfo, Plan};
 use crate::graph::Graph;
+use crate::methods::reference::{self, ReferenceSet};
 use crate::methods::shell::{self, Shell};
 use crate::methods::view_slices::{self, SliceChunk};
 use crate::scene::{Light, Lighting as LightingMode, Method, Reference, Scene, SceneObject, ViewSlices};
-use crate::types::{BaseVertex, FrameParams, SliceParams, VertexFrame};
+use crate::types::{BaseVertex, FrameParams, ReferenceParams, SliceParams, VertexFrame};
 
 /// Overrides of what the scene file says, from the command line or tests.
 #[derive(Debug, Clone, Default)]
@@ -84,6 +85,8 @@ pub struct ObjectPlan {
     pub frames: Option<Vec<VertexFrame>>,
     /// Index into `Blueprint::bakes`.
     pub bake: Option<usize>,
+    /// Reference method: the ray step (world units).
+    pub reference_step: Option<f64>,
 }
 
 pub struct BakePlan {
@@ -97,6 +100,8 @@ pub struct BakePlan {
 pub enum Part {
     Base,
     Slices(usize),
+    /// All Reference objects of the frame, traced in one dispatch.
+    Reference,
 }
 
 pub struct Blueprint {
@@ -108,6 +113,8 @@ pub struct Blueprint {
     /// Graph instances: (object index, part), in the order of `plan`'s object indices.
     pub instances: Vec<(usize, Part)>,
     pub bakes: Vec<BakePlan>,
+    /// The Reference objects' BVH, shells and atlas layout (if any object uses the method).
+    pub reference: Option<ReferenceSet>,
     pub graph: Graph,
     pub plan: Plan,
 }
@@ -136,11 +143,15 @@ impl Blueprint {
             .map(|o| ObjectPlan::new(scene, o, &view, &light, opts, &mut bakes))
             .collect::<Result<Vec<_>>>()?;
         let graph = Graph::load(opts.graph.as_deref().unwrap_or(&default_graph()))?;
-        let (instances, infos) = instances(&objects, view.eye);
+        let reference = reference_set(&objects, &bakes, &view, size);
+        let (instances, infos) = instances(&objects, reference.as_ref(), view.eye);
         let plan = plan::plan(&graph, &wgsl_root(), &infos)?;
         check_bindings(&graph, &plan)?;
-        let samples_texels =
-            plan.passes.iter().flat_map(|p| &p.bindings).any(|b| b.name == "volume" || b.name == "normals");
+        let samples_texels = plan
+            .passes
+            .iter()
+            .flat_map(|p| &p.bindings)
+            .any(|b| ["volume", "normals", "texel_atlas"].contains(&b.name.as_str()));
         if !samples_texels {
             // A graph that samples no texel (the slicing debug graphs) bakes nothing.
             bakes.clear();
@@ -155,10 +166,38 @@ impl Blueprint {
             objects,
             instances,
             bakes,
+            reference,
             graph,
             plan,
         })
     }
+}
+
+/// The BVH and tables of the frame's Reference objects.
+fn reference_set(
+    objects: &[ObjectPlan],
+    bakes: &[BakePlan],
+    view: &View,
+    size: (u32, u32),
+) -> Option<ReferenceSet> {
+    let members: Vec<usize> = (0..objects.len()).filter(|&i| objects[i].reference_step.is_some()).collect();
+    if members.is_empty() {
+        return None;
+    }
+    let bake_of = |i: usize| &bakes[objects[i].bake.unwrap_or(0)];
+    let resolutions: Vec<[u32; 3]> = members.iter().map(|&i| bake_of(i).request.resolution).collect();
+    let lengths: Vec<f32> = members.iter().map(|&i| bake_of(i).opacity_length).collect();
+    let right_dir = view.forward.cross(view.up).normalize();
+    let up_dir = right_dir.cross(view.forward);
+    let half = (0.5 * view.fov_y.to_radians()).tan();
+    let aspect = size.0 as f64 / size.1 as f64;
+    let (r, u) = ((right_dir * half * aspect).as_vec3(), (up_dir * half).as_vec3());
+    let params = ReferenceParams {
+        right: [r.x, r.y, r.z, view.near as f32],
+        up: [u.x, u.y, u.z, view.far as f32],
+        counts: [0; 4],
+    };
+    Some(reference::build(objects, &members, &resolutions, &lengths, params))
 }
 
 /// The camera, with the depth range of everything drawn for the projection's near and far planes.
@@ -250,13 +289,22 @@ impl ObjectPlan {
             per_pixel: false,
             frames: None,
             bake: None,
+            reference_step: None,
             object,
         };
         let Some(method) = plan.object.method.as_ref().map(|m| opts.apply(m)) else { return Ok(plan) };
         let vs = match method {
             Method::ViewSlices(vs) => vs,
-            Method::Reference(_) => {
-                return Err(Error::Invalid("the Reference method is not implemented yet".into()))
+            Method::Reference(r) => {
+                plan.per_pixel = r.lighting == LightingMode::PerPixel;
+                plan.frames = plan.per_pixel.then(|| shell::vertex_frames(&plan.object.surface));
+                let texel = plan.object.texel.clone().unwrap_or_default();
+                let bake = texels::bake_index(scene, &texel, plan.per_pixel, light, bakes)?;
+                plan.bake = Some(bake);
+                let step =
+                    r.step.unwrap_or_else(|| reference::default_step(&plan, bakes[bake].request.resolution));
+                plan.reference_step = Some(step);
+                return Ok(plan);
             }
         };
         let planes = vs.planes;
@@ -281,9 +329,19 @@ impl ObjectPlan {
 
 /// Graph instances: each object's base surface and slice chunks, with what the planner needs to
 /// know of them (filters; back to front by object, chunks in sweep order).
-fn instances(objects: &[ObjectPlan], eye: DVec3) -> (Vec<(usize, Part)>, Vec<ObjectInfo>) {
+fn instances(
+    objects: &[ObjectPlan],
+    reference: Option<&ReferenceSet>,
+    eye: DVec3,
+) -> (Vec<(usize, Part)>, Vec<ObjectInfo>) {
     let mut instances = Vec::new();
     let mut infos = Vec::new();
+    if let Some(set) = reference {
+        let first = set.objects[0];
+        instances.push((first, Part::Reference));
+        let name = objects[first].object.name.clone();
+        infos.push(ObjectInfo { name, filters: vec!["Reference"], distance: 0.0, order: 0 });
+    }
     for (i, o) in objects.iter().enumerate() {
         let positions = &o.object.surface.positions;
         let centre = positions.iter().sum::<DVec3>() / positions.len().max(1) as f64;
@@ -293,6 +351,7 @@ fn instances(objects: &[ObjectPlan], eye: DVec3) -> (Vec<(usize, Part)>, Vec<Obj
             let (filter, order) = match part {
                 Part::Base => ("BaseSurface", 0),
                 Part::Slices(c) => ("ViewSlices", c as u32),
+                Part::Reference => unreachable!("reference instances are added once, above"),
             };
             instances.push((i, part));
             infos.push(ObjectInfo { name: o.object.name.clone(), filters: vec![filter], distance, order });
@@ -317,6 +376,13 @@ pub const INSTANCE_RESOURCES: &[&str] = &[
     "volume",
     "normals",
     "vertex_frames",
+    "reference_params",
+    "reference_nodes",
+    "reference_prisms",
+    "reference_objects",
+    "texel_atlas",
+    "normal_atlas",
+    "reference_state",
 ];
 
 /// Every WGSL global a kept pass uses must name a graph texture or a runtime resource, so that

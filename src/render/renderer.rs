@@ -2,6 +2,7 @@
 
 use crate::bake::{self, Baker};
 use crate::error::{Error, Result};
+use crate::gpu::cache::{self, GpuCache};
 use crate::gpu::timing::Timer;
 use crate::gpu::GpuContext;
 use crate::graph::exec::{Executor, Inputs};
@@ -35,15 +36,27 @@ pub struct Renderer {
 
 impl Renderer {
     pub fn new(ctx: &GpuContext, blueprint: Blueprint) -> Result<Self> {
+        Self::with_cache(ctx, blueprint, &mut GpuCache::default())
+    }
+
+    /// Like [`Renderer::new`], taking shader modules, pipelines and bakes from `cache` where
+    /// nothing that defines them changed (the preview's hot reload).
+    pub fn with_cache(ctx: &GpuContext, blueprint: Blueprint, cache: &mut GpuCache) -> Result<Self> {
         for o in &blueprint.objects {
             for c in &o.chunks {
                 let max = ctx.limits.max_storage_buffer_binding_size;
                 view_slices::check_capacity(c.capacity, max, &o.object.name, c.params.plane_count)?;
             }
         }
+        if let Some(set) = &blueprint.reference {
+            set.check_limits(ctx.limits.max_storage_buffer_binding_size)?;
+        }
         let mut baker = Baker::new(&wgsl_root());
-        let baked: Vec<bake::Baked> =
-            blueprint.bakes.iter().map(|b| baker.bake(ctx, &b.request)).collect::<Result<_>>()?;
+        let baked: Vec<bake::Baked> = blueprint
+            .bakes
+            .iter()
+            .map(|b| cache.bake(cache::key(&b.request), || baker.bake(ctx, &b.request)))
+            .collect::<Result<_>>()?;
         let sampler = ctx.device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("volume_sampler"),
             address_mode_u: wgpu::AddressMode::Repeat,
@@ -66,7 +79,7 @@ impl Renderer {
             .iter()
             .map(|&(i, part)| instance_inputs(ctx, &blueprint, &blueprint.objects[i], part, &baked))
             .collect();
-        let exec = Executor::new(ctx, blueprint.graph.clone(), &blueprint.plan, blueprint.size)?;
+        let exec = Executor::new(ctx, blueprint.graph.clone(), &blueprint.plan, blueprint.size, cache)?;
         let timer = Timer::new(ctx, blueprint.plan.passes.len() as u32);
         let (w, h) = blueprint.size;
         let readback = ctx.device.create_buffer(&wgpu::BufferDescriptor {
@@ -77,7 +90,7 @@ impl Renderer {
         });
         let mut r = Self { blueprint, exec, frame, objects, timer, readback };
         // Pipelines now, so that a bad kernel fails before any frame.
-        r.exec.prepare(ctx, &r.blueprint.plan, &r.frame, &r.objects)?;
+        r.exec.prepare(ctx, &r.blueprint.plan, &r.frame, &r.objects, cache)?;
         ctx.wait()?;
         Ok(r)
     }
@@ -100,7 +113,24 @@ impl Renderer {
     }
 
     fn read_output(&self, ctx: &GpuContext) -> Result<Image> {
-        let name = &self.blueprint.graph.file.outputs[0];
+        self.read_texture(ctx, &self.blueprint.graph.file.outputs[0])
+    }
+
+    /// The texel and normal atlases of the Reference objects as the kernel reads them (for the
+    /// CPU twin); `None` without Reference objects.
+    pub fn reference_atlases(&self, ctx: &GpuContext) -> Result<Option<(Vec<u8>, Vec<u8>)>> {
+        let Some(i) = self.blueprint.instances.iter().position(|p| p.1 == Part::Reference) else {
+            return Ok(None);
+        };
+        let read = |name: &str| {
+            let b = &self.objects[i].buffers[name];
+            ctx.read_buffer(b, 0, b.size())
+        };
+        Ok(Some((read("texel_atlas")?, read("normal_atlas")?)))
+    }
+
+    /// Reads a graph texture (Rgba32Float) back as a linear image.
+    pub fn read_texture(&self, ctx: &GpuContext, name: &str) -> Result<Image> {
         let texture =
             self.exec.texture(name).ok_or_else(|| Error::Invalid(format!("output `{name}` was pruned")))?;
         if texture.format() != wgpu::TextureFormat::Rgba32Float {
@@ -161,6 +191,12 @@ fn instance_inputs(
             );
             inputs.counts.insert("base_vertices".into(), base.len() as u32);
         }
+        Part::Reference => {
+            if let Some(set) = &bp.reference {
+                set.add_inputs(ctx, &mut inputs, bp.size);
+                set.copy_volumes(ctx, &inputs, baked);
+            }
+        }
         Part::Slices(chunk) => {
             let c = &o.chunks[chunk];
             view_slices::add_inputs(ctx, &mut inputs, &o.shell, &c.params, c.capacity, o.trivial_reject);
@@ -190,14 +226,18 @@ impl Renderer {
             m.push(("voltex_gpu_ms".into(), format!("{t:.3}")));
         }
         for o in &self.blueprint.objects {
-            let method = match &o.sweep {
-                Some(p) => format!(
+            let method = match (&o.sweep, o.reference_step) {
+                (_, Some(step)) => format!(
+                    "Reference(step: {step:.6}, lighting: {})",
+                    if o.per_pixel { "PerPixel" } else { "Baked" }
+                ),
+                (Some(p), _) => format!(
                     "ViewSlices(planes: {}, trivial_reject: {}, lighting: {})",
                     p.plane_count,
                     o.trivial_reject,
                     if o.per_pixel { "PerPixel" } else { "Baked" }
                 ),
-                None => "BaseSurface".into(),
+                (None, _) => "BaseSurface".into(),
             };
             m.push((format!("voltex_object_{}", o.object.name), method));
         }

@@ -25,6 +25,9 @@ pub struct Scene {
     pub texels: BTreeMap<String, Texel>,
     #[serde(default)]
     pub nodes: Vec<Node>,
+    /// Settings of `voltex regress` runs: render size and pass thresholds.
+    #[serde(default)]
+    pub regress: Regress,
     /// OBJ meshes and height images loaded and checked by `load`, by resolved path.
     #[serde(skip)]
     pub(super) assets: super::validate::Assets,
@@ -44,6 +47,34 @@ pub struct Output {
     pub width: u32,
     #[serde(deserialize_with = "v::output_size")]
     pub height: u32,
+}
+
+/// `regress: (size: (128, 128), max_flip: 0.01, max_rel_rmse: 0.02)`, every field optional.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Regress {
+    /// Render size of regression runs (width, height; default: `output`).
+    #[serde(default, deserialize_with = "v::opt_size2")]
+    pub size: Option<[u32; 2]>,
+    /// Largest mean FLIP (tonemapped, 0..=1) against the reference that passes.
+    #[serde(default = "default_max_flip", deserialize_with = "v::unit")]
+    pub max_flip: f64,
+    /// Largest relative RMSE (linear HDR) against the reference that passes.
+    #[serde(default = "default_max_rel_rmse", deserialize_with = "v::non_negative")]
+    pub max_rel_rmse: f64,
+}
+
+fn default_max_flip() -> f64 {
+    0.01
+}
+fn default_max_rel_rmse() -> f64 {
+    0.02
+}
+
+impl Default for Regress {
+    fn default() -> Self {
+        Regress { size: None, max_flip: default_max_flip(), max_rel_rmse: default_max_rel_rmse() }
+    }
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize)]

@@ -75,6 +75,7 @@ macro_rules! adapter {
 adapter!(positive, f64, Positive, |v| v.0);
 adapter!(opt_positive, Option<f64>, Option<Positive>, |v| v.map(|x| x.0));
 adapter!(non_negative, f64, NonNegative, |v| v.0);
+adapter!(unit, f64, Unit, |v| v.0);
 adapter!(jitter, f64, Jitter, |v| v.0);
 adapter!(distortion, f64, Distortion, |v| v.0);
 adapter!(fov, f64, FieldOfView, |v| v.0);
@@ -91,6 +92,7 @@ adapter!(color, [f32; 3], [Unit; 3], |v| v.map(|x| x.0 as f32));
 adapter!(light_color, [f32; 3], [NonNegative; 3], |v| v.map(|x| x.0 as f32));
 adapter!(opt_color, Option<[f32; 3]>, Option<[Unit; 3]>, |v| v.map(|c| c.map(|x| x.0 as f32)));
 adapter!(output_size, u32, OutputSize, |v| v.0);
+adapter!(opt_size2, Option<[u32; 2]>, Option<[OutputSize; 2]>, |v| v.map(|s| s.map(|x| x.0)));
 adapter!(planes, u32, PlaneCount, |v| v.0);
 adapter!(resolution, [u32; 3], [Resolution; 3], |v| v.map(|x| x.0));
 adapter!(octaves, u32, Octaves, |v| v.0);

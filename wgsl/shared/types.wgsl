@@ -94,3 +94,32 @@ struct HeightfieldParams {
     color_low: vec4<f32>,
     color_high: vec4<f32>,
 }
+
+// Reference tracer (twins: ReferenceParams, ReferenceNode, ReferencePrism, ReferenceObject in src/types.rs).
+struct ReferenceParams {
+    right: vec4<f32>,
+    up: vec4<f32>,
+    counts: vec4<u32>,
+}
+
+struct ReferenceNode {
+    min: vec4<f32>,
+    max: vec4<f32>,
+}
+
+struct ReferencePrism {
+    vertices: vec4<u32>,
+    uv01: vec4<f32>,
+    uv2: vec4<f32>,
+}
+
+struct ReferenceObject {
+    resolution: vec4<u32>,
+    atlas: vec4<u32>,
+    params: vec4<f32>,
+}
+
+struct ReferenceState {
+    color: vec4<f32>,
+    resume: vec4<f32>,
+}

@@ -1,0 +1,196 @@
+//! One scene of a run: load, plan, render, compare with `<stem>.ref.exr`, write the artefacts
+//! and the record, and with `--update` the reference.
+
+use std::path::Path;
+use std::time::Instant;
+
+use super::discover::SceneEntry;
+use super::record::{Record, Status, ARTEFACTS, IMAGES};
+use super::Args;
+use crate::gpu::GpuContext;
+use crate::io::{self, Image};
+use crate::metrics;
+use crate::render::{Blueprint, RenderOptions, Renderer};
+use crate::scene::{self, Regress};
+use crate::{Error, Result};
+
+/// A rendered scene with what the report needs from its renderer.
+struct Rendered {
+    image: Image,
+    gpu_ms: Option<f64>,
+    metadata: Vec<(String, String)>,
+}
+
+/// Checks one scene. Problems of the scene or its reference become the record's status; only
+/// failures to write into the output folder or the reference are errors.
+pub(super) fn check(ctx: &GpuContext, opts: &Args, entry: &SceneEntry) -> Result<Record> {
+    let start = Instant::now();
+    let folder = opts.out.join(&entry.folder);
+    std::fs::create_dir_all(&folder)
+        .map_err(|e| Error::file(&folder, format!("cannot create folder: {e}")))?;
+    let defaults = Regress::default();
+    let mut rec = Record {
+        scene: entry.rel.clone(),
+        scene_path: entry.path.display().to_string(),
+        reference_path: entry.reference.display().to_string(),
+        status: Status::BrokenScene,
+        updated: false,
+        message: None,
+        warnings: Vec::new(),
+        size: None,
+        flip: None,
+        rel_rmse: None,
+        max_flip: defaults.max_flip,
+        max_rel_rmse: defaults.max_rel_rmse,
+        nonfinite_pixels: None,
+        gpu_ms: None,
+        wall_ms: 0.0,
+        adapter: ctx.adapter_line(),
+        reference_adapter: None,
+        images: Vec::new(),
+        shard: opts.shard.to_string(),
+        finished_unix: 0,
+        voltex_version: env!("CARGO_PKG_VERSION").to_string(),
+    };
+    // A panic on some input is a bug, but still only this scene's problem.
+    let rendered =
+        std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| render(ctx, opts, entry, &mut rec)))
+            .unwrap_or_else(|p| Err(Error::file(&entry.path, super::panic_text(&p))));
+    match rendered {
+        Ok(frame) => compare(opts, entry, &folder, &frame, &mut rec)?,
+        Err(e) => rec.message = Some(e.to_string()),
+    }
+    rec.wall_ms = start.elapsed().as_secs_f64() * 1e3;
+    rec.finished_unix =
+        std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map(|d| d.as_secs()).unwrap_or(0);
+    rec.images.sort_by_key(|i| IMAGES.iter().position(|n| n == i));
+    rec.write(&folder)?;
+    // Artefacts of an earlier run that this one did not write would mislead a reader of the folder.
+    for name in ARTEFACTS {
+        let written = match name {
+            "actual.exr" => rec.size.is_some(),
+            _ => rec.images.iter().any(|i| i == name),
+        };
+        if !written {
+            let _ = std::fs::remove_file(folder.join(name));
+        }
+    }
+    Ok(rec)
+}
+
+/// Loads, plans and renders the scene; any error here makes it a broken scene.
+fn render(ctx: &GpuContext, opts: &Args, entry: &SceneEntry, rec: &mut Record) -> Result<Rendered> {
+    let scene = scene::load(&entry.path)?;
+    rec.max_flip = scene.regress.max_flip;
+    rec.max_rel_rmse = scene.regress.max_rel_rmse;
+    let size = opts
+        .size
+        .or(scene.regress.size.map(|[w, h]| (w, h)))
+        .unwrap_or((scene.output.width, scene.output.height));
+    let bp = Blueprint::new(&scene, &RenderOptions { size: Some(size), ..Default::default() })?;
+    for o in &bp.objects {
+        for w in &o.object.report.warnings {
+            rec.warnings.push(format!("object `{}`: {w}", o.object.name));
+        }
+    }
+    let mut renderer = Renderer::new(ctx, bp)?;
+    let frame = renderer.render(ctx)?;
+    let metadata = renderer.metadata(ctx, &frame);
+    Ok(Rendered { gpu_ms: frame.gpu_ms(), image: frame.image, metadata })
+}
+
+/// Writes the render, compares it with the reference, and updates the reference if asked.
+fn compare(opts: &Args, entry: &SceneEntry, folder: &Path, frame: &Rendered, rec: &mut Record) -> Result<()> {
+    let image = &frame.image;
+    rec.size = Some([image.width, image.height]);
+    rec.gpu_ms = frame.gpu_ms;
+    let nonfinite = metrics::count_nonfinite(image);
+    rec.nonfinite_pixels = Some(nonfinite);
+    let meta: Vec<(&str, String)> = frame.metadata.iter().map(|(k, v)| (k.as_str(), v.clone())).collect();
+    io::exr::write(&folder.join("actual.exr"), image, &meta)?;
+    io::png::write_tonemapped(&folder.join("actual.png"), image)?;
+    rec.images.push("actual.png".into());
+
+    let mut size_mismatch = false;
+    if !entry.reference.exists() {
+        rec.status = Status::New;
+        rec.message = Some(format!("no reference image {}", entry.reference.display()));
+    } else {
+        match io::exr::read(&entry.reference) {
+            Err(e) => {
+                rec.status = Status::BrokenReference;
+                rec.message = Some(format!(
+                    "{e} (delete it and run with --update to write a new one from this render)"
+                ));
+            }
+            Ok((reference, ref_meta)) => {
+                rec.reference_adapter =
+                    ref_meta.iter().find(|(k, _)| k == "voltex_adapter").map(|(_, v)| v.clone());
+                io::png::write_tonemapped(&folder.join("reference.png"), &reference)?;
+                rec.images.push("reference.png".into());
+                if !reference.same_size(image) {
+                    size_mismatch = true;
+                    rec.status = Status::BrokenReference;
+                    rec.message = Some(format!(
+                        "{}: reference is {}x{}, the render is {}x{} (regress.size or --size changed? \
+                         --update rewrites it)",
+                        entry.reference.display(),
+                        reference.width,
+                        reference.height,
+                        image.width,
+                        image.height
+                    ));
+                } else {
+                    measure(image, &reference, folder, rec)?;
+                }
+            }
+        }
+    }
+    if nonfinite > 0 {
+        let note = format!("{nonfinite} pixels of the render are NaN or infinite");
+        rec.message = Some(match rec.message.take() {
+            Some(m) => format!("{m}; {note}"),
+            None => note,
+        });
+    }
+    let rewrite = matches!(rec.status, Status::New | Status::Regressed) || size_mismatch;
+    if opts.update && rewrite {
+        let mut meta = meta;
+        meta.push(("voltex_regress_scene", entry.rel.clone()));
+        io::exr::write(&entry.reference, image, &meta)?;
+        rec.updated = true;
+        let what = format!("--update wrote {}", entry.reference.display());
+        rec.message = Some(match rec.message.take() {
+            Some(m) if rec.status != Status::New => format!("{m}; {what}"),
+            _ => what,
+        });
+    }
+    Ok(())
+}
+
+/// FLIP and relative RMSE against a reference of the same size; writes the FLIP heat map.
+fn measure(image: &Image, reference: &Image, folder: &Path, rec: &mut Record) -> Result<()> {
+    let flip = metrics::flip(image, reference)?;
+    let rel = metrics::relative_rmse(image, reference)?;
+    let heat = metrics::diff_heatmap(&flip.map, image.width, image.height);
+    io::png::write_rgba8(&folder.join("diff.png"), image.width, image.height, &heat)?;
+    rec.images.push("diff.png".into());
+    rec.flip = flip.mean.is_finite().then_some(flip.mean);
+    rec.rel_rmse = rel.is_finite().then_some(rel);
+    let flip_ok = flip.mean <= rec.max_flip;
+    let rel_ok = rel <= rec.max_rel_rmse;
+    if flip_ok && rel_ok {
+        rec.status = Status::Pass;
+    } else {
+        rec.status = Status::Regressed;
+        let mut over = Vec::new();
+        if !flip_ok {
+            over.push(format!("mean FLIP {:.5} > {}", flip.mean, rec.max_flip));
+        }
+        if !rel_ok {
+            over.push(format!("relative RMSE {:.5} > {}", rel, rec.max_rel_rmse));
+        }
+        rec.message = Some(over.join(", "));
+    }
+    Ok(())
+}

@@ -1,0 +1,220 @@
+//! `voltex regress DIR`: renders every scene under a folder headless, compares each with the
+//! reference image beside it (`<stem>.ref.exr`: mean FLIP of the tonemapped images and relative
+//! RMSE of the linear HDR values, thresholds from the scene's `regress` field), and writes per
+//! scene `actual.exr`, `actual.png`, `reference.png`, `diff.png` (FLIP heat map) and a
+//! `result.json` record into `OUT/<scene path without .ron>/`, then `OUT/index.html` from every
+//! record under `OUT` (so shards and copied folders merge into one report).
+//!
+//! Statuses: pass, regressed, new (no reference), broken scene (it fails to load, plan or render),
+//! broken reference (unreadable, other size). Every scene is checked before the exit status says
+//! whether all passed. References are written only with `--update`, and only for new, regressed
+//! and other-size ones.
+//!
+//! `--jobs N` runs N scenes on threads sharing one [`GpuContext`]. wgpu errors raised outside an
+//! error scope are collected per device, so with N > 1 such an error may be reported on the
+//! scene that happened to look next; rerun the scene alone to be sure which one raised it.
+
+mod check;
+mod discover;
+mod progress;
+pub mod record;
+pub mod report;
+
+pub use discover::{find, SceneEntry, Shard};
+pub use record::{Record, Status};
+
+use std::collections::BTreeSet;
+use std::panic::{catch_unwind, AssertUnwindSafe};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::mpsc;
+
+use crate::gpu::GpuContext;
+use crate::io::atomic::check_writable_dir;
+use crate::{Error, Result};
+use progress::Progress;
+
+/// The `regress` command line.
+#[derive(clap::Args, Debug, Clone)]
+pub struct Args {
+    /// Folder searched recursively for scene files (`*.ron` except render graphs), or one scene.
+    #[arg(required_unless_present = "report_only")]
+    pub dir: Option<PathBuf>,
+    /// Output folder: a subfolder per scene and index.html.
+    #[arg(long, default_value = "out/regress")]
+    pub out: PathBuf,
+    /// Write `<stem>.ref.exr` for scenes that are new, regressed or whose reference has another
+    /// size (passing ones are left untouched). Without it no reference is ever written.
+    #[arg(long)]
+    pub update: bool,
+    /// Render size WIDTHxHEIGHT for every scene (default: the scene's regress.size, else its output).
+    #[arg(long, value_parser = parse_size)]
+    pub size: Option<(u32, u32)>,
+    /// Scenes rendered concurrently (threads sharing one GPU device).
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=256))]
+    pub jobs: u32,
+    /// Check only shard i of n (1-based): the scenes whose 0-based index k in the sorted list has
+    /// k % n == i - 1.
+    #[arg(long, default_value = "1/1")]
+    pub shard: Shard,
+    /// Render nothing: rebuild OUT/index.html from the records under OUT (after merging shards).
+    #[arg(long, value_name = "OUT", conflicts_with_all = ["dir", "out", "update", "size", "jobs", "shard"])]
+    pub report_only: Option<PathBuf>,
+}
+
+fn parse_size(s: &str) -> std::result::Result<(u32, u32), String> {
+    let bad = || format!("`{s}`: expected WIDTHxHEIGHT between 1x1 and 16384x16384, e.g. 128x128");
+    let (w, h) = s.split_once('x').ok_or_else(bad)?;
+    let (w, h): (u32, u32) = (w.parse().map_err(|_| bad())?, h.parse().map_err(|_| bad())?);
+    if !(1..=16384).contains(&w) || !(1..=16384).contains(&h) {
+        return Err(bad());
+    }
+    Ok((w, h))
+}
+
+/// What a run or `--report-only` did.
+pub struct Outcome {
+    /// Scenes checked by this run, in the sorted order (all records for `--report-only`).
+    pub records: Vec<Record>,
+    /// Records under the output folder that could not be read.
+    pub unreadable: Vec<Error>,
+    pub report: PathBuf,
+}
+
+impl Outcome {
+    /// Scenes that did not pass (and were not updated), plus unreadable records.
+    pub fn failures(&self) -> usize {
+        self.records.iter().filter(|r| r.failed()).count() + self.unreadable.len()
+    }
+}
+
+/// Runs `voltex regress` as the command line asked: prints the summary and the report's path, and
+/// fails when a scene did not pass.
+pub fn command(args: &Args) -> Result<()> {
+    let outcome = match &args.report_only {
+        Some(out) => report_only(out)?,
+        None => run(args)?,
+    };
+    print!("{}", report::summary_table(&outcome.records));
+    for e in &outcome.unreadable {
+        println!("unreadable record: {e}");
+    }
+    println!("report: {}", outcome.report.display());
+    match outcome.failures() {
+        0 => Ok(()),
+        n => Err(Error::Invalid(format!(
+            "{n} of {} scene{} did not pass (see {})",
+            outcome.records.len() + outcome.unreadable.len(),
+            if outcome.records.len() == 1 { "" } else { "s" },
+            outcome.report.display()
+        ))),
+    }
+}
+
+/// Checks the scenes of `args.dir` (this shard's share) and rewrites the report.
+pub fn run(args: &Args) -> Result<Outcome> {
+    let dir = args.dir.as_deref().ok_or_else(|| Error::Invalid("regress: no scene folder given".into()))?;
+    let all = find(dir)?;
+    if all.is_empty() {
+        return Err(Error::file(dir, "no scene files (*.ron) in this folder"));
+    }
+    let scenes = args.shard.take(all);
+    // Everything that will be written must be writable before any rendering.
+    std::fs::create_dir_all(&args.out)
+        .map_err(|e| Error::file(&args.out, format!("cannot create the output folder: {e}")))?;
+    check_writable_dir(&args.out)?;
+    if args.update {
+        let folders: BTreeSet<PathBuf> = scenes.iter().map(|s| parent(&s.reference)).collect();
+        folders.iter().try_for_each(|d| check_writable_dir(d))?;
+    }
+    let records = if scenes.is_empty() {
+        eprintln!("shard {}: no scenes", args.shard);
+        Vec::new()
+    } else {
+        let ctx = GpuContext::new()?;
+        run_scenes(&ctx, args, &scenes)?
+    };
+    let (found, unreadable) = record::collect(&args.out)?;
+    let report = report::write_index(&args.out, &found, &unreadable)?;
+    Ok(Outcome { records, unreadable, report })
+}
+
+/// Rebuilds `out/index.html` from the records under `out`.
+pub fn report_only(out: &Path) -> Result<Outcome> {
+    check_writable_dir(out)?;
+    let (found, unreadable) = record::collect(out)?;
+    if found.is_empty() && unreadable.is_empty() {
+        return Err(Error::file(out, "no regress records (result.json) in this folder"));
+    }
+    let report = report::write_index(out, &found, &unreadable)?;
+    let mut records: Vec<Record> = found.into_iter().map(|f| f.record).collect();
+    records.sort_by(|a, b| a.scene.cmp(&b.scene));
+    Ok(Outcome { records, unreadable, report })
+}
+
+fn parent(path: &Path) -> PathBuf {
+    match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => PathBuf::from("."),
+    }
+}
+
+enum Event {
+    Started(usize),
+    Done(usize, Box<Result<Record>>),
+}
+
+/// Checks `scenes` on `args.jobs` threads sharing `ctx`. A failure to write into the output folder
+/// (or a reference) stops handing out scenes and is returned once the running ones finish.
+fn run_scenes(ctx: &GpuContext, args: &Args, scenes: &[SceneEntry]) -> Result<Vec<Record>> {
+    let mut progress = Progress::new(scenes.len());
+    let (next, stop) = (AtomicUsize::new(0), AtomicBool::new(false));
+    let mut records: Vec<Option<Record>> = vec![None; scenes.len()];
+    let mut first_error = None;
+    std::thread::scope(|s| {
+        let (tx, rx) = mpsc::channel();
+        for _ in 0..(args.jobs as usize).min(scenes.len()) {
+            let (tx, next, stop) = (tx.clone(), &next, &stop);
+            s.spawn(move || {
+                while !stop.load(Ordering::Relaxed) {
+                    let i = next.fetch_add(1, Ordering::Relaxed);
+                    let Some(entry) = scenes.get(i) else { break };
+                    let _ = tx.send(Event::Started(i));
+                    let result = catch_unwind(AssertUnwindSafe(|| check::check(ctx, args, entry)))
+                        .unwrap_or_else(|p| {
+                            Err(Error::Invalid(format!("{}: {}", entry.rel, panic_text(&p))))
+                        });
+                    let _ = tx.send(Event::Done(i, Box::new(result)));
+                }
+            });
+        }
+        drop(tx);
+        for event in rx {
+            match event {
+                Event::Started(i) => progress.started(&scenes[i].rel),
+                Event::Done(i, result) => match *result {
+                    Ok(rec) => {
+                        progress.finished(&rec);
+                        records[i] = Some(rec);
+                    }
+                    Err(e) => {
+                        stop.store(true, Ordering::Relaxed);
+                        progress.note(&format!("error: {}: {e}", scenes[i].rel));
+                        first_error.get_or_insert(e);
+                    }
+                },
+            }
+        }
+    });
+    progress.end();
+    match first_error {
+        Some(e) => Err(e),
+        None => Ok(records.into_iter().flatten().collect()),
+    }
+}
+
+/// The message of a caught panic.
+pub(crate) fn panic_text(p: &Box<dyn std::any::Any + Send>) -> String {
+    let msg = p.downcast_ref::<&str>().map(|s| s.to_string()).or_else(|| p.downcast_ref::<String>().cloned());
+    format!("internal error: panicked: {}", msg.unwrap_or_else(|| "(no message)".into()))
+}
