@@ -81,18 +81,19 @@ fn num(v: Option<f64>) -> String {
     v.filter(|v| v.is_finite()).map(|v| format!("{v:.6}")).unwrap_or_default()
 }
 
-/// One row per measured setting; `passes` lists `name=ms` of every pass (compute passes first).
+/// One row per measured setting; `passes` lists `name=ms` of every pass (compute passes first);
+/// `compute_wall_ms` is the wall time of a compute-only frame, to check `compute_ms` against.
 pub(super) fn csv(rows: &[Row]) -> String {
     let mut s = String::from(
-        "method,knobs,planes,trivial_reject,step,gpu_ms,compute_ms,raster_ms,wall_ms,flip,rel_rmse,\
-         method_front,overall_front,passes\n",
+        "method,knobs,planes,trivial_reject,step,gpu_ms,compute_ms,raster_ms,wall_ms,compute_wall_ms,\
+         flip,rel_rmse,method_front,overall_front,passes\n",
     );
     for r in rows {
         let o = &r.setting.options;
         let sum = |compute: bool| r.passes.iter().filter(|p| p.compute == compute).map(|p| p.ms).sum::<f64>();
         let passes: Vec<String> = r.passes.iter().map(|p| format!("{}={:.4}", p.name, p.ms)).collect();
         s.push_str(&format!(
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
             r.setting.method,
             r.setting.knobs,
             o.planes.map(|p| p.to_string()).unwrap_or_default(),
@@ -102,6 +103,7 @@ pub(super) fn csv(rows: &[Row]) -> String {
             num(Some(sum(true))),
             num(Some(sum(false))),
             num(Some(r.wall_ms)),
+            num(Some(r.compute_wall_ms)),
             num(Some(r.flip)),
             num(Some(r.rel_rmse)),
             r.method_front,

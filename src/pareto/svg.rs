@@ -192,6 +192,7 @@ pub fn render(chart: &Chart) -> String {
     );
     // Each series: its front as a step line, then its points.
     let at = |p: &Point| (x.px(p.x), y.px(p.y));
+    let mut tags: Vec<(f64, f64, f64)> = Vec::new();
     let drawable = |p: &&Point| p.x.is_finite() && p.y.is_finite();
     for (i, series) in chart.series.iter().enumerate() {
         let colour = COLOURS[i % COLOURS.len()];
@@ -201,13 +202,23 @@ pub fn render(chart: &Chart) -> String {
         let _ = writeln!(s, r#"<g class="series" fill="{colour}" stroke="{colour}">"#);
         let _ =
             writeln!(s, r#"<path class="front" d="{}" fill="none" stroke-width="1.5"/>"#, step_path(&line));
-        for (&j, (px, py)) in on_front.iter().zip(&line) {
+        for (&j, &(px, py)) in on_front.iter().zip(&line) {
+            // Left out where it would overlap a tag already written (the tooltip still names it).
+            let tag = &series.points[j].tag;
+            let rect = (px + 7.0, px + 7.0 + 5.8 * tag.chars().count() as f64, py - 7.0);
+            if tags
+                .iter()
+                .any(|t: &(f64, f64, f64)| rect.0 < t.1 && t.0 < rect.1 && (rect.2 - t.2).abs() < 11.0)
+            {
+                continue;
+            }
+            tags.push(rect);
             let _ = writeln!(
                 s,
                 r#"<text class="tag" x="{:.1}" y="{:.1}" stroke="none" font-size="10">{}</text>"#,
-                px + 7.0,
-                py - 7.0,
-                escape(&series.points[j].tag)
+                rect.0,
+                rect.2,
+                escape(tag)
             );
         }
         for p in series.points.iter().filter(drawable) {
@@ -325,6 +336,15 @@ mod tests {
         assert_eq!(svg.matches(r#"class="overall-point""#).count(), 5);
         assert!(svg.contains(">ViewSlices</text>") && svg.contains(">Reference</text>"));
         assert!(svg.matches(r#"class="tick""#).count() >= 6, "{svg}");
+    }
+
+    #[test]
+    fn overlapping_tags_are_left_out() {
+        let s = [series("a", &[(10.0, 0.1), (10.5, 0.0999), (100.0, 0.01)])];
+        let svg = render(&Chart { title: "t", x_label: "x", y_label: "y", series: &s });
+        assert_well_formed(&svg);
+        assert_eq!(svg.matches(r#"class="point""#).count(), 3);
+        assert_eq!(svg.matches(r#"class="tag""#).count(), 2, "{svg}");
     }
 
     #[test]
