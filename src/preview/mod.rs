@@ -1,0 +1,8 @@
+//! `voltex preview`: a window showing a scene, rebuilt whenever a file it depends on changes.
+//! [`session`] is the reload machinery (headless, tested on its own), [`watch`] the file watcher.
+
+pub mod session;
+pub mod watch;
+
+pub use session::{Outcome, Session};
+pub use watch::Watcher;
