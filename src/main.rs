@@ -1,4 +1,4 @@
-//! The `voltex` command line: render, plan, info, bench.
+//! The `voltex` command line: render, preview, regress, plan, info, bench.
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -39,6 +39,13 @@ struct Overrides {
 }
 
 #[derive(clap::ValueEnum, Clone, Copy)]
+enum ViewArg {
+    Image,
+    Reference,
+    Difference,
+}
+
+#[derive(clap::ValueEnum, Clone, Copy)]
 enum MethodArg {
     ViewSlices,
     Reference,
@@ -60,6 +67,22 @@ enum Command {
         scene: PathBuf,
         #[command(flatten)]
         overrides: Overrides,
+    },
+    /// Open a window showing the scene, redrawn whenever the scene, its files, a graph or a kernel
+    /// changes (keys and mouse: see the overlay and the README).
+    Preview {
+        scene: PathBuf,
+        #[command(flatten)]
+        overrides: Overrides,
+        /// Write each newly shown frame, as presented, to DIR/frame-N.png.
+        #[arg(long)]
+        record: Option<PathBuf>,
+        /// Close the window after this many seconds.
+        #[arg(long)]
+        quit_after: Option<f64>,
+        /// The view to start in (keys 1, 2, 3 switch).
+        #[arg(long, value_enum, default_value = "image")]
+        view: ViewArg,
     },
     /// Render every scene under a folder and compare it with its reference image (<stem>.ref.exr).
     Regress(voltex::regress::Args),
@@ -118,6 +141,7 @@ impl Overrides {
                 MethodArg::Reference => MethodKind::Reference,
             }),
             step: self.step,
+            ..Default::default()
         })
     }
 }
@@ -128,6 +152,18 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Render { scene, output, overrides } => render(&scene, output, &overrides),
         Command::Plan { scene, overrides } => plan(&scene, &overrides),
+        Command::Preview { scene, overrides, record, quit_after, view } => {
+            use voltex::preview::present::Mode;
+            let mode = match view {
+                ViewArg::Image => Mode::Image,
+                ViewArg::Reference => Mode::Reference,
+                ViewArg::Difference => Mode::Difference,
+            };
+            overrides.options().and_then(|options| {
+                let args = voltex::preview::window::PreviewArgs { scene, options, record, quit_after, mode };
+                voltex::preview::window::run(args)
+            })
+        }
         Command::Regress(args) => voltex::regress::command(&args),
         Command::Info => GpuContext::new().map(|ctx| print!("{}", ctx.describe())),
         Command::Bench { scenes, planes, size, frames, reference_planes } => {

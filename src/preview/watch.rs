@@ -21,6 +21,8 @@ pub struct Watcher {
     debouncer: Debouncer<RecommendedWatcher, RecommendedCache>,
     events: Receiver<DebounceEventResult>,
     dirs: Vec<PathBuf>,
+    /// Folders whose changes are ours (recordings, screenshots), not the user's.
+    pub ignore: Vec<PathBuf>,
 }
 
 impl Watcher {
@@ -30,7 +32,7 @@ impl Watcher {
             let _ = tx.send(r);
         })
         .map_err(|e| Error::Invalid(format!("cannot watch files: {e}")))?;
-        let mut w = Watcher { debouncer, events, dirs: Vec::new() };
+        let mut w = Watcher { debouncer, events, dirs: Vec::new(), ignore: Vec::new() };
         w.watch(dirs)?;
         Ok(w)
     }
@@ -63,7 +65,8 @@ impl Watcher {
             match self.events.recv_timeout(if out.is_empty() { left } else { Duration::ZERO }) {
                 Ok(Ok(events)) => {
                     for e in events {
-                        out.extend(e.event.paths.iter().filter(|p| relevant(p)).cloned());
+                        let ours = |p: &PathBuf| self.ignore.iter().any(|d| p.starts_with(d));
+                        out.extend(e.event.paths.iter().filter(|p| relevant(p) && !ours(p)).cloned());
                     }
                 }
                 Ok(Err(errors)) => {

@@ -18,7 +18,9 @@ use crate::graph::Graph;
 use crate::methods::reference::{self, ReferenceSet};
 use crate::methods::shell::{self, Shell};
 use crate::methods::view_slices::{self, SliceChunk};
-use crate::scene::{Light, Lighting as LightingMode, Method, Reference, Scene, SceneObject, ViewSlices};
+use crate::scene::{
+    Camera, Light, Lighting as LightingMode, Method, Reference, Scene, SceneObject, ViewSlices,
+};
 use crate::types::{BaseVertex, FrameParams, ReferenceParams, SliceParams, VertexFrame};
 
 /// Overrides of what the scene file says, from the command line or tests.
@@ -32,6 +34,11 @@ pub struct RenderOptions {
     pub method: Option<MethodKind>,
     /// Ray step for `Reference` objects (world units).
     pub step: Option<f64>,
+    /// Methods replacing those of named objects (the preview's per-object switch), before
+    /// `method` and the knob overrides apply.
+    pub object_methods: Vec<(String, Method)>,
+    /// A camera replacing the scene's (the preview's orbit).
+    pub camera: Option<Camera>,
 }
 
 /// A method without its knobs, to switch every object to it (`--method`).
@@ -135,7 +142,7 @@ impl Blueprint {
     /// Like [`Blueprint::new`] with the scene's objects given (tests alter their surfaces).
     pub fn with_objects(scene: &Scene, objects: Vec<SceneObject>, opts: &RenderOptions) -> Result<Self> {
         let size = opts.size.unwrap_or((scene.output.width, scene.output.height));
-        let view = View::new(scene, &objects)?;
+        let view = View::new(scene, opts.camera.as_ref().unwrap_or(&scene.camera), &objects)?;
         let light = Lighting::of(scene);
         let mut bakes: Vec<BakePlan> = Vec::new();
         let mut objects = objects
@@ -211,8 +218,7 @@ struct View {
 }
 
 impl View {
-    fn new(scene: &Scene, objects: &[SceneObject]) -> Result<Self> {
-        let cam = &scene.camera;
+    fn new(scene: &Scene, cam: &Camera, objects: &[SceneObject]) -> Result<Self> {
         let forward = (cam.target - cam.eye).normalize_or_zero();
         if forward == DVec3::ZERO || forward.cross(cam.up).length_squared() < 1e-12 {
             return Err(Error::Invalid(format!(
@@ -292,7 +298,11 @@ impl ObjectPlan {
             reference_step: None,
             object,
         };
-        let Some(method) = plan.object.method.as_ref().map(|m| opts.apply(m)) else { return Ok(plan) };
+        let name = &plan.object.name;
+        let chosen = opts.object_methods.iter().find(|(n, _)| n == name).map(|(_, m)| m);
+        let Some(method) = chosen.or(plan.object.method.as_ref()).map(|m| opts.apply(m)) else {
+            return Ok(plan);
+        };
         let vs = match method {
             Method::ViewSlices(vs) => vs,
             Method::Reference(r) => {

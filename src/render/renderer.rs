@@ -129,6 +129,11 @@ impl Renderer {
         Ok(Some((read("texel_atlas")?, read("normal_atlas")?)))
     }
 
+    /// The graph's first output (the linear image), as rendered by the last frame.
+    pub fn output_texture(&self) -> Option<&wgpu::Texture> {
+        self.exec.texture(&self.blueprint.graph.file.outputs[0])
+    }
+
     /// Reads a graph texture (Rgba32Float) back as a linear image.
     pub fn read_texture(&self, ctx: &GpuContext, name: &str) -> Result<Image> {
         let texture =
