@@ -1,5 +1,6 @@
 // Shows a frame in the preview window: the tonemapped image, the reference, or their difference, with the overlay text.
 #include "shared/font.wgsl"
+#include "shared/fullscreen.wgsl"
 
 struct PresentParams {
     // 0: image, 1: reference, 2: difference (relative, as a heat map).
@@ -24,8 +25,7 @@ struct PresentParams {
 
 @vertex
 fn vs_main(@builtin(vertex_index) index: u32) -> @builtin(position) vec4<f32> {
-    let uv = vec2<f32>(f32((index << 1u) & 2u), f32(index & 2u));
-    return vec4<f32>(uv * 2.0 - 1.0, 0.0, 1.0);
+    return fullscreen_position(index);
 }
 
 // As src/io/mod.rs `tonemap`: Narkowicz's ACES fit (the sRGB encoding follows).
