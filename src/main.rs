@@ -33,6 +33,9 @@ struct Overrides {
     /// Render every textured object with this method (its lighting mode is kept).
     #[arg(long, value_enum)]
     method: Option<MethodArg>,
+    /// Render N x N samples per pixel and average them (anti-aliasing; e.g. 2 or 4).
+    #[arg(long)]
+    supersample: Option<u32>,
     /// Ray step (world units) for Reference objects (default: the scene's, else half a voxel).
     #[arg(long, allow_negative_numbers = true)]
     step: Option<f64>,
@@ -126,6 +129,13 @@ impl Overrides {
                 )));
             }
         }
+        if let Some(n) = self.supersample {
+            if !(1..=8).contains(&n) {
+                return Err(voltex::Error::Invalid(format!(
+                    "--supersample {n}: expected 1 to 8 samples per axis"
+                )));
+            }
+        }
         if let Some(s) = self.step {
             if !(s.is_finite() && s > 0.0) {
                 return Err(voltex::Error::Invalid(format!("--step {s}: expected a positive world length")));
@@ -141,6 +151,7 @@ impl Overrides {
                 MethodArg::Reference => MethodKind::Reference,
             }),
             step: self.step,
+            supersample: self.supersample,
             ..Default::default()
         })
     }

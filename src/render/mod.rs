@@ -39,6 +39,10 @@ pub struct RenderOptions {
     pub object_methods: Vec<(String, Method)>,
     /// A camera replacing the scene's (the preview's orbit).
     pub camera: Option<Camera>,
+    /// Render at `n` times the width and height and average each `n x n` block: every pixel is
+    /// then the mean over its area rather than a point sample (anti-aliasing; a reference for
+    /// methods that filter textures by the pixel footprint, as mipmaps do).
+    pub supersample: Option<u32>,
 }
 
 /// A method without its knobs, to switch every object to it (`--method`).
@@ -113,7 +117,9 @@ pub enum Part {
 
 pub struct Blueprint {
     pub scene_path: PathBuf,
+    /// The size rendered at (the output size times `supersample`).
     pub size: (u32, u32),
+    pub supersample: u32,
     pub eye: DVec3,
     pub frame: FrameParams,
     pub objects: Vec<ObjectPlan>,
@@ -141,7 +147,9 @@ impl Blueprint {
 
     /// Like [`Blueprint::new`] with the scene's objects given (tests alter their surfaces).
     pub fn with_objects(scene: &Scene, objects: Vec<SceneObject>, opts: &RenderOptions) -> Result<Self> {
-        let size = opts.size.unwrap_or((scene.output.width, scene.output.height));
+        let (w, h) = opts.size.unwrap_or((scene.output.width, scene.output.height));
+        let n = opts.supersample.unwrap_or(1).max(1);
+        let size = (w * n, h * n);
         let view = View::new(scene, opts.camera.as_ref().unwrap_or(&scene.camera), &objects)?;
         let light = Lighting::of(scene);
         let mut bakes: Vec<BakePlan> = Vec::new();
@@ -168,6 +176,7 @@ impl Blueprint {
         Ok(Self {
             scene_path: scene.path.clone(),
             size,
+            supersample: n,
             eye: view.eye,
             frame,
             objects,

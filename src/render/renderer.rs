@@ -100,7 +100,7 @@ impl Renderer {
         self.timer.reset();
         self.exec.run(ctx, &self.blueprint.plan, &self.frame, &self.objects, &mut self.timer)?;
         let pass_times = self.timer.read(ctx)?;
-        let image = self.read_output(ctx)?;
+        let image = self.read_output(ctx)?.box_downsample(self.blueprint.supersample);
         Ok(Frame { image, pass_times })
     }
 
