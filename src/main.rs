@@ -49,6 +49,7 @@ enum ViewArg {
 enum MethodArg {
     ViewSlices,
     Reference,
+    AxisSlices,
 }
 
 #[derive(Subcommand)]
@@ -139,6 +140,7 @@ impl Overrides {
             method: self.method.map(|m| match m {
                 MethodArg::ViewSlices => MethodKind::ViewSlices,
                 MethodArg::Reference => MethodKind::Reference,
+                MethodArg::AxisSlices => MethodKind::AxisSlices,
             }),
             step: self.step,
             ..Default::default()
