@@ -102,3 +102,33 @@ pub fn bake(
     }
     Ok(AxisBaked { arrays, occupancy })
 }
+
+/// Reads every layer (or depth slice) of level 0 of a texture back, tightly packed (tests).
+pub fn read_texture(ctx: &GpuContext, texture: &wgpu::Texture, bytes_per_texel: u32) -> Result<Vec<u8>> {
+    let size = texture.size();
+    let row = size.width * bytes_per_texel;
+    let padded = row.div_ceil(256) * 256;
+    let rows = size.height * size.depth_or_array_layers;
+    let staging = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("texture readback"),
+        size: padded as u64 * rows as u64,
+        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let mut enc = ctx.device.create_command_encoder(&Default::default());
+    enc.copy_texture_to_buffer(
+        texture.as_image_copy(),
+        wgpu::TexelCopyBufferInfo {
+            buffer: &staging,
+            layout: wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(padded),
+                rows_per_image: Some(size.height),
+            },
+        },
+        size,
+    );
+    ctx.queue.submit([enc.finish()]);
+    let bytes = ctx.map_read(&staging)?;
+    Ok((0..rows as usize).flat_map(|y| bytes[y * padded as usize..][..row as usize].to_vec()).collect())
+}
