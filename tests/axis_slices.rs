@@ -312,3 +312,102 @@ fn bad_knobs_name_their_position() {
         assert!(err.contains(expected), "{knob}: {err}");
     }
 }
+
+/// The pear seen from `elevation` degrees above its base, at 64x64: (three directions,
+/// horizontal only) mean FLIP against the reference.
+fn pear_errors(elevation: f64) -> (f64, f64) {
+    let source = std::fs::read_to_string(example("pear.ron")).unwrap();
+    let (target, distance) = (0.45, 3.0);
+    let e = elevation.to_radians();
+    let camera = format!(
+        "camera: (eye: (0.0, {:.4}, {:.4}), target: (0.0, 0.0, {target})",
+        -distance * e.cos(),
+        target + distance * e.sin()
+    );
+    let scene = source.replace("camera: (eye: (0.0, -2.3, 1.9), target: (0.0, 0.0, 0.45)", &camera);
+    let size = RenderOptions { size: Some((64, 64)), ..Default::default() };
+    let reference = render(&scene, &RenderOptions { method: Some(MethodKind::Reference), ..size.clone() });
+    let flip = |s: &str| voltex::metrics::flip(&render(s, &size), &reference).unwrap().mean;
+    (flip(&scene), flip(&scene.replace("max_angle: 80.0", "max_angle: 80.0, directions: Horizontal")))
+}
+
+#[test]
+fn error_against_view_angle_stays_bounded_with_three_directions() {
+    eprintln!("elevation  FLIP three  FLIP horizontal");
+    for elevation in [60.0, 30.0, 15.0, 5.0] {
+        let (three, horizontal) = pear_errors(elevation);
+        eprintln!("{elevation:>9}  {three:>10.4}  {horizontal:>15.4}");
+        assert!(three < 0.08, "elevation {elevation}: FLIP {three}");
+        if elevation <= 15.0 {
+            assert!(
+                horizontal > 1.5 * three,
+                "elevation {elevation}: horizontal {horizontal}, three {three}"
+            );
+        }
+    }
+}
+
+/// Numbers for the notes (run with `--ignored --nocapture`): per example scene, prisms, the
+/// triangles of full-resolution horizontal slicing, triangles drawn with and without culling,
+/// and the draw pass's GPU time.
+#[test]
+#[ignore]
+fn triangle_counts_and_times() {
+    let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
+    eprintln!(
+        "scene | prisms | finest | drawn: culling+LOD / no culling / no LOD | draw ms: same three | frame ms (wall): same three"
+    );
+    for name in
+        ["pear", "pear_grazing", "two_pears", "pears_on_sphere", "heightfield_plane", "heightfield_sphere"]
+    {
+        let text = std::fs::read_to_string(example(&format!("{name}.ron"))).unwrap();
+        let off = text
+            .replace("AxisSlices(", "AxisSlices(empty_culling: false, ")
+            .replace("empty_culling: false, back_face_culling: true", "empty_culling: false");
+        let finest_lod = text
+            .replace("depth: 1.0, pixels: 1.0, ", "")
+            .replace("depth: 1.0, pixels: 1.0", "")
+            .replace("AxisSlices(", "AxisSlices(depth: 0.0001, pixels: 0.0001, ");
+        let mut row = Vec::new();
+        let mut finest = 0u64;
+        let mut prisms = 0usize;
+        for t in [&text, &off, &finest_lod] {
+            finest = 0;
+            prisms = 0;
+            let scene = scene::parse(t, &example("x.ron")).unwrap();
+            let opts = RenderOptions { size: Some((256, 256)), ..Default::default() };
+            let mut r = Renderer::new(&ctx, Blueprint::new(&scene, &opts).unwrap()).unwrap();
+            for _ in 0..2 {
+                r.render(&ctx).unwrap();
+            }
+            let start = std::time::Instant::now();
+            let times = r.render_timed(&ctx).unwrap();
+            let wall = start.elapsed().as_secs_f64() * 1e3;
+            let draw: f64 = times
+                .iter()
+                .filter(|t| t.0.contains("axis_slices") && t.0.starts_with("draw"))
+                .map(|t| t.1)
+                .sum();
+            let mut drawn = 0;
+            for (i, &(o, part)) in r.blueprint.instances.iter().enumerate() {
+                if part == Part::AxisSlices {
+                    let plan = r.blueprint.objects[o].axis.as_ref().unwrap();
+                    let (_, v) = voltex::methods::axis_slices::read_back(
+                        &ctx,
+                        r.instance_inputs(i),
+                        plan.prisms.len(),
+                    )
+                    .unwrap();
+                    drawn += v.len() / 3;
+                    finest += plan.prisms.len() as u64 * plan.params.resolution[2] as u64;
+                    prisms += plan.prisms.len();
+                }
+            }
+            row.push((drawn, draw, wall));
+        }
+        eprintln!(
+            "{name} | {prisms} | {finest} | {} / {} / {} | {:.2} / {:.2} / {:.2} | {:.1} / {:.1} / {:.1}",
+            row[0].0, row[1].0, row[2].0, row[0].1, row[1].1, row[2].1, row[0].2, row[1].2, row[2].2
+        );
+    }
+}
