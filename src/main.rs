@@ -52,6 +52,7 @@ enum ViewArg {
 enum MethodArg {
     ViewSlices,
     Reference,
+    AxisSlices,
 }
 
 #[derive(Subcommand)]
@@ -149,6 +150,7 @@ impl Overrides {
             method: self.method.map(|m| match m {
                 MethodArg::ViewSlices => MethodKind::ViewSlices,
                 MethodArg::Reference => MethodKind::Reference,
+                MethodArg::AxisSlices => MethodKind::AxisSlices,
             }),
             step: self.step,
             supersample: self.supersample,

@@ -34,6 +34,10 @@ fn wgsl_structs_match_rust() {
         layout!(ReferencePrism; vertices, uv01, uv2),
         layout!(ReferenceObject; resolution, atlas, params),
         layout!(ReferenceState; color, resume),
+        layout!(AxisParams; resolution, criteria, forward, flags),
+        layout!(AxisChoice; direction, level, first, count, vertex_count, vertex_offset, reverse, culled),
+        layout!(AxisVertex; position, texcoord, normal),
+        layout!(AxisBake; resolution, level),
     ];
     let mut seen = 0;
     for (_, ty) in kernel.module.types.iter() {

@@ -378,9 +378,10 @@ impl State {
             .iter()
             .filter_map(|o| {
                 let lighting = o.object.method.as_ref()?.lighting();
-                let m = match (o.reference_step, &o.sweep) {
-                    (Some(step), _) => Method::Reference(Reference { step: Some(step), lighting }),
-                    (None, Some(p)) => Method::ViewSlices(ViewSlices {
+                let m = match (o.reference_step, &o.sweep, &o.axis) {
+                    (_, _, Some(a)) => Method::AxisSlices(a.method),
+                    (Some(step), _, _) => Method::Reference(Reference { step: Some(step), lighting }),
+                    (None, Some(p), _) => Method::ViewSlices(ViewSlices {
                         planes: p.plane_count,
                         trivial_reject: o.trivial_reject,
                         lighting,
@@ -446,6 +447,9 @@ impl State {
                             trivial_reject: true,
                             lighting: r.lighting,
                         }),
+                        Method::AxisSlices(_) => {
+                            Method::Reference(Reference { step: None, lighting: Default::default() })
+                        }
                     };
                     self.set_method(name, next);
                 }
@@ -462,6 +466,15 @@ impl State {
                         Method::Reference(mut r) => {
                             r.step = r.step.map(|s| if finer { s / 2.0 } else { s * 2.0 });
                             Method::Reference(r)
+                        }
+                        // Finer: see less deep inside contours (more slices).
+                        Method::AxisSlices(mut a) => {
+                            a.depth = if finer {
+                                (a.depth / 2.0).max(1.0 / 64.0)
+                            } else {
+                                (a.depth * 2.0).min(1024.0)
+                            };
+                            Method::AxisSlices(a)
                         }
                     };
                     self.set_method(name, next);
@@ -506,6 +519,9 @@ impl State {
 
 fn describe(m: &Method) -> String {
     match m {
+        Method::AxisSlices(a) => {
+            format!("AxisSlices(depth: {}, pixels: {}, {:?})", a.depth, a.pixels, a.directions)
+        }
         Method::ViewSlices(v) => format!("ViewSlices(planes: {}, lighting: {:?})", v.planes, v.lighting),
         Method::Reference(r) => {
             format!(

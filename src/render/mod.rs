@@ -15,11 +15,12 @@ use crate::bake::BakeRequest;
 use crate::error::{Error, Result};
 use crate::graph::plan::{self, ObjectInfo, Plan};
 use crate::graph::Graph;
+use crate::methods::axis_slices::AxisPlan;
 use crate::methods::reference::{self, ReferenceSet};
 use crate::methods::shell::{self, Shell};
 use crate::methods::view_slices::{self, SliceChunk};
 use crate::scene::{
-    Camera, Light, Lighting as LightingMode, Method, Reference, Scene, SceneObject, ViewSlices,
+    AxisSlices, Camera, Light, Lighting as LightingMode, Method, Reference, Scene, SceneObject, ViewSlices,
 };
 use crate::types::{BaseVertex, FrameParams, ReferenceParams, SliceParams, VertexFrame};
 
@@ -50,7 +51,19 @@ pub struct RenderOptions {
 pub enum MethodKind {
     ViewSlices,
     Reference,
+    AxisSlices,
 }
+
+/// Axis slicing's knobs when an object is switched to it from another method.
+pub const DEFAULT_AXIS_SLICES: AxisSlices = AxisSlices {
+    depth: 1.0,
+    pixels: 1.0,
+    max_angle: 80.0,
+    directions: crate::scene::SliceDirections::Three,
+    blend: crate::scene::SliceBlend::Binary,
+    back_face_culling: false,
+    empty_culling: true,
+};
 
 /// Plane count when an object is switched to view slicing from a method without planes.
 pub const DEFAULT_PLANES: u32 = 400;
@@ -62,6 +75,7 @@ impl RenderOptions {
         let kind = self.method.unwrap_or(match method {
             Method::ViewSlices(_) => MethodKind::ViewSlices,
             Method::Reference(_) => MethodKind::Reference,
+            Method::AxisSlices(_) => MethodKind::AxisSlices,
         });
         match (kind, method) {
             (MethodKind::ViewSlices, Method::ViewSlices(vs)) => Method::ViewSlices(ViewSlices {
@@ -78,6 +92,8 @@ impl RenderOptions {
                 Method::Reference(Reference { step: self.step.or(r.step), lighting })
             }
             (MethodKind::Reference, _) => Method::Reference(Reference { step: self.step, lighting }),
+            (MethodKind::AxisSlices, Method::AxisSlices(a)) => Method::AxisSlices(*a),
+            (MethodKind::AxisSlices, _) => Method::AxisSlices(DEFAULT_AXIS_SLICES),
         }
     }
 }
@@ -98,6 +114,8 @@ pub struct ObjectPlan {
     pub bake: Option<usize>,
     /// Reference method: the ray step (world units).
     pub reference_step: Option<f64>,
+    /// Axis-aligned slicing (Meyer & Neyret).
+    pub axis: Option<AxisPlan>,
 }
 
 pub struct BakePlan {
@@ -113,6 +131,8 @@ pub enum Part {
     Slices(usize),
     /// All Reference objects of the frame, traced in one dispatch.
     Reference,
+    /// An object's axis-aligned slices.
+    AxisSlices,
 }
 
 pub struct Blueprint {
@@ -150,7 +170,9 @@ impl Blueprint {
         let (w, h) = opts.size.unwrap_or((scene.output.width, scene.output.height));
         let n = opts.supersample.unwrap_or(1).max(1);
         let size = (w * n, h * n);
-        let view = View::new(scene, opts.camera.as_ref().unwrap_or(&scene.camera), &objects)?;
+        let mut view = View::new(scene, opts.camera.as_ref().unwrap_or(&scene.camera), &objects)?;
+        // Pixels per unit of tangent, for the slice-count criterion (at the rendered size).
+        view.focal = 0.5 * size.1 as f64 / (0.5 * view.fov_y.to_radians()).tan();
         let light = Lighting::of(scene);
         let mut bakes: Vec<BakePlan> = Vec::new();
         let mut objects = objects
@@ -162,11 +184,8 @@ impl Blueprint {
         let (instances, infos) = instances(&objects, reference.as_ref(), view.eye);
         let plan = plan::plan(&graph, &wgsl_root(), &infos)?;
         check_bindings(&graph, &plan)?;
-        let samples_texels = plan
-            .passes
-            .iter()
-            .flat_map(|p| &p.bindings)
-            .any(|b| ["volume", "normals", "texel_atlas"].contains(&b.name.as_str()));
+        let samples_texels =
+            plan.passes.iter().flat_map(|p| &p.bindings).any(|b| TEXEL_BINDINGS.contains(&b.name.as_str()));
         if !samples_texels {
             // A graph that samples no texel (the slicing debug graphs) bakes nothing.
             bakes.clear();
@@ -224,6 +243,8 @@ struct View {
     fov_y: f64,
     near: f64,
     far: f64,
+    /// Focal length in pixels (half the image height over tan(fov_y / 2)).
+    focal: f64,
 }
 
 impl View {
@@ -243,7 +264,7 @@ impl View {
         }
         far *= 1.01;
         let near = (far * 1e-4).max(1e-6);
-        Ok(Self { eye: cam.eye, forward, up: cam.up, fov_y: cam.fov_y, near, far })
+        Ok(Self { eye: cam.eye, forward, up: cam.up, fov_y: cam.fov_y, near, far, focal: 1.0 })
     }
 
     fn forward_f32(&self) -> [f32; 3] {
@@ -305,6 +326,7 @@ impl ObjectPlan {
             frames: None,
             bake: None,
             reference_step: None,
+            axis: None,
             object,
         };
         let name = &plan.object.name;
@@ -314,6 +336,16 @@ impl ObjectPlan {
         };
         let vs = match method {
             Method::ViewSlices(vs) => vs,
+            Method::AxisSlices(a) => {
+                let texel = plan.object.texel.clone().unwrap_or_default();
+                let bake = texels::bake_index_axis(scene, &texel, light, bakes)?;
+                plan.bake = Some(bake);
+                let res = bakes[bake].request.resolution;
+                let name = &plan.object.name;
+                let axis = AxisPlan::new(&plan.shell, &a, res, view.forward_f32(), view.focal, name)?;
+                plan.axis = Some(axis);
+                return Ok(plan);
+            }
             Method::Reference(r) => {
                 plan.per_pixel = r.lighting == LightingMode::PerPixel;
                 plan.frames = plan.per_pixel.then(|| shell::vertex_frames(&plan.object.surface));
@@ -366,18 +398,27 @@ fn instances(
         let centre = positions.iter().sum::<DVec3>() / positions.len().max(1) as f64;
         let distance = (centre - eye).length();
         let parts = o.base.iter().map(|_| Part::Base).chain((0..o.chunks.len()).map(Part::Slices));
-        for part in parts {
-            let (filter, order) = match part {
-                Part::Base => ("BaseSurface", 0),
-                Part::Slices(c) => ("ViewSlices", c as u32),
+        let axis = o.axis.iter().map(|_| Part::AxisSlices);
+        for part in parts.chain(axis) {
+            let (filters, order) = match part {
+                Part::Base => (vec!["BaseSurface"], 0),
+                Part::Slices(c) => (vec!["ViewSlices"], c as u32),
+                Part::AxisSlices => {
+                    let blended = o.axis.as_ref().is_some_and(|a| a.blended);
+                    (vec!["AxisSlices", if blended { "AxisSlicesBlended" } else { "AxisSlicesBinary" }], 0)
+                }
                 Part::Reference => unreachable!("reference instances are added once, above"),
             };
             instances.push((i, part));
-            infos.push(ObjectInfo { name: o.object.name.clone(), filters: vec![filter], distance, order });
+            infos.push(ObjectInfo { name: o.object.name.clone(), filters, distance, order });
         }
     }
     (instances, infos)
 }
+
+/// Bindings that sample baked texels: a graph using none of them bakes nothing.
+const TEXEL_BINDINGS: &[&str] =
+    &["volume", "normals", "texel_atlas", "axis_slices_s", "axis_slices_t", "axis_slices_w"];
 
 /// Resources the runtime binds by name: per frame, and per instance (an object's base surface or
 /// one chunk of its slices).
@@ -402,6 +443,16 @@ pub const INSTANCE_RESOURCES: &[&str] = &[
     "texel_atlas",
     "normal_atlas",
     "reference_state",
+    "axis_params",
+    "axis_occupancy",
+    "axis_choices",
+    "axis_draw_args",
+    "axis_vertices",
+    "axis_slices_s",
+    "axis_slices_t",
+    "axis_slices_w",
+    "axis_sampler",
+    "axis_sampler_side",
 ];
 
 /// Every WGSL global a kept pass uses must name a graph texture or a runtime resource, so that

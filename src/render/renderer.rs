@@ -7,7 +7,7 @@ use crate::gpu::timing::Timer;
 use crate::gpu::GpuContext;
 use crate::graph::exec::{Executor, Inputs};
 use crate::io::Image;
-use crate::methods::view_slices;
+use crate::methods::{axis_slices, view_slices};
 use crate::render::{wgsl_root, Blueprint, ObjectPlan, Part};
 use crate::types::{ObjectParams, VertexFrame};
 
@@ -118,6 +118,11 @@ impl Renderer {
 
     /// The texel and normal atlases of the Reference objects as the kernel reads them (for the
     /// CPU twin); `None` without Reference objects.
+    /// The inputs of graph instance `i` (tests and benchmarks read kernel outputs from them).
+    pub fn instance_inputs(&self, i: usize) -> &Inputs {
+        &self.objects[i]
+    }
+
     pub fn reference_atlases(&self, ctx: &GpuContext) -> Result<Option<(Vec<u8>, Vec<u8>)>> {
         let Some(i) = self.blueprint.instances.iter().position(|p| p.1 == Part::Reference) else {
             return Ok(None);
@@ -216,6 +221,12 @@ fn instance_inputs(
                 inputs.views.insert("normals".into(), baked[b].normals.create_view(&Default::default()));
             }
         }
+        Part::AxisSlices => {
+            let (Some(plan), Some(b)) = (&o.axis, o.bake) else { return inputs };
+            if let Some(axis) = &baked[b].axis {
+                axis_slices::add_inputs(ctx, &mut inputs, &o.shell, plan, axis);
+            }
+        }
     }
     inputs
 }
@@ -231,18 +242,19 @@ impl Renderer {
             m.push(("voltex_gpu_ms".into(), format!("{t:.3}")));
         }
         for o in &self.blueprint.objects {
-            let method = match (&o.sweep, o.reference_step) {
-                (_, Some(step)) => format!(
+            let method = match (&o.sweep, o.reference_step, &o.axis) {
+                (_, _, Some(a)) => format!("{:?}", a.method),
+                (_, Some(step), _) => format!(
                     "Reference(step: {step:.6}, lighting: {})",
                     if o.per_pixel { "PerPixel" } else { "Baked" }
                 ),
-                (Some(p), _) => format!(
+                (Some(p), _, _) => format!(
                     "ViewSlices(planes: {}, trivial_reject: {}, lighting: {})",
                     p.plane_count,
                     o.trivial_reject,
                     if o.per_pixel { "PerPixel" } else { "Baked" }
                 ),
-                (None, _) => "BaseSurface".into(),
+                (None, _, _) => "BaseSurface".into(),
             };
             m.push((format!("voltex_object_{}", o.object.name), method));
         }
