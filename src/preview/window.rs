@@ -438,18 +438,17 @@ impl State {
             }
             "m" | "M" => {
                 if let Some((name, m)) = selected {
+                    // ViewSlices -> AxisSlices -> Reference -> ViewSlices (lighting kept where it exists).
                     let next = match m {
-                        Method::ViewSlices(v) => {
-                            Method::Reference(Reference { step: None, lighting: v.lighting })
+                        Method::ViewSlices(_) => Method::AxisSlices(crate::render::DEFAULT_AXIS_SLICES),
+                        Method::AxisSlices(_) => {
+                            Method::Reference(Reference { step: None, lighting: Default::default() })
                         }
                         Method::Reference(r) => Method::ViewSlices(ViewSlices {
                             planes: DEFAULT_PLANES,
                             trivial_reject: true,
                             lighting: r.lighting,
                         }),
-                        Method::AxisSlices(_) => {
-                            Method::Reference(Reference { step: None, lighting: Default::default() })
-                        }
                     };
                     self.set_method(name, next);
                 }
