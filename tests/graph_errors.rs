@@ -115,7 +115,8 @@ fn assert_err(e: voltex::Error, at: &str, words: &[&str]) {
 #[test]
 fn frame_graph_parses_and_plans() {
     let g = Graph::load(&root().join("graphs/frame.ron")).unwrap();
-    let p = plan(&g, &wgsl_root(), &objects(&[&["ViewSlices", "BaseSurface"], &["Reference"]])).unwrap();
+    let all = objects(&[&["ViewSlices", "BaseSurface"], &["Reference"], &["RayMarch"]]);
+    let p = plan(&g, &wgsl_root(), &all).unwrap();
     assert_eq!(
         names(&p),
         [
@@ -126,6 +127,9 @@ fn frame_graph_parses_and_plans() {
             "draw_slices",
             "trace_reference",
             "composite_reference",
+            "bake_transfer",
+            "ray_march",
+            "composite_ray_march",
             "composite"
         ]
     );

@@ -73,6 +73,12 @@ impl Blueprint {
                     (frames.len() * 32) as u64,
                 ));
             }
+            if let Some(m) = &o.ray_march {
+                out.push((
+                    format!("object {name}: hypertexture parameters, transfer tables, per-pixel march state"),
+                    m.bytes(self.size),
+                ));
+            }
             if let Some(base) = &o.base {
                 out.push((format!("object {name}: base triangles"), (base.len() * 32) as u64));
             }
@@ -110,6 +116,16 @@ impl Blueprint {
         s += "\nobjects:\n";
         for o in &self.objects {
             let method = match (&o.sweep, o.reference_step) {
+                _ if o.ray_march.is_some() => {
+                    let m = o.ray_march.as_ref().unwrap();
+                    format!(
+                        "{} of hypertexture \"{}\", {} noise(s), {} dispatch(es) per frame",
+                        m.describe(),
+                        m.hypertexture,
+                        m.packed.noises.len(),
+                        m.dispatches
+                    )
+                }
                 (_, Some(step)) => format!(
                     "Reference step {step:.6} lighting {}, {} dispatch(es) per frame",
                     if o.per_pixel { "PerPixel" } else { "Baked" },
@@ -125,7 +141,11 @@ impl Blueprint {
                 ),
                 (None, _) => "base surface only".into(),
             };
-            s += &format!("  {:<16} {} triangles  {method}\n", o.object.name, o.shell.prisms.len());
+            let what = match &o.object.hypertexture {
+                Some(_) => "hypertexture".to_string(),
+                None => format!("{} triangles", o.shell.prisms.len()),
+            };
+            s += &format!("  {:<16} {what}  {method}\n", o.object.name);
             for w in &o.object.report.warnings {
                 s += &format!("    warning: {w}\n");
             }

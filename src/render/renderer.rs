@@ -119,6 +119,16 @@ impl Renderer {
         Ok(Some((read("texel_atlas")?, read("normal_atlas")?)))
     }
 
+    /// Reads back a buffer of graph instance `instance` (tests and tools: a layer, a table).
+    pub fn read_instance_buffer(&self, ctx: &GpuContext, instance: usize, name: &str) -> Result<Vec<u8>> {
+        let b = self
+            .objects
+            .get(instance)
+            .and_then(|i| i.buffers.get(name))
+            .ok_or_else(|| Error::Invalid(format!("graph instance {instance} has no buffer `{name}`")))?;
+        ctx.read_buffer(b, 0, b.size())
+    }
+
     /// Reads a graph texture (Rgba32Float) back as a linear image.
     pub fn read_texture(&self, ctx: &GpuContext, name: &str) -> Result<Image> {
         let texture =
@@ -181,6 +191,11 @@ fn instance_inputs(
             );
             inputs.counts.insert("base_vertices".into(), base.len() as u32);
         }
+        Part::RayMarch => {
+            if let Some(m) = &o.ray_march {
+                m.add_inputs(ctx, &mut inputs, bp.size);
+            }
+        }
         Part::Reference => {
             if let Some(set) = &bp.reference {
                 set.add_inputs(ctx, &mut inputs, bp.size);
@@ -217,6 +232,7 @@ impl Renderer {
         }
         for o in &self.blueprint.objects {
             let method = match (&o.sweep, o.reference_step) {
+                _ if o.ray_march.is_some() => o.ray_march.as_ref().map(|m| m.describe()).unwrap_or_default(),
                 (_, Some(step)) => format!(
                     "Reference(step: {step:.6}, lighting: {})",
                     if o.per_pixel { "PerPixel" } else { "Baked" }

@@ -1,0 +1,36 @@
+// The hypertexture density of Gilet & Dischler 2009 (eq. 3 to 5) and its RGBA transfer function.
+// Reads the kernel's `hyper`, `hyper_noises` and `transfer_tables`. CPU twin:
+// src/cpu/hypertexture.rs (same names).
+#include "shared/fields.wgsl"
+#include "shared/transfer.wgsl"
+
+// O(x - k V/|V|) with k combining the noises in order from 0: noise i gives
+// t_i = T_i((1 + noise(f_i (x + r_i V))) / 2) and then k += a_i t_i (Sum) or
+// k = k (1 - t_i) + a_i t_i (Blend). Noise i's shape table is table i. One loop iteration per noise.
+fn hyper_density(x: vec3<f32>) -> f32 {
+    let v = vector_field(x);
+    let dir = unit_or_zero(v);
+    var k = 0.0;
+    for (var i = 0u; i < hyper.kinds.z; i++) {
+        let n = hyper_noises[i];
+        let t = transfer_lookup(i, 0.5 + 0.5 * simplex3((x + n.shift * v) * n.frequency, n.seed));
+        if (n.blend != 0u) {
+            k = k * (1.0 - t) + n.amplitude * t;
+        } else {
+            k += n.amplitude * t;
+        }
+    }
+    return object_density(x - k * dir);
+}
+
+// Colour (straight rgb) and opacity per opacity length at a density: the four tables after the
+// noises' shape tables.
+fn hyper_color(density: f32) -> vec4<f32> {
+    let first = hyper.kinds.z;
+    return vec4<f32>(
+        transfer_lookup(first, density),
+        transfer_lookup(first + 1u, density),
+        transfer_lookup(first + 2u, density),
+        transfer_lookup(first + 3u, density),
+    );
+}
