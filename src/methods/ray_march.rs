@@ -172,3 +172,47 @@ impl RayMarchPlan {
         }
     }
 }
+
+/// What `probe_hypertexture.wgsl` returns: the transfer tables as `bake_transfer.wgsl` filled
+/// them, and four vectors per point (see the kernel).
+pub struct Probed {
+    pub tables: Vec<f32>,
+    pub values: Vec<[f32; 4]>,
+}
+
+/// Runs `bake_transfer.wgsl` and then `probe_hypertexture.wgsl` at `points` (object space; w: a
+/// noise seed as f32 bits) for this object: the kernels' side of the twin tests.
+pub fn probe(ctx: &GpuContext, plan: &RayMarchPlan, points: &[[f32; 4]]) -> Result<Probed> {
+    use crate::bake::storage;
+    use crate::gpu::kernel::ComputeKernel;
+    let root = crate::render::wgsl_root();
+    let mut inputs = Inputs::default();
+    plan.add_inputs(ctx, &mut inputs, (1, 1));
+    let b = &mut inputs.buffers;
+    b.insert("probe_points".into(), storage(ctx, "probe_points", bytemuck::cast_slice(points)));
+    let zeros = vec![0u8; points.len() * 64];
+    b.insert("probe_values".into(), storage(ctx, "probe_values", &zeros));
+    let mut encoder = ctx.device.create_command_encoder(&Default::default());
+    let functions = plan.packed.functions.len() as u32;
+    ComputeKernel::load(ctx, &root, "bake_transfer.wgsl")?.dispatch(
+        ctx,
+        &mut encoder,
+        &inputs,
+        [TRANSFER_SIZE as u32, functions, 1],
+    )?;
+    ComputeKernel::load(ctx, &root, "probe_hypertexture.wgsl")?.dispatch(
+        ctx,
+        &mut encoder,
+        &inputs,
+        [points.len() as u32, 1, 1],
+    )?;
+    ctx.queue.submit([encoder.finish()]);
+    let read = |name: &str| {
+        let buffer = &inputs.buffers[name];
+        ctx.read_buffer(buffer, 0, buffer.size())
+    };
+    let tables = bytemuck::pod_collect_to_vec(&read("transfer_tables")?);
+    let values = bytemuck::pod_collect_to_vec(&read("probe_values")?);
+    ctx.take_errors()?;
+    Ok(Probed { tables, values })
+}
