@@ -1,4 +1,4 @@
-//! The `voltex` command line: render, plan, info, bench.
+//! The `voltex` command line: render, plan, regress, info, bench, bench-hyper.
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -81,6 +81,18 @@ enum Command {
         #[arg(long, default_value_t = 4000)]
         reference_planes: u32,
     },
+    /// Benchmark hypertexture ray marching (the 2009 paper's Figure 11 set-up): frame times and
+    /// the share of noise evaluation.
+    BenchHyper {
+        #[arg(long, value_parser = parse_size, default_value = "512x512")]
+        size: (u32, u32),
+        /// Timed frames per setting (after warm-up); the median is reported.
+        #[arg(long, default_value_t = 3)]
+        frames: usize,
+        /// Only the first object (sphere).
+        #[arg(long)]
+        quick: bool,
+    },
 }
 
 fn parse_size(s: &str) -> std::result::Result<(u32, u32), String> {
@@ -133,6 +145,7 @@ fn main() -> ExitCode {
         Command::Bench { scenes, planes, size, frames, reference_planes } => {
             voltex::bench::run(&scenes, &planes, size, frames, reference_planes)
         }
+        Command::BenchHyper { size, frames, quick } => voltex::hypertexture::bench::run(size, frames, quick),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

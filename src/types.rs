@@ -247,7 +247,8 @@ pub struct HyperParams {
     /// x: object kind, y: field kind (`hypertexture::OBJECT_*`, `FIELD_*`), z: noise count,
     /// w: seed of the field perturbation.
     pub kinds: [u32; 4],
-    /// x: shadow-ray step (world), y: central-difference offset of the gradient (world).
+    /// x: shadow-ray step (world), y: central-difference offset of the gradient (world), z: the
+    /// largest shift (object space) with a small margin: farther from the object the density is 0.
     pub march: [f32; 4],
     /// Work of one dispatch, in density evaluations: x the budget, y the most samples of a shadow
     /// ray, z the most one sample may cost (so a sample is begun only when it fits).
@@ -295,6 +296,7 @@ pub struct TransferPoint {
 pub struct MarchState {
     /// rgb: premultiplied colour gathered so far; a: coverage (1 - transmittance).
     pub color: [f32; 4],
-    /// x: index of the next sample; z: 1 once finished.
+    /// x: index of the next sample; y: density evaluations so far; z: 1 once finished; w: those
+    /// of the evaluations that ran the noises (y and w for benchmarks).
     pub resume: [f32; 4],
 }

@@ -42,48 +42,50 @@ fn step_alpha(a: f32, step: f32) -> f32 {
     return 1.0 - exp2(log2(1.0 - min(a, MAX_ALPHA)) * step / hyper.bounds_max.w);
 }
 
-// Outward unit normal at x (object space) from the world-space density gradient by central
-// differences; facing the viewer where the gradient vanishes.
-fn surface_normal(x: vec3<f32>, ray: vec3<f32>) -> vec3<f32> {
+// Phong as the Reference method shades it, at x (object space): the outward normal from the
+// world-space density gradient by central differences (facing the viewer where the gradient
+// vanishes), and with `shadows` the transmittance towards the light up to the bounds' exit, which
+// dims the diffuse and specular terms. Gradient and shadow samples share one loop so the density
+// is compiled once for both (lavapipe makes a much slower kernel of several inlined copies).
+// Returns the colour (xyz) and the density evaluations it took (w).
+fn shade(x: vec3<f32>, ray: vec3<f32>, albedo: vec3<f32>) -> vec4<f32> {
     let e = hyper.march.y;
-    let dx = hyper.to_local[0].xyz * e;
-    let dy = hyper.to_local[1].xyz * e;
-    let dz = hyper.to_local[2].xyz * e;
-    let g = vec3<f32>(
-        hyper_density(x + dx) - hyper_density(x - dx),
-        hyper_density(x + dy) - hyper_density(x - dy),
-        hyper_density(x + dz) - hyper_density(x - dz),
-    );
-    let len = length(g);
-    return select(-ray, -g / len, len > 1e-12);
-}
-
-// Transmittance from x (object space) towards the light to the bounds' exit (x), and the density
-// evaluations it took (y).
-fn shadow(x: vec3<f32>) -> vec2<f32> {
-    let l = (hyper.to_local * vec4<f32>(frame.light_dir.xyz, 0.0)).xyz;
-    let exit = max(bounds_span(x, l).y, 0.0);
-    let n = u32(clamp(ceil(exit / hyper.march.x), 1.0, f32(hyper.budget.y)));
-    let h = exit / f32(n);
-    var transmittance = 1.0;
+    var l = vec3<f32>(0.0);
+    var h = 0.0;
+    var n = 0u;
+    if (shadows) {
+        l = (hyper.to_local * vec4<f32>(frame.light_dir.xyz, 0.0)).xyz;
+        let exit = max(bounds_span(x, l).y, 0.0);
+        n = u32(clamp(ceil(exit / hyper.march.x), 1.0, f32(hyper.budget.y)));
+        h = exit / f32(n);
+    }
+    var g = vec3<f32>(0.0);
+    var lit = 1.0;
     var j = 0u;
-    while (j < n && transmittance >= MIN_TRANSMITTANCE) {
-        let a = hyper_color(hyper_density(x + l * ((f32(j) + 0.5) * h))).a;
-        transmittance *= 1.0 - step_alpha(a, h);
+    while (j < 6u + n && lit >= MIN_TRANSMITTANCE) {
+        let axis = min(j / 2u, 2u);
+        let side = select(-1.0, 1.0, (j & 1u) == 0u);
+        var p = x + l * ((f32(j) - 5.5) * h);
+        if (j < 6u) {
+            p = x + hyper.to_local[axis].xyz * (side * e);
+        }
+        let density = hyper_density(p);
+        if (j < 6u) {
+            g[axis] += side * density;
+        } else {
+            lit *= 1.0 - step_alpha(hyper_opacity(density), h);
+        }
         j++;
     }
-    return vec2<f32>(transmittance, f32(j));
-}
-
-// Phong as the Reference method shades: ambient plus diffuse and a white highlight, the latter
-// two dimmed by the light's transmittance.
-fn phong_shade(albedo: vec3<f32>, n: vec3<f32>, ray: vec3<f32>, lit: f32) -> vec3<f32> {
-    let l = frame.light_dir.xyz;
+    let len = length(g);
+    let normal = select(-ray, -g / len, len > 1e-12);
+    let light = frame.light_dir.xyz;
     let ambient = frame.light_dir.w;
-    let h = normalize(l - ray);
-    let diffuse = max(dot(n, l), 0.0);
-    let specular = select(0.0, 0.25 * pow(max(dot(n, h), 0.0), 32.0), diffuse > 0.0);
-    return albedo * (ambient + (1.0 - ambient) * diffuse * lit) + vec3<f32>(specular * lit);
+    let half_way = normalize(light - ray);
+    let diffuse = max(dot(normal, light), 0.0);
+    let specular = select(0.0, 0.25 * pow(max(dot(normal, half_way), 0.0), 32.0), diffuse > 0.0);
+    let colour = albedo * (ambient + (1.0 - ambient) * diffuse * lit) + vec3<f32>(specular * lit);
+    return vec4<f32>(colour, f32(j));
 }
 
 @compute @workgroup_size(8, 8, 1)
@@ -128,23 +130,23 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     var budget = i32(hyper.budget.x);
     let worst = i32(hyper.budget.z);
+    // Most samples of the bounds are far from the object: their density is 0.
+    let empty = hyper_color(0.0);
     while (k < n && transmittance >= MIN_TRANSMITTANCE && budget >= worst) {
         let x = origin + dir * (t0 + (f32(k) + 0.5) * h);
-        let rgba = hyper_color(hyper_density(x));
+        let density = hyper_density(x);
+        var rgba = empty;
+        if (density > 0.0) {
+            rgba = hyper_color(density);
+        }
         budget -= 1;
         if (rgba.a > 1e-6) {
             let alpha = step_alpha(rgba.a, h);
             var colour = rgba.rgb;
             if (phong) {
-                let normal = surface_normal(x, d);
-                budget -= 6;
-                var lit = 1.0;
-                if (shadows) {
-                    let s = shadow(x);
-                    lit = s.x;
-                    budget -= i32(s.y);
-                }
-                colour = phong_shade(colour, normal, d, lit);
+                let shaded = shade(x, d, colour);
+                colour = shaded.xyz;
+                budget -= i32(shaded.w);
             }
             rgb += colour * alpha * transmittance;
             transmittance *= 1.0 - alpha;
@@ -152,8 +154,10 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         k++;
     }
     let finished = k >= n || transmittance < MIN_TRANSMITTANCE;
+    // resume: next sample, density evaluations so far, finished, evaluations that ran the noises.
+    let evaluations = state.resume.y + f32(i32(hyper.budget.x) - budget);
     ray_march_state[pixel] = MarchState(
         vec4<f32>(rgb, 1.0 - transmittance),
-        vec4<f32>(f32(k), 0.0, select(0.0, 1.0, finished), 0.0),
+        vec4<f32>(f32(k), evaluations, select(0.0, 1.0, finished), state.resume.w + f32(noised_evaluations)),
     );
 }

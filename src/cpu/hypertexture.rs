@@ -57,6 +57,20 @@ impl Model<'_> {
         d.clamp(0.0, 1.0)
     }
 
+    /// A lower bound of the distance from x to where the density is positive.
+    pub fn support_distance(&self, x: DVec3) -> f64 {
+        let s = v3(self.params.object);
+        match self.params.kinds[0] {
+            OBJECT_ELLIPSOID => ((x / s).length() - 1.0) * s.min_element(),
+            OBJECT_TORUS => DVec2::new(DVec2::new(x.x, x.y).length() - s.x, x.z).length() - s.y,
+            OBJECT_BOX => {
+                let q = x.abs() - s;
+                q.max(DVec3::ZERO).length() + q.max_element().min(0.0)
+            }
+            _ => x.length() - s.x,
+        }
+    }
+
     /// The closest point of the object's boundary (ellipsoid: radial projection).
     pub fn closest_surface_point(&self, x: DVec3) -> DVec3 {
         let s = v3(self.params.object);
@@ -156,8 +170,12 @@ impl Model<'_> {
         k
     }
 
-    /// The hypertexture density O(x - k V/|V|).
+    /// The hypertexture density O(x - k V/|V|); 0 without evaluating the noises farther than the
+    /// largest shift from the object.
     pub fn hyper_density(&self, x: DVec3) -> f64 {
+        if self.support_distance(x) > self.params.march[2] as f64 {
+            return 0.0;
+        }
         let v = self.vector_field(x);
         self.object_density(x - unit_or_zero(v) * self.distortion(x, v))
     }

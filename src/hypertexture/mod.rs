@@ -3,6 +3,8 @@
 //! points that `bake_transfer.wgsl` samples into tables (the noises' shape tables first, then the
 //! red, green, blue and opacity tables of the colour transfer function).
 
+pub mod bench;
+
 use glam::DVec3;
 
 use crate::cpu::bake_transfer::{HERMITE, LINEAR, TRANSFER_SIZE};

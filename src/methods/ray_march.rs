@@ -92,7 +92,7 @@ pub fn plan(
         field_center: packed.field_center,
         perturb: packed.perturb,
         kinds: packed.kinds,
-        march: [shadow_step as f32, step as f32, 0.0, 0.0],
+        march: [shadow_step as f32, step as f32, (h.max_shift() * (1.0 + 1e-4) + 1e-6) as f32, 0.0],
         budget: [evals, shadow_samples, worst, 0],
     };
     Ok(RayMarchPlan {

@@ -44,6 +44,27 @@ fn object_density(x: vec3<f32>) -> f32 {
     return clamp(d, 0.0, 1.0);
 }
 
+// A lower bound of the distance from x to where the object's density is positive: exact for
+// the sphere, torus and box; for the ellipsoid (|x / radii| - 1) times its smallest radius.
+fn support_distance(x: vec3<f32>) -> f32 {
+    let s = hyper.object;
+    switch hyper.kinds.x {
+        case OBJECT_ELLIPSOID: {
+            return (length(x / s.xyz) - 1.0) * min(min(s.x, s.y), s.z);
+        }
+        case OBJECT_TORUS: {
+            return length(vec2<f32>(length(x.xy) - s.x, x.z)) - s.y;
+        }
+        case OBJECT_BOX: {
+            let q = abs(x) - s.xyz;
+            return length(max(q, vec3<f32>(0.0))) + min(max(max(q.x, q.y), q.z), 0.0);
+        }
+        default: {
+            return length(x) - s.x;
+        }
+    }
+}
+
 // The closest point of the object's boundary (ellipsoid: the radial projection, exact on its
 // axes). Where it is not unique and has no preferred direction (a sphere's centre, a torus's core
 // circle) x itself, so the field vanishes there.
