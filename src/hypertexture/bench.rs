@@ -3,7 +3,9 @@
 //! shading, Phong, and Phong with shadow rays. Per setting: the median wall time of a frame after
 //! warm-up, the density evaluations the frame made and those that ran the noises (counted by the
 //! kernel: points farther than the largest shift from the object skip them), and the share of the
-//! frame that those noise evaluations alone would take at the rate `bench_simplex.wgsl` measures.
+//! frame that those noise evaluations alone would take at the rate `bench_simplex.wgsl` measures
+//! ("rate"), and the share measured directly ("A/B"): the same frame with the noises compiled out
+//! (override `noise_off`), timed in alternation, compared per density evaluation.
 //!
 //! Frames are timed by wall clock after `device.poll`: lavapipe's compute timestamps come back
 //! wrong once a render pass has run in the process, and every frame ends with raster passes.
@@ -73,6 +75,26 @@ pub fn noise_rate(ctx: &GpuContext) -> Result<f64> {
     Ok((threads[0] * threads[1] * PER_THREAD) as f64 / median(times))
 }
 
+/// Median frame time (ms, wall clock) and the density evaluations of the last frame (all, and
+/// those that ran the noises), for renderers timed in alternation (so load changes hit both).
+struct Timed {
+    renderer: Renderer,
+    times: Vec<f64>,
+}
+
+impl Timed {
+    fn counts(&self, ctx: &GpuContext) -> Result<(f64, f64, f64)> {
+        let r = &self.renderer;
+        let instance = r.blueprint.instances.iter().position(|p| p.1 == Part::RayMarch).unwrap_or(0);
+        let states: Vec<MarchState> =
+            bytemuck::pod_collect_to_vec(&r.read_instance_buffer(ctx, instance, "ray_march_state")?);
+        let evals: f64 = states.iter().map(|s| s.resume[1] as f64).sum();
+        let noised: f64 = states.iter().map(|s| s.resume[3] as f64).sum();
+        let covered = states.iter().filter(|s| s.color[3] > 0.5).count() as f64 / states.len().max(1) as f64;
+        Ok((evals, noised, covered))
+    }
+}
+
 pub fn run(size: (u32, u32), frames: usize, quick: bool) -> Result<()> {
     let ctx = GpuContext::new()?;
     let rate = noise_rate(&ctx)?;
@@ -84,43 +106,51 @@ pub fn run(size: (u32, u32), frames: usize, quick: bool) -> Result<()> {
     );
     println!(
         "\n| object | quality | step | shading | dispatches | coverage | frame ms (wall) | fps | M density evals | M \
-         noise evals | noise alone ms | noise share |"
+         noise evals | noise alone ms | noise share (rate) | noise share (A/B) |"
     );
-    println!("|---|---|---|---|---|---|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|");
     let objects = if quick { &OBJECTS[..1] } else { OBJECTS };
     for (name, object, rotate) in objects {
         for quality in QUALITIES {
             for shading in SHADINGS {
                 let text = scene_text(object, rotate, quality, shading);
                 let scene = crate::scene::parse(&text, Path::new("bench-hyper.ron"))?;
-                let bp = Blueprint::new(&scene, &RenderOptions { size: Some(size), ..Default::default() })?;
-                let plan = bp.objects.iter().find_map(|o| o.ray_march.clone()).expect("a RayMarch object");
-                let mut r = Renderer::new(&ctx, bp)?;
-                r.render_timed(&ctx)?;
-                let mut times = Vec::new();
-                for _ in 0..frames {
-                    let t = Instant::now();
-                    r.render_timed(&ctx)?;
-                    times.push(t.elapsed().as_secs_f64() * 1e3);
+                let opts = RenderOptions { size: Some(size), ..Default::default() };
+                let mut runs = Vec::new();
+                for noise in [true, false] {
+                    let mut bp = Blueprint::new(&scene, &opts)?;
+                    bp.objects.iter_mut().filter_map(|o| o.ray_march.as_mut()).for_each(|m| m.noise = noise);
+                    let mut renderer = Renderer::new(&ctx, bp)?;
+                    renderer.render_timed(&ctx)?;
+                    runs.push(Timed { renderer, times: Vec::new() });
                 }
-                let ms = median(times);
-                let instance = r.blueprint.instances.iter().position(|p| p.1 == Part::RayMarch).unwrap_or(0);
-                let bytes = r.read_instance_buffer(&ctx, instance, "ray_march_state")?;
-                let states: Vec<MarchState> = bytemuck::pod_collect_to_vec(&bytes);
-                let evals: f64 = states.iter().map(|s| s.resume[1] as f64).sum();
-                let noised: f64 = states.iter().map(|s| s.resume[3] as f64).sum();
-                let covered = states.iter().filter(|s| s.color[3] > 0.5).count() as f64 / states.len() as f64;
+                for _ in 0..frames {
+                    for run in runs.iter_mut() {
+                        let t = Instant::now();
+                        run.renderer.render_timed(&ctx)?;
+                        run.times.push(t.elapsed().as_secs_f64() * 1e3);
+                    }
+                }
+                let plan = runs[0].renderer.blueprint.objects.iter().find_map(|o| o.ray_march.clone());
+                let plan = plan.expect("a RayMarch object");
+                let ms = median(runs[0].times.clone());
+                let ms_off = median(runs[1].times.clone());
+                let (evals, noised, covered) = runs[0].counts(&ctx)?;
+                let (evals_off, _, _) = runs[1].counts(&ctx)?;
                 let noise_ms = noised * NOISE_COUNT / rate * 1e3;
+                // Time per density evaluation with and without the noises.
+                let ab = 1.0 - (ms_off / evals_off) / (ms / evals);
                 println!(
                     "| {name} | {quality} | {} | {shading} | {} | {:.0}% | {ms:.1} | {:.2} | {:.1} | {:.1} | {noise_ms:.1} | \
-                     {:.0}% |",
+                     {:.0}% | {:.0}% |",
                     plan.step,
                     plan.dispatches,
                     covered * 100.0,
                     1e3 / ms,
                     evals / 1e6,
                     noised * NOISE_COUNT / 1e6,
-                    100.0 * noise_ms / ms
+                    100.0 * noise_ms / ms,
+                    100.0 * ab
                 );
             }
         }

@@ -48,6 +48,8 @@ pub struct RayMarchPlan {
     pub dispatches: u32,
     /// World-space corners of the enlarged bounds.
     pub corners: [DVec3; 8],
+    /// Benchmarks: `false` compiles the noises out (override `noise_off`).
+    pub noise: bool,
 }
 
 /// `name`: the object's; `node`: its hypertexture's name and frame.
@@ -104,16 +106,21 @@ pub fn plan(
         shadow_step,
         dispatches: dispatches as u32,
         corners,
+        noise: true,
     })
 }
 
 impl RayMarchPlan {
     /// Values of the kernel's override constants.
     pub fn constants(&self) -> Vec<(String, f64)> {
-        vec![
+        let mut c = vec![
             ("phong".into(), self.shade.phong as u32 as f64),
             ("shadows".into(), self.shade.shadows as u32 as f64),
-        ]
+        ];
+        if !self.noise {
+            c.push(("noise_off".into(), 1.0));
+        }
+        c
     }
 
     /// The method as written in metadata and `voltex plan`.

@@ -9,6 +9,8 @@
 // k = k (1 - t_i) + a_i t_i (Blend). Noise i's shape table is table i. One loop iteration per noise.
 // Evaluations of `hyper_density` that ran the noises, for benchmarks (per invocation).
 var<private> noised_evaluations: u32;
+// Benchmarks only: every noise reads 0 (and is compiled out), to measure what noise costs.
+override noise_off: bool = false;
 
 // Points farther than the largest shift (`hyper.march.z`) from the object have density 0
 // whatever the noises say (|k V/|V|| <= sum of amplitudes): they skip the noises.
@@ -22,7 +24,11 @@ fn hyper_density(x: vec3<f32>) -> f32 {
     var k = 0.0;
     for (var i = 0u; i < hyper.kinds.z; i++) {
         let n = hyper_noises[i];
-        let t = transfer_lookup(i, 0.5 + 0.5 * simplex3((x + n.shift * v) * n.frequency, n.seed));
+        var value = 0.0;
+        if (!noise_off) {
+            value = simplex3((x + n.shift * v) * n.frequency, n.seed);
+        }
+        let t = transfer_lookup(i, 0.5 + 0.5 * value);
         if (n.blend != 0u) {
             k = k * (1.0 - t) + n.amplitude * t;
         } else {
