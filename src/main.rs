@@ -33,9 +33,13 @@ struct Overrides {
     /// Render every textured object with this method (its lighting mode is kept).
     #[arg(long, value_enum)]
     method: Option<MethodArg>,
-    /// Ray step (world units) for Reference objects (default: the scene's, else half a voxel).
+    /// Ray step (world units) for Reference and RayMarch objects (default: the scene's, else half
+    /// a voxel for Reference).
     #[arg(long, allow_negative_numbers = true)]
     step: Option<f64>,
+    /// Time of the frame in seconds (animated hypertextures; default: the scene's `time`).
+    #[arg(long, allow_negative_numbers = true)]
+    time: Option<f64>,
 }
 
 #[derive(clap::ValueEnum, Clone, Copy)]
@@ -115,6 +119,9 @@ impl Overrides {
                 )));
             }
         }
+        if let Some(t) = self.time.filter(|t| !t.is_finite()) {
+            return Err(voltex::Error::Invalid(format!("--time {t}: expected a finite number of seconds")));
+        }
         if let Some(s) = self.step {
             if !(s.is_finite() && s > 0.0) {
                 return Err(voltex::Error::Invalid(format!("--step {s}: expected a positive world length")));
@@ -130,6 +137,7 @@ impl Overrides {
                 MethodArg::Reference => MethodKind::Reference,
             }),
             step: self.step,
+            time: self.time,
         })
     }
 }

@@ -248,7 +248,8 @@ pub struct HyperParams {
     /// w: seed of the field perturbation.
     pub kinds: [u32; 4],
     /// x: shadow-ray step (world), y: central-difference offset of the gradient (world), z: the
-    /// largest shift (object space) with a small margin: farther from the object the density is 0.
+    /// largest shift (object space) with a small margin: farther from the object the density is 0;
+    /// w: the frame's time (seconds, animated hypertextures).
     pub march: [f32; 4],
     /// Work of one dispatch, in density evaluations: x the budget, y the most samples of a shadow
     /// ray, z the most one sample may cost (so a sample is begun only when it fits).
@@ -256,7 +257,8 @@ pub struct HyperParams {
 }
 
 /// One noise of a hypertexture: `t = T((1 + simplex(frequency (x + shift V))) / 2)`, combined
-/// into `k` by `k += amplitude t` or, with `blend`, `k = k (1 - t) + amplitude t`.
+/// into `k` by `k += amplitude t` or, with `blend`, `k = k (1 - t) + amplitude t`. In animated
+/// hypertextures the noise is 4D, its fourth coordinate `speed` times the frame's time.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
 pub struct HyperNoise {
@@ -265,7 +267,8 @@ pub struct HyperNoise {
     pub shift: f32,
     pub blend: u32,
     pub seed: u32,
-    pub _pad: [u32; 3],
+    pub speed: f32,
+    pub _pad: [u32; 2],
 }
 
 /// A transfer function to sample into a table: `count` control points from `first`; `kind` 0 is

@@ -9,7 +9,7 @@ use glam::DVec3;
 use voltex::cpu::bake::pcg_hash;
 use voltex::cpu::bake_transfer::bake_transfer;
 use voltex::cpu::hypertexture::Model;
-use voltex::cpu::noise_simplex::simplex3;
+use voltex::cpu::noise_simplex::{simplex3, simplex4};
 use voltex::cpu::ray_march::{ray_march, MarchView};
 use voltex::gpu::GpuContext;
 use voltex::methods::ray_march::{probe, RayMarchPlan};
@@ -99,6 +99,7 @@ fn simplex_noise_kernel_matches_twin() {
         .collect();
     let gpu = probe(&ctx().lock().unwrap_or_else(|e| e.into_inner()), plan, &points).unwrap();
     let (mut max, mut sum, mut lo, mut hi): (f64, f64, f64, f64) = (0.0, 0.0, 1.0, -1.0);
+    let mut max4: f64 = 0.0;
     for (i, p) in points.iter().enumerate() {
         let x = DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64);
         let cpu = simplex3(x, p[3].to_bits());
@@ -107,9 +108,15 @@ fn simplex_noise_kernel_matches_twin() {
         sum += d;
         lo = lo.min(cpu);
         hi = hi.max(cpu);
+        let w = (0.37f32 * p[0] + 1.3) as f64;
+        let cpu4 = simplex4(x.extend(w), p[3].to_bits());
+        max4 = max4.max((gpu.values[4 * i][3] as f64 - cpu4).abs());
     }
-    eprintln!("simplex3 GPU vs f64 twin: max {max:.2e}, mean {:.2e}; range [{lo:.3}, {hi:.3}]", sum / 4096.0);
-    assert!(max < 1e-4, "max difference {max}");
+    eprintln!(
+        "simplex3 GPU vs f64 twin: max {max:.2e}, mean {:.2e}; range [{lo:.3}, {hi:.3}]; simplex4: max {max4:.2e}",
+        sum / 4096.0
+    );
+    assert!(max < 1e-4 && max4 < 1e-4, "max difference {max}, 4D {max4}");
     assert!(lo < -0.7 && hi > 0.7);
 }
 
@@ -385,6 +392,26 @@ fn shift_one_on_a_sphere_is_a_radial_displacement() {
     let (gpu, cpu, surface) = spreads[0];
     assert!(gpu < 1e-5 && cpu < 1e-12 && surface < 1e-12, "r = 1: {:?}", spreads[0]);
     assert!(spreads[1].0 > 0.02 && spreads[1].1 > 0.02, "r = 0 varies along the radius: {:?}", spreads[1]);
+}
+
+/// Animated hypertextures (4D noise, the paper's future work): the frame changes with time, and
+/// kernel and twin agree at each time.
+#[test]
+fn animated_hypertextures_change_with_time() {
+    let animated = CLOUD.replace("shift: 0.3)", "shift: 0.3, speed: 0.8)");
+    assert_ne!(animated, CLOUD);
+    let scene = one(&animated, "RayMarch(step: 0.02, shading: Phong)");
+    let mut layers = Vec::new();
+    for time in [0.0, 0.7] {
+        let (gpu, cpu, _) = layer_and_twin(&scene, &RenderOptions { time: Some(time), ..sized(32, 32) });
+        let (max, mean, _) = compare(&gpu, &cpu);
+        eprintln!("animated, time {time}: kernel vs twin max {max:.2e}, mean {mean:.2e}");
+        assert!(mean < 1e-5 && max < 1e-3);
+        layers.push(gpu);
+    }
+    let (_, change, _) = compare(&layers[0], &layers[1]);
+    eprintln!("animated: mean change of the layer from time 0 to 0.7: {change:.3}");
+    assert!(change > 1e-3);
 }
 
 /// Halving the step changes the error, not the brightness (the shared step-corrected opacity).

@@ -35,7 +35,7 @@ fn wgsl_structs_match_rust() {
         layout!(ReferenceObject; resolution, atlas, params),
         layout!(ReferenceState; color, resume),
         layout!(HyperParams; to_local, right, up, bounds_min, bounds_max, object, field, field_center, perturb, kinds, march, budget),
-        layout!(HyperNoise; amplitude, frequency, shift, blend, seed),
+        layout!(HyperNoise; amplitude, frequency, shift, blend, seed, speed),
         layout!(TransferFunction; first, count, kind, _pad),
         layout!(TransferPoint; x, y, slope, _pad),
         layout!(MarchState; color, resume),

@@ -7,7 +7,8 @@
 @group(0) @binding(2) var<storage, read> transfer_tables: array<f32>;
 // xyz: the point (object space); w: a noise seed (u32 bits).
 @group(0) @binding(3) var<storage, read> probe_points: array<vec4<f32>>;
-// Four per point: (simplex3(p, seed), O(p), table 0 at fract(|p.x|), 0), (V(p), 0),
+// Four per point: (simplex3(p, seed), O(p), table 0 at fract(|p.x|), simplex4((p, 0.37 p.x + 1.3),
+// seed)), (V(p), 0),
 // (density, 0, 0, 0), rgba of the density.
 @group(0) @binding(4) var<storage, read_write> probe_values: array<vec4<f32>>;
 
@@ -19,7 +20,8 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let p = probe_points[i].xyz;
     let seed = bitcast<u32>(probe_points[i].w);
-    probe_values[4u * i] = vec4<f32>(simplex3(p, seed), object_density(p), transfer_lookup(0u, fract(abs(p.x))), 0.0);
+    let n4 = simplex4(vec4<f32>(p, 0.37 * p.x + 1.3), seed);
+    probe_values[4u * i] = vec4<f32>(simplex3(p, seed), object_density(p), transfer_lookup(0u, fract(abs(p.x))), n4);
     probe_values[4u * i + 1u] = vec4<f32>(vector_field(p), 0.0);
     let density = hyper_density(p);
     probe_values[4u * i + 2u] = vec4<f32>(density, 0.0, 0.0, 0.0);

@@ -2,10 +2,10 @@
 //! fields, table lookups, the hypertexture density (Gilet & Dischler 2009, eq. 3 to 5) and its
 //! colour, read from the same packed parameters the kernels read.
 
-use glam::{DVec2, DVec3};
+use glam::{DVec2, DVec3, DVec4};
 
 use super::bake_transfer::TRANSFER_SIZE;
-use super::noise_simplex::simplex3;
+use super::noise_simplex::{simplex3, simplex4};
 use crate::hypertexture::{
     FIELD_CONSTANT, FIELD_FROM_CENTRE, FIELD_SWIRL, OBJECT_BOX, OBJECT_ELLIPSOID, OBJECT_TORUS,
 };
@@ -161,8 +161,16 @@ impl Model<'_> {
     /// The distortion factor k of eq. 5 at x, given V(x).
     pub fn distortion(&self, x: DVec3, v: DVec3) -> f64 {
         let mut k = 0.0;
-        for (i, n) in self.noises.iter().enumerate().take(self.params.kinds[2] as usize) {
-            let noise = simplex3((x + v * n.shift as f64) * n.frequency as f64, n.seed);
+        let noises = &self.noises[..self.params.kinds[2] as usize];
+        let animated = crate::hypertexture::animated(noises);
+        let time = self.params.march[3] as f64;
+        for (i, n) in noises.iter().enumerate() {
+            let q = (x + v * n.shift as f64) * n.frequency as f64;
+            let noise = if animated {
+                simplex4(DVec4::new(q.x, q.y, q.z, n.speed as f64 * time), n.seed)
+            } else {
+                simplex3(q, n.seed)
+            };
             let t = transfer_lookup(self.tables, i as u32, 0.5 + 0.5 * noise);
             let a = n.amplitude as f64;
             k = if n.blend != 0 { k * (1.0 - t) + a * t } else { k + a * t };

@@ -96,7 +96,8 @@ pub fn pack(h: &Hypertexture) -> Packed {
             shift: n.shift as f32,
             blend: (n.operator == Operator::Blend) as u32,
             seed: n.seed,
-            _pad: [0; 3],
+            speed: n.speed as f32,
+            _pad: [0; 2],
         });
         match &n.shape {
             ShapeTransfer::Curve(points) => {
@@ -130,6 +131,12 @@ pub fn pack(h: &Hypertexture) -> Packed {
         }
     }
     p
+}
+
+/// Whether a hypertexture's noises are 4D (some noise has a speed): the kernels' override
+/// `animated`.
+pub fn animated(noises: &[HyperNoise]) -> bool {
+    noises.iter().any(|n| n.speed != 0.0)
 }
 
 impl Packed {

@@ -59,6 +59,7 @@ pub fn plan(
     h: &Hypertexture,
     method: &RayMarch,
     camera: &Camera,
+    time: f64,
 ) -> Result<RayMarchPlan> {
     let packed = hypertexture::pack(h);
     let to_world = &node.to_world;
@@ -94,7 +95,7 @@ pub fn plan(
         field_center: packed.field_center,
         perturb: packed.perturb,
         kinds: packed.kinds,
-        march: [shadow_step as f32, step as f32, (h.max_shift() * (1.0 + 1e-4) + 1e-6) as f32, 0.0],
+        march: [shadow_step as f32, step as f32, (h.max_shift() * (1.0 + 1e-4) + 1e-6) as f32, time as f32],
         budget: [evals, shadow_samples, worst, 0],
     };
     Ok(RayMarchPlan {
@@ -119,6 +120,9 @@ impl RayMarchPlan {
         ];
         if !self.noise {
             c.push(("noise_off".into(), 1.0));
+        }
+        if hypertexture::animated(&self.packed.noises) {
+            c.push(("animated".into(), 1.0));
         }
         c
     }

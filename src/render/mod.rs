@@ -35,6 +35,8 @@ pub struct RenderOptions {
     pub method: Option<MethodKind>,
     /// Ray step for `Reference` and `RayMarch` objects (world units).
     pub step: Option<f64>,
+    /// Time of the frame in seconds (animated hypertextures; default: the scene's).
+    pub time: Option<f64>,
 }
 
 /// A method without its knobs, to switch every object to it (`--method`).
@@ -328,7 +330,9 @@ impl ObjectPlan {
                 let h = scene.hypertextures.get(&node.name).ok_or_else(|| {
                     Error::Invalid(format!("{}: unknown hypertexture `{}`", scene.path.display(), node.name))
                 })?;
-                plan.ray_march = Some(ray_march::plan(&plan.object.name, node, h, &rm, &view.camera())?);
+                let time = opts.time.unwrap_or(scene.time);
+                plan.ray_march =
+                    Some(ray_march::plan(&plan.object.name, node, h, &rm, &view.camera(), time)?);
                 return Ok(plan);
             }
             Method::Reference(r) => {

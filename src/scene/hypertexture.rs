@@ -147,6 +147,9 @@ pub struct Noise {
     pub operator: Operator,
     #[serde(default)]
     pub seed: u32,
+    /// Animation: noise cycles per second along time (4D noise; 0: still).
+    #[serde(default, deserialize_with = "v::finite")]
+    pub speed: f64,
 }
 
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]

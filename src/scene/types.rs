@@ -28,6 +28,9 @@ pub struct Scene {
     pub hypertextures: BTreeMap<String, super::hypertexture::Hypertexture>,
     #[serde(default)]
     pub nodes: Vec<Node>,
+    /// Time of the frame in seconds (animated hypertextures; `--time` overrides it).
+    #[serde(default, deserialize_with = "v::finite")]
+    pub time: f64,
     /// Settings of `voltex regress` runs: render size and pass thresholds.
     #[serde(default)]
     pub regress: Regress,

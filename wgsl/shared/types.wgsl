@@ -146,9 +146,9 @@ struct HyperNoise {
     shift: f32,
     blend: u32,
     seed: u32,
+    speed: f32,
     _pad0: u32,
     _pad1: u32,
-    _pad2: u32,
 }
 
 struct TransferFunction {
