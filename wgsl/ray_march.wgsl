@@ -16,7 +16,6 @@ const MIN_TRANSMITTANCE: f32 = 1e-4;
 const MAX_ALPHA: f32 = 0.999999;
 // Raster depth is coarse far from the camera: opaque surfaces are moved back by this margin.
 const DEPTH_SLACK: f32 = 2e-3;
-const FAR: f32 = 3.4e38;
 
 @group(0) @binding(0) var<uniform> frame: FrameParams;
 @group(0) @binding(1) var<uniform> hyper: HyperParams;

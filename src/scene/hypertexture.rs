@@ -10,8 +10,9 @@ use super::values::{self as v, Mark};
 
 /// Most noises one hypertexture combines.
 pub const MAX_NOISES: usize = 8;
-/// Most control points of a curve or ramp, and most entries of a sampled table.
+/// Most control points of a curve or ramp.
 pub const MAX_POINTS: usize = 64;
+/// Most values of a sampled table.
 pub const MAX_TABLE: usize = 256;
 
 /// `hypertextures: { "name": (object: .., field: .., noises: [..], color: ..) }`.
