@@ -221,6 +221,72 @@ pub struct ReferenceState {
     pub resume: [f32; 4],
 }
 
+/// Per-object parameters of Meyer & Neyret axis-aligned slicing (uniform `axis_params`).
+/// Mirrored as `AxisParams` in `wgsl/shared/types.wgsl`. Directions: 0 = s, 1 = t, 2 = w.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct AxisParams {
+    /// xyz: texel resolution along s, t, w (the finest slice counts); w: prism count.
+    pub resolution: [u32; 4],
+    /// x: `d`, how deep inside a contour may be seen (voxels); y: `p`, largest apparent distance
+    /// between slices (pixels); z: maximum view angle the criteria are evaluated at (radians);
+    /// w: focal length in pixels (half the image height over tan(fov_y / 2)).
+    pub criteria: [f32; 4],
+    /// xyz: unit camera forward; w: unused.
+    pub forward: [f32; 4],
+    /// x: allowed directions (bit i for direction i); y: vertex capacity; z: back-face culling
+    /// (0/1); w: empty-texel culling (0/1).
+    pub flags: [u32; 4],
+}
+
+/// What `choose_axis_slices` decided for one prism, and where `emit_axis_slices` writes it.
+/// Mirrored as `AxisChoice` in `wgsl/shared/types.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq, Eq)]
+pub struct AxisChoice {
+    /// 0 = s, 1 = t, 2 = w.
+    pub direction: u32,
+    /// Power-of-two level: slices are `ceil(resolution / 2^level)` per texel.
+    pub level: u32,
+    /// Global index of the first slice position crossing the prism (s, t: across tiles).
+    pub first: i32,
+    /// Slice positions crossing the prism, before empty-slice culling.
+    pub count: u32,
+    /// Triangle-list vertices emitted (0 when culled).
+    pub vertex_count: u32,
+    /// First vertex in `axis_vertices` (exclusive scan in prism order).
+    pub vertex_offset: u32,
+    /// 1 when slices are emitted from the last position down (back to front).
+    pub reverse: u32,
+    /// 1 when the prism was culled as back-facing.
+    pub culled: u32,
+}
+
+/// One vertex of an extruded slice (a triangle for `w` slices, a ruled quad for `s` and `t`).
+/// Mirrored as `AxisVertex` in `wgsl/shared/types.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct AxisVertex {
+    /// xyz: camera-relative position; w: world thickness of the slab the slice stands for.
+    pub position: [f32; 4],
+    /// xy: coordinates in the slice image; z: array layer; w: direction.
+    pub texcoord: [f32; 4],
+    /// xyz: unit normal of the slice plane; w: unused.
+    pub normal: [f32; 4],
+}
+
+/// One dispatch of `bake_axis_slices` (uniform `axis_bake`).
+/// Mirrored as `AxisBake` in `wgsl/shared/types.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct AxisBake {
+    /// xyz: texel resolution (s, t, w); w: direction (0 = s, 1 = t, 2 = w).
+    pub resolution: [u32; 4],
+    /// x: level; y: first array layer of the level; z: slices in the level; w: first occupancy
+    /// word of the level.
+    pub level: [u32; 4],
+}
+
 /// One hypertexture object of the `RayMarch` method (uniform `hyper`). Object space is the node's
 /// local frame; the camera sits at the origin of camera-relative world space.
 #[repr(C)]

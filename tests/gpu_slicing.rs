@@ -29,13 +29,15 @@ fn gpu_slices(shell: &Shell, params: &SliceParams, trivial_reject: bool) -> Vec<
     let info = ObjectInfo { name: "shell".into(), filters: vec!["ViewSlices"], distance: 0.0, order: 0 };
     let plan = plan::plan(&graph, &root.join("wgsl"), &[info]).unwrap();
     assert_eq!(plan.passes.len(), 3);
-    let mut exec = Executor::new(ctx, graph, &plan, (1, 1)).unwrap();
+    let mut cache = voltex::gpu::cache::GpuCache::default();
+    let mut exec = Executor::new(ctx, graph, &plan, (1, 1), &mut cache).unwrap();
     let mut params = *params;
     let capacity = view_slices::vertex_capacity(shell, &params).max(3);
     params.vertex_capacity = capacity as u32;
     let mut inputs = Inputs::default();
     view_slices::add_inputs(ctx, &mut inputs, shell, &params, capacity, trivial_reject);
     let mut timer = Timer::new(ctx, 4);
+    exec.prepare(ctx, &plan, &Inputs::default(), std::slice::from_ref(&inputs), &mut cache).unwrap();
     exec.run(ctx, &plan, &Inputs::default(), std::slice::from_ref(&inputs), &mut timer).unwrap();
     // The per-plane draw arguments agree with the CPU twin's scan.
     let bytes = ctx.read_buffer(&inputs.buffers["plane_draws"], 0, params.plane_count as u64 * 16).unwrap();

@@ -1,5 +1,6 @@
 //! CPU twins of the kernels whose math matters; tests run both on the same inputs.
 
+pub mod axis_slices;
 pub mod bake;
 pub mod bake_transfer;
 pub mod hypertexture;

@@ -1,5 +1,6 @@
 //! Device, shader loading and validation, reflection, timestamps.
 
+pub mod cache;
 pub mod context;
 pub mod kernel;
 pub mod reflect;

@@ -14,6 +14,8 @@ pub struct Kernel {
     pub module: naga::Module,
     pub info: naga::valid::ModuleInfo,
     pub files: Vec<PathBuf>,
+    /// Hash of the expanded source: the GPU module is reused while it is unchanged.
+    pub source_hash: u64,
 }
 
 /// Expanded source plus, for each expanded line, the file and line it came from.
@@ -108,7 +110,8 @@ fn load_expanded(name: &str, ex: Expanded) -> Result<Kernel> {
             }
             Error::at(ex.locate(line, col), format!("WGSL validation error: {msg}"))
         })?;
-    Ok(Kernel { name: name.to_string(), module, info, files: ex.files })
+    let source_hash = crate::gpu::cache::key(&ex.text);
+    Ok(Kernel { name: name.to_string(), module, info, files: ex.files, source_hash })
 }
 
 fn first_line(diagnostic: &str) -> String {

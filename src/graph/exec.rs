@@ -5,6 +5,7 @@ use std::borrow::Cow;
 use std::collections::HashMap;
 
 use crate::error::{Error, Result};
+use crate::gpu::cache::{self, GpuCache, Layout, Pipeline};
 use crate::gpu::reflect::{self, BindingKind};
 use crate::gpu::timing::Timer;
 use crate::gpu::GpuContext;
@@ -38,11 +39,6 @@ pub const COUNTS: &[&str] = &[
     "transfer_functions",
 ];
 
-enum Pipeline {
-    Compute(wgpu::ComputePipeline),
-    Render(wgpu::RenderPipeline),
-}
-
 struct Texture {
     texture: wgpu::Texture,
     view: wgpu::TextureView,
@@ -53,12 +49,20 @@ pub struct Executor {
     graph: Graph,
     textures: HashMap<String, Texture>,
     modules: HashMap<String, wgpu::ShaderModule>,
-    layouts: Vec<(Vec<wgpu::BindGroupLayout>, wgpu::PipelineLayout)>,
+    layouts: Vec<Layout>,
     pipelines: HashMap<(usize, String), Pipeline>,
 }
 
 impl Executor {
-    pub fn new(ctx: &GpuContext, graph: Graph, plan: &Plan, size: (u32, u32)) -> Result<Self> {
+    /// Graph textures, shader modules and layouts for a plan; modules and layouts come from
+    /// `cache` when their source and bindings are unchanged.
+    pub fn new(
+        ctx: &GpuContext,
+        graph: Graph,
+        plan: &Plan,
+        size: (u32, u32),
+        cache: &mut GpuCache,
+    ) -> Result<Self> {
         let max2d = ctx.limits.max_texture_dimension_2d;
         if size.0 > max2d || size.1 > max2d {
             return Err(Error::Gpu(format!(
@@ -119,17 +123,20 @@ impl Executor {
         let mut layouts = Vec::new();
         for p in &plan.passes {
             let name = p.decl.shader().to_string();
-            if let std::collections::hash_map::Entry::Vacant(slot) = modules.entry(name) {
-                let label = format!("shader {}", slot.key());
-                let module = ctx.scoped(&label, || {
+            let label = format!("shader {name}");
+            let module = cache.module(p.kernel.source_hash, || {
+                ctx.scoped(&label, || {
                     ctx.device.create_shader_module(wgpu::ShaderModuleDescriptor {
                         label: Some(&label),
                         source: wgpu::ShaderSource::Naga(Cow::Owned(p.kernel.module.clone())),
                     })
-                })?;
-                slot.insert(module);
-            }
-            layouts.push(pass_layout(ctx, p));
+                })
+            })?;
+            modules.insert(name, module);
+            let entries: Vec<wgpu::BindGroupLayoutEntry> =
+                p.bindings.iter().map(reflect::layout_entry).collect();
+            let groups: Vec<u32> = p.bindings.iter().map(|b| b.group).collect();
+            layouts.push(cache.layout(cache::key(&(&entries, &groups)), || pass_layout(ctx, p)));
         }
         Ok(Self { graph, textures, modules, layouts, pipelines: HashMap::new() })
     }
@@ -145,10 +152,11 @@ impl Executor {
         plan: &Plan,
         frame: &Inputs,
         objects: &[Inputs],
+        cache: &mut GpuCache,
     ) -> Result<()> {
         for i in 0..plan.passes.len() {
             for inst in instance_inputs(&plan.passes[i], frame, objects) {
-                self.pipeline(ctx, plan, i, frame, inst)?;
+                self.pipeline(ctx, plan, i, frame, inst, cache)?;
             }
         }
         Ok(())
@@ -161,6 +169,7 @@ impl Executor {
         index: usize,
         frame: &Inputs,
         inst: &Inputs,
+        cache: &mut GpuCache,
     ) -> Result<()> {
         let pass = &plan.passes[index];
         let constants = specialisation(pass, frame, inst).map_err(|name| {
@@ -177,79 +186,93 @@ impl Executor {
             return Ok(());
         }
         let module = &self.modules[pass.decl.shader()];
-        let layout = &self.layouts[index].1;
+        let layout = &self.layouts[index].pipeline;
         let options = wgpu::PipelineCompilationOptions {
             constants: &constants,
             zero_initialize_workgroup_memory: true,
         };
         let label = format!("{} ({})", pass.decl.name(), pass.decl.shader());
-        let pipeline = match &pass.decl {
-            PassDecl::Compute { entry, .. } => ctx.scoped(&label, || {
-                Pipeline::Compute(ctx.device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                    label: Some(&label),
-                    layout: Some(layout),
-                    module,
-                    entry_point: Some(entry),
-                    compilation_options: options.clone(),
-                    cache: None,
-                }))
-            })?,
-            PassDecl::Raster { vertex, fragment, targets, depth, .. } => {
-                let color: Vec<Option<wgpu::ColorTargetState>> = targets
-                    .iter()
-                    .map(|t| {
-                        Some(wgpu::ColorTargetState {
-                            format: self.textures[&t.resource].texture.format(),
-                            blend: match t.blend {
-                                Blend::Replace => None,
-                                Blend::PremultipliedOver => {
-                                    Some(wgpu::BlendState::PREMULTIPLIED_ALPHA_BLENDING)
-                                }
-                                Blend::Add => {
-                                    let add = wgpu::BlendComponent {
-                                        src_factor: wgpu::BlendFactor::One,
-                                        dst_factor: wgpu::BlendFactor::One,
-                                        operation: wgpu::BlendOperation::Add,
-                                    };
-                                    Some(wgpu::BlendState { color: add, alpha: add })
-                                }
-                            },
-                            write_mask: wgpu::ColorWrites::ALL,
-                        })
-                    })
-                    .collect();
-                let depth_stencil = depth.as_ref().map(|d| wgpu::DepthStencilState {
-                    format: self.textures[&d.resource].texture.format(),
-                    depth_write_enabled: Some(d.write),
-                    depth_compare: Some(d.compare.wgpu()),
-                    stencil: Default::default(),
-                    bias: Default::default(),
-                });
-                ctx.scoped(&label, || {
-                    Pipeline::Render(ctx.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        let formats: Vec<wgpu::TextureFormat> = match &pass.decl {
+            PassDecl::Raster { targets, depth, .. } => targets
+                .iter()
+                .map(|t| &t.resource)
+                .chain(depth.iter().map(|d| &d.resource))
+                .map(|r| self.textures[r].texture.format())
+                .collect(),
+            PassDecl::Compute { .. } => Vec::new(),
+        };
+        // Everything that defines the pipeline: source, bindings, the pass (entries, blending,
+        // depth), target formats and specialisation.
+        let desc = cache::key(&(pass.kernel.source_hash, &pass.bindings, &pass.decl, &formats, &constants));
+        let pipeline = cache.pipeline(desc, || {
+            Ok(match &pass.decl {
+                PassDecl::Compute { entry, .. } => ctx.scoped(&label, || {
+                    Pipeline::Compute(ctx.device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
                         label: Some(&label),
                         layout: Some(layout),
-                        vertex: wgpu::VertexState {
-                            module,
-                            entry_point: Some(vertex),
-                            compilation_options: options.clone(),
-                            buffers: &[],
-                        },
-                        primitive: wgpu::PrimitiveState::default(),
-                        depth_stencil,
-                        multisample: Default::default(),
-                        fragment: Some(wgpu::FragmentState {
-                            module,
-                            entry_point: Some(fragment),
-                            compilation_options: options.clone(),
-                            targets: &color,
-                        }),
-                        multiview_mask: None,
+                        module,
+                        entry_point: Some(entry),
+                        compilation_options: options.clone(),
                         cache: None,
                     }))
-                })?
-            }
-        };
+                })?,
+                PassDecl::Raster { vertex, fragment, targets, depth, .. } => {
+                    let color: Vec<Option<wgpu::ColorTargetState>> = targets
+                        .iter()
+                        .map(|t| {
+                            Some(wgpu::ColorTargetState {
+                                format: self.textures[&t.resource].texture.format(),
+                                blend: match t.blend {
+                                    Blend::Replace => None,
+                                    Blend::PremultipliedOver => {
+                                        Some(wgpu::BlendState::PREMULTIPLIED_ALPHA_BLENDING)
+                                    }
+                                    Blend::Add => {
+                                        let add = wgpu::BlendComponent {
+                                            src_factor: wgpu::BlendFactor::One,
+                                            dst_factor: wgpu::BlendFactor::One,
+                                            operation: wgpu::BlendOperation::Add,
+                                        };
+                                        Some(wgpu::BlendState { color: add, alpha: add })
+                                    }
+                                },
+                                write_mask: wgpu::ColorWrites::ALL,
+                            })
+                        })
+                        .collect();
+                    let depth_stencil = depth.as_ref().map(|d| wgpu::DepthStencilState {
+                        format: self.textures[&d.resource].texture.format(),
+                        depth_write_enabled: Some(d.write),
+                        depth_compare: Some(d.compare.wgpu()),
+                        stencil: Default::default(),
+                        bias: Default::default(),
+                    });
+                    ctx.scoped(&label, || {
+                        Pipeline::Render(ctx.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                            label: Some(&label),
+                            layout: Some(layout),
+                            vertex: wgpu::VertexState {
+                                module,
+                                entry_point: Some(vertex),
+                                compilation_options: options.clone(),
+                                buffers: &[],
+                            },
+                            primitive: wgpu::PrimitiveState::default(),
+                            depth_stencil,
+                            multisample: Default::default(),
+                            fragment: Some(wgpu::FragmentState {
+                                module,
+                                entry_point: Some(fragment),
+                                compilation_options: options.clone(),
+                                targets: &color,
+                            }),
+                            multiview_mask: None,
+                            cache: None,
+                        }))
+                    })?
+                }
+            })
+        })?;
         self.pipelines.insert(key, pipeline);
         Ok(())
     }
@@ -263,7 +286,6 @@ impl Executor {
         objects: &[Inputs],
         timer: &mut Timer,
     ) -> Result<()> {
-        self.prepare(ctx, plan, frame, objects)?;
         let mut encoder =
             ctx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
         let mut written: Vec<String> = Vec::new();
@@ -482,7 +504,7 @@ impl Executor {
         frame: &Inputs,
         inst: &Inputs,
     ) -> Result<Vec<wgpu::BindGroup>> {
-        let (bgls, _) = &self.layouts[index];
+        let bgls = &self.layouts[index].groups;
         let mut out = Vec::new();
         for (group, bgl) in bgls.iter().enumerate() {
             let mut entries = Vec::new();
@@ -597,9 +619,9 @@ fn constants_key(constants: &[(&str, f64)]) -> String {
     format!("{constants:?}")
 }
 
-fn pass_layout(ctx: &GpuContext, pass: &PlannedPass) -> (Vec<wgpu::BindGroupLayout>, wgpu::PipelineLayout) {
-    let groups = pass.bindings.iter().map(|b| b.group + 1).max().unwrap_or(0);
-    let bgls: Vec<wgpu::BindGroupLayout> = (0..groups)
+fn pass_layout(ctx: &GpuContext, pass: &PlannedPass) -> Layout {
+    let count = pass.bindings.iter().map(|b| b.group + 1).max().unwrap_or(0);
+    let groups: Vec<wgpu::BindGroupLayout> = (0..count)
         .map(|g| {
             let entries: Vec<_> =
                 pass.bindings.iter().filter(|b| b.group == g).map(reflect::layout_entry).collect();
@@ -607,13 +629,13 @@ fn pass_layout(ctx: &GpuContext, pass: &PlannedPass) -> (Vec<wgpu::BindGroupLayo
                 .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: None, entries: &entries })
         })
         .collect();
-    let refs: Vec<Option<&wgpu::BindGroupLayout>> = bgls.iter().map(Some).collect();
-    let layout = ctx.device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+    let refs: Vec<Option<&wgpu::BindGroupLayout>> = groups.iter().map(Some).collect();
+    let pipeline = ctx.device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
         label: Some(pass.decl.name()),
         bind_group_layouts: &refs,
         immediate_size: 0,
     });
-    (bgls, layout)
+    Layout { groups, pipeline }
 }
 
 fn instance_inputs<'a>(pass: &PlannedPass, frame: &'a Inputs, objects: &'a [Inputs]) -> Vec<&'a Inputs> {

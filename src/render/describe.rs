@@ -35,6 +35,12 @@ impl Blueprint {
                 ),
                 bake::bytes(r, b.request.per_pixel),
             ));
+            if b.request.axis_slices {
+                out.push((
+                    format!("texel {} slice images (s, t, w; all levels) rgba16f", b.texel),
+                    bake::axis_slices::bytes(r),
+                ));
+            }
         }
         if let Some(r) = &self.reference {
             out.push((
@@ -65,6 +71,12 @@ impl Blueprint {
                     cap * std::mem::size_of::<SliceVertex>() as u64
                         + sweep.plane_count as u64 * 4
                         + o.chunks.len() as u64 * (16 + 48),
+                ));
+            }
+            if let Some(a) = &o.axis {
+                out.push((
+                    format!("object {name}: axis slice vertices (capacity {}) + choices", a.capacity),
+                    a.capacity * 48 + a.prisms.len() as u64 * (32 + 64) + shell + 16,
                 ));
             }
             if let Some(frames) = &o.frames {
@@ -112,10 +124,13 @@ impl Blueprint {
                 bake::mip_count(r) - 1,
                 if b.request.per_pixel { "per-pixel (albedo + normals)" } else { "baked" }
             );
+            if b.request.axis_slices {
+                s += "  (and its slice images: bake_axis_slices.wgsl per direction and level)\n";
+            }
         }
         s += "\nobjects:\n";
         for o in &self.objects {
-            let method = match (&o.sweep, o.reference_step) {
+            let method = match (&o.sweep, o.reference_step, &o.axis) {
                 _ if o.ray_march.is_some() => {
                     let m = o.ray_march.as_ref().unwrap();
                     format!(
@@ -126,12 +141,13 @@ impl Blueprint {
                         m.dispatches
                     )
                 }
-                (_, Some(step)) => format!(
+                (_, _, Some(a)) => format!("{:?}, vertex capacity {}", a.method, a.capacity),
+                (_, Some(step), _) => format!(
                     "Reference step {step:.6} lighting {}, {} dispatch(es) per frame",
                     if o.per_pixel { "PerPixel" } else { "Baked" },
                     self.reference.as_ref().map_or(0, |r| r.dispatches)
                 ),
-                (Some(p), _) => format!(
+                (Some(p), _, _) => format!(
                     "ViewSlices planes {} spacing {:.4} trivial_reject {} lighting {}, {} chunk(s)",
                     p.plane_count,
                     p.spacing,
@@ -139,7 +155,7 @@ impl Blueprint {
                     if o.per_pixel { "PerPixel" } else { "Baked" },
                     o.chunks.len()
                 ),
-                (None, _) => "base surface only".into(),
+                (None, _, _) => "base surface only".into(),
             };
             let what = match &o.object.hypertexture {
                 Some(_) => "hypertexture".to_string(),

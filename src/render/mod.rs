@@ -15,12 +15,14 @@ use crate::bake::BakeRequest;
 use crate::error::{Error, Result};
 use crate::graph::plan::{self, ObjectInfo, Plan};
 use crate::graph::Graph;
+use crate::methods::axis_slices::AxisPlan;
 use crate::methods::ray_march::{self, RayMarchPlan};
 use crate::methods::reference::{self, ReferenceSet};
 use crate::methods::shell::{self, Shell};
 use crate::methods::view_slices::{self, SliceChunk};
 use crate::scene::{
-    Light, Lighting as LightingMode, Method, RayMarch, Reference, Scene, SceneObject, ViewSlices,
+    AxisSlices, Camera, Light, Lighting as LightingMode, Method, RayMarch, Reference, Scene, SceneObject,
+    ViewSlices,
 };
 use crate::types::{BaseVertex, FrameParams, ReferenceParams, SliceParams, VertexFrame};
 
@@ -35,6 +37,15 @@ pub struct RenderOptions {
     pub method: Option<MethodKind>,
     /// Ray step for `Reference` and `RayMarch` objects (world units).
     pub step: Option<f64>,
+    /// Methods replacing those of named objects (the preview's per-object switch), before
+    /// `method` and the knob overrides apply.
+    pub object_methods: Vec<(String, Method)>,
+    /// A camera replacing the scene's (the preview's orbit).
+    pub camera: Option<Camera>,
+    /// Render at `n` times the width and height and average each `n x n` block: every pixel is
+    /// then the mean over its area rather than a point sample (anti-aliasing; a reference for
+    /// methods that filter textures by the pixel footprint, as mipmaps do).
+    pub supersample: Option<u32>,
     /// Time of the frame in seconds (animated hypertextures; default: the scene's).
     pub time: Option<f64>,
 }
@@ -44,7 +55,19 @@ pub struct RenderOptions {
 pub enum MethodKind {
     ViewSlices,
     Reference,
+    AxisSlices,
 }
+
+/// Axis slicing's knobs when an object is switched to it from another method.
+pub const DEFAULT_AXIS_SLICES: AxisSlices = AxisSlices {
+    depth: 1.0,
+    pixels: 1.0,
+    max_angle: 80.0,
+    directions: crate::scene::SliceDirections::Three,
+    blend: crate::scene::SliceBlend::Binary,
+    back_face_culling: false,
+    empty_culling: true,
+};
 
 /// Plane count when an object is switched to view slicing from a method without planes.
 pub const DEFAULT_PLANES: u32 = 400;
@@ -60,6 +83,7 @@ impl RenderOptions {
         let kind = self.method.unwrap_or(match method {
             Method::ViewSlices(_) => MethodKind::ViewSlices,
             Method::Reference(_) | Method::RayMarch(_) => MethodKind::Reference,
+            Method::AxisSlices(_) => MethodKind::AxisSlices,
         });
         match (kind, method) {
             (MethodKind::ViewSlices, Method::ViewSlices(vs)) => Method::ViewSlices(ViewSlices {
@@ -76,6 +100,8 @@ impl RenderOptions {
                 Method::Reference(Reference { step: self.step.or(r.step), lighting })
             }
             (MethodKind::Reference, _) => Method::Reference(Reference { step: self.step, lighting }),
+            (MethodKind::AxisSlices, Method::AxisSlices(a)) => Method::AxisSlices(*a),
+            (MethodKind::AxisSlices, _) => Method::AxisSlices(DEFAULT_AXIS_SLICES),
         }
     }
 }
@@ -96,6 +122,8 @@ pub struct ObjectPlan {
     pub bake: Option<usize>,
     /// Reference method: the ray step (world units).
     pub reference_step: Option<f64>,
+    /// Axis-aligned slicing (Meyer & Neyret).
+    pub axis: Option<AxisPlan>,
     /// RayMarch method: the packed hypertexture and march settings.
     pub ray_march: Option<RayMarchPlan>,
 }
@@ -113,13 +141,17 @@ pub enum Part {
     Slices(usize),
     /// All Reference objects of the frame, traced in one dispatch.
     Reference,
+    /// An object's axis-aligned slices.
+    AxisSlices,
     /// A hypertexture object, ray-marched into its own layer.
     RayMarch,
 }
 
 pub struct Blueprint {
     pub scene_path: PathBuf,
+    /// The size rendered at (the output size times `supersample`).
     pub size: (u32, u32),
+    pub supersample: u32,
     pub eye: DVec3,
     pub frame: FrameParams,
     pub objects: Vec<ObjectPlan>,
@@ -147,8 +179,13 @@ impl Blueprint {
 
     /// Like [`Blueprint::new`] with the scene's objects given (tests alter their surfaces).
     pub fn with_objects(scene: &Scene, objects: Vec<SceneObject>, opts: &RenderOptions) -> Result<Self> {
-        let size = opts.size.unwrap_or((scene.output.width, scene.output.height));
-        let view = View::new(scene, &objects, size)?;
+        let (w, h) = opts.size.unwrap_or((scene.output.width, scene.output.height));
+        let n = opts.supersample.unwrap_or(1).max(1);
+        let size = (w * n, h * n);
+        let mut view = View::new(scene, opts.camera.as_ref().unwrap_or(&scene.camera), &objects)?;
+        // Pixels per unit of tangent, for the slice-count criterion (at the rendered size).
+        view.focal = 0.5 * size.1 as f64 / (0.5 * view.fov_y.to_radians()).tan();
+        view.size = size;
         let light = Lighting::of(scene);
         let mut bakes: Vec<BakePlan> = Vec::new();
         let mut objects = objects
@@ -160,11 +197,8 @@ impl Blueprint {
         let (instances, infos) = instances(&objects, reference.as_ref(), view.eye);
         let plan = plan::plan(&graph, &wgsl_root(), &infos)?;
         check_bindings(&graph, &plan)?;
-        let samples_texels = plan
-            .passes
-            .iter()
-            .flat_map(|p| &p.bindings)
-            .any(|b| ["volume", "normals", "texel_atlas"].contains(&b.name.as_str()));
+        let samples_texels =
+            plan.passes.iter().flat_map(|p| &p.bindings).any(|b| TEXEL_BINDINGS.contains(&b.name.as_str()));
         if !samples_texels {
             // A graph that samples no texel (the slicing debug graphs) bakes nothing.
             bakes.clear();
@@ -174,6 +208,7 @@ impl Blueprint {
         Ok(Self {
             scene_path: scene.path.clone(),
             size,
+            supersample: n,
             eye: view.eye,
             frame,
             objects,
@@ -213,12 +248,14 @@ struct View {
     fov_y: f64,
     near: f64,
     far: f64,
+    /// Focal length in pixels (half the image height over tan(fov_y / 2)).
+    focal: f64,
+    /// The rendered size (for the ray casters' camera).
     size: (u32, u32),
 }
 
 impl View {
-    fn new(scene: &Scene, objects: &[SceneObject], size: (u32, u32)) -> Result<Self> {
-        let cam = &scene.camera;
+    fn new(scene: &Scene, cam: &Camera, objects: &[SceneObject]) -> Result<Self> {
         let forward = (cam.target - cam.eye).normalize_or_zero();
         if forward == DVec3::ZERO || forward.cross(cam.up).length_squared() < 1e-12 {
             return Err(Error::Invalid(format!(
@@ -240,7 +277,7 @@ impl View {
         }
         far *= 1.01;
         let near = (far * 1e-4).max(1e-6);
-        Ok(Self { eye: cam.eye, forward, up: cam.up, fov_y: cam.fov_y, near, far, size })
+        Ok(Self { eye: cam.eye, forward, up: cam.up, fov_y: cam.fov_y, near, far, focal: 1.0, size: (1, 1) })
     }
 
     /// The camera as ray casting kernels see it: a pixel's ray is `forward + sx right + sy up`.
@@ -317,10 +354,15 @@ impl ObjectPlan {
             frames: None,
             bake: None,
             reference_step: None,
+            axis: None,
             ray_march: None,
             object,
         };
-        let Some(method) = plan.object.method.as_ref().map(|m| opts.apply(m)) else { return Ok(plan) };
+        let name = &plan.object.name;
+        let chosen = opts.object_methods.iter().find(|(n, _)| n == name).map(|(_, m)| m);
+        let Some(method) = chosen.or(plan.object.method.as_ref()).map(|m| opts.apply(m)) else {
+            return Ok(plan);
+        };
         let vs = match method {
             Method::ViewSlices(vs) => vs,
             Method::RayMarch(rm) => {
@@ -333,6 +375,16 @@ impl ObjectPlan {
                 let time = opts.time.unwrap_or(scene.time);
                 plan.ray_march =
                     Some(ray_march::plan(&plan.object.name, node, h, &rm, &view.camera(), time)?);
+                return Ok(plan);
+            }
+            Method::AxisSlices(a) => {
+                let texel = plan.object.texel.clone().unwrap_or_default();
+                let bake = texels::bake_index_axis(scene, &texel, light, bakes)?;
+                plan.bake = Some(bake);
+                let res = bakes[bake].request.resolution;
+                let name = &plan.object.name;
+                let axis = AxisPlan::new(&plan.shell, &a, res, view.forward_f32(), view.focal, name)?;
+                plan.axis = Some(axis);
                 return Ok(plan);
             }
             Method::Reference(r) => {
@@ -387,21 +439,30 @@ fn instances(
         let centre = positions.iter().sum::<DVec3>() / positions.len().max(1) as f64;
         let distance = (centre - eye).length();
         let parts = o.base.iter().map(|_| Part::Base).chain((0..o.chunks.len()).map(Part::Slices));
+        let axis = o.axis.iter().map(|_| Part::AxisSlices);
         let march = o.ray_march.as_ref().map(|m| (m.corners.iter().sum::<DVec3>() / 8.0 - eye).length());
         let distance = march.unwrap_or(distance);
-        for part in parts.chain(march.map(|_| Part::RayMarch)) {
-            let (filter, order) = match part {
-                Part::Base => ("BaseSurface", 0),
-                Part::Slices(c) => ("ViewSlices", c as u32),
-                Part::RayMarch => ("RayMarch", 0),
+        for part in parts.chain(axis).chain(march.map(|_| Part::RayMarch)) {
+            let (filters, order) = match part {
+                Part::Base => (vec!["BaseSurface"], 0),
+                Part::Slices(c) => (vec!["ViewSlices"], c as u32),
+                Part::AxisSlices => {
+                    let blended = o.axis.as_ref().is_some_and(|a| a.blended);
+                    (vec!["AxisSlices", if blended { "AxisSlicesBlended" } else { "AxisSlicesBinary" }], 0)
+                }
+                Part::RayMarch => (vec!["RayMarch"], 0),
                 Part::Reference => unreachable!("reference instances are added once, above"),
             };
             instances.push((i, part));
-            infos.push(ObjectInfo { name: o.object.name.clone(), filters: vec![filter], distance, order });
+            infos.push(ObjectInfo { name: o.object.name.clone(), filters, distance, order });
         }
     }
     (instances, infos)
 }
+
+/// Bindings that sample baked texels: a graph using none of them bakes nothing.
+const TEXEL_BINDINGS: &[&str] =
+    &["volume", "normals", "texel_atlas", "axis_slices_s", "axis_slices_t", "axis_slices_w"];
 
 /// Resources the runtime binds by name: per frame, and per instance (an object's base surface or
 /// one chunk of its slices).
@@ -432,6 +493,16 @@ pub const INSTANCE_RESOURCES: &[&str] = &[
     "transfer_functions",
     "transfer_tables",
     "ray_march_state",
+    "axis_params",
+    "axis_occupancy",
+    "axis_choices",
+    "axis_draw_args",
+    "axis_vertices",
+    "axis_slices_s",
+    "axis_slices_t",
+    "axis_slices_w",
+    "axis_sampler",
+    "axis_sampler_side",
 ];
 
 /// Every WGSL global a kept pass uses must name a graph texture or a runtime resource, so that

@@ -2,11 +2,12 @@
 
 use crate::bake::{self, Baker};
 use crate::error::{Error, Result};
+use crate::gpu::cache::{self, GpuCache};
 use crate::gpu::timing::Timer;
 use crate::gpu::GpuContext;
 use crate::graph::exec::{Executor, Inputs};
 use crate::io::Image;
-use crate::methods::view_slices;
+use crate::methods::{axis_slices, view_slices};
 use crate::render::{wgsl_root, Blueprint, ObjectPlan, Part};
 use crate::types::{ObjectParams, VertexFrame};
 
@@ -35,6 +36,12 @@ pub struct Renderer {
 
 impl Renderer {
     pub fn new(ctx: &GpuContext, blueprint: Blueprint) -> Result<Self> {
+        Self::with_cache(ctx, blueprint, &mut GpuCache::default())
+    }
+
+    /// Like [`Renderer::new`], taking shader modules, pipelines and bakes from `cache` where
+    /// nothing that defines them changed (the preview's hot reload).
+    pub fn with_cache(ctx: &GpuContext, blueprint: Blueprint, cache: &mut GpuCache) -> Result<Self> {
         for o in &blueprint.objects {
             for c in &o.chunks {
                 let max = ctx.limits.max_storage_buffer_binding_size;
@@ -45,8 +52,11 @@ impl Renderer {
             set.check_limits(ctx.limits.max_storage_buffer_binding_size)?;
         }
         let mut baker = Baker::new(&wgsl_root());
-        let baked: Vec<bake::Baked> =
-            blueprint.bakes.iter().map(|b| baker.bake(ctx, &b.request)).collect::<Result<_>>()?;
+        let baked: Vec<bake::Baked> = blueprint
+            .bakes
+            .iter()
+            .map(|b| cache.bake(cache::key(&b.request), || baker.bake(ctx, &b.request)))
+            .collect::<Result<_>>()?;
         let sampler = ctx.device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("volume_sampler"),
             address_mode_u: wgpu::AddressMode::Repeat,
@@ -69,7 +79,7 @@ impl Renderer {
             .iter()
             .map(|&(i, part)| instance_inputs(ctx, &blueprint, &blueprint.objects[i], part, &baked))
             .collect();
-        let exec = Executor::new(ctx, blueprint.graph.clone(), &blueprint.plan, blueprint.size)?;
+        let exec = Executor::new(ctx, blueprint.graph.clone(), &blueprint.plan, blueprint.size, cache)?;
         let timer = Timer::new(ctx, blueprint.plan.passes.len() as u32);
         let (w, h) = blueprint.size;
         let readback = ctx.device.create_buffer(&wgpu::BufferDescriptor {
@@ -80,7 +90,7 @@ impl Renderer {
         });
         let mut r = Self { blueprint, exec, frame, objects, timer, readback };
         // Pipelines now, so that a bad kernel fails before any frame.
-        r.exec.prepare(ctx, &r.blueprint.plan, &r.frame, &r.objects)?;
+        r.exec.prepare(ctx, &r.blueprint.plan, &r.frame, &r.objects, cache)?;
         ctx.wait()?;
         Ok(r)
     }
@@ -90,7 +100,7 @@ impl Renderer {
         self.timer.reset();
         self.exec.run(ctx, &self.blueprint.plan, &self.frame, &self.objects, &mut self.timer)?;
         let pass_times = self.timer.read(ctx)?;
-        let image = self.read_output(ctx)?;
+        let image = self.read_output(ctx)?.box_downsample(self.blueprint.supersample);
         Ok(Frame { image, pass_times })
     }
 
@@ -108,6 +118,11 @@ impl Renderer {
 
     /// The texel and normal atlases of the Reference objects as the kernel reads them (for the
     /// CPU twin); `None` without Reference objects.
+    /// The inputs of graph instance `i` (tests and benchmarks read kernel outputs from them).
+    pub fn instance_inputs(&self, i: usize) -> &Inputs {
+        &self.objects[i]
+    }
+
     pub fn reference_atlases(&self, ctx: &GpuContext) -> Result<Option<(Vec<u8>, Vec<u8>)>> {
         let Some(i) = self.blueprint.instances.iter().position(|p| p.1 == Part::Reference) else {
             return Ok(None);
@@ -127,6 +142,11 @@ impl Renderer {
             .and_then(|i| i.buffers.get(name))
             .ok_or_else(|| Error::Invalid(format!("graph instance {instance} has no buffer `{name}`")))?;
         ctx.read_buffer(b, 0, b.size())
+    }
+
+    /// The graph's first output (the linear image), as rendered by the last frame.
+    pub fn output_texture(&self) -> Option<&wgpu::Texture> {
+        self.exec.texture(&self.blueprint.graph.file.outputs[0])
     }
 
     /// Reads a graph texture (Rgba32Float) back as a linear image.
@@ -216,6 +236,12 @@ fn instance_inputs(
                 inputs.views.insert("normals".into(), baked[b].normals.create_view(&Default::default()));
             }
         }
+        Part::AxisSlices => {
+            let (Some(plan), Some(b)) = (&o.axis, o.bake) else { return inputs };
+            if let Some(axis) = &baked[b].axis {
+                axis_slices::add_inputs(ctx, &mut inputs, &o.shell, plan, axis);
+            }
+        }
     }
     inputs
 }
@@ -231,19 +257,20 @@ impl Renderer {
             m.push(("voltex_gpu_ms".into(), format!("{t:.3}")));
         }
         for o in &self.blueprint.objects {
-            let method = match (&o.sweep, o.reference_step) {
+            let method = match (&o.sweep, o.reference_step, &o.axis) {
                 _ if o.ray_march.is_some() => o.ray_march.as_ref().map(|m| m.describe()).unwrap_or_default(),
-                (_, Some(step)) => format!(
+                (_, _, Some(a)) => format!("{:?}", a.method),
+                (_, Some(step), _) => format!(
                     "Reference(step: {step:.6}, lighting: {})",
                     if o.per_pixel { "PerPixel" } else { "Baked" }
                 ),
-                (Some(p), _) => format!(
+                (Some(p), _, _) => format!(
                     "ViewSlices(planes: {}, trivial_reject: {}, lighting: {})",
                     p.plane_count,
                     o.trivial_reject,
                     if o.per_pixel { "PerPixel" } else { "Baked" }
                 ),
-                (None, _) => "BaseSurface".into(),
+                (None, _, _) => "BaseSurface".into(),
             };
             m.push((format!("voltex_object_{}", o.object.name), method));
         }

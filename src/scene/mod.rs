@@ -32,6 +32,18 @@ fn options() -> ron::Options {
         .with_default_extension(Extensions::IMPLICIT_SOME | Extensions::UNWRAP_VARIANT_NEWTYPES)
 }
 
+impl Scene {
+    /// The files (meshes, images) the scene refers to, resolved.
+    pub fn asset_paths(&self) -> Vec<std::path::PathBuf> {
+        self.assets.meshes.keys().chain(self.assets.images.keys()).cloned().collect()
+    }
+
+    /// The scene file's text.
+    pub fn source(&self) -> &str {
+        &self.source
+    }
+}
+
 /// Reads, parses and checks a scene file, and loads the files it refers to.
 pub fn load(path: &Path) -> Result<Scene> {
     let source = std::fs::read_to_string(path).map_err(|e| Error::file(path, e))?;

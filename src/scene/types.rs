@@ -381,6 +381,7 @@ pub enum Method {
     ViewSlices(ViewSlices),
     Reference(Reference),
     RayMarch(RayMarch),
+    AxisSlices(AxisSlices),
 }
 
 impl Method {
@@ -389,6 +390,7 @@ impl Method {
             Method::ViewSlices(m) => m.lighting,
             Method::Reference(m) => m.lighting,
             Method::RayMarch(_) => Lighting::Baked,
+            Method::AxisSlices(_) => Lighting::Baked,
         }
     }
 }
@@ -471,6 +473,61 @@ pub struct ViewSlices {
     pub trivial_reject: bool,
     #[serde(default)]
     pub lighting: Lighting,
+}
+
+/// Meyer & Neyret 1998: the texel baked into slice images along s, t and w with power-of-two
+/// levels; per base triangle one direction and level chosen by the quality criteria.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AxisSlices {
+    /// `d` of the criterion `h tan(a) / d <= 1`: how deep, in voxels, the inside of a contour
+    /// may be seen between two slices.
+    #[serde(default = "one_f64", deserialize_with = "v::slice_depth")]
+    pub depth: f64,
+    /// `p` of the criterion `h sin(a) / (z / f) <= p`: the largest apparent distance between two
+    /// slices on screen, in pixels.
+    #[serde(default = "one_f64", deserialize_with = "v::slice_pixels")]
+    pub pixels: f64,
+    /// Largest view angle (degrees from a slice set's normal) the criteria are evaluated at.
+    #[serde(default = "default_max_angle", deserialize_with = "v::max_angle")]
+    pub max_angle: f64,
+    #[serde(default)]
+    pub directions: SliceDirections,
+    #[serde(default)]
+    pub blend: SliceBlend,
+    /// Skip prisms whose base and top triangles both face away (approximate: see README).
+    #[serde(default)]
+    pub back_face_culling: bool,
+    /// Skip slices (and so texels) whose slice image is empty.
+    #[serde(default = "yes")]
+    pub empty_culling: bool,
+}
+
+fn one_f64() -> f64 {
+    1.0
+}
+fn default_max_angle() -> f64 {
+    80.0
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
+pub enum SliceDirections {
+    /// Horizontal (w) and the two vertical sets (s, t), chosen per triangle.
+    #[default]
+    Three,
+    /// Horizontal slices only (to measure what the vertical sets gain).
+    Horizontal,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
+pub enum SliceBlend {
+    /// The paper's binary alpha: the step-corrected opacity thresholded at 1/2, depth-tested and
+    /// written, so intersecting texels are right.
+    #[default]
+    Binary,
+    /// Semi-transparent slices blended back to front within each prism, prisms sorted back to
+    /// front by centre: slices of overlapping prisms are not interleaved.
+    Blended,
 }
 
 fn yes() -> bool {

@@ -124,6 +124,36 @@ struct ReferenceState {
     resume: vec4<f32>,
 }
 
+// Axis-aligned slicing, Meyer & Neyret (twins: AxisParams, AxisChoice, AxisVertex, AxisBake in src/types.rs).
+struct AxisParams {
+    resolution: vec4<u32>,
+    criteria: vec4<f32>,
+    forward: vec4<f32>,
+    flags: vec4<u32>,
+}
+
+struct AxisChoice {
+    direction: u32,
+    level: u32,
+    first: i32,
+    count: u32,
+    vertex_count: u32,
+    vertex_offset: u32,
+    reverse: u32,
+    culled: u32,
+}
+
+struct AxisVertex {
+    position: vec4<f32>,
+    texcoord: vec4<f32>,
+    normal: vec4<f32>,
+}
+
+struct AxisBake {
+    resolution: vec4<u32>,
+    level: vec4<u32>,
+}
+
 // Hypertextures (twins: HyperParams, HyperNoise, TransferFunction, TransferPoint, MarchState in src/types.rs).
 struct HyperParams {
     to_local: mat4x4<f32>,
