@@ -8,6 +8,7 @@ pub mod cpu;
 pub mod error;
 pub mod gpu;
 pub mod graph;
+pub mod hypertexture;
 pub mod io;
 pub mod mesh;
 pub mod methods;

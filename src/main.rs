@@ -1,4 +1,4 @@
-//! The `voltex` command line: render, preview, regress, plan, info, bench.
+//! The `voltex` command line: render, preview, regress, plan, info, bench, bench-hyper.
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -36,9 +36,13 @@ struct Overrides {
     /// Render N x N samples per pixel and average them (anti-aliasing; e.g. 2 or 4).
     #[arg(long)]
     supersample: Option<u32>,
-    /// Ray step (world units) for Reference objects (default: the scene's, else half a voxel).
+    /// Ray step (world units) for Reference and RayMarch objects (default: the scene's, else half
+    /// a voxel for Reference).
     #[arg(long, allow_negative_numbers = true)]
     step: Option<f64>,
+    /// Time of the frame in seconds (animated hypertextures; default: the scene's `time`).
+    #[arg(long, allow_negative_numbers = true)]
+    time: Option<f64>,
 }
 
 #[derive(clap::ValueEnum, Clone, Copy)]
@@ -108,6 +112,18 @@ enum Command {
         #[arg(long, default_value_t = 4000)]
         reference_planes: u32,
     },
+    /// Benchmark hypertexture ray marching (the 2009 paper's Figure 11 set-up): frame times and
+    /// the share of noise evaluation.
+    BenchHyper {
+        #[arg(long, value_parser = parse_size, default_value = "512x512")]
+        size: (u32, u32),
+        /// Timed frames per setting (after warm-up); the median is reported.
+        #[arg(long, default_value_t = 3)]
+        frames: usize,
+        /// Only the first object (sphere).
+        #[arg(long)]
+        quick: bool,
+    },
 }
 
 fn parse_size(s: &str) -> std::result::Result<(u32, u32), String> {
@@ -129,6 +145,9 @@ impl Overrides {
                     voltex::scene::MAX_PLANES
                 )));
             }
+        }
+        if let Some(t) = self.time.filter(|t| !t.is_finite()) {
+            return Err(voltex::Error::Invalid(format!("--time {t}: expected a finite number of seconds")));
         }
         if let Some(n) = self.supersample {
             if !(1..=8).contains(&n) {
@@ -154,6 +173,7 @@ impl Overrides {
             }),
             step: self.step,
             supersample: self.supersample,
+            time: self.time,
             ..Default::default()
         })
     }
@@ -182,6 +202,7 @@ fn main() -> ExitCode {
         Command::Bench { scenes, planes, size, frames, reference_planes } => {
             voltex::bench::run(&scenes, &planes, size, frames, reference_planes)
         }
+        Command::BenchHyper { size, frames, quick } => voltex::hypertexture::bench::run(size, frames, quick),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -286,3 +286,86 @@ pub struct AxisBake {
     /// word of the level.
     pub level: [u32; 4],
 }
+
+/// One hypertexture object of the `RayMarch` method (uniform `hyper`). Object space is the node's
+/// local frame; the camera sits at the origin of camera-relative world space.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct HyperParams {
+    /// Camera-relative world to object space (affine, column-major).
+    pub to_local: [[f32; 4]; 4],
+    /// xyz: camera right scaled by the half-width at unit distance; w: near plane distance.
+    pub right: [f32; 4],
+    /// xyz: camera up scaled by the half-height at unit distance; w: far plane distance.
+    pub up: [f32; 4],
+    /// xyz: object-space bounds enlarged by the largest shift; w: ray step (world units).
+    pub bounds_min: [f32; 4],
+    /// xyz: upper corner; w: opacity length (world length over which the transfer opacity is reached).
+    pub bounds_max: [f32; 4],
+    /// Sphere: x radius; ellipsoid: xyz radii; torus: x major, y minor; box: xyz half extents.
+    pub object: [f32; 4],
+    /// FromCentre: xyz centre; Constant: xyz vector; Swirl: xyz unit axis, w twist.
+    pub field: [f32; 4],
+    /// Swirl: xyz a point on the axis.
+    pub field_center: [f32; 4],
+    /// Field perturbation: x direction amount, y frequency (0: off), z magnitude amount.
+    pub perturb: [f32; 4],
+    /// x: object kind, y: field kind (`hypertexture::OBJECT_*`, `FIELD_*`), z: noise count,
+    /// w: seed of the field perturbation.
+    pub kinds: [u32; 4],
+    /// x: shadow-ray step (world), y: central-difference offset of the gradient (world), z: the
+    /// largest shift (object space) with a small margin: farther from the object the density is 0;
+    /// w: the frame's time (seconds, animated hypertextures).
+    pub march: [f32; 4],
+    /// Work of one dispatch, in density evaluations: x the budget, y the most samples of a shadow
+    /// ray, z the most one sample may cost (so a sample is begun only when it fits).
+    pub budget: [u32; 4],
+}
+
+/// One noise of a hypertexture: `t = T((1 + simplex(frequency (x + shift V))) / 2)`, combined
+/// into `k` by `k += amplitude t` or, with `blend`, `k = k (1 - t) + amplitude t`. In animated
+/// hypertextures the noise is 4D, its fourth coordinate `speed` times the frame's time.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct HyperNoise {
+    pub amplitude: f32,
+    pub frequency: f32,
+    pub shift: f32,
+    pub blend: u32,
+    pub seed: u32,
+    pub speed: f32,
+    pub _pad: [u32; 2],
+}
+
+/// A transfer function to sample into a table: `count` control points from `first`; `kind` 0 is
+/// a cubic Hermite curve (points carry slopes), 1 piecewise linear.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct TransferFunction {
+    pub first: u32,
+    pub count: u32,
+    pub kind: u32,
+    pub _pad: u32,
+}
+
+/// A control point: position `x` in [0, 1], value `y`, slope `dy/dx` (Hermite curves only).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct TransferPoint {
+    pub x: f32,
+    pub y: f32,
+    pub slope: f32,
+    pub _pad: f32,
+}
+
+/// Per-pixel progress of the ray marcher between its dispatches (`ray_march_state`); all zero is
+/// a ray not yet begun.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct MarchState {
+    /// rgb: premultiplied colour gathered so far; a: coverage (1 - transmittance).
+    pub color: [f32; 4],
+    /// x: index of the next sample; y: density evaluations so far; z: 1 once finished; w: those
+    /// of the evaluations that ran the noises (y and w for benchmarks).
+    pub resume: [f32; 4],
+}

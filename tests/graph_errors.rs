@@ -120,6 +120,7 @@ fn frame_graph_parses_and_plans() {
         &["Reference"],
         &["AxisSlices", "AxisSlicesBinary"],
         &["AxisSlices", "AxisSlicesBlended"],
+        &["RayMarch"],
     ];
     let p = plan(&g, &wgsl_root(), &objects(all)).unwrap();
     assert_eq!(
@@ -137,6 +138,9 @@ fn frame_graph_parses_and_plans() {
             "blend_axis_slices",
             "trace_reference",
             "composite_reference",
+            "bake_transfer",
+            "ray_march",
+            "composite_ray_march",
             "composite"
         ]
     );

@@ -2,6 +2,10 @@
 
 pub mod axis_slices;
 pub mod bake;
+pub mod bake_transfer;
+pub mod hypertexture;
+pub mod noise_simplex;
 pub mod prism_map;
+pub mod ray_march;
 pub mod slice_prisms;
 pub mod trace_reference;

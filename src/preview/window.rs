@@ -18,7 +18,7 @@ use crate::error::{Error, Result};
 use crate::gpu::GpuContext;
 use crate::io::Image;
 use crate::render::{MethodKind, RenderOptions, DEFAULT_PLANES};
-use crate::scene::{Camera, Method, Reference, ViewSlices, MAX_PLANES};
+use crate::scene::{Camera, Method, Reference, Shading, ViewSlices, MAX_PLANES};
 
 /// `voltex preview` options.
 pub struct PreviewArgs {
@@ -449,6 +449,15 @@ impl State {
                             trivial_reject: true,
                             lighting: r.lighting,
                         }),
+                        // Hypertextures have no texel for other methods: cycle their shading.
+                        Method::RayMarch(mut h) => {
+                            h.shading = match h.shading {
+                                Shading::None => Shading::Phong,
+                                Shading::Phong => Shading::PhongShadows,
+                                Shading::PhongShadows => Shading::None,
+                            };
+                            Method::RayMarch(h)
+                        }
                     };
                     self.set_method(name, next);
                 }
@@ -474,6 +483,11 @@ impl State {
                                 (a.depth * 2.0).min(1024.0)
                             };
                             Method::AxisSlices(a)
+                        }
+                        Method::RayMarch(mut h) => {
+                            let step = h.step();
+                            h.step = Some(if finer { step / 2.0 } else { step * 2.0 });
+                            Method::RayMarch(h)
                         }
                     };
                     self.set_method(name, next);
@@ -518,6 +532,7 @@ impl State {
 
 fn describe(m: &Method) -> String {
     match m {
+        Method::RayMarch(h) => format!("RayMarch(step: {:.5}, shading: {:?})", h.step(), h.shading),
         Method::AxisSlices(a) => {
             format!("AxisSlices(depth: {}, pixels: {}, {:?})", a.depth, a.pixels, a.directions)
         }

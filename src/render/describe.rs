@@ -85,6 +85,12 @@ impl Blueprint {
                     (frames.len() * 32) as u64,
                 ));
             }
+            if let Some(m) = &o.ray_march {
+                out.push((
+                    format!("object {name}: hypertexture parameters, transfer tables, per-pixel march state"),
+                    m.bytes(self.size),
+                ));
+            }
             if let Some(base) = &o.base {
                 out.push((format!("object {name}: base triangles"), (base.len() * 32) as u64));
             }
@@ -125,6 +131,16 @@ impl Blueprint {
         s += "\nobjects:\n";
         for o in &self.objects {
             let method = match (&o.sweep, o.reference_step, &o.axis) {
+                _ if o.ray_march.is_some() => {
+                    let m = o.ray_march.as_ref().unwrap();
+                    format!(
+                        "{} of hypertexture \"{}\", {} noise(s), {} dispatch(es) per frame",
+                        m.describe(),
+                        m.hypertexture,
+                        m.packed.noises.len(),
+                        m.dispatches
+                    )
+                }
                 (_, _, Some(a)) => format!("{:?}, vertex capacity {}", a.method, a.capacity),
                 (_, Some(step), _) => format!(
                     "Reference step {step:.6} lighting {}, {} dispatch(es) per frame",
@@ -141,7 +157,11 @@ impl Blueprint {
                 ),
                 (None, _, _) => "base surface only".into(),
             };
-            s += &format!("  {:<16} {} triangles  {method}\n", o.object.name, o.shell.prisms.len());
+            let what = match &o.object.hypertexture {
+                Some(_) => "hypertexture".to_string(),
+                None => format!("{} triangles", o.shell.prisms.len()),
+            };
+            s += &format!("  {:<16} {what}  {method}\n", o.object.name);
             for w in &o.object.report.warnings {
                 s += &format!("    warning: {w}\n");
             }

@@ -16,11 +16,13 @@ use crate::error::{Error, Result};
 use crate::graph::plan::{self, ObjectInfo, Plan};
 use crate::graph::Graph;
 use crate::methods::axis_slices::AxisPlan;
+use crate::methods::ray_march::{self, RayMarchPlan};
 use crate::methods::reference::{self, ReferenceSet};
 use crate::methods::shell::{self, Shell};
 use crate::methods::view_slices::{self, SliceChunk};
 use crate::scene::{
-    AxisSlices, Camera, Light, Lighting as LightingMode, Method, Reference, Scene, SceneObject, ViewSlices,
+    AxisSlices, Camera, Light, Lighting as LightingMode, Method, RayMarch, Reference, Scene, SceneObject,
+    ViewSlices,
 };
 use crate::types::{BaseVertex, FrameParams, ReferenceParams, SliceParams, VertexFrame};
 
@@ -33,7 +35,7 @@ pub struct RenderOptions {
     pub trivial_reject: Option<bool>,
     /// Render every textured object with this method (keeping its lighting mode).
     pub method: Option<MethodKind>,
-    /// Ray step for `Reference` objects (world units).
+    /// Ray step for `Reference` and `RayMarch` objects (world units).
     pub step: Option<f64>,
     /// Methods replacing those of named objects (the preview's per-object switch), before
     /// `method` and the knob overrides apply.
@@ -44,6 +46,8 @@ pub struct RenderOptions {
     /// then the mean over its area rather than a point sample (anti-aliasing; a reference for
     /// methods that filter textures by the pixel footprint, as mipmaps do).
     pub supersample: Option<u32>,
+    /// Time of the frame in seconds (animated hypertextures; default: the scene's).
+    pub time: Option<f64>,
 }
 
 /// A method without its knobs, to switch every object to it (`--method`).
@@ -71,10 +75,14 @@ pub const DEFAULT_PLANES: u32 = 400;
 impl RenderOptions {
     /// An object's method after the overrides: switched to `method` if given, knobs replaced.
     pub fn apply(&self, method: &Method) -> Method {
+        if let Method::RayMarch(rm) = method {
+            // Hypertextures have no texel for other methods: only the step changes.
+            return Method::RayMarch(RayMarch { step: self.step.or(rm.step), ..*rm });
+        }
         let lighting = method.lighting();
         let kind = self.method.unwrap_or(match method {
             Method::ViewSlices(_) => MethodKind::ViewSlices,
-            Method::Reference(_) => MethodKind::Reference,
+            Method::Reference(_) | Method::RayMarch(_) => MethodKind::Reference,
             Method::AxisSlices(_) => MethodKind::AxisSlices,
         });
         match (kind, method) {
@@ -116,6 +124,8 @@ pub struct ObjectPlan {
     pub reference_step: Option<f64>,
     /// Axis-aligned slicing (Meyer & Neyret).
     pub axis: Option<AxisPlan>,
+    /// RayMarch method: the packed hypertexture and march settings.
+    pub ray_march: Option<RayMarchPlan>,
 }
 
 pub struct BakePlan {
@@ -133,6 +143,8 @@ pub enum Part {
     Reference,
     /// An object's axis-aligned slices.
     AxisSlices,
+    /// A hypertexture object, ray-marched into its own layer.
+    RayMarch,
 }
 
 pub struct Blueprint {
@@ -173,6 +185,7 @@ impl Blueprint {
         let mut view = View::new(scene, opts.camera.as_ref().unwrap_or(&scene.camera), &objects)?;
         // Pixels per unit of tangent, for the slice-count criterion (at the rendered size).
         view.focal = 0.5 * size.1 as f64 / (0.5 * view.fov_y.to_radians()).tan();
+        view.size = size;
         let light = Lighting::of(scene);
         let mut bakes: Vec<BakePlan> = Vec::new();
         let mut objects = objects
@@ -180,7 +193,7 @@ impl Blueprint {
             .map(|o| ObjectPlan::new(scene, o, &view, &light, opts, &mut bakes))
             .collect::<Result<Vec<_>>>()?;
         let graph = Graph::load(opts.graph.as_deref().unwrap_or(&default_graph()))?;
-        let reference = reference_set(&objects, &bakes, &view, size);
+        let reference = reference_set(&objects, &bakes, &view);
         let (instances, infos) = instances(&objects, reference.as_ref(), view.eye);
         let plan = plan::plan(&graph, &wgsl_root(), &infos)?;
         check_bindings(&graph, &plan)?;
@@ -209,12 +222,7 @@ impl Blueprint {
 }
 
 /// The BVH and tables of the frame's Reference objects.
-fn reference_set(
-    objects: &[ObjectPlan],
-    bakes: &[BakePlan],
-    view: &View,
-    size: (u32, u32),
-) -> Option<ReferenceSet> {
+fn reference_set(objects: &[ObjectPlan], bakes: &[BakePlan], view: &View) -> Option<ReferenceSet> {
     let members: Vec<usize> = (0..objects.len()).filter(|&i| objects[i].reference_step.is_some()).collect();
     if members.is_empty() {
         return None;
@@ -222,11 +230,8 @@ fn reference_set(
     let bake_of = |i: usize| &bakes[objects[i].bake.unwrap_or(0)];
     let resolutions: Vec<[u32; 3]> = members.iter().map(|&i| bake_of(i).request.resolution).collect();
     let lengths: Vec<f32> = members.iter().map(|&i| bake_of(i).opacity_length).collect();
-    let right_dir = view.forward.cross(view.up).normalize();
-    let up_dir = right_dir.cross(view.forward);
-    let half = (0.5 * view.fov_y.to_radians()).tan();
-    let aspect = size.0 as f64 / size.1 as f64;
-    let (r, u) = ((right_dir * half * aspect).as_vec3(), (up_dir * half).as_vec3());
+    let camera = view.camera();
+    let (r, u) = (camera.right.as_vec3(), camera.up.as_vec3());
     let params = ReferenceParams {
         right: [r.x, r.y, r.z, view.near as f32],
         up: [u.x, u.y, u.z, view.far as f32],
@@ -245,6 +250,8 @@ struct View {
     far: f64,
     /// Focal length in pixels (half the image height over tan(fov_y / 2)).
     focal: f64,
+    /// The rendered size (for the ray casters' camera).
+    size: (u32, u32),
 }
 
 impl View {
@@ -261,10 +268,31 @@ impl View {
             for (&p, &h) in o.surface.positions.iter().zip(&o.surface.heights) {
                 far = far.max((p - cam.eye).dot(forward)).max((p + h - cam.eye).dot(forward));
             }
+            let hyper = o.hypertexture.as_ref().and_then(|n| Some((n, scene.hypertextures.get(&n.name)?)));
+            if let Some((node, h)) = hyper {
+                for c in h.world_corners(&node.to_world) {
+                    far = far.max((c - cam.eye).dot(forward));
+                }
+            }
         }
         far *= 1.01;
         let near = (far * 1e-4).max(1e-6);
-        Ok(Self { eye: cam.eye, forward, up: cam.up, fov_y: cam.fov_y, near, far, focal: 1.0 })
+        Ok(Self { eye: cam.eye, forward, up: cam.up, fov_y: cam.fov_y, near, far, focal: 1.0, size: (1, 1) })
+    }
+
+    /// The camera as ray casting kernels see it: a pixel's ray is `forward + sx right + sy up`.
+    fn camera(&self) -> ray_march::Camera {
+        let right_dir = self.forward.cross(self.up).normalize();
+        let up_dir = right_dir.cross(self.forward);
+        let half = (0.5 * self.fov_y.to_radians()).tan();
+        let aspect = self.size.0 as f64 / self.size.1 as f64;
+        ray_march::Camera {
+            eye: self.eye,
+            right: right_dir * half * aspect,
+            up: up_dir * half,
+            near: self.near,
+            far: self.far,
+        }
     }
 
     fn forward_f32(&self) -> [f32; 3] {
@@ -327,6 +355,7 @@ impl ObjectPlan {
             bake: None,
             reference_step: None,
             axis: None,
+            ray_march: None,
             object,
         };
         let name = &plan.object.name;
@@ -336,6 +365,18 @@ impl ObjectPlan {
         };
         let vs = match method {
             Method::ViewSlices(vs) => vs,
+            Method::RayMarch(rm) => {
+                let node = plan.object.hypertexture.as_ref().ok_or_else(|| {
+                    Error::Invalid(format!("object \"{}\": RayMarch needs a hypertexture", plan.object.name))
+                })?;
+                let h = scene.hypertextures.get(&node.name).ok_or_else(|| {
+                    Error::Invalid(format!("{}: unknown hypertexture `{}`", scene.path.display(), node.name))
+                })?;
+                let time = opts.time.unwrap_or(scene.time);
+                plan.ray_march =
+                    Some(ray_march::plan(&plan.object.name, node, h, &rm, &view.camera(), time)?);
+                return Ok(plan);
+            }
             Method::AxisSlices(a) => {
                 let texel = plan.object.texel.clone().unwrap_or_default();
                 let bake = texels::bake_index_axis(scene, &texel, light, bakes)?;
@@ -399,7 +440,9 @@ fn instances(
         let distance = (centre - eye).length();
         let parts = o.base.iter().map(|_| Part::Base).chain((0..o.chunks.len()).map(Part::Slices));
         let axis = o.axis.iter().map(|_| Part::AxisSlices);
-        for part in parts.chain(axis) {
+        let march = o.ray_march.as_ref().map(|m| (m.corners.iter().sum::<DVec3>() / 8.0 - eye).length());
+        let distance = march.unwrap_or(distance);
+        for part in parts.chain(axis).chain(march.map(|_| Part::RayMarch)) {
             let (filters, order) = match part {
                 Part::Base => (vec!["BaseSurface"], 0),
                 Part::Slices(c) => (vec!["ViewSlices"], c as u32),
@@ -407,6 +450,7 @@ fn instances(
                     let blended = o.axis.as_ref().is_some_and(|a| a.blended);
                     (vec!["AxisSlices", if blended { "AxisSlicesBlended" } else { "AxisSlicesBinary" }], 0)
                 }
+                Part::RayMarch => (vec!["RayMarch"], 0),
                 Part::Reference => unreachable!("reference instances are added once, above"),
             };
             instances.push((i, part));
@@ -443,6 +487,12 @@ pub const INSTANCE_RESOURCES: &[&str] = &[
     "texel_atlas",
     "normal_atlas",
     "reference_state",
+    "hyper",
+    "hyper_noises",
+    "transfer_points",
+    "transfer_functions",
+    "transfer_tables",
+    "ray_march_state",
     "axis_params",
     "axis_occupancy",
     "axis_choices",
@@ -497,8 +547,10 @@ fn projection(fov_y: f64, aspect: f64, near: f64, far: f64) -> DMat4 {
 
 /// Values of the WGSL `override` constants an object's kernels are specialised with.
 fn object_constants(o: &ObjectPlan) -> Vec<(String, f64)> {
-    vec![
+    let mut c = vec![
         ("trivial_reject".into(), o.trivial_reject as u32 as f64),
         ("per_pixel_lighting".into(), o.per_pixel as u32 as f64),
-    ]
+    ];
+    c.extend(o.ray_march.iter().flat_map(|m| m.constants()));
+    c
 }

@@ -134,6 +134,16 @@ impl Renderer {
         Ok(Some((read("texel_atlas")?, read("normal_atlas")?)))
     }
 
+    /// Reads back a buffer of graph instance `instance` (tests and tools: a layer, a table).
+    pub fn read_instance_buffer(&self, ctx: &GpuContext, instance: usize, name: &str) -> Result<Vec<u8>> {
+        let b = self
+            .objects
+            .get(instance)
+            .and_then(|i| i.buffers.get(name))
+            .ok_or_else(|| Error::Invalid(format!("graph instance {instance} has no buffer `{name}`")))?;
+        ctx.read_buffer(b, 0, b.size())
+    }
+
     /// The graph's first output (the linear image), as rendered by the last frame.
     pub fn output_texture(&self) -> Option<&wgpu::Texture> {
         self.exec.texture(&self.blueprint.graph.file.outputs[0])
@@ -201,6 +211,11 @@ fn instance_inputs(
             );
             inputs.counts.insert("base_vertices".into(), base.len() as u32);
         }
+        Part::RayMarch => {
+            if let Some(m) = &o.ray_march {
+                m.add_inputs(ctx, &mut inputs, bp.size);
+            }
+        }
         Part::Reference => {
             if let Some(set) = &bp.reference {
                 set.add_inputs(ctx, &mut inputs, bp.size);
@@ -243,6 +258,7 @@ impl Renderer {
         }
         for o in &self.blueprint.objects {
             let method = match (&o.sweep, o.reference_step, &o.axis) {
+                _ if o.ray_march.is_some() => o.ray_march.as_ref().map(|m| m.describe()).unwrap_or_default(),
                 (_, _, Some(a)) => format!("{:?}", a.method),
                 (_, Some(step), _) => format!(
                     "Reference(step: {step:.6}, lighting: {})",

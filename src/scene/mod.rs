@@ -9,12 +9,14 @@
 pub const MAX_PLANES: u32 = 16384;
 
 mod flatten;
+pub mod hypertexture;
 mod image;
 mod types;
 mod validate;
 mod values;
 
-pub use flatten::SceneObject;
+pub use flatten::{HyperNode, SceneObject};
+pub use hypertexture::Hypertexture;
 pub use image::HeightImage;
 pub use types::*;
 pub use values::Mark;

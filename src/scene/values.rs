@@ -76,6 +76,10 @@ macro_rules! adapter {
 }
 
 adapter!(positive, f64, Positive, |v| v.0);
+adapter!(finite, f64, Finite, |v| v.0);
+adapter!(positive3, DVec3, [Positive; 3], |v| DVec3::new(v[0].0, v[1].0, v[2].0));
+adapter!(rgba, [f64; 4], [Unit; 4], |v| v.map(|x| x.0));
+adapter!(unit_list, Vec<f64>, Vec<Unit>, |v| v.into_iter().map(|x| x.0).collect());
 adapter!(opt_positive, Option<f64>, Option<Positive>, |v| v.map(|x| x.0));
 adapter!(non_negative, f64, NonNegative, |v| v.0);
 adapter!(unit, f64, Unit, |v| v.0);

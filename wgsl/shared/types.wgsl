@@ -153,3 +153,49 @@ struct AxisBake {
     resolution: vec4<u32>,
     level: vec4<u32>,
 }
+
+// Hypertextures (twins: HyperParams, HyperNoise, TransferFunction, TransferPoint, MarchState in src/types.rs).
+struct HyperParams {
+    to_local: mat4x4<f32>,
+    right: vec4<f32>,
+    up: vec4<f32>,
+    bounds_min: vec4<f32>,
+    bounds_max: vec4<f32>,
+    object: vec4<f32>,
+    field: vec4<f32>,
+    field_center: vec4<f32>,
+    perturb: vec4<f32>,
+    kinds: vec4<u32>,
+    march: vec4<f32>,
+    budget: vec4<u32>,
+}
+
+struct HyperNoise {
+    amplitude: f32,
+    frequency: f32,
+    shift: f32,
+    blend: u32,
+    seed: u32,
+    speed: f32,
+    _pad0: u32,
+    _pad1: u32,
+}
+
+struct TransferFunction {
+    first: u32,
+    count: u32,
+    kind: u32,
+    _pad: u32,
+}
+
+struct TransferPoint {
+    x: f32,
+    y: f32,
+    slope: f32,
+    _pad: f32,
+}
+
+struct MarchState {
+    color: vec4<f32>,
+    resume: vec4<f32>,
+}
