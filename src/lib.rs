@@ -13,6 +13,7 @@ pub mod io;
 pub mod mesh;
 pub mod methods;
 pub mod metrics;
+pub mod pareto;
 pub mod preview;
 pub mod regress;
 pub mod scene;

@@ -1,4 +1,4 @@
-//! The `voltex` command line: render, preview, regress, plan, info, bench, bench-hyper.
+//! The `voltex` command line: render, preview, regress, pareto, plan, info, bench, bench-hyper.
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -124,6 +124,31 @@ enum Command {
         #[arg(long)]
         quick: bool,
     },
+    /// Speed against error: sweep each method's quality knobs, time every setting with GPU
+    /// timestamps, measure its error against a truth image, write pareto.csv and pareto.svg.
+    Pareto {
+        scene: PathBuf,
+        #[arg(long, value_parser = parse_size, default_value = "256x256")]
+        size: (u32, u32),
+        /// Timed frames per setting (after warm-up); medians are reported.
+        #[arg(long, default_value_t = 5)]
+        frames: usize,
+        /// Output folder (default: out/pareto/<scene name>).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// What errors are measured against: `reference` or `view-slices:PLANES`.
+        #[arg(long, default_value = "reference")]
+        truth: voltex::pareto::Truth,
+        /// Methods to sweep.
+        #[arg(long, value_enum, value_delimiter = ',', default_values = ["view-slices", "reference"])]
+        methods: Vec<MethodArg>,
+        /// ViewSlices plane counts (each with the trivial reject on and off).
+        #[arg(long, value_delimiter = ',', default_values_t = voltex::pareto::DEFAULT_PLANES)]
+        planes: Vec<u32>,
+        /// Reference ray steps, as multiples of the default step.
+        #[arg(long, value_delimiter = ',', default_values_t = voltex::pareto::DEFAULT_STEP_FACTORS)]
+        steps: Vec<f64>,
+    },
 }
 
 fn parse_size(s: &str) -> std::result::Result<(u32, u32), String> {
@@ -166,11 +191,7 @@ impl Overrides {
             graph: self.graph.clone(),
             planes: self.planes,
             trivial_reject: self.no_trivial_reject.then_some(false),
-            method: self.method.map(|m| match m {
-                MethodArg::ViewSlices => MethodKind::ViewSlices,
-                MethodArg::Reference => MethodKind::Reference,
-                MethodArg::AxisSlices => MethodKind::AxisSlices,
-            }),
+            method: self.method.map(method_kind),
             step: self.step,
             supersample: self.supersample,
             time: self.time,
@@ -203,6 +224,19 @@ fn main() -> ExitCode {
             voltex::bench::run(&scenes, &planes, size, frames, reference_planes)
         }
         Command::BenchHyper { size, frames, quick } => voltex::hypertexture::bench::run(size, frames, quick),
+        Command::Pareto { scene, size, frames, out, truth, methods, planes, steps } => {
+            let methods = methods.into_iter().map(method_kind).collect();
+            voltex::pareto::run(&voltex::pareto::Args {
+                scene,
+                size,
+                frames,
+                out,
+                truth,
+                methods,
+                planes,
+                steps,
+            })
+        }
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -280,4 +314,12 @@ fn render(scene_path: &Path, output: Option<PathBuf>, overrides: &Overrides) -> 
         println!("  {pass:<20} {ms:>9.3} ms");
     }
     Ok(())
+}
+
+fn method_kind(m: MethodArg) -> MethodKind {
+    match m {
+        MethodArg::ViewSlices => MethodKind::ViewSlices,
+        MethodArg::Reference => MethodKind::Reference,
+        MethodArg::AxisSlices => MethodKind::AxisSlices,
+    }
 }

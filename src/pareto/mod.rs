@@ -1,0 +1,318 @@
+//! `voltex pareto SCENE`: speed against error. Sweeps each method's quality knobs over the
+//! scene's textured objects, measures every setting's GPU time per frame ([`measure`]) and its
+//! error against a truth image (mean FLIP, relative RMSE), and writes `pareto.csv` and
+//! `pareto.svg` ([`svg`]) with the Pareto fronts ([`front`]) per method and overall.
+//!
+//! A setting is a method label, a description of its knobs and the [`RenderOptions`] that apply
+//! them; a new method adds a function like [`view_slices`] and one line in [`sweep`].
+
+pub mod front;
+pub mod measure;
+mod report;
+pub mod svg;
+
+use std::fmt;
+use std::path::PathBuf;
+use std::str::FromStr;
+
+use crate::error::{Error, Result};
+use crate::gpu::GpuContext;
+use crate::io::{atomic, Image};
+use crate::render::{Blueprint, MethodKind, RenderOptions};
+use crate::scene::{Scene, MAX_PLANES};
+use report::Row;
+
+/// Default plane counts of the `ViewSlices` sweep.
+pub const DEFAULT_PLANES: [u32; 8] = [16, 32, 64, 128, 256, 512, 1024, 2048];
+/// Default ray steps of the `Reference` sweep, as multiples of its default step.
+pub const DEFAULT_STEP_FACTORS: [f64; 5] = [2.0, 4.0, 8.0, 16.0, 32.0];
+
+/// What errors are measured against.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Truth {
+    /// Every textured object ray cast by `Reference` with its default step.
+    Reference,
+    /// Every textured object sliced by `ViewSlices` with this many planes (a converged slicing).
+    ViewSlices(u32),
+}
+
+impl FromStr for Truth {
+    type Err = String;
+    fn from_str(s: &str) -> std::result::Result<Self, String> {
+        const EXPECTED: &str = "expected `reference` or `view-slices:PLANES`, e.g. view-slices:4096";
+        if s == "reference" {
+            return Ok(Truth::Reference);
+        }
+        let n = s.strip_prefix("view-slices:").ok_or(EXPECTED)?;
+        match n.parse::<u32>() {
+            Ok(n) if (1..=MAX_PLANES).contains(&n) => Ok(Truth::ViewSlices(n)),
+            _ => Err(format!("`{n}`: expected a plane count in 1..={MAX_PLANES}")),
+        }
+    }
+}
+
+impl fmt::Display for Truth {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Truth::Reference => write!(f, "Reference, default step"),
+            Truth::ViewSlices(n) => write!(f, "ViewSlices, {n} planes"),
+        }
+    }
+}
+
+impl Truth {
+    fn options(self, size: (u32, u32)) -> RenderOptions {
+        let size = Some(size);
+        match self {
+            Truth::Reference => {
+                RenderOptions { size, method: Some(MethodKind::Reference), ..Default::default() }
+            }
+            Truth::ViewSlices(n) => RenderOptions {
+                size,
+                method: Some(MethodKind::ViewSlices),
+                planes: Some(n),
+                trivial_reject: Some(true),
+                ..Default::default()
+            },
+        }
+    }
+}
+
+/// The command's arguments.
+#[derive(Debug, Clone)]
+pub struct Args {
+    pub scene: PathBuf,
+    pub size: (u32, u32),
+    /// Timed frames per setting (after warm-up); medians are reported.
+    pub frames: usize,
+    /// Output folder (default `out/pareto/<scene stem>`), created if missing.
+    pub out: Option<PathBuf>,
+    pub truth: Truth,
+    /// Methods to sweep.
+    pub methods: Vec<MethodKind>,
+    /// `ViewSlices` plane counts (each with the trivial reject on and off).
+    pub planes: Vec<u32>,
+    /// `Reference` steps as multiples of the default step.
+    pub steps: Vec<f64>,
+}
+
+/// One point of the sweep.
+#[derive(Debug, Clone)]
+pub struct Setting {
+    pub method: &'static str,
+    /// The knobs, e.g. `planes=64 reject=on` (no commas: it is a CSV field).
+    pub knobs: String,
+    /// A short name for the chart, e.g. `64` (`64 no-reject` with the trivial reject off).
+    pub tag: String,
+    pub options: RenderOptions,
+}
+
+impl Args {
+    fn check(&self) -> Result<()> {
+        if let Some(&p) = self.planes.iter().find(|&&p| p == 0 || p > MAX_PLANES) {
+            return Err(Error::Invalid(format!("--planes {p}: expected plane counts in 1..={MAX_PLANES}")));
+        }
+        if let Some(&f) = self.steps.iter().find(|&&f| !(f.is_finite() && f > 0.0)) {
+            return Err(Error::Invalid(format!(
+                "--steps {f}: expected positive multiples of the default step"
+            )));
+        }
+        if self.frames == 0 {
+            return Err(Error::Invalid("--frames 0: expected at least one timed frame".into()));
+        }
+        Ok(())
+    }
+
+    pub fn out_dir(&self) -> PathBuf {
+        self.out
+            .clone()
+            .unwrap_or_else(|| PathBuf::from("out/pareto").join(self.scene.file_stem().unwrap_or_default()))
+    }
+}
+
+/// `ViewSlices`: each plane count with the trivial reject on and off (a speed knob only).
+pub fn view_slices(args: &Args) -> Vec<Setting> {
+    let mut v = Vec::new();
+    for planes in unique(args.planes.iter().copied()) {
+        for reject in [true, false] {
+            v.push(Setting {
+                method: "ViewSlices",
+                knobs: format!("planes={planes} reject={}", if reject { "on" } else { "off" }),
+                tag: if reject { planes.to_string() } else { format!("{planes} no-reject") },
+                options: RenderOptions {
+                    size: Some(args.size),
+                    method: Some(MethodKind::ViewSlices),
+                    planes: Some(planes),
+                    trivial_reject: Some(reject),
+                    ..Default::default()
+                },
+            });
+        }
+    }
+    v
+}
+
+/// `Reference`: the ray step as multiples of `default_step` (one step for all objects).
+pub fn reference(args: &Args, default_step: f64) -> Vec<Setting> {
+    unique(args.steps.iter().copied())
+        .into_iter()
+        .map(|f| Setting {
+            method: "Reference",
+            knobs: format!("step={f}x"),
+            tag: format!("{f}x"),
+            options: RenderOptions {
+                size: Some(args.size),
+                method: Some(MethodKind::Reference),
+                step: Some(f * default_step),
+                ..Default::default()
+            },
+        })
+        .collect()
+}
+
+/// Every setting of the methods asked for, with notes on what cannot be swept.
+pub fn sweep(scene: &Scene, args: &Args) -> Result<(Vec<Setting>, Vec<String>)> {
+    let mut settings = Vec::new();
+    let mut notes = Vec::new();
+    for &m in &args.methods {
+        match m {
+            MethodKind::ViewSlices => settings.extend(view_slices(args)),
+            MethodKind::Reference => match reference_default_step(scene, args.size) {
+                Ok(Some(step)) => settings.extend(reference(args, step)),
+                Ok(None) => notes.push("Reference: not measured: no textured object".into()),
+                Err(e) => notes.push(format!("Reference: not measured: {e}")),
+            },
+            MethodKind::AxisSlices => {
+                // Its criteria knobs have no command-line override yet: the defaults only.
+                settings.push(Setting {
+                    method: "AxisSlices",
+                    knobs: "defaults".into(),
+                    tag: "default".into(),
+                    options: RenderOptions {
+                        size: Some(args.size),
+                        method: Some(MethodKind::AxisSlices),
+                        ..Default::default()
+                    },
+                });
+                notes.push("AxisSlices: measured at its default criteria only".into());
+            }
+        }
+    }
+    Ok((settings, notes))
+}
+
+/// The `Reference` method's default step for the scene: the smallest of its textured objects'
+/// default steps (half the smallest voxel extent, see `methods::reference::default_step`).
+pub fn reference_default_step(scene: &Scene, size: (u32, u32)) -> Result<Option<f64>> {
+    let opts = RenderOptions { size: Some(size), method: Some(MethodKind::Reference), ..Default::default() };
+    let bp = Blueprint::new(scene, &opts)?;
+    Ok(bp.objects.iter().filter_map(|o| o.reference_step).min_by(f64::total_cmp))
+}
+
+pub fn run(args: &Args) -> Result<()> {
+    args.check()?;
+    let scene = crate::scene::load(&args.scene)?;
+    let Planned { settings, blueprints, mut notes } = plan(&scene, args)?;
+    // Fail on the output folder before any GPU work.
+    let out = args.out_dir();
+    std::fs::create_dir_all(&out)
+        .map_err(|e| Error::file(&out, format!("cannot create the output folder: {e}")))?;
+    atomic::check_writable_dir(&out)?;
+
+    let n = settings.len();
+    let load = report::load_average();
+    let ctx = GpuContext::new()?;
+    eprintln!("truth: {}", args.truth);
+    let truth = measure::image(&ctx, Blueprint::new(&scene, &args.truth.options(args.size))?)?;
+    let mut rows = Vec::new();
+    for (i, (s, bp)) in settings.into_iter().zip(blueprints).enumerate() {
+        eprintln!("[{}/{n}] {} {}", i + 1, s.method, s.knobs);
+        match measure_setting(&scene, args, &s, bp, &truth) {
+            Ok(row) => rows.push(row),
+            Err(e) => note(&mut notes, &s, &e),
+        }
+    }
+    if rows.is_empty() {
+        return Err(Error::Invalid(format!("nothing was measured: {}", notes.join("; "))));
+    }
+    report::mark_fronts(&mut rows);
+
+    let csv_path = out.join("pareto.csv");
+    let svg_path = out.join("pareto.svg");
+    atomic::write_bytes(&csv_path, report::csv(&rows).as_bytes())?;
+    let title = format!(
+        "{}: time against error ({}x{}, truth: {})",
+        args.scene.file_stem().unwrap_or_default().to_string_lossy(),
+        args.size.0,
+        args.size.1,
+        args.truth
+    );
+    atomic::write_bytes(&svg_path, report::chart(&rows, &title, ctx.has_timestamps()).as_bytes())?;
+    crate::io::png::write_tonemapped(&out.join("truth.png"), &truth)?;
+    report::print_report(args, &ctx, &rows, &notes, load);
+    println!("wrote {}, {} and truth.png", csv_path.display(), svg_path.display());
+    Ok(())
+}
+
+/// Times one setting and measures its error. On a fresh device, so that no render pass has run
+/// on it when its compute passes are timed alone (phase 1); then whole frames (phase 2), right
+/// after, so both phases see the same machine load.
+fn measure_setting(scene: &Scene, args: &Args, s: &Setting, bp: Blueprint, truth: &Image) -> Result<Row> {
+    let ctx = GpuContext::new()?;
+    let compute = measure::compute_passes(&ctx, bp, args.frames)?;
+    let frames = measure::full_frames(&ctx, Blueprint::new(scene, &s.options)?, args.frames)?;
+    Row::new(s.clone(), compute, frames, truth)
+}
+
+/// The settings to measure, each with its blueprint (CPU only: planning fails early), and notes
+/// on what cannot be measured. The truth must plan; a setting that does not is skipped.
+fn plan(scene: &Scene, args: &Args) -> Result<Planned> {
+    Blueprint::new(scene, &args.truth.options(args.size)).map_err(|e| {
+        let hint = if args.truth == Truth::Reference { "; try --truth view-slices:4096" } else { "" };
+        Error::Invalid(format!("the truth ({}) cannot be rendered: {e}{hint}", args.truth))
+    })?;
+    let (all, mut notes) = sweep(scene, args)?;
+    let (mut settings, mut blueprints) = (Vec::new(), Vec::new());
+    for s in all {
+        match Blueprint::new(scene, &s.options) {
+            Ok(bp) => {
+                settings.push(s);
+                blueprints.push(bp);
+            }
+            Err(e) => note(&mut notes, &s, &e),
+        }
+    }
+    if settings.is_empty() {
+        return Err(Error::Invalid(format!(
+            "{}: nothing to measure: {}",
+            args.scene.display(),
+            notes.join("; ")
+        )));
+    }
+    Ok(Planned { settings, blueprints, notes })
+}
+
+struct Planned {
+    settings: Vec<Setting>,
+    blueprints: Vec<Blueprint>,
+    notes: Vec<String>,
+}
+
+/// Records why a setting was skipped, once per method and message.
+fn note(notes: &mut Vec<String>, s: &Setting, e: &Error) {
+    let line = format!("{}: not measured: {e}", s.method);
+    if !notes.contains(&line) {
+        eprintln!("{line} ({})", s.knobs);
+        notes.push(line);
+    }
+}
+
+fn unique<T: PartialEq>(items: impl Iterator<Item = T>) -> Vec<T> {
+    let mut v = Vec::new();
+    for x in items {
+        if !v.contains(&x) {
+            v.push(x);
+        }
+    }
+    v
+}

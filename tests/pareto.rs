@@ -1,0 +1,197 @@
+//! `voltex pareto` through the real binary: reduced sweeps on a small scene write the CSV (one
+//! row per setting, error falling with the plane count and rising with the ray step), the SVG
+//! with every point and the truth; bad input fails with status 1 before any rendering. No test
+//! asserts a duration.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+const BIN: &str = env!("CARGO_BIN_EXE_voltex");
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn temp_dir(test: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("voltex-pareto-{}-{test}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// Runs `voltex pareto ARGS` against this checkout's kernels and scenes.
+fn pareto(args: &[&str]) -> Output {
+    let mut cmd = Command::new(BIN);
+    cmd.arg("pareto").args(args).env("VOLTEX_ROOT", root());
+    if std::env::var_os("XDG_RUNTIME_DIR").is_none() {
+        cmd.env("XDG_RUNTIME_DIR", std::env::temp_dir());
+    }
+    cmd.output().unwrap()
+}
+
+fn text(out: &Output) -> String {
+    format!("{}{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr))
+}
+
+fn scene(name: &str) -> String {
+    root().join("scenes/view_slices").join(name).to_str().unwrap().to_string()
+}
+
+/// The CSV as header → column index, and rows of fields.
+fn read_csv(path: &Path) -> (Vec<String>, Vec<Vec<String>>) {
+    let csv = std::fs::read_to_string(path).unwrap();
+    let mut lines = csv.lines().map(|l| l.split(',').map(str::to_string).collect::<Vec<_>>());
+    let header = lines.next().unwrap();
+    let rows: Vec<Vec<String>> = lines.collect();
+    for r in &rows {
+        assert_eq!(r.len(), header.len(), "row {r:?} against header {header:?}");
+    }
+    (header, rows)
+}
+
+#[test]
+fn view_slices_sweep_writes_csv_svg_and_fronts() {
+    let dir = temp_dir("sweep");
+    let out = dir.join("result");
+    let args = [
+        scene("torus_egg.ron"),
+        "--size".into(),
+        "48x48".into(),
+        "--frames".into(),
+        "1".into(),
+        "--planes".into(),
+        "16,64".into(),
+        "--methods".into(),
+        "view-slices".into(),
+        "--truth".into(),
+        "view-slices:1024".into(),
+        "--out".into(),
+        out.to_str().unwrap().into(),
+    ];
+    let run = pareto(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    let log = text(&run);
+    println!("{log}");
+    assert_eq!(run.status.code(), Some(0), "{log}");
+    assert!(log.contains("adapter: ") && log.contains("overall front:"), "{log}");
+
+    let (header, rows) = read_csv(&out.join("pareto.csv"));
+    let col =
+        |name: &str| header.iter().position(|h| h == name).unwrap_or_else(|| panic!("no column {name}"));
+    for c in [
+        "method",
+        "knobs",
+        "gpu_ms",
+        "wall_ms",
+        "flip",
+        "rel_rmse",
+        "method_front",
+        "overall_front",
+        "passes",
+    ] {
+        col(c);
+    }
+    assert_eq!(rows.len(), 4, "16 and 64 planes, reject on and off: {rows:?}");
+    let get = |planes: &str, reject: &str, c: &str| -> String {
+        rows.iter()
+            .find(|r| r[col("planes")] == planes && r[col("trivial_reject")] == reject)
+            .unwrap_or_else(|| panic!("no row planes={planes} reject={reject}"))[col(c)]
+        .clone()
+    };
+    let num = |planes: &str, reject: &str, c: &str| get(planes, reject, c).parse::<f64>().unwrap();
+    for reject in ["true", "false"] {
+        assert_eq!(get("16", reject, "method"), "ViewSlices");
+        let (coarse, fine) = (num("16", reject, "flip"), num("64", reject, "flip"));
+        println!("reject {reject}: FLIP {coarse:.4} at 16 planes, {fine:.4} at 64");
+        assert!(coarse > fine, "error should fall with the plane count: {coarse} vs {fine}");
+        assert!(num("16", reject, "rel_rmse") > num("64", reject, "rel_rmse"));
+        assert!(num("64", reject, "wall_ms").is_finite());
+        assert!(get("64", reject, "passes").contains("draw_slices="));
+    }
+    // The trivial reject changes speed, not the image (up to blending order within a plane).
+    assert!((num("64", "true", "flip") - num("64", "false", "flip")).abs() < 1e-4);
+    // The most accurate setting (the faster of the two at 64 planes) is on both fronts.
+    let on = |c: &str| rows.iter().filter(|r| r[col("planes")] == "64" && r[col(c)] == "true").count();
+    assert!(on("overall_front") >= 1 && on("method_front") >= 1, "{rows:?}");
+
+    let svg = std::fs::read_to_string(out.join("pareto.svg")).unwrap();
+    assert!(svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"));
+    assert_eq!(svg.matches(r#"class="point""#).count(), 4);
+    assert!(svg.contains(">ViewSlices</text>"));
+    assert!(out.join("truth.png").is_file());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn reference_truth_and_step_sweep() {
+    let dir = temp_dir("reference");
+    let out = dir.join("result");
+    let out_s = out.to_str().unwrap().to_string();
+    let scene = scene("torus_egg.ron");
+    let args =
+        [&scene, "--size", "40x40", "--frames", "1", "--planes", "16", "--steps", "8,32", "--out", &out_s];
+    let run = pareto(&args);
+    let log = text(&run);
+    println!("{log}");
+    assert_eq!(run.status.code(), Some(0), "{log}");
+    assert!(log.contains("truth: Reference, default step"), "{log}");
+    assert!(log.contains("Reference front:") && log.contains("ViewSlices front:"), "{log}");
+
+    let (header, rows) = read_csv(&out.join("pareto.csv"));
+    let col = |name: &str| header.iter().position(|h| h == name).unwrap();
+    let reference: Vec<&Vec<String>> = rows.iter().filter(|r| r[col("method")] == "Reference").collect();
+    assert_eq!(reference.len(), 2, "{rows:?}");
+    assert_eq!(rows.len(), 4, "ViewSlices at 16 planes, reject on and off, and two steps: {rows:?}");
+    let by = |k: &str| reference.iter().find(|r| r[col("knobs")] == k).unwrap_or_else(|| panic!("no {k}"));
+    let f = |k: &str, c: &str| by(k)[col(c)].parse::<f64>().unwrap();
+    let ratio = f("step=32x", "step") / f("step=8x", "step");
+    assert!((ratio - 4.0).abs() < 1e-3, "steps are multiples of one default step: {ratio}");
+    println!("Reference FLIP {:.4} at 8x, {:.4} at 32x", f("step=8x", "flip"), f("step=32x", "flip"));
+    assert!(f("step=32x", "flip") > f("step=8x", "flip"), "error should grow with the step");
+    assert!(by("step=8x")[col("passes")].contains("trace_reference="));
+    let svg = std::fs::read_to_string(out.join("pareto.svg")).unwrap();
+    assert_eq!(svg.matches(r#"class="point""#).count(), 4);
+    assert!(svg.contains(">Reference</text>") && svg.contains(">ViewSlices</text>"));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn bad_scene_fails_at_its_line_and_column() {
+    let dir = temp_dir("bad-scene");
+    let file = dir.join("scene.ron");
+    std::fs::write(&file, "Scene(\n    output: (width: 64, hieght: 64),\n)\n").unwrap();
+    let out = dir.join("result");
+    let run = pareto(&[file.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    let log = text(&run);
+    assert_eq!(run.status.code(), Some(1), "{log}");
+    assert!(log.contains(&format!("{}:2:", file.display())), "{log}");
+    assert!(!log.contains("panicked"), "{log}");
+    assert!(!out.exists(), "nothing should be written");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn unwritable_output_fails_before_rendering() {
+    let dir = temp_dir("bad-out");
+    let blocker = dir.join("file");
+    std::fs::write(&blocker, "not a folder").unwrap();
+    let out = blocker.join("result");
+    let run = pareto(&[&scene("flat_box.ron"), "--out", out.to_str().unwrap(), "--truth", "view-slices:64"]);
+    let log = text(&run);
+    assert_eq!(run.status.code(), Some(1), "{log}");
+    assert!(log.contains(out.to_str().unwrap()), "the error names the folder: {log}");
+    assert!(!log.contains("compute passes") && !log.contains("panicked"), "{log}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn bad_sweep_values_are_errors() {
+    let dir = temp_dir("bad-values");
+    let out = dir.join("result");
+    let run = pareto(&[&scene("flat_box.ron"), "--out", out.to_str().unwrap(), "--planes", "0,16"]);
+    let log = text(&run);
+    assert_eq!(run.status.code(), Some(1), "{log}");
+    assert!(log.contains("--planes 0"), "{log}");
+    let run = pareto(&[&scene("flat_box.ron"), "--truth", "view-slices:x"]);
+    assert_eq!(run.status.code(), Some(2), "clap rejects the value: {}", text(&run));
+    let _ = std::fs::remove_dir_all(&dir);
+}
