@@ -12,16 +12,9 @@ use std::time::Instant;
 use crate::error::Result;
 use crate::gpu::GpuContext;
 use crate::io::Image;
+use crate::pareto::measure::timed;
 use crate::render::{Blueprint, RenderOptions, Renderer};
 use crate::scene::Scene;
-
-fn median(mut v: Vec<f64>) -> f64 {
-    if v.is_empty() {
-        return f64::NAN;
-    }
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
-}
 
 pub fn default_scenes() -> Vec<PathBuf> {
     let root = crate::project_root().join("scenes/view_slices");
@@ -81,7 +74,7 @@ pub fn run(
     for s in &settings {
         let bp = Blueprint::new(&scenes[s.scene], &options(s, Some(slices_only.clone())))?;
         let mut r = Renderer::new(&ctx, bp)?;
-        let (slicing, _) = timed(&ctx, &mut r, frames)?;
+        let (slicing, _) = timed(&ctx, &mut r, frames, None)?;
         let mut cpu = Vec::new();
         let mut fragments = 0.0;
         for o in &r.blueprint.objects {
@@ -113,7 +106,7 @@ pub fn run(
         let image = r.render(&ctx)?.image;
         row.rel_rmse = crate::metrics::relative_rmse(&image, reference)?;
         row.flip = crate::metrics::flip(&image, reference)?.mean;
-        let (passes, wall) = timed(&ctx, &mut r, frames)?;
+        let (passes, wall) = timed(&ctx, &mut r, frames, None)?;
         row.raster = passes.into_iter().filter(|p| p.0.starts_with("draw") || p.0 == "composite").collect();
         row.wall_ms = wall;
     }
@@ -158,28 +151,6 @@ pub fn run(
     Ok(())
 }
 
-/// Renders warm-up frames, then `frames` timed ones: median GPU ms per pass and median wall ms.
-fn timed(ctx: &GpuContext, r: &mut Renderer, frames: usize) -> Result<(Vec<(String, f64)>, f64)> {
-    r.render_timed(ctx)?;
-    r.render_timed(ctx)?;
-    let mut per_pass: Vec<(String, Vec<f64>)> = Vec::new();
-    let mut wall = Vec::new();
-    for _ in 0..frames.max(1) {
-        let t = Instant::now();
-        let times = r.render_timed(ctx)?;
-        wall.push(t.elapsed().as_secs_f64() * 1e3);
-        for (name, ms) in times {
-            match per_pass.iter_mut().find(|p| p.0 == name) {
-                Some(p) => p.1.push(ms),
-                None => per_pass.push((name, vec![ms])),
-            }
-        }
-    }
-    Ok((per_pass.into_iter().map(|(n, v)| (n, median(v))).collect(), median(wall)))
-}
-
-/// Pixels covered by slice triangles (their projected area, clipped to the viewport's bounds
-/// only by skipping triangles wholly outside): the fragments `draw_slices` shades.
 fn covered_pixels(bp: &Blueprint, planes: &[Vec<crate::types::SliceVertex>]) -> f64 {
     let vp = glam::Mat4::from_cols_array_2d(&bp.frame.view_proj);
     let (w, h) = (bp.size.0 as f32, bp.size.1 as f32);

@@ -1,4 +1,4 @@
-//! The `voltex` command line: render, plan, info, bench, pareto.
+//! The `voltex` command line: render, preview, regress, pareto, plan, info, bench, bench-hyper.
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -33,15 +33,30 @@ struct Overrides {
     /// Render every textured object with this method (its lighting mode is kept).
     #[arg(long, value_enum)]
     method: Option<MethodArg>,
-    /// Ray step (world units) for Reference objects (default: the scene's, else half a voxel).
+    /// Render N x N samples per pixel and average them (anti-aliasing; e.g. 2 or 4).
+    #[arg(long)]
+    supersample: Option<u32>,
+    /// Ray step (world units) for Reference and RayMarch objects (default: the scene's, else half
+    /// a voxel for Reference).
     #[arg(long, allow_negative_numbers = true)]
     step: Option<f64>,
+    /// Time of the frame in seconds (animated hypertextures; default: the scene's `time`).
+    #[arg(long, allow_negative_numbers = true)]
+    time: Option<f64>,
+}
+
+#[derive(clap::ValueEnum, Clone, Copy)]
+enum ViewArg {
+    Image,
+    Reference,
+    Difference,
 }
 
 #[derive(clap::ValueEnum, Clone, Copy)]
 enum MethodArg {
     ViewSlices,
     Reference,
+    AxisSlices,
 }
 
 #[derive(Subcommand)]
@@ -60,6 +75,22 @@ enum Command {
         scene: PathBuf,
         #[command(flatten)]
         overrides: Overrides,
+    },
+    /// Open a window showing the scene, redrawn whenever the scene, its files, a graph or a kernel
+    /// changes (keys and mouse: see the overlay and the README).
+    Preview {
+        scene: PathBuf,
+        #[command(flatten)]
+        overrides: Overrides,
+        /// Write each newly shown frame, as presented, to DIR/frame-N.png.
+        #[arg(long)]
+        record: Option<PathBuf>,
+        /// Close the window after this many seconds.
+        #[arg(long)]
+        quit_after: Option<f64>,
+        /// The view to start in (keys 1, 2, 3 switch).
+        #[arg(long, value_enum, default_value = "image")]
+        view: ViewArg,
     },
     /// Render every scene under a folder and compare it with its reference image (<stem>.ref.exr).
     Regress(voltex::regress::Args),
@@ -80,6 +111,18 @@ enum Command {
         /// Plane count of the converged image that errors are measured against.
         #[arg(long, default_value_t = 4000)]
         reference_planes: u32,
+    },
+    /// Benchmark hypertexture ray marching (the 2009 paper's Figure 11 set-up): frame times and
+    /// the share of noise evaluation.
+    BenchHyper {
+        #[arg(long, value_parser = parse_size, default_value = "512x512")]
+        size: (u32, u32),
+        /// Timed frames per setting (after warm-up); the median is reported.
+        #[arg(long, default_value_t = 3)]
+        frames: usize,
+        /// Only the first object (sphere).
+        #[arg(long)]
+        quick: bool,
     },
     /// Speed against error: sweep each method's quality knobs, time every setting with GPU
     /// timestamps, measure its error against a truth image, write pareto.csv and pareto.svg.
@@ -128,6 +171,16 @@ impl Overrides {
                 )));
             }
         }
+        if let Some(t) = self.time.filter(|t| !t.is_finite()) {
+            return Err(voltex::Error::Invalid(format!("--time {t}: expected a finite number of seconds")));
+        }
+        if let Some(n) = self.supersample {
+            if !(1..=8).contains(&n) {
+                return Err(voltex::Error::Invalid(format!(
+                    "--supersample {n}: expected 1 to 8 samples per axis"
+                )));
+            }
+        }
         if let Some(s) = self.step {
             if !(s.is_finite() && s > 0.0) {
                 return Err(voltex::Error::Invalid(format!("--step {s}: expected a positive world length")));
@@ -138,11 +191,11 @@ impl Overrides {
             graph: self.graph.clone(),
             planes: self.planes,
             trivial_reject: self.no_trivial_reject.then_some(false),
-            method: self.method.map(|m| match m {
-                MethodArg::ViewSlices => MethodKind::ViewSlices,
-                MethodArg::Reference => MethodKind::Reference,
-            }),
+            method: self.method.map(method_kind),
             step: self.step,
+            supersample: self.supersample,
+            time: self.time,
+            ..Default::default()
         })
     }
 }
@@ -153,11 +206,24 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Render { scene, output, overrides } => render(&scene, output, &overrides),
         Command::Plan { scene, overrides } => plan(&scene, &overrides),
+        Command::Preview { scene, overrides, record, quit_after, view } => {
+            use voltex::preview::present::Mode;
+            let mode = match view {
+                ViewArg::Image => Mode::Image,
+                ViewArg::Reference => Mode::Reference,
+                ViewArg::Difference => Mode::Difference,
+            };
+            overrides.options().and_then(|options| {
+                let args = voltex::preview::window::PreviewArgs { scene, options, record, quit_after, mode };
+                voltex::preview::window::run(args)
+            })
+        }
         Command::Regress(args) => voltex::regress::command(&args),
         Command::Info => GpuContext::new().map(|ctx| print!("{}", ctx.describe())),
         Command::Bench { scenes, planes, size, frames, reference_planes } => {
             voltex::bench::run(&scenes, &planes, size, frames, reference_planes)
         }
+        Command::BenchHyper { size, frames, quick } => voltex::hypertexture::bench::run(size, frames, quick),
         Command::Pareto { scene, size, frames, out, truth, methods, planes, steps } => {
             let methods = methods.into_iter().map(method_kind).collect();
             voltex::pareto::run(&voltex::pareto::Args {
@@ -254,5 +320,6 @@ fn method_kind(m: MethodArg) -> MethodKind {
     match m {
         MethodArg::ViewSlices => MethodKind::ViewSlices,
         MethodArg::Reference => MethodKind::Reference,
+        MethodArg::AxisSlices => MethodKind::AxisSlices,
     }
 }

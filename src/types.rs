@@ -220,3 +220,152 @@ pub struct ReferenceState {
     /// x: ray distance to resume from; y: 1 once started; z: 1 once finished.
     pub resume: [f32; 4],
 }
+
+/// Per-object parameters of Meyer & Neyret axis-aligned slicing (uniform `axis_params`).
+/// Mirrored as `AxisParams` in `wgsl/shared/types.wgsl`. Directions: 0 = s, 1 = t, 2 = w.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct AxisParams {
+    /// xyz: texel resolution along s, t, w (the finest slice counts); w: prism count.
+    pub resolution: [u32; 4],
+    /// x: `d`, how deep inside a contour may be seen (voxels); y: `p`, largest apparent distance
+    /// between slices (pixels); z: maximum view angle the criteria are evaluated at (radians);
+    /// w: focal length in pixels (half the image height over tan(fov_y / 2)).
+    pub criteria: [f32; 4],
+    /// xyz: unit camera forward; w: unused.
+    pub forward: [f32; 4],
+    /// x: allowed directions (bit i for direction i); y: vertex capacity; z: back-face culling
+    /// (0/1); w: empty-texel culling (0/1).
+    pub flags: [u32; 4],
+}
+
+/// What `choose_axis_slices` decided for one prism, and where `emit_axis_slices` writes it.
+/// Mirrored as `AxisChoice` in `wgsl/shared/types.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq, Eq)]
+pub struct AxisChoice {
+    /// 0 = s, 1 = t, 2 = w.
+    pub direction: u32,
+    /// Power-of-two level: slices are `ceil(resolution / 2^level)` per texel.
+    pub level: u32,
+    /// Global index of the first slice position crossing the prism (s, t: across tiles).
+    pub first: i32,
+    /// Slice positions crossing the prism, before empty-slice culling.
+    pub count: u32,
+    /// Triangle-list vertices emitted (0 when culled).
+    pub vertex_count: u32,
+    /// First vertex in `axis_vertices` (exclusive scan in prism order).
+    pub vertex_offset: u32,
+    /// 1 when slices are emitted from the last position down (back to front).
+    pub reverse: u32,
+    /// 1 when the prism was culled as back-facing.
+    pub culled: u32,
+}
+
+/// One vertex of an extruded slice (a triangle for `w` slices, a ruled quad for `s` and `t`).
+/// Mirrored as `AxisVertex` in `wgsl/shared/types.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct AxisVertex {
+    /// xyz: camera-relative position; w: world thickness of the slab the slice stands for.
+    pub position: [f32; 4],
+    /// xy: coordinates in the slice image; z: array layer; w: direction.
+    pub texcoord: [f32; 4],
+    /// xyz: unit normal of the slice plane; w: unused.
+    pub normal: [f32; 4],
+}
+
+/// One dispatch of `bake_axis_slices` (uniform `axis_bake`).
+/// Mirrored as `AxisBake` in `wgsl/shared/types.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct AxisBake {
+    /// xyz: texel resolution (s, t, w); w: direction (0 = s, 1 = t, 2 = w).
+    pub resolution: [u32; 4],
+    /// x: level; y: first array layer of the level; z: slices in the level; w: first occupancy
+    /// word of the level.
+    pub level: [u32; 4],
+}
+
+/// One hypertexture object of the `RayMarch` method (uniform `hyper`). Object space is the node's
+/// local frame; the camera sits at the origin of camera-relative world space.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct HyperParams {
+    /// Camera-relative world to object space (affine, column-major).
+    pub to_local: [[f32; 4]; 4],
+    /// xyz: camera right scaled by the half-width at unit distance; w: near plane distance.
+    pub right: [f32; 4],
+    /// xyz: camera up scaled by the half-height at unit distance; w: far plane distance.
+    pub up: [f32; 4],
+    /// xyz: object-space bounds enlarged by the largest shift; w: ray step (world units).
+    pub bounds_min: [f32; 4],
+    /// xyz: upper corner; w: opacity length (world length over which the transfer opacity is reached).
+    pub bounds_max: [f32; 4],
+    /// Sphere: x radius; ellipsoid: xyz radii; torus: x major, y minor; box: xyz half extents.
+    pub object: [f32; 4],
+    /// FromCentre: xyz centre; Constant: xyz vector; Swirl: xyz unit axis, w twist.
+    pub field: [f32; 4],
+    /// Swirl: xyz a point on the axis.
+    pub field_center: [f32; 4],
+    /// Field perturbation: x direction amount, y frequency (0: off), z magnitude amount.
+    pub perturb: [f32; 4],
+    /// x: object kind, y: field kind (`hypertexture::OBJECT_*`, `FIELD_*`), z: noise count,
+    /// w: seed of the field perturbation.
+    pub kinds: [u32; 4],
+    /// x: shadow-ray step (world), y: central-difference offset of the gradient (world), z: the
+    /// largest shift (object space) with a small margin: farther from the object the density is 0;
+    /// w: the frame's time (seconds, animated hypertextures).
+    pub march: [f32; 4],
+    /// Work of one dispatch, in density evaluations: x the budget, y the most samples of a shadow
+    /// ray, z the most one sample may cost (so a sample is begun only when it fits).
+    pub budget: [u32; 4],
+}
+
+/// One noise of a hypertexture: `t = T((1 + simplex(frequency (x + shift V))) / 2)`, combined
+/// into `k` by `k += amplitude t` or, with `blend`, `k = k (1 - t) + amplitude t`. In animated
+/// hypertextures the noise is 4D, its fourth coordinate `speed` times the frame's time.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct HyperNoise {
+    pub amplitude: f32,
+    pub frequency: f32,
+    pub shift: f32,
+    pub blend: u32,
+    pub seed: u32,
+    pub speed: f32,
+    pub _pad: [u32; 2],
+}
+
+/// A transfer function to sample into a table: `count` control points from `first`; `kind` 0 is
+/// a cubic Hermite curve (points carry slopes), 1 piecewise linear.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct TransferFunction {
+    pub first: u32,
+    pub count: u32,
+    pub kind: u32,
+    pub _pad: u32,
+}
+
+/// A control point: position `x` in [0, 1], value `y`, slope `dy/dx` (Hermite curves only).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct TransferPoint {
+    pub x: f32,
+    pub y: f32,
+    pub slope: f32,
+    pub _pad: f32,
+}
+
+/// Per-pixel progress of the ray marcher between its dispatches (`ray_march_state`); all zero is
+/// a ray not yet begun.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct MarchState {
+    /// rgb: premultiplied colour gathered so far; a: coverage (1 - transmittance).
+    pub color: [f32; 4],
+    /// x: index of the next sample; y: density evaluations so far; z: 1 once finished; w: those
+    /// of the evaluations that ran the noises (y and w for benchmarks).
+    pub resume: [f32; 4],
+}

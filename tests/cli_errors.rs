@@ -135,8 +135,8 @@ fn unknown_field() {
 
 #[test]
 fn unknown_method_variant() {
-    let text = replaced(&flat_box(), "ViewSlices(planes", "RayMarch(planes");
-    assert_scene_error("method", &text, "RayMarch", &["RayMarch", "ViewSlices"]);
+    let text = replaced(&flat_box(), "ViewSlices(planes", "RayTrace(planes");
+    assert_scene_error("method", &text, "RayTrace", &["RayTrace", "ViewSlices", "RayMarch"]);
 }
 
 #[test]

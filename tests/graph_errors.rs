@@ -115,17 +115,32 @@ fn assert_err(e: voltex::Error, at: &str, words: &[&str]) {
 #[test]
 fn frame_graph_parses_and_plans() {
     let g = Graph::load(&root().join("graphs/frame.ron")).unwrap();
-    let p = plan(&g, &wgsl_root(), &objects(&[&["ViewSlices", "BaseSurface"], &["Reference"]])).unwrap();
+    let all: &[&[&str]] = &[
+        &["ViewSlices", "BaseSurface"],
+        &["Reference"],
+        &["AxisSlices", "AxisSlicesBinary"],
+        &["AxisSlices", "AxisSlicesBlended"],
+        &["RayMarch"],
+    ];
+    let p = plan(&g, &wgsl_root(), &objects(all)).unwrap();
     assert_eq!(
         names(&p),
         [
             "draw_base",
+            "choose_axis_slices",
+            "scan_axis_slices",
+            "emit_axis_slices",
+            "draw_axis_slices",
             "count_slices",
             "scan_plane_offsets",
             "emit_slices",
             "draw_slices",
+            "blend_axis_slices",
             "trace_reference",
             "composite_reference",
+            "bake_transfer",
+            "ray_march",
+            "composite_ray_march",
             "composite"
         ]
     );

@@ -148,3 +148,21 @@ fn step_changes_error_not_brightness() {
     eprintln!("mean brightness: {coarse:.5} with step 0.02, {fine:.5} with 0.005");
     assert!((coarse - fine).abs() / fine < 0.01, "{coarse} against {fine}");
 }
+
+/// Supersampling averages each pixel's area: a 2x2 render of the box of fog equals the mean of the
+/// four sub-pixel renders, and stays within the range of the point-sampled image.
+#[test]
+fn supersampled_reference_is_the_pixel_average() {
+    let scene = scene::load(&example("flat_box.ron")).unwrap();
+    let render = |opts: RenderOptions| {
+        let bp = Blueprint::new(&scene, &opts).unwrap();
+        let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
+        Renderer::new(&ctx, bp).unwrap().render(&ctx).unwrap().image
+    };
+    let fine = render(reference(32));
+    let averaged = render(RenderOptions { supersample: Some(2), ..reference(16) });
+    assert_eq!((averaged.width, averaged.height), (16, 16));
+    let expected = fine.box_downsample(2);
+    let (max, _) = differences(&averaged, &expected);
+    assert!(max < 1e-5, "supersampled against averaged: {max}");
+}

@@ -34,6 +34,15 @@ fn wgsl_structs_match_rust() {
         layout!(ReferencePrism; vertices, uv01, uv2),
         layout!(ReferenceObject; resolution, atlas, params),
         layout!(ReferenceState; color, resume),
+        layout!(AxisParams; resolution, criteria, forward, flags),
+        layout!(AxisChoice; direction, level, first, count, vertex_count, vertex_offset, reverse, culled),
+        layout!(AxisVertex; position, texcoord, normal),
+        layout!(AxisBake; resolution, level),
+        layout!(HyperParams; to_local, right, up, bounds_min, bounds_max, object, field, field_center, perturb, kinds, march, budget),
+        layout!(HyperNoise; amplitude, frequency, shift, blend, seed, speed),
+        layout!(TransferFunction; first, count, kind, _pad),
+        layout!(TransferPoint; x, y, slope, _pad),
+        layout!(MarchState; color, resume),
     ];
     let mut seen = 0;
     for (_, ty) in kernel.module.types.iter() {

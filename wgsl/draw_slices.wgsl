@@ -1,5 +1,6 @@
 // Draws view-aligned slice polygons with trilinear texel sampling, step-corrected opacity, premultiplied.
 #include "shared/types.wgsl"
+#include "shared/shading.wgsl"
 
 // Per-pixel (Phong) lighting from the baked normals instead of the shading baked into the texel.
 override per_pixel_lighting: bool = false;
@@ -87,12 +88,8 @@ fn fs_main(in: VsOut) -> @location(0) vec4<f32> {
         let tex_normal = textureSample(normals, volume_sampler, in.uvw).xyz;
         var n = in.n_s * tex_normal.x + in.n_t * tex_normal.y + in.n_w * tex_normal.z;
         n = select(-ray, normalize(n), dot(n, n) > 1e-20);
-        let l = frame.light_dir.xyz;
-        let ambient = frame.light_dir.w;
-        let h = normalize(l - ray);
-        let diffuse = max(dot(n, l), 0.0);
-        let specular = select(0.0, 0.25 * pow(max(dot(n, h), 0.0), 32.0), diffuse > 0.0);
-        rgb = rgb * (ambient + (1.0 - ambient) * diffuse) + vec3<f32>(specular * corrected);
+        let albedo = texel.rgb * select(0.0, 1.0 / a, a > 1e-6);
+        rgb = corrected * shade_phong(albedo, n, frame.light_dir, -ray, PIXEL_SPECULAR, PIXEL_SHININESS);
     }
     return vec4<f32>(rgb * frame.light_color.rgb, corrected);
 }

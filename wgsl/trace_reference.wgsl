@@ -1,6 +1,7 @@
 // Ground truth: exact ray casting through the prisms of every Reference object, one pixel per thread; CPU twin in src/cpu/trace_reference.rs.
 #include "shared/types.wgsl"
 #include "shared/prism_map.wgsl"
+#include "shared/shading.wgsl"
 
 // Work per dispatch, in samples (a window's collection counts WINDOW_COST): the pass is dispatched
 // `reference_dispatches` times and each pixel resumes from `reference_state`. Lavapipe ends every
@@ -197,7 +198,7 @@ fn sample_volume(object: ReferenceObject, uvw: vec3<f32>, normals: bool) -> vec4
     return out;
 }
 
-// Phong lighting exactly as draw_slices.wgsl does it, with the exact barycentrics.
+// Per-pixel lighting as draw_slices.wgsl does it (shared/shading.wgsl), with the exact barycentrics.
 fn shade(object: ReferenceObject, shape: ptr<function, PrismShape>, b: vec3<f32>, uvw: vec3<f32>, ray: vec3<f32>, albedo: vec3<f32>) -> vec3<f32> {
     let fa = vertex_frames[(*shape).ids[0]];
     let fb = vertex_frames[(*shape).ids[1]];
@@ -209,12 +210,7 @@ fn shade(object: ReferenceObject, shape: ptr<function, PrismShape>, b: vec3<f32>
     let tn = sample_volume(object, uvw, true).xyz;
     var n = cross(dt, dw) * sign_j * tn.x + cross(dw, ds) * sign_j * tn.y + cross(ds, dt) * sign_j * tn.z;
     n = select(-ray, normalize(n), dot(n, n) > 1e-20);
-    let l = frame.light_dir.xyz;
-    let ambient = frame.light_dir.w;
-    let h = normalize(l - ray);
-    let diffuse = max(dot(n, l), 0.0);
-    let specular = select(0.0, 0.25 * pow(max(dot(n, h), 0.0), 32.0), diffuse > 0.0);
-    return albedo * (ambient + (1.0 - ambient) * diffuse) + vec3<f32>(specular);
+    return shade_phong(albedo, n, frame.light_dir, -ray, PIXEL_SPECULAR, PIXEL_SHININESS);
 }
 
 // Extinction (w) and extinction-weighted colour (xyz) of prism `index` at x.

@@ -2,6 +2,8 @@
 //! premultiplied `rgba8unorm`, full mip chain), plus a normal volume when a per-pixel-lit object
 //! uses it. Only texels some object draws are baked, each (texel, lighting) pair once.
 
+pub mod axis_slices;
+
 use std::path::Path;
 
 use wgpu::util::DeviceExt;
@@ -29,6 +31,8 @@ pub struct BakeRequest {
     /// Texel-space direction towards the light, and the ambient term.
     pub light: [f32; 3],
     pub ambient: f32,
+    /// Also bake the slice images of axis-aligned slicing.
+    pub axis_slices: bool,
 }
 
 #[derive(Clone)]
@@ -36,6 +40,8 @@ pub struct Baked {
     pub volume: wgpu::Texture,
     /// The normal volume (1x1x1 when `per_pixel` is off: the binding exists, nothing is stored).
     pub normals: wgpu::Texture,
+    /// The slice images when the request asked for them.
+    pub axis: Option<axis_slices::AxisBaked>,
 }
 
 pub fn mip_count(res: [u32; 3]) -> u32 {
@@ -59,12 +65,19 @@ pub struct Baker {
     implicit: Option<ComputeKernel>,
     heightfield: Option<ComputeKernel>,
     downsample: Option<ComputeKernel>,
+    axis: Option<ComputeKernel>,
     wgsl_root: std::path::PathBuf,
 }
 
 impl Baker {
     pub fn new(wgsl_root: &Path) -> Self {
-        Self { implicit: None, heightfield: None, downsample: None, wgsl_root: wgsl_root.to_path_buf() }
+        Self {
+            implicit: None,
+            heightfield: None,
+            downsample: None,
+            axis: None,
+            wgsl_root: wgsl_root.to_path_buf(),
+        }
     }
 
     fn kernel<'a>(
@@ -148,9 +161,16 @@ impl Baker {
             mip.views.insert("destination".into(), level_view(&volume, level));
             down.dispatch(ctx, &mut encoder, &mip, mip_size(req.resolution, level))?;
         }
+        let axis = match req.axis_slices {
+            true => {
+                let kernel = Self::kernel(&mut self.axis, ctx, &root, "bake_axis_slices.wgsl")?;
+                Some(axis_slices::bake(ctx, kernel, &mut encoder, &volume, req.resolution)?)
+            }
+            false => None,
+        };
         ctx.queue.submit([encoder.finish()]);
         ctx.take_errors()?;
-        Ok(Baked { volume, normals })
+        Ok(Baked { volume, normals, axis })
     }
 }
 

@@ -1,6 +1,11 @@
 //! CPU twins of the kernels whose math matters; tests run both on the same inputs.
 
+pub mod axis_slices;
 pub mod bake;
+pub mod bake_transfer;
+pub mod hypertexture;
+pub mod noise_simplex;
 pub mod prism_map;
+pub mod ray_march;
 pub mod slice_prisms;
 pub mod trace_reference;

@@ -50,7 +50,8 @@ impl GpuContext {
         Err(Error::Gpu(NO_ADAPTER.into()))
     }
 
-    fn open(adapter: wgpu::Adapter) -> Result<Self> {
+    /// Opens a device on `adapter` (the preview picks one compatible with its window).
+    pub fn open(adapter: wgpu::Adapter) -> Result<Self> {
         let info = adapter.get_info();
         let features = adapter.features() & OPTIONAL_FEATURES;
         let limits = adapter.limits();

@@ -27,8 +27,17 @@ pub struct Inputs {
 }
 
 /// Count names the runtime provides (per object or per frame).
-pub const COUNTS: &[&str] =
-    &["prisms", "planes", "plane_blocks", "base_vertices", "width", "height", "reference_dispatches"];
+pub const COUNTS: &[&str] = &[
+    "prisms",
+    "planes",
+    "plane_blocks",
+    "base_vertices",
+    "width",
+    "height",
+    "reference_dispatches",
+    "ray_march_dispatches",
+    "transfer_functions",
+];
 
 struct Texture {
     texture: wgpu::Texture,

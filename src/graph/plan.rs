@@ -11,7 +11,15 @@ use crate::gpu::shader::{self, Kernel};
 use crate::graph::{Draw, Graph, Instances, PassDecl, ResourceDecl};
 
 /// Object filters a pass can be instanced over.
-pub const OBJECT_FILTERS: &[&str] = &["ViewSlices", "BaseSurface", "Reference"];
+pub const OBJECT_FILTERS: &[&str] = &[
+    "ViewSlices",
+    "BaseSurface",
+    "Reference",
+    "AxisSlices",
+    "AxisSlicesBinary",
+    "AxisSlicesBlended",
+    "RayMarch",
+];
 
 /// What the planner needs to know of a scene object.
 #[derive(Debug, Clone)]

@@ -78,6 +78,26 @@ impl Image {
     }
 
     /// Same width and height as `other`.
+    /// The mean of each `n x n` block (`n` = 1 returns the image itself); sizes must divide.
+    pub fn box_downsample(self, n: u32) -> Image {
+        if n <= 1 {
+            return self;
+        }
+        let (w, h) = (self.width / n, self.height / n);
+        Image::from_fn(w, h, |x, y| {
+            let mut sum = [0.0f64; 4];
+            for dy in 0..n {
+                for dx in 0..n {
+                    let p = self.get(x * n + dx, y * n + dy);
+                    for c in 0..4 {
+                        sum[c] += p[c] as f64;
+                    }
+                }
+            }
+            sum.map(|v| (v / (n * n) as f64) as f32)
+        })
+    }
+
     pub fn same_size(&self, other: &Image) -> bool {
         self.width == other.width && self.height == other.height
     }

@@ -1,5 +1,8 @@
-//! Host side of each method. Now: view-aligned prism slicing, the reference ray caster, and the opaque base surface.
+//! Host side of each method: view-aligned prism slicing, the reference ray caster, hypertexture ray
+//! marching, and the opaque base surface.
 
+pub mod axis_slices;
+pub mod ray_march;
 pub mod reference;
 pub mod shell;
 pub mod view_slices;

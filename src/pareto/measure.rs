@@ -94,7 +94,7 @@ pub fn image(ctx: &GpuContext, bp: Blueprint) -> Result<Image> {
 
 /// Warm-up frames (`warmed`: the wall ms of one already rendered), then `frames` timed ones:
 /// median GPU ms per pass (submission order) and median wall ms per frame.
-fn timed(
+pub fn timed(
     ctx: &GpuContext,
     r: &mut Renderer,
     frames: usize,

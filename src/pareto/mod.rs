@@ -183,6 +183,20 @@ pub fn sweep(scene: &Scene, args: &Args) -> Result<(Vec<Setting>, Vec<String>)> 
                 Ok(None) => notes.push("Reference: not measured: no textured object".into()),
                 Err(e) => notes.push(format!("Reference: not measured: {e}")),
             },
+            MethodKind::AxisSlices => {
+                // Its criteria knobs have no command-line override yet: the defaults only.
+                settings.push(Setting {
+                    method: "AxisSlices",
+                    knobs: "defaults".into(),
+                    tag: "default".into(),
+                    options: RenderOptions {
+                        size: Some(args.size),
+                        method: Some(MethodKind::AxisSlices),
+                        ..Default::default()
+                    },
+                });
+                notes.push("AxisSlices: measured at its default criteria only".into());
+            }
         }
     }
     Ok((settings, notes))

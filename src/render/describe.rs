@@ -35,6 +35,12 @@ impl Blueprint {
                 ),
                 bake::bytes(r, b.request.per_pixel),
             ));
+            if b.request.axis_slices {
+                out.push((
+                    format!("texel {} slice images (s, t, w; all levels) rgba16f", b.texel),
+                    bake::axis_slices::bytes(r),
+                ));
+            }
         }
         if let Some(r) = &self.reference {
             out.push((
@@ -67,10 +73,22 @@ impl Blueprint {
                         + o.chunks.len() as u64 * (16 + 48),
                 ));
             }
+            if let Some(a) = &o.axis {
+                out.push((
+                    format!("object {name}: axis slice vertices (capacity {}) + choices", a.capacity),
+                    a.capacity * 48 + a.prisms.len() as u64 * (32 + 64) + shell + 16,
+                ));
+            }
             if let Some(frames) = &o.frames {
                 out.push((
                     format!("object {name}: vertex frames (per-pixel lighting)"),
                     (frames.len() * 32) as u64,
+                ));
+            }
+            if let Some(m) = &o.ray_march {
+                out.push((
+                    format!("object {name}: hypertexture parameters, transfer tables, per-pixel march state"),
+                    m.bytes(self.size),
                 ));
             }
             if let Some(base) = &o.base {
@@ -106,16 +124,30 @@ impl Blueprint {
                 bake::mip_count(r) - 1,
                 if b.request.per_pixel { "per-pixel (albedo + normals)" } else { "baked" }
             );
+            if b.request.axis_slices {
+                s += "  (and its slice images: bake_axis_slices.wgsl per direction and level)\n";
+            }
         }
         s += "\nobjects:\n";
         for o in &self.objects {
-            let method = match (&o.sweep, o.reference_step) {
-                (_, Some(step)) => format!(
+            let method = match (&o.sweep, o.reference_step, &o.axis) {
+                _ if o.ray_march.is_some() => {
+                    let m = o.ray_march.as_ref().unwrap();
+                    format!(
+                        "{} of hypertexture \"{}\", {} noise(s), {} dispatch(es) per frame",
+                        m.describe(),
+                        m.hypertexture,
+                        m.packed.noises.len(),
+                        m.dispatches
+                    )
+                }
+                (_, _, Some(a)) => format!("{:?}, vertex capacity {}", a.method, a.capacity),
+                (_, Some(step), _) => format!(
                     "Reference step {step:.6} lighting {}, {} dispatch(es) per frame",
                     if o.per_pixel { "PerPixel" } else { "Baked" },
                     self.reference.as_ref().map_or(0, |r| r.dispatches)
                 ),
-                (Some(p), _) => format!(
+                (Some(p), _, _) => format!(
                     "ViewSlices planes {} spacing {:.4} trivial_reject {} lighting {}, {} chunk(s)",
                     p.plane_count,
                     p.spacing,
@@ -123,9 +155,13 @@ impl Blueprint {
                     if o.per_pixel { "PerPixel" } else { "Baked" },
                     o.chunks.len()
                 ),
-                (None, _) => "base surface only".into(),
+                (None, _, _) => "base surface only".into(),
             };
-            s += &format!("  {:<16} {} triangles  {method}\n", o.object.name, o.shell.prisms.len());
+            let what = match &o.object.hypertexture {
+                Some(_) => "hypertexture".to_string(),
+                None => format!("{} triangles", o.shell.prisms.len()),
+            };
+            s += &format!("  {:<16} {what}  {method}\n", o.object.name);
             for w in &o.object.report.warnings {
                 s += &format!("    warning: {w}\n");
             }

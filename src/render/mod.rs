@@ -15,10 +15,15 @@ use crate::bake::BakeRequest;
 use crate::error::{Error, Result};
 use crate::graph::plan::{self, ObjectInfo, Plan};
 use crate::graph::Graph;
+use crate::methods::axis_slices::AxisPlan;
+use crate::methods::ray_march::{self, RayMarchPlan};
 use crate::methods::reference::{self, ReferenceSet};
 use crate::methods::shell::{self, Shell};
 use crate::methods::view_slices::{self, SliceChunk};
-use crate::scene::{Light, Lighting as LightingMode, Method, Reference, Scene, SceneObject, ViewSlices};
+use crate::scene::{
+    AxisSlices, Camera, Light, Lighting as LightingMode, Method, RayMarch, Reference, Scene, SceneObject,
+    ViewSlices,
+};
 use crate::types::{BaseVertex, FrameParams, ReferenceParams, SliceParams, VertexFrame};
 
 /// Overrides of what the scene file says, from the command line or tests.
@@ -30,8 +35,19 @@ pub struct RenderOptions {
     pub trivial_reject: Option<bool>,
     /// Render every textured object with this method (keeping its lighting mode).
     pub method: Option<MethodKind>,
-    /// Ray step for `Reference` objects (world units).
+    /// Ray step for `Reference` and `RayMarch` objects (world units).
     pub step: Option<f64>,
+    /// Methods replacing those of named objects (the preview's per-object switch), before
+    /// `method` and the knob overrides apply.
+    pub object_methods: Vec<(String, Method)>,
+    /// A camera replacing the scene's (the preview's orbit).
+    pub camera: Option<Camera>,
+    /// Render at `n` times the width and height and average each `n x n` block: every pixel is
+    /// then the mean over its area rather than a point sample (anti-aliasing; a reference for
+    /// methods that filter textures by the pixel footprint, as mipmaps do).
+    pub supersample: Option<u32>,
+    /// Time of the frame in seconds (animated hypertextures; default: the scene's).
+    pub time: Option<f64>,
 }
 
 /// A method without its knobs, to switch every object to it (`--method`).
@@ -39,7 +55,19 @@ pub struct RenderOptions {
 pub enum MethodKind {
     ViewSlices,
     Reference,
+    AxisSlices,
 }
+
+/// Axis slicing's knobs when an object is switched to it from another method.
+pub const DEFAULT_AXIS_SLICES: AxisSlices = AxisSlices {
+    depth: 1.0,
+    pixels: 1.0,
+    max_angle: 80.0,
+    directions: crate::scene::SliceDirections::Three,
+    blend: crate::scene::SliceBlend::Binary,
+    back_face_culling: false,
+    empty_culling: true,
+};
 
 /// Plane count when an object is switched to view slicing from a method without planes.
 pub const DEFAULT_PLANES: u32 = 400;
@@ -47,10 +75,15 @@ pub const DEFAULT_PLANES: u32 = 400;
 impl RenderOptions {
     /// An object's method after the overrides: switched to `method` if given, knobs replaced.
     pub fn apply(&self, method: &Method) -> Method {
+        if let Method::RayMarch(rm) = method {
+            // Hypertextures have no texel for other methods: only the step changes.
+            return Method::RayMarch(RayMarch { step: self.step.or(rm.step), ..*rm });
+        }
         let lighting = method.lighting();
         let kind = self.method.unwrap_or(match method {
             Method::ViewSlices(_) => MethodKind::ViewSlices,
-            Method::Reference(_) => MethodKind::Reference,
+            Method::Reference(_) | Method::RayMarch(_) => MethodKind::Reference,
+            Method::AxisSlices(_) => MethodKind::AxisSlices,
         });
         match (kind, method) {
             (MethodKind::ViewSlices, Method::ViewSlices(vs)) => Method::ViewSlices(ViewSlices {
@@ -67,6 +100,8 @@ impl RenderOptions {
                 Method::Reference(Reference { step: self.step.or(r.step), lighting })
             }
             (MethodKind::Reference, _) => Method::Reference(Reference { step: self.step, lighting }),
+            (MethodKind::AxisSlices, Method::AxisSlices(a)) => Method::AxisSlices(*a),
+            (MethodKind::AxisSlices, _) => Method::AxisSlices(DEFAULT_AXIS_SLICES),
         }
     }
 }
@@ -87,6 +122,10 @@ pub struct ObjectPlan {
     pub bake: Option<usize>,
     /// Reference method: the ray step (world units).
     pub reference_step: Option<f64>,
+    /// Axis-aligned slicing (Meyer & Neyret).
+    pub axis: Option<AxisPlan>,
+    /// RayMarch method: the packed hypertexture and march settings.
+    pub ray_march: Option<RayMarchPlan>,
 }
 
 pub struct BakePlan {
@@ -102,11 +141,17 @@ pub enum Part {
     Slices(usize),
     /// All Reference objects of the frame, traced in one dispatch.
     Reference,
+    /// An object's axis-aligned slices.
+    AxisSlices,
+    /// A hypertexture object, ray-marched into its own layer.
+    RayMarch,
 }
 
 pub struct Blueprint {
     pub scene_path: PathBuf,
+    /// The size rendered at (the output size times `supersample`).
     pub size: (u32, u32),
+    pub supersample: u32,
     pub eye: DVec3,
     pub frame: FrameParams,
     pub objects: Vec<ObjectPlan>,
@@ -134,8 +179,13 @@ impl Blueprint {
 
     /// Like [`Blueprint::new`] with the scene's objects given (tests alter their surfaces).
     pub fn with_objects(scene: &Scene, objects: Vec<SceneObject>, opts: &RenderOptions) -> Result<Self> {
-        let size = opts.size.unwrap_or((scene.output.width, scene.output.height));
-        let view = View::new(scene, &objects)?;
+        let (w, h) = opts.size.unwrap_or((scene.output.width, scene.output.height));
+        let n = opts.supersample.unwrap_or(1).max(1);
+        let size = (w * n, h * n);
+        let mut view = View::new(scene, opts.camera.as_ref().unwrap_or(&scene.camera), &objects)?;
+        // Pixels per unit of tangent, for the slice-count criterion (at the rendered size).
+        view.focal = 0.5 * size.1 as f64 / (0.5 * view.fov_y.to_radians()).tan();
+        view.size = size;
         let light = Lighting::of(scene);
         let mut bakes: Vec<BakePlan> = Vec::new();
         let mut objects = objects
@@ -143,15 +193,12 @@ impl Blueprint {
             .map(|o| ObjectPlan::new(scene, o, &view, &light, opts, &mut bakes))
             .collect::<Result<Vec<_>>>()?;
         let graph = Graph::load(opts.graph.as_deref().unwrap_or(&default_graph()))?;
-        let reference = reference_set(&objects, &bakes, &view, size);
+        let reference = reference_set(&objects, &bakes, &view);
         let (instances, infos) = instances(&objects, reference.as_ref(), view.eye);
         let plan = plan::plan(&graph, &wgsl_root(), &infos)?;
         check_bindings(&graph, &plan)?;
-        let samples_texels = plan
-            .passes
-            .iter()
-            .flat_map(|p| &p.bindings)
-            .any(|b| ["volume", "normals", "texel_atlas"].contains(&b.name.as_str()));
+        let samples_texels =
+            plan.passes.iter().flat_map(|p| &p.bindings).any(|b| TEXEL_BINDINGS.contains(&b.name.as_str()));
         if !samples_texels {
             // A graph that samples no texel (the slicing debug graphs) bakes nothing.
             bakes.clear();
@@ -161,6 +208,7 @@ impl Blueprint {
         Ok(Self {
             scene_path: scene.path.clone(),
             size,
+            supersample: n,
             eye: view.eye,
             frame,
             objects,
@@ -174,12 +222,7 @@ impl Blueprint {
 }
 
 /// The BVH and tables of the frame's Reference objects.
-fn reference_set(
-    objects: &[ObjectPlan],
-    bakes: &[BakePlan],
-    view: &View,
-    size: (u32, u32),
-) -> Option<ReferenceSet> {
+fn reference_set(objects: &[ObjectPlan], bakes: &[BakePlan], view: &View) -> Option<ReferenceSet> {
     let members: Vec<usize> = (0..objects.len()).filter(|&i| objects[i].reference_step.is_some()).collect();
     if members.is_empty() {
         return None;
@@ -187,11 +230,8 @@ fn reference_set(
     let bake_of = |i: usize| &bakes[objects[i].bake.unwrap_or(0)];
     let resolutions: Vec<[u32; 3]> = members.iter().map(|&i| bake_of(i).request.resolution).collect();
     let lengths: Vec<f32> = members.iter().map(|&i| bake_of(i).opacity_length).collect();
-    let right_dir = view.forward.cross(view.up).normalize();
-    let up_dir = right_dir.cross(view.forward);
-    let half = (0.5 * view.fov_y.to_radians()).tan();
-    let aspect = size.0 as f64 / size.1 as f64;
-    let (r, u) = ((right_dir * half * aspect).as_vec3(), (up_dir * half).as_vec3());
+    let camera = view.camera();
+    let (r, u) = (camera.right.as_vec3(), camera.up.as_vec3());
     let params = ReferenceParams {
         right: [r.x, r.y, r.z, view.near as f32],
         up: [u.x, u.y, u.z, view.far as f32],
@@ -208,11 +248,14 @@ struct View {
     fov_y: f64,
     near: f64,
     far: f64,
+    /// Focal length in pixels (half the image height over tan(fov_y / 2)).
+    focal: f64,
+    /// The rendered size (for the ray casters' camera).
+    size: (u32, u32),
 }
 
 impl View {
-    fn new(scene: &Scene, objects: &[SceneObject]) -> Result<Self> {
-        let cam = &scene.camera;
+    fn new(scene: &Scene, cam: &Camera, objects: &[SceneObject]) -> Result<Self> {
         let forward = (cam.target - cam.eye).normalize_or_zero();
         if forward == DVec3::ZERO || forward.cross(cam.up).length_squared() < 1e-12 {
             return Err(Error::Invalid(format!(
@@ -225,10 +268,31 @@ impl View {
             for (&p, &h) in o.surface.positions.iter().zip(&o.surface.heights) {
                 far = far.max((p - cam.eye).dot(forward)).max((p + h - cam.eye).dot(forward));
             }
+            let hyper = o.hypertexture.as_ref().and_then(|n| Some((n, scene.hypertextures.get(&n.name)?)));
+            if let Some((node, h)) = hyper {
+                for c in h.world_corners(&node.to_world) {
+                    far = far.max((c - cam.eye).dot(forward));
+                }
+            }
         }
         far *= 1.01;
         let near = (far * 1e-4).max(1e-6);
-        Ok(Self { eye: cam.eye, forward, up: cam.up, fov_y: cam.fov_y, near, far })
+        Ok(Self { eye: cam.eye, forward, up: cam.up, fov_y: cam.fov_y, near, far, focal: 1.0, size: (1, 1) })
+    }
+
+    /// The camera as ray casting kernels see it: a pixel's ray is `forward + sx right + sy up`.
+    fn camera(&self) -> ray_march::Camera {
+        let right_dir = self.forward.cross(self.up).normalize();
+        let up_dir = right_dir.cross(self.forward);
+        let half = (0.5 * self.fov_y.to_radians()).tan();
+        let aspect = self.size.0 as f64 / self.size.1 as f64;
+        ray_march::Camera {
+            eye: self.eye,
+            right: right_dir * half * aspect,
+            up: up_dir * half,
+            near: self.near,
+            far: self.far,
+        }
     }
 
     fn forward_f32(&self) -> [f32; 3] {
@@ -290,11 +354,39 @@ impl ObjectPlan {
             frames: None,
             bake: None,
             reference_step: None,
+            axis: None,
+            ray_march: None,
             object,
         };
-        let Some(method) = plan.object.method.as_ref().map(|m| opts.apply(m)) else { return Ok(plan) };
+        let name = &plan.object.name;
+        let chosen = opts.object_methods.iter().find(|(n, _)| n == name).map(|(_, m)| m);
+        let Some(method) = chosen.or(plan.object.method.as_ref()).map(|m| opts.apply(m)) else {
+            return Ok(plan);
+        };
         let vs = match method {
             Method::ViewSlices(vs) => vs,
+            Method::RayMarch(rm) => {
+                let node = plan.object.hypertexture.as_ref().ok_or_else(|| {
+                    Error::Invalid(format!("object \"{}\": RayMarch needs a hypertexture", plan.object.name))
+                })?;
+                let h = scene.hypertextures.get(&node.name).ok_or_else(|| {
+                    Error::Invalid(format!("{}: unknown hypertexture `{}`", scene.path.display(), node.name))
+                })?;
+                let time = opts.time.unwrap_or(scene.time);
+                plan.ray_march =
+                    Some(ray_march::plan(&plan.object.name, node, h, &rm, &view.camera(), time)?);
+                return Ok(plan);
+            }
+            Method::AxisSlices(a) => {
+                let texel = plan.object.texel.clone().unwrap_or_default();
+                let bake = texels::bake_index_axis(scene, &texel, light, bakes)?;
+                plan.bake = Some(bake);
+                let res = bakes[bake].request.resolution;
+                let name = &plan.object.name;
+                let axis = AxisPlan::new(&plan.shell, &a, res, view.forward_f32(), view.focal, name)?;
+                plan.axis = Some(axis);
+                return Ok(plan);
+            }
             Method::Reference(r) => {
                 plan.per_pixel = r.lighting == LightingMode::PerPixel;
                 plan.frames = plan.per_pixel.then(|| shell::vertex_frames(&plan.object.surface));
@@ -347,18 +439,30 @@ fn instances(
         let centre = positions.iter().sum::<DVec3>() / positions.len().max(1) as f64;
         let distance = (centre - eye).length();
         let parts = o.base.iter().map(|_| Part::Base).chain((0..o.chunks.len()).map(Part::Slices));
-        for part in parts {
-            let (filter, order) = match part {
-                Part::Base => ("BaseSurface", 0),
-                Part::Slices(c) => ("ViewSlices", c as u32),
+        let axis = o.axis.iter().map(|_| Part::AxisSlices);
+        let march = o.ray_march.as_ref().map(|m| (m.corners.iter().sum::<DVec3>() / 8.0 - eye).length());
+        let distance = march.unwrap_or(distance);
+        for part in parts.chain(axis).chain(march.map(|_| Part::RayMarch)) {
+            let (filters, order) = match part {
+                Part::Base => (vec!["BaseSurface"], 0),
+                Part::Slices(c) => (vec!["ViewSlices"], c as u32),
+                Part::AxisSlices => {
+                    let blended = o.axis.as_ref().is_some_and(|a| a.blended);
+                    (vec!["AxisSlices", if blended { "AxisSlicesBlended" } else { "AxisSlicesBinary" }], 0)
+                }
+                Part::RayMarch => (vec!["RayMarch"], 0),
                 Part::Reference => unreachable!("reference instances are added once, above"),
             };
             instances.push((i, part));
-            infos.push(ObjectInfo { name: o.object.name.clone(), filters: vec![filter], distance, order });
+            infos.push(ObjectInfo { name: o.object.name.clone(), filters, distance, order });
         }
     }
     (instances, infos)
 }
+
+/// Bindings that sample baked texels: a graph using none of them bakes nothing.
+const TEXEL_BINDINGS: &[&str] =
+    &["volume", "normals", "texel_atlas", "axis_slices_s", "axis_slices_t", "axis_slices_w"];
 
 /// Resources the runtime binds by name: per frame, and per instance (an object's base surface or
 /// one chunk of its slices).
@@ -383,6 +487,22 @@ pub const INSTANCE_RESOURCES: &[&str] = &[
     "texel_atlas",
     "normal_atlas",
     "reference_state",
+    "hyper",
+    "hyper_noises",
+    "transfer_points",
+    "transfer_functions",
+    "transfer_tables",
+    "ray_march_state",
+    "axis_params",
+    "axis_occupancy",
+    "axis_choices",
+    "axis_draw_args",
+    "axis_vertices",
+    "axis_slices_s",
+    "axis_slices_t",
+    "axis_slices_w",
+    "axis_sampler",
+    "axis_sampler_side",
 ];
 
 /// Every WGSL global a kept pass uses must name a graph texture or a runtime resource, so that
@@ -427,8 +547,10 @@ fn projection(fov_y: f64, aspect: f64, near: f64, far: f64) -> DMat4 {
 
 /// Values of the WGSL `override` constants an object's kernels are specialised with.
 fn object_constants(o: &ObjectPlan) -> Vec<(String, f64)> {
-    vec![
+    let mut c = vec![
         ("trivial_reject".into(), o.trivial_reject as u32 as f64),
         ("per_pixel_lighting".into(), o.per_pixel as u32 as f64),
-    ]
+    ];
+    c.extend(o.ray_march.iter().flat_map(|m| m.constants()));
+    c
 }

@@ -7,7 +7,7 @@ use crate::gpu::timing::Timer;
 use crate::gpu::GpuContext;
 use crate::graph::exec::{Executor, Inputs};
 use crate::io::Image;
-use crate::methods::view_slices;
+use crate::methods::{axis_slices, view_slices};
 use crate::render::{wgsl_root, Blueprint, ObjectPlan, Part};
 use crate::types::{ObjectParams, VertexFrame};
 
@@ -100,7 +100,7 @@ impl Renderer {
         self.timer.reset();
         self.exec.run(ctx, &self.blueprint.plan, &self.frame, &self.objects, &mut self.timer)?;
         let pass_times = self.timer.read(ctx)?;
-        let image = self.read_output(ctx)?;
+        let image = self.read_output(ctx)?.box_downsample(self.blueprint.supersample);
         Ok(Frame { image, pass_times })
     }
 
@@ -118,6 +118,11 @@ impl Renderer {
 
     /// The texel and normal atlases of the Reference objects as the kernel reads them (for the
     /// CPU twin); `None` without Reference objects.
+    /// The inputs of graph instance `i` (tests and benchmarks read kernel outputs from them).
+    pub fn instance_inputs(&self, i: usize) -> &Inputs {
+        &self.objects[i]
+    }
+
     pub fn reference_atlases(&self, ctx: &GpuContext) -> Result<Option<(Vec<u8>, Vec<u8>)>> {
         let Some(i) = self.blueprint.instances.iter().position(|p| p.1 == Part::Reference) else {
             return Ok(None);
@@ -127,6 +132,21 @@ impl Renderer {
             ctx.read_buffer(b, 0, b.size())
         };
         Ok(Some((read("texel_atlas")?, read("normal_atlas")?)))
+    }
+
+    /// Reads back a buffer of graph instance `instance` (tests and tools: a layer, a table).
+    pub fn read_instance_buffer(&self, ctx: &GpuContext, instance: usize, name: &str) -> Result<Vec<u8>> {
+        let b = self
+            .objects
+            .get(instance)
+            .and_then(|i| i.buffers.get(name))
+            .ok_or_else(|| Error::Invalid(format!("graph instance {instance} has no buffer `{name}`")))?;
+        ctx.read_buffer(b, 0, b.size())
+    }
+
+    /// The graph's first output (the linear image), as rendered by the last frame.
+    pub fn output_texture(&self) -> Option<&wgpu::Texture> {
+        self.exec.texture(&self.blueprint.graph.file.outputs[0])
     }
 
     /// Reads a graph texture (Rgba32Float) back as a linear image.
@@ -191,6 +211,11 @@ fn instance_inputs(
             );
             inputs.counts.insert("base_vertices".into(), base.len() as u32);
         }
+        Part::RayMarch => {
+            if let Some(m) = &o.ray_march {
+                m.add_inputs(ctx, &mut inputs, bp.size);
+            }
+        }
         Part::Reference => {
             if let Some(set) = &bp.reference {
                 set.add_inputs(ctx, &mut inputs, bp.size);
@@ -211,6 +236,12 @@ fn instance_inputs(
                 inputs.views.insert("normals".into(), baked[b].normals.create_view(&Default::default()));
             }
         }
+        Part::AxisSlices => {
+            let (Some(plan), Some(b)) = (&o.axis, o.bake) else { return inputs };
+            if let Some(axis) = &baked[b].axis {
+                axis_slices::add_inputs(ctx, &mut inputs, &o.shell, plan, axis);
+            }
+        }
     }
     inputs
 }
@@ -226,18 +257,20 @@ impl Renderer {
             m.push(("voltex_gpu_ms".into(), format!("{t:.3}")));
         }
         for o in &self.blueprint.objects {
-            let method = match (&o.sweep, o.reference_step) {
-                (_, Some(step)) => format!(
+            let method = match (&o.sweep, o.reference_step, &o.axis) {
+                _ if o.ray_march.is_some() => o.ray_march.as_ref().map(|m| m.describe()).unwrap_or_default(),
+                (_, _, Some(a)) => format!("{:?}", a.method),
+                (_, Some(step), _) => format!(
                     "Reference(step: {step:.6}, lighting: {})",
                     if o.per_pixel { "PerPixel" } else { "Baked" }
                 ),
-                (Some(p), _) => format!(
+                (Some(p), _, _) => format!(
                     "ViewSlices(planes: {}, trivial_reject: {}, lighting: {})",
                     p.plane_count,
                     o.trivial_reject,
                     if o.per_pixel { "PerPixel" } else { "Baked" }
                 ),
-                (None, _) => "BaseSurface".into(),
+                (None, _, _) => "BaseSurface".into(),
             };
             m.push((format!("voltex_object_{}", o.object.name), method));
         }

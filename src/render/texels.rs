@@ -63,10 +63,23 @@ pub(super) fn bake_index(
             // z-up base surface; PerPixel lighting is right everywhere.
             light: light.direction,
             ambient: light.ambient,
+            axis_slices: false,
         },
         opacity_length: t.opacity_length,
     });
     Ok(bakes.len() - 1)
+}
+
+/// Like [`bake_index`], with the slice images of axis-aligned slicing baked too.
+pub(super) fn bake_index_axis(
+    scene: &Scene,
+    texel: &str,
+    light: &Lighting,
+    bakes: &mut Vec<BakePlan>,
+) -> Result<usize> {
+    let i = bake_index(scene, texel, false, light, bakes)?;
+    bakes[i].request.axis_slices = true;
+    Ok(i)
 }
 
 /// A scene shape as the bake kernels take it: (shape, albedo, opacity).

@@ -17,6 +17,16 @@ pub struct SceneObject {
     pub base_color: Option<[f32; 3]>,
     /// Prism check of `surface` (no errors, else `objects()` fails); warnings for the user.
     pub report: PrismReport,
+    /// A hypertexture node (its `surface` is empty).
+    pub hypertexture: Option<HyperNode>,
+}
+
+/// A node drawing a hypertexture: its name in `Scene::hypertextures` and the node's frame.
+#[derive(Debug, Clone)]
+pub struct HyperNode {
+    pub name: String,
+    /// The node's frame (object space of the hypertexture) to world.
+    pub to_world: DMat4,
 }
 
 impl Scene {
@@ -49,6 +59,19 @@ impl Scene {
                 method: n.method.as_ref().map(|m| m.value.clone()),
                 base_color: n.base_color,
                 report,
+                hypertexture: None,
+            });
+        } else if let Some(h) = &n.hypertexture {
+            // Without a method, a hypertexture node is ray-marched with the defaults.
+            let method = n.method.as_ref().map_or(Method::RayMarch(Default::default()), |m| m.value.clone());
+            out.push(SceneObject {
+                name: n.name.clone(),
+                surface: Default::default(),
+                texel: None,
+                method: Some(method),
+                base_color: None,
+                report: PrismReport::default(),
+                hypertexture: Some(HyperNode { name: h.value.clone(), to_world: world }),
             });
         }
         for c in &n.children {

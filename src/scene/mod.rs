@@ -9,12 +9,14 @@
 pub const MAX_PLANES: u32 = 16384;
 
 mod flatten;
+pub mod hypertexture;
 mod image;
 mod types;
 mod validate;
 mod values;
 
-pub use flatten::SceneObject;
+pub use flatten::{HyperNode, SceneObject};
+pub use hypertexture::Hypertexture;
 pub use image::HeightImage;
 pub use types::*;
 pub use values::Mark;
@@ -28,6 +30,18 @@ fn options() -> ron::Options {
     // Method variants wrap a struct: `ViewSlices(planes: 400)` rather than `ViewSlices((planes: 400))`.
     ron::Options::default()
         .with_default_extension(Extensions::IMPLICIT_SOME | Extensions::UNWRAP_VARIANT_NEWTYPES)
+}
+
+impl Scene {
+    /// The files (meshes, images) the scene refers to, resolved.
+    pub fn asset_paths(&self) -> Vec<std::path::PathBuf> {
+        self.assets.meshes.keys().chain(self.assets.images.keys()).cloned().collect()
+    }
+
+    /// The scene file's text.
+    pub fn source(&self) -> &str {
+        &self.source
+    }
 }
 
 /// Reads, parses and checks a scene file, and loads the files it refers to.

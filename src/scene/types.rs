@@ -23,8 +23,14 @@ pub struct Scene {
     pub lights: Vec<Light>,
     #[serde(default)]
     pub texels: BTreeMap<String, Texel>,
+    /// Hypertextures (Gilet & Dischler 2009) that nodes draw with `RayMarch`.
+    #[serde(default)]
+    pub hypertextures: BTreeMap<String, super::hypertexture::Hypertexture>,
     #[serde(default)]
     pub nodes: Vec<Node>,
+    /// Time of the frame in seconds (animated hypertextures; `--time` overrides it).
+    #[serde(default, deserialize_with = "v::finite")]
+    pub time: f64,
     /// Settings of `voltex regress` runs: render size and pass thresholds.
     #[serde(default)]
     pub regress: Regress,
@@ -246,6 +252,9 @@ pub struct Node {
     pub uv_tiling: [f64; 2],
     #[serde(default)]
     pub texel: Option<Mark<String>>,
+    /// A hypertexture drawn in this node's frame (instead of a surface with a texel).
+    #[serde(default)]
+    pub hypertexture: Option<Mark<String>>,
     #[serde(default)]
     pub method: Option<Mark<Method>>,
     /// Draw the base surface opaque with this colour.
@@ -371,6 +380,8 @@ pub enum HeightScale {
 pub enum Method {
     ViewSlices(ViewSlices),
     Reference(Reference),
+    RayMarch(RayMarch),
+    AxisSlices(AxisSlices),
 }
 
 impl Method {
@@ -378,8 +389,65 @@ impl Method {
         match self {
             Method::ViewSlices(m) => m.lighting,
             Method::Reference(m) => m.lighting,
+            Method::RayMarch(_) => Lighting::Baked,
+            Method::AxisSlices(_) => Lighting::Baked,
         }
     }
+}
+
+/// Ray marching of a hypertexture (Gilet & Dischler 2009), front to back with the shared
+/// step-corrected opacity.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RayMarch {
+    /// The paper's presets: HQ (step 0.002) or IE (step 0.015, the default).
+    #[serde(default)]
+    pub quality: Quality,
+    /// Ray step in world units (replaces the preset's).
+    #[serde(default, deserialize_with = "v::opt_positive")]
+    pub step: Option<f64>,
+    #[serde(default)]
+    pub shading: Shading,
+    /// Step of shadow rays (world units; default twice the ray step).
+    #[serde(default, deserialize_with = "v::opt_positive")]
+    pub shadow_step: Option<f64>,
+}
+
+impl RayMarch {
+    pub fn step(&self) -> f64 {
+        self.step.unwrap_or(self.quality.step())
+    }
+}
+
+/// The quality settings of the paper's Figure 11.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
+pub enum Quality {
+    /// High quality: step 0.002.
+    #[serde(rename = "HQ")]
+    High,
+    /// Interactive exploration: step 0.015.
+    #[default]
+    #[serde(rename = "IE")]
+    Interactive,
+}
+
+impl Quality {
+    pub fn step(self) -> f64 {
+        match self {
+            Quality::High => 0.002,
+            Quality::Interactive => 0.015,
+        }
+    }
+}
+
+/// Shading of a hypertexture: the transfer function's colour as is, Phong with the density
+/// gradient by central differences, or Phong with shadow rays towards the light.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
+pub enum Shading {
+    #[default]
+    None,
+    Phong,
+    PhongShadows,
 }
 
 /// Exact ray casting through the prisms with a fine fixed step: the ground truth.
@@ -405,6 +473,61 @@ pub struct ViewSlices {
     pub trivial_reject: bool,
     #[serde(default)]
     pub lighting: Lighting,
+}
+
+/// Meyer & Neyret 1998: the texel baked into slice images along s, t and w with power-of-two
+/// levels; per base triangle one direction and level chosen by the quality criteria.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AxisSlices {
+    /// `d` of the criterion `h tan(a) / d <= 1`: how deep, in voxels, the inside of a contour
+    /// may be seen between two slices.
+    #[serde(default = "one_f64", deserialize_with = "v::slice_depth")]
+    pub depth: f64,
+    /// `p` of the criterion `h sin(a) / (z / f) <= p`: the largest apparent distance between two
+    /// slices on screen, in pixels.
+    #[serde(default = "one_f64", deserialize_with = "v::slice_pixels")]
+    pub pixels: f64,
+    /// Largest view angle (degrees from a slice set's normal) the criteria are evaluated at.
+    #[serde(default = "default_max_angle", deserialize_with = "v::max_angle")]
+    pub max_angle: f64,
+    #[serde(default)]
+    pub directions: SliceDirections,
+    #[serde(default)]
+    pub blend: SliceBlend,
+    /// Skip prisms whose base and top triangles both face away (approximate: see README).
+    #[serde(default)]
+    pub back_face_culling: bool,
+    /// Skip slices (and so texels) whose slice image is empty.
+    #[serde(default = "yes")]
+    pub empty_culling: bool,
+}
+
+fn one_f64() -> f64 {
+    1.0
+}
+fn default_max_angle() -> f64 {
+    80.0
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
+pub enum SliceDirections {
+    /// Horizontal (w) and the two vertical sets (s, t), chosen per triangle.
+    #[default]
+    Three,
+    /// Horizontal slices only (to measure what the vertical sets gain).
+    Horizontal,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
+pub enum SliceBlend {
+    /// The paper's binary alpha: the step-corrected opacity thresholded at 1/2, depth-tested and
+    /// written, so intersecting texels are right.
+    #[default]
+    Binary,
+    /// Semi-transparent slices blended back to front within each prism, prisms sorted back to
+    /// front by centre: slices of overlapping prisms are not interleaved.
+    Blended,
 }
 
 fn yes() -> bool {

@@ -2,7 +2,7 @@
 //! of the files the scene refers to (OBJ meshes, height images).
 
 use super::image::HeightImage;
-use super::types::{HeightScale, Node, Scene, Surface};
+use super::types::{HeightScale, Method, Node, Scene, Surface};
 use super::values::Mark;
 use crate::error::Error;
 use crate::mesh::{obj, Mesh};
@@ -86,8 +86,10 @@ impl Checker<'_> {
         }
     }
 
-    fn node(&mut self, n: &Node) {
-        if let Some(m) = &n.method {
+    fn node(&mut self, n: &Node, parent: glam::DMat4) {
+        let world = parent * n.transform.matrix();
+        self.hypertexture_node(n, &world);
+        if let Some(m) = n.method.as_ref().filter(|m| !matches!(m.value, Method::RayMarch(_))) {
             if n.texel.is_none() {
                 self.fail(m, format!("node \"{}\" has a method: expected a `texel`", n.name));
             } else if n.surface.is_none() {
@@ -144,10 +146,60 @@ impl Checker<'_> {
             }
         }
         for c in &n.children {
-            self.node(c);
+            self.node(c, world);
+        }
+    }
+
+    /// A hypertexture node draws a known hypertexture with `RayMarch` and nothing else; a step
+    /// that would need more than `MAX_SAMPLES_PER_RAY` samples across the bounds is refused.
+    fn hypertexture_node(&mut self, n: &Node, world: &glam::DMat4) {
+        let ray_march = n.method.as_ref().filter(|m| matches!(m.value, Method::RayMarch(_)));
+        let Some(h) = &n.hypertexture else {
+            if let Some(m) = ray_march {
+                let msg =
+                    format!("node \"{}\" is drawn with RayMarch: expected `hypertexture: \"name\"`", n.name);
+                self.fail(m, msg);
+            }
+            return;
+        };
+        if n.surface.is_some() || n.texel.is_some() {
+            let msg = "a node draws either a `surface` with a `texel` or a `hypertexture`, not both".into();
+            self.fail(h, msg);
+            return;
+        }
+        if let Some(m) = n.method.as_ref().filter(|_| ray_march.is_none()) {
+            self.fail(m, "a hypertexture node is drawn with RayMarch(...): expected RayMarch".into());
+            return;
+        }
+        let Some(model) = self.scene.hypertextures.get(&h.value) else {
+            let names: Vec<String> = self.scene.hypertextures.keys().map(|k| format!("\"{k}\"")).collect();
+            let expected = if names.is_empty() {
+                "no hypertextures are defined in `hypertextures`".to_string()
+            } else {
+                format!("expected one of {}", names.join(", "))
+            };
+            self.fail(h, format!("unknown hypertexture \"{}\": {expected}", h.value));
+            return;
+        };
+        if let Some(Method::RayMarch(rm)) = ray_march.map(|m| &m.value) {
+            let diagonal = super::hypertexture::diagonal(&model.world_corners(world));
+            let samples = diagonal / rm.step();
+            if samples > MAX_SAMPLES_PER_RAY {
+                let msg = format!(
+                    "a step of {} takes {samples:.3e} samples across the bounds of \"{}\" (diagonal {diagonal:.4}): \
+                     expected a step of at least {:.3e}",
+                    rm.step(),
+                    h.value,
+                    diagonal / MAX_SAMPLES_PER_RAY
+                );
+                self.fail(ray_march.unwrap(), msg);
+            }
         }
     }
 }
+
+/// More samples than this along one ray means a step far finer than any scene needs.
+pub const MAX_SAMPLES_PER_RAY: f64 = 1e5;
 
 pub(super) fn check(scene: &Scene, dir: &Path) -> Findings {
     let mut c = Checker {
@@ -165,8 +217,13 @@ pub(super) fn check(scene: &Scene, dir: &Path) -> Findings {
     } else if view.normalize().cross(cam.up.normalize()).length() < 1e-6 {
         c.fail(cam, "expected a camera `up` that is not parallel to the view direction".into());
     }
+    for h in scene.hypertextures.values() {
+        super::hypertexture::check(h, &mut |seq, msg| {
+            c.f.fail.entry(seq).or_insert(msg);
+        });
+    }
     for n in &scene.nodes {
-        c.node(n);
+        c.node(n, glam::DMat4::IDENTITY);
     }
     c.f
 }

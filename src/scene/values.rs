@@ -31,6 +31,9 @@ checked_f64!(Unit, |v| (0.0..=1.0).contains(&v), "a number in [0, 1]");
 checked_f64!(NonZero, |v| v != 0.0, "a finite non-zero number");
 checked_f64!(Jitter, |v| (0.0..0.5).contains(&v), "a jitter in [0, 0.5) (fraction of a cell)");
 checked_f64!(Distortion, |v| (0.0..0.9).contains(&v), "a distortion in [0, 0.9)");
+checked_f64!(SliceDepth, |v| v > 0.0 && v <= 1024.0, "a depth in (0, 1024] voxels");
+checked_f64!(SlicePixels, |v| v > 0.0 && v <= 1024.0, "a slice distance in (0, 1024] pixels");
+checked_f64!(MaxAngle, |v| v > 0.0 && v < 90.0, "a view angle in (0, 90) degrees");
 checked_f64!(FieldOfView, |v| v > 0.0 && v < 180.0, "a field of view in (0, 180) degrees");
 
 macro_rules! checked_u32 {
@@ -73,12 +76,19 @@ macro_rules! adapter {
 }
 
 adapter!(positive, f64, Positive, |v| v.0);
+adapter!(finite, f64, Finite, |v| v.0);
+adapter!(positive3, DVec3, [Positive; 3], |v| DVec3::new(v[0].0, v[1].0, v[2].0));
+adapter!(rgba, [f64; 4], [Unit; 4], |v| v.map(|x| x.0));
+adapter!(unit_list, Vec<f64>, Vec<Unit>, |v| v.into_iter().map(|x| x.0).collect());
 adapter!(opt_positive, Option<f64>, Option<Positive>, |v| v.map(|x| x.0));
 adapter!(non_negative, f64, NonNegative, |v| v.0);
 adapter!(unit, f64, Unit, |v| v.0);
 adapter!(jitter, f64, Jitter, |v| v.0);
 adapter!(distortion, f64, Distortion, |v| v.0);
 adapter!(fov, f64, FieldOfView, |v| v.0);
+adapter!(slice_depth, f64, SliceDepth, |v| v.0);
+adapter!(slice_pixels, f64, SlicePixels, |v| v.0);
+adapter!(max_angle, f64, MaxAngle, |v| v.0);
 adapter!(finite_f32, f32, Finite, |v| v.0 as f32);
 adapter!(positive_f32, f32, Positive, |v| v.0 as f32);
 adapter!(non_negative_f32, f32, NonNegative, |v| v.0 as f32);

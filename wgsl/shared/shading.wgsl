@@ -21,6 +21,10 @@ fn shade_lambert(albedo: vec3<f32>, normal: vec3<f32>, light: vec4<f32>) -> vec3
     return albedo * (light.w + (1.0 - light.w) * max(dot(normal, l), 0.0));
 }
 
+// The highlight of per-pixel lighting, the same for every method (draw_slices, trace_reference).
+const PIXEL_SPECULAR: f32 = 0.25;
+const PIXEL_SHININESS: f32 = 32.0;
+
 // Lambert plus a white Blinn-Phong highlight, for per-pixel lighting of baked normals.
 // `view` points from the surface towards the eye.
 fn shade_phong(albedo: vec3<f32>, normal: vec3<f32>, light: vec4<f32>, view: vec3<f32>,

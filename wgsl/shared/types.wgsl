@@ -123,3 +123,79 @@ struct ReferenceState {
     color: vec4<f32>,
     resume: vec4<f32>,
 }
+
+// Axis-aligned slicing, Meyer & Neyret (twins: AxisParams, AxisChoice, AxisVertex, AxisBake in src/types.rs).
+struct AxisParams {
+    resolution: vec4<u32>,
+    criteria: vec4<f32>,
+    forward: vec4<f32>,
+    flags: vec4<u32>,
+}
+
+struct AxisChoice {
+    direction: u32,
+    level: u32,
+    first: i32,
+    count: u32,
+    vertex_count: u32,
+    vertex_offset: u32,
+    reverse: u32,
+    culled: u32,
+}
+
+struct AxisVertex {
+    position: vec4<f32>,
+    texcoord: vec4<f32>,
+    normal: vec4<f32>,
+}
+
+struct AxisBake {
+    resolution: vec4<u32>,
+    level: vec4<u32>,
+}
+
+// Hypertextures (twins: HyperParams, HyperNoise, TransferFunction, TransferPoint, MarchState in src/types.rs).
+struct HyperParams {
+    to_local: mat4x4<f32>,
+    right: vec4<f32>,
+    up: vec4<f32>,
+    bounds_min: vec4<f32>,
+    bounds_max: vec4<f32>,
+    object: vec4<f32>,
+    field: vec4<f32>,
+    field_center: vec4<f32>,
+    perturb: vec4<f32>,
+    kinds: vec4<u32>,
+    march: vec4<f32>,
+    budget: vec4<u32>,
+}
+
+struct HyperNoise {
+    amplitude: f32,
+    frequency: f32,
+    shift: f32,
+    blend: u32,
+    seed: u32,
+    speed: f32,
+    _pad0: u32,
+    _pad1: u32,
+}
+
+struct TransferFunction {
+    first: u32,
+    count: u32,
+    kind: u32,
+    _pad: u32,
+}
+
+struct TransferPoint {
+    x: f32,
+    y: f32,
+    slope: f32,
+    _pad: f32,
+}
+
+struct MarchState {
+    color: vec4<f32>,
+    resume: vec4<f32>,
+}

@@ -1,0 +1,134 @@
+//! Slice images for axis-aligned slicing: from a baked texel volume, per direction (s, t, w) a 2D
+//! texture array holding every power-of-two level (finest first), each coarser slice combining
+//! `2^level` voxel slices, and one occupancy word per slice for empty-slice culling.
+
+use crate::cpu::axis_slices::{array_layers, level_count, level_layer, level_slices, occupancy_base};
+use crate::error::{Error, Result};
+use crate::gpu::kernel::ComputeKernel;
+use crate::gpu::GpuContext;
+use crate::graph::exec::Inputs;
+use crate::types::AxisBake;
+
+#[derive(Clone)]
+pub struct AxisBaked {
+    /// Per direction s, t, w: `Rgba16Float` premultiplied slice images, all levels as layers.
+    pub arrays: [wgpu::Texture; 3],
+    /// One word per (direction, level, slice), non-zero where the slice image is not empty.
+    pub occupancy: wgpu::Buffer,
+}
+
+/// Image size of a direction's slices: s slices are (t, w) images, t slices (s, w), w slices (s, t).
+pub fn image_size(res: [u32; 3], direction: usize) -> [u32; 2] {
+    match direction {
+        0 => [res[1], res[2]],
+        1 => [res[0], res[2]],
+        _ => [res[0], res[1]],
+    }
+}
+
+/// Bytes of the slice arrays (f16 RGBA) and occupancy words of a texel.
+pub fn bytes(res: [u32; 3]) -> u64 {
+    (0..3)
+        .map(|d| {
+            let [w, h] = image_size(res, d);
+            (w as u64 * h as u64 * 8 + 4) * array_layers(res[d]) as u64
+        })
+        .sum()
+}
+
+/// Records the bake of every level of every direction from `volume` (level 0 is read).
+pub fn bake(
+    ctx: &GpuContext,
+    kernel: &mut ComputeKernel,
+    encoder: &mut wgpu::CommandEncoder,
+    volume: &wgpu::Texture,
+    res: [u32; 3],
+) -> Result<AxisBaked> {
+    let max_layers = ctx.limits.max_texture_array_layers;
+    if let Some(d) = (0..3).find(|&d| array_layers(res[d]) > max_layers) {
+        return Err(Error::Gpu(format!(
+            "texel resolution {res:?}: {} slice layers along {} are beyond this adapter's limit of {max_layers} \
+             array layers",
+            array_layers(res[d]),
+            ["s", "t", "w"][d]
+        )));
+    }
+    let words: u32 = (0..3).map(|d| array_layers(res[d])).sum();
+    let occupancy = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("axis_occupancy"),
+        size: (words as u64 * 4).max(16),
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
+        mapped_at_creation: false,
+    });
+    encoder.clear_buffer(&occupancy, 0, None);
+    let arrays = [0, 1, 2].map(|d| {
+        let [w, h] = image_size(res, d);
+        ctx.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some(["axis_slices_s", "axis_slices_t", "axis_slices_w"][d]),
+            size: wgpu::Extent3d { width: w, height: h, depth_or_array_layers: array_layers(res[d]) },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Rgba16Float,
+            usage: wgpu::TextureUsages::STORAGE_BINDING
+                | wgpu::TextureUsages::TEXTURE_BINDING
+                | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        })
+    });
+    let source = crate::bake::level_view(volume, 0);
+    for (d, array) in arrays.iter().enumerate() {
+        let destination = array.create_view(&wgpu::TextureViewDescriptor {
+            dimension: Some(wgpu::TextureViewDimension::D2Array),
+            ..Default::default()
+        });
+        for level in 0..level_count(res[d]) {
+            let n = level_slices(res[d], level);
+            let params = AxisBake {
+                resolution: [res[0], res[1], res[2], d as u32],
+                level: [level, level_layer(res[d], level), n, occupancy_base(res, d as u32, level)],
+            };
+            let mut inputs = Inputs::default();
+            inputs.buffers.insert(
+                "axis_bake".into(),
+                crate::bake::uniform(ctx, "axis_bake", bytemuck::bytes_of(&params)),
+            );
+            inputs.buffers.insert("axis_occupancy".into(), occupancy.clone());
+            inputs.views.insert("volume".into(), source.clone());
+            inputs.views.insert("destination".into(), destination.clone());
+            let [w, h] = image_size(res, d);
+            kernel.dispatch(ctx, encoder, &inputs, [w, h, n])?;
+        }
+    }
+    Ok(AxisBaked { arrays, occupancy })
+}
+
+/// Reads every layer (or depth slice) of level 0 of a texture back, tightly packed (tests).
+pub fn read_texture(ctx: &GpuContext, texture: &wgpu::Texture, bytes_per_texel: u32) -> Result<Vec<u8>> {
+    let size = texture.size();
+    let row = size.width * bytes_per_texel;
+    let padded = row.div_ceil(256) * 256;
+    let rows = size.height * size.depth_or_array_layers;
+    let staging = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("texture readback"),
+        size: padded as u64 * rows as u64,
+        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let mut enc = ctx.device.create_command_encoder(&Default::default());
+    enc.copy_texture_to_buffer(
+        texture.as_image_copy(),
+        wgpu::TexelCopyBufferInfo {
+            buffer: &staging,
+            layout: wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(padded),
+                rows_per_image: Some(size.height),
+            },
+        },
+        size,
+    );
+    ctx.queue.submit([enc.finish()]);
+    let bytes = ctx.map_read(&staging)?;
+    Ok((0..rows as usize).flat_map(|y| bytes[y * padded as usize..][..row as usize].to_vec()).collect())
+}

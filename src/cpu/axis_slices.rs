@@ -1,0 +1,322 @@
+//! CPU twins of the axis-slicing kernels (`choose_axis_slices`, `emit_axis_slices`,
+//! `bake_axis_slices` and `wgsl/shared/axis_slices.wgsl`), in f32 like the kernels so that the
+//! discrete decisions (direction, level) agree. Directions: 0 = s, 1 = t, 2 = w.
+
+use glam::{Vec2, Vec3, Vec4};
+
+use crate::types::{AxisChoice, AxisParams, AxisVertex};
+
+/// Most slices of one direction crossing one prism.
+pub const MAX_PRISM_SLICES: u32 = 4096;
+
+/// A prism as the kernels see it: camera-relative corners, uvs, slice normals and thicknesses.
+#[derive(Clone, Debug)]
+pub struct AxisFrame {
+    pub bottom: [Vec3; 3],
+    pub top: [Vec3; 3],
+    pub uv: [Vec2; 3],
+    /// Per direction: unit slice-plane normal (xyz) and the texel's thickness along it (w).
+    pub axes: [Vec4; 3],
+    pub centre: Vec3,
+    pub has_uv: bool,
+}
+
+fn axis_of(n: Vec3, along: Vec3) -> Vec4 {
+    let len = n.length();
+    if len < 1e-20 {
+        return Vec4::ZERO;
+    }
+    let mut u = n / len;
+    let mut l = u.dot(along);
+    if l < 0.0 {
+        u = -u;
+        l = -l;
+    }
+    u.extend(l)
+}
+
+impl AxisFrame {
+    pub fn new(bottom: [Vec3; 3], top: [Vec3; 3], uv: [Vec2; 3]) -> Self {
+        let mid = |i: usize| 0.5 * (bottom[i] + top[i]);
+        let (e1, e2) = (mid(1) - mid(0), mid(2) - mid(0));
+        let (d1, d2) = (uv[1] - uv[0], uv[2] - uv[0]);
+        let det = d1.x * d2.y - d2.x * d1.y;
+        let dw = ((top[0] - bottom[0]) + (top[1] - bottom[1]) + (top[2] - bottom[2])) / 3.0;
+        let has_uv = det.abs() > 1e-12;
+        let (ds, dt) = if has_uv {
+            ((e1 * d2.y - e2 * d1.y) / det, (e2 * d1.x - e1 * d2.x) / det)
+        } else {
+            (Vec3::ZERO, Vec3::ZERO)
+        };
+        let axes = [axis_of(dt.cross(dw), ds), axis_of(dw.cross(ds), dt), axis_of(ds.cross(dt), dw)];
+        let centre = (0..3).map(|i| bottom[i] + top[i]).sum::<Vec3>() / 6.0;
+        Self { bottom, top, uv, axes, centre, has_uv }
+    }
+
+    /// The frame of prism `index` of a shell (camera-relative, as uploaded).
+    pub fn of_shell(shell: &crate::methods::shell::Shell, index: usize) -> Self {
+        let p = &shell.prisms[index];
+        let v = |i: usize| &shell.vertices[p.vertices[i] as usize];
+        let b = |i: usize| Vec4::from(v(i).bottom).truncate();
+        let t = |i: usize| Vec4::from(v(i).top).truncate();
+        let uv =
+            [Vec2::new(p.uv01[0], p.uv01[1]), Vec2::new(p.uv01[2], p.uv01[3]), Vec2::new(p.uv2[0], p.uv2[1])];
+        Self::new([b(0), b(1), b(2)], [t(0), t(1), t(2)], uv)
+    }
+}
+
+pub fn level_count(r: u32) -> u32 {
+    32 - r.max(1).leading_zeros()
+}
+
+pub fn level_slices(r: u32, level: u32) -> u32 {
+    (r + (1 << level) - 1) >> level
+}
+
+/// First array layer of `level` in a direction's slice array (finest level first).
+pub fn level_layer(r: u32, level: u32) -> u32 {
+    (0..level).map(|l| level_slices(r, l)).sum()
+}
+
+/// Layers of a direction's slice array (all levels).
+pub fn array_layers(r: u32) -> u32 {
+    level_layer(r, level_count(r))
+}
+
+/// First occupancy word of (direction, level): directions s, t, w one after the other.
+pub fn occupancy_base(resolution: [u32; 3], direction: u32, level: u32) -> u32 {
+    (0..direction).map(|d| array_layers(resolution[d as usize])).sum::<u32>()
+        + level_layer(resolution[direction as usize], level)
+}
+
+pub fn slice_layer(g: i32, n: u32) -> u32 {
+    g.rem_euclid(n as i32) as u32
+}
+
+/// The quality score `(1/c^2 - 1) h^2` of a direction (section 4.2); huge when unusable.
+pub fn direction_score(f: &AxisFrame, params: &AxisParams, d: usize, view: Vec3) -> f32 {
+    let axis = f.axes[d];
+    let c = axis.truncate().dot(view).abs();
+    if c < 1e-6 || axis.w <= 0.0 || (d < 2 && !f.has_uv) {
+        return 3.0e38;
+    }
+    let h = axis.w / params.resolution[d] as f32;
+    (1.0 / (c * c) - 1.0) * h * h
+}
+
+/// Slices needed by the criteria `h tan(a) / d <= 1` and `h sin(a) / (z / f) <= p` (the smaller,
+/// since meeting either suffices), with `a` clamped to the maximum view angle, for a direction
+/// of `r` slices at the finest level whose texel thickness is `thickness` at view depth `z`.
+pub fn needed_slices(params: &AxisParams, r: u32, cos_a: f32, thickness: f32, z: f32) -> f32 {
+    let a = cos_a.clamp(0.0, 1.0).acos().min(params.criteria[2]);
+    let depth = r as f32 * a.tan() / params.criteria[0];
+    let pixels = thickness * a.sin() * params.criteria[3] / (z.max(1e-6) * params.criteria[1]);
+    depth.min(pixels).clamp(1.0, r as f32)
+}
+
+/// The coarsest power-of-two level of `r` slices with at least `needed` slices.
+pub fn level_for(r: u32, needed: f32) -> u32 {
+    let mut level = 0;
+    while level + 1 < level_count(r) && level_slices(r, level + 1) as f32 >= needed {
+        level += 1;
+    }
+    level
+}
+
+/// Direction, level and slice range of a prism; `vertex_count` and the offset are left at 0.
+pub fn choose_axis(f: &AxisFrame, params: &AxisParams) -> AxisChoice {
+    let view = f.centre.normalize();
+    let (mut best, mut best_score) = (2usize, 3.4e38f32);
+    for k in 0..3 {
+        let d = (k + 2) % 3;
+        if params.flags[0] & (1 << d) == 0 {
+            continue;
+        }
+        let s = direction_score(f, params, d, view);
+        if s < best_score {
+            (best, best_score) = (d, s);
+        }
+    }
+    let axis = f.axes[best];
+    let r = params.resolution[best];
+    let z = f.centre.dot(Vec4::from(params.forward).truncate());
+    let needed = needed_slices(params, r, axis.truncate().dot(view).abs(), axis.w, z);
+    let level = level_for(r, needed);
+    let n = level_slices(r, level);
+    let (mut first, mut count) = (0, n);
+    if best < 2 {
+        let c = f.uv.map(|uv| uv[best]);
+        let (lo, hi) = (c[0].min(c[1]).min(c[2]), c[0].max(c[1]).max(c[2]));
+        let g_lo = (lo * n as f32 - 0.5).ceil() as i32;
+        let g_hi = (hi * n as f32 - 0.5).floor() as i32;
+        first = g_lo;
+        count = (g_hi - g_lo + 1).clamp(0, MAX_PRISM_SLICES as i32) as u32;
+    }
+    AxisChoice {
+        direction: best as u32,
+        level,
+        first,
+        count,
+        reverse: (axis.truncate().dot(view) > 0.0) as u32,
+        ..Default::default()
+    }
+}
+
+/// Whether both the base and the top triangle face away from the eye.
+pub fn back_facing(f: &AxisFrame) -> bool {
+    let w = f.axes[2].truncate();
+    let orient = |n: Vec3| if n.dot(w) < 0.0 { -n } else { n };
+    let nb = orient((f.bottom[1] - f.bottom[0]).cross(f.bottom[2] - f.bottom[0]));
+    let nt = orient((f.top[1] - f.top[0]).cross(f.top[2] - f.top[0]));
+    nb.dot(f.bottom[0]) > 0.0 && nt.dot(f.top[0]) > 0.0
+}
+
+/// The j-th slice position drawn (back to front).
+pub fn slice_position(c: &AxisChoice, j: u32) -> i32 {
+    let k = if c.reverse == 1 { c.count - 1 - j } else { j };
+    c.first + k as i32
+}
+
+fn occupied(c: &AxisChoice, params: &AxisParams, occupancy: &[u32], g: i32) -> bool {
+    if params.flags[3] == 0 {
+        return true;
+    }
+    let res = [params.resolution[0], params.resolution[1], params.resolution[2]];
+    let n = level_slices(res[c.direction as usize], c.level);
+    occupancy[(occupancy_base(res, c.direction, c.level) + slice_layer(g, n)) as usize] != 0
+}
+
+/// Crossings of the line `uv[direction] = x` with the uv triangle's edges (half-open edges, so
+/// a line crosses 0 or 2 of them): (edge start, edge end, parameter).
+fn crossings(f: &AxisFrame, direction: usize, x: f32) -> Vec<(usize, usize, f32)> {
+    (0..3)
+        .filter_map(|e| {
+            let e2 = (e + 1) % 3;
+            let (a, b) = (f.uv[e][direction], f.uv[e2][direction]);
+            ((a <= x && x < b) || (b <= x && x < a)).then(|| (e, e2, (x - a) / (b - a)))
+        })
+        .collect()
+}
+
+/// Twin of `choose_axis_slices`: the choice with its vertex count (culling applied).
+pub fn choose_axis_slices(f: &AxisFrame, params: &AxisParams, occupancy: &[u32]) -> AxisChoice {
+    let mut c = choose_axis(f, params);
+    if params.flags[2] != 0 && back_facing(f) {
+        c.culled = 1;
+        return c;
+    }
+    c.vertex_count = emit_axis_slices(f, params, occupancy, &c).len() as u32;
+    c
+}
+
+/// Twin of `emit_axis_slices`: the slices of one prism, back to front, as triangle-list vertices.
+pub fn emit_axis_slices(
+    f: &AxisFrame,
+    params: &AxisParams,
+    occupancy: &[u32],
+    c: &AxisChoice,
+) -> Vec<AxisVertex> {
+    let d = c.direction as usize;
+    let r = params.resolution[d];
+    let n = level_slices(r, c.level);
+    let layer0 = level_layer(r, c.level);
+    let axis = f.axes[d];
+    let normal = axis.truncate().extend(0.0).to_array();
+    let thickness = axis.w / n as f32;
+    let mut out = Vec::new();
+    for j in 0..c.count {
+        let g = slice_position(c, j);
+        if !occupied(c, params, occupancy, g) {
+            continue;
+        }
+        let layer = (layer0 + slice_layer(g, n)) as f32;
+        let x = (g as f32 + 0.5) / n as f32;
+        if d == 2 {
+            for i in 0..3 {
+                let p = f.bottom[i].lerp(f.top[i], x);
+                out.push(AxisVertex {
+                    position: p.extend(thickness).to_array(),
+                    texcoord: [f.uv[i].x, f.uv[i].y, layer, 2.0],
+                    normal,
+                });
+            }
+            continue;
+        }
+        let hits = crossings(f, d, x);
+        if hits.len() < 2 {
+            continue;
+        }
+        let other = 1 - d;
+        let ends: Vec<(Vec3, f32, f32)> = hits[..2]
+            .iter()
+            .flat_map(|&(a, b, l)| {
+                let u = f.uv[a][other] + (f.uv[b][other] - f.uv[a][other]) * l;
+                [(f.bottom[a].lerp(f.bottom[b], l), u, 0.0), (f.top[a].lerp(f.top[b], l), u, 1.0)]
+            })
+            .collect();
+        for k in [0, 2, 3, 0, 3, 1] {
+            let (p, u, v) = ends[k];
+            out.push(AxisVertex {
+                position: p.extend(thickness).to_array(),
+                texcoord: [u, v, layer, d as f32],
+                normal,
+            });
+        }
+    }
+    out
+}
+
+/// Twin of `bake_axis_slices`: every level of every direction from an RGBA8 premultiplied volume
+/// (`s` fastest), as (per direction, layers of `width x height` RGBA texels) and the occupancy
+/// words.
+pub fn bake_axis_slices(volume: &[[u8; 4]], res: [u32; 3]) -> ([Vec<[f32; 4]>; 3], Vec<u32>) {
+    let voxel = |p: [u32; 3]| {
+        let v = volume[((p[2] * res[1] + p[1]) * res[0] + p[0]) as usize];
+        v.map(|x| x as f32 / 255.0)
+    };
+    let mut arrays: [Vec<[f32; 4]>; 3] = Default::default();
+    let mut occupancy = Vec::new();
+    for d in 0..3 {
+        let size = match d {
+            0 => [res[1], res[2]],
+            1 => [res[0], res[2]],
+            _ => [res[0], res[1]],
+        };
+        for level in 0..level_count(res[d]) {
+            let span = 1u32 << level;
+            for k in 0..level_slices(res[d], level) {
+                let (begin, end) = (k * span, ((k + 1) * span).min(res[d]));
+                let mut any = false;
+                for y in 0..size[1] {
+                    for x in 0..size[0] {
+                        let (mut optical, mut colour) = (0.0f32, Vec3::ZERO);
+                        for j in begin..end {
+                            let p = match d {
+                                0 => [j, x, y],
+                                1 => [x, j, y],
+                                _ => [x, y, j],
+                            };
+                            let v = voxel(p);
+                            let a = v[3].clamp(0.0, 1.0);
+                            if a > 0.0 {
+                                let e = -(1.0 - a).max(1e-6).ln();
+                                optical += e;
+                                colour += e * Vec3::new(v[0], v[1], v[2]) / a;
+                            }
+                        }
+                        let mut out = [0.0; 4];
+                        if optical > 0.0 {
+                            let alpha = 1.0 - (-optical / (end - begin) as f32).exp();
+                            let c = colour / optical * alpha;
+                            out = [c.x, c.y, c.z, alpha];
+                        }
+                        any |= out[3] >= 0.5 / 255.0;
+                        arrays[d].push(out);
+                    }
+                }
+                occupancy.push(any as u32);
+            }
+        }
+    }
+    (arrays, occupancy)
+}

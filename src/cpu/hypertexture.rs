@@ -1,0 +1,196 @@
+//! CPU twin (f64) of `wgsl/shared/{fields,transfer,hypertexture}.wgsl`: soft objects, vector
+//! fields, table lookups, the hypertexture density (Gilet & Dischler 2009, eq. 3 to 5) and its
+//! colour, read from the same packed parameters the kernels read.
+
+use glam::{DVec2, DVec3, DVec4};
+
+use super::bake_transfer::TRANSFER_SIZE;
+use super::noise_simplex::{simplex3, simplex4};
+use crate::hypertexture::{
+    FIELD_CONSTANT, FIELD_FROM_CENTRE, FIELD_SWIRL, OBJECT_BOX, OBJECT_ELLIPSOID, OBJECT_TORUS,
+};
+use crate::types::{HyperNoise, HyperParams};
+
+/// Vectors shorter than this have no direction (mirrors `TINY`).
+pub const TINY: f64 = 1e-12;
+
+/// A packed hypertexture and its sampled transfer tables, as the kernels see them.
+#[derive(Clone, Copy)]
+pub struct Model<'a> {
+    pub params: &'a HyperParams,
+    pub noises: &'a [HyperNoise],
+    pub tables: &'a [f64],
+}
+
+fn v3(a: [f32; 4]) -> DVec3 {
+    DVec3::new(a[0] as f64, a[1] as f64, a[2] as f64)
+}
+
+pub fn unit_or_zero(v: DVec3) -> DVec3 {
+    let len = v.length();
+    if len > TINY {
+        v / len
+    } else {
+        DVec3::ZERO
+    }
+}
+
+/// Table `table` at `x`, linearly interpolated (clamped to [0, 1]).
+pub fn transfer_lookup(tables: &[f64], table: u32, x: f64) -> f64 {
+    let u = x.clamp(0.0, 1.0) * (TRANSFER_SIZE - 1) as f64;
+    let i = (u as usize).min(TRANSFER_SIZE - 2);
+    let base = table as usize * TRANSFER_SIZE + i;
+    let f = u - i as f64;
+    tables[base] * (1.0 - f) + tables[base + 1] * f
+}
+
+impl Model<'_> {
+    /// O(x), the soft object's density in [0, 1].
+    pub fn object_density(&self, x: DVec3) -> f64 {
+        let s = v3(self.params.object);
+        let d = match self.params.kinds[0] {
+            OBJECT_ELLIPSOID => 1.0 - (x / s).length(),
+            OBJECT_TORUS => 1.0 - DVec2::new(DVec2::new(x.x, x.y).length() - s.x, x.z).length() / s.y,
+            OBJECT_BOX => 1.0 - (x.abs() / s).max_element(),
+            _ => 1.0 - x.length() / s.x,
+        };
+        d.clamp(0.0, 1.0)
+    }
+
+    /// A lower bound of the distance from x to where the density is positive.
+    pub fn support_distance(&self, x: DVec3) -> f64 {
+        let s = v3(self.params.object);
+        match self.params.kinds[0] {
+            OBJECT_ELLIPSOID => ((x / s).length() - 1.0) * s.min_element(),
+            OBJECT_TORUS => DVec2::new(DVec2::new(x.x, x.y).length() - s.x, x.z).length() - s.y,
+            OBJECT_BOX => {
+                let q = x.abs() - s;
+                q.max(DVec3::ZERO).length() + q.max_element().min(0.0)
+            }
+            _ => x.length() - s.x,
+        }
+    }
+
+    /// The closest point of the object's boundary (ellipsoid: radial projection).
+    pub fn closest_surface_point(&self, x: DVec3) -> DVec3 {
+        let s = v3(self.params.object);
+        match self.params.kinds[0] {
+            OBJECT_ELLIPSOID => {
+                let k = (x / s).length();
+                if k > TINY {
+                    x / k
+                } else {
+                    x
+                }
+            }
+            OBJECT_TORUS => {
+                let r = DVec2::new(x.x, x.y).length();
+                let around = if r > TINY { DVec2::new(x.x, x.y) / r } else { DVec2::X };
+                let ring = DVec3::new(around.x * s.x, around.y * s.x, 0.0);
+                let q = x - ring;
+                let len = q.length();
+                if len > TINY {
+                    ring + q * (s.y / len)
+                } else {
+                    x
+                }
+            }
+            OBJECT_BOX => {
+                let a = x.abs();
+                if a.cmpgt(s).any() {
+                    return x.clamp(-s, s);
+                }
+                let gap = s - a;
+                let side = |c: f64| if c >= 0.0 { 1.0 } else { -1.0 };
+                let mut p = x;
+                if gap.x <= gap.y && gap.x <= gap.z {
+                    p.x = side(x.x) * s.x;
+                } else if gap.y <= gap.z {
+                    p.y = side(x.y) * s.y;
+                } else {
+                    p.z = side(x.z) * s.z;
+                }
+                p
+            }
+            _ => {
+                let len = x.length();
+                if len > TINY {
+                    x * (s.x / len)
+                } else {
+                    x
+                }
+            }
+        }
+    }
+
+    /// The unperturbed vector field.
+    pub fn base_field(&self, x: DVec3) -> DVec3 {
+        let c = self.closest_surface_point(x) - x;
+        let f = self.params.field;
+        match self.params.kinds[1] {
+            FIELD_FROM_CENTRE => {
+                let side = if self.object_density(x) > 0.0 { 1.0 } else { -1.0 };
+                unit_or_zero(x - v3(f)) * (side * c.length())
+            }
+            FIELD_CONSTANT => v3(f),
+            FIELD_SWIRL => {
+                let around = unit_or_zero(v3(f).cross(x - v3(self.params.field_center)));
+                c + around * (f[3] as f64 * c.length())
+            }
+            _ => c,
+        }
+    }
+
+    /// V(x), with the perturbation of direction and magnitude when it is on.
+    pub fn vector_field(&self, x: DVec3) -> DVec3 {
+        let mut v = self.base_field(x);
+        let p = self.params.perturb.map(|c| c as f64);
+        if p[1] > 0.0 {
+            let q = x * p[1];
+            let seed = self.params.kinds[3];
+            let n = DVec3::new(
+                simplex3(q, seed),
+                simplex3(q, seed.wrapping_add(1)),
+                simplex3(q, seed.wrapping_add(2)),
+            );
+            v = (v + n * (p[0] * v.length())) * (1.0 + p[2] * simplex3(q, seed.wrapping_add(3)));
+        }
+        v
+    }
+
+    /// The distortion factor k of eq. 5 at x, given V(x).
+    pub fn distortion(&self, x: DVec3, v: DVec3) -> f64 {
+        let mut k = 0.0;
+        let noises = &self.noises[..self.params.kinds[2] as usize];
+        let animated = crate::hypertexture::animated(noises);
+        let time = self.params.march[3] as f64;
+        for (i, n) in noises.iter().enumerate() {
+            let q = (x + v * n.shift as f64) * n.frequency as f64;
+            let noise = if animated {
+                simplex4(DVec4::new(q.x, q.y, q.z, n.speed as f64 * time), n.seed)
+            } else {
+                simplex3(q, n.seed)
+            };
+            let t = transfer_lookup(self.tables, i as u32, 0.5 + 0.5 * noise);
+            let a = n.amplitude as f64;
+            k = if n.blend != 0 { k * (1.0 - t) + a * t } else { k + a * t };
+        }
+        k
+    }
+
+    /// The hypertexture density O(x - k V/|V|); 0 without evaluating the noises farther than the
+    /// largest shift from the object.
+    pub fn hyper_density(&self, x: DVec3) -> f64 {
+        if self.support_distance(x) > self.params.march[2] as f64 {
+            return 0.0;
+        }
+        let v = self.vector_field(x);
+        self.object_density(x - unit_or_zero(v) * self.distortion(x, v))
+    }
+
+    /// Straight colour and opacity per opacity length at a density.
+    pub fn hyper_color(&self, density: f64) -> [f64; 4] {
+        let first = self.params.kinds[2];
+        std::array::from_fn(|c| transfer_lookup(self.tables, first + c as u32, density))
+    }
+}

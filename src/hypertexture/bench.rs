@@ -1,0 +1,159 @@
+//! `voltex bench-hyper`: the set-up of the paper's Figure 11 on the current adapter: one
+//! hypertexture (three noises) on three objects covering most of the window, HQ and IE steps, no
+//! shading, Phong, and Phong with shadow rays. Per setting: the median wall time of a frame after
+//! warm-up, the density evaluations the frame made and those that ran the noises (counted by the
+//! kernel: points farther than the largest shift from the object skip them), and the share of the
+//! frame that those noise evaluations alone would take at the rate `bench_simplex.wgsl` measures
+//! ("rate"), and the share measured directly ("A/B"): the same frame with the noises compiled out
+//! (override `noise_off`), timed in alternation, compared per density evaluation.
+//!
+//! Frames are timed by wall clock after `device.poll`: lavapipe's compute timestamps come back
+//! wrong once a render pass has run in the process, and every frame ends with raster passes.
+//! Only the segment strategy "enlarged bounds" exists so far (depth peeling and splats come later).
+
+use std::path::Path;
+use std::time::Instant;
+
+use crate::error::Result;
+use crate::gpu::kernel::ComputeKernel;
+use crate::gpu::GpuContext;
+use crate::graph::exec::Inputs;
+use crate::render::{Blueprint, Part, RenderOptions, Renderer};
+use crate::types::MarchState;
+
+/// Stand-ins for the paper's bunny, teapot and cube until meshes come: soft primitives (name,
+/// object, node rotation), each covering about 3/4 of the window.
+const OBJECTS: &[(&str, &str, &str)] = &[
+    ("sphere", "Sphere(radius: 1.0)", "(0.0, 0.0, 0.0)"),
+    ("torus", "Torus(major: 0.72, minor: 0.4)", "(60.0, 0.0, 0.0)"),
+    ("box", "Box(size: (1.3, 1.3, 1.3))", "(20.0, 0.0, 35.0)"),
+];
+const QUALITIES: &[&str] = &["HQ", "IE"];
+const SHADINGS: &[&str] = &["None", "Phong", "PhongShadows"];
+/// The hypertexture of every row: holes plus a two-octave turbulence.
+const NOISES: &str = "[(shape: Curve([(0.0, 0.0, 0.0), (0.2, 1.0, 0.0), (0.8, 1.0, 0.0), (1.0, 0.0, 0.0)]), \
+    amplitude: 0.15, frequency: 2.5, shift: 0.5), (shape: Table([1.0, 0.0, 1.0]), amplitude: 0.05, frequency: 6.0, \
+    shift: 0.5, seed: 1), (shape: Table([1.0, 0.0, 1.0]), amplitude: 0.025, frequency: 12.0, shift: 0.5, seed: 2)]";
+const NOISE_COUNT: f64 = 3.0;
+
+fn scene_text(object: &str, rotate: &str, quality: &str, shading: &str) -> String {
+    format!(
+        "Scene(output: (width: 512, height: 512), camera: (eye: (0.0, -2.5, 0.9), target: (0.0, 0.0, 0.0), \
+         fov_y: 40.0), ambient: 0.2, lights: [Directional(direction: (-0.5, 0.6, -0.7))], hypertextures: {{ \"h\": \
+         (object: {object}, noises: {NOISES}, color: Step(threshold: 0.35, color: (0.8, 0.72, 0.62)), \
+         opacity_length: 0.01) }}, nodes: [(name: \"object\", transform: (rotate: {rotate}), hypertexture: \"h\", \
+         method: RayMarch(quality: {quality}, shading: {shading}))])"
+    )
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
+}
+
+/// Simplex evaluations per second of `bench_simplex.wgsl` (wall clock, median of 5, after warm-up).
+pub fn noise_rate(ctx: &GpuContext) -> Result<f64> {
+    const PER_THREAD: u32 = 1024;
+    let threads = [4096u32, 16, 1];
+    let mut kernel = ComputeKernel::load(ctx, &crate::render::wgsl_root(), "bench_simplex.wgsl")?;
+    let mut inputs = Inputs::default();
+    let out = vec![0u8; (threads[0] * threads[1] * 4) as usize];
+    inputs.buffers.insert("bench_out".into(), crate::bake::storage(ctx, "bench_out", &out));
+    inputs.constants.push(("evaluations".into(), PER_THREAD as f64));
+    let mut times = Vec::new();
+    for i in 0..6 {
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        kernel.dispatch(ctx, &mut encoder, &inputs, threads)?;
+        let t = Instant::now();
+        ctx.queue.submit([encoder.finish()]);
+        ctx.wait()?;
+        if i > 0 {
+            times.push(t.elapsed().as_secs_f64());
+        }
+    }
+    ctx.take_errors()?;
+    Ok((threads[0] * threads[1] * PER_THREAD) as f64 / median(times))
+}
+
+/// Median frame time (ms, wall clock) and the density evaluations of the last frame (all, and
+/// those that ran the noises), for renderers timed in alternation (so load changes hit both).
+struct Timed {
+    renderer: Renderer,
+    times: Vec<f64>,
+}
+
+impl Timed {
+    fn counts(&self, ctx: &GpuContext) -> Result<(f64, f64, f64)> {
+        let r = &self.renderer;
+        let instance = r.blueprint.instances.iter().position(|p| p.1 == Part::RayMarch).unwrap_or(0);
+        let states: Vec<MarchState> =
+            bytemuck::pod_collect_to_vec(&r.read_instance_buffer(ctx, instance, "ray_march_state")?);
+        let evals: f64 = states.iter().map(|s| s.resume[1] as f64).sum();
+        let noised: f64 = states.iter().map(|s| s.resume[3] as f64).sum();
+        let covered = states.iter().filter(|s| s.color[3] > 0.5).count() as f64 / states.len().max(1) as f64;
+        Ok((evals, noised, covered))
+    }
+}
+
+pub fn run(size: (u32, u32), frames: usize, quick: bool) -> Result<()> {
+    let ctx = GpuContext::new()?;
+    let rate = noise_rate(&ctx)?;
+    println!(
+        "bench-hyper on {}: {size:?}, median of {frames} frame(s) after one warm-up; simplex noise alone: {:.0} M \
+         evaluations/s",
+        ctx.adapter_line(),
+        rate / 1e6
+    );
+    println!(
+        "\n| object | quality | step | shading | dispatches | coverage | frame ms (wall) | fps | M density evals | M \
+         noise evals | noise alone ms | noise share (rate) | noise share (A/B) |"
+    );
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+    let objects = if quick { &OBJECTS[..1] } else { OBJECTS };
+    for (name, object, rotate) in objects {
+        for quality in QUALITIES {
+            for shading in SHADINGS {
+                let text = scene_text(object, rotate, quality, shading);
+                let scene = crate::scene::parse(&text, Path::new("bench-hyper.ron"))?;
+                let opts = RenderOptions { size: Some(size), ..Default::default() };
+                let mut runs = Vec::new();
+                for noise in [true, false] {
+                    let mut bp = Blueprint::new(&scene, &opts)?;
+                    bp.objects.iter_mut().filter_map(|o| o.ray_march.as_mut()).for_each(|m| m.noise = noise);
+                    let mut renderer = Renderer::new(&ctx, bp)?;
+                    renderer.render_timed(&ctx)?;
+                    runs.push(Timed { renderer, times: Vec::new() });
+                }
+                for _ in 0..frames {
+                    for run in runs.iter_mut() {
+                        let t = Instant::now();
+                        run.renderer.render_timed(&ctx)?;
+                        run.times.push(t.elapsed().as_secs_f64() * 1e3);
+                    }
+                }
+                let plan = runs[0].renderer.blueprint.objects.iter().find_map(|o| o.ray_march.clone());
+                let plan = plan.expect("a RayMarch object");
+                let ms = median(runs[0].times.clone());
+                let ms_off = median(runs[1].times.clone());
+                let (evals, noised, covered) = runs[0].counts(&ctx)?;
+                let (evals_off, _, _) = runs[1].counts(&ctx)?;
+                let noise_ms = noised * NOISE_COUNT / rate * 1e3;
+                // Time per density evaluation with and without the noises.
+                let ab = 1.0 - (ms_off / evals_off) / (ms / evals);
+                println!(
+                    "| {name} | {quality} | {} | {shading} | {} | {:.0}% | {ms:.1} | {:.2} | {:.1} | {:.1} | {noise_ms:.1} | \
+                     {:.0}% | {:.0}% |",
+                    plan.step,
+                    plan.dispatches,
+                    covered * 100.0,
+                    1e3 / ms,
+                    evals / 1e6,
+                    noised * NOISE_COUNT / 1e6,
+                    100.0 * noise_ms / ms,
+                    100.0 * ab
+                );
+            }
+        }
+    }
+    Ok(())
+}

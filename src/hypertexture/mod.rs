@@ -1,0 +1,191 @@
+//! Hypertextures (Gilet & Dischler 2009) packed for the kernels: the soft object and vector field
+//! as `HyperParams` fields, one `HyperNoise` per noise, and every transfer function as control
+//! points that `bake_transfer.wgsl` samples into tables (the noises' shape tables first, then the
+//! red, green, blue and opacity tables of the colour transfer function).
+
+pub mod bench;
+
+use glam::DVec3;
+
+use crate::cpu::bake_transfer::{HERMITE, LINEAR, TRANSFER_SIZE};
+use crate::scene::hypertexture::{ColorTransfer, Field, Operator, ShapeTransfer, SoftObject};
+use crate::scene::Hypertexture;
+use crate::types::{HyperNoise, TransferFunction, TransferPoint};
+
+/// `HyperParams::kinds[0]` (mirrored in wgsl/shared/fields.wgsl).
+pub const OBJECT_SPHERE: u32 = 0;
+pub const OBJECT_ELLIPSOID: u32 = 1;
+pub const OBJECT_TORUS: u32 = 2;
+pub const OBJECT_BOX: u32 = 3;
+/// `HyperParams::kinds[1]`.
+pub const FIELD_CLOSEST_SURFACE: u32 = 0;
+pub const FIELD_FROM_CENTRE: u32 = 1;
+pub const FIELD_CONSTANT: u32 = 2;
+pub const FIELD_SWIRL: u32 = 3;
+
+/// The parts of `HyperParams` a hypertexture fixes (the camera, frame and march settings are
+/// added by `methods::ray_march`), its noises and its transfer functions.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Packed {
+    pub object: [f32; 4],
+    pub field: [f32; 4],
+    pub field_center: [f32; 4],
+    pub perturb: [f32; 4],
+    /// Object kind, field kind, noise count, perturbation seed.
+    pub kinds: [u32; 4],
+    pub noises: Vec<HyperNoise>,
+    pub functions: Vec<TransferFunction>,
+    pub points: Vec<TransferPoint>,
+    /// Object-space bounds enlarged by the largest shift.
+    pub bounds: (DVec3, DVec3),
+    pub opacity_length: f64,
+}
+
+fn f4(v: DVec3, w: f64) -> [f32; 4] {
+    [v.x as f32, v.y as f32, v.z as f32, w as f32]
+}
+
+pub fn pack(h: &Hypertexture) -> Packed {
+    let (kind, object) = match &h.object.value {
+        SoftObject::Sphere { radius } => (OBJECT_SPHERE, f4(DVec3::splat(*radius), 0.0)),
+        SoftObject::Ellipsoid { radii } => (OBJECT_ELLIPSOID, f4(*radii, 0.0)),
+        SoftObject::Torus { major, minor } => (OBJECT_TORUS, f4(DVec3::new(*major, *minor, 0.0), 0.0)),
+        SoftObject::Box { size } => (OBJECT_BOX, f4(*size * 0.5, 0.0)),
+    };
+    let mut p = Packed {
+        object,
+        field: [0.0; 4],
+        field_center: [0.0; 4],
+        perturb: [0.0; 4],
+        kinds: [kind, FIELD_CLOSEST_SURFACE, h.noises.len() as u32, 0],
+        noises: Vec::new(),
+        functions: Vec::new(),
+        points: Vec::new(),
+        bounds: h.bounds(),
+        opacity_length: h.opacity_length,
+    };
+    let base = match &h.field {
+        Field::Perturbed { field, amount, frequency, magnitude, seed } => {
+            p.perturb = [*amount as f32, *frequency as f32, *magnitude as f32, 0.0];
+            p.kinds[3] = *seed;
+            &field.value
+        }
+        f => f,
+    };
+    match base {
+        Field::FromCentre { center } => {
+            p.kinds[1] = FIELD_FROM_CENTRE;
+            p.field = f4(*center, 0.0);
+        }
+        Field::Constant { direction } => {
+            p.kinds[1] = FIELD_CONSTANT;
+            p.field = f4(*direction, 0.0);
+        }
+        Field::Swirl { axis, center, twist } => {
+            p.kinds[1] = FIELD_SWIRL;
+            p.field = f4(axis.normalize(), *twist);
+            p.field_center = f4(*center, 0.0);
+        }
+        // Validation refuses a perturbed field inside another.
+        Field::ClosestSurface | Field::Perturbed { .. } => {}
+    }
+    for n in h.noises.iter() {
+        p.noises.push(HyperNoise {
+            amplitude: n.amplitude as f32,
+            frequency: n.frequency as f32,
+            shift: n.shift as f32,
+            blend: (n.operator == Operator::Blend) as u32,
+            seed: n.seed,
+            speed: n.speed as f32,
+            _pad: [0; 2],
+        });
+        match &n.shape {
+            ShapeTransfer::Curve(points) => {
+                p.function(HERMITE, points.iter().map(|c| (c.0, c.1, c.2)));
+            }
+            ShapeTransfer::Table(values) => {
+                let last = (values.0.len() - 1).max(1) as f64;
+                p.function(LINEAR, values.0.iter().enumerate().map(|(i, &y)| (i as f64 / last, y, 0.0)));
+            }
+        }
+    }
+    match &h.color {
+        ColorTransfer::Ramp(points) => {
+            for c in 0..4 {
+                p.function(LINEAR, points.iter().map(|q| (q.0, q.1[c], 0.0)));
+            }
+        }
+        ColorTransfer::Step { threshold, color, opacity } => {
+            // Zero up to the table entry at or below the threshold, the value from the next one:
+            // the tables' linear filtering then blurs the step over 1/255 of density.
+            let cell = 1.0 / (TRANSFER_SIZE - 1) as f64;
+            let below = (threshold / cell).floor() * cell;
+            let values = [color[0] as f64, color[1] as f64, color[2] as f64, *opacity];
+            for value in values {
+                let mut pts = vec![(below, 0.0, 0.0), (below + cell, value, 0.0)];
+                if below > 0.0 {
+                    pts.insert(0, (0.0, 0.0, 0.0));
+                }
+                p.function(LINEAR, pts.into_iter());
+            }
+        }
+    }
+    p
+}
+
+/// Whether a hypertexture's noises are 4D (some noise has a speed): the kernels' override
+/// `animated`.
+pub fn animated(noises: &[HyperNoise]) -> bool {
+    noises.iter().any(|n| n.speed != 0.0)
+}
+
+impl Packed {
+    fn function(&mut self, kind: u32, points: impl Iterator<Item = (f64, f64, f64)>) {
+        let first = self.points.len() as u32;
+        self.points.extend(points.map(|(x, y, slope)| TransferPoint {
+            x: x as f32,
+            y: y as f32,
+            slope: slope as f32,
+            _pad: 0.0,
+        }));
+        let count = self.points.len() as u32 - first;
+        self.functions.push(TransferFunction { first, count, kind, _pad: 0 });
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cpu::bake_transfer::bake_transfer;
+
+    fn parse(text: &str) -> Hypertexture {
+        let scene = format!(
+            "Scene(output: (width: 8, height: 8), camera: (eye: (0, -3, 0), target: (0, 0, 0)), \
+             hypertextures: {{ \"h\": {text} }})"
+        );
+        crate::scene::parse(&scene, std::path::Path::new("t.ron")).unwrap().hypertextures["h"].clone()
+    }
+
+    /// A step colour transfer is transparent below its threshold and opaque from one table entry
+    /// above it; a Hermite curve passes through its control points.
+    #[test]
+    fn tables_follow_the_control_points() {
+        let h = parse(
+            "(object: Sphere(radius: 1.0), noises: [(shape: Curve([(0.0, 0.0, 0.0), (0.5, 1.0, 0.0), \
+             (1.0, 0.2, -1.0)]), amplitude: 0.1, frequency: 2.0)], color: Step(threshold: 0.3, \
+             color: (1.0, 0.5, 0.25), opacity: 0.8))",
+        );
+        let p = pack(&h);
+        assert_eq!(p.functions.len(), 5);
+        let t = bake_transfer(&p.functions, &p.points);
+        let at = |table: usize, x: f64| crate::cpu::hypertexture::transfer_lookup(&t, table as u32, x);
+        assert!(
+            (at(0, 0.5) - 1.0).abs() < 1e-3 && at(0, 0.0).abs() < 1e-9 && (at(0, 1.0) - 0.2).abs() < 1e-6
+        );
+        let cell = 1.0 / 255.0;
+        assert_eq!(at(4, 0.3 - cell), 0.0);
+        // (Control points are f32: the entry just past the step is 0.8 to 2e-6.)
+        assert!((at(4, 0.3 + cell) - 0.8).abs() < 1e-5 && (at(2, 0.9) - 0.5).abs() < 1e-6);
+        assert_eq!(p.bounds.1, DVec3::splat(1.1));
+    }
+}

@@ -1,0 +1,171 @@
+//! Host side of Meyer & Neyret's axis-aligned slicing (1998): per object the slicing parameters,
+//! the prisms sorted back to front and the buffers of `choose_axis_slices`, `scan_axis_slices`,
+//! `emit_axis_slices` and `draw_axis_slices`. The slice images come from `bake::axis_slices`.
+
+use crate::bake::axis_slices::AxisBaked;
+use crate::cpu::axis_slices::{self as twin, AxisFrame};
+use crate::error::{Error, Result};
+use crate::methods::shell::Shell;
+use crate::scene::{AxisSlices, SliceBlend, SliceDirections};
+use crate::types::{AxisParams, AxisVertex, Prism};
+
+/// Slice-vertex budget of one object: the storage-binding size every WebGPU adapter offers.
+pub const MAX_VERTEX_BYTES: u64 = 128 << 20;
+
+pub struct AxisPlan {
+    pub params: AxisParams,
+    /// The shell's prisms sorted back to front by centre distance (the draw order of texels).
+    pub prisms: Vec<Prism>,
+    /// Slice-vertex capacity: every prism at its finest level in its largest direction.
+    pub capacity: u64,
+    pub blended: bool,
+    pub method: AxisSlices,
+}
+
+impl AxisPlan {
+    /// `forward` is the camera's unit forward, `focal` the focal length in pixels.
+    pub fn new(
+        shell: &Shell,
+        m: &AxisSlices,
+        resolution: [u32; 3],
+        forward: [f32; 3],
+        focal: f64,
+        object: &str,
+    ) -> Result<Self> {
+        let directions = match m.directions {
+            SliceDirections::Three => 0b111,
+            SliceDirections::Horizontal => 0b100,
+        };
+        let mut params = AxisParams {
+            resolution: [resolution[0], resolution[1], resolution[2], shell.prisms.len() as u32],
+            criteria: [m.depth as f32, m.pixels as f32, m.max_angle.to_radians() as f32, focal as f32],
+            forward: [forward[0], forward[1], forward[2], 0.0],
+            flags: [directions, 0, m.back_face_culling as u32, m.empty_culling as u32],
+        };
+        let distance = |p: &Prism| {
+            let c = p.sphere;
+            c[0] * c[0] + c[1] * c[1] + c[2] * c[2]
+        };
+        let mut prisms = shell.prisms.clone();
+        prisms.sort_by(|a, b| distance(b).total_cmp(&distance(a)));
+        let sorted = Shell { vertices: shell.vertices.clone(), prisms: prisms.clone() };
+        let capacity: u64 = (0..prisms.len()).map(|i| finest_vertices(&sorted, i, &params)).sum();
+        let bytes = capacity * std::mem::size_of::<AxisVertex>() as u64;
+        if bytes > MAX_VERTEX_BYTES {
+            return Err(Error::Invalid(format!(
+                "object `{object}`: axis slices need up to {:.0} MiB of slice vertices, beyond the limit of {} \
+                 MiB per object; use a coarser texel or fewer uv tiles per triangle",
+                bytes as f64 / 1048576.0,
+                MAX_VERTEX_BYTES >> 20
+            )));
+        }
+        params.flags[1] = capacity.max(3) as u32;
+        Ok(Self {
+            params,
+            prisms,
+            capacity: capacity.max(3),
+            blended: m.blend == SliceBlend::Blended,
+            method: *m,
+        })
+    }
+
+    /// The prisms in draw order with the shell's vertices (what the kernels read).
+    pub fn shell(&self, shell: &Shell) -> Shell {
+        Shell { vertices: shell.vertices.clone(), prisms: self.prisms.clone() }
+    }
+}
+
+/// Upper bound of a prism's vertices: its finest level in whichever allowed direction has most.
+fn finest_vertices(shell: &Shell, index: usize, params: &AxisParams) -> u64 {
+    let f = AxisFrame::of_shell(shell, index);
+    (0..3)
+        .filter(|&d| params.flags[0] & (1 << d) != 0)
+        .map(|d| {
+            let r = params.resolution[d];
+            if d == 2 {
+                return 3 * r as u64;
+            }
+            let c = f.uv.map(|uv| uv[d]);
+            let (lo, hi) = (c[0].min(c[1]).min(c[2]), c[0].max(c[1]).max(c[2]));
+            let span = ((hi - lo) * r as f32).ceil() as u64 + 2;
+            6 * span.min(twin::MAX_PRISM_SLICES as u64)
+        })
+        .max()
+        .unwrap_or(0)
+}
+
+/// Adds the buffers, views and samplers of one object's axis slicing to `inputs`.
+pub fn add_inputs(
+    ctx: &crate::gpu::GpuContext,
+    inputs: &mut crate::graph::exec::Inputs,
+    shell: &Shell,
+    plan: &AxisPlan,
+    baked: &AxisBaked,
+) {
+    use crate::bake::{storage, uniform};
+    let buffer = |label: &str, size: u64, extra: wgpu::BufferUsages| {
+        ctx.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(label),
+            size: size.max(16),
+            usage: wgpu::BufferUsages::STORAGE
+                | wgpu::BufferUsages::COPY_DST
+                | wgpu::BufferUsages::COPY_SRC
+                | extra,
+            mapped_at_creation: false,
+        })
+    };
+    let b = &mut inputs.buffers;
+    b.insert("axis_params".into(), uniform(ctx, "axis_params", bytemuck::bytes_of(&plan.params)));
+    b.insert("shell_vertices".into(), storage(ctx, "shell_vertices", bytemuck::cast_slice(&shell.vertices)));
+    b.insert("prisms".into(), storage(ctx, "prisms", bytemuck::cast_slice(&plan.prisms)));
+    b.insert("axis_occupancy".into(), baked.occupancy.clone());
+    let choices = plan.prisms.len() as u64 * std::mem::size_of::<crate::types::AxisChoice>() as u64;
+    b.insert("axis_choices".into(), buffer("axis_choices", choices, wgpu::BufferUsages::empty()));
+    b.insert("axis_draw_args".into(), buffer("axis_draw_args", 16, wgpu::BufferUsages::INDIRECT));
+    let bytes = plan.capacity * std::mem::size_of::<AxisVertex>() as u64;
+    b.insert("axis_vertices".into(), buffer("axis_vertices", bytes, wgpu::BufferUsages::empty()));
+    for (name, t) in ["axis_slices_s", "axis_slices_t", "axis_slices_w"].iter().zip(&baked.arrays) {
+        let view = t.create_view(&wgpu::TextureViewDescriptor {
+            dimension: Some(wgpu::TextureViewDimension::D2Array),
+            ..Default::default()
+        });
+        inputs.views.insert(name.to_string(), view);
+    }
+    let sampler = |label: &str, v: wgpu::AddressMode| {
+        ctx.device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some(label),
+            address_mode_u: wgpu::AddressMode::Repeat,
+            address_mode_v: v,
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            ..Default::default()
+        })
+    };
+    inputs.samplers.insert("axis_sampler".into(), sampler("axis_sampler", wgpu::AddressMode::Repeat));
+    inputs
+        .samplers
+        .insert("axis_sampler_side".into(), sampler("axis_sampler_side", wgpu::AddressMode::ClampToEdge));
+    inputs.counts.insert("prisms".into(), plan.prisms.len() as u32);
+    inputs.constants.push(("blended_slices".into(), plan.blended as u32 as f64));
+}
+
+/// Reads back the per-prism choices and the drawn vertices after a frame (tests, `bench`).
+pub fn read_back(
+    ctx: &crate::gpu::GpuContext,
+    inputs: &crate::graph::exec::Inputs,
+    prisms: usize,
+) -> Result<(Vec<crate::types::AxisChoice>, Vec<AxisVertex>)> {
+    let choices = ctx.read_buffer(&inputs.buffers["axis_choices"], 0, (prisms * 32) as u64)?;
+    let args = ctx.read_buffer(&inputs.buffers["axis_draw_args"], 0, 16)?;
+    let drawn = bytemuck::pod_read_unaligned::<u32>(&args[..4]) as u64;
+    let vertices = if drawn > 0 {
+        ctx.read_buffer(
+            &inputs.buffers["axis_vertices"],
+            0,
+            drawn * std::mem::size_of::<AxisVertex>() as u64,
+        )?
+    } else {
+        Vec::new()
+    };
+    Ok((bytemuck::pod_collect_to_vec(&choices), bytemuck::pod_collect_to_vec(&vertices)))
+}

@@ -1,0 +1,229 @@
+//! Host side of the `RayMarch` method (hypertextures, Gilet & Dischler 2009): per object, the
+//! packed hypertexture with the camera and march settings (`HyperParams`), its transfer functions
+//! for `bake_transfer.wgsl`, and how many dispatches of `ray_march.wgsl` a frame needs so that
+//! every ray finishes while no dispatch exceeds its work budget.
+
+use glam::{DMat4, DVec3};
+
+use crate::cpu::bake_transfer::TRANSFER_SIZE;
+use crate::cpu::ray_march::Shade;
+use crate::error::{Error, Result};
+use crate::gpu::GpuContext;
+use crate::graph::exec::Inputs;
+use crate::hypertexture::{self, Packed};
+use crate::scene::hypertexture::diagonal;
+use crate::scene::{Hypertexture, RayMarch, Shading};
+use crate::types::{HyperParams, MarchState};
+
+/// Loop iterations one invocation may run per dispatch. Lavapipe silently ends every loop of an
+/// invocation after 65535 iterations in all; a density evaluation costs one iteration per noise
+/// plus one of the sample or shadow loop around it.
+pub const LOOP_BUDGET: u32 = 48_000;
+/// Most samples of one shadow ray (its step grows when the bounds are longer).
+pub const MAX_SHADOW_SAMPLES: u32 = 256;
+/// More dispatches than this means a step far finer than the scene needs.
+pub const MAX_DISPATCHES: u32 = 20_000;
+
+/// The camera as the kernels see it (see `ReferenceParams`).
+#[derive(Debug, Clone, Copy)]
+pub struct Camera {
+    pub eye: DVec3,
+    /// Right and up scaled by the half extents of the image at unit distance.
+    pub right: DVec3,
+    pub up: DVec3,
+    pub near: f64,
+    pub far: f64,
+}
+
+/// One RayMarch object of a frame.
+#[derive(Debug, Clone)]
+pub struct RayMarchPlan {
+    pub hypertexture: String,
+    pub packed: Packed,
+    pub params: HyperParams,
+    pub shade: Shade,
+    pub step: f64,
+    pub shadow_step: f64,
+    /// Dispatches of `ray_march.wgsl` per frame.
+    pub dispatches: u32,
+    /// World-space corners of the enlarged bounds.
+    pub corners: [DVec3; 8],
+    /// Benchmarks: `false` compiles the noises out (override `noise_off`).
+    pub noise: bool,
+}
+
+/// `name`: the object's; `node`: its hypertexture's name and frame.
+pub fn plan(
+    name: &str,
+    node: &crate::scene::HyperNode,
+    h: &Hypertexture,
+    method: &RayMarch,
+    camera: &Camera,
+    time: f64,
+) -> Result<RayMarchPlan> {
+    let packed = hypertexture::pack(h);
+    let to_world = &node.to_world;
+    let corners = h.world_corners(to_world);
+    let diagonal = diagonal(&corners);
+    let step = method.step();
+    let shadow_step = method.shadow_step.unwrap_or(2.0 * step);
+    let shade =
+        Shade { phong: method.shading != Shading::None, shadows: method.shading == Shading::PhongShadows };
+    let evals = LOOP_BUDGET / (packed.noises.len() as u32 + 1);
+    let shadow_samples = ((diagonal / shadow_step).ceil() as u32).clamp(1, MAX_SHADOW_SAMPLES);
+    let worst = 1 + 6 * shade.phong as u32 + shadow_samples * shade.shadows as u32;
+    // Every unfinished ray advances at least `evals / worst` samples per dispatch.
+    let samples = (diagonal / step).ceil() + 1.0;
+    let dispatches = (samples / (evals / worst) as f64).ceil() + 1.0;
+    if dispatches > MAX_DISPATCHES as f64 {
+        return Err(Error::Invalid(format!(
+            "object \"{name}\": a RayMarch step of {step} needs {dispatches} dispatches per frame (at most \
+             {MAX_DISPATCHES}): use a larger `step`"
+        )));
+    }
+    // Camera-relative world to the node's frame.
+    let to_local = (to_world.inverse() * DMat4::from_translation(camera.eye)).as_mat4();
+    let (lo, hi) = packed.bounds;
+    let params = HyperParams {
+        to_local: to_local.to_cols_array_2d(),
+        right: [camera.right.x as f32, camera.right.y as f32, camera.right.z as f32, camera.near as f32],
+        up: [camera.up.x as f32, camera.up.y as f32, camera.up.z as f32, camera.far as f32],
+        bounds_min: [lo.x as f32, lo.y as f32, lo.z as f32, step as f32],
+        bounds_max: [hi.x as f32, hi.y as f32, hi.z as f32, packed.opacity_length as f32],
+        object: packed.object,
+        field: packed.field,
+        field_center: packed.field_center,
+        perturb: packed.perturb,
+        kinds: packed.kinds,
+        march: [shadow_step as f32, step as f32, (h.max_shift() * (1.0 + 1e-4) + 1e-6) as f32, time as f32],
+        budget: [evals, shadow_samples, worst, 0],
+    };
+    Ok(RayMarchPlan {
+        hypertexture: node.name.clone(),
+        packed,
+        params,
+        shade,
+        step,
+        shadow_step,
+        dispatches: dispatches as u32,
+        corners,
+        noise: true,
+    })
+}
+
+impl RayMarchPlan {
+    /// Values of the kernel's override constants.
+    pub fn constants(&self) -> Vec<(String, f64)> {
+        let mut c = vec![
+            ("phong".into(), self.shade.phong as u32 as f64),
+            ("shadows".into(), self.shade.shadows as u32 as f64),
+        ];
+        if !self.noise {
+            c.push(("noise_off".into(), 1.0));
+        }
+        if hypertexture::animated(&self.packed.noises) {
+            c.push(("animated".into(), 1.0));
+        }
+        c
+    }
+
+    /// The method as written in metadata and `voltex plan`.
+    pub fn describe(&self) -> String {
+        let shading = match (self.shade.phong, self.shade.shadows) {
+            (false, _) => "None",
+            (true, false) => "Phong",
+            (true, true) => "PhongShadows",
+        };
+        format!("RayMarch(step: {:.6}, shading: {shading}, shadow_step: {:.6})", self.step, self.shadow_step)
+    }
+
+    /// GPU bytes of the object's buffers (state per pixel included).
+    pub fn bytes(&self, size: (u32, u32)) -> u64 {
+        (std::mem::size_of::<HyperParams>()
+            + self.packed.noises.len() * 32
+            + self.packed.points.len() * 16
+            + self.packed.functions.len() * (16 + 4 * TRANSFER_SIZE)) as u64
+            + size.0 as u64 * size.1 as u64 * std::mem::size_of::<MarchState>() as u64
+    }
+
+    /// Buffers, counts and constants of the object's graph instance.
+    pub fn add_inputs(&self, ctx: &GpuContext, inputs: &mut Inputs, size: (u32, u32)) {
+        use crate::bake::{storage, uniform};
+        inputs.counts.insert("ray_march_dispatches".into(), self.dispatches);
+        inputs.counts.insert("transfer_functions".into(), self.packed.functions.len() as u32);
+        inputs.constants.extend(self.constants());
+        let b = &mut inputs.buffers;
+        b.insert("hyper".into(), uniform(ctx, "hyper", bytemuck::bytes_of(&self.params)));
+        b.insert(
+            "hyper_noises".into(),
+            storage(ctx, "hyper_noises", bytemuck::cast_slice(&self.packed.noises)),
+        );
+        b.insert(
+            "transfer_points".into(),
+            storage(ctx, "transfer_points", bytemuck::cast_slice(&self.packed.points)),
+        );
+        b.insert(
+            "transfer_functions".into(),
+            storage(ctx, "transfer_functions", bytemuck::cast_slice(&self.packed.functions)),
+        );
+        let words = self.packed.functions.len() * TRANSFER_SIZE;
+        for (name, bytes) in [
+            ("transfer_tables", words as u64 * 4),
+            ("ray_march_state", size.0 as u64 * size.1 as u64 * std::mem::size_of::<MarchState>() as u64),
+        ] {
+            let buffer = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(name),
+                size: bytes,
+                usage: wgpu::BufferUsages::STORAGE
+                    | wgpu::BufferUsages::COPY_DST
+                    | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            });
+            b.insert(name.into(), buffer);
+        }
+    }
+}
+
+/// What `probe_hypertexture.wgsl` returns: the transfer tables as `bake_transfer.wgsl` filled
+/// them, and four vectors per point (see the kernel).
+pub struct Probed {
+    pub tables: Vec<f32>,
+    pub values: Vec<[f32; 4]>,
+}
+
+/// Runs `bake_transfer.wgsl` and then `probe_hypertexture.wgsl` at `points` (object space; w: a
+/// noise seed as f32 bits) for this object: the kernels' side of the twin tests.
+pub fn probe(ctx: &GpuContext, plan: &RayMarchPlan, points: &[[f32; 4]]) -> Result<Probed> {
+    use crate::bake::storage;
+    use crate::gpu::kernel::ComputeKernel;
+    let root = crate::render::wgsl_root();
+    let mut inputs = Inputs::default();
+    plan.add_inputs(ctx, &mut inputs, (1, 1));
+    let b = &mut inputs.buffers;
+    b.insert("probe_points".into(), storage(ctx, "probe_points", bytemuck::cast_slice(points)));
+    let zeros = vec![0u8; points.len() * 64];
+    b.insert("probe_values".into(), storage(ctx, "probe_values", &zeros));
+    let mut encoder = ctx.device.create_command_encoder(&Default::default());
+    let functions = plan.packed.functions.len() as u32;
+    ComputeKernel::load(ctx, &root, "bake_transfer.wgsl")?.dispatch(
+        ctx,
+        &mut encoder,
+        &inputs,
+        [TRANSFER_SIZE as u32, functions, 1],
+    )?;
+    ComputeKernel::load(ctx, &root, "probe_hypertexture.wgsl")?.dispatch(
+        ctx,
+        &mut encoder,
+        &inputs,
+        [points.len() as u32, 1, 1],
+    )?;
+    ctx.queue.submit([encoder.finish()]);
+    let read = |name: &str| {
+        let buffer = &inputs.buffers[name];
+        ctx.read_buffer(buffer, 0, buffer.size())
+    };
+    let tables = bytemuck::pod_collect_to_vec(&read("transfer_tables")?);
+    let values = bytemuck::pod_collect_to_vec(&read("probe_values")?);
+    ctx.take_errors()?;
+    Ok(Probed { tables, values })
+}

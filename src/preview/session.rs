@@ -1,0 +1,111 @@
+//! The preview's reload machinery, without a window: a scene file turned into a renderer, rebuilt
+//! on demand through a [`GpuCache`] so that an edit re-makes only what it changed, and the last
+//! good renderer kept (and shown) whenever a rebuild fails.
+
+use std::path::{Path, PathBuf};
+
+use crate::gpu::cache::{CacheStats, GpuCache};
+use crate::gpu::GpuContext;
+use crate::render::{default_graph, wgsl_root, Blueprint, Frame, RenderOptions, Renderer};
+use crate::scene::{self, Scene};
+use crate::Result;
+
+/// What a rebuild did.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Outcome {
+    /// A new renderer is current; what it had to create (modules, pipelines, bakes).
+    Rebuilt(CacheStats),
+    /// The last good renderer stays; the error, with `file:line:col` where there is one.
+    Failed(String),
+}
+
+pub struct Session {
+    pub scene_path: PathBuf,
+    /// Overrides (size, graph, methods, camera) applied on every rebuild.
+    pub options: RenderOptions,
+    cache: GpuCache,
+    scene: Option<Scene>,
+    renderer: Option<Renderer>,
+    /// The current error (cleared by a successful rebuild).
+    pub error: Option<String>,
+    /// The last error printed, so each distinct error is logged once.
+    logged: Option<String>,
+}
+
+impl Session {
+    /// Builds the first renderer; a failure leaves the session without one and with `error` set.
+    pub fn open(ctx: &GpuContext, scene_path: &Path, options: RenderOptions) -> Self {
+        let mut s = Session {
+            scene_path: scene_path.to_path_buf(),
+            options,
+            cache: GpuCache::default(),
+            scene: None,
+            renderer: None,
+            error: None,
+            logged: None,
+        };
+        s.rebuild(ctx);
+        s
+    }
+
+    /// Reloads the scene, graph and kernels and makes a renderer, reusing whatever is unchanged.
+    pub fn rebuild(&mut self, ctx: &GpuContext) -> Outcome {
+        self.cache.begin();
+        let built = scene::load(&self.scene_path).and_then(|scene| {
+            let bp = Blueprint::new(&scene, &self.options)?;
+            let renderer = Renderer::with_cache(ctx, bp, &mut self.cache)?;
+            Ok((scene, renderer))
+        });
+        match built {
+            Ok((scene, renderer)) => {
+                self.cache.retain_used();
+                self.scene = Some(scene);
+                self.renderer = Some(renderer);
+                self.error = None;
+                self.logged = None;
+                Outcome::Rebuilt(self.cache.stats)
+            }
+            Err(e) => {
+                let msg = e.to_string();
+                if self.logged.as_deref() != Some(&msg) {
+                    eprintln!("error: {msg}");
+                    self.logged = Some(msg.clone());
+                }
+                self.error = Some(msg.clone());
+                Outcome::Failed(msg)
+            }
+        }
+    }
+
+    /// Renders a frame with the last good renderer (`None` before any build succeeded).
+    pub fn render(&mut self, ctx: &GpuContext) -> Option<Result<Frame>> {
+        self.renderer.as_mut().map(|r| r.render(ctx))
+    }
+
+    pub fn renderer(&self) -> Option<&Renderer> {
+        self.renderer.as_ref()
+    }
+
+    pub fn scene(&self) -> Option<&Scene> {
+        self.scene.as_ref()
+    }
+
+    /// Folders to watch, recursively: the scene's folder, those of the files it refers to, the
+    /// graph's folder and the WGSL root (editors save by renaming, so files are not watched alone).
+    pub fn watch_dirs(&self) -> Vec<PathBuf> {
+        let parent = |p: &Path| p.parent().map(Path::to_path_buf).unwrap_or_else(|| PathBuf::from("."));
+        let graph = self.options.graph.clone().unwrap_or_else(default_graph);
+        let mut dirs = vec![parent(&self.scene_path), parent(&graph), wgsl_root()];
+        if let Some(scene) = &self.scene {
+            dirs.extend(scene.asset_paths().iter().map(|p| parent(p)));
+        }
+        let mut canonical: Vec<PathBuf> =
+            dirs.into_iter().map(|d| std::fs::canonicalize(&d).unwrap_or(d)).collect();
+        canonical.sort();
+        canonical.dedup();
+        // A folder inside another watched one is covered by the recursive watch.
+        let all = canonical.clone();
+        canonical.retain(|d| !all.iter().any(|o| o != d && d.starts_with(o)));
+        canonical
+    }
+}

@@ -1,0 +1,301 @@
+//! Scene types of hypertextures (Gilet & Dischler 2009, section 4): a soft object, a vector field,
+//! noises filtered by shape transfer functions, and an RGBA transfer function on density. Value
+//! ranges are checked while parsing; list lengths and control-point order by [`check`] (positioned
+//! through [`Mark`]s).
+
+use glam::{DMat4, DVec3};
+use serde::Deserialize;
+
+use super::values::{self as v, Mark};
+
+/// Most noises one hypertexture combines.
+pub const MAX_NOISES: usize = 8;
+/// Most control points of a curve or ramp.
+pub const MAX_POINTS: usize = 64;
+/// Most values of a sampled table.
+pub const MAX_TABLE: usize = 256;
+
+/// `hypertextures: { "name": (object: .., field: .., noises: [..], color: ..) }`.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Hypertexture {
+    pub object: Mark<SoftObject>,
+    #[serde(default)]
+    pub field: Field,
+    /// Combined in order into the distortion factor k (eq. 5); 1 to [`MAX_NOISES`].
+    pub noises: Mark<Vec<Noise>>,
+    /// Colour and opacity by density.
+    pub color: ColorTransfer,
+    /// World length over which the transfer function's opacity is reached.
+    #[serde(default = "default_opacity_length", deserialize_with = "v::positive")]
+    pub opacity_length: f64,
+}
+
+fn default_opacity_length() -> f64 {
+    0.05
+}
+
+/// Soft objects in their node's frame: density 1 at the core falling linearly to 0 on the boundary.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum SoftObject {
+    /// `1 - |x| / radius`.
+    Sphere {
+        #[serde(deserialize_with = "v::positive")]
+        radius: f64,
+    },
+    /// `1 - |x / radii|`.
+    Ellipsoid {
+        #[serde(deserialize_with = "v::positive3")]
+        radii: DVec3,
+    },
+    /// Axis z: `1 - (distance to the core circle of radius major) / minor`.
+    Torus {
+        #[serde(deserialize_with = "v::positive")]
+        major: f64,
+        #[serde(deserialize_with = "v::positive")]
+        minor: f64,
+    },
+    /// Edge lengths `size`, centred: `1 - max_i |x_i| / (size_i / 2)`.
+    Box {
+        #[serde(deserialize_with = "v::positive3")]
+        size: DVec3,
+    },
+}
+
+impl SoftObject {
+    /// Where the density can be positive: (min, max) in the node's frame.
+    pub fn bounds(&self) -> (DVec3, DVec3) {
+        let h = match self {
+            SoftObject::Sphere { radius } => DVec3::splat(*radius),
+            SoftObject::Ellipsoid { radii } => *radii,
+            SoftObject::Torus { major, minor } => DVec3::new(major + minor, major + minor, *minor),
+            SoftObject::Box { size } => *size * 0.5,
+        };
+        (-h, h)
+    }
+}
+
+/// The vector field V of eq. 3 and 4 (the paper's Figure 8).
+#[derive(Debug, Clone, Default, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum Field {
+    /// Towards the closest point of the object's boundary (`x + V` lies on it).
+    #[default]
+    ClosestSurface,
+    /// Away from `center` inside the object (towards it outside), with the length of the
+    /// closest-surface vector: the closest-surface field of a sphere seen from a shifted centre.
+    FromCentre {
+        #[serde(deserialize_with = "v::vec3")]
+        center: DVec3,
+    },
+    /// The same vector everywhere (its length matters where noises are shifted by it).
+    Constant {
+        #[serde(deserialize_with = "v::direction")]
+        direction: DVec3,
+    },
+    /// The closest-surface vector plus `twist` times its length around `axis` (through `center`).
+    Swirl {
+        #[serde(default = "z_axis", deserialize_with = "v::direction")]
+        axis: DVec3,
+        #[serde(default, deserialize_with = "v::vec3")]
+        center: DVec3,
+        #[serde(default = "one", deserialize_with = "v::finite")]
+        twist: f64,
+    },
+    /// Another field (not itself perturbed) with its direction perturbed by a vector noise of
+    /// `amount` times its length and its length scaled by `1 + magnitude * noise`, noises at
+    /// `frequency` (cycles per unit of the node's frame).
+    Perturbed {
+        field: Box<Mark<Field>>,
+        #[serde(default = "half", deserialize_with = "v::non_negative")]
+        amount: f64,
+        #[serde(deserialize_with = "v::positive")]
+        frequency: f64,
+        #[serde(default, deserialize_with = "v::unit")]
+        magnitude: f64,
+        #[serde(default)]
+        seed: u32,
+    },
+}
+
+fn z_axis() -> DVec3 {
+    DVec3::Z
+}
+fn one() -> f64 {
+    1.0
+}
+fn half() -> f64 {
+    0.5
+}
+
+/// One noise of eq. 5: `t = T((1 + noise(frequency (x + shift V))) / 2)`, added to k as
+/// `amplitude t` (Sum) or blended over it, `k (1 - t) + amplitude t` (Blend).
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Noise {
+    pub shape: ShapeTransfer,
+    /// The largest shift (world depth of the detail, in the node's frame).
+    #[serde(deserialize_with = "v::non_negative")]
+    pub amplitude: f64,
+    /// Noise cycles per unit: larger is smaller detail.
+    #[serde(deserialize_with = "v::positive")]
+    pub frequency: f64,
+    /// r: how far along V the noise is evaluated (0: at x; 1: at x + V).
+    #[serde(default, deserialize_with = "v::unit")]
+    pub shift: f64,
+    #[serde(default)]
+    pub operator: Operator,
+    #[serde(default)]
+    pub seed: u32,
+    /// Animation: noise cycles per second along time (4D noise; 0: still).
+    #[serde(default, deserialize_with = "v::finite")]
+    pub speed: f64,
+}
+
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
+pub enum Operator {
+    #[default]
+    Sum,
+    Blend,
+}
+
+/// A 1D shape transfer function on [0, 1] with values in [0, 1].
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+pub enum ShapeTransfer {
+    /// Control points `(x, y, slope)` joined by cubic Hermite segments (clamped to [0, 1]);
+    /// constant beyond the first and last points.
+    Curve(Mark<Vec<Mark<CurvePoint>>>),
+    /// Values at evenly spaced x from 0 to 1, joined linearly.
+    Table(Mark<TableValues>),
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+pub struct CurvePoint(
+    #[serde(deserialize_with = "v::unit")] pub f64,
+    #[serde(deserialize_with = "v::unit")] pub f64,
+    #[serde(deserialize_with = "v::finite")] pub f64,
+);
+
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(transparent)]
+pub struct TableValues(#[serde(deserialize_with = "v::unit_list")] pub Vec<f64>);
+
+/// Colour (linear rgb) and opacity per opacity length, by density.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+pub enum ColorTransfer {
+    /// Control points `(density, (r, g, b, a))` joined linearly.
+    Ramp(Mark<Vec<Mark<RampPoint>>>),
+    /// Transparent below `threshold`, `color` and `opacity` from it on: an iso-surface look.
+    Step {
+        #[serde(deserialize_with = "v::unit")]
+        threshold: f64,
+        #[serde(deserialize_with = "v::color")]
+        color: [f32; 3],
+        #[serde(default = "one", deserialize_with = "v::unit")]
+        opacity: f64,
+    },
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+pub struct RampPoint(
+    #[serde(deserialize_with = "v::unit")] pub f64,
+    #[serde(deserialize_with = "v::rgba")] pub [f64; 4],
+);
+
+impl Hypertexture {
+    /// The largest shift `k` can reach: the sum of the amplitudes (Blend never exceeds it).
+    pub fn max_shift(&self) -> f64 {
+        self.noises.iter().map(|n| n.amplitude).sum()
+    }
+
+    /// The object's bounds enlarged by the largest shift, so no detail is clipped.
+    pub fn bounds(&self) -> (DVec3, DVec3) {
+        let (lo, hi) = self.object.bounds();
+        let a = DVec3::splat(self.max_shift());
+        (lo - a, hi + a)
+    }
+
+    /// The eight corners of the enlarged bounds through `to_world`.
+    pub fn world_corners(&self, to_world: &DMat4) -> [DVec3; 8] {
+        let (lo, hi) = self.bounds();
+        std::array::from_fn(|i| {
+            let pick = |bit: usize, a: f64, b: f64| if i & bit == 0 { a } else { b };
+            to_world.transform_point3(DVec3::new(
+                pick(1, lo.x, hi.x),
+                pick(2, lo.y, hi.y),
+                pick(4, lo.z, hi.z),
+            ))
+        })
+    }
+}
+
+/// The length of the diagonal of the box holding `corners`: no ray crosses the bounds on a
+/// longer stretch.
+pub fn diagonal(corners: &[DVec3]) -> f64 {
+    let lo = corners.iter().fold(DVec3::INFINITY, |a, &c| a.min(c));
+    let hi = corners.iter().fold(DVec3::NEG_INFINITY, |a, &c| a.max(c));
+    (hi - lo).length()
+}
+
+/// Checks that need whole lists: counts, control-point order. Each failure is (mark, message).
+pub(super) fn check(h: &Hypertexture, fail: &mut dyn FnMut(usize, String)) {
+    if let SoftObject::Torus { major, minor } = &h.object.value {
+        if minor >= major {
+            fail(h.object.seq, format!("expected a torus minor radius below the major radius ({major})"));
+        }
+    }
+    if let Field::Perturbed { field, .. } = &h.field {
+        if matches!(field.value, Field::Perturbed { .. }) {
+            fail(
+                field.seq,
+                "expected ClosestSurface, FromCentre, Constant or Swirl: a perturbed field is perturbed once"
+                    .into(),
+            );
+        }
+    }
+    let n = h.noises.len();
+    if n == 0 || n > MAX_NOISES {
+        fail(h.noises.seq, format!("expected 1 to {MAX_NOISES} noises, found {n}"));
+    }
+    for noise in h.noises.iter() {
+        match &noise.shape {
+            ShapeTransfer::Curve(points) => {
+                check_points(points, MAX_POINTS, |p| p.0, "curve", fail);
+            }
+            ShapeTransfer::Table(values) => {
+                let n = values.0.len();
+                if !(2..=MAX_TABLE).contains(&n) {
+                    fail(values.seq, format!("expected a table of 2 to {MAX_TABLE} values, found {n}"));
+                }
+            }
+        }
+    }
+    if let ColorTransfer::Ramp(points) = &h.color {
+        check_points(points, MAX_POINTS, |p| p.0, "ramp", fail);
+    }
+}
+
+fn check_points<T>(
+    points: &Mark<Vec<Mark<T>>>,
+    max: usize,
+    x: impl Fn(&T) -> f64,
+    what: &str,
+    fail: &mut dyn FnMut(usize, String),
+) {
+    let n = points.len();
+    if !(2..=max).contains(&n) {
+        fail(points.seq, format!("expected a {what} of 2 to {max} control points, found {n}"));
+        return;
+    }
+    for w in points.windows(2) {
+        let (a, b) = (x(&w[0]), x(&w[1]));
+        if b <= a {
+            let how = if b == a { "repeats" } else { "comes before" };
+            fail(
+                w[1].seq,
+                format!("control point at x = {b} {how} the previous one (x = {a}): expected control points sorted by x, each x once"),
+            );
+        }
+    }
+}

@@ -1,0 +1,413 @@
+//! Axis-aligned slicing (Meyer & Neyret 1998): the direction choice and slice counts at known
+//! angles (CPU twin), the kernels against their twins on the same inputs, the slice-image bake
+//! against its twin, brightness independent of the level, the error against the reference at a
+//! grazing view with three directions and with horizontal slices only, and bad knobs.
+
+use std::path::{Path, PathBuf};
+use std::sync::{Mutex, OnceLock};
+
+use glam::{Vec2, Vec3};
+use voltex::bake::{BakeRequest, BakeSource, Baker};
+use voltex::cpu::axis_slices::{self as twin, AxisFrame};
+use voltex::cpu::bake::{pack_shapes, Shape};
+use voltex::gpu::GpuContext;
+use voltex::io::Image;
+use voltex::render::{Blueprint, MethodKind, Part, RenderOptions, Renderer};
+use voltex::scene;
+use voltex::types::AxisParams;
+
+fn ctx() -> &'static Mutex<GpuContext> {
+    static CTX: OnceLock<Mutex<GpuContext>> = OnceLock::new();
+    CTX.get_or_init(|| {
+        Mutex::new(GpuContext::new().expect("a GPU adapter (software Vulkan: mesa-vulkan-drivers)"))
+    })
+}
+
+fn example(name: &str) -> PathBuf {
+    voltex::project_root().join("scenes/meyer_neyret").join(name)
+}
+
+/// Parameters; a tiny `pixels` leaves criterion 1 alone, a tiny `depth` criterion 2.
+fn params(res: [u32; 3], depth: f32, pixels: f32, max_angle_deg: f32, focal: f32) -> AxisParams {
+    AxisParams {
+        resolution: [res[0], res[1], res[2], 1],
+        criteria: [depth, pixels, max_angle_deg.to_radians(), focal],
+        forward: [0.0, 0.0, -1.0, 0.0],
+        flags: [0b111, 1 << 20, 0, 0],
+    }
+}
+
+/// A unit square's first triangle (uv = xy, height 1 along z) centred `distance` from the eye,
+/// seen at `angle` degrees from its normal (the view in the yz plane).
+fn unit_prism(angle: f32, distance: f32) -> AxisFrame {
+    let a = angle.to_radians();
+    // The eye at the origin looks along v at the prism's centre, (1/3, 1/3, 1/2) of the prism.
+    let v = Vec3::new(0.0, a.sin(), -a.cos());
+    let offset = v * distance - Vec3::new(1.0 / 3.0, 1.0 / 3.0, 0.5);
+    let bottom = [Vec3::ZERO, Vec3::X, Vec3::Y].map(|p| p + offset);
+    let top = bottom.map(|p| p + Vec3::Z);
+    AxisFrame::new(bottom, top, [Vec2::ZERO, Vec2::X, Vec2::Y])
+}
+
+#[test]
+fn direction_choice_at_known_angles() {
+    // Cubic voxels: the set most facing the view wins; ties go to the horizontal set.
+    let p = params([64, 64, 64], 1.0, 1e6, 89.0, 1.0);
+    let dir = |angle: f32, p: &AxisParams| twin::choose_axis(&unit_prism(angle, 10.0), p).direction;
+    assert_eq!(dir(0.0, &p), 2);
+    assert_eq!(dir(40.0, &p), 2);
+    assert_eq!(dir(50.0, &p), 1, "past 45 degrees the t set (normal along y) faces the view more");
+    assert_eq!(dir(85.0, &p), 1);
+    // 16 horizontal slices against 64 vertical ones: (1/c^2 - 1) h^2 switches where
+    // tan(a) / 16 = cot(a) / 64, i.e. tan(a) = 1/2 (26.57 degrees).
+    let p = params([64, 64, 16], 1.0, 1e6, 89.0, 1.0);
+    assert_eq!(dir(24.0, &p), 2);
+    assert_eq!(dir(29.0, &p), 1);
+    // Horizontal only: always w.
+    let mut h = p;
+    h.flags[0] = 0b100;
+    assert_eq!(dir(85.0, &h), 2);
+    // The stack is drawn from its far end: from the bottom when seen from above.
+    assert_eq!(twin::choose_axis(&unit_prism(10.0, 10.0), &p).reverse, 0);
+}
+
+#[test]
+fn slice_counts_at_known_angles() {
+    let only_w = |mut p: AxisParams| {
+        p.flags[0] = 0b100;
+        p
+    };
+    let slices = |angle: f32, p: &AxisParams| {
+        let c = twin::choose_axis(&unit_prism(angle, 10.0), p);
+        twin::level_slices(p.resolution[c.direction as usize], c.level)
+    };
+    // h tan(a) / d <= 1 with h = 64 / N voxels: N >= 64 tan(a) / d, rounded up to a power of two.
+    let p = only_w(params([64, 64, 64], 1.0, 1e-6, 89.0, 1.0));
+    assert_eq!(slices(0.0, &p), 1, "seen straight on, one combined slice suffices");
+    assert_eq!(slices(10.0, &p), 16, "64 tan(10) = 11.3");
+    assert_eq!(slices(30.0, &p), 64, "64 tan(30) = 37");
+    let p4 = only_w(params([64, 64, 64], 4.0, 1e-6, 89.0, 1.0));
+    assert_eq!(slices(30.0, &p4), 16, "64 tan(30) / 4 = 9.2");
+    // The maximum view angle caps a: 64 tan(60) / 8 = 13.9 at 85 degrees.
+    let capped = only_w(params([64, 64, 64], 8.0, 1e-6, 60.0, 1.0));
+    assert_eq!(slices(85.0, &capped), 16);
+    // h sin(a) / (z / f) <= p in world units: N >= L sin(a) f / (z p) = 1 * 0.5 * 100 / (10 * 1) = 5.
+    let far = only_w(params([64, 64, 64], 1e-3, 1.0, 89.0, 100.0));
+    let c = twin::choose_axis(&unit_prism(30.0, 10.0), &far);
+    let z = 10.0 * 30f32.to_radians().cos();
+    let expected = (0.5 * 100.0 / z).ceil() as u32;
+    assert_eq!(twin::level_slices(64, c.level), expected.next_power_of_two());
+}
+
+/// The f16 values of an `Rgba16Float` readback.
+fn f16s(bytes: &[u8]) -> Vec<f32> {
+    bytes
+        .chunks_exact(2)
+        .map(|b| {
+            let h = u16::from_le_bytes([b[0], b[1]]);
+            let (sign, exp, frac) = ((h >> 15) as i32, ((h >> 10) & 31) as i32, (h & 1023) as f32);
+            let v = match exp {
+                0 => frac * 2f32.powi(-24),
+                31 => f32::INFINITY,
+                _ => (1.0 + frac / 1024.0) * 2f32.powi(exp - 15),
+            };
+            if sign == 1 {
+                -v
+            } else {
+                v
+            }
+        })
+        .collect()
+}
+
+#[test]
+fn slice_image_bake_matches_its_twin() {
+    let res = [16, 12, 8];
+    let shapes = pack_shapes(&[
+        (Shape::Sphere { center: [0.4, 0.5, 0.4], radius: 0.3 }, [0.9, 0.3, 0.2], 0.7),
+        (Shape::Ellipsoid { center: [0.8, 0.2, 0.6], radii: [0.2, 0.3, 0.15] }, [0.2, 0.8, 0.3], 1.0),
+    ]);
+    let request = BakeRequest {
+        resolution: res,
+        source: BakeSource::Implicit(shapes),
+        per_pixel: false,
+        light: [0.3, 0.4, 0.8],
+        ambient: 0.3,
+        axis_slices: true,
+    };
+    let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
+    let baked = Baker::new(&voltex::project_root().join("wgsl")).bake(&ctx, &request).unwrap();
+    let volume = voltex::bake::axis_slices::read_texture(&ctx, &baked.volume, 4).unwrap();
+    let axis = baked.axis.unwrap();
+    let gpu: Vec<Vec<f32>> = axis
+        .arrays
+        .iter()
+        .map(|t| f16s(&voltex::bake::axis_slices::read_texture(&ctx, t, 8).unwrap()))
+        .collect();
+    let words: u64 = (0..3).map(|d| twin::array_layers(res[d]) as u64).sum();
+    let occupancy: Vec<u32> =
+        bytemuck::pod_collect_to_vec(&ctx.read_buffer(&axis.occupancy, 0, words * 4).unwrap());
+    drop(ctx);
+    let voxels: Vec<[u8; 4]> = volume.chunks_exact(4).map(|c| [c[0], c[1], c[2], c[3]]).collect();
+    let (cpu, cpu_occupancy) = twin::bake_axis_slices(&voxels, res);
+    assert_eq!(occupancy, cpu_occupancy);
+    assert!(cpu_occupancy.contains(&0) && cpu_occupancy.contains(&1), "some slices empty, some not");
+    for d in 0..3 {
+        let cpu: Vec<f32> = cpu[d].iter().flatten().copied().collect();
+        assert_eq!(gpu[d].len(), cpu.len(), "direction {d}");
+        let worst =
+            gpu[d].iter().zip(&cpu).map(|(g, c)| (g - c).abs() / c.abs().max(0.05)).fold(0.0, f32::max);
+        assert!(worst < 4e-3, "direction {d}: worst relative difference {worst}");
+    }
+    // Coarser levels keep what finer ones hold: the coarsest w slice is the combination of all.
+    let top = twin::level_layer(res[2], twin::level_count(res[2]) - 1) as usize;
+    let layer = (res[0] * res[1]) as usize;
+    let coarsest_alpha: f32 = gpu[2][top * layer * 4..][..layer * 4].iter().skip(3).step_by(4).sum();
+    assert!(coarsest_alpha > 0.0);
+}
+
+/// Renders `scene` with `opts`, returning the image and, per prism, GPU and twin choices.
+fn gpu_and_twin(scene: &Path, opts: &RenderOptions) -> usize {
+    let scene = scene::load(scene).unwrap();
+    let bp = Blueprint::new(&scene, opts).unwrap();
+    let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
+    let mut r = Renderer::new(&ctx, bp).unwrap();
+    r.render(&ctx).unwrap();
+    let mut checked = 0;
+    for (i, &(o, part)) in r.blueprint.instances.iter().enumerate() {
+        if part != Part::AxisSlices {
+            continue;
+        }
+        let object = &r.blueprint.objects[o];
+        let plan = object.axis.as_ref().unwrap();
+        let inputs = r.instance_inputs(i);
+        let (choices, vertices) =
+            voltex::methods::axis_slices::read_back(&ctx, inputs, plan.prisms.len()).unwrap();
+        let words = inputs.buffers["axis_occupancy"].size();
+        let occupancy: Vec<u32> = bytemuck::pod_collect_to_vec(
+            &ctx.read_buffer(&inputs.buffers["axis_occupancy"], 0, words).unwrap(),
+        );
+        let shell = plan.shell(&object.shell);
+        let mut same = 0;
+        for (p, gpu) in choices.iter().enumerate() {
+            let f = AxisFrame::of_shell(&shell, p);
+            let mut cpu = twin::choose_axis_slices(&f, &plan.params, &occupancy);
+            cpu.vertex_offset = gpu.vertex_offset;
+            if cpu != *gpu {
+                continue;
+            }
+            same += 1;
+            if cpu.vertex_count == 0 {
+                continue;
+            }
+            let at = gpu.vertex_offset as usize;
+            let emitted = twin::emit_axis_slices(&f, &plan.params, &occupancy, &cpu);
+            for (k, (c, g)) in emitted.iter().zip(&vertices[at..at + emitted.len()]).enumerate() {
+                let close = |a: [f32; 4], b: [f32; 4]| {
+                    (0..4).all(|j| (a[j] - b[j]).abs() <= 1e-4 * (1.0 + a[j].abs()))
+                };
+                assert!(
+                    close(c.position, g.position)
+                        && close(c.texcoord, g.texcoord)
+                        && close(c.normal, g.normal),
+                    "prism {p} vertex {k}: cpu {c:?} gpu {g:?}"
+                );
+            }
+        }
+        // Discrete decisions may differ only where f32 rounding straddles a boundary.
+        assert!(same * 100 >= choices.len() * 99, "{same} of {} prisms agree", choices.len());
+        let total: u32 = choices.iter().map(|c| c.vertex_count).sum();
+        assert_eq!(vertices.len() as u32, total, "everything counted is drawn");
+        checked += choices.len();
+    }
+    checked
+}
+
+#[test]
+fn kernels_match_their_twins_on_every_example_scene() {
+    let mut scenes: Vec<PathBuf> = std::fs::read_dir(example(""))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "ron"))
+        .collect();
+    scenes.sort();
+    assert!(scenes.len() >= 4);
+    for s in &scenes {
+        let opts = RenderOptions { size: Some((32, 32)), ..Default::default() };
+        let n = gpu_and_twin(s, &opts);
+        assert!(n > 0, "{} has AxisSlices prisms", s.display());
+    }
+}
+
+fn render(scene: &str, opts: &RenderOptions) -> Image {
+    let scene = scene::parse(scene, Path::new("inline.ron")).unwrap();
+    let bp = Blueprint::new(&scene, opts).unwrap();
+    let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
+    let mut r = Renderer::new(&ctx, bp).unwrap();
+    r.render(&ctx).unwrap().image
+}
+
+const FOG_BOX: &str = r#"Scene(
+    output: (width: 48, height: 48),
+    camera: (eye: (0.0, -2.7, 2.7), target: (0.0, 0.0, 0.25), fov_y: 40.0),
+    ambient: 1.0,
+    texels: { "fog": (resolution: (16, 16, 16), opacity_length: 0.5, source: Constant(color: (0.8, 0.6, 0.4), opacity: 0.5)) },
+    nodes: [(name: "box", surface: Plane(size: (2.0, 2.0), cells: (4, 4)), height: (length: 0.5), texel: "fog",
+             method: AxisSlices(blend: Blended, depth: DEPTH))],
+)"#;
+
+#[test]
+fn blended_fog_box_keeps_its_brightness_at_every_level() {
+    // A uniform fog box: combined slices keep the optical depth, so the image keeps the
+    // reference's brightness whatever level the criteria pick.
+    let reference = render(
+        &FOG_BOX.replace("DEPTH", "1.0"),
+        &RenderOptions { method: Some(MethodKind::Reference), ..Default::default() },
+    );
+    let sum = |img: &Image| (0..img.len()).map(|i| img.pixels[i][0] as f64).sum::<f64>();
+    for depth in ["0.25", "2.0", "8.0"] {
+        let img = render(&FOG_BOX.replace("DEPTH", depth), &RenderOptions::default());
+        let e = voltex::metrics::relative_rmse(&img, &reference).unwrap();
+        let ratio = sum(&img) / sum(&reference);
+        eprintln!("fog box, depth {depth}: relative RMSE {e:.4}, brightness ratio {ratio:.4}");
+        assert!((ratio - 1.0).abs() < 0.02, "depth {depth}: brightness ratio {ratio}");
+        // What remains is where slices cut the box's sides (fewer slices: coarser steps there).
+        assert!(e < 0.2, "depth {depth}: relative RMSE {e}");
+    }
+}
+
+#[test]
+fn three_directions_bound_the_error_at_grazing_views() {
+    let path = example("pear.ron");
+    let source = std::fs::read_to_string(&path).unwrap();
+    // 80 degrees from the vertical: horizontal slices show gaps, vertical sets do not.
+    let grazing = source.replace(
+        "camera: (eye: (0.0, -2.3, 1.9), target: (0.0, 0.0, 0.45)",
+        "camera: (eye: (0.0, -3.0, 0.98), target: (0.0, 0.0, 0.45)",
+    );
+    assert_ne!(grazing, source, "the pear scene's camera line");
+    let size = RenderOptions { size: Some((64, 64)), ..Default::default() };
+    let reference = render(&grazing, &RenderOptions { method: Some(MethodKind::Reference), ..size.clone() });
+    let three = render(&grazing, &size);
+    let horizontal =
+        render(&grazing.replace("max_angle: 80.0", "max_angle: 80.0, directions: Horizontal"), &size);
+    let flip = |img: &Image| voltex::metrics::flip(img, &reference).unwrap().mean;
+    let (e3, e1) = (flip(&three), flip(&horizontal));
+    eprintln!("grazing pear: FLIP three directions {e3:.4}, horizontal only {e1:.4}");
+    assert!(e3 < 0.08, "three directions: FLIP {e3}");
+    assert!(e1 > 1.5 * e3, "horizontal only ({e1}) is worse than three directions ({e3})");
+}
+
+#[test]
+fn bad_knobs_name_their_position() {
+    for (knob, expected) in [
+        ("max_angle: 95.0", "a view angle in (0, 90) degrees"),
+        ("depth: 0.0", "a depth in (0, 1024] voxels"),
+        ("pixels: -1.0", "a slice distance in (0, 1024] pixels"),
+        ("directions: Diagonal", "Diagonal"),
+    ] {
+        let text = FOG_BOX.replace("depth: DEPTH", knob);
+        let err = scene::parse(&text, Path::new("bad.ron")).unwrap_err().to_string();
+        assert!(err.starts_with("bad.ron:7:"), "{knob}: {err}");
+        assert!(err.contains(expected), "{knob}: {err}");
+    }
+}
+
+/// The pear seen from `elevation` degrees above its base, at 64x64: (three directions,
+/// horizontal only) mean FLIP against the reference.
+fn pear_errors(elevation: f64) -> (f64, f64) {
+    let source = std::fs::read_to_string(example("pear.ron")).unwrap();
+    let (target, distance) = (0.45, 3.0);
+    let e = elevation.to_radians();
+    let camera = format!(
+        "camera: (eye: (0.0, {:.4}, {:.4}), target: (0.0, 0.0, {target})",
+        -distance * e.cos(),
+        target + distance * e.sin()
+    );
+    let scene = source.replace("camera: (eye: (0.0, -2.3, 1.9), target: (0.0, 0.0, 0.45)", &camera);
+    let size = RenderOptions { size: Some((64, 64)), ..Default::default() };
+    let reference = render(&scene, &RenderOptions { method: Some(MethodKind::Reference), ..size.clone() });
+    let flip = |s: &str| voltex::metrics::flip(&render(s, &size), &reference).unwrap().mean;
+    (flip(&scene), flip(&scene.replace("max_angle: 80.0", "max_angle: 80.0, directions: Horizontal")))
+}
+
+#[test]
+fn error_against_view_angle_stays_bounded_with_three_directions() {
+    eprintln!("elevation  FLIP three  FLIP horizontal");
+    for elevation in [60.0, 30.0, 15.0, 5.0] {
+        let (three, horizontal) = pear_errors(elevation);
+        eprintln!("{elevation:>9}  {three:>10.4}  {horizontal:>15.4}");
+        assert!(three < 0.08, "elevation {elevation}: FLIP {three}");
+        if elevation <= 15.0 {
+            assert!(
+                horizontal > 1.5 * three,
+                "elevation {elevation}: horizontal {horizontal}, three {three}"
+            );
+        }
+    }
+}
+
+/// Numbers for the notes (run with `--ignored --nocapture`): per example scene, prisms, the
+/// triangles of full-resolution horizontal slicing, triangles drawn with and without culling,
+/// and the draw pass's GPU time.
+#[test]
+#[ignore]
+fn triangle_counts_and_times() {
+    let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
+    eprintln!(
+        "scene | prisms | finest | drawn: culling+LOD / no culling / no LOD | draw ms: same three | frame ms (wall): same three"
+    );
+    for name in
+        ["pear", "pear_grazing", "two_pears", "pears_on_sphere", "heightfield_plane", "heightfield_sphere"]
+    {
+        let text = std::fs::read_to_string(example(&format!("{name}.ron"))).unwrap();
+        let off = text
+            .replace("AxisSlices(", "AxisSlices(empty_culling: false, ")
+            .replace("empty_culling: false, back_face_culling: true", "empty_culling: false");
+        let finest_lod = text
+            .replace("depth: 1.0, pixels: 1.0, ", "")
+            .replace("depth: 1.0, pixels: 1.0", "")
+            .replace("AxisSlices(", "AxisSlices(depth: 0.0001, pixels: 0.0001, ");
+        let mut row = Vec::new();
+        let mut finest = 0u64;
+        let mut prisms = 0usize;
+        for t in [&text, &off, &finest_lod] {
+            finest = 0;
+            prisms = 0;
+            let scene = scene::parse(t, &example("x.ron")).unwrap();
+            let opts = RenderOptions { size: Some((256, 256)), ..Default::default() };
+            let mut r = Renderer::new(&ctx, Blueprint::new(&scene, &opts).unwrap()).unwrap();
+            for _ in 0..2 {
+                r.render(&ctx).unwrap();
+            }
+            let start = std::time::Instant::now();
+            let times = r.render_timed(&ctx).unwrap();
+            let wall = start.elapsed().as_secs_f64() * 1e3;
+            let draw: f64 = times
+                .iter()
+                .filter(|t| t.0.contains("axis_slices") && t.0.starts_with("draw"))
+                .map(|t| t.1)
+                .sum();
+            let mut drawn = 0;
+            for (i, &(o, part)) in r.blueprint.instances.iter().enumerate() {
+                if part == Part::AxisSlices {
+                    let plan = r.blueprint.objects[o].axis.as_ref().unwrap();
+                    let (_, v) = voltex::methods::axis_slices::read_back(
+                        &ctx,
+                        r.instance_inputs(i),
+                        plan.prisms.len(),
+                    )
+                    .unwrap();
+                    drawn += v.len() / 3;
+                    finest += plan.prisms.len() as u64 * plan.params.resolution[2] as u64;
+                    prisms += plan.prisms.len();
+                }
+            }
+            row.push((drawn, draw, wall));
+        }
+        eprintln!(
+            "{name} | {prisms} | {finest} | {} / {} / {} | {:.2} / {:.2} / {:.2} | {:.1} / {:.1} / {:.1}",
+            row[0].0, row[1].0, row[2].0, row[0].1, row[1].1, row[2].1, row[0].2, row[1].2, row[2].2
+        );
+    }
+}

@@ -1,0 +1,548 @@
+//! Hypertextures (Gilet & Dischler 2009): the kernels against their f64 CPU twins (simplex noise,
+//! transfer tables, soft objects, vector fields, density, colour, whole images), the analytic
+//! checks of the paper's model, and bad input reported at its position.
+
+use std::path::{Path, PathBuf};
+use std::sync::{Mutex, OnceLock};
+
+use glam::DVec3;
+use voltex::cpu::bake::pcg_hash;
+use voltex::cpu::bake_transfer::bake_transfer;
+use voltex::cpu::hypertexture::Model;
+use voltex::cpu::noise_simplex::{simplex3, simplex4};
+use voltex::cpu::ray_march::{ray_march, MarchView};
+use voltex::gpu::GpuContext;
+use voltex::methods::ray_march::{probe, RayMarchPlan};
+use voltex::render::{Blueprint, Part, RenderOptions, Renderer};
+use voltex::scene;
+use voltex::types::MarchState;
+
+fn ctx() -> &'static Mutex<GpuContext> {
+    static CTX: OnceLock<Mutex<GpuContext>> = OnceLock::new();
+    CTX.get_or_init(|| {
+        Mutex::new(GpuContext::new().expect("a GPU adapter (software Vulkan: mesa-vulkan-drivers)"))
+    })
+}
+
+fn example(name: &str) -> PathBuf {
+    voltex::project_root().join("scenes/hypertextures").join(name)
+}
+
+const EXAMPLES: &[&str] = &[
+    "fig4_identity.ron",
+    "fig4_holes.ron",
+    "fig4_craters.ron",
+    "fig4_isolines.ron",
+    "fig5_multiple_noises.ron",
+    "fig6_clouds.ron",
+    "fig8_vector_fields.ron",
+];
+
+fn sized(w: u32, h: u32) -> RenderOptions {
+    RenderOptions { size: Some((w, h)), ..Default::default() }
+}
+
+fn blueprint(scene: &scene::Scene, opts: &RenderOptions) -> Blueprint {
+    Blueprint::new(scene, opts).unwrap()
+}
+
+fn plans(bp: &Blueprint) -> Vec<&RayMarchPlan> {
+    bp.objects.iter().filter_map(|o| o.ray_march.as_ref()).collect()
+}
+
+/// A scene with one hypertexture `h` (given as RON) on a node drawn with `method`.
+fn one(hypertexture: &str, method: &str) -> scene::Scene {
+    let text = format!(
+        "#![enable(implicit_some)]\nScene(\n    output: (width: 32, height: 32),\n    camera: (eye: (0.0, -4.5, 1.2), \
+         target: (0.0, 0.0, 0.0), fov_y: 35.0),\n    lights: [Directional(direction: (-0.5, 0.6, -0.7))],\n    \
+         hypertextures: {{ \"h\": {hypertexture} }},\n    nodes: [(name: \"n\", transform: (rotate: (10.0, 0.0, 20.0)), \
+         hypertexture: \"h\", method: {method})],\n)\n"
+    );
+    scene::parse(&text, Path::new("test.ron")).unwrap_or_else(|e| panic!("{e}\n{text}"))
+}
+
+/// A small pseudo-random generator in [0, 1).
+struct Rng(u32);
+impl Rng {
+    fn next(&mut self) -> f64 {
+        self.0 = pcg_hash(self.0);
+        self.0 as f64 / 4294967296.0
+    }
+    fn in_box(&mut self, lo: DVec3, hi: DVec3) -> DVec3 {
+        lo + (hi - lo) * DVec3::new(self.next(), self.next(), self.next())
+    }
+}
+
+fn point(p: DVec3, seed: u32) -> [f32; 4] {
+    [p.x as f32, p.y as f32, p.z as f32, f32::from_bits(seed)]
+}
+
+/// The twin's model of a plan, with the tables the CPU twin of `bake_transfer` fills.
+fn twin_tables(plan: &RayMarchPlan) -> Vec<f64> {
+    bake_transfer(&plan.packed.functions, &plan.packed.points)
+}
+
+fn model<'a>(plan: &'a RayMarchPlan, tables: &'a [f64]) -> Model<'a> {
+    Model { params: &plan.params, noises: &plan.packed.noises, tables }
+}
+
+/// 3D simplex noise: the kernel and the f64 twin agree on points up to 40 units from the origin
+/// and on any seed.
+#[test]
+fn simplex_noise_kernel_matches_twin() {
+    let scene = scene::load(&example("fig4_holes.ron")).unwrap();
+    let bp = blueprint(&scene, &sized(8, 8));
+    let plan = plans(&bp)[0];
+    let mut rng = Rng(7);
+    let points: Vec<[f32; 4]> = (0..4096)
+        .map(|i| point(rng.in_box(DVec3::splat(-40.0), DVec3::splat(40.0)), pcg_hash(i) % 1000))
+        .collect();
+    let gpu = probe(&ctx().lock().unwrap_or_else(|e| e.into_inner()), plan, &points).unwrap();
+    let (mut max, mut sum, mut lo, mut hi): (f64, f64, f64, f64) = (0.0, 0.0, 1.0, -1.0);
+    let mut max4: f64 = 0.0;
+    for (i, p) in points.iter().enumerate() {
+        let x = DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64);
+        let cpu = simplex3(x, p[3].to_bits());
+        let d = (gpu.values[4 * i][0] as f64 - cpu).abs();
+        max = max.max(d);
+        sum += d;
+        lo = lo.min(cpu);
+        hi = hi.max(cpu);
+        let w = (0.37f32 * p[0] + 1.3) as f64;
+        let cpu4 = simplex4(x.extend(w), p[3].to_bits());
+        max4 = max4.max((gpu.values[4 * i][3] as f64 - cpu4).abs());
+    }
+    eprintln!(
+        "simplex3 GPU vs f64 twin: max {max:.2e}, mean {:.2e}; range [{lo:.3}, {hi:.3}]; simplex4: max {max4:.2e}",
+        sum / 4096.0
+    );
+    assert!(max < 1e-4 && max4 < 1e-4, "max difference {max}, 4D {max4}");
+    assert!(lo < -0.7 && hi > 0.7);
+}
+
+/// Transfer tables (Hermite curves, sampled tables, ramps, steps) of every example hypertexture:
+/// `bake_transfer.wgsl` against its twin.
+#[test]
+fn transfer_tables_match_twin() {
+    let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
+    let mut worst: f64 = 0.0;
+    let mut functions = 0;
+    for name in EXAMPLES {
+        let scene = scene::load(&example(name)).unwrap();
+        let bp = blueprint(&scene, &sized(8, 8));
+        for plan in plans(&bp) {
+            let gpu = probe(&ctx, plan, &[[0.0; 4]]).unwrap();
+            let cpu = twin_tables(plan);
+            assert_eq!(gpu.tables.len(), cpu.len());
+            for (g, c) in gpu.tables.iter().zip(&cpu) {
+                worst = worst.max((*g as f64 - c).abs());
+            }
+            functions += plan.packed.functions.len();
+        }
+    }
+    eprintln!("transfer tables: {functions} functions, GPU vs f64 twin max {worst:.2e}");
+    assert!(worst < 1e-5, "{worst}");
+}
+
+/// Soft objects, vector fields (all six of Figure 8), the density of eq. 3 to 5 and the colour
+/// transfer: the kernel against the twin at random points in the enlarged bounds of every example.
+#[test]
+fn fields_density_and_colour_match_twin() {
+    let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
+    let mut rng = Rng(99);
+    for name in EXAMPLES {
+        let scene = scene::load(&example(name)).unwrap();
+        let bp = blueprint(&scene, &sized(8, 8));
+        let mut worst = [0.0f64; 4];
+        let mut count = 0;
+        for plan in plans(&bp) {
+            let (lo, hi) = plan.packed.bounds;
+            let points: Vec<[f32; 4]> = (0..1024).map(|_| point(rng.in_box(lo, hi), 0)).collect();
+            let gpu = probe(&ctx, plan, &points).unwrap();
+            let tables = twin_tables(plan);
+            let m = model(plan, &tables);
+            for (i, p) in points.iter().enumerate() {
+                let x = DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64);
+                let g = &gpu.values[4 * i..4 * i + 4];
+                let v = m.vector_field(x);
+                let field_err = (DVec3::new(g[1][0] as f64, g[1][1] as f64, g[1][2] as f64) - v).length()
+                    / v.length().max(1.0);
+                let density = m.hyper_density(x);
+                let colour = m.hyper_color(density);
+                let colour_err = (0..4).map(|c| (g[3][c] as f64 - colour[c]).abs()).fold(0.0, f64::max);
+                let errs = [
+                    (g[0][1] as f64 - m.object_density(x)).abs(),
+                    field_err,
+                    (g[2][0] as f64 - density).abs(),
+                    colour_err,
+                ];
+                for k in 0..4 {
+                    worst[k] = worst[k].max(errs[k]);
+                }
+                count += (density > 0.0) as usize;
+            }
+        }
+        eprintln!(
+            "{name}: GPU vs f64 twin max: object {:.1e}, field {:.1e} (relative), density {:.1e}, colour {:.1e}; \
+             {count} points inside",
+            worst[0], worst[1], worst[2], worst[3]
+        );
+        assert!(
+            worst[0] < 1e-6 && worst[1] < 1e-5 && worst[2] < 1e-4 && worst[3] < 2e-3,
+            "{name}: {worst:?}"
+        );
+        assert!(count > 100, "{name}: enough points where the density is positive");
+    }
+}
+
+/// The kernel's premultiplied layer of the first RayMarch object, as `composite_ray_march`
+/// blends it (colour times the light colour, coverage), and the twin's.
+fn layer_and_twin(scene: &scene::Scene, opts: &RenderOptions) -> (Vec<[f64; 4]>, Vec<[f64; 4]>, u32) {
+    let bp = blueprint(scene, opts);
+    let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
+    let mut r = Renderer::new(&ctx, bp).unwrap();
+    let frame = r.render(&ctx).unwrap();
+    assert_eq!(voltex::metrics::count_nonfinite(&frame.image), 0);
+    let instance = r.blueprint.instances.iter().position(|p| p.1 == Part::RayMarch).unwrap();
+    let bytes = r.read_instance_buffer(&ctx, instance, "ray_march_state").unwrap();
+    drop(ctx);
+    let f = &r.blueprint.frame;
+    let light = [f.light_color[0] as f64, f.light_color[1] as f64, f.light_color[2] as f64];
+    let gpu: Vec<[f64; 4]> = bytemuck::pod_collect_to_vec::<u8, MarchState>(&bytes)
+        .iter()
+        .map(|s| std::array::from_fn(|c| s.color[c] as f64 * if c < 3 { light[c] } else { 1.0 }))
+        .collect();
+    let o = r.blueprint.objects.iter().find(|o| o.ray_march.is_some()).unwrap();
+    let plan = o.ray_march.as_ref().unwrap();
+    let tables = twin_tables(plan);
+    let v3 = |a: [f32; 4]| DVec3::new(a[0] as f64, a[1] as f64, a[2] as f64);
+    let view = MarchView {
+        width: r.blueprint.size.0,
+        height: r.blueprint.size.1,
+        forward: v3(f.forward),
+        light_dir: v3(f.light_dir),
+        ambient: f.light_dir[3] as f64,
+        light_color: light,
+    };
+    let cpu = ray_march(&view, model(plan, &tables), plan.shade);
+    (gpu, cpu, plan.dispatches)
+}
+
+/// Largest difference of any channel, mean difference, and the share of pixels off by more
+/// than 0.02 in some channel.
+fn compare(gpu: &[[f64; 4]], cpu: &[[f64; 4]]) -> (f64, f64, f64) {
+    let (mut max, mut sum, mut off) = (0.0f64, 0.0, 0);
+    for (g, c) in gpu.iter().zip(cpu) {
+        let d = (0..4).map(|k| (g[k] - c[k]).abs()).fold(0.0, f64::max);
+        max = max.max(d);
+        sum += (0..4).map(|k| (g[k] - c[k]).abs()).sum::<f64>() / 4.0;
+        off += (d > 0.02) as usize;
+    }
+    (max, sum / gpu.len() as f64, off as f64 / gpu.len() as f64)
+}
+
+const CLOUD: &str = "(object: Sphere(radius: 1.0), field: Perturbed(field: Swirl(twist: 0.6), amount: 0.3, \
+    frequency: 2.0, magnitude: 0.5), noises: [(shape: Curve([(0.0, 0.0, 0.0), (0.5, 0.4, 1.2), (1.0, 1.0, 0.0)]), \
+    amplitude: 0.4, frequency: 1.5, shift: 0.3), (shape: Table([0.0, 1.0, 0.3]), amplitude: 0.15, frequency: 4.0, \
+    operator: Blend, seed: 3)], color: Ramp([(0.0, (1.0, 0.9, 0.8, 0.0)), (0.3, (0.9, 0.8, 0.7, 0.2)), \
+    (1.0, (0.5, 0.6, 0.9, 0.9))]), opacity_length: 0.3)";
+
+/// Whole images: the kernel (resuming across dispatches) and the twin agree on a semi-transparent
+/// hypertexture unshaded, with Phong, and with Phong and shadow rays; and on the Figure 6 clouds.
+#[test]
+fn images_match_twin() {
+    let cases = [
+        ("cloud, no shading", one(CLOUD, "RayMarch(step: 0.02)")),
+        ("cloud, Phong", one(CLOUD, "RayMarch(step: 0.02, shading: Phong)")),
+        (
+            "cloud, Phong + shadows",
+            one(CLOUD, "RayMarch(step: 0.01, shading: PhongShadows, shadow_step: 0.04)"),
+        ),
+    ];
+    let mut resumed = false;
+    for (what, scene) in &cases {
+        let (gpu, cpu, dispatches) = layer_and_twin(scene, &sized(32, 32));
+        let (max, mean, off) = compare(&gpu, &cpu);
+        eprintln!(
+            "{what}: {dispatches} dispatch(es), max {max:.2e}, mean {mean:.2e}, {:.2}% pixels off by > 0.02",
+            off * 100.0
+        );
+        assert!(mean < 1e-5 && max < 1e-3, "{what}: max {max}, mean {mean}, off {off}");
+        let covered = cpu.iter().filter(|p| p[3] > 0.05).count();
+        assert!(covered > 100, "{what}: the object covers {covered} pixels");
+        resumed |= dispatches > 2;
+    }
+    assert!(resumed, "some case needs several dispatches per frame");
+    let scene = scene::load(&example("fig6_clouds.ron")).unwrap();
+    let (gpu, cpu, _) = layer_and_twin(&scene, &sized(48, 20));
+    let (max, mean, off) = compare(&gpu, &cpu);
+    eprintln!("fig6_clouds (first object): max {max:.2e}, mean {mean:.2e}, {:.2}% pixels off", off * 100.0);
+    assert!(mean < 1e-5 && max < 1e-3);
+    // An iso-surface (a step opacity): a sample on the other side of the threshold in f32 than in
+    // f64 changes a pixel, so only the share of such pixels is bounded.
+    let scene = scene::load(&example("fig4_holes.ron")).unwrap();
+    let (gpu, cpu, _) = layer_and_twin(&scene, &sized(96, 32));
+    let (max, mean, off) = compare(&gpu, &cpu);
+    eprintln!(
+        "fig4_holes (first object, Phong): max {max:.2e}, mean {mean:.2e}, {:.2}% pixels off",
+        off * 100.0
+    );
+    assert!(mean < 1e-4 && off < 0.01);
+}
+
+/// With every amplitude 0 the density is the soft object's, exactly, whatever the noises and the
+/// field; drawn as an iso-surface it is a sphere whose silhouette is known per pixel.
+#[test]
+fn zero_amplitude_gives_the_undistorted_object() {
+    let h = "(object: Sphere(radius: 1.0), field: Perturbed(field: ClosestSurface, frequency: 3.0), \
+        noises: [(shape: Table([0.0, 1.0]), amplitude: 0.0, frequency: 3.0, shift: 0.5), \
+        (shape: Table([1.0, 0.0, 1.0]), amplitude: 0.0, frequency: 7.0, operator: Blend)], \
+        color: Step(threshold: 0.4, color: (1.0, 1.0, 1.0)), opacity_length: 0.001)";
+    let scene = one(h, "RayMarch(step: 0.01)");
+    let bp = blueprint(&scene, &sized(40, 40));
+    let plan = plans(&bp)[0];
+    let mut rng = Rng(5);
+    let points: Vec<[f32; 4]> =
+        (0..2048).map(|_| point(rng.in_box(DVec3::splat(-1.1), DVec3::splat(1.1)), 0)).collect();
+    let gpu = probe(&ctx().lock().unwrap_or_else(|e| e.into_inner()), plan, &points).unwrap();
+    let tables = twin_tables(plan);
+    let m = model(plan, &tables);
+    for (i, p) in points.iter().enumerate() {
+        let x = DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64);
+        assert_eq!(gpu.values[4 * i + 2][0], gpu.values[4 * i][1], "kernel at {x}");
+        assert_eq!(m.hyper_density(x), m.object_density(x), "twin at {x}");
+    }
+    // The iso-surface at density 0.4 is the sphere of radius 0.6 around the node's origin.
+    let (gpu, _, _) = layer_and_twin(&scene, &sized(40, 40));
+    let f = &bp.frame;
+    let v3 = |a: [f32; 4]| DVec3::new(a[0] as f64, a[1] as f64, a[2] as f64);
+    let (forward, right, up) = (v3(f.forward), v3(plan.params.right), v3(plan.params.up));
+    let eye = scene.camera.eye;
+    let (mut inside, mut outside) = (0, 0);
+    for y in 0..40 {
+        for x in 0..40 {
+            let sx = 2.0 * (x as f64 + 0.5) / 40.0 - 1.0;
+            let sy = 1.0 - 2.0 * (y as f64 + 0.5) / 40.0;
+            let d = (forward + right * sx + up * sy).normalize();
+            let closest = (eye - d * eye.dot(d)).length();
+            let chord = 2.0 * (0.36 - closest * closest).max(0.0).sqrt();
+            let coverage = gpu[y * 40 + x][3];
+            if chord > 0.05 {
+                assert!(coverage > 0.999, "pixel ({x}, {y}) crosses the sphere: coverage {coverage}");
+                inside += 1;
+            } else if closest > 0.6 + 0.006 {
+                assert_eq!(coverage, 0.0, "pixel ({x}, {y}) misses the sphere");
+                outside += 1;
+            }
+        }
+    }
+    eprintln!("a = 0: density equals the soft object's at 2048 points; {inside} pixels covered, {outside} empty as the sphere says");
+    assert!(inside > 200 && outside > 200);
+}
+
+/// r = 1 with the closest-surface field on a sphere (section 4.1): every point of a radius is
+/// given the same distortion k (the noise is evaluated where the radius meets the surface), so
+/// the density along a radius is the soft sphere's shifted by k: a displacement along the radius.
+/// With r = 0 the distortion varies along the radius.
+#[test]
+fn shift_one_on_a_sphere_is_a_radial_displacement() {
+    let noises = |r: &str| {
+        format!(
+            "(object: Sphere(radius: 1.0), field: ClosestSurface, noises: [(shape: Curve([(0.0, 0.0, 0.0), \
+             (0.5, 0.3, 1.0), (1.0, 1.0, 0.0)]), amplitude: 0.2, frequency: 2.0, shift: {r}), (shape: Table([1.0, 0.0, \
+             1.0]), amplitude: 0.1, frequency: 5.0, shift: {r}, seed: 4)], color: Step(threshold: 0.5, color: (1.0, \
+             1.0, 1.0)))"
+        )
+    };
+    let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
+    let radii = [0.35, 0.5, 0.65, 0.8, 0.95];
+    let mut spreads = Vec::new();
+    for r in ["1.0", "0.0"] {
+        let scene = one(&noises(r), "RayMarch()");
+        let bp = blueprint(&scene, &sized(8, 8));
+        let plan = plans(&bp)[0];
+        let tables = twin_tables(plan);
+        let m = model(plan, &tables);
+        let mut rng = Rng(11);
+        let dirs: Vec<DVec3> =
+            (0..256).map(|_| (rng.in_box(DVec3::splat(-1.0), DVec3::ONE)).normalize_or(DVec3::X)).collect();
+        let points: Vec<[f32; 4]> =
+            dirs.iter().flat_map(|&u| radii.iter().map(move |&rho| point(u * rho, 0))).collect();
+        let gpu = probe(&ctx, plan, &points).unwrap();
+        let (mut gpu_spread, mut cpu_spread, mut surface): (f64, f64, f64) = (0.0, 0.0, 0.0);
+        for (j, &u) in dirs.iter().enumerate() {
+            // k implied by the density at radius rho: d = 1 - (rho - k), so k = rho - 1 + d.
+            let k_gpu: Vec<f64> = (0..radii.len())
+                .map(|i| radii[i] - 1.0 + gpu.values[4 * (j * radii.len() + i) + 2][0] as f64)
+                .collect();
+            let k_cpu: Vec<f64> = radii.iter().map(|&rho| rho - 1.0 + m.hyper_density(u * rho)).collect();
+            let spread = |k: &[f64]| {
+                k.iter().fold(f64::MIN, |a, &b| a.max(b)) - k.iter().fold(f64::MAX, |a, &b| a.min(b))
+            };
+            gpu_spread = gpu_spread.max(spread(&k_gpu));
+            cpu_spread = cpu_spread.max(spread(&k_cpu));
+            // ... and k is the distortion evaluated on the surface (where V = 0).
+            surface = surface.max((k_cpu[0] - m.distortion(u, DVec3::ZERO)).abs());
+        }
+        eprintln!(
+            "shift {r}: largest spread of k along a radius: kernel {gpu_spread:.2e}, twin {cpu_spread:.2e}"
+        );
+        spreads.push((gpu_spread, cpu_spread, surface));
+    }
+    let (gpu, cpu, surface) = spreads[0];
+    assert!(gpu < 1e-5 && cpu < 1e-12 && surface < 1e-12, "r = 1: {:?}", spreads[0]);
+    assert!(spreads[1].0 > 0.02 && spreads[1].1 > 0.02, "r = 0 varies along the radius: {:?}", spreads[1]);
+}
+
+/// Animated hypertextures (4D noise, the paper's future work): the frame changes with time, and
+/// kernel and twin agree at each time.
+#[test]
+fn animated_hypertextures_change_with_time() {
+    let animated = CLOUD.replace("shift: 0.3)", "shift: 0.3, speed: 0.8)");
+    assert_ne!(animated, CLOUD);
+    let scene = one(&animated, "RayMarch(step: 0.02, shading: Phong)");
+    let mut layers = Vec::new();
+    for time in [0.0, 0.7] {
+        let (gpu, cpu, _) = layer_and_twin(&scene, &RenderOptions { time: Some(time), ..sized(32, 32) });
+        let (max, mean, _) = compare(&gpu, &cpu);
+        eprintln!("animated, time {time}: kernel vs twin max {max:.2e}, mean {mean:.2e}");
+        assert!(mean < 1e-5 && max < 1e-3);
+        layers.push(gpu);
+    }
+    let (_, change, _) = compare(&layers[0], &layers[1]);
+    eprintln!("animated: mean change of the layer from time 0 to 0.7: {change:.3}");
+    assert!(change > 1e-3);
+}
+
+/// Halving the step changes the error, not the brightness (the shared step-corrected opacity).
+#[test]
+fn step_changes_error_not_brightness() {
+    let mean = |step: f64| {
+        let scene = one(CLOUD, &format!("RayMarch(step: {step})"));
+        let (gpu, _, _) = layer_and_twin(&scene, &sized(32, 32));
+        gpu.iter().map(|p| p[0] + p[1] + p[2] + p[3]).sum::<f64>() / gpu.len() as f64
+    };
+    let (coarse, fine) = (mean(0.04), mean(0.01));
+    eprintln!("mean layer: {coarse:.5} with step 0.04, {fine:.5} with 0.01");
+    assert!((coarse - fine).abs() / fine < 0.01, "{coarse} against {fine}");
+}
+
+// ---- bad input ----
+
+const BASE: &str = r#"#![enable(implicit_some)]
+Scene(
+    output: (width: 16, height: 16),
+    camera: (eye: (0.0, -4.0, 0.0), target: (0.0, 0.0, 0.0)),
+    hypertextures: {
+        "h": (
+            object: Sphere(radius: 1.0),
+            field: ClosestSurface,
+            noises: [
+                (shape: Curve([(0.0, 0.0, 0.0), (0.5, 1.0, 0.0), (1.0, 0.0, 0.0)]), amplitude: 0.2, frequency: 2.0),
+            ],
+            color: Ramp([(0.0, (1.0, 1.0, 1.0, 0.0)), (1.0, (1.0, 1.0, 1.0, 1.0))]),
+        ),
+    },
+    nodes: [(name: "n", hypertexture: "h", method: RayMarch(quality: HQ, shading: None))],
+)
+"#;
+
+/// The base scene with `line` (1-based) replaced; the error must be at `line` and the column
+/// where `at` starts in the new line, and mention `word`.
+#[track_caller]
+fn bad(line: usize, text: &str, at: &str, word: &str) {
+    let mut lines: Vec<&str> = BASE.lines().collect();
+    lines[line - 1] = text;
+    let source = lines.join("\n");
+    let col = text.find(at).unwrap_or_else(|| panic!("{at} in {text}")) + 1;
+    let e = match scene::parse(&source, Path::new("test.ron")) {
+        Ok(scene) => Blueprint::new(&scene, &RenderOptions::default()).err().map(|e| e.to_string()),
+        Err(e) => Some(e.to_string()),
+    }
+    .unwrap_or_else(|| panic!("expected an error for: {text}"));
+    let want = format!("test.ron:{line}:{col}: ");
+    assert!(e.starts_with(&want), "want {want}... got {e}");
+    assert!(e.contains(word), "want `{word}` in {e}");
+}
+
+#[test]
+fn base_hypertexture_scene_is_valid() {
+    let scene = scene::parse(BASE, Path::new("test.ron")).unwrap();
+    let bp = blueprint(&scene, &RenderOptions::default());
+    let plan = plans(&bp)[0];
+    assert_eq!((plan.step, plan.shade.phong), (0.002, false));
+}
+
+#[test]
+fn bad_transfer_functions_are_reported_at_their_position() {
+    let noise = |shape: &str| format!("                (shape: {shape}, amplitude: 0.2, frequency: 2.0),");
+    bad(10, &noise("Curve([(0.0, 0.0, 0.0), (0.5, 1.5, 0.0), (1.0, 0.0, 0.0)])"), "1.5", "[0, 1]");
+    bad(10, &noise("Curve([(0.0, 0.0, 0.0), (0.6, 1.0, 0.0), (0.4, 0.0, 0.0)])"), "(0.4", "comes before");
+    bad(10, &noise("Curve([(0.0, 0.0, 0.0), (0.5, 1.0, 0.0), (0.5, 0.0, 0.0)])"), "(0.5, 0.0", "repeats");
+    bad(10, &noise("Curve([(0.3, 0.0, 0.0)])"), "[(0.3", "2 to 64 control points");
+    bad(10, &noise("Table([0.0, -0.1])"), "-0.1", "[0, 1]");
+    bad(10, &noise("Table([1.0])"), "[1.0]", "table of 2 to 256");
+    let ramp = "            color: Ramp([(0.0, (1.0, 1.0, 1.0, 0.0)), (1.0, (1.0, 2.0, 1.0, 1.0))]),";
+    bad(12, ramp, "2.0", "[0, 1]");
+    let ramp = "            color: Ramp([(0.5, (1.0, 1.0, 1.0, 0.0)), (0.2, (1.0, 1.0, 1.0, 1.0))]),";
+    bad(12, ramp, "(0.2", "sorted by x");
+    bad(12, "            color: Step(threshold: 1.2, color: (1.0, 1.0, 1.0)),", "1.2", "[0, 1]");
+}
+
+#[test]
+fn bad_noises_are_reported_at_their_position() {
+    let mut lines: Vec<&str> = BASE.lines().collect();
+    lines[9] = "";
+    let e = scene::parse(&lines.join("\n"), Path::new("test.ron")).unwrap_err().to_string();
+    assert!(e.starts_with("test.ron:9:21: ") && e.contains("1 to 8 noises, found 0"), "{e}");
+    let noise = "                (shape: Table([0.0, 1.0]), amplitude: 0.2, frequency: 0.0),";
+    bad(10, noise, "0.0)", "positive");
+    let noise = "                (shape: Table([0.0, 1.0]), amplitude: -0.2, frequency: 1.0),";
+    bad(10, noise, "-0.2", ">= 0");
+    let noise = "                (shape: Table([0.0, 1.0]), amplitude: 0.2, frequency: 1.0, shift: 2.0),";
+    bad(10, noise, "2.0)", "[0, 1]");
+    let nine = "(shape: Table([0.0, 1.0]), amplitude: 0.1, frequency: 1.0), ".repeat(9);
+    let mut lines: Vec<String> = BASE.lines().map(String::from).collect();
+    lines[9] = format!("                {nine}");
+    let e = scene::parse(&lines.join("\n"), Path::new("test.ron")).unwrap_err().to_string();
+    assert!(e.starts_with("test.ron:9:21: ") && e.contains("1 to 8 noises, found 9"), "{e}");
+}
+
+#[test]
+fn bad_objects_fields_and_methods_are_reported_at_their_position() {
+    bad(7, "            object: Torus(major: 0.5, minor: 0.6),", "Torus", "below the major radius");
+    bad(7, "            object: Sphere(radius: 0.0),", "0.0", "positive");
+    // (Checks of a whole tuple are reported where it ends, like every direction in a scene.)
+    bad(8, "            field: Constant(direction: (0.0, 0.0, 0.0)),", ")),", "non-zero direction");
+    let field = "            field: Perturbed(field: Perturbed(field: ClosestSurface, frequency: 1.0), frequency: 2.0),";
+    bad(8, field, "Perturbed(field: Closest", "perturbed once");
+    let node = |m: &str| format!("    nodes: [(name: \"n\", hypertexture: \"h\", method: {m})],");
+    bad(15, &node("RayMarch(step: 0.0)"), "0.0", "positive");
+    bad(15, &node("RayMarch(step: 1e-9)"), "RayMarch", "expected a step of at least");
+    bad(15, &node("RayMarch(shading: Gouraud)"), "Gouraud", "PhongShadows");
+    bad(15, &node("ViewSlices(planes: 10)"), "ViewSlices", "expected RayMarch");
+    bad(15, "    nodes: [(name: \"n\", hypertexture: \"g\")],", "\"g\"", "expected one of \"h\"");
+    bad(15, "    nodes: [(name: \"n\", method: RayMarch())],", "RayMarch", "expected `hypertexture");
+    let both =
+        "    nodes: [(name: \"n\", surface: Sphere(radius: 1.0, segments: (8, 4)), hypertexture: \"h\")],";
+    bad(15, both, "\"h\"", "not both");
+}
+
+/// The binary reports a bad hypertexture with its position and exit status 1, and writes nothing.
+#[test]
+fn binary_reports_bad_hypertextures() {
+    let dir = std::env::temp_dir().join(format!("voltex-hyper-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("bad.ron");
+    std::fs::write(&path, BASE.replace("frequency: 2.0)", "frequency: 0.0)")).unwrap();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_voltex"))
+        .args(["render", path.to_str().unwrap(), "-o"])
+        .arg(dir.join("out.exr"))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.contains("bad.ron:10:") && err.contains("positive"), "{err}");
+    assert!(!dir.join("out.exr").exists());
+    std::fs::remove_dir_all(&dir).ok();
+}

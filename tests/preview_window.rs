@@ -1,0 +1,73 @@
+//! The real preview window under Xvfb with software Vulkan: it shows the scene, and after the
+//! scene file changes on disk the next frame it shows differs. Needs `xvfb-run` (package `xvfb`;
+//! `.ci/run` installs it).
+
+use std::path::Path;
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+const BIN: &str = env!("CARGO_BIN_EXE_voltex");
+
+fn wait_for(path: &Path, child: &mut std::process::Child) {
+    let deadline = Instant::now() + Duration::from_secs(60);
+    while !path.exists() {
+        if let Ok(Some(status)) = child.try_wait() {
+            panic!("the preview exited ({status}) before writing {}", path.display());
+        }
+        assert!(Instant::now() < deadline, "no {} within a minute", path.display());
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    // The PNG is written atomically; give the window a moment before the next step.
+    std::thread::sleep(Duration::from_millis(200));
+}
+
+#[test]
+fn window_shows_the_scene_and_follows_its_file() {
+    let have_xvfb =
+        Command::new("xvfb-run").arg("--help").stdout(Stdio::null()).stderr(Stdio::null()).status().is_ok();
+    assert!(have_xvfb, "xvfb-run is missing: apt-get install -y xvfb (.ci/run installs it)");
+    let dir = std::env::temp_dir().join(format!("voltex-window-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let text = std::fs::read_to_string(root.join("scenes/view_slices/flat_box.ron")).unwrap();
+    let scene = dir.join("scene.ron");
+    std::fs::write(&scene, &text).unwrap();
+    let record = dir.join("frames");
+    // Its own process group, so that the window under xvfb-run ends with it.
+    use std::os::unix::process::CommandExt;
+    let mut child = Command::new("xvfb-run")
+        .process_group(0)
+        .args(["-a", "-s", "-screen 0 1280x800x24", BIN, "preview"])
+        .arg(&scene)
+        .args(["--size", "64x64", "--quit-after", "60", "--record"])
+        .arg(&record)
+        .env("VOLTEX_ROOT", root)
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let first = record.join("frame-0.png");
+    wait_for(&first, &mut child);
+    let t = Instant::now();
+    std::fs::write(&scene, text.replacen("color: (0.8, 0.6, 0.4)", "color: (0.2, 0.4, 0.9)", 1)).unwrap();
+    let second = record.join("frame-1.png");
+    wait_for(&second, &mut child);
+    eprintln!("window: save to recorded frame in {:.0} ms", t.elapsed().as_secs_f64() * 1e3);
+    let _ = Command::new("kill").args(["-TERM", "--", &format!("-{}", child.id())]).status();
+    let out = child.wait_with_output().unwrap();
+    let (w, h, a) = voltex::io::png::read_rgba8(&first).unwrap();
+    let (_, _, b) = voltex::io::png::read_rgba8(&second).unwrap();
+    assert!(w >= 64 && h >= 64);
+    // The fog turned from orange to blue: many pixels change, blue rises.
+    let changed = a.iter().zip(&b).filter(|(p, q)| p != q).count();
+    let blue = |img: &[[u8; 4]]| img.iter().map(|p| p[2] as u64).sum::<u64>();
+    assert!(
+        changed > a.len() / 10,
+        "{changed} of {} pixels changed; stderr: {}",
+        a.len(),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(blue(&b) > blue(&a));
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -1,0 +1,33 @@
+// Per prism: slice direction (smallest (1/c^2 - 1) h^2), power-of-two level from the criteria, culling, vertex count.
+#include "shared/types.wgsl"
+
+@group(0) @binding(0) var<uniform> axis_params: AxisParams;
+@group(0) @binding(1) var<storage, read> shell_vertices: array<ShellVertex>;
+@group(0) @binding(2) var<storage, read> prisms: array<Prism>;
+@group(0) @binding(3) var<storage, read> axis_occupancy: array<u32>;
+@group(0) @binding(4) var<storage, read_write> axis_choices: array<AxisChoice>;
+
+#include "shared/axis_slices.wgsl"
+
+@compute @workgroup_size(64)
+fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let index = gid.x;
+    if (index >= axis_params.resolution.w) {
+        return;
+    }
+    var f = load_axis_frame(index);
+    var c = choose_axis(&f);
+    c.vertex_count = 0u;
+    c.vertex_offset = 0u;
+    if (axis_params.flags.z != 0u && back_facing(&f)) {
+        c.culled = 1u;
+    } else {
+        for (var j = 0u; j < c.count; j++) {
+            let g = slice_position(c, j);
+            if (slice_occupied(c, g)) {
+                c.vertex_count += slice_vertex_count(&f, c, g);
+            }
+        }
+    }
+    axis_choices[index] = c;
+}

@@ -1,0 +1,63 @@
+// Draws extruded axis-aligned slices from the slice-image arrays: binary alpha test (depth-written) or step-corrected blending.
+#include "shared/types.wgsl"
+
+// Blend semi-transparent slices back to front instead of the alpha test (set per object).
+override blended_slices: bool = false;
+
+@group(0) @binding(0) var<uniform> frame: FrameParams;
+@group(0) @binding(1) var<uniform> object: ObjectParams;
+@group(0) @binding(2) var<storage, read> axis_vertices: array<AxisVertex>;
+@group(0) @binding(3) var axis_slices_s: texture_2d_array<f32>;
+@group(0) @binding(4) var axis_slices_t: texture_2d_array<f32>;
+@group(0) @binding(5) var axis_slices_w: texture_2d_array<f32>;
+// Repeats along both image axes (w slices: s, t); the side sampler clamps the image's v (= w).
+@group(0) @binding(6) var axis_sampler: sampler;
+@group(0) @binding(7) var axis_sampler_side: sampler;
+
+struct VsOut {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) uv: vec2<f32>,
+    @location(1) rel: vec3<f32>,
+    @location(2) @interpolate(flat) layer: u32,
+    @location(3) @interpolate(flat) direction: u32,
+    @location(4) @interpolate(flat) normal: vec4<f32>,
+}
+
+@vertex
+fn vs_main(@builtin(vertex_index) index: u32) -> VsOut {
+    let v = axis_vertices[index];
+    var out: VsOut;
+    out.clip = frame.view_proj * vec4<f32>(v.position.xyz, 1.0);
+    out.uv = v.texcoord.xy;
+    out.rel = v.position.xyz;
+    out.layer = u32(v.texcoord.z + 0.5);
+    out.direction = u32(v.texcoord.w + 0.5);
+    out.normal = vec4<f32>(v.normal.xyz, v.position.w);
+    return out;
+}
+
+@fragment
+fn fs_main(in: VsOut) -> @location(0) vec4<f32> {
+    var texel: vec4<f32>;
+    if (in.direction == 2u) {
+        texel = textureSampleLevel(axis_slices_w, axis_sampler, in.uv, in.layer, 0.0);
+    } else if (in.direction == 0u) {
+        texel = textureSampleLevel(axis_slices_s, axis_sampler_side, in.uv, in.layer, 0.0);
+    } else {
+        texel = textureSampleLevel(axis_slices_t, axis_sampler_side, in.uv, in.layer, 0.0);
+    }
+    // World length of this pixel's ray through the slab the slice stands for.
+    let ray = normalize(in.rel);
+    let step = in.normal.w / max(abs(dot(ray, in.normal.xyz)), 1e-4);
+    let a = clamp(texel.a, 0.0, 1.0);
+    let corrected = 1.0 - pow(1.0 - min(a, 0.999999), step / object.opacity_length);
+    let albedo = texel.rgb / max(a, 1e-6);
+    if (!blended_slices) {
+        // Binary alpha as in the paper: the step-corrected opacity is thresholded.
+        if (corrected < 0.5) {
+            discard;
+        }
+        return vec4<f32>(albedo * frame.light_color.rgb, 1.0);
+    }
+    return vec4<f32>(albedo * corrected * frame.light_color.rgb, corrected);
+}

@@ -1,0 +1,147 @@
+// Soft objects (density 1 at the core falling to 0 on the boundary) and the vector fields of the
+// paper's Figure 8, in object space. Reads the kernel's `hyper: HyperParams`. CPU twin:
+// src/cpu/hypertexture.rs (same names).
+#include "shared/simplex.wgsl"
+
+// HyperParams.kinds.x (twins: OBJECT_* in src/hypertexture/mod.rs).
+const OBJECT_SPHERE: u32 = 0u;
+const OBJECT_ELLIPSOID: u32 = 1u;
+const OBJECT_TORUS: u32 = 2u;
+const OBJECT_BOX: u32 = 3u;
+// HyperParams.kinds.y (twins: FIELD_*).
+const FIELD_CLOSEST_SURFACE: u32 = 0u;
+const FIELD_FROM_CENTRE: u32 = 1u;
+const FIELD_CONSTANT: u32 = 2u;
+const FIELD_SWIRL: u32 = 3u;
+// Vectors shorter than this have no direction (the paper's null vector).
+const TINY: f32 = 1e-12;
+
+fn unit_or_zero(v: vec3<f32>) -> vec3<f32> {
+    let len = length(v);
+    return select(vec3<f32>(0.0), v / len, len > TINY);
+}
+
+// O(x): sphere 1 - |x| / r; ellipsoid 1 - |x / radii|; torus (axis z) 1 - (distance to the core
+// circle) / minor; box 1 - max_i |x_i| / half_i. Clamped to [0, 1].
+fn object_density(x: vec3<f32>) -> f32 {
+    let s = hyper.object;
+    var d = 0.0;
+    switch hyper.kinds.x {
+        case OBJECT_ELLIPSOID: {
+            d = 1.0 - length(x / s.xyz);
+        }
+        case OBJECT_TORUS: {
+            d = 1.0 - length(vec2<f32>(length(x.xy) - s.x, x.z)) / s.y;
+        }
+        case OBJECT_BOX: {
+            let q = abs(x) / s.xyz;
+            d = 1.0 - max(max(q.x, q.y), q.z);
+        }
+        default: {
+            d = 1.0 - length(x) / s.x;
+        }
+    }
+    return clamp(d, 0.0, 1.0);
+}
+
+// A lower bound of the distance from x to where the object's density is positive: exact for
+// the sphere, torus and box; for the ellipsoid (|x / radii| - 1) times its smallest radius.
+fn support_distance(x: vec3<f32>) -> f32 {
+    let s = hyper.object;
+    switch hyper.kinds.x {
+        case OBJECT_ELLIPSOID: {
+            return (length(x / s.xyz) - 1.0) * min(min(s.x, s.y), s.z);
+        }
+        case OBJECT_TORUS: {
+            return length(vec2<f32>(length(x.xy) - s.x, x.z)) - s.y;
+        }
+        case OBJECT_BOX: {
+            let q = abs(x) - s.xyz;
+            return length(max(q, vec3<f32>(0.0))) + min(max(max(q.x, q.y), q.z), 0.0);
+        }
+        default: {
+            return length(x) - s.x;
+        }
+    }
+}
+
+// The closest point of the object's boundary (ellipsoid: the radial projection, exact on its
+// axes). Where it is not unique and has no preferred direction (a sphere's centre, a torus's core
+// circle) x itself, so the field vanishes there.
+fn closest_surface_point(x: vec3<f32>) -> vec3<f32> {
+    let s = hyper.object;
+    switch hyper.kinds.x {
+        case OBJECT_ELLIPSOID: {
+            let k = length(x / s.xyz);
+            return select(x, x / k, k > TINY);
+        }
+        case OBJECT_TORUS: {
+            let r = length(x.xy);
+            let around = select(vec2<f32>(1.0, 0.0), x.xy / r, r > TINY);
+            let ring = vec3<f32>(around * s.x, 0.0);
+            let q = x - ring;
+            let len = length(q);
+            return select(x, ring + q * (s.y / len), len > TINY);
+        }
+        case OBJECT_BOX: {
+            let h = s.xyz;
+            let a = abs(x);
+            if (any(a > h)) {
+                return clamp(x, -h, h);
+            }
+            // Inside: onto the nearest face.
+            let gap = h - a;
+            let side = select(vec3<f32>(-1.0), vec3<f32>(1.0), x >= vec3<f32>(0.0));
+            var p = x;
+            if (gap.x <= gap.y && gap.x <= gap.z) {
+                p.x = side.x * h.x;
+            } else if (gap.y <= gap.z) {
+                p.y = side.y * h.y;
+            } else {
+                p.z = side.z * h.z;
+            }
+            return p;
+        }
+        default: {
+            let len = length(x);
+            return select(x, x * (s.x / len), len > TINY);
+        }
+    }
+}
+
+// The unperturbed field: towards the closest surface point; away from a shifted centre (inside the
+// object, towards it outside) with the closest-surface length; a constant vector; or the
+// closest-surface vector turned around an axis by `twist` (its tangential part over its length).
+fn base_field(x: vec3<f32>) -> vec3<f32> {
+    let c = closest_surface_point(x) - x;
+    switch hyper.kinds.y {
+        case FIELD_FROM_CENTRE: {
+            let side = select(-1.0, 1.0, object_density(x) > 0.0);
+            return unit_or_zero(x - hyper.field.xyz) * (side * length(c));
+        }
+        case FIELD_CONSTANT: {
+            return hyper.field.xyz;
+        }
+        case FIELD_SWIRL: {
+            let around = unit_or_zero(cross(hyper.field.xyz, x - hyper.field_center.xyz));
+            return c + around * (hyper.field.w * length(c));
+        }
+        default: {
+            return c;
+        }
+    }
+}
+
+// V(x): the base field, perturbed when `perturb.y` (a frequency) is positive: its direction by a
+// vector noise scaled by `perturb.x` times its length, its length by 1 + perturb.z * noise.
+fn vector_field(x: vec3<f32>) -> vec3<f32> {
+    var v = base_field(x);
+    let p = hyper.perturb;
+    if (p.y > 0.0) {
+        let q = x * p.y;
+        let seed = hyper.kinds.w;
+        let n = vec3<f32>(simplex3(q, seed), simplex3(q, seed + 1u), simplex3(q, seed + 2u));
+        v = (v + n * (p.x * length(v))) * (1.0 + p.z * simplex3(q, seed + 3u));
+    }
+    return v;
+}

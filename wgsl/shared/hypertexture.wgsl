@@ -1,0 +1,63 @@
+// The hypertexture density of Gilet & Dischler 2009 (eq. 3 to 5) and its RGBA transfer function.
+// Reads the kernel's `hyper`, `hyper_noises` and `transfer_tables`. CPU twin:
+// src/cpu/hypertexture.rs (same names).
+#include "shared/fields.wgsl"
+#include "shared/transfer.wgsl"
+
+// O(x - k V/|V|) with k combining the noises in order from 0: noise i gives
+// t_i = T_i((1 + noise(f_i (x + r_i V))) / 2) and then k += a_i t_i (Sum) or
+// k = k (1 - t_i) + a_i t_i (Blend); the noise is 4D when `animated`. Noise i's shape table is
+// table i. One loop iteration per noise.
+// Evaluations of `hyper_density` that ran the noises, for benchmarks (per invocation).
+var<private> noised_evaluations: u32;
+// Benchmarks only: every noise reads 0 (and is compiled out), to measure what noise costs.
+override noise_off: bool = false;
+// Animated hypertextures: every noise is 4D, its fourth coordinate speed times the frame's time
+// (`hyper.march.w`); set when some noise of the object has a speed.
+override animated: bool = false;
+
+// Points farther than the largest shift (`hyper.march.z`) from the object have density 0
+// whatever the noises say (|k V/|V|| <= sum of amplitudes): they skip the noises.
+fn hyper_density(x: vec3<f32>) -> f32 {
+    if (support_distance(x) > hyper.march.z) {
+        return 0.0;
+    }
+    noised_evaluations += 1u;
+    let v = vector_field(x);
+    let dir = unit_or_zero(v);
+    var k = 0.0;
+    for (var i = 0u; i < hyper.kinds.z; i++) {
+        let n = hyper_noises[i];
+        var value = 0.0;
+        let q = (x + n.shift * v) * n.frequency;
+        if (animated && !noise_off) {
+            value = simplex4(vec4<f32>(q, n.speed * hyper.march.w), n.seed);
+        } else if (!noise_off) {
+            value = simplex3(q, n.seed);
+        }
+        let t = transfer_lookup(i, 0.5 + 0.5 * value);
+        if (n.blend != 0u) {
+            k = k * (1.0 - t) + n.amplitude * t;
+        } else {
+            k += n.amplitude * t;
+        }
+    }
+    return object_density(x - k * dir);
+}
+
+// Colour (straight rgb) and opacity per opacity length at a density: the four tables after the
+// noises' shape tables.
+fn hyper_color(density: f32) -> vec4<f32> {
+    let first = hyper.kinds.z;
+    return vec4<f32>(
+        transfer_lookup(first, density),
+        transfer_lookup(first + 1u, density),
+        transfer_lookup(first + 2u, density),
+        transfer_lookup(first + 3u, density),
+    );
+}
+
+// Opacity per opacity length at a density (the colour transfer's fourth table).
+fn hyper_opacity(density: f32) -> f32 {
+    return transfer_lookup(hyper.kinds.z + 3u, density);
+}
