@@ -1,14 +1,13 @@
 // Blends a RayMarch object's premultiplied layer (its per-pixel march state) over the frame.
 #include "shared/types.wgsl"
+#include "shared/fullscreen.wgsl"
 
 @group(0) @binding(0) var<uniform> frame: FrameParams;
 @group(0) @binding(1) var<storage, read> ray_march_state: array<MarchState>;
 
 @vertex
 fn vs_main(@builtin(vertex_index) index: u32) -> @builtin(position) vec4<f32> {
-    // One triangle covering the viewport.
-    let uv = vec2<f32>(f32((index << 1u) & 2u), f32(index & 2u));
-    return vec4<f32>(uv * 2.0 - 1.0, 0.0, 1.0);
+    return fullscreen_position(index);
 }
 
 @fragment

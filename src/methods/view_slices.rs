@@ -150,17 +150,7 @@ pub fn add_inputs(
     trivial_reject: bool,
 ) {
     use crate::bake::{storage, uniform};
-    let buffer = |label: &str, size: u64, extra: wgpu::BufferUsages| {
-        ctx.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some(label),
-            size: size.max(16),
-            usage: wgpu::BufferUsages::STORAGE
-                | wgpu::BufferUsages::COPY_DST
-                | wgpu::BufferUsages::COPY_SRC
-                | extra,
-            mapped_at_creation: false,
-        })
-    };
+    let buffer = |label: &str, size: u64, extra| crate::bake::work_buffer(ctx, label, size, extra);
     let b = &mut inputs.buffers;
     b.insert("slice_params".into(), uniform(ctx, "slice_params", bytemuck::bytes_of(params)));
     b.insert("shell_vertices".into(), storage(ctx, "shell_vertices", bytemuck::cast_slice(&shell.vertices)));
