@@ -70,6 +70,15 @@ enum Command {
         #[command(flatten)]
         overrides: Overrides,
     },
+    /// Compare two EXR images: FLIP, relative RMSE, largest difference and non-finite pixels;
+    /// optionally write a FLIP heat map (no GPU needed).
+    Compare {
+        actual: PathBuf,
+        reference: PathBuf,
+        /// Write the FLIP error heat map here (PNG).
+        #[arg(long)]
+        diff: Option<PathBuf>,
+    },
     /// Print the bakes, passes, pipelines and GPU memory a scene will use (no GPU needed).
     Plan {
         scene: PathBuf,
@@ -205,6 +214,7 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Render { scene, output, overrides } => render(&scene, output, &overrides),
+        Command::Compare { actual, reference, diff } => compare(&actual, &reference, diff.as_deref()),
         Command::Plan { scene, overrides } => plan(&scene, &overrides),
         Command::Preview { scene, overrides, record, quit_after, view } => {
             use voltex::preview::present::Mode;
@@ -245,6 +255,27 @@ fn main() -> ExitCode {
             ExitCode::FAILURE
         }
     }
+}
+
+fn compare(actual: &Path, reference: &Path, diff: Option<&Path>) -> voltex::Result<()> {
+    use voltex::metrics;
+    let (a, _) = voltex::io::exr::read(actual)?;
+    let (r, _) = voltex::io::exr::read(reference)?;
+    let flip = metrics::flip(&a, &r)?;
+    println!("FLIP (mean)         {:.5}", flip.mean);
+    println!("relative RMSE       {:.5}", metrics::relative_rmse(&a, &r)?);
+    println!("largest difference  {:.3e}", metrics::max_abs_diff(&a, &r)?);
+    println!("non-finite pixels   {} / {}", metrics::count_nonfinite(&a), metrics::count_nonfinite(&r));
+    if let Some(path) = diff {
+        voltex::io::png::write_rgba8(
+            path,
+            a.width,
+            a.height,
+            &metrics::diff_heatmap(&flip.map, a.width, a.height),
+        )?;
+        println!("heat map            {}", path.display());
+    }
+    Ok(())
 }
 
 /// Mesa prints "XDG_RUNTIME_DIR is invalid" on every device unless that variable names a private

@@ -508,3 +508,33 @@ fn plan_of_a_bad_scene_fails_like_render() {
     let loc = format!("{}:{}: ", scene.display(), line_col(&text, "NaN"));
     assert_fails(&out, &dir, &[&loc]);
 }
+
+/// `voltex compare`: an image against itself is error-free, against another image it is not, and
+/// a missing file is an error naming it.
+#[test]
+fn compare_images() {
+    let dir = temp_dir("compare");
+    let golden = root().join("tests/golden");
+    let (a, b) = (golden.join("view_slices_torus_egg.exr"), golden.join("view_slices_terrain.exr"));
+    let heat = dir.join("out/heat.png");
+    let same = voltex(&["compare", a.to_str().unwrap(), a.to_str().unwrap()], None);
+    assert!(same.status.success(), "{}", stderr(&same));
+    let text = String::from_utf8_lossy(&same.stdout).to_string();
+    assert!(
+        text.contains("FLIP (mean)         0.00000") && text.contains("largest difference  0.000e0"),
+        "{text}"
+    );
+    let other = voltex(
+        &["compare", a.to_str().unwrap(), b.to_str().unwrap(), "--diff", heat.to_str().unwrap()],
+        None,
+    );
+    assert!(other.status.success(), "{}", stderr(&other));
+    let text = String::from_utf8_lossy(&other.stdout).to_string();
+    let flip: f64 = text.lines().next().unwrap().split_whitespace().last().unwrap().parse().unwrap();
+    assert!(flip > 0.05, "{text}");
+    assert!(heat.is_file());
+    let missing = dir.join("nothing.exr");
+    let out = voltex(&["compare", missing.to_str().unwrap(), a.to_str().unwrap()], None);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(stderr(&out).contains("nothing.exr"), "{}", stderr(&out));
+}

@@ -84,14 +84,21 @@ fn compare(shell: &Shell, params: &SliceParams, trivial_reject: bool, ambiguous:
                 continue;
             }
             for (a, b) in gv.iter().zip(&cv) {
+                // Signed distances carry a rounding error relative to the plane offset |d|, which
+                // a crossing on an edge nearly parallel to the plane magnifies; fused
+                // multiply-adds on real GPUs round differently from the twin (seen on an H100).
+                let slack = 1.0 + d.abs();
                 for i in 0..3 {
                     worst = worst.max((a.position[i] - b.position[i]).abs());
-                    let tol = 1e-5 * (1.0 + b.position[i].abs());
+                    let tol = 1e-5 * (1.0 + b.position[i].abs()) * slack;
                     assert!(
                         (a.position[i] - b.position[i]).abs() <= tol,
                         "plane {k} prism {p}: {a:?} vs {b:?}"
                     );
-                    assert!((a.uvw[i] - b.uvw[i]).abs() <= 1e-5, "plane {k} prism {p}: {a:?} vs {b:?}");
+                    assert!(
+                        (a.uvw[i] - b.uvw[i]).abs() <= 3e-5 * slack,
+                        "plane {k} prism {p}: {a:?} vs {b:?}"
+                    );
                 }
                 assert!(a.position.iter().chain(&a.uvw).all(|x| x.is_finite()));
             }

@@ -1,5 +1,5 @@
 //! Host side of the bake kernels: a texel source becomes an RGBA texel volume (3D texture,
-//! premultiplied `rgba8unorm`, full mip chain), plus a normal volume when a per-pixel-lit object
+//! premultiplied `rgba8unorm`, level 0 only: every method samples it at full resolution), plus a normal volume when a per-pixel-lit object
 //! uses it. Only texels some object draws are baked, each (texel, lighting) pair once.
 
 pub mod axis_slices;
@@ -44,40 +44,23 @@ pub struct Baked {
     pub axis: Option<axis_slices::AxisBaked>,
 }
 
-pub fn mip_count(res: [u32; 3]) -> u32 {
-    32 - res.iter().max().copied().unwrap_or(1).max(1).leading_zeros()
-}
-
-fn mip_size(res: [u32; 3], level: u32) -> [u32; 3] {
-    res.map(|r| (r >> level).max(1))
-}
-
-/// Bytes a bake allocates on the GPU (volume with mips, plus normals at full resolution).
+/// Bytes a bake allocates on the GPU (volume, plus normals at the same resolution).
 pub fn bytes(res: [u32; 3], per_pixel: bool) -> u64 {
-    let volume: u64 =
-        (0..mip_count(res)).map(|l| mip_size(res, l).iter().map(|&x| x as u64).product::<u64>() * 4).sum();
-    let normals = if per_pixel { res.iter().map(|&x| x as u64).product::<u64>() * 4 } else { 4 };
-    volume + normals
+    let volume = res.iter().map(|&x| x as u64).product::<u64>() * 4;
+    volume + if per_pixel { volume } else { 4 }
 }
 
 /// The bake kernels, loaded once and reused for every texel.
 pub struct Baker {
     implicit: Option<ComputeKernel>,
     heightfield: Option<ComputeKernel>,
-    downsample: Option<ComputeKernel>,
     axis: Option<ComputeKernel>,
     wgsl_root: std::path::PathBuf,
 }
 
 impl Baker {
     pub fn new(wgsl_root: &Path) -> Self {
-        Self {
-            implicit: None,
-            heightfield: None,
-            downsample: None,
-            axis: None,
-            wgsl_root: wgsl_root.to_path_buf(),
-        }
+        Self { implicit: None, heightfield: None, axis: None, wgsl_root: wgsl_root.to_path_buf() }
     }
 
     fn kernel<'a>(
@@ -100,11 +83,9 @@ impl Baker {
                 req.resolution
             )));
         }
-        let mips = mip_count(req.resolution);
-        let volume =
-            volume_texture(ctx, "texel volume", req.resolution, mips, wgpu::TextureFormat::Rgba8Unorm);
+        let volume = volume_texture(ctx, "texel volume", req.resolution, wgpu::TextureFormat::Rgba8Unorm);
         let normals_res = if req.per_pixel { req.resolution } else { [1, 1, 1] };
-        let normals = volume_texture(ctx, "texel normals", normals_res, 1, wgpu::TextureFormat::Rgba8Snorm);
+        let normals = volume_texture(ctx, "texel normals", normals_res, wgpu::TextureFormat::Rgba8Snorm);
         let params = crate::cpu::bake::bake_params(req.resolution, 0, req.light, req.ambient);
         let mut inputs = Inputs::default();
         inputs.constants.push(("per_pixel_lighting".into(), req.per_pixel as u32 as f64));
@@ -154,13 +135,6 @@ impl Baker {
                 )?;
             }
         }
-        let down = Self::kernel(&mut self.downsample, ctx, &root, "downsample_volume.wgsl")?;
-        for level in 1..mips {
-            let mut mip = Inputs::default();
-            mip.views.insert("source".into(), level_view(&volume, level - 1));
-            mip.views.insert("destination".into(), level_view(&volume, level));
-            down.dispatch(ctx, &mut encoder, &mip, mip_size(req.resolution, level))?;
-        }
         let axis = match req.axis_slices {
             true => {
                 let kernel = Self::kernel(&mut self.axis, ctx, &root, "bake_axis_slices.wgsl")?;
@@ -178,13 +152,12 @@ fn volume_texture(
     ctx: &GpuContext,
     label: &str,
     res: [u32; 3],
-    mips: u32,
     format: wgpu::TextureFormat,
 ) -> wgpu::Texture {
     ctx.device.create_texture(&wgpu::TextureDescriptor {
         label: Some(label),
         size: wgpu::Extent3d { width: res[0], height: res[1], depth_or_array_layers: res[2] },
-        mip_level_count: mips,
+        mip_level_count: 1,
         sample_count: 1,
         dimension: wgpu::TextureDimension::D3,
         format,

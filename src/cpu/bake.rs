@@ -1,5 +1,4 @@
-//! CPU twins of the bake kernels (`wgsl/bake_implicit.wgsl`, `wgsl/bake_heightfield.wgsl`,
-//! `wgsl/downsample_volume.wgsl`) and of `wgsl/shared/{noise,shading}.wgsl`: same names, same
+//! CPU twins of the bake kernels (`wgsl/bake_implicit.wgsl`, `wgsl/bake_heightfield.wgsl`) and of `wgsl/shared/{noise,shading}.wgsl`: same names, same
 //! f32 math, so tests can compare GPU bakes against these voxel by voxel (up to 8-bit storage).
 //! Also the constructors that pack shapes into the GPU structs.
 
@@ -288,7 +287,7 @@ pub fn bake_heightfield_voxel(
     (rgba, normal)
 }
 
-// ---- volumes and downsample_volume.wgsl ----
+// ---- volumes ----
 
 /// A CPU RGBA volume, x fastest: texel (x,y,z) at `x + X * (y + Y * z)`.
 #[derive(Clone, Debug, PartialEq)]
@@ -316,28 +315,6 @@ impl Volume {
         }
         Volume { size, texels }
     }
-}
-
-/// Mip size below `size` (halved, at least 1), as wgpu sizes mips.
-pub fn mip_size(size: [u32; 3]) -> [u32; 3] {
-    size.map(|s| (s / 2).max(1))
-}
-
-/// `downsample_volume.wgsl`: 2x2x2 box filter, source coordinates clamped for odd sizes.
-pub fn downsample(source: &Volume) -> Volume {
-    let last = source.size.map(|s| s - 1);
-    Volume::from_fn(mip_size(source.size), |id| {
-        let mut sum = [0.0f32; 4];
-        for k in 0..8u32 {
-            let offset = [k & 1, (k >> 1) & 1, (k >> 2) & 1];
-            let c = [0, 1, 2].map(|i| (2 * id[i] + offset[i]).min(last[i]));
-            let t = source.get(c);
-            for (s, t) in sum.iter_mut().zip(t) {
-                *s += t;
-            }
-        }
-        sum.map(|s| s * 0.125)
-    })
 }
 
 /// Whole-volume CPU bakes (for comparisons): (rgba, normals with w = 0).

@@ -272,35 +272,15 @@ fn shading_with_the_light_along_the_normal_gives_the_albedo() {
     assert_eq!(gradient_normal([0.0; 3]), [0.0, 0.0, 1.0]);
 }
 
-#[test]
-fn downsample_of_a_constant_volume_is_constant() {
-    let value = [0.2, 0.4, 0.1, 0.5];
-    for size in [[8, 8, 8], [5, 3, 1], [1, 1, 7]] {
-        let v = Volume::from_fn(size, |_| value);
-        let d = downsample(&v);
-        assert_eq!(d.size, mip_size(size));
-        assert_eq!(d.texels.len(), d.size.iter().product::<u32>() as usize);
-        for t in &d.texels {
-            for i in 0..4 {
-                assert!(close(t[i], value[i], 1e-7));
-            }
-        }
-    }
-    // A box filter averages the eight children.
-    let v = Volume::from_fn([2, 2, 2], |p| [(p[0] + 2 * p[1] + 4 * p[2]) as f32; 4]);
-    assert_eq!(downsample(&v).texels, vec![[3.5; 4]]);
-}
-
 /// The bake kernels validate with naga, use the agreed global names and workgroup size, and their
 /// shared structs have the Rust layouts.
 #[test]
 fn bake_kernels_validate_and_match_the_contract() {
     use naga::{AddressSpace, TypeInner};
     let root = crate::project_root().join("wgsl");
-    let kernels: [(&str, &[&str]); 3] = [
+    let kernels: [(&str, &[&str]); 2] = [
         ("bake_implicit.wgsl", &["bake_params", "shapes", "balls", "volume", "normals"]),
         ("bake_heightfield.wgsl", &["bake_params", "heightfield", "volume", "normals"]),
-        ("downsample_volume.wgsl", &["source", "destination"]),
     ];
     for (file, globals) in kernels {
         let k = crate::gpu::shader::load(&root, file).unwrap_or_else(|e| panic!("{e}"));

@@ -26,7 +26,7 @@ impl Blueprint {
             let r = b.request.resolution;
             out.push((
                 format!(
-                    "texel {} {}x{}x{} rgba8 + mips{}",
+                    "texel {} {}x{}x{} rgba8{}",
                     b.texel,
                     r[0],
                     r[1],
@@ -116,12 +116,11 @@ impl Blueprint {
                 BakeSource::Heightfield(_) => "bake_heightfield.wgsl",
             };
             s += &format!(
-                "  {:<16} {}x{}x{}  {kind} + downsample_volume.wgsl x{}  lighting {}\n",
+                "  {:<16} {}x{}x{}  {kind}  lighting {}\n",
                 b.texel,
                 r[0],
                 r[1],
                 r[2],
-                bake::mip_count(r) - 1,
                 if b.request.per_pixel { "per-pixel (albedo + normals)" } else { "baked" }
             );
             if b.request.axis_slices {

@@ -44,7 +44,7 @@ pub struct RenderOptions {
     pub camera: Option<Camera>,
     /// Render at `n` times the width and height and average each `n x n` block: every pixel is
     /// then the mean over its area rather than a point sample (anti-aliasing; a reference for
-    /// methods that filter textures by the pixel footprint, as mipmaps do).
+    /// methods that filter by the pixel footprint).
     pub supersample: Option<u32>,
     /// Time of the frame in seconds (animated hypertextures; default: the scene's).
     pub time: Option<f64>,
