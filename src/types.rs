@@ -157,10 +157,29 @@ pub struct HeightfieldParams {
     pub base: f32,
     /// Opacity per opacity length of the filled region.
     pub opacity: f32,
-    pub _pad1: f32,
+    /// Darkening with depth (Meyer & Neyret 3.2): albedo times `1 - darkening * (top - w) / top`,
+    /// `top` the highest possible height.
+    pub darkening: f32,
     /// rgb: albedo at w = 0; a: unused.
     pub color_low: [f32; 4],
     /// rgb: albedo at w = base + amplitude (the highest possible height); a: unused.
+    pub color_high: [f32; 4],
+}
+
+/// A height field from a grey-level image (`heights`, row-major from the top row, values in
+/// [0,1]). Mirrored as `HeightImageParams` in `wgsl/shared/types.wgsl`. Height
+/// `h(s,t) = base + amplitude * image(s,t)`, bilinear with wrapping.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct HeightImageParams {
+    pub width: u32,
+    pub height: u32,
+    pub _pad0: [u32; 2],
+    pub amplitude: f32,
+    pub base: f32,
+    pub opacity: f32,
+    pub darkening: f32,
+    pub color_low: [f32; 4],
     pub color_high: [f32; 4],
 }
 

@@ -166,6 +166,54 @@ fn slice_image_bake_matches_its_twin() {
     assert!(coarsest_alpha > 0.0);
 }
 
+/// The height-image bake kernel against its twin on the example's cobbles, with darkening: every
+/// voxel within one 8-bit step but where the surface crosses it (coverage is steep there).
+#[test]
+fn height_image_bake_matches_its_twin() {
+    let img =
+        scene::HeightImage::load(&voltex::project_root().join("scenes/meyer_neyret/cobbles.png")).unwrap();
+    let hi = voltex::types::HeightImageParams {
+        width: img.width as u32,
+        height: img.height as u32,
+        amplitude: 0.8,
+        base: 0.1,
+        opacity: 0.9,
+        darkening: 0.7,
+        color_low: [0.25, 0.22, 0.2, 0.0],
+        color_high: [0.75, 0.7, 0.62, 0.0],
+        ..Default::default()
+    };
+    let res = [32, 32, 16];
+    let (light, ambient) = ([0.3, 0.4, 0.8], 0.3);
+    let request = BakeRequest {
+        resolution: res,
+        source: BakeSource::HeightImage(hi, voltex::bake::Heights(std::sync::Arc::new(img.data.clone()))),
+        per_pixel: false,
+        light,
+        ambient,
+        axis_slices: false,
+    };
+    let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
+    let baked = Baker::new(&voltex::project_root().join("wgsl")).bake(&ctx, &request).unwrap();
+    let gpu = voltex::bake::axis_slices::read_texture(&ctx, &baked.volume, 4).unwrap();
+    drop(ctx);
+    let params = voltex::cpu::bake::bake_params(res, 0, light, ambient);
+    let (mut off, mut worst, mut filled) = (0, 0, 0);
+    for (i, g) in gpu.chunks_exact(4).enumerate() {
+        let i = i as u32;
+        let voxel = [i % res[0], (i / res[0]) % res[1], i / (res[0] * res[1])];
+        let (c, _) = voltex::cpu::bake::bake_height_image_voxel(&params, &hi, &img.data, voxel, false);
+        let d = (0..4).map(|k| (g[k] as i32 - (c[k] * 255.0).round() as i32).abs()).max().unwrap();
+        worst = worst.max(d);
+        off += (d > 1) as u32;
+        filled += (g[3] > 0) as u32;
+    }
+    let n = res.iter().product::<u32>();
+    eprintln!("height image bake: {off} of {n} voxels differ by more than one step (worst {worst})");
+    assert!(filled > n / 4 && filled < n, "some voxels filled, some empty ({filled})");
+    assert!(off * 200 < n && worst <= 16, "{off} voxels off, worst {worst}");
+}
+
 /// Renders `scene` with `opts`, returning the image and, per prism, GPU and twin choices.
 fn gpu_and_twin(scene: &Path, opts: &RenderOptions) -> usize {
     let scene = scene::load(scene).unwrap();

@@ -188,3 +188,29 @@ fn example_scenes_load_and_flatten() {
     }
     assert!(count >= 4);
 }
+
+/// `ImageHeight` texels: a missing image, a file that is no PNG and a channel the image lacks are
+/// errors naming the file (and `line:col` in the scene).
+#[test]
+fn image_height_errors() {
+    let source = |channel: u32| {
+        format!(
+            r#"        "t": (resolution: (8, 8, 8), source: ImageHeight(image: "h.png", channel: {channel}, amplitude: 0.5, color_low: (0.1, 0.1, 0.1), color_high: (0.9, 0.9, 0.9))),"#
+        )
+    };
+    let text = with_lines(&[(6, &source(0))]);
+    assert_err_files("hmissing", &text, &[], "scene.ron", 6, 65, "expected a PNG file");
+    let (_, r) = load("hgarbage", &text, &[("h.png", "not an image")]);
+    let e = r.expect_err("a text file is no PNG").to_string();
+    assert!(e.contains("h.png") && e.contains("expected a PNG image"), "{e}");
+    let dir = temp_dir("hchannel");
+    std::fs::copy(voltex::project_root().join("scenes/meyer_neyret/cobbles.png"), dir.join("h.png")).unwrap();
+    let path = dir.join("scene.ron");
+    std::fs::write(&path, with_lines(&[(6, &source(2))])).unwrap();
+    let e = scene::load(&path).expect_err("a grey image has one channel").to_string();
+    assert!(e.starts_with(&format!("{}:6:65: ", path.display())), "{e}");
+    assert!(e.contains("expected a channel in 0..1"), "{e}");
+    std::fs::write(&path, with_lines(&[(6, &source(0))])).unwrap();
+    let s = scene::load(&path).unwrap();
+    assert_eq!(s.image("h.png").map(|i| (i.width, i.height, i.channels)), Some((64, 64, 1)));
+}

@@ -2,6 +2,7 @@
 #include "shared/types.wgsl"
 #include "shared/noise.wgsl"
 #include "shared/shading.wgsl"
+#include "shared/height_voxel.wgsl"
 
 // true: rgb is the unshaded albedo and `normals` receives N (per-pixel lighting by the renderer);
 // false: rgb is Lambert-shaded with bake_params.light and `normals` is not written.
@@ -18,32 +19,12 @@ fn heightfield_sample(hf: HeightfieldParams, st: vec2<f32>) -> vec3<f32> {
     return vec3<f32>(hf.base + hf.amplitude * (0.5 + 0.5 * n.x), 0.5 * hf.amplitude * n.yz);
 }
 
-struct BakedVoxel {
-    rgba: vec4<f32>, // premultiplied
-    normal: vec3<f32>,
-}
-
 fn bake_heightfield_voxel(hf: HeightfieldParams, voxel: vec3<u32>) -> BakedVoxel {
     let res = bake_params.resolution.xyz;
     let p = (vec3<f32>(voxel) + 0.5) / vec3<f32>(res);
     let voxel_size = 1.0 / f32(max(res.x, max(res.y, res.z)));
-    let h = heightfield_sample(hf, p.xy);
-    // F = w - h(s,t) is negative inside; its gradient (-dh/ds, -dh/dt, 1) is the outward normal and
-    // F / |grad F| the distance to the surface to first order.
-    let g = vec3<f32>(-h.y, -h.z, 1.0);
-    let d = (p.z - h.x) / length(g);
-    var out: BakedVoxel;
-    out.normal = gradient_normal(g);
-    let coverage = clamp(0.5 - d / voxel_size, 0.0, 1.0);
-    let alpha = clamp(hf.opacity * coverage, 0.0, 1.0);
-    // Colour by height: color_low at w = 0, color_high at the highest possible height.
-    let top = max(hf.base + hf.amplitude, 1.0e-6);
-    var rgb = mix(hf.color_low.rgb, hf.color_high.rgb, clamp(p.z / top, 0.0, 1.0));
-    if (!per_pixel_lighting) {
-        rgb = shade_lambert(rgb, out.normal, bake_params.light);
-    }
-    out.rgba = vec4<f32>(clamp(rgb, vec3<f32>(0.0), vec3<f32>(1.0)) * alpha, alpha);
-    return out;
+    return height_voxel(heightfield_sample(hf, p.xy), p, voxel_size, hf.opacity, hf.darkening,
+                        hf.color_low.rgb, hf.color_high.rgb, hf.base + hf.amplitude);
 }
 
 @compute @workgroup_size(4, 4, 4)

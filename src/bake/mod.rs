@@ -13,13 +13,28 @@ use crate::error::{Error, Result};
 use crate::gpu::kernel::ComputeKernel;
 use crate::gpu::GpuContext;
 use crate::graph::exec::Inputs;
-use crate::types::{BakeParams, HeightfieldParams};
+use crate::types::{BakeParams, HeightImageParams, HeightfieldParams};
 
 /// What a bake kernel evaluates.
 #[derive(Debug)]
 pub enum BakeSource {
     Implicit(PackedShapes),
     Heightfield(HeightfieldParams),
+    HeightImage(HeightImageParams, Heights),
+}
+
+/// The heights of a height image (row-major from the top row), shown in `Debug` (and so in the
+/// bake cache's content key) by a digest of the values rather than the values themselves.
+#[derive(Clone)]
+pub struct Heights(pub std::sync::Arc<Vec<f32>>);
+
+impl std::fmt::Debug for Heights {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        use std::hash::{Hash, Hasher};
+        let mut h = std::collections::hash_map::DefaultHasher::new();
+        self.0.iter().for_each(|v| v.to_bits().hash(&mut h));
+        write!(f, "Heights({} values, digest {:016x})", self.0.len(), h.finish())
+    }
 }
 
 #[derive(Debug)]
@@ -54,13 +69,20 @@ pub fn bytes(res: [u32; 3], per_pixel: bool) -> u64 {
 pub struct Baker {
     implicit: Option<ComputeKernel>,
     heightfield: Option<ComputeKernel>,
+    height_image: Option<ComputeKernel>,
     axis: Option<ComputeKernel>,
     wgsl_root: std::path::PathBuf,
 }
 
 impl Baker {
     pub fn new(wgsl_root: &Path) -> Self {
-        Self { implicit: None, heightfield: None, axis: None, wgsl_root: wgsl_root.to_path_buf() }
+        Self {
+            implicit: None,
+            heightfield: None,
+            height_image: None,
+            axis: None,
+            wgsl_root: wgsl_root.to_path_buf(),
+        }
     }
 
     fn kernel<'a>(
@@ -128,6 +150,24 @@ impl Baker {
                     .buffers
                     .insert("heightfield".into(), uniform(ctx, "heightfield", bytemuck::bytes_of(hf)));
                 Self::kernel(&mut self.heightfield, ctx, &root, "bake_heightfield.wgsl")?.dispatch(
+                    ctx,
+                    &mut encoder,
+                    &inputs,
+                    req.resolution,
+                )?;
+            }
+            BakeSource::HeightImage(hi, heights) => {
+                inputs
+                    .buffers
+                    .insert("bake_params".into(), uniform(ctx, "bake_params", bytemuck::bytes_of(&params)));
+                inputs
+                    .buffers
+                    .insert("height_image".into(), uniform(ctx, "height_image", bytemuck::bytes_of(hi)));
+                inputs.buffers.insert(
+                    "heights".into(),
+                    storage(ctx, "heights", bytemuck::cast_slice(heights.0.as_slice())),
+                );
+                Self::kernel(&mut self.height_image, ctx, &root, "bake_height_image.wgsl")?.dispatch(
                     ctx,
                     &mut encoder,
                     &inputs,

@@ -2,7 +2,7 @@
 //! f32 math, so tests can compare GPU bakes against these voxel by voxel (up to 8-bit storage).
 //! Also the constructors that pack shapes into the GPU structs.
 
-use crate::types::{BakeParams, HeightfieldParams, ImplicitShape};
+use crate::types::{BakeParams, HeightImageParams, HeightfieldParams, ImplicitShape};
 
 /// `ImplicitShape::kind` values; mirrored as `SHAPE_*` consts in `wgsl/bake_implicit.wgsl`.
 pub const SPHERE: u32 = 0;
@@ -268,6 +268,37 @@ pub fn heightfield_sample(hf: &HeightfieldParams, st: [f32; 2]) -> [f32; 3] {
     [hf.base + hf.amplitude * (0.5 + 0.5 * v), 0.5 * hf.amplitude * g[0], 0.5 * hf.amplitude * g[1]]
 }
 
+/// What `shared/height_voxel.wgsl` takes besides the height sample and the voxel.
+pub struct HeightLook {
+    pub opacity: f32,
+    pub darkening: f32,
+    pub color_low: [f32; 4],
+    pub color_high: [f32; 4],
+    /// The highest possible height.
+    pub top: f32,
+}
+
+/// `shared/height_voxel.wgsl`: (premultiplied rgba, outward normal) of the voxel at `p` below or
+/// above the height sample `h = (h, dh/ds, dh/dt)`.
+pub fn height_voxel(
+    params: &BakeParams,
+    h: [f32; 3],
+    p: V3,
+    voxel_size: f32,
+    look: &HeightLook,
+    per_pixel: bool,
+) -> ([f32; 4], [f32; 3]) {
+    let g = [-h[1], -h[2], 1.0];
+    let d = (p[2] - h[0]) / length(g);
+    let normal = gradient_normal(g);
+    let top = look.top.max(1.0e-6);
+    let f = (p[2] / top).clamp(0.0, 1.0);
+    let dark = (1.0 - look.darkening * ((top - p[2]) / top).clamp(0.0, 1.0)).clamp(0.0, 1.0);
+    let albedo = [0, 1, 2].map(|i| (look.color_low[i] + (look.color_high[i] - look.color_low[i]) * f) * dark);
+    let rgba = finish(albedo, look.opacity, normal, d, voxel_size, params.light, per_pixel);
+    (rgba, normal)
+}
+
 /// One voxel of `bake_heightfield.wgsl`: (premultiplied rgba, outward normal).
 pub fn bake_heightfield_voxel(
     params: &BakeParams,
@@ -276,15 +307,62 @@ pub fn bake_heightfield_voxel(
     per_pixel: bool,
 ) -> ([f32; 4], [f32; 3]) {
     let (p, voxel_size) = voxel_centre(params.resolution, voxel);
-    let h = heightfield_sample(hf, [p[0], p[1]]);
-    let g = [-h[1], -h[2], 1.0];
-    let d = (p[2] - h[0]) / length(g);
-    let normal = gradient_normal(g);
-    let top = (hf.base + hf.amplitude).max(1.0e-6);
-    let f = (p[2] / top).clamp(0.0, 1.0);
-    let albedo = [0, 1, 2].map(|i| hf.color_low[i] + (hf.color_high[i] - hf.color_low[i]) * f);
-    let rgba = finish(albedo, hf.opacity, normal, d, voxel_size, params.light, per_pixel);
-    (rgba, normal)
+    let look = HeightLook {
+        opacity: hf.opacity,
+        darkening: hf.darkening,
+        color_low: hf.color_low,
+        color_high: hf.color_high,
+        top: hf.base + hf.amplitude,
+    };
+    height_voxel(params, heightfield_sample(hf, [p[0], p[1]]), p, voxel_size, &look, per_pixel)
+}
+
+// ---- bake_height_image.wgsl ----
+
+/// Bilinear height of the image with wrapping; pixel centres at (i + 0.5) / size, t = 0 the bottom
+/// row (as `HeightImage::sample`, in f32 as the kernel does it).
+fn image_height(hi: &HeightImageParams, heights: &[f32], st: [f32; 2]) -> f32 {
+    let (w, h) = (hi.width as i32, hi.height as i32);
+    let pixel = |x: i32, y: i32| heights[(y.rem_euclid(h) * w + x.rem_euclid(w)) as usize];
+    let x = st[0] * w as f32 - 0.5;
+    let y = (1.0 - st[1]) * h as f32 - 0.5;
+    let (x0, y0) = (x.floor(), y.floor());
+    let (fx, fy) = (x - x0, y - y0);
+    let (xi, yi) = (x0 as i32, y0 as i32);
+    let mix = |a: f32, b: f32, t: f32| a * (1.0 - t) + b * t;
+    let top = mix(pixel(xi, yi), pixel(xi + 1, yi), fx);
+    let bottom = mix(pixel(xi, yi + 1), pixel(xi + 1, yi + 1), fx);
+    mix(top, bottom, fy)
+}
+
+/// `(h, dh/ds, dh/dt)` with `h = base + amplitude * image(s, t)`, the slopes by central
+/// differences one pixel apart.
+pub fn height_image_sample(hi: &HeightImageParams, heights: &[f32], st: [f32; 2]) -> [f32; 3] {
+    let e = [1.0 / hi.width as f32, 1.0 / hi.height as f32];
+    let at = |ds: f32, dt: f32| image_height(hi, heights, [st[0] + ds, st[1] + dt]);
+    let ds = (at(e[0], 0.0) - at(-e[0], 0.0)) / (2.0 * e[0]);
+    let dt = (at(0.0, e[1]) - at(0.0, -e[1])) / (2.0 * e[1]);
+    let a = hi.amplitude;
+    [hi.base + a * at(0.0, 0.0), a * ds, a * dt]
+}
+
+/// One voxel of `bake_height_image.wgsl`: (premultiplied rgba, outward normal).
+pub fn bake_height_image_voxel(
+    params: &BakeParams,
+    hi: &HeightImageParams,
+    heights: &[f32],
+    voxel: [u32; 3],
+    per_pixel: bool,
+) -> ([f32; 4], [f32; 3]) {
+    let (p, voxel_size) = voxel_centre(params.resolution, voxel);
+    let look = HeightLook {
+        opacity: hi.opacity,
+        darkening: hi.darkening,
+        color_low: hi.color_low,
+        color_high: hi.color_high,
+        top: hi.base + hi.amplitude,
+    };
+    height_voxel(params, height_image_sample(hi, heights, [p[0], p[1]]), p, voxel_size, &look, per_pixel)
 }
 
 // ---- volumes ----

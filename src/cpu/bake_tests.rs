@@ -278,9 +278,10 @@ fn shading_with_the_light_along_the_normal_gives_the_albedo() {
 fn bake_kernels_validate_and_match_the_contract() {
     use naga::{AddressSpace, TypeInner};
     let root = crate::project_root().join("wgsl");
-    let kernels: [(&str, &[&str]); 2] = [
+    let kernels: [(&str, &[&str]); 3] = [
         ("bake_implicit.wgsl", &["bake_params", "shapes", "balls", "volume", "normals"]),
         ("bake_heightfield.wgsl", &["bake_params", "heightfield", "volume", "normals"]),
+        ("bake_height_image.wgsl", &["bake_params", "height_image", "heights", "volume", "normals"]),
     ];
     for (file, globals) in kernels {
         let k = crate::gpu::shader::load(&root, file).unwrap_or_else(|e| panic!("{e}"));
@@ -332,7 +333,7 @@ fn bake_kernels_validate_and_match_the_contract() {
                         std::mem::offset_of!(HeightfieldParams, amplitude),
                         std::mem::offset_of!(HeightfieldParams, base),
                         std::mem::offset_of!(HeightfieldParams, opacity),
-                        std::mem::offset_of!(HeightfieldParams, _pad1),
+                        std::mem::offset_of!(HeightfieldParams, darkening),
                         std::mem::offset_of!(HeightfieldParams, color_low),
                         std::mem::offset_of!(HeightfieldParams, color_high),
                     ],
@@ -346,4 +347,40 @@ fn bake_kernels_validate_and_match_the_contract() {
     }
     assert_eq!(std::mem::offset_of!(ImplicitShape, color), 48);
     assert_eq!(std::mem::size_of::<ImplicitShape>(), 64);
+}
+
+#[test]
+fn height_image_heights_and_darkening() {
+    // A 4x2 image, rising along s; row 0 is the top row (t = 1).
+    let heights = [0.0, 0.25, 0.5, 0.75, 0.0, 0.25, 0.5, 0.75];
+    let hi = HeightImageParams {
+        width: 4,
+        height: 2,
+        amplitude: 0.8,
+        base: 0.1,
+        opacity: 1.0,
+        color_low: [0.5, 0.5, 0.5, 0.0],
+        color_high: [0.5, 0.5, 0.5, 0.0],
+        ..Default::default()
+    };
+    // At a pixel centre the height is exact, the slope the central difference one pixel apart.
+    let h = height_image_sample(&hi, &heights, [(1.0 + 0.5) / 4.0, 0.5]);
+    assert!(
+        close(h[0], 0.1 + 0.8 * 0.25, 1e-6) && close(h[1], 0.8 * (0.5 - 0.0) / (2.0 / 4.0), 1e-5),
+        "{h:?}"
+    );
+    assert!(close(h[2], 0.0, 1e-6));
+    // Darkening scales the albedo by 1 - darkening * (top - w) / top, in the filled voxels only.
+    let params = bake_params([4, 2, 8], 0, [0.0, 0.0, 1.0], 1.0);
+    let at = |darkening: f32, k: u32| {
+        bake_height_image_voxel(&params, &HeightImageParams { darkening, ..hi }, &heights, [3, 0, k], true).0
+    };
+    let top = 0.9;
+    for k in 0..3 {
+        let w = (k as f32 + 0.5) / 8.0;
+        let (plain, dark) = (at(0.0, k), at(0.6, k));
+        assert!(close(plain[3], 1.0, 1e-6), "voxel {k} is filled");
+        assert!(close(dark[0], plain[0] * (1.0 - 0.6 * (top - w) / top), 1e-6), "{k}: {plain:?} {dark:?}");
+    }
+    assert_eq!(at(0.6, 7), [0.0; 4], "above the surface: empty");
 }

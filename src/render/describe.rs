@@ -114,6 +114,7 @@ impl Blueprint {
             let kind = match b.request.source {
                 BakeSource::Implicit(_) => "bake_implicit.wgsl",
                 BakeSource::Heightfield(_) => "bake_heightfield.wgsl",
+                BakeSource::HeightImage(..) => "bake_height_image.wgsl",
             };
             s += &format!(
                 "  {:<16} {}x{}x{}  {kind}  lighting {}\n",

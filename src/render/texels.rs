@@ -1,11 +1,11 @@
 //! Scene texels as bake requests: only texels some object draws, each (texel, lighting) once.
 
-use crate::bake::{BakeRequest, BakeSource};
+use crate::bake::{BakeRequest, BakeSource, Heights};
 use crate::cpu::bake::{pack_shapes, Shape as BakeShape};
 use crate::error::{Error, Result};
 use crate::render::{BakePlan, Lighting};
 use crate::scene::{Scene, Shape, TexelSource};
-use crate::types::HeightfieldParams;
+use crate::types::{HeightImageParams, HeightfieldParams};
 
 /// Index of the bake for `texel` with the given lighting, added if new.
 pub(super) fn bake_index(
@@ -35,19 +35,52 @@ pub(super) fn bake_index(
             color_low,
             color_high,
             opacity,
+            darkening,
+        } => BakeSource::Heightfield(HeightfieldParams {
+            frequency: *frequency,
+            octaves: *octaves,
+            seed: *seed,
+            amplitude: *amplitude,
+            base: *base,
+            opacity: *opacity,
+            darkening: *darkening,
+            color_low: rgb0(color_low),
+            color_high: rgb0(color_high),
+            ..Default::default()
+        }),
+        TexelSource::ImageHeight {
+            image,
+            channel,
+            amplitude,
+            base,
+            color_low,
+            color_high,
+            opacity,
+            darkening,
         } => {
-            let c = |v: &[f32; 3]| [v[0], v[1], v[2], 0.0];
-            BakeSource::Heightfield(HeightfieldParams {
-                frequency: *frequency,
-                octaves: *octaves,
-                seed: *seed,
-                amplitude: *amplitude,
-                base: *base,
-                opacity: *opacity,
-                color_low: c(color_low),
-                color_high: c(color_high),
-                ..Default::default()
-            })
+            let img = scene.image(&image.value).ok_or_else(|| {
+                Error::Invalid(format!(
+                    "{}: height image {} was not loaded",
+                    scene.path.display(),
+                    image.value
+                ))
+            })?;
+            let heights: Vec<f32> =
+                img.data.iter().skip(*channel as usize).step_by(img.channels).copied().collect();
+            BakeSource::HeightImage(
+                HeightImageParams {
+                    width: img.width as u32,
+                    height: img.height as u32,
+                    amplitude: *amplitude,
+                    base: *base,
+                    opacity: *opacity,
+                    darkening: *darkening,
+                    color_low: rgb0(color_low),
+                    color_high: rgb0(color_high),
+                    ..Default::default()
+                },
+                Heights(std::sync::Arc::new(heights)),
+            )
         }
         TexelSource::Constant { color, opacity } => {
             BakeSource::Implicit(pack_shapes(&[(BakeShape::Constant, *color, *opacity)]))
@@ -80,6 +113,10 @@ pub(super) fn bake_index_axis(
     let i = bake_index(scene, texel, false, light, bakes)?;
     bakes[i].request.axis_slices = true;
     Ok(i)
+}
+
+fn rgb0(v: &[f32; 3]) -> [f32; 4] {
+    [v[0], v[1], v[2], 0.0]
 }
 
 /// A scene shape as the bake kernels take it: (shape, albedo, opacity).

@@ -38,6 +38,11 @@ impl Scene {
         self.assets.meshes.keys().chain(self.assets.images.keys()).cloned().collect()
     }
 
+    /// A height image the scene refers to (by its path as written), as `load` read it.
+    pub fn image(&self, path: &str) -> Option<&HeightImage> {
+        self.assets.images.get(&self.assets.dir.join(path)).map(|i| i.as_ref())
+    }
+
     /// The scene file's text.
     pub fn source(&self) -> &str {
         &self.source

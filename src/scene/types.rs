@@ -165,6 +165,31 @@ pub enum TexelSource {
         color_high: [f32; 3],
         #[serde(default = "one_f32", deserialize_with = "v::unit_f32")]
         opacity: f32,
+        /// Albedo darkened with depth: times `1 - darkening * (top - w) / top`, `top` the highest
+        /// possible height (grooves read darker).
+        #[serde(default, deserialize_with = "v::unit_f32")]
+        darkening: f32,
+    },
+    /// Height field from a grey-level PNG (Meyer & Neyret 1998, 3.2): voxel filled where
+    /// `w < base + amplitude * image(s, t)`, the image sampled bilinearly with wrapping (t = 0 is
+    /// its bottom row) and its slopes by central differences one pixel apart.
+    ImageHeight {
+        image: Mark<String>,
+        /// Channel of the image holding the height (0 for grey images).
+        #[serde(default)]
+        channel: u32,
+        #[serde(deserialize_with = "v::finite_f32")]
+        amplitude: f32,
+        #[serde(default, deserialize_with = "v::finite_f32")]
+        base: f32,
+        #[serde(deserialize_with = "v::color")]
+        color_low: [f32; 3],
+        #[serde(deserialize_with = "v::color")]
+        color_high: [f32; 3],
+        #[serde(default = "one_f32", deserialize_with = "v::unit_f32")]
+        opacity: f32,
+        #[serde(default, deserialize_with = "v::unit_f32")]
+        darkening: f32,
     },
     /// A uniform volume (analytic tests).
     Constant {

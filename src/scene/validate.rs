@@ -2,7 +2,7 @@
 //! of the files the scene refers to (OBJ meshes, height images).
 
 use super::image::HeightImage;
-use super::types::{HeightScale, Method, Node, Scene, Surface};
+use super::types::{HeightScale, Method, Node, Scene, Surface, TexelSource};
 use super::values::Mark;
 use crate::error::Error;
 use crate::mesh::{obj, Mesh};
@@ -86,6 +86,19 @@ impl Checker<'_> {
         }
     }
 
+    /// Loads the image at `path` and checks it has `channel`; a failure is reported at `at`.
+    fn image_channel<T>(&mut self, path: &Mark<String>, channel: u32, at: &Mark<T>) {
+        if let Some(img) = self.image(path) {
+            if channel as usize >= img.channels {
+                let msg = format!(
+                    "expected a channel in 0..{} ({} has {} channels)",
+                    img.channels, path.value, img.channels
+                );
+                self.fail(at, msg);
+            }
+        }
+    }
+
     fn node(&mut self, n: &Node, parent: glam::DMat4) {
         let world = parent * n.transform.matrix();
         self.hypertexture_node(n, &world);
@@ -133,15 +146,7 @@ impl Checker<'_> {
                     self.fail(scale, "built-in surfaces have no vertex attribute: expected Texture(path: ..) or an Obj surface".into());
                 }
                 (HeightScale::Texture { path, channel }, Some(_)) => {
-                    if let Some(img) = self.image(path) {
-                        if *channel as usize >= img.channels {
-                            let msg = format!(
-                                "expected a channel in 0..{} ({} has {} channels)",
-                                img.channels, path.value, img.channels
-                            );
-                            self.fail(scale, msg);
-                        }
-                    }
+                    self.image_channel(path, *channel, scale)
                 }
             }
         }
@@ -221,6 +226,11 @@ pub(super) fn check(scene: &Scene, dir: &Path) -> Findings {
         super::hypertexture::check(h, &mut |seq, msg| {
             c.f.fail.entry(seq).or_insert(msg);
         });
+    }
+    for t in scene.texels.values() {
+        if let TexelSource::ImageHeight { image, channel, .. } = &t.source {
+            c.image_channel(image, *channel, image);
+        }
     }
     for n in &scene.nodes {
         c.node(n, glam::DMat4::IDENTITY);

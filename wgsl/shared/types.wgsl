@@ -90,7 +90,20 @@ struct HeightfieldParams {
     amplitude: f32,
     base: f32,
     opacity: f32,
-    _pad1: f32,
+    darkening: f32,
+    color_low: vec4<f32>,
+    color_high: vec4<f32>,
+}
+
+// Height field from a grey-level image (twin: HeightImageParams in src/types.rs).
+struct HeightImageParams {
+    width: u32,
+    height: u32,
+    _pad0: vec2<u32>,
+    amplitude: f32,
+    base: f32,
+    opacity: f32,
+    darkening: f32,
     color_low: vec4<f32>,
     color_high: vec4<f32>,
 }
