@@ -70,6 +70,17 @@ enum Command {
         #[command(flatten)]
         overrides: Overrides,
     },
+    /// Bake texels on the GPU and write each as a slice stack: OUT/<texel>/slice_000.png onwards
+    /// (RGBA, premultiplied, the scene's first light baked in), readable as `Slices(dir: ..)`.
+    Bake {
+        scene: PathBuf,
+        /// Texels to bake (default: every texel of the scene).
+        #[arg(long = "texel")]
+        texels: Vec<String>,
+        /// Output folder (default: out/bake/<scene name>).
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
     /// Compare two EXR images: FLIP, relative RMSE, largest difference and non-finite pixels;
     /// optionally write a FLIP heat map (no GPU needed).
     Compare {
@@ -214,6 +225,7 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Render { scene, output, overrides } => render(&scene, output, &overrides),
+        Command::Bake { scene, texels, out } => bake(&scene, &texels, out),
         Command::Compare { actual, reference, diff } => compare(&actual, &reference, diff.as_deref()),
         Command::Plan { scene, overrides } => plan(&scene, &overrides),
         Command::Preview { scene, overrides, record, quit_after, view } => {
@@ -255,6 +267,34 @@ fn main() -> ExitCode {
             ExitCode::FAILURE
         }
     }
+}
+
+fn bake(scene_path: &Path, texels: &[String], out: Option<PathBuf>) -> voltex::Result<()> {
+    let scene = scene::load(scene_path)?;
+    let names: Vec<String> =
+        if texels.is_empty() { scene.texels.keys().cloned().collect() } else { texels.to_vec() };
+    if names.is_empty() {
+        return Err(voltex::Error::Invalid(format!("{}: the scene defines no texels", scene_path.display())));
+    }
+    // Every plan first, so an unknown texel fails before any GPU work.
+    let plans =
+        names.iter().map(|n| voltex::render::baked_texel(&scene, n)).collect::<voltex::Result<Vec<_>>>()?;
+    let out =
+        out.unwrap_or_else(|| PathBuf::from("out/bake").join(scene_path.file_stem().unwrap_or_default()));
+    std::fs::create_dir_all(&out).map_err(|e| voltex::Error::file(&out, e))?;
+    io::atomic::check_writable_dir(&out)?;
+    let ctx = GpuContext::new()?;
+    let mut baker = voltex::bake::Baker::new(&voltex::render::wgsl_root());
+    for plan in plans {
+        let start = std::time::Instant::now();
+        let baked = baker.bake(&ctx, &plan.request)?;
+        let volume = voltex::bake::axis_slices::read_texture(&ctx, &baked.volume, 4)?;
+        let dir = out.join(&plan.texel);
+        voltex::bake::stack::write(&dir, plan.request.resolution, &volume)?;
+        let [w, h, d] = plan.request.resolution;
+        println!("{} ({w}x{h}x{d}, {:.0} ms)", dir.display(), start.elapsed().as_secs_f64() * 1e3);
+    }
+    Ok(())
 }
 
 fn compare(actual: &Path, reference: &Path, diff: Option<&Path>) -> voltex::Result<()> {

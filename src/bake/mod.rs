@@ -3,6 +3,7 @@
 //! uses it. Only texels some object draws are baked, each (texel, lighting) pair once.
 
 pub mod axis_slices;
+pub mod stack;
 
 use std::path::Path;
 
@@ -21,6 +22,8 @@ pub enum BakeSource {
     Implicit(PackedShapes),
     Heightfield(HeightfieldParams),
     HeightImage(HeightImageParams, Heights),
+    /// A slice stack's texels (rgba8, premultiplied, baked shading), uploaded as they are.
+    Stack(StackTexels),
 }
 
 /// The heights of a height image (row-major from the top row), shown in `Debug` (and so in the
@@ -34,6 +37,19 @@ impl std::fmt::Debug for Heights {
         let mut h = std::collections::hash_map::DefaultHasher::new();
         self.0.iter().for_each(|v| v.to_bits().hash(&mut h));
         write!(f, "Heights({} values, digest {:016x})", self.0.len(), h.finish())
+    }
+}
+
+/// Bytes shown in `Debug` by a digest, like [`Heights`].
+#[derive(Clone)]
+pub struct StackTexels(pub std::sync::Arc<Vec<u8>>);
+
+impl std::fmt::Debug for StackTexels {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        use std::hash::{Hash, Hasher};
+        let mut h = std::collections::hash_map::DefaultHasher::new();
+        self.0.hash(&mut h);
+        write!(f, "Bytes({}, digest {:016x})", self.0.len(), h.finish())
     }
 }
 
@@ -174,6 +190,26 @@ impl Baker {
                     req.resolution,
                 )?;
             }
+            BakeSource::Stack(texels) => {
+                let [w, h, d] = req.resolution;
+                if texels.0.len() != (w * h * d * 4) as usize || req.per_pixel {
+                    return Err(Error::Invalid(format!(
+                        "a {w}x{h}x{d} slice stack with baked shading was expected (got {} bytes{})",
+                        texels.0.len(),
+                        if req.per_pixel { ", per-pixel lighting" } else { "" }
+                    )));
+                }
+                ctx.queue.write_texture(
+                    volume.as_image_copy(),
+                    &texels.0,
+                    wgpu::TexelCopyBufferLayout {
+                        offset: 0,
+                        bytes_per_row: Some(w * 4),
+                        rows_per_image: Some(h),
+                    },
+                    wgpu::Extent3d { width: w, height: h, depth_or_array_layers: d },
+                );
+            }
         }
         let axis = match req.axis_slices {
             true => {
@@ -203,7 +239,8 @@ fn volume_texture(
         format,
         usage: wgpu::TextureUsages::STORAGE_BINDING
             | wgpu::TextureUsages::TEXTURE_BINDING
-            | wgpu::TextureUsages::COPY_SRC,
+            | wgpu::TextureUsages::COPY_SRC
+            | wgpu::TextureUsages::COPY_DST,
         view_formats: &[],
     })
 }

@@ -115,6 +115,7 @@ impl Blueprint {
                 BakeSource::Implicit(_) => "bake_implicit.wgsl",
                 BakeSource::Heightfield(_) => "bake_heightfield.wgsl",
                 BakeSource::HeightImage(..) => "bake_height_image.wgsl",
+                BakeSource::Stack(_) => "slice stack (uploaded)",
             };
             s += &format!(
                 "  {:<16} {}x{}x{}  {kind}  lighting {}\n",

@@ -164,6 +164,13 @@ pub struct Blueprint {
     pub plan: Plan,
 }
 
+/// The bake of `texel` with the scene's first light baked in (what `voltex bake` writes out).
+pub fn baked_texel(scene: &Scene, texel: &str) -> Result<BakePlan> {
+    let mut bakes = Vec::new();
+    texels::bake_index(scene, texel, false, &Lighting::of(scene), &mut bakes)?;
+    Ok(bakes.remove(0))
+}
+
 pub fn default_graph() -> PathBuf {
     crate::project_root().join("graphs/frame.ron")
 }

@@ -1,6 +1,6 @@
 //! Scene texels as bake requests: only texels some object draws, each (texel, lighting) once.
 
-use crate::bake::{BakeRequest, BakeSource, Heights};
+use crate::bake::{BakeRequest, BakeSource, Heights, StackTexels};
 use crate::cpu::bake::{pack_shapes, Shape as BakeShape};
 use crate::error::{Error, Result};
 use crate::render::{BakePlan, Lighting};
@@ -81,6 +81,18 @@ pub(super) fn bake_index(
                 },
                 Heights(std::sync::Arc::new(heights)),
             )
+        }
+        TexelSource::Slices { dir } => {
+            if per_pixel {
+                return Err(Error::Invalid(format!(
+                    "{}: texel \"{texel}\" is a slice stack with its shading baked in: draw it with `lighting: Baked`",
+                    scene.path.display()
+                )));
+            }
+            let s = scene.stack(&dir.value).ok_or_else(|| {
+                Error::Invalid(format!("{}: slice stack {} was not loaded", scene.path.display(), dir.value))
+            })?;
+            BakeSource::Stack(StackTexels(std::sync::Arc::new(s.texels.clone())))
         }
         TexelSource::Constant { color, opacity } => {
             BakeSource::Implicit(pack_shapes(&[(BakeShape::Constant, *color, *opacity)]))

@@ -33,14 +33,20 @@ fn options() -> ron::Options {
 }
 
 impl Scene {
-    /// The files (meshes, images) the scene refers to, resolved.
+    /// The files (meshes, images) and slice-stack folders the scene refers to, resolved.
     pub fn asset_paths(&self) -> Vec<std::path::PathBuf> {
-        self.assets.meshes.keys().chain(self.assets.images.keys()).cloned().collect()
+        let stacks = self.assets.stacks.keys();
+        self.assets.meshes.keys().chain(self.assets.images.keys()).chain(stacks).cloned().collect()
     }
 
     /// A height image the scene refers to (by its path as written), as `load` read it.
     pub fn image(&self, path: &str) -> Option<&HeightImage> {
         self.assets.images.get(&self.assets.dir.join(path)).map(|i| i.as_ref())
+    }
+
+    /// A slice stack the scene refers to (by its path as written), as `load` read it.
+    pub fn stack(&self, path: &str) -> Option<&crate::bake::stack::SliceStack> {
+        self.assets.stacks.get(&self.assets.dir.join(path)).map(|s| s.as_ref())
     }
 
     /// The scene file's text.

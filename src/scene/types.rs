@@ -191,6 +191,9 @@ pub enum TexelSource {
         #[serde(default, deserialize_with = "v::unit_f32")]
         darkening: f32,
     },
+    /// A slice stack written by `voltex bake` (one RGBA PNG per `w` slice, premultiplied, shading
+    /// baked in): the texel's `resolution` must be the stack's. Drawn with baked lighting only.
+    Slices { dir: Mark<String> },
     /// A uniform volume (analytic tests).
     Constant {
         #[serde(deserialize_with = "v::color")]

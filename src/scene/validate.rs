@@ -4,6 +4,7 @@
 use super::image::HeightImage;
 use super::types::{HeightScale, Method, Node, Scene, Surface, TexelSource};
 use super::values::Mark;
+use crate::bake::stack::{self, SliceStack};
 use crate::error::Error;
 use crate::mesh::{obj, Mesh};
 use std::collections::BTreeMap;
@@ -16,6 +17,7 @@ pub struct Assets {
     pub dir: PathBuf,
     pub meshes: BTreeMap<PathBuf, Arc<Mesh>>,
     pub images: BTreeMap<PathBuf, Arc<HeightImage>>,
+    pub stacks: BTreeMap<PathBuf, Arc<SliceStack>>,
 }
 
 /// What the checks found: messages for marks (positioned by a second parse), and the first error
@@ -83,6 +85,30 @@ impl Checker<'_> {
                 self.other(e);
                 None
             }
+        }
+    }
+
+    /// Loads the slice stack at `path` and checks it has the texel's resolution.
+    fn stack(&mut self, path: &Mark<String>, resolution: [u32; 3]) {
+        let full = self.f.assets.dir.join(&path.value);
+        if !full.is_dir() {
+            let msg = format!(
+                "expected a slice-stack folder written by `voltex bake`, but {} is none",
+                full.display()
+            );
+            return self.fail(path, msg);
+        }
+        match stack::read(&full) {
+            Ok(s) if s.resolution != resolution => {
+                let [w, h, d] = s.resolution;
+                let msg =
+                    format!("expected the texel's resolution {resolution:?}: the stack holds {w}x{h}x{d}");
+                self.fail(path, msg);
+            }
+            Ok(s) => {
+                self.f.assets.stacks.insert(full, Arc::new(s));
+            }
+            Err(e) => self.other(e),
         }
     }
 
@@ -228,8 +254,10 @@ pub(super) fn check(scene: &Scene, dir: &Path) -> Findings {
         });
     }
     for t in scene.texels.values() {
-        if let TexelSource::ImageHeight { image, channel, .. } = &t.source {
-            c.image_channel(image, *channel, image);
+        match &t.source {
+            TexelSource::ImageHeight { image, channel, .. } => c.image_channel(image, *channel, image),
+            TexelSource::Slices { dir } => c.stack(dir, t.resolution),
+            _ => {}
         }
     }
     for n in &scene.nodes {

@@ -1,0 +1,87 @@
+//! `voltex bake` writes a texel as a slice stack, and a `Slices(dir: ..)` texel reads it back: the
+//! scene renders the same from the stack as from its recipe. Bad stacks are errors at `line:col`.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+const BIN: &str = env!("CARGO_BIN_EXE_voltex");
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn voltex(args: &[&str]) -> Output {
+    let mut cmd = Command::new(BIN);
+    cmd.args(args).env("VOLTEX_ROOT", root());
+    if std::env::var_os("XDG_RUNTIME_DIR").is_none() {
+        cmd.env("XDG_RUNTIME_DIR", std::env::temp_dir());
+    }
+    cmd.output().unwrap()
+}
+
+fn ok(out: Output) -> String {
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    String::from_utf8_lossy(&out.stdout).into_owned()
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+#[test]
+fn a_baked_stack_renders_like_its_recipe() {
+    let dir = std::env::temp_dir().join(format!("voltex-bake-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let recipe = root().join("scenes/meyer_neyret/heightfield_image.ron");
+    let printed = ok(voltex(&["bake", s(&recipe), "--out", s(&dir)]));
+    assert!(printed.contains("cobbles (64x64x16"), "{printed}");
+    assert!(dir.join("cobbles/slice_015.png").is_file() && !dir.join("cobbles/slice_016.png").exists());
+
+    // The same scene with the texel read from the stack.
+    let text = std::fs::read_to_string(&recipe).unwrap();
+    let start = text.find("source: ImageHeight(").unwrap();
+    let end = start + text[start..].find("\n            ),").unwrap() + "\n            ),".len();
+    let from_stack = format!("{}source: Slices(dir: \"cobbles\"),{}", &text[..start], &text[end..]);
+    let scene = dir.join("from_stack.ron");
+    std::fs::write(&scene, &from_stack).unwrap();
+    let (a, b) = (dir.join("recipe.exr"), dir.join("stack.exr"));
+    ok(voltex(&["render", s(&recipe), "--size", "64x64", "-o", s(&a)]));
+    ok(voltex(&["render", s(&scene), "--size", "64x64", "-o", s(&b)]));
+    let compared = ok(voltex(&["compare", s(&b), s(&a)]));
+    assert!(compared.contains("largest difference  0.000e0"), "{compared}");
+
+    // A stack of another resolution, and a missing one, are errors at the `dir` string.
+    let line = from_stack.lines().position(|l| l.contains("Slices(dir")).unwrap() + 1;
+    let col = from_stack.lines().nth(line - 1).unwrap().find("\"cobbles\"").unwrap() + 1;
+    for (name, edit, expected) in [
+        ("other_res.ron", ("(64, 64, 16)", "(64, 64, 8)"), "the stack holds 64x64x16"),
+        ("missing.ron", ("\"cobbles\"", "\"nothing\""), "expected a slice-stack folder"),
+    ] {
+        let path = dir.join(name);
+        std::fs::write(&path, from_stack.replace(edit.0, edit.1)).unwrap();
+        let out = voltex(&["render", s(&path), "--size", "64x64", "-o", s(&dir.join("x.exr"))]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{err}");
+        assert!(err.contains(&format!("{}:{line}:{col}", path.display())) && err.contains(expected), "{err}");
+    }
+    // Per-pixel lighting cannot relight baked shading.
+    let path = dir.join("per_pixel.ron");
+    std::fs::write(
+        &path,
+        from_stack
+            .replace("AxisSlices(depth: 1.0, pixels: 1.0)", "ViewSlices(planes: 16, lighting: PerPixel)"),
+    )
+    .unwrap();
+    let out = voltex(&["render", s(&path), "--size", "64x64", "-o", s(&dir.join("x.exr"))]);
+    assert!(
+        String::from_utf8_lossy(&out.stderr).contains("lighting: Baked"),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    // An unknown texel name fails before any GPU work.
+    let out = voltex(&["bake", s(&recipe), "--texel", "nope", "--out", s(&dir)]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("nope"));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
