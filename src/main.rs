@@ -43,6 +43,10 @@ struct Overrides {
     /// Time of the frame in seconds (animated hypertextures; default: the scene's `time`).
     #[arg(long, allow_negative_numbers = true)]
     time: Option<f64>,
+    /// AxisSlices criteria for every AxisSlices object: `D,P` (slice depth in voxels, apparent
+    /// slice distance in pixels) or one value for both (default: the scene's).
+    #[arg(long, value_parser = parse_criteria)]
+    criteria: Option<(f64, f64)>,
 }
 
 #[derive(clap::ValueEnum, Clone, Copy)]
@@ -168,7 +172,21 @@ enum Command {
         /// Reference ray steps, as multiples of the default step.
         #[arg(long, value_delimiter = ',', default_values_t = voltex::pareto::DEFAULT_STEP_FACTORS)]
         steps: Vec<f64>,
+        /// AxisSlices criteria: d (voxels) = p (pixels) = each value.
+        #[arg(long, value_delimiter = ',', default_values_t = voltex::pareto::DEFAULT_CRITERIA)]
+        criteria: Vec<f64>,
     },
+}
+
+fn parse_criteria(s: &str) -> std::result::Result<(f64, f64), String> {
+    let value = |v: &str| {
+        let bad = || "expected D,P or one value for both, each in (0, 1024]".to_string();
+        v.trim().parse::<f64>().ok().filter(|v| *v > 0.0 && *v <= 1024.0).ok_or_else(bad)
+    };
+    match s.split_once(',') {
+        Some((d, p)) => Ok((value(d)?, value(p)?)),
+        None => value(s).map(|v| (v, v)),
+    }
 }
 
 fn parse_size(s: &str) -> std::result::Result<(u32, u32), String> {
@@ -215,6 +233,7 @@ impl Overrides {
             step: self.step,
             supersample: self.supersample,
             time: self.time,
+            axis_criteria: self.criteria,
             ..Default::default()
         })
     }
@@ -246,7 +265,7 @@ fn main() -> ExitCode {
             voltex::bench::run(&scenes, &planes, size, frames, reference_planes)
         }
         Command::BenchHyper { size, frames, quick } => voltex::hypertexture::bench::run(size, frames, quick),
-        Command::Pareto { scene, size, frames, out, truth, methods, planes, steps } => {
+        Command::Pareto { scene, size, frames, out, truth, methods, planes, steps, criteria } => {
             let methods = methods.into_iter().map(method_kind).collect();
             voltex::pareto::run(&voltex::pareto::Args {
                 scene,
@@ -257,6 +276,7 @@ fn main() -> ExitCode {
                 methods,
                 planes,
                 steps,
+                criteria,
             })
         }
     };

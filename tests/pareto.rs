@@ -195,3 +195,46 @@ fn bad_sweep_values_are_errors() {
     assert_eq!(run.status.code(), Some(2), "clap rejects the value: {}", text(&run));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `--methods axis-slices` sweeps the criteria d = p: finer criteria draw more slices (more GPU
+/// work) and are closer to the truth.
+#[test]
+fn axis_slices_criteria_sweep() {
+    let dir = temp_dir("axis");
+    let out = dir.join("result");
+    let out_s = out.to_str().unwrap().to_string();
+    let scene = root().join("scenes/meyer_neyret/pear.ron").to_str().unwrap().to_string();
+    let args = [
+        &scene,
+        "--size",
+        "48x48",
+        "--frames",
+        "1",
+        "--methods",
+        "axis-slices",
+        "--criteria",
+        "0.25,8",
+        "--out",
+        &out_s,
+    ];
+    let run = pareto(&args);
+    let log = text(&run);
+    assert_eq!(run.status.code(), Some(0), "{log}");
+    let (header, rows) = read_csv(&out.join("pareto.csv"));
+    let col = |name: &str| header.iter().position(|h| h == name).unwrap();
+    let get = |k: &str, c: &str| {
+        let r = rows.iter().find(|r| r[col("knobs")] == k).unwrap_or_else(|| panic!("no {k}: {rows:?}"));
+        r[col(c)].parse::<f64>().unwrap()
+    };
+    assert_eq!(rows.len(), 2, "{rows:?}");
+    println!(
+        "AxisSlices FLIP {:.4} at d=p=0.25, {:.4} at d=p=8",
+        get("d=p=0.25", "flip"),
+        get("d=p=8", "flip")
+    );
+    assert!(get("d=p=0.25", "flip") < get("d=p=8", "flip"), "finer criteria are closer to the truth");
+    let bad = pareto(&[&scene, "--methods", "axis-slices", "--criteria", "0", "--out", &out_s]);
+    assert_eq!(bad.status.code(), Some(1));
+    assert!(text(&bad).contains("--criteria 0"), "{}", text(&bad));
+    let _ = std::fs::remove_dir_all(&dir);
+}

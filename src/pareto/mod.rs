@@ -27,6 +27,8 @@ pub const DEFAULT_PLANES: [u32; 8] = [16, 32, 64, 128, 256, 512, 1024, 2048];
 /// Default ray steps of the `Reference` sweep, as multiples of its default step.
 /// (2x, half the truth's cost, would double the sweep's time; pass it with `--steps` if wanted.)
 pub const DEFAULT_STEP_FACTORS: [f64; 4] = [4.0, 8.0, 16.0, 32.0];
+/// Default `AxisSlices` criteria swept: `d = p` = each value (smaller: more slices).
+pub const DEFAULT_CRITERIA: [f64; 6] = [0.25, 0.5, 1.0, 2.0, 4.0, 8.0];
 
 /// What errors are measured against.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -95,6 +97,8 @@ pub struct Args {
     pub planes: Vec<u32>,
     /// `Reference` steps as multiples of the default step.
     pub steps: Vec<f64>,
+    /// `AxisSlices` criteria, `d = p` (voxels and pixels).
+    pub criteria: Vec<f64>,
 }
 
 /// One point of the sweep.
@@ -117,6 +121,9 @@ impl Args {
             return Err(Error::Invalid(format!(
                 "--steps {f}: expected positive multiples of the default step"
             )));
+        }
+        if let Some(&c) = self.criteria.iter().find(|&&c| !(c > 0.0 && c <= 1024.0)) {
+            return Err(Error::Invalid(format!("--criteria {c}: expected values in (0, 1024]")));
         }
         if self.frames == 0 {
             return Err(Error::Invalid("--frames 0: expected at least one timed frame".into()));
@@ -153,6 +160,28 @@ pub fn view_slices(args: &Args) -> Vec<Setting> {
     v
 }
 
+/// `AxisSlices`: both criteria `d` (voxels) and `p` (pixels) set to each value; each object keeps
+/// its other knobs (directions, blend, culling), or the defaults when it used another method.
+pub fn axis_slices(args: &Args) -> Vec<Setting> {
+    let mut criteria = args.criteria.clone();
+    criteria.sort_by(f64::total_cmp);
+    criteria.dedup();
+    criteria
+        .into_iter()
+        .map(|c| Setting {
+            method: "AxisSlices",
+            knobs: format!("d=p={c}"),
+            tag: format!("{c}"),
+            options: RenderOptions {
+                size: Some(args.size),
+                method: Some(MethodKind::AxisSlices),
+                axis_criteria: Some((c, c)),
+                ..Default::default()
+            },
+        })
+        .collect()
+}
+
 /// `Reference`: the ray step as multiples of `default_step` (one step for all objects).
 pub fn reference(args: &Args, default_step: f64) -> Vec<Setting> {
     unique(args.steps.iter().copied())
@@ -183,20 +212,7 @@ pub fn sweep(scene: &Scene, args: &Args) -> Result<(Vec<Setting>, Vec<String>)> 
                 Ok(None) => notes.push("Reference: not measured: no textured object".into()),
                 Err(e) => notes.push(format!("Reference: not measured: {e}")),
             },
-            MethodKind::AxisSlices => {
-                // Its criteria knobs have no command-line override yet: the defaults only.
-                settings.push(Setting {
-                    method: "AxisSlices",
-                    knobs: "defaults".into(),
-                    tag: "default".into(),
-                    options: RenderOptions {
-                        size: Some(args.size),
-                        method: Some(MethodKind::AxisSlices),
-                        ..Default::default()
-                    },
-                });
-                notes.push("AxisSlices: measured at its default criteria only".into());
-            }
+            MethodKind::AxisSlices => settings.extend(axis_slices(args)),
         }
     }
     Ok((settings, notes))

@@ -46,6 +46,9 @@ pub struct RenderOptions {
     /// then the mean over its area rather than a point sample (anti-aliasing; a reference for
     /// methods that filter by the pixel footprint).
     pub supersample: Option<u32>,
+    /// AxisSlices criteria `(d, p)` for every AxisSlices object: slice depth in voxels and
+    /// apparent slice distance in pixels (`--criteria`, the Pareto sweep).
+    pub axis_criteria: Option<(f64, f64)>,
     /// Time of the frame in seconds (animated hypertextures; default: the scene's).
     pub time: Option<f64>,
 }
@@ -100,8 +103,11 @@ impl RenderOptions {
                 Method::Reference(Reference { step: self.step.or(r.step), lighting })
             }
             (MethodKind::Reference, _) => Method::Reference(Reference { step: self.step, lighting }),
-            (MethodKind::AxisSlices, Method::AxisSlices(a)) => Method::AxisSlices(*a),
-            (MethodKind::AxisSlices, _) => Method::AxisSlices(DEFAULT_AXIS_SLICES),
+            (MethodKind::AxisSlices, m) => {
+                let a = if let Method::AxisSlices(a) = m { *a } else { DEFAULT_AXIS_SLICES };
+                let (depth, pixels) = self.axis_criteria.unwrap_or((a.depth, a.pixels));
+                Method::AxisSlices(AxisSlices { depth, pixels, ..a })
+            }
         }
     }
 }
