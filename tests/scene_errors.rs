@@ -179,8 +179,13 @@ fn example_scenes_load_and_flatten() {
                 let s = scene::load(&p).unwrap_or_else(|e| panic!("{e}"));
                 let objects = s.objects().unwrap_or_else(|e| panic!("{e}"));
                 assert!(!objects.is_empty(), "{}", p.display());
+                // The hard-case catalogue is degenerate on purpose: only the prism checks'
+                // degenerate-triangle and zero-height warnings are expected there.
+                let hard_case = p.parent().is_some_and(|d| d.ends_with("hard_cases"));
                 for o in &objects {
-                    assert!(o.report.warnings.is_empty(), "{}: {:?}", p.display(), o.report);
+                    let expected =
+                        |w: &String| hard_case && (w.contains("degenerate") || w.contains("zero-length"));
+                    assert!(o.report.warnings.iter().all(expected), "{}: {:?}", p.display(), o.report);
                 }
                 count += 1;
             }

@@ -27,19 +27,18 @@ struct VsOut {
 }
 
 // Barycentrics of p (in the triangle's plane) in the triangle q0 q1 q2; (1/3, 1/3, 1/3) if degenerate.
+// Area ratios against n = e1 x e2 (rounding grows as 1/sin of the smallest angle, not 1/sin^2).
 fn barycentrics(p: vec3<f32>, q0: vec3<f32>, q1: vec3<f32>, q2: vec3<f32>) -> vec3<f32> {
     let e1 = q1 - q0;
     let e2 = q2 - q0;
     let e = p - q0;
-    let d11 = dot(e1, e1);
-    let d12 = dot(e1, e2);
-    let d22 = dot(e2, e2);
-    let det = d11 * d22 - d12 * d12;
-    if (det <= 1e-12 * d11 * d22) {
+    let n = cross(e1, e2);
+    let nn = dot(n, n);
+    if (nn <= 1e-12 * dot(e1, e1) * dot(e2, e2)) {
         return vec3<f32>(1.0 / 3.0);
     }
-    let b1 = (d22 * dot(e, e1) - d12 * dot(e, e2)) / det;
-    let b2 = (d11 * dot(e, e2) - d12 * dot(e, e1)) / det;
+    let b1 = dot(cross(e, e2), n) / nn;
+    let b2 = dot(cross(e1, e), n) / nn;
     return vec3<f32>(1.0 - b1 - b2, b1, b2);
 }
 

@@ -77,11 +77,14 @@ pub fn base_vertices(surface: &BaseSurface, eye: DVec3) -> Vec<BaseVertex> {
     out
 }
 
-/// Per welded vertex, `dP/ds` and `dP/dt` of its triangles (from their uv mapping), weighted by
-/// triangle area, for per-pixel lighting that is continuous across prism edges.
+/// Per welded vertex, `dP/ds` and `dP/dt` of its triangles (from their uv mapping), averaged with
+/// triangle area as the weight, for per-pixel lighting that is continuous across prism edges.
+/// An average, not a sum: the lengths matter (the Jacobian's cofactors mix `ds x dt` with
+/// `dt x dw`, and the Reference's default step is taken from them), and a sum would scale them
+/// with the area around the vertex.
 pub fn vertex_frames(surface: &BaseSurface) -> Vec<VertexFrame> {
     let n = surface.positions.len();
-    let mut sum = vec![(DVec3::ZERO, DVec3::ZERO); n];
+    let mut sum = vec![(DVec3::ZERO, DVec3::ZERO, 0.0); n];
     for (t, uv) in surface.triangles.iter().zip(&surface.corner_uvs) {
         let p = t.map(|i| surface.positions[i as usize]);
         let (e1, e2) = (p[1] - p[0], p[2] - p[0]);
@@ -94,10 +97,51 @@ pub fn vertex_frames(surface: &BaseSurface) -> Vec<VertexFrame> {
         let dt = (e2 * d1.x - e1 * d2.x) / det;
         let area = 0.5 * e1.cross(e2).length();
         for &i in t {
-            sum[i as usize].0 += ds * area;
-            sum[i as usize].1 += dt * area;
+            let s = &mut sum[i as usize];
+            s.0 += ds * area;
+            s.1 += dt * area;
+            s.2 += area;
         }
     }
     let f = |v: DVec3| [v.x as f32, v.y as f32, v.z as f32, 0.0];
-    sum.into_iter().map(|(ds, dt)| VertexFrame { ds: f(ds), dt: f(dt) }).collect()
+    sum.into_iter()
+        .map(|(ds, dt, area)| {
+            // Zero-area triangles around a vertex alone: no direction to average.
+            let k = if area > 0.0 { 1.0 / area } else { 0.0 };
+            VertexFrame { ds: f(ds * k), dt: f(dt * k) }
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::DVec2;
+
+    /// The frames are `dP/ds` and `dP/dt` themselves, whatever the triangle sizes: on a plane of
+    /// size L with one texture tile, both have length L at every vertex (a fine and a coarse grid,
+    /// at unit scale and at 1e-4).
+    #[test]
+    fn frames_are_the_uv_derivatives_at_any_scale_and_tessellation() {
+        for scale in [1.0, 1e-4] {
+            for cells in [1, 16] {
+                let mesh = crate::mesh::generate::plane([2.0 * scale, 2.0 * scale], [cells, cells], 0.0, 0);
+                let frames = vertex_frames(&mesh.to_base(0.5 * scale, None, DVec2::ONE));
+                for f in &frames {
+                    let v = |a: [f32; 4]| DVec3::new(a[0] as f64, a[1] as f64, a[2] as f64);
+                    let (ds, dt) = (v(f.ds), v(f.dt));
+                    assert!(
+                        (ds.length() / (2.0 * scale) - 1.0).abs() < 1e-6,
+                        "scale {scale}, cells {cells}: |ds| = {}",
+                        ds.length()
+                    );
+                    assert!(
+                        (dt.length() / (2.0 * scale) - 1.0).abs() < 1e-6,
+                        "scale {scale}, cells {cells}: |dt| = {}",
+                        dt.length()
+                    );
+                }
+            }
+        }
+    }
 }

@@ -172,17 +172,17 @@ fn bracketed_root(c: vec4<f32>, lo_in: f32, hi_in: f32) -> f32 {
 }
 
 // Barycentrics of x (in the triangle's plane) in q0 q1 q2; x < -1 when the triangle is degenerate.
+// Area ratios against n = e1 x e2: rounding grows as 1/sin of the smallest angle, not 1/sin^2 as
+// with the normal equations (which lost every digit of a sliver's barycentrics in f32).
 fn section_barycentrics(x: vec3<f32>, q0: vec3<f32>, q1: vec3<f32>, q2: vec3<f32>) -> vec3<f32> {
     let e1 = q1 - q0;
     let e2 = q2 - q0;
     let e = x - q0;
-    let d11 = dot(e1, e1);
-    let d12 = dot(e1, e2);
-    let d22 = dot(e2, e2);
-    let det = d11 * d22 - d12 * d12;
-    let b1 = (d22 * dot(e, e1) - d12 * dot(e, e2)) / det;
-    let b2 = (d11 * dot(e, e2) - d12 * dot(e, e1)) / det;
-    let degenerate = det <= 1e-12 * d11 * d22 || det == 0.0;
+    let n = cross(e1, e2);
+    let nn = dot(n, n);
+    let b1 = dot(cross(e, e2), n) / nn;
+    let b2 = dot(cross(e1, e), n) / nn;
+    let degenerate = nn <= 1e-12 * dot(e1, e1) * dot(e2, e2) || nn == 0.0;
     return select(vec3<f32>(1.0 - b1 - b2, b1, b2), vec3<f32>(-2.0), degenerate);
 }
 
