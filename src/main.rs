@@ -5,6 +5,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
+use voltex::gpu::cache::GpuCache;
 use voltex::gpu::GpuContext;
 use voltex::render::{Blueprint, MethodKind, RenderOptions, Renderer};
 use voltex::{io, scene, Result};
@@ -68,9 +69,16 @@ enum Command {
     /// Render a scene headless to EXR (linear, with metadata) and a tonemapped PNG.
     Render {
         scene: PathBuf,
-        /// Output EXR (default: out/<scene name>.exr); the PNG goes beside it.
+        /// Output EXR (default: out/<scene name>.exr); the PNG goes beside it. With --frames, the
+        /// first frame's path: frame N is written as <stem>_NNNN.exr beside it.
         #[arg(short, long)]
         output: Option<PathBuf>,
+        /// Render frames A to B (inclusive) of an animation, at time N / fps for frame N.
+        #[arg(long, value_parser = parse_frames, conflicts_with = "time")]
+        frames: Option<(u32, u32)>,
+        /// Frames per second of --frames.
+        #[arg(long, default_value_t = 24.0, requires = "frames")]
+        fps: f64,
         #[command(flatten)]
         overrides: Overrides,
     },
@@ -189,6 +197,16 @@ fn parse_criteria(s: &str) -> std::result::Result<(f64, f64), String> {
     }
 }
 
+fn parse_frames(s: &str) -> std::result::Result<(u32, u32), String> {
+    let bad = || "expected A..B, frame numbers with A <= B <= 99999, e.g. 0..47".to_string();
+    let (a, b) = s.split_once("..").ok_or_else(bad)?;
+    let (a, b): (u32, u32) = (a.trim().parse().map_err(|_| bad())?, b.trim().parse().map_err(|_| bad())?);
+    if a > b || b > 99_999 {
+        return Err(bad());
+    }
+    Ok((a, b))
+}
+
 fn parse_size(s: &str) -> std::result::Result<(u32, u32), String> {
     let (w, h) = s.split_once('x').ok_or("expected WIDTHxHEIGHT, e.g. 512x512")?;
     let w: u32 = w.parse().map_err(|_| "expected WIDTHxHEIGHT, e.g. 512x512")?;
@@ -243,7 +261,10 @@ fn main() -> ExitCode {
     private_runtime_dir();
     let cli = Cli::parse();
     let result = match cli.command {
-        Command::Render { scene, output, overrides } => render(&scene, output, &overrides),
+        Command::Render { scene, output, frames: None, overrides, .. } => render(&scene, output, &overrides),
+        Command::Render { scene, output, frames: Some(frames), fps, overrides } => {
+            render_frames(&scene, output, frames, fps, &overrides)
+        }
         Command::Bake { scene, texels, out } => bake(&scene, &texels, out),
         Command::Compare { actual, reference, diff } => compare(&actual, &reference, diff.as_deref()),
         Command::Plan { scene, overrides } => plan(&scene, &overrides),
@@ -365,12 +386,44 @@ fn plan(scene_path: &Path, overrides: &Overrides) -> Result<()> {
 fn render(scene_path: &Path, output: Option<PathBuf>, overrides: &Overrides) -> Result<()> {
     let opts = overrides.options()?;
     let scene = scene::load(scene_path)?;
+    let exr_path = output_path(scene_path, output)?;
+    let ctx = GpuContext::new()?;
+    render_one(&ctx, &scene, &opts, &exr_path, &mut GpuCache::default(), true)
+}
+
+/// `render --frames A..B`: one scene, one device, bakes shared between frames; frame N at time
+/// N / fps is written as `<stem>_NNNN.exr` (and `.png`) beside the output path.
+fn render_frames(
+    scene_path: &Path,
+    output: Option<PathBuf>,
+    (first, last): (u32, u32),
+    fps: f64,
+    overrides: &Overrides,
+) -> Result<()> {
+    if !(fps.is_finite() && fps > 0.0) {
+        return Err(voltex::Error::Invalid(format!("--fps {fps}: expected a positive frame rate")));
+    }
+    let opts = overrides.options()?;
+    let scene = scene::load(scene_path)?;
+    let path = output_path(scene_path, output)?;
+    let stem = path.file_stem().unwrap_or_default().to_string_lossy().to_string();
+    let ctx = GpuContext::new()?;
+    let mut cache = GpuCache::default();
+    for n in first..=last {
+        let frame_opts = RenderOptions { time: Some(n as f64 / fps), ..opts.clone() };
+        let exr = path.with_file_name(format!("{stem}_{n:04}.exr"));
+        render_one(&ctx, &scene, &frame_opts, &exr, &mut cache, n == first)?;
+    }
+    Ok(())
+}
+
+/// The EXR path to write (default `out/<stem>.exr`), its folder checked writable before any GPU
+/// work (`out/` is created when missing).
+fn output_path(scene_path: &Path, output: Option<PathBuf>) -> Result<PathBuf> {
     let exr_path = output.unwrap_or_else(|| {
         let stem = scene_path.file_stem().unwrap_or_default();
         PathBuf::from("out").join(stem).with_extension("exr")
     });
-    let png_path = exr_path.with_extension("png");
-    // Fail before any GPU work if the output cannot be written.
     let dir = match exr_path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
         _ => PathBuf::from("."),
@@ -379,18 +432,31 @@ fn render(scene_path: &Path, output: Option<PathBuf>, overrides: &Overrides) -> 
         std::fs::create_dir_all(&dir).map_err(|e| voltex::Error::file(&dir, e))?;
     }
     io::atomic::check_writable_dir(&dir)?;
-    let bp = Blueprint::new(&scene, &opts)?;
-    for o in &bp.objects {
+    Ok(exr_path)
+}
+
+fn render_one(
+    ctx: &GpuContext,
+    scene: &scene::Scene,
+    opts: &RenderOptions,
+    exr_path: &Path,
+    cache: &mut GpuCache,
+    warn: bool,
+) -> Result<()> {
+    let png_path = exr_path.with_extension("png");
+    let bp = Blueprint::new(scene, opts)?;
+    for o in bp.objects.iter().filter(|_| warn) {
         for w in &o.object.report.warnings {
-            eprintln!("warning: {}: object `{}`: {w}", scene_path.display(), o.object.name);
+            eprintln!("warning: {}: object `{}`: {w}", scene.path.display(), o.object.name);
         }
     }
-    let ctx = GpuContext::new()?;
-    let mut renderer = Renderer::new(&ctx, bp)?;
-    let frame = renderer.render(&ctx)?;
-    let metadata = renderer.metadata(&ctx, &frame);
+    cache.begin();
+    let mut renderer = Renderer::with_cache(ctx, bp, cache)?;
+    cache.retain_used();
+    let frame = renderer.render(ctx)?;
+    let metadata = renderer.metadata(ctx, &frame);
     let meta: Vec<(&str, String)> = metadata.iter().map(|(k, v)| (k.as_str(), v.clone())).collect();
-    io::exr::write(&exr_path, &frame.image, &meta)?;
+    io::exr::write(exr_path, &frame.image, &meta)?;
     io::png::write_tonemapped(&png_path, &frame.image)?;
     let gpu = frame.gpu_ms().map(|t| format!("{t:.2} ms GPU")).unwrap_or_else(|| "no GPU timestamps".into());
     println!(

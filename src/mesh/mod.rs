@@ -2,6 +2,7 @@
 //! loader that make them, and the prism checks that say whether their extrusions are usable.
 
 pub mod generate;
+pub mod motion;
 pub mod obj;
 pub mod prism;
 

@@ -187,7 +187,7 @@ pub fn wgsl_root() -> PathBuf {
 
 impl Blueprint {
     pub fn new(scene: &Scene, opts: &RenderOptions) -> Result<Self> {
-        Self::with_objects(scene, scene.objects()?, opts)
+        Self::with_objects(scene, scene.objects_at(opts.time.unwrap_or(scene.time))?, opts)
     }
 
     /// Like [`Blueprint::new`] with the scene's objects given (tests alter their surfaces).

@@ -3,7 +3,7 @@
 use super::types::{HeightScale, Method, Node, Scene, Surface};
 use crate::error::{Error, FileLoc, Result};
 use crate::mesh::prism::{self, PrismReport};
-use crate::mesh::{generate, BaseSurface, Mesh};
+use crate::mesh::{generate, motion, BaseSurface, Mesh};
 use glam::{DMat4, DVec2};
 use std::sync::Arc;
 
@@ -33,17 +33,22 @@ impl Scene {
     /// Flattens the node tree (child transform = parent * child) into objects, one per node with a
     /// surface, in document order (depth first). Fails on the first object whose prisms are invalid.
     pub fn objects(&self) -> Result<Vec<SceneObject>> {
+        self.objects_at(self.time)
+    }
+
+    /// [`Scene::objects`] at time `time` (seconds): nodes with a `motion` are animated.
+    pub fn objects_at(&self, time: f64) -> Result<Vec<SceneObject>> {
         let mut out = Vec::new();
         for n in &self.nodes {
-            self.flatten(n, DMat4::IDENTITY, &mut out)?;
+            self.flatten(n, DMat4::IDENTITY, time, &mut out)?;
         }
         Ok(out)
     }
 
-    fn flatten(&self, n: &Node, parent: DMat4, out: &mut Vec<SceneObject>) -> Result<()> {
+    fn flatten(&self, n: &Node, parent: DMat4, time: f64, out: &mut Vec<SceneObject>) -> Result<()> {
         let world = parent * n.transform.matrix();
         if let Some(surface) = &n.surface {
-            let surface = self.base_surface(n, surface, &world)?;
+            let surface = self.base_surface(n, surface, &world, time)?;
             let report = prism::check(&surface);
             if !report.errors.is_empty() {
                 let (line, col) = node_position(&self.source, &n.name);
@@ -75,12 +80,12 @@ impl Scene {
             });
         }
         for c in &n.children {
-            self.flatten(c, world, out)?;
+            self.flatten(c, world, time, out)?;
         }
         Ok(())
     }
 
-    fn base_surface(&self, n: &Node, surface: &Surface, world: &DMat4) -> Result<BaseSurface> {
+    fn base_surface(&self, n: &Node, surface: &Surface, world: &DMat4, time: f64) -> Result<BaseSurface> {
         let assets = &self.assets;
         let missing =
             |what: &str, p: &str| Error::Invalid(format!("object \"{}\": {what} {p} was not loaded", n.name));
@@ -121,7 +126,21 @@ impl Scene {
                 )
             }
         };
-        let base = mesh.to_base(n.height.length, scale.as_deref(), DVec2::from(n.uv_tiling));
+        let mut base = mesh.to_base(n.height.length, scale.as_deref(), DVec2::from(n.uv_tiling));
+        let m = &n.motion;
+        let wave = m.wave.map(|w| motion::Wave {
+            amplitude: w.amplitude,
+            wavelength: w.wavelength,
+            speed: w.speed,
+            direction: w.direction.normalize(),
+        });
+        let wind = m.wind.map(|w| motion::Wind {
+            strength: w.strength,
+            frequency: w.frequency,
+            wavelength: w.wavelength,
+            direction: w.direction.normalize(),
+        });
+        motion::animate(&mut base, wave.as_ref(), wind.as_ref(), time);
         Ok(base.transformed(world))
     }
 }

@@ -288,6 +288,9 @@ pub struct Node {
     /// Draw the base surface opaque with this colour.
     #[serde(default, deserialize_with = "v::opt_color")]
     pub base_color: Option<[f32; 3]>,
+    /// Animation of the base surface and height vectors with the scene time.
+    #[serde(default)]
+    pub motion: Motion,
     #[serde(default)]
     pub children: Vec<Node>,
 }
@@ -297,6 +300,44 @@ fn one2() -> [f64; 2] {
 }
 
 /// `translate * rotate * scale`; `rotate` is Euler XYZ in degrees.
+/// Meyer & Neyret's animation modes: a wave deforming the base surface, wind swaying the height
+/// vectors (see `mesh::motion`).
+#[derive(Debug, Clone, Copy, PartialEq, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Motion {
+    #[serde(default)]
+    pub wave: Option<WaveMotion>,
+    #[serde(default)]
+    pub wind: Option<WindMotion>,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WaveMotion {
+    #[serde(deserialize_with = "v::finite")]
+    pub amplitude: f64,
+    #[serde(deserialize_with = "v::positive")]
+    pub wavelength: f64,
+    #[serde(default, deserialize_with = "v::finite")]
+    pub speed: f64,
+    #[serde(deserialize_with = "v::direction")]
+    pub direction: DVec3,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WindMotion {
+    /// Lean as a fraction of the height vector's length, in [0, 1].
+    #[serde(deserialize_with = "v::unit")]
+    pub strength: f64,
+    #[serde(default, deserialize_with = "v::finite")]
+    pub frequency: f64,
+    #[serde(deserialize_with = "v::positive")]
+    pub wavelength: f64,
+    #[serde(deserialize_with = "v::direction")]
+    pub direction: DVec3,
+}
+
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Transform {

@@ -1,0 +1,79 @@
+//! Animation (Meyer & Neyret 1998, section 5): `render --frames A..B` writes a numbered sequence at
+//! time N / fps, each frame the same as a single render at that `--time`; motions animate the
+//! shell; bad motions and frame ranges are errors.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+const BIN: &str = env!("CARGO_BIN_EXE_voltex");
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn voltex(args: &[&str]) -> Output {
+    let mut cmd = Command::new(BIN);
+    cmd.args(args).env("VOLTEX_ROOT", root());
+    if std::env::var_os("XDG_RUNTIME_DIR").is_none() {
+        cmd.env("XDG_RUNTIME_DIR", std::env::temp_dir());
+    }
+    cmd.output().unwrap()
+}
+
+fn ok(out: Output) -> String {
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    String::from_utf8_lossy(&out.stdout).into_owned()
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+fn largest_difference(a: &Path, b: &Path) -> f64 {
+    let text = ok(voltex(&["compare", s(a), s(b)]));
+    let line = text.lines().find(|l| l.starts_with("largest difference")).unwrap();
+    line.split_whitespace().last().unwrap().parse().unwrap()
+}
+
+#[test]
+fn frames_are_renders_at_their_time() {
+    let dir = std::env::temp_dir().join(format!("voltex-frames-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let scene = root().join("scenes/meyer_neyret/waving_flag.ron");
+    let seq = dir.join("flag.exr");
+    ok(voltex(&["render", s(&scene), "--size", "64x48", "--frames", "2..4", "--fps", "4", "-o", s(&seq)]));
+    let frame = |n: u32| dir.join(format!("flag_{n:04}.exr"));
+    assert!(frame(2).is_file() && frame(3).is_file() && frame(4).is_file() && !frame(1).exists());
+    // Frame 3 at 4 fps is the scene at 0.75 s.
+    let single = dir.join("single.exr");
+    ok(voltex(&["render", s(&scene), "--size", "64x48", "--time", "0.75", "-o", s(&single)]));
+    assert_eq!(largest_difference(&frame(3), &single), 0.0);
+    // The flag moves between frames.
+    assert!(largest_difference(&frame(2), &frame(4)) > 0.05);
+
+    for (args, word) in [
+        (vec!["--frames", "4..2"], "expected A..B"),
+        (vec!["--frames", "0..2", "--time", "1"], "cannot be used with"),
+    ] {
+        let mut all = vec!["render", s(&scene), "-o", s(&seq)];
+        all.extend(args);
+        let out = voltex(&all);
+        assert_eq!(out.status.code(), Some(2), "clap rejects it");
+        assert!(
+            String::from_utf8_lossy(&out.stderr).contains(word),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+    // A motion with a zero wavelength is an error at its line:col.
+    let text = std::fs::read_to_string(&scene).unwrap().replace("wavelength: 1.2", "wavelength: 0.0");
+    let bad = dir.join("bad.ron");
+    std::fs::write(&bad, &text).unwrap();
+    let out = voltex(&["render", s(&bad), "-o", s(&seq)]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    let line = text.lines().position(|l| l.contains("wavelength: 0.0")).unwrap() + 1;
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.contains(&format!("bad.ron:{line}:")) && err.contains("positive"), "{err}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
