@@ -312,8 +312,11 @@ fn main() -> ExitCode {
 
 fn bake(scene_path: &Path, texels: &[String], out: Option<PathBuf>) -> voltex::Result<()> {
     let scene = scene::load(scene_path)?;
+    // A sequence is baked as its frames.
+    let volumes =
+        scene.texels.iter().filter(|(_, t)| !matches!(t.source, scene::TexelSource::Sequence { .. }));
     let names: Vec<String> =
-        if texels.is_empty() { scene.texels.keys().cloned().collect() } else { texels.to_vec() };
+        if texels.is_empty() { volumes.map(|(n, _)| n.clone()).collect() } else { texels.to_vec() };
     if names.is_empty() {
         return Err(voltex::Error::Invalid(format!("{}: the scene defines no texels", scene_path.display())));
     }

@@ -77,3 +77,38 @@ fn frames_are_renders_at_their_time() {
     assert!(err.contains(&format!("bad.ron:{line}:")) && err.contains("positive"), "{err}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A cycling volume sequence draws `texels[floor(t * fps) mod n]`; its frames must be texels of
+/// its resolution and no sequences, reported at their `line:col`.
+#[test]
+fn volume_sequences_cycle() {
+    let path = root().join("scenes/meyer_neyret/waving_flag.ron");
+    let scene = voltex::scene::load(&path).unwrap();
+    let at = |t: f64| scene.objects_at(t).unwrap()[0].texel.clone().unwrap();
+    let drawn: Vec<String> = [0.0, 0.2, 0.4, 0.6, 0.7, -0.1].iter().map(|&t| at(t)).collect();
+    assert_eq!(drawn, ["tufts_1", "tufts_2", "tufts_3", "tufts_2", "tufts_1", "tufts_2"]);
+
+    let text = std::fs::read_to_string(&path).unwrap();
+    let dir = std::env::temp_dir().join(format!("voltex-sequence-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    for (from, to, needle, word) in [
+        ("\"tufts_3\", \"tufts_2\"]", "\"tufts_9\", \"tufts_2\"]", "\"tufts_9\"", "unknown texel"),
+        ("\"tufts_3\", \"tufts_2\"]", "\"tufts\", \"tufts_2\"]", "\"tufts\", \"tufts_2\"]", "is a sequence"),
+        (
+            "\"tufts_1\": (\n            resolution: (32, 32, 32)",
+            "\"tufts_1\": (\n            resolution: (32, 32, 16)",
+            "\"tufts_1\", \"tufts_2\", \"tufts_3\"",
+            "resolution",
+        ),
+    ] {
+        assert!(text.contains(from), "{from}");
+        let bad = text.replace(from, to);
+        let file = dir.join("bad.ron");
+        std::fs::write(&file, &bad).unwrap();
+        let e = voltex::scene::load(&file).expect_err(word).to_string();
+        let offset = bad.find(needle).unwrap();
+        let line = bad[..offset].lines().count();
+        assert!(e.contains(&format!("bad.ron:{line}:")) && e.contains(word), "{e}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}

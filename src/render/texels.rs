@@ -94,6 +94,12 @@ pub(super) fn bake_index(
             })?;
             BakeSource::Stack(StackTexels(std::sync::Arc::new(s.texels.clone())))
         }
+        TexelSource::Sequence { .. } => {
+            return Err(Error::Invalid(format!(
+                "{}: texel \"{texel}\" is a sequence: bake its frames instead",
+                scene.path.display()
+            )))
+        }
         TexelSource::Constant { color, opacity } => {
             BakeSource::Implicit(pack_shapes(&[(BakeShape::Constant, *color, *opacity)]))
         }

@@ -1,6 +1,6 @@
 //! The node tree flattened into world-space objects with their base surfaces.
 
-use super::types::{HeightScale, Method, Node, Scene, Surface};
+use super::types::{HeightScale, Method, Node, Scene, Surface, TexelSource};
 use crate::error::{Error, FileLoc, Result};
 use crate::mesh::prism::{self, PrismReport};
 use crate::mesh::{generate, motion, BaseSurface, Mesh};
@@ -60,7 +60,7 @@ impl Scene {
             out.push(SceneObject {
                 name: n.name.clone(),
                 surface,
-                texel: n.texel.as_ref().map(|t| t.value.clone()),
+                texel: n.texel.as_ref().map(|t| self.texel_at(&t.value, time)),
                 method: n.method.as_ref().map(|m| m.value.clone()),
                 base_color: n.base_color,
                 report,
@@ -83,6 +83,17 @@ impl Scene {
             self.flatten(c, world, time, out)?;
         }
         Ok(())
+    }
+
+    /// The texel drawn at `time`: a sequence's current frame, else `name` itself.
+    fn texel_at(&self, name: &str, time: f64) -> String {
+        match self.texels.get(name).map(|t| &t.source) {
+            Some(TexelSource::Sequence { texels, fps }) if !texels.is_empty() => {
+                let frame = ((time * fps).floor() as i64).rem_euclid(texels.len() as i64);
+                texels[frame as usize].value.clone()
+            }
+            _ => name.to_string(),
+        }
     }
 
     fn base_surface(&self, n: &Node, surface: &Surface, world: &DMat4, time: f64) -> Result<BaseSurface> {

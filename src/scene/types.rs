@@ -194,6 +194,13 @@ pub enum TexelSource {
     /// A slice stack written by `voltex bake` (one RGBA PNG per `w` slice, premultiplied, shading
     /// baked in): the texel's `resolution` must be the stack's. Drawn with baked lighting only.
     Slices { dir: Mark<String> },
+    /// Cycling volume sequence (Meyer & Neyret 1998, section 5): at time `t` the texel is
+    /// `texels[floor(t * fps) mod n]`, each frame a texel of this map with this resolution.
+    Sequence {
+        texels: Vec<Mark<String>>,
+        #[serde(deserialize_with = "v::positive")]
+        fps: f64,
+    },
     /// A uniform volume (analytic tests).
     Constant {
         #[serde(deserialize_with = "v::color")]

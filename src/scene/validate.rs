@@ -88,6 +88,31 @@ impl Checker<'_> {
         }
     }
 
+    /// Each frame of a sequence is a texel of the same resolution, and no sequence itself.
+    fn sequence(&mut self, frames: &[Mark<String>], resolution: [u32; 3]) {
+        if frames.is_empty() {
+            let path = self.scene.path.display();
+            return self
+                .other(Error::Invalid(format!("{path}: expected at least one texel name in a sequence")));
+        }
+        for f in frames {
+            match self.scene.texels.get(&f.value) {
+                None => self.fail(f, format!("unknown texel \"{}\" in a sequence", f.value)),
+                Some(t) if matches!(t.source, TexelSource::Sequence { .. }) => {
+                    self.fail(f, format!("\"{}\" is a sequence: expected a texel with a volume", f.value))
+                }
+                Some(t) if t.resolution != resolution => {
+                    let msg = format!(
+                        "expected a texel of the sequence's resolution {resolution:?}, \"{}\" has {:?}",
+                        f.value, t.resolution
+                    );
+                    self.fail(f, msg)
+                }
+                Some(_) => {}
+            }
+        }
+    }
+
     /// Loads the slice stack at `path` and checks it has the texel's resolution.
     fn stack(&mut self, path: &Mark<String>, resolution: [u32; 3]) {
         let full = self.f.assets.dir.join(&path.value);
@@ -257,6 +282,7 @@ pub(super) fn check(scene: &Scene, dir: &Path) -> Findings {
         match &t.source {
             TexelSource::ImageHeight { image, channel, .. } => c.image_channel(image, *channel, image),
             TexelSource::Slices { dir } => c.stack(dir, t.resolution),
+            TexelSource::Sequence { texels, .. } => c.sequence(texels, t.resolution),
             _ => {}
         }
     }
