@@ -453,9 +453,8 @@ fn render_one(
             eprintln!("warning: {}: object `{}`: {w}", scene.path.display(), o.object.name);
         }
     }
-    cache.begin();
+    // Nothing is evicted: a sequence's frames come back, and a scene's bakes are bounded.
     let mut renderer = Renderer::with_cache(ctx, bp, cache)?;
-    cache.retain_used();
     let frame = renderer.render(ctx)?;
     let metadata = renderer.metadata(ctx, &frame);
     let meta: Vec<(&str, String)> = metadata.iter().map(|(k, v)| (k.as_str(), v.clone())).collect();
