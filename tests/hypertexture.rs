@@ -83,7 +83,7 @@ fn twin_tables(plan: &RayMarchPlan) -> Vec<f64> {
 }
 
 fn model<'a>(plan: &'a RayMarchPlan, tables: &'a [f64]) -> Model<'a> {
-    Model { params: &plan.params, noises: &plan.packed.noises, tables }
+    Model { params: &plan.params, noises: &plan.packed.noises, tables, grid: None }
 }
 
 /// 3D simplex noise: the kernel and the f64 twin agree on points up to 40 units from the origin

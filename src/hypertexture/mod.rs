@@ -4,6 +4,7 @@
 //! red, green, blue and opacity tables of the colour transfer function).
 
 pub mod bench;
+pub mod mesh;
 
 use glam::DVec3;
 
@@ -17,6 +18,7 @@ pub const OBJECT_SPHERE: u32 = 0;
 pub const OBJECT_ELLIPSOID: u32 = 1;
 pub const OBJECT_TORUS: u32 = 2;
 pub const OBJECT_BOX: u32 = 3;
+pub const OBJECT_MESH: u32 = 4;
 /// `HyperParams::kinds[1]`.
 pub const FIELD_CLOSEST_SURFACE: u32 = 0;
 pub const FIELD_FROM_CENTRE: u32 = 1;
@@ -39,6 +41,8 @@ pub struct Packed {
     /// Object-space bounds enlarged by the largest shift.
     pub bounds: (DVec3, DVec3),
     pub opacity_length: f64,
+    /// Mesh objects: the mesh and where its grid samples lie.
+    pub mesh: Option<(std::sync::Arc<mesh::MeshShape>, mesh::GridSpec)>,
 }
 
 fn f4(v: DVec3, w: f64) -> [f32; 4] {
@@ -51,6 +55,13 @@ pub fn pack(h: &Hypertexture) -> Packed {
         SoftObject::Ellipsoid { radii } => (OBJECT_ELLIPSOID, f4(*radii, 0.0)),
         SoftObject::Torus { major, minor } => (OBJECT_TORUS, f4(DVec3::new(*major, *minor, 0.0), 0.0)),
         SoftObject::Box { size } => (OBJECT_BOX, f4(*size * 0.5, 0.0)),
+        SoftObject::Mesh { .. } => (OBJECT_MESH, [0.0; 4]),
+    };
+    let mesh = match &h.object.value {
+        SoftObject::Mesh { shape: Some(shape), resolution, .. } => {
+            Some((shape.clone(), shape.grid(*resolution, h.max_shift())))
+        }
+        _ => None,
     };
     let mut p = Packed {
         object,
@@ -63,6 +74,7 @@ pub fn pack(h: &Hypertexture) -> Packed {
         points: Vec::new(),
         bounds: h.bounds(),
         opacity_length: h.opacity_length,
+        mesh,
     };
     let base = match &h.field {
         Field::Perturbed { field, amount, frequency, magnitude, seed } => {

@@ -3,8 +3,12 @@
 //! ranges are checked while parsing; list lengths and control-point order by [`check`] (positioned
 //! through [`Mark`]s).
 
+use std::sync::Arc;
+
 use glam::{DMat4, DVec3};
 use serde::Deserialize;
+
+use crate::hypertexture::mesh::MeshShape;
 
 use super::values::{self as v, Mark};
 
@@ -61,6 +65,20 @@ pub enum SoftObject {
         #[serde(deserialize_with = "v::positive3")]
         size: DVec3,
     },
+    /// A closed triangle mesh (OBJ, relative to the scene file) baked into a grid of
+    /// `resolution^3` samples: inside distance to the surface over the largest inside distance.
+    Mesh {
+        path: Mark<String>,
+        #[serde(default = "default_grid", deserialize_with = "v::grid_resolution")]
+        resolution: u32,
+        /// Loaded and checked by `scene::load`.
+        #[serde(skip)]
+        shape: Option<Arc<MeshShape>>,
+    },
+}
+
+fn default_grid() -> u32 {
+    64
 }
 
 impl SoftObject {
@@ -71,6 +89,9 @@ impl SoftObject {
             SoftObject::Ellipsoid { radii } => *radii,
             SoftObject::Torus { major, minor } => DVec3::new(major + minor, major + minor, *minor),
             SoftObject::Box { size } => *size * 0.5,
+            SoftObject::Mesh { shape, .. } => {
+                return shape.as_ref().map_or((DVec3::ZERO, DVec3::ZERO), |s| (s.lo, s.hi));
+            }
         };
         (-h, h)
     }

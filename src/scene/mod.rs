@@ -68,6 +68,11 @@ pub fn parse(source: &str, path: &Path) -> Result<Scene> {
     if let Some(e) = found.other {
         return Err(e);
     }
+    for h in scene.hypertextures.values_mut() {
+        if let hypertexture::SoftObject::Mesh { path, shape, .. } = &mut h.object.value {
+            *shape = found.assets.shapes.get(&dir.join(&path.value)).cloned();
+        }
+    }
     scene.assets = found.assets;
     scene.source = source.to_string();
     Ok(scene)

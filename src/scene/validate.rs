@@ -5,6 +5,7 @@ use super::image::HeightImage;
 use super::types::{HeightScale, Method, Node, Scene, Surface};
 use super::values::Mark;
 use crate::error::Error;
+use crate::hypertexture::mesh::MeshShape;
 use crate::mesh::{obj, Mesh};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -16,6 +17,8 @@ pub struct Assets {
     pub dir: PathBuf,
     pub meshes: BTreeMap<PathBuf, Arc<Mesh>>,
     pub images: BTreeMap<PathBuf, Arc<HeightImage>>,
+    /// Hypertexture mesh objects, welded and checked.
+    pub shapes: BTreeMap<PathBuf, Arc<MeshShape>>,
 }
 
 /// What the checks found: messages for marks (positioned by a second parse), and the first error
@@ -60,6 +63,21 @@ impl Checker<'_> {
                 self.other(e);
                 None
             }
+        }
+    }
+
+    /// A hypertexture's mesh object: loaded, welded and checked for closure.
+    fn mesh_object(&mut self, path: &Mark<String>) {
+        let full = self.f.assets.dir.join(&path.value);
+        if self.f.assets.shapes.contains_key(&full) {
+            return;
+        }
+        let Some(mesh) = self.mesh(path) else { return };
+        match MeshShape::new(&mesh, &full) {
+            Ok(shape) => {
+                self.f.assets.shapes.insert(full, Arc::new(shape));
+            }
+            Err(msg) => self.fail(path, msg),
         }
     }
 
@@ -221,6 +239,11 @@ pub(super) fn check(scene: &Scene, dir: &Path) -> Findings {
         super::hypertexture::check(h, &mut |seq, msg| {
             c.f.fail.entry(seq).or_insert(msg);
         });
+    }
+    for h in scene.hypertextures.values() {
+        if let super::hypertexture::SoftObject::Mesh { path, .. } = &h.object.value {
+            c.mesh_object(path);
+        }
     }
     for n in &scene.nodes {
         c.node(n, glam::DMat4::IDENTITY);

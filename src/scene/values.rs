@@ -64,6 +64,12 @@ checked_u32!(Frequency, 1, 1024, "a frequency (lattice cells per tile)");
 checked_u32!(Cells, 1, 4096, "a cell count");
 checked_u32!(Around, 3, 4096, "a segment count");
 checked_u32!(PoleToPole, 2, 4096, "a segment count");
+checked_u32!(
+    GridResolution,
+    4,
+    crate::hypertexture::mesh::MAX_RESOLUTION,
+    "a mesh grid resolution (samples per axis)"
+);
 
 // `deserialize_with` adapters: public types stay plain (f64, DVec3, [f32; 3], u32).
 macro_rules! adapter {
@@ -106,6 +112,7 @@ adapter!(opt_size2, Option<[u32; 2]>, Option<[OutputSize; 2]>, |v| v.map(|s| s.m
 adapter!(planes, u32, PlaneCount, |v| v.0);
 adapter!(resolution, [u32; 3], [Resolution; 3], |v| v.map(|x| x.0));
 adapter!(octaves, u32, Octaves, |v| v.0);
+adapter!(grid_resolution, u32, GridResolution, |v| v.0);
 adapter!(frequency, u32, Frequency, |v| v.0);
 adapter!(cells, [u32; 2], [Cells; 2], |v| v.map(|x| x.0));
 adapter!(sphere_segments, [u32; 2], (Around, PoleToPole), |v| [v.0 .0, v.1 .0]);

@@ -168,6 +168,15 @@ struct HyperParams {
     kinds: vec4<u32>,
     march: vec4<f32>,
     budget: vec4<u32>,
+    grid_min: vec4<f32>,
+    grid_max: vec4<f32>,
+}
+
+// A mesh object's grid bake (twin: MeshGridParams in src/types.rs).
+struct MeshGridParams {
+    lo: vec4<f32>,
+    hi: vec4<f32>,
+    counts: vec4<u32>,
 }
 
 struct HyperNoise {
