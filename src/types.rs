@@ -333,7 +333,7 @@ pub struct HyperParams {
 pub struct MeshGridParams {
     pub lo: [f32; 4],
     pub hi: [f32; 4],
-    /// x: samples per axis, y: triangles, z: BVH nodes.
+    /// x: samples per axis, y: triangles, z: BVH nodes, w: closed parts.
     pub counts: [u32; 4],
 }
 

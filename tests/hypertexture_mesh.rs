@@ -50,6 +50,19 @@ fn sphere_obj(radius: f64, around: usize, rings: usize) -> String {
     s
 }
 
+/// A closed box from `lo` to `hi` whose vertices start at OBJ index `base + 1`.
+fn box_obj(lo: [f64; 3], hi: [f64; 3], base: usize) -> String {
+    let mut s = String::new();
+    for k in 0..8 {
+        let c = |a: usize| if k >> a & 1 == 1 { hi[a] } else { lo[a] };
+        s += &format!("v {} {} {}\n", c(0), c(1), c(2));
+    }
+    for f in [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]] {
+        s += &format!("f {} {} {} {}\n", base + f[0] + 1, base + f[1] + 1, base + f[2] + 1, base + f[3] + 1);
+    }
+    s
+}
+
 /// A temporary folder holding `files` (name, text).
 fn folder(tag: &str, files: &[(&str, &str)]) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("voltex-mesh-{tag}-{}", std::process::id()));
@@ -87,16 +100,21 @@ fn sized(w: u32, h: u32) -> RenderOptions {
     RenderOptions { size: Some((w, h)), ..Default::default() }
 }
 
-/// The grid of a 24 x 12 sphere and of a box made of 12 triangles: the kernel (BVH, f32) against
+/// The grid of a 24 x 12 sphere, of a box made of 12 triangles and of the union of two
+/// overlapping boxes: the kernel (a BVH per part, f32) against
 /// the brute-force f64 twin, sample by sample (closest points: on the surface at the twin's
 /// distance).
 #[test]
 fn bake_kernel_matches_twin() {
     let cube = "v -1 -0.5 -0.7\nv 1 -0.5 -0.7\nv 1 0.5 -0.7\nv -1 0.5 -0.7\nv -1 -0.5 0.7\nv 1 -0.5 0.7\nv 1 0.5 0.7\n\
                 v -1 0.5 0.7\nf 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n";
-    let dir = folder("twin", &[("sphere.obj", &sphere_obj(1.0, 24, 12)), ("box.obj", cube)]);
+    // Two overlapping boxes: their union (a part buried in another is not its boundary).
+    let union =
+        box_obj([-1.0, -0.5, -0.5], [0.3, 0.5, 0.5], 0) + &box_obj([-0.2, -0.3, -0.3], [1.0, 0.3, 0.3], 8);
+    let files = [("sphere.obj", &sphere_obj(1.0, 24, 12)[..]), ("box.obj", cube), ("union.obj", &union)];
+    let dir = folder("twin", &files);
     let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
-    for (name, n) in [("sphere.obj", 24), ("box.obj", 20)] {
+    for (name, n) in [("sphere.obj", 24), ("box.obj", 20), ("union.obj", 24)] {
         let m = voltex::mesh::obj::load(&dir.join(name)).unwrap();
         let shape = MeshShape::new(&m, &dir.join(name)).unwrap();
         let spec = shape.grid(n, 0.2);
@@ -134,6 +152,15 @@ fn bake_kernel_matches_twin() {
         assert!(vec_err < 1e-5 && dist_err < 1e-5, "vector {vec_err}, distance {dist_err}");
         assert_eq!(flips, 0);
         assert!((depth as f64 - twin_depth).abs() < 1e-5);
+        if name == "union.obj" {
+            assert_eq!(shape.parts.len(), 2);
+            // On the second box's end face buried in the first (x = -0.2): 0.5 to the first
+            // box's faces, not 0 to the buried face; inside the second box only: 0.3.
+            let (_, d) = voltex::cpu::bake_mesh_grid::sample(&shape, DVec3::new(-0.2, 0.0, 0.0));
+            assert!((d - 0.5).abs() < 1e-12, "{d}");
+            let (_, d) = voltex::cpu::bake_mesh_grid::sample(&shape, DVec3::new(0.6, 0.0, 0.0));
+            assert!((d - 0.3).abs() < 1e-12, "{d}");
+        }
     }
 }
 
@@ -322,7 +349,7 @@ fn bad_meshes_are_reported_at_their_position() {
     let e = fails("Mesh(path: \"open.obj\")");
     assert!(at(&e) && e.contains("open.obj:5:1: open mesh") && e.contains("expected a closed mesh"), "{e}");
     let e = fails("Mesh(path: \"flat.obj\")");
-    assert!(at(&e) && e.contains("flat.obj: degenerate mesh: it encloses no volume"), "{e}");
+    assert!(at(&e) && e.contains("flat.obj:4:1: degenerate mesh") && e.contains("encloses no volume"), "{e}");
     let e = fails("Mesh(path: \"broken.obj\")");
     assert!(e.contains("broken.obj:2:5: vertex index 2 out of range"), "{e}");
     let e = fails("Mesh(path: \"open.obj\", resolution: 0)");

@@ -1,4 +1,4 @@
-// Bakes a closed mesh into a hypertexture mesh object's grid: per sample the vector to the closest surface point and the signed distance (positive inside, by ray parity voted over three directions), and the largest inside distance; CPU twin src/cpu/bake_mesh_grid.rs.
+// Bakes a closed mesh into a hypertexture mesh object's grid: per sample the vector to the closest surface point and the signed distance (positive inside, by ray parity voted over three directions) of the union of its closed parts, and the largest inside distance; CPU twin src/cpu/bake_mesh_grid.rs.
 #include "shared/types.wgsl"
 
 @group(0) @binding(0) var<uniform> grid_params: MeshGridParams;
@@ -13,7 +13,10 @@ struct BvhNode {
     first: u32,
 }
 
+// One BVH per closed part, concatenated (children and triangles indexed in the whole).
 @group(0) @binding(1) var<storage, read> mesh_nodes: array<BvhNode>;
+// Per part: x its root node.
+@group(0) @binding(5) var<storage, read> mesh_parts: array<vec4<u32>>;
 // Three corners per triangle, in leaf order.
 @group(0) @binding(2) var<storage, read> mesh_triangles: array<vec4<f32>>;
 @group(0) @binding(3) var<storage, read_write> mesh_grid: array<vec4<f32>>;
@@ -100,11 +103,11 @@ fn box_distance2(p: vec3<f32>, node: BvhNode) -> f32 {
 
 // The closest surface point to p: the BVH walked nearer child first, skipping boxes farther than
 // the best so far.
-fn closest_point(p: vec3<f32>) -> vec3<f32> {
+fn closest_point(p: vec3<f32>, root: u32) -> vec3<f32> {
     var best = 3.4e38;
     var point = p;
     var stack: array<u32, STACK_SIZE>;
-    stack[0] = 0u;
+    stack[0] = root;
     var top = 1u;
     while (top > 0u) {
         top -= 1u;
@@ -153,11 +156,11 @@ fn crosses(o: vec3<f32>, d: vec3<f32>, t: u32) -> bool {
 }
 
 // The number of triangles the ray from o along d crosses, odd when o is inside.
-fn crossings(o: vec3<f32>, d: vec3<f32>) -> u32 {
+fn crossings(o: vec3<f32>, d: vec3<f32>, root: u32) -> u32 {
     let inv = 1.0 / d;
     var hits = 0u;
     var stack: array<u32, STACK_SIZE>;
-    stack[0] = 0u;
+    stack[0] = root;
     var top = 1u;
     while (top > 0u) {
         top -= 1u;
@@ -193,11 +196,22 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let lo = grid_params.lo.xyz;
     let p = lo + (grid_params.hi.xyz - lo) * (vec3<f32>(id) / f32(n - 1u));
-    let q = closest_point(p);
-    let votes = (crossings(p, DIR0) & 1u) + (crossings(p, DIR1) & 1u) + (crossings(p, DIR2) & 1u);
-    let inside = votes >= 2u;
-    let dist = length(q - p);
-    mesh_grid[id.x + n * (id.y + n * id.z)] = vec4<f32>(q - p, select(-dist, dist, inside));
+    // The union of the parts: the largest signed distance of any part.
+    var best = vec4<f32>(0.0, 0.0, 0.0, -3.4e38);
+    for (var part = 0u; part < grid_params.counts.w; part++) {
+        let root = mesh_parts[part].x;
+        let q = closest_point(p, root);
+        let votes = (crossings(p, DIR0, root) & 1u) + (crossings(p, DIR1, root) & 1u)
+            + (crossings(p, DIR2, root) & 1u);
+        let dist = length(q - p);
+        let signed = select(-dist, dist, votes >= 2u);
+        if (signed > best.w) {
+            best = vec4<f32>(q - p, signed);
+        }
+    }
+    mesh_grid[id.x + n * (id.y + n * id.z)] = best;
+    let inside = best.w > 0.0;
+    let dist = best.w;
     if (inside) {
         atomicMax(&mesh_depth[0], bitcast<u32>(dist));
     }

@@ -1,6 +1,7 @@
 //! CPU twin (f64) of `wgsl/bake_mesh_grid.wgsl`: per grid sample the vector to the closest
 //! surface point and the signed distance (positive inside, ray parity voted over three skewed
-//! directions), by brute force over every triangle (ground truth: no BVH to get wrong).
+//! directions) of the union of the mesh's closed parts, by brute force over every triangle
+//! (ground truth: no BVH to get wrong).
 
 use glam::DVec3;
 
@@ -74,31 +75,41 @@ fn crosses(o: DVec3, d: DVec3, [a, b, c]: [DVec3; 3]) -> bool {
     u >= 0.0 && v >= 0.0 && u + v <= 1.0 && e2.dot(qv) / det > 0.0
 }
 
-/// Whether p is inside: odd crossings along at least two of the three directions.
-pub fn inside(shape: &MeshShape, p: DVec3) -> bool {
+/// Whether p is inside the part made of `triangles`: odd crossings along at least two of the
+/// three directions.
+pub fn inside(shape: &MeshShape, triangles: std::ops::Range<usize>, p: DVec3) -> bool {
     let votes = DIRECTIONS
         .iter()
         .filter(|d| {
             let d = DVec3::from_array(**d);
-            (0..shape.triangles.len()).filter(|&t| crosses(p, d, shape.triangle(t))).count() % 2 == 1
+            triangles.clone().filter(|&t| crosses(p, d, shape.triangle(t))).count() % 2 == 1
         })
         .count();
     votes >= 2
 }
 
-/// The sample at p: (vector to the closest surface point, signed distance).
+/// The sample at p: (vector to the closest surface point, signed distance) of the union of the
+/// parts (the part with the largest signed distance).
 pub fn sample(shape: &MeshShape, p: DVec3) -> (DVec3, f64) {
-    let mut best = (f64::INFINITY, p);
-    for t in 0..shape.triangles.len() {
-        let [a, b, c] = shape.triangle(t);
-        let q = on_triangle(p, a, b, c);
-        let d2 = (q - p).length_squared();
-        if d2 < best.0 {
-            best = (d2, q);
+    let mut out = (DVec3::ZERO, f64::NEG_INFINITY);
+    for &(first, count) in &shape.parts {
+        let range = first as usize..(first + count) as usize;
+        let mut best = (f64::INFINITY, p);
+        for t in range.clone() {
+            let [a, b, c] = shape.triangle(t);
+            let q = on_triangle(p, a, b, c);
+            let d2 = (q - p).length_squared();
+            if d2 < best.0 {
+                best = (d2, q);
+            }
+        }
+        let dist = best.0.sqrt();
+        let signed = if inside(shape, range, p) { dist } else { -dist };
+        if signed > out.1 {
+            out = (best.1 - p, signed);
         }
     }
-    let dist = best.0.sqrt();
-    (best.1 - p, if inside(shape, p) { dist } else { -dist })
+    out
 }
 
 /// Every sample of the grid (x fastest, then y, then z) as (vector xyz, signed distance), and the

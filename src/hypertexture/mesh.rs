@@ -5,6 +5,11 @@
 //! `clamp(inside distance / largest inside distance, 0, 1)`, the soft primitives' falloff (a
 //! sphere's `1 - |x| / r` is its inside distance over its radius); the ray marcher samples the
 //! grid trilinearly for the density and the closest-surface field.
+//!
+//! A mesh made of several closed parts (edge-connected components) is their union, so parts may
+//! overlap (a teapot's spout and handle through its body): each sample keeps the part with the
+//! largest signed distance, which is exact outside the union and never counts a surface buried
+//! in another part as the object's boundary.
 
 use std::collections::HashMap;
 use std::hash::{Hash, Hasher};
@@ -21,6 +26,8 @@ use crate::types::MeshGridParams;
 
 /// Most samples per axis of a mesh grid (16 bytes each: 32 MiB at 128).
 pub const MAX_RESOLUTION: u32 = 128;
+/// Most closed parts of one mesh (the bake walks each part's BVH per sample).
+pub const MAX_PARTS: usize = 16;
 
 /// A closed triangle mesh in its node's frame, vertices welded by position.
 #[derive(Debug, Clone, PartialEq)]
@@ -29,6 +36,8 @@ pub struct MeshShape {
     pub triangles: Vec<[u32; 3]>,
     pub lo: DVec3,
     pub hi: DVec3,
+    /// Closed parts: (first triangle, triangle count); triangles are grouped by part.
+    pub parts: Vec<(u32, u32)>,
     /// Of positions and triangles: the bake cache's key.
     pub hash: u64,
 }
@@ -48,9 +57,9 @@ impl GridSpec {
         self.lo + (self.hi - self.lo) * f
     }
 
-    pub fn params(&self, triangles: u32, nodes: u32) -> MeshGridParams {
+    pub fn params(&self, triangles: u32, nodes: u32, parts: u32) -> MeshGridParams {
         let f = |v: DVec3| [v.x as f32, v.y as f32, v.z as f32, 0.0];
-        MeshGridParams { lo: f(self.lo), hi: f(self.hi), counts: [self.n, triangles, nodes, 0] }
+        MeshGridParams { lo: f(self.lo), hi: f(self.hi), counts: [self.n, triangles, nodes, parts] }
     }
 }
 
@@ -114,28 +123,67 @@ impl MeshShape {
         }
         let lo = positions.iter().fold(DVec3::INFINITY, |a, &p| a.min(p));
         let hi = positions.iter().fold(DVec3::NEG_INFINITY, |a, &p| a.max(p));
-        let volume: f64 = triangles
-            .iter()
-            .map(|t| {
-                let [a, b, c] = t.map(|i| positions[i as usize] - lo);
-                a.dot(b.cross(c)) / 6.0
-            })
-            .sum();
-        let extent = (hi - lo).max_element();
-        if volume.abs() <= 1e-9 * extent.powi(3) {
+        // Parts: triangles joined by shared vertices (union-find), grouped in order of first face.
+        let mut root: Vec<u32> = (0..positions.len() as u32).collect();
+        fn find(root: &mut [u32], mut i: u32) -> u32 {
+            while root[i as usize] != i {
+                root[i as usize] = root[root[i as usize] as usize];
+                i = root[i as usize];
+            }
+            i
+        }
+        for t in &triangles {
+            for e in 1..3 {
+                let (a, b) = (find(&mut root, t[0]), find(&mut root, t[e]));
+                root[a.max(b) as usize] = a.min(b);
+            }
+        }
+        let mut part_of: HashMap<u32, usize> = HashMap::new();
+        let mut groups: Vec<Vec<usize>> = Vec::new();
+        for (t, tri) in triangles.iter().enumerate() {
+            let r = find(&mut root, tri[0]);
+            let g = *part_of.entry(r).or_insert_with(|| {
+                groups.push(Vec::new());
+                groups.len() - 1
+            });
+            groups[g].push(t);
+        }
+        if groups.len() > MAX_PARTS {
             return Err(format!(
-                "{}: degenerate mesh: it encloses no volume (bounds {:?} to {:?})",
+                "{}: {} separate closed parts: expected at most {MAX_PARTS}",
                 path.display(),
-                lo.to_array(),
-                hi.to_array()
+                groups.len()
             ));
         }
+        let extent = (hi - lo).max_element();
+        let mut parts = Vec::new();
+        let mut grouped = Vec::with_capacity(triangles.len());
+        for g in &groups {
+            let volume: f64 = g
+                .iter()
+                .map(|&t| {
+                    let [a, b, c] = triangles[t].map(|i| positions[i as usize] - lo);
+                    a.dot(b.cross(c)) / 6.0
+                })
+                .sum();
+            if volume.abs() <= 1e-9 * extent.powi(3) {
+                return Err(format!(
+                    "{}: degenerate mesh: the part of this face encloses no volume (bounds {:?} to {:?})",
+                    at(g[0]),
+                    lo.to_array(),
+                    hi.to_array()
+                ));
+            }
+            parts.push((grouped.len() as u32, g.len() as u32));
+            grouped.extend(g.iter().map(|&t| triangles[t]));
+        }
+        let triangles = grouped;
         let mut h = std::collections::hash_map::DefaultHasher::new();
         for p in &positions {
             p.to_array().map(f64::to_bits).hash(&mut h);
         }
         triangles.hash(&mut h);
-        Ok(MeshShape { positions, triangles, lo, hi, hash: h.finish() })
+        Ok(MeshShape { positions, triangles, lo, hi, parts, hash: h.finish() })
     }
 
     /// The grid of `n` samples per axis over the mesh's bounds enlarged by the largest shift (the
@@ -159,29 +207,44 @@ pub struct MeshGrid {
     pub depth: wgpu::Buffer,
 }
 
-/// Runs `bake_mesh_grid.wgsl` for `shape` over `spec`: one thread per sample, the closest point
-/// found through a BVH over the triangles (`methods::reference::flat_bvh`).
+/// Runs `bake_mesh_grid.wgsl` for `shape` over `spec`: one thread per sample, closest points
+/// and ray crossings found through a BVH per part (`methods::reference::flat_bvh`).
 pub fn bake(ctx: &GpuContext, shape: &MeshShape, spec: &GridSpec) -> Result<MeshGrid> {
     use crate::bake::{storage, uniform};
     use crate::gpu::kernel::ComputeKernel;
-    let boxes: Vec<Aabb> = (0..shape.triangles.len())
-        .map(|t| {
-            let pts = shape.triangle(t).map(|p| Vec3A::new(p.x as f32, p.y as f32, p.z as f32));
-            let b = Aabb::from_points(&pts);
-            // Grown so that f32 rounding never loses a triangle.
-            let pad = Vec3A::splat(1e-5 * (b.max - b.min).max_element() + 1e-6);
-            Aabb::new(b.min - pad, b.max + pad)
-        })
-        .collect();
-    let (nodes, order) = crate::methods::reference::flat_bvh(&boxes);
-    let corners: Vec<[f32; 4]> = order
-        .iter()
-        .flat_map(|&t| shape.triangle(t as usize).map(|p| [p.x as f32, p.y as f32, p.z as f32, 0.0]))
-        .collect();
-    let params = spec.params(order.len() as u32, nodes.len() as u32);
+    // One BVH per part, concatenated: a part's root, then its nodes; leaves index the triangles
+    // (in each part's leaf order), inner nodes their first child, both offset to the whole.
+    let mut nodes = Vec::new();
+    let mut corners: Vec<[f32; 4]> = Vec::new();
+    let mut roots: Vec<[u32; 4]> = Vec::new();
+    for &(first, count) in &shape.parts {
+        let boxes: Vec<Aabb> = (first..first + count)
+            .map(|t| {
+                let pts = shape.triangle(t as usize).map(|p| Vec3A::new(p.x as f32, p.y as f32, p.z as f32));
+                let b = Aabb::from_points(&pts);
+                // Grown so that f32 rounding never loses a triangle.
+                let pad = Vec3A::splat(1e-5 * (b.max - b.min).max_element() + 1e-6);
+                Aabb::new(b.min - pad, b.max + pad)
+            })
+            .collect();
+        let (part_nodes, order) = crate::methods::reference::flat_bvh(&boxes);
+        let (node_base, tri_base) = (nodes.len() as u32, (corners.len() / 3) as u32);
+        roots.push([node_base, first, count, 0]);
+        nodes.extend(part_nodes.into_iter().map(|mut n| {
+            let leaf = n.min[3].to_bits() > 0;
+            let base = if leaf { tri_base } else { node_base };
+            n.max[3] = f32::from_bits(n.max[3].to_bits() + base);
+            n
+        }));
+        corners.extend(order.iter().flat_map(|&t| {
+            shape.triangle((first + t) as usize).map(|p| [p.x as f32, p.y as f32, p.z as f32, 0.0])
+        }));
+    }
+    let params = spec.params(shape.triangles.len() as u32, nodes.len() as u32, roots.len() as u32);
     let mut inputs = Inputs::default();
     let b = &mut inputs.buffers;
     b.insert("grid_params".into(), uniform(ctx, "grid_params", bytemuck::bytes_of(&params)));
+    b.insert("mesh_parts".into(), storage(ctx, "mesh_parts", bytemuck::cast_slice(&roots)));
     b.insert("mesh_nodes".into(), storage(ctx, "mesh_nodes", bytemuck::cast_slice(&nodes)));
     b.insert("mesh_triangles".into(), storage(ctx, "mesh_triangles", bytemuck::cast_slice(&corners)));
     let n = spec.n as u64;
