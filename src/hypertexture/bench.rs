@@ -1,7 +1,7 @@
 //! `voltex bench-hyper`: the set-up of the paper's Figure 11 on the current adapter: one
 //! hypertexture (three noises) on five objects (three soft primitives, the cube and teapot meshes
-//! of the Figure 11 scenes, whose grid bakes it also times) covering most of the window, HQ and IE steps, no
-//! shading, Phong, and Phong with shadow rays. Per setting: the median wall time of a frame after
+//! of the Figure 11 scenes, whose grid bakes it also times) covering most of the window, HQ and
+//! IE steps, no shading, Phong, and Phong with shadow rays. Per setting: the median wall time of a frame after
 //! warm-up, the density evaluations the frame made and those that ran the noises (counted by the
 //! kernel: points farther than the largest shift from the object skip them), and the share of the
 //! frame that those noise evaluations alone would take at the rate `bench_simplex.wgsl` measures
