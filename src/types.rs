@@ -349,7 +349,10 @@ pub struct HyperNoise {
     pub blend: u32,
     pub seed: u32,
     pub speed: f32,
-    pub _pad: [u32; 2],
+    /// The noise's first shape table, and its row count: 1 for a 1D shape transfer function, or
+    /// the rows of a 2D one (`Grid`), one table per density from 0 to 1.
+    pub table: u32,
+    pub rows: u32,
 }
 
 /// A transfer function to sample into a table: `count` control points from `first`; `kind` 0 is

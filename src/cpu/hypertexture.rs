@@ -198,14 +198,15 @@ impl Model<'_> {
         let noises = &self.noises[..self.params.kinds[2] as usize];
         let animated = crate::hypertexture::animated(noises);
         let time = self.params.march[3] as f64;
-        for (i, n) in noises.iter().enumerate() {
+        let density = self.object_density(x);
+        for n in noises {
             let q = (x + v * n.shift as f64) * n.frequency as f64;
             let noise = if animated {
                 simplex4(DVec4::new(q.x, q.y, q.z, n.speed as f64 * time), n.seed)
             } else {
                 simplex3(q, n.seed)
             };
-            let t = transfer_lookup(self.tables, i as u32, 0.5 + 0.5 * noise);
+            let t = self.shape_lookup(n, 0.5 + 0.5 * noise, density);
             let a = n.amplitude as f64;
             k = if n.blend != 0 { k * (1.0 - t) + a * t } else { k + a * t };
         }
@@ -222,9 +223,27 @@ impl Model<'_> {
         self.object_density(x - unit_or_zero(v) * self.distortion(x, v))
     }
 
+    /// A noise's shape transfer function at noise value u (2D: bilinear with the density o).
+    pub fn shape_lookup(&self, n: &HyperNoise, u: f64, o: f64) -> f64 {
+        if n.rows <= 1 {
+            return transfer_lookup(self.tables, n.table, u);
+        }
+        let r = o.clamp(0.0, 1.0) * (n.rows - 1) as f64;
+        let row = (r as u32).min(n.rows - 2);
+        let a = transfer_lookup(self.tables, n.table + row, u);
+        let b = transfer_lookup(self.tables, n.table + row + 1, u);
+        a + (b - a) * (r - row as f64)
+    }
+
+    /// The first colour table: after the last noise's shape tables.
+    pub fn color_tables(&self) -> u32 {
+        let last = &self.noises[self.params.kinds[2] as usize - 1];
+        last.table + last.rows.max(1)
+    }
+
     /// Straight colour and opacity per opacity length at a density.
     pub fn hyper_color(&self, density: f64) -> [f64; 4] {
-        let first = self.params.kinds[2];
+        let first = self.color_tables();
         std::array::from_fn(|c| transfer_lookup(self.tables, first + c as u32, density))
     }
 }

@@ -1,7 +1,8 @@
 //! Hypertextures (Gilet & Dischler 2009) packed for the kernels: the soft object and vector field
 //! as `HyperParams` fields, one `HyperNoise` per noise, and every transfer function as control
-//! points that `bake_transfer.wgsl` samples into tables (the noises' shape tables first, then the
-//! red, green, blue and opacity tables of the colour transfer function).
+//! points that `bake_transfer.wgsl` samples into tables (the noises' shape tables first, one per
+//! noise or one per row of a 2D shape transfer function, then the red, green, blue and opacity
+//! tables of the colour transfer function).
 
 pub mod bench;
 pub mod mesh;
@@ -102,6 +103,11 @@ pub fn pack(h: &Hypertexture) -> Packed {
         Field::ClosestSurface | Field::Perturbed { .. } => {}
     }
     for n in h.noises.iter() {
+        let table = p.functions.len() as u32;
+        let rows = match &n.shape {
+            ShapeTransfer::Grid(rows) => rows.0.len() as u32,
+            _ => 1,
+        };
         p.noises.push(HyperNoise {
             amplitude: n.amplitude as f32,
             frequency: n.frequency as f32,
@@ -109,16 +115,16 @@ pub fn pack(h: &Hypertexture) -> Packed {
             blend: (n.operator == Operator::Blend) as u32,
             seed: n.seed,
             speed: n.speed as f32,
-            _pad: [0; 2],
+            table,
+            rows,
         });
         match &n.shape {
             ShapeTransfer::Curve(points) => {
                 p.function(HERMITE, points.iter().map(|c| (c.0, c.1, c.2)));
             }
-            ShapeTransfer::Table(values) => {
-                let last = (values.0.len() - 1).max(1) as f64;
-                p.function(LINEAR, values.0.iter().enumerate().map(|(i, &y)| (i as f64 / last, y, 0.0)));
-            }
+            ShapeTransfer::Table(values) => p.table(&values.0),
+            // One table per row: the lookup interpolates between rows by density.
+            ShapeTransfer::Grid(rows) => rows.0.iter().for_each(|row| p.table(row)),
         }
     }
     match &h.color {
@@ -152,6 +158,12 @@ pub fn animated(noises: &[HyperNoise]) -> bool {
 }
 
 impl Packed {
+    /// Values at evenly spaced x from 0 to 1, joined linearly.
+    fn table(&mut self, values: &[f64]) {
+        let last = (values.len() - 1).max(1) as f64;
+        self.function(LINEAR, values.iter().enumerate().map(|(i, &y)| (i as f64 / last, y, 0.0)));
+    }
+
     fn function(&mut self, kind: u32, points: impl Iterator<Item = (f64, f64, f64)>) {
         let first = self.points.len() as u32;
         self.points.extend(points.map(|(x, y, slope)| TransferPoint {

@@ -18,6 +18,8 @@ pub const MAX_NOISES: usize = 8;
 pub const MAX_POINTS: usize = 64;
 /// Most values of a sampled table.
 pub const MAX_TABLE: usize = 256;
+/// Most rows (densities) of a 2D shape transfer function.
+pub const MAX_ROWS: usize = 64;
 
 /// `hypertextures: { "name": (object: .., field: .., noises: [..], color: ..) }`.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
@@ -189,7 +191,15 @@ pub enum ShapeTransfer {
     Curve(Mark<Vec<Mark<CurvePoint>>>),
     /// Values at evenly spaced x from 0 to 1, joined linearly.
     Table(Mark<TableValues>),
+    /// A 2D shape transfer function (the paper's eq. 6, Figure 7): rows of values at evenly
+    /// spaced noise values from 0 to 1, the rows at evenly spaced object densities O(x) from 0
+    /// (first row) to 1 (last), joined bilinearly.
+    Grid(Mark<GridRows>),
 }
+
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(transparent)]
+pub struct GridRows(#[serde(deserialize_with = "v::unit_rows")] pub Vec<Vec<f64>>);
 
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
 pub struct CurvePoint(
@@ -288,6 +298,21 @@ pub(super) fn check(h: &Hypertexture, fail: &mut dyn FnMut(usize, String)) {
                 let n = values.0.len();
                 if !(2..=MAX_TABLE).contains(&n) {
                     fail(values.seq, format!("expected a table of 2 to {MAX_TABLE} values, found {n}"));
+                }
+            }
+            ShapeTransfer::Grid(rows) => {
+                let n = rows.0.len();
+                let width = rows.0.first().map_or(0, Vec::len);
+                if !(2..=MAX_ROWS).contains(&n) {
+                    fail(rows.seq, format!("expected a grid of 2 to {MAX_ROWS} rows (densities), found {n}"));
+                } else if !(2..=MAX_TABLE).contains(&width) {
+                    fail(rows.seq, format!("expected grid rows of 2 to {MAX_TABLE} values, found {width}"));
+                } else if let Some(i) = rows.0.iter().position(|r| r.len() != width) {
+                    let found = rows.0[i].len();
+                    fail(
+                        rows.seq,
+                        format!("grid row {} has {found} values: expected every row as long as the first ({width})", i + 1),
+                    );
                 }
             }
         }

@@ -86,6 +86,10 @@ adapter!(finite, f64, Finite, |v| v.0);
 adapter!(positive3, DVec3, [Positive; 3], |v| DVec3::new(v[0].0, v[1].0, v[2].0));
 adapter!(rgba, [f64; 4], [Unit; 4], |v| v.map(|x| x.0));
 adapter!(unit_list, Vec<f64>, Vec<Unit>, |v| v.into_iter().map(|x| x.0).collect());
+adapter!(unit_rows, Vec<Vec<f64>>, Vec<Vec<Unit>>, |v| v
+    .into_iter()
+    .map(|r| r.into_iter().map(|x| x.0).collect())
+    .collect());
 adapter!(opt_positive, Option<f64>, Option<Positive>, |v| v.map(|x| x.0));
 adapter!(non_negative, f64, NonNegative, |v| v.0);
 adapter!(unit, f64, Unit, |v| v.0);

@@ -186,8 +186,8 @@ struct HyperNoise {
     blend: u32,
     seed: u32,
     speed: f32,
-    _pad0: u32,
-    _pad1: u32,
+    table: u32,
+    rows: u32,
 }
 
 struct TransferFunction {
