@@ -337,7 +337,14 @@ fn unchanged_mesh_is_not_rebaked() {
 fn bad_meshes_are_reported_at_their_position() {
     let open = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 2 3 4\n";
     let flat = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 3 2\n";
-    let dir = folder("bad", &[("open.obj", open), ("flat.obj", flat), ("broken.obj", "v 0 0 0\nf 1 2 3\n")]);
+    let sphere = sphere_obj(1.0, 8, 4);
+    let files = [
+        ("open.obj", open),
+        ("flat.obj", flat),
+        ("broken.obj", "v 0 0 0\nf 1 2 3\n"),
+        ("sphere.obj", &sphere),
+    ];
+    let dir = folder("bad", &files);
     let fails = |object: &str| {
         let path = dir.join("scene.ron");
         std::fs::write(&path, scene_text(object, NOISE, "RayMarch()")).unwrap();
@@ -359,4 +366,24 @@ fn bad_meshes_are_reported_at_their_position() {
     );
     let e = fails("Mesh(path: \"open.obj\", resolution: 1000)");
     assert!(at(&e) && e.contains("found 1000"), "{e}");
+
+    // The step check sees the mesh's bounds (diagonal 2 sqrt(3) + the shift: 1.5e5 samples).
+    let path = dir.join("scene.ron");
+    std::fs::write(&path, scene_text("Mesh(path: \"sphere.obj\")", NOISE, "RayMarch(step: 0.00003)"))
+        .unwrap();
+    let e = scene::load(&path).err().map(|e| e.to_string()).unwrap_or_default();
+    assert!(e.contains("scene.ron:7:") && e.contains("samples across the bounds"), "{e}");
+
+    // Through the binary: exit status 1, the position, no output written.
+    let path = dir.join("scene.ron");
+    std::fs::write(&path, scene_text("Mesh(path: \"open.obj\")", NOISE, "RayMarch()")).unwrap();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_voltex"))
+        .args(["render", path.to_str().unwrap(), "-o"])
+        .arg(dir.join("out.exr"))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(at(&err) && err.contains("open.obj:5:1: open mesh"), "{err}");
+    assert!(!dir.join("out.exr").exists() && !dir.join("out.png").exists());
 }

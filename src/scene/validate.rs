@@ -200,6 +200,11 @@ impl Checker<'_> {
             return;
         };
         if let Some(Method::RayMarch(rm)) = ray_march.map(|m| &m.value) {
+            // Mesh objects get their bounds from the mesh, loaded before the nodes are checked.
+            let mut model = model.clone();
+            if let super::hypertexture::SoftObject::Mesh { path, shape, .. } = &mut model.object.value {
+                *shape = self.f.assets.shapes.get(&self.f.assets.dir.join(&path.value)).cloned();
+            }
             let diagonal = super::hypertexture::diagonal(&model.world_corners(world));
             let samples = diagonal / rm.step();
             if samples > MAX_SAMPLES_PER_RAY {
