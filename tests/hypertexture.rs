@@ -495,7 +495,8 @@ fn bad_transfer_functions_are_reported_at_their_position() {
 }
 
 /// 2D shape transfer functions (eq. 6): a grid whose rows are equal is its 1D table (kernel and
-/// twin); `Grid([[0, 0], [1, 1]])` is T = O(x) whatever the noise, so on a sphere with the
+/// twin); an image gives the grid of its pixels; bad images fail at their position;
+/// `Grid([[0, 0], [1, 1]])` is T = O(x) whatever the noise, so on a sphere with the
 /// closest-surface field every point at |x| >= a / (1 + a) moves inwards by a (1 - |x|): the
 /// density is (1 + a)(1 - |x|) exactly.
 #[test]
@@ -529,6 +530,38 @@ fn grid_shape_transfer_functions() {
     let max = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max);
     let (d_gpu, d_cpu) = (max(&table_gpu, &grid_gpu), max(&table_cpu, &grid_cpu));
     let (depth_gpu, depth_cpu) = density("Grid([[0.0, 0.0], [1.0, 1.0]])");
+    // The same function from a grayscale PNG image (top row: density 0).
+    let dir = std::env::temp_dir().join(format!("voltex-grid-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let png = |name: &str, w: u32, h: u32, grey: &dyn Fn(u32, u32) -> u8| {
+        let pixels: Vec<[u8; 4]> = (0..w * h).map(|i| grey(i % w, i / w)).map(|g| [g, g, g, 255]).collect();
+        voltex::io::png::write_rgba8(&dir.join(name), w, h, &pixels).unwrap();
+        format!("Image(path: \"{}\")", dir.join(name).display())
+    };
+    let image = png("depth.png", 2, 2, &|_, y| if y == 0 { 0 } else { 255 });
+    let (image_gpu, image_cpu) = density(&image);
+    let d_image = max(&image_gpu, &depth_gpu).max(max(&image_cpu, &depth_cpu));
+    assert!(d_image == 0.0, "image against grid: {d_image}");
+    let source = |shape: &str| {
+        let text = BASE.lines().map(|l| {
+            if l.contains("(shape:") {
+                format!("                (shape: {shape}, amplitude: 0.2, frequency: 2.0),")
+            } else {
+                l.to_string()
+            }
+        });
+        text.collect::<Vec<_>>().join("\n")
+    };
+    let one_row = png("one_row.png", 4, 1, &|_, _| 0);
+    let e = scene::parse(&source(&one_row), Path::new("test.ron")).unwrap_err().to_string();
+    assert!(
+        e.starts_with("test.ron:10:") && e.contains("2 to 64 rows (density)") && e.contains("is 4x1"),
+        "{e}"
+    );
+    let missing = "Image(path: \"/nonexistent/t.png\")";
+    let e = scene::parse(&source(missing), Path::new("test.ron")).unwrap_err().to_string();
+    assert!(e.starts_with("test.ron:10:") && e.contains("t.png does not exist"), "{e}");
+    std::fs::remove_dir_all(&dir).ok();
     let (mut analytic_gpu, mut analytic_cpu, mut checked) = (0.0f64, 0.0f64, 0);
     for (i, p) in points.iter().enumerate() {
         let r = DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64).length();

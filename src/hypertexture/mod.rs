@@ -104,10 +104,7 @@ pub fn pack(h: &Hypertexture) -> Packed {
     }
     for n in h.noises.iter() {
         let table = p.functions.len() as u32;
-        let rows = match &n.shape {
-            ShapeTransfer::Grid(rows) => rows.0.len() as u32,
-            _ => 1,
-        };
+        let rows = n.shape.rows().map_or(1, |r| r.len() as u32);
         p.noises.push(HyperNoise {
             amplitude: n.amplitude as f32,
             frequency: n.frequency as f32,
@@ -124,7 +121,9 @@ pub fn pack(h: &Hypertexture) -> Packed {
             }
             ShapeTransfer::Table(values) => p.table(&values.0),
             // One table per row: the lookup interpolates between rows by density.
-            ShapeTransfer::Grid(rows) => rows.0.iter().for_each(|row| p.table(row)),
+            ShapeTransfer::Grid(_) | ShapeTransfer::Image { .. } => {
+                n.shape.rows().unwrap_or_default().iter().for_each(|row| p.table(row))
+            }
         }
     }
     match &h.color {

@@ -195,6 +195,26 @@ pub enum ShapeTransfer {
     /// spaced noise values from 0 to 1, the rows at evenly spaced object densities O(x) from 0
     /// (first row) to 1 (last), joined bilinearly.
     Grid(Mark<GridRows>),
+    /// A 2D shape transfer function from a grayscale PNG image (relative to the scene file; its
+    /// first channel): columns are noise values from 0 (left) to 1, rows densities from 0 (top)
+    /// to 1, as a `Grid` whose rows are the image's.
+    Image {
+        path: Mark<String>,
+        /// Filled by `scene::load` from the image.
+        #[serde(skip)]
+        rows: Vec<Vec<f64>>,
+    },
+}
+
+impl ShapeTransfer {
+    /// The rows of a 2D function (`Grid` or `Image`); `None` for 1D ones.
+    pub fn rows(&self) -> Option<&[Vec<f64>]> {
+        match self {
+            ShapeTransfer::Grid(rows) => Some(&rows.0),
+            ShapeTransfer::Image { rows, .. } => Some(rows),
+            _ => None,
+        }
+    }
 }
 
 #[derive(Debug, Clone, PartialEq, Deserialize)]
@@ -300,6 +320,8 @@ pub(super) fn check(h: &Hypertexture, fail: &mut dyn FnMut(usize, String)) {
                     fail(values.seq, format!("expected a table of 2 to {MAX_TABLE} values, found {n}"));
                 }
             }
+            // Its size is checked when the image is loaded.
+            ShapeTransfer::Image { .. } => {}
             ShapeTransfer::Grid(rows) => {
                 let n = rows.0.len();
                 let width = rows.0.first().map_or(0, Vec::len);

@@ -72,6 +72,14 @@ pub fn parse(source: &str, path: &Path) -> Result<Scene> {
         if let hypertexture::SoftObject::Mesh { path, shape, .. } = &mut h.object.value {
             *shape = found.assets.shapes.get(&dir.join(&path.value)).cloned();
         }
+        for noise in h.noises.value.iter_mut() {
+            if let hypertexture::ShapeTransfer::Image { path, rows } = &mut noise.shape {
+                if let Some(img) = found.assets.images.get(&dir.join(&path.value)) {
+                    let at = |x: usize, y: usize| img.data[(y * img.width + x) * img.channels] as f64;
+                    *rows = (0..img.height).map(|y| (0..img.width).map(|x| at(x, y)).collect()).collect();
+                }
+            }
+        }
     }
     scene.assets = found.assets;
     scene.source = source.to_string();

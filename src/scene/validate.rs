@@ -81,6 +81,19 @@ impl Checker<'_> {
         }
     }
 
+    /// A 2D shape transfer function's image: 2 to 256 columns (noise), 2 to 64 rows (density).
+    fn shape_image(&mut self, path: &Mark<String>) {
+        use super::hypertexture::{MAX_ROWS, MAX_TABLE};
+        let Some(img) = self.image(path) else { return };
+        if !(2..=MAX_TABLE).contains(&img.width) || !(2..=MAX_ROWS).contains(&img.height) {
+            let msg = format!(
+                "expected an image of 2 to {MAX_TABLE} columns (noise) and 2 to {MAX_ROWS} rows (density), {} is {}x{}",
+                path.value, img.width, img.height
+            );
+            self.fail(path, msg);
+        }
+    }
+
     fn image(&mut self, path: &Mark<String>) -> Option<Arc<HeightImage>> {
         let full = self.f.assets.dir.join(&path.value);
         if let Some(m) = self.f.assets.images.get(&full) {
@@ -248,6 +261,11 @@ pub(super) fn check(scene: &Scene, dir: &Path) -> Findings {
     for h in scene.hypertextures.values() {
         if let super::hypertexture::SoftObject::Mesh { path, .. } = &h.object.value {
             c.mesh_object(path);
+        }
+        for noise in h.noises.iter() {
+            if let super::hypertexture::ShapeTransfer::Image { path, .. } = &noise.shape {
+                c.shape_image(path);
+            }
         }
     }
     for n in &scene.nodes {
