@@ -218,6 +218,12 @@ fn mesh_hypertexture_matches_twin() {
     let object = "Mesh(path: \"sphere.obj\", resolution: 32)";
     let scene = mesh_scene(&dir, object, NOISE, "RayMarch(step: 0.02)");
     let bp = Blueprint::new(&scene, &sized(8, 8)).unwrap();
+    // `voltex plan` lists the bake.
+    let text = bp.describe();
+    assert!(
+        text.contains("32x32x32  bake_mesh_grid.wgsl  mesh grid of 960 triangles in 1 part(s)"),
+        "{text}"
+    );
     let plan = plan_of(&bp);
     let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
     let grid = plan.bake_mesh_grid(&ctx).unwrap().unwrap();
