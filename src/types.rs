@@ -339,6 +339,21 @@ pub struct HyperParams {
     /// Work of one dispatch, in density evaluations: x the budget, y the most samples of a shadow
     /// ray, z the most one sample may cost (so a sample is begun only when it fits).
     pub budget: [u32; 4],
+    /// Mesh objects: xyz the lower corner of the baked grid (object space), w samples per axis.
+    pub grid_min: [f32; 4],
+    /// Mesh objects: xyz the upper corner of the baked grid.
+    pub grid_max: [f32; 4],
+}
+
+/// What `bake_mesh_grid.wgsl` bakes: samples at the vertices of an `n^3` grid from `lo` to `hi`
+/// (object space) of a closed mesh whose triangles are ordered as the leaves of its BVH.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct MeshGridParams {
+    pub lo: [f32; 4],
+    pub hi: [f32; 4],
+    /// x: samples per axis, y: triangles, z: BVH nodes, w: closed parts.
+    pub counts: [u32; 4],
 }
 
 /// One noise of a hypertexture: `t = T((1 + simplex(frequency (x + shift V))) / 2)`, combined
@@ -353,7 +368,10 @@ pub struct HyperNoise {
     pub blend: u32,
     pub seed: u32,
     pub speed: f32,
-    pub _pad: [u32; 2],
+    /// The noise's first shape table, and its row count: 1 for a 1D shape transfer function, or
+    /// the rows of a 2D one (`Grid`), one table per density from 0 to 1.
+    pub table: u32,
+    pub rows: u32,
 }
 
 /// A transfer function to sample into a table: `count` control points from `first`; `kind` 0 is

@@ -405,7 +405,7 @@ fn layers_and_twins(name: &str) -> Vec<(String, Layer, Layer)> {
         let object = &r.blueprint.objects[o];
         let plan = object.ray_march.as_ref().unwrap();
         let tables = bake_transfer(&plan.packed.functions, &plan.packed.points);
-        let model = Model { params: &plan.params, noises: &plan.packed.noises, tables: &tables };
+        let model = Model { params: &plan.params, noises: &plan.packed.noises, tables: &tables, grid: None };
         let cpu = ray_march(&view, model, plan.shade);
         assert!(gpu.iter().chain(&cpu).flatten().all(|v| v.is_finite()), "{name}: non-finite layer values");
         out.push((object.object.name.clone(), gpu, cpu));

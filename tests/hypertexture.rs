@@ -36,6 +36,7 @@ const EXAMPLES: &[&str] = &[
     "fig5_multiple_noises.ron",
     "fig6_clouds.ron",
     "fig8_vector_fields.ron",
+    "fig7_2d_transfer.ron",
 ];
 
 fn sized(w: u32, h: u32) -> RenderOptions {
@@ -83,7 +84,7 @@ fn twin_tables(plan: &RayMarchPlan) -> Vec<f64> {
 }
 
 fn model<'a>(plan: &'a RayMarchPlan, tables: &'a [f64]) -> Model<'a> {
-    Model { params: &plan.params, noises: &plan.packed.noises, tables }
+    Model { params: &plan.params, noises: &plan.packed.noises, tables, grid: None }
 }
 
 /// 3D simplex noise: the kernel and the f64 twin agree on points up to 40 units from the origin
@@ -482,11 +483,101 @@ fn bad_transfer_functions_are_reported_at_their_position() {
     bad(10, &noise("Curve([(0.3, 0.0, 0.0)])"), "[(0.3", "2 to 64 control points");
     bad(10, &noise("Table([0.0, -0.1])"), "-0.1", "[0, 1]");
     bad(10, &noise("Table([1.0])"), "[1.0]", "table of 2 to 256");
+    bad(10, &noise("Grid([[0.0, 1.0]])"), "[[0.0", "2 to 64 rows");
+    bad(10, &noise("Grid([[0.0], [1.0]])"), "[[0.0", "rows of 2 to 256 values");
+    bad(10, &noise("Grid([[0.0, 1.0], [1.0, 0.5, 0.0]])"), "[[0.0", "grid row 2 has 3 values");
+    bad(10, &noise("Grid([[0.0, 1.0], [1.0, 1.5]])"), "1.5", "[0, 1]");
     let ramp = "            color: Ramp([(0.0, (1.0, 1.0, 1.0, 0.0)), (1.0, (1.0, 2.0, 1.0, 1.0))]),";
     bad(12, ramp, "2.0", "[0, 1]");
     let ramp = "            color: Ramp([(0.5, (1.0, 1.0, 1.0, 0.0)), (0.2, (1.0, 1.0, 1.0, 1.0))]),";
     bad(12, ramp, "(0.2", "sorted by x");
     bad(12, "            color: Step(threshold: 1.2, color: (1.0, 1.0, 1.0)),", "1.2", "[0, 1]");
+}
+
+/// 2D shape transfer functions (eq. 6): a grid whose rows are equal is its 1D table (kernel and
+/// twin); an image gives the grid of its pixels; bad images fail at their position;
+/// `Grid([[0, 0], [1, 1]])` is T = O(x) whatever the noise, so on a sphere with the
+/// closest-surface field every point at |x| >= a / (1 + a) moves inwards by a (1 - |x|): the
+/// density is (1 + a)(1 - |x|) exactly.
+#[test]
+fn grid_shape_transfer_functions() {
+    let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
+    let h = |shape: &str| {
+        format!(
+            "(object: Sphere(radius: 1.0), noises: [(shape: {shape}, amplitude: 0.3, frequency: 2.5, shift: 1.0)], \
+             color: Step(threshold: 0.5, color: (1.0, 1.0, 1.0)))"
+        )
+    };
+    let mut rng = Rng(5);
+    let points: Vec<[f32; 4]> =
+        (0..2048).map(|_| point(rng.in_box(DVec3::splat(-1.3), DVec3::splat(1.3)), 0)).collect();
+    let density = |shape: &str| {
+        let scene = one(&h(shape), "RayMarch()");
+        let bp = blueprint(&scene, &sized(8, 8));
+        let plan = plans(&bp)[0];
+        let gpu = probe(&ctx, plan, &points).unwrap();
+        let tables = twin_tables(plan);
+        let m = model(plan, &tables);
+        let cpu: Vec<f64> = points
+            .iter()
+            .map(|p| m.hyper_density(DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64)))
+            .collect();
+        let g: Vec<f64> = (0..points.len()).map(|i| gpu.values[4 * i + 2][0] as f64).collect();
+        (g, cpu)
+    };
+    let (table_gpu, table_cpu) = density("Table([0.0, 0.2, 1.0])");
+    let (grid_gpu, grid_cpu) = density("Grid([[0.0, 0.2, 1.0], [0.0, 0.2, 1.0], [0.0, 0.2, 1.0]])");
+    let max = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max);
+    let (d_gpu, d_cpu) = (max(&table_gpu, &grid_gpu), max(&table_cpu, &grid_cpu));
+    let (depth_gpu, depth_cpu) = density("Grid([[0.0, 0.0], [1.0, 1.0]])");
+    // The same function from a grayscale PNG image (top row: density 0).
+    let dir = std::env::temp_dir().join(format!("voltex-grid-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let png = |name: &str, w: u32, h: u32, grey: &dyn Fn(u32, u32) -> u8| {
+        let pixels: Vec<[u8; 4]> = (0..w * h).map(|i| grey(i % w, i / w)).map(|g| [g, g, g, 255]).collect();
+        voltex::io::png::write_rgba8(&dir.join(name), w, h, &pixels).unwrap();
+        format!("Image(path: \"{}\")", dir.join(name).display())
+    };
+    let image = png("depth.png", 2, 2, &|_, y| if y == 0 { 0 } else { 255 });
+    let (image_gpu, image_cpu) = density(&image);
+    let d_image = max(&image_gpu, &depth_gpu).max(max(&image_cpu, &depth_cpu));
+    assert!(d_image == 0.0, "image against grid: {d_image}");
+    let source = |shape: &str| {
+        let text = BASE.lines().map(|l| {
+            if l.contains("(shape:") {
+                format!("                (shape: {shape}, amplitude: 0.2, frequency: 2.0),")
+            } else {
+                l.to_string()
+            }
+        });
+        text.collect::<Vec<_>>().join("\n")
+    };
+    let one_row = png("one_row.png", 4, 1, &|_, _| 0);
+    let e = scene::parse(&source(&one_row), Path::new("test.ron")).unwrap_err().to_string();
+    assert!(
+        e.starts_with("test.ron:10:") && e.contains("2 to 64 rows (density)") && e.contains("is 4x1"),
+        "{e}"
+    );
+    let missing = "Image(path: \"/nonexistent/t.png\")";
+    let e = scene::parse(&source(missing), Path::new("test.ron")).unwrap_err().to_string();
+    assert!(e.starts_with("test.ron:10:") && e.contains("t.png does not exist"), "{e}");
+    std::fs::remove_dir_all(&dir).ok();
+    let (mut analytic_gpu, mut analytic_cpu, mut checked) = (0.0f64, 0.0f64, 0);
+    for (i, p) in points.iter().enumerate() {
+        let r = DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64).length();
+        if r >= 0.3 / 1.3 + 0.01 {
+            let want = (1.3 * (1.0 - r)).clamp(0.0, 1.0);
+            analytic_gpu = analytic_gpu.max((depth_gpu[i] - want).abs());
+            analytic_cpu = analytic_cpu.max((depth_cpu[i] - want).abs());
+            checked += (r < 1.0) as usize;
+        }
+    }
+    eprintln!(
+        "2D shape transfer: equal rows vs 1D table max {d_gpu:.1e} (kernel), {d_cpu:.1e} (twin); T = O(x): density vs \
+         (1 + a)(1 - |x|) max {analytic_gpu:.1e} (kernel), {analytic_cpu:.1e} (twin) over {checked} points inside"
+    );
+    assert!(d_gpu < 1e-5 && d_cpu < 1e-12, "{d_gpu} {d_cpu}");
+    assert!(analytic_gpu < 1e-5 && analytic_cpu < 1e-6 && checked > 100, "{analytic_gpu} {analytic_cpu}");
 }
 
 #[test]

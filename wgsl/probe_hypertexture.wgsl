@@ -11,6 +11,9 @@
 // seed)), (V(p), 0),
 // (density, 0, 0, 0), rgba of the density.
 @group(0) @binding(4) var<storage, read_write> probe_values: array<vec4<f32>>;
+// Mesh objects: the baked grid and its largest inside distance (f32 bits); stand-ins otherwise.
+@group(0) @binding(5) var<storage, read> mesh_grid: array<vec4<f32>>;
+@group(0) @binding(6) var<storage, read> mesh_depth: array<u32>;
 
 @compute @workgroup_size(64, 1, 1)
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {

@@ -23,6 +23,9 @@ const DEPTH_SLACK: f32 = 2e-3;
 @group(0) @binding(3) var<storage, read> transfer_tables: array<f32>;
 @group(0) @binding(4) var depth: texture_depth_2d;
 @group(0) @binding(5) var<storage, read_write> ray_march_state: array<MarchState>;
+// Mesh objects: the baked grid and its largest inside distance (f32 bits); stand-ins otherwise.
+@group(0) @binding(6) var<storage, read> mesh_grid: array<vec4<f32>>;
+@group(0) @binding(7) var<storage, read> mesh_depth: array<u32>;
 
 // Parameters (entry, exit) where the ray o + t d (object space) is inside the enlarged bounds;
 // entry > exit when it misses. Zero direction components are nudged, never divided by.

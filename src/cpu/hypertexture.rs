@@ -7,7 +7,7 @@ use glam::{DVec2, DVec3, DVec4};
 use super::bake_transfer::TRANSFER_SIZE;
 use super::noise_simplex::{simplex3, simplex4};
 use crate::hypertexture::{
-    FIELD_CONSTANT, FIELD_FROM_CENTRE, FIELD_SWIRL, OBJECT_BOX, OBJECT_ELLIPSOID, OBJECT_TORUS,
+    FIELD_CONSTANT, FIELD_FROM_CENTRE, FIELD_SWIRL, OBJECT_BOX, OBJECT_ELLIPSOID, OBJECT_MESH, OBJECT_TORUS,
 };
 use crate::types::{HyperNoise, HyperParams};
 
@@ -20,6 +20,8 @@ pub struct Model<'a> {
     pub params: &'a HyperParams,
     pub noises: &'a [HyperNoise],
     pub tables: &'a [f64],
+    /// Mesh objects: the baked grid's samples and its largest inside distance.
+    pub grid: Option<(&'a [[f32; 4]], f32)>,
 }
 
 fn v3(a: [f32; 4]) -> DVec3 {
@@ -45,6 +47,25 @@ pub fn transfer_lookup(tables: &[f64], table: u32, x: f64) -> f64 {
 }
 
 impl Model<'_> {
+    /// The mesh grid at x (clamped to the grid), trilinear: vector to the closest surface point
+    /// and signed distance (mirrors `mesh_sample`).
+    pub fn mesh_sample(&self, x: DVec3) -> (DVec3, f64) {
+        let (cells, _) = self.grid.expect("a mesh object's grid");
+        let n = self.params.grid_min[3] as usize;
+        let lo = v3(self.params.grid_min);
+        let u = ((x - lo) / (v3(self.params.grid_max) - lo)).clamp(DVec3::ZERO, DVec3::ONE) * (n - 1) as f64;
+        let i = u.to_array().map(|c| (c as usize).min(n - 2));
+        let f = u - DVec3::new(i[0] as f64, i[1] as f64, i[2] as f64);
+        let mut acc = DVec4::ZERO;
+        for corner in 0..8 {
+            let b = [corner & 1, (corner >> 1) & 1, (corner >> 2) & 1];
+            let w: f64 = (0..3).map(|a| if b[a] == 1 { f[a] } else { 1.0 - f[a] }).product();
+            let c = cells[(i[0] + b[0]) + n * ((i[1] + b[1]) + n * (i[2] + b[2]))];
+            acc += DVec4::from_array(c.map(|v| v as f64)) * w;
+        }
+        (acc.truncate(), acc.w)
+    }
+
     /// O(x), the soft object's density in [0, 1].
     pub fn object_density(&self, x: DVec3) -> f64 {
         let s = v3(self.params.object);
@@ -52,6 +73,7 @@ impl Model<'_> {
             OBJECT_ELLIPSOID => 1.0 - (x / s).length(),
             OBJECT_TORUS => 1.0 - DVec2::new(DVec2::new(x.x, x.y).length() - s.x, x.z).length() / s.y,
             OBJECT_BOX => 1.0 - (x.abs() / s).max_element(),
+            OBJECT_MESH => self.mesh_sample(x).1 / self.grid.map_or(1.0, |g| g.1 as f64),
             _ => 1.0 - x.length() / s.x,
         };
         d.clamp(0.0, 1.0)
@@ -66,6 +88,14 @@ impl Model<'_> {
             OBJECT_BOX => {
                 let q = x.abs() - s;
                 q.max(DVec3::ZERO).length() + q.max_element().min(0.0)
+            }
+            OBJECT_MESH => {
+                let out = (v3(self.params.grid_min) - x).max(x - v3(self.params.grid_max));
+                if out.cmpgt(DVec3::ZERO).any() {
+                    out.max(DVec3::ZERO).length()
+                } else {
+                    -self.mesh_sample(x).1 * 0.57735
+                }
             }
             _ => x.length() - s.x,
         }
@@ -111,6 +141,10 @@ impl Model<'_> {
                     p.z = side(x.z) * s.z;
                 }
                 p
+            }
+            OBJECT_MESH => {
+                let c = x.clamp(v3(self.params.grid_min), v3(self.params.grid_max));
+                c + self.mesh_sample(c).0
             }
             _ => {
                 let len = x.length();
@@ -164,14 +198,15 @@ impl Model<'_> {
         let noises = &self.noises[..self.params.kinds[2] as usize];
         let animated = crate::hypertexture::animated(noises);
         let time = self.params.march[3] as f64;
-        for (i, n) in noises.iter().enumerate() {
+        let density = self.object_density(x);
+        for n in noises {
             let q = (x + v * n.shift as f64) * n.frequency as f64;
             let noise = if animated {
                 simplex4(DVec4::new(q.x, q.y, q.z, n.speed as f64 * time), n.seed)
             } else {
                 simplex3(q, n.seed)
             };
-            let t = transfer_lookup(self.tables, i as u32, 0.5 + 0.5 * noise);
+            let t = self.shape_lookup(n, 0.5 + 0.5 * noise, density);
             let a = n.amplitude as f64;
             k = if n.blend != 0 { k * (1.0 - t) + a * t } else { k + a * t };
         }
@@ -188,9 +223,27 @@ impl Model<'_> {
         self.object_density(x - unit_or_zero(v) * self.distortion(x, v))
     }
 
+    /// A noise's shape transfer function at noise value u (2D: bilinear with the density o).
+    pub fn shape_lookup(&self, n: &HyperNoise, u: f64, o: f64) -> f64 {
+        if n.rows <= 1 {
+            return transfer_lookup(self.tables, n.table, u);
+        }
+        let r = o.clamp(0.0, 1.0) * (n.rows - 1) as f64;
+        let row = (r as u32).min(n.rows - 2);
+        let a = transfer_lookup(self.tables, n.table + row, u);
+        let b = transfer_lookup(self.tables, n.table + row + 1, u);
+        a + (b - a) * (r - row as f64)
+    }
+
+    /// The first colour table: after the last noise's shape tables.
+    pub fn color_tables(&self) -> u32 {
+        let last = &self.noises[self.params.kinds[2] as usize - 1];
+        last.table + last.rows.max(1)
+    }
+
     /// Straight colour and opacity per opacity length at a density.
     pub fn hyper_color(&self, density: f64) -> [f64; 4] {
-        let first = self.params.kinds[2];
+        let first = self.color_tables();
         std::array::from_fn(|c| transfer_lookup(self.tables, first + c as u32, density))
     }
 }

@@ -2,6 +2,7 @@
 
 pub mod axis_slices;
 pub mod bake;
+pub mod bake_mesh_grid;
 pub mod bake_transfer;
 pub mod hypertexture;
 pub mod noise_simplex;

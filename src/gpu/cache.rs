@@ -1,12 +1,14 @@
 //! GPU objects kept across rebuilds of a frame (the preview's hot reload): shader modules by the
 //! hash of their expanded source, pipeline layouts by their bindings, pipelines by everything that
-//! defines them, and baked texels by their request. A rebuild asks the cache first, so an edit
-//! recompiles or rebakes only what it changed; `stats` counts what was actually made.
+//! defines them, baked texels by their request, and hypertexture mesh grids by their mesh and
+//! grid. A rebuild asks the cache first, so an edit recompiles or rebakes only what it changed;
+//! `stats` counts what was actually made.
 
 use std::collections::{HashMap, HashSet};
 use std::hash::{Hash, Hasher};
 
 use crate::bake::Baked;
+use crate::hypertexture::mesh::MeshGrid;
 
 /// What a build created (not found in the cache).
 #[derive(Debug, Default, Clone, Copy, PartialEq, Eq)]
@@ -34,6 +36,7 @@ pub struct GpuCache {
     layouts: HashMap<u64, Layout>,
     pipelines: HashMap<u64, Pipeline>,
     bakes: HashMap<u64, Baked>,
+    grids: HashMap<u64, MeshGrid>,
     /// Keys used since the last `begin`, so that `retain_used` can drop what a rebuild left behind.
     used: HashSet<u64>,
     pub stats: CacheStats,
@@ -61,6 +64,7 @@ impl GpuCache {
         self.layouts.retain(|k, _| used.contains(k));
         self.pipelines.retain(|k, _| used.contains(k));
         self.bakes.retain(|k, _| used.contains(k));
+        self.grids.retain(|k, _| used.contains(k));
     }
 
     pub fn module(
@@ -107,5 +111,21 @@ impl GpuCache {
         self.stats.bakes += 1;
         self.bakes.insert(key, b.clone());
         Ok(b)
+    }
+
+    /// A hypertexture mesh object's grid (counted as a bake).
+    pub fn grid(
+        &mut self,
+        key: u64,
+        make: impl FnOnce() -> crate::Result<MeshGrid>,
+    ) -> crate::Result<MeshGrid> {
+        self.used.insert(key);
+        if let Some(g) = self.grids.get(&key) {
+            return Ok(g.clone());
+        }
+        let g = make()?;
+        self.stats.bakes += 1;
+        self.grids.insert(key, g.clone());
+        Ok(g)
     }
 }

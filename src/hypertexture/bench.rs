@@ -1,6 +1,7 @@
 //! `voltex bench-hyper`: the set-up of the paper's Figure 11 on the current adapter: one
-//! hypertexture (three noises) on three objects covering most of the window, HQ and IE steps, no
-//! shading, Phong, and Phong with shadow rays. Per setting: the median wall time of a frame after
+//! hypertexture (three noises) on five objects (three soft primitives, the cube and teapot meshes
+//! of the Figure 11 scenes, whose grid bakes it also times) covering most of the window, HQ and
+//! IE steps, no shading, Phong, and Phong with shadow rays. Per setting: the median wall time of a frame after
 //! warm-up, the density evaluations the frame made and those that ran the noises (counted by the
 //! kernel: points farther than the largest shift from the object skip them), and the share of the
 //! frame that those noise evaluations alone would take at the rate `bench_simplex.wgsl` measures
@@ -21,12 +22,19 @@ use crate::graph::exec::Inputs;
 use crate::render::{Blueprint, Part, RenderOptions, Renderer};
 use crate::types::MarchState;
 
-/// Stand-ins for the paper's bunny, teapot and cube until meshes come: soft primitives (name,
-/// object, node rotation), each covering about 3/4 of the window.
+/// The paper's objects: soft primitives standing in for its bunny, and the cube and teapot meshes
+/// of the Figure 11 example scenes (`{meshes}`: their folder) : (name, object, node transform),
+/// each covering about 3/4 of the window.
 const OBJECTS: &[(&str, &str, &str)] = &[
-    ("sphere", "Sphere(radius: 1.0)", "(0.0, 0.0, 0.0)"),
-    ("torus", "Torus(major: 0.72, minor: 0.4)", "(60.0, 0.0, 0.0)"),
-    ("box", "Box(size: (1.3, 1.3, 1.3))", "(20.0, 0.0, 35.0)"),
+    ("sphere", "Sphere(radius: 1.0)", "(rotate: (0.0, 0.0, 0.0))"),
+    ("torus", "Torus(major: 0.72, minor: 0.4)", "(rotate: (60.0, 0.0, 0.0))"),
+    ("box", "Box(size: (1.3, 1.3, 1.3))", "(rotate: (20.0, 0.0, 35.0))"),
+    ("cube mesh", "Mesh(path: \"{meshes}/cube.obj\")", "(rotate: (20.0, 0.0, 35.0), scale: (0.8, 0.8, 0.8))"),
+    (
+        "teapot mesh",
+        "Mesh(path: \"{meshes}/teapot.obj\")",
+        "(translate: (-0.03, 0.0, -0.4), rotate: (0.0, 0.0, -20.0), scale: (0.42, 0.42, 0.42))",
+    ),
 ];
 const QUALITIES: &[&str] = &["HQ", "IE"];
 const SHADINGS: &[&str] = &["None", "Phong", "PhongShadows"];
@@ -36,12 +44,14 @@ const NOISES: &str = "[(shape: Curve([(0.0, 0.0, 0.0), (0.2, 1.0, 0.0), (0.8, 1.
     shift: 0.5, seed: 1), (shape: Table([1.0, 0.0, 1.0]), amplitude: 0.025, frequency: 12.0, shift: 0.5, seed: 2)]";
 const NOISE_COUNT: f64 = 3.0;
 
-fn scene_text(object: &str, rotate: &str, quality: &str, shading: &str) -> String {
+fn scene_text(object: &str, transform: &str, quality: &str, shading: &str) -> String {
+    let meshes = crate::project_root().join("scenes/hypertextures/meshes");
+    let object = object.replace("{meshes}", &meshes.display().to_string());
     format!(
         "Scene(output: (width: 512, height: 512), camera: (eye: (0.0, -2.5, 0.9), target: (0.0, 0.0, 0.0), \
          fov_y: 40.0), ambient: 0.2, lights: [Directional(direction: (-0.5, 0.6, -0.7))], hypertextures: {{ \"h\": \
          (object: {object}, noises: {NOISES}, color: Step(threshold: 0.35, color: (0.8, 0.72, 0.62)), \
-         opacity_length: 0.01) }}, nodes: [(name: \"object\", transform: (rotate: {rotate}), hypertexture: \"h\", \
+         opacity_length: 0.01) }}, nodes: [(name: \"object\", transform: {transform}, hypertexture: \"h\", \
          method: RayMarch(quality: {quality}, shading: {shading}))])"
     )
 }
@@ -104,16 +114,40 @@ pub fn run(size: (u32, u32), frames: usize, quick: bool) -> Result<()> {
         ctx.adapter_line(),
         rate / 1e6
     );
+    for (name, object, transform) in OBJECTS.iter().filter(|o| o.1.starts_with("Mesh")) {
+        let scene =
+            crate::scene::parse(&scene_text(object, transform, "IE", "None"), Path::new("bench-hyper.ron"))?;
+        let bp = Blueprint::new(&scene, &RenderOptions { size: Some(size), ..Default::default() })?;
+        let plan = bp.objects.iter().find_map(|o| o.ray_march.as_ref()).expect("a RayMarch object");
+        let (shape, spec) = plan.packed.mesh.as_ref().expect("a mesh object");
+        let mut times = Vec::new();
+        // The first bake compiles the kernel.
+        for _ in 0..4 {
+            let t = Instant::now();
+            let grid = super::mesh::bake(&ctx, shape, spec)?;
+            super::mesh::read(&ctx, &grid)?;
+            times.push(t.elapsed().as_secs_f64() * 1e3);
+        }
+        println!(
+            "mesh grid bake, {name}: {} triangles in {} part(s), {}^3 samples: {:.1} ms (wall, with readback; median of 3 \
+             after one that compiles the kernel: {:.1} ms)",
+            shape.triangles.len(),
+            shape.parts.len(),
+            spec.n,
+            median(times[1..].to_vec()),
+            times[0]
+        );
+    }
     println!(
         "\n| object | quality | step | shading | dispatches | coverage | frame ms (wall) | fps | M density evals | M \
          noise evals | noise alone ms | noise share (rate) | noise share (A/B) |"
     );
     println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|");
     let objects = if quick { &OBJECTS[..1] } else { OBJECTS };
-    for (name, object, rotate) in objects {
+    for (name, object, transform) in objects {
         for quality in QUALITIES {
             for shading in SHADINGS {
-                let text = scene_text(object, rotate, quality, shading);
+                let text = scene_text(object, transform, quality, shading);
                 let scene = crate::scene::parse(&text, Path::new("bench-hyper.ron"))?;
                 let opts = RenderOptions { size: Some(size), ..Default::default() };
                 let mut runs = Vec::new();

@@ -1,9 +1,11 @@
 //! Hypertextures (Gilet & Dischler 2009) packed for the kernels: the soft object and vector field
 //! as `HyperParams` fields, one `HyperNoise` per noise, and every transfer function as control
-//! points that `bake_transfer.wgsl` samples into tables (the noises' shape tables first, then the
-//! red, green, blue and opacity tables of the colour transfer function).
+//! points that `bake_transfer.wgsl` samples into tables (the noises' shape tables first, one per
+//! noise or one per row of a 2D shape transfer function, then the red, green, blue and opacity
+//! tables of the colour transfer function).
 
 pub mod bench;
+pub mod mesh;
 
 use glam::DVec3;
 
@@ -17,6 +19,7 @@ pub const OBJECT_SPHERE: u32 = 0;
 pub const OBJECT_ELLIPSOID: u32 = 1;
 pub const OBJECT_TORUS: u32 = 2;
 pub const OBJECT_BOX: u32 = 3;
+pub const OBJECT_MESH: u32 = 4;
 /// `HyperParams::kinds[1]`.
 pub const FIELD_CLOSEST_SURFACE: u32 = 0;
 pub const FIELD_FROM_CENTRE: u32 = 1;
@@ -39,6 +42,8 @@ pub struct Packed {
     /// Object-space bounds enlarged by the largest shift.
     pub bounds: (DVec3, DVec3),
     pub opacity_length: f64,
+    /// Mesh objects: the mesh and where its grid samples lie.
+    pub mesh: Option<(std::sync::Arc<mesh::MeshShape>, mesh::GridSpec)>,
 }
 
 fn f4(v: DVec3, w: f64) -> [f32; 4] {
@@ -51,6 +56,13 @@ pub fn pack(h: &Hypertexture) -> Packed {
         SoftObject::Ellipsoid { radii } => (OBJECT_ELLIPSOID, f4(*radii, 0.0)),
         SoftObject::Torus { major, minor } => (OBJECT_TORUS, f4(DVec3::new(*major, *minor, 0.0), 0.0)),
         SoftObject::Box { size } => (OBJECT_BOX, f4(*size * 0.5, 0.0)),
+        SoftObject::Mesh { .. } => (OBJECT_MESH, [0.0; 4]),
+    };
+    let mesh = match &h.object.value {
+        SoftObject::Mesh { shape: Some(shape), resolution, .. } => {
+            Some((shape.clone(), shape.grid(*resolution, h.max_shift())))
+        }
+        _ => None,
     };
     let mut p = Packed {
         object,
@@ -63,6 +75,7 @@ pub fn pack(h: &Hypertexture) -> Packed {
         points: Vec::new(),
         bounds: h.bounds(),
         opacity_length: h.opacity_length,
+        mesh,
     };
     let base = match &h.field {
         Field::Perturbed { field, amount, frequency, magnitude, seed } => {
@@ -90,6 +103,8 @@ pub fn pack(h: &Hypertexture) -> Packed {
         Field::ClosestSurface | Field::Perturbed { .. } => {}
     }
     for n in h.noises.iter() {
+        let table = p.functions.len() as u32;
+        let rows = n.shape.rows().map_or(1, |r| r.len() as u32);
         p.noises.push(HyperNoise {
             amplitude: n.amplitude as f32,
             frequency: n.frequency as f32,
@@ -97,15 +112,17 @@ pub fn pack(h: &Hypertexture) -> Packed {
             blend: (n.operator == Operator::Blend) as u32,
             seed: n.seed,
             speed: n.speed as f32,
-            _pad: [0; 2],
+            table,
+            rows,
         });
         match &n.shape {
             ShapeTransfer::Curve(points) => {
                 p.function(HERMITE, points.iter().map(|c| (c.0, c.1, c.2)));
             }
-            ShapeTransfer::Table(values) => {
-                let last = (values.0.len() - 1).max(1) as f64;
-                p.function(LINEAR, values.0.iter().enumerate().map(|(i, &y)| (i as f64 / last, y, 0.0)));
+            ShapeTransfer::Table(values) => p.table(&values.0),
+            // One table per row: the lookup interpolates between rows by density.
+            ShapeTransfer::Grid(_) | ShapeTransfer::Image { .. } => {
+                n.shape.rows().unwrap_or_default().iter().for_each(|row| p.table(row))
             }
         }
     }
@@ -140,6 +157,12 @@ pub fn animated(noises: &[HyperNoise]) -> bool {
 }
 
 impl Packed {
+    /// Values at evenly spaced x from 0 to 1, joined linearly.
+    fn table(&mut self, values: &[f64]) {
+        let last = (values.len() - 1).max(1) as f64;
+        self.function(LINEAR, values.iter().enumerate().map(|(i, &y)| (i as f64 / last, y, 0.0)));
+    }
+
     fn function(&mut self, kind: u32, points: impl Iterator<Item = (f64, f64, f64)>) {
         let first = self.points.len() as u32;
         self.points.extend(points.map(|(x, y, slope)| TransferPoint {

@@ -73,6 +73,8 @@ pub struct Mesh {
     pub vertex_uvs: Vec<DVec2>,
     /// Optional scalar per vertex (OBJ: first colour channel of `v x y z r g b`).
     pub attribute: Option<Vec<f64>>,
+    /// OBJ: the line of the `f` statement of each triangle, for errors (empty when generated).
+    pub face_lines: Vec<u32>,
 }
 
 impl Mesh {

@@ -32,6 +32,7 @@ pub fn parse(text: &str, path: &Path) -> Result<Mesh> {
     // Faces as corners (v index, optional vt index) with the line of the face for late checks.
     let mut triangles: Vec<[u32; 3]> = Vec::new();
     let mut tri_vts: Vec<[Option<u32>; 3]> = Vec::new();
+    let mut face_lines: Vec<u32> = Vec::new();
 
     for (ln, raw) in text.lines().enumerate() {
         let line_no = ln + 1;
@@ -111,6 +112,7 @@ pub fn parse(text: &str, path: &Path) -> Result<Mesh> {
                     let c = [corners[0], corners[k], corners[k + 1]];
                     triangles.push(c.map(|c| c.0));
                     tri_vts.push(c.map(|c| c.1));
+                    face_lines.push(line_no as u32);
                 }
             }
             _ => {}
@@ -149,6 +151,7 @@ pub fn parse(text: &str, path: &Path) -> Result<Mesh> {
         corner_uvs,
         vertex_uvs: vec![],
         attribute,
+        face_lines,
     };
     m.vertex_uvs = m.vertex_uvs_from_corners();
     Ok(m)

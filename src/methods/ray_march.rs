@@ -10,6 +10,7 @@ use crate::cpu::ray_march::Shade;
 use crate::error::{Error, Result};
 use crate::gpu::GpuContext;
 use crate::graph::exec::Inputs;
+use crate::hypertexture::mesh::{self, MeshGrid};
 use crate::hypertexture::{self, Packed};
 use crate::scene::hypertexture::diagonal;
 use crate::scene::{Hypertexture, RayMarch, Shading};
@@ -97,7 +98,14 @@ pub fn plan(
         kinds: packed.kinds,
         march: [shadow_step as f32, step as f32, (h.max_shift() * (1.0 + 1e-4) + 1e-6) as f32, time as f32],
         budget: [evals, shadow_samples, worst, 0],
+        grid_min: [0.0; 4],
+        grid_max: [0.0; 4],
     };
+    let mut params = params;
+    if let Some((_, g)) = &packed.mesh {
+        params.grid_min = [g.lo.x as f32, g.lo.y as f32, g.lo.z as f32, g.n as f32];
+        params.grid_max = [g.hi.x as f32, g.hi.y as f32, g.hi.z as f32, 0.0];
+    }
     Ok(RayMarchPlan {
         hypertexture: node.name.clone(),
         packed,
@@ -143,12 +151,33 @@ impl RayMarchPlan {
             + self.packed.noises.len() * 32
             + self.packed.points.len() * 16
             + self.packed.functions.len() * (16 + 4 * TRANSFER_SIZE)) as u64
+            + self.packed.mesh.as_ref().map_or(0, |(_, g)| (g.n as u64).pow(3) * 16)
             + size.0 as u64 * size.1 as u64 * std::mem::size_of::<MarchState>() as u64
     }
 
-    /// Buffers, counts and constants of the object's graph instance.
-    pub fn add_inputs(&self, ctx: &GpuContext, inputs: &mut Inputs, size: (u32, u32)) {
+    /// The mesh grid's cache key and a function that bakes it, for mesh objects.
+    pub fn mesh_grid_key(&self) -> Option<u64> {
+        self.packed.mesh.as_ref().map(|(shape, spec)| crate::gpu::cache::key(&(shape.hash, spec)))
+    }
+
+    /// Bakes the mesh grid of a mesh object (`bake_mesh_grid.wgsl`).
+    pub fn bake_mesh_grid(&self, ctx: &GpuContext) -> Result<Option<MeshGrid>> {
+        self.packed.mesh.as_ref().map(|(shape, spec)| mesh::bake(ctx, shape, spec)).transpose()
+    }
+
+    /// Buffers, counts and constants of the object's graph instance; `grid`: the baked mesh
+    /// grid of a mesh object.
+    pub fn add_inputs(
+        &self,
+        ctx: &GpuContext,
+        inputs: &mut Inputs,
+        size: (u32, u32),
+        grid: Option<&MeshGrid>,
+    ) {
         use crate::bake::{storage, uniform};
+        let grid = grid.cloned().unwrap_or_else(|| mesh::unused(ctx));
+        inputs.buffers.insert("mesh_grid".into(), grid.grid);
+        inputs.buffers.insert("mesh_depth".into(), grid.depth);
         inputs.counts.insert("ray_march_dispatches".into(), self.dispatches);
         inputs.counts.insert("transfer_functions".into(), self.packed.functions.len() as u32);
         inputs.constants.extend(self.constants());
@@ -198,7 +227,8 @@ pub fn probe(ctx: &GpuContext, plan: &RayMarchPlan, points: &[[f32; 4]]) -> Resu
     use crate::gpu::kernel::ComputeKernel;
     let root = crate::render::wgsl_root();
     let mut inputs = Inputs::default();
-    plan.add_inputs(ctx, &mut inputs, (1, 1));
+    let grid = plan.bake_mesh_grid(ctx)?;
+    plan.add_inputs(ctx, &mut inputs, (1, 1), grid.as_ref());
     let b = &mut inputs.buffers;
     b.insert("probe_points".into(), storage(ctx, "probe_points", bytemuck::cast_slice(points)));
     let zeros = vec![0u8; points.len() * 64];

@@ -94,6 +94,23 @@ pub fn default_step(o: &ObjectPlan, resolution: [u32; 3]) -> f64 {
     0.5 * extent.max(1e-9)
 }
 
+/// A BVH2 over `boxes` (obvhs) flattened for the kernels, and the primitive order its leaves
+/// index: a node's `min.w` is its primitive count as u32 bits (0: inner node), `max.w` its first
+/// primitive (leaf, in that order) or its first child (inner; the second follows it).
+pub fn flat_bvh(boxes: &[Aabb]) -> (Vec<ReferenceNode>, Vec<u32>) {
+    let mut time = Default::default();
+    let bvh = build_bvh2(boxes, BvhBuildParams::medium_build(), &mut time);
+    let nodes = bvh
+        .nodes
+        .iter()
+        .map(|n| ReferenceNode {
+            min: [n.aabb.min.x, n.aabb.min.y, n.aabb.min.z, f32::from_bits(n.prim_count)],
+            max: [n.aabb.max.x, n.aabb.max.y, n.aabb.max.z, f32::from_bits(n.first_index)],
+        })
+        .collect();
+    (nodes, bvh.primitive_indices)
+}
+
 /// Words per row of a volume copied out of a texture (rows padded to 256 bytes).
 fn row_pitch(width: u32) -> u32 {
     (width * 4).div_ceil(256) * 64
@@ -164,18 +181,10 @@ pub fn build(
         }
     }
     if !prisms.is_empty() {
-        let mut time = Default::default();
-        let bvh = build_bvh2(&boxes, BvhBuildParams::medium_build(), &mut time);
+        let (nodes, order) = flat_bvh(&boxes);
         // Prisms in leaf order, so leaves index them directly.
-        set.prisms = bvh.primitive_indices.iter().map(|&i| prisms[i as usize]).collect();
-        set.nodes = bvh
-            .nodes
-            .iter()
-            .map(|n| ReferenceNode {
-                min: [n.aabb.min.x, n.aabb.min.y, n.aabb.min.z, f32::from_bits(n.prim_count)],
-                max: [n.aabb.max.x, n.aabb.max.y, n.aabb.max.z, f32::from_bits(n.first_index)],
-            })
-            .collect();
+        set.prisms = order.iter().map(|&i| prisms[i as usize]).collect();
+        set.nodes = nodes;
     }
     set.params.counts = [set.nodes.len() as u32, set.prisms.len() as u32, set.table.len() as u32, 0];
     set.dispatches = ((work / SAMPLES_PER_DISPATCH).ceil() + 1.0).min(u32::MAX as f64) as u32;

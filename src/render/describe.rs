@@ -87,7 +87,10 @@ impl Blueprint {
             }
             if let Some(m) = &o.ray_march {
                 out.push((
-                    format!("object {name}: hypertexture parameters, transfer tables, per-pixel march state"),
+                    format!(
+                        "object {name}: hypertexture parameters, transfer tables, per-pixel march state{}",
+                        if m.packed.mesh.is_some() { ", mesh grid" } else { "" }
+                    ),
                     m.bytes(self.size),
                 ));
             }
@@ -106,8 +109,21 @@ impl Blueprint {
             self.size.0,
             self.size.1
         );
-        if self.bakes.is_empty() {
+        let grids: Vec<_> = self
+            .objects
+            .iter()
+            .filter_map(|o| Some((&o.object.name, o.ray_march.as_ref()?.packed.mesh.as_ref()?)))
+            .collect();
+        if self.bakes.is_empty() && grids.is_empty() {
             s += "  (none)\n";
+        }
+        for (name, (shape, spec)) in grids {
+            s += &format!(
+                "  {name:<16} {n}x{n}x{n}  bake_mesh_grid.wgsl  mesh grid of {} triangles in {} part(s)\n",
+                shape.triangles.len(),
+                shape.parts.len(),
+                n = spec.n
+            );
         }
         for b in &self.bakes {
             let r = b.request.resolution;

@@ -506,6 +506,8 @@ pub const INSTANCE_RESOURCES: &[&str] = &[
     "transfer_functions",
     "transfer_tables",
     "ray_march_state",
+    "mesh_grid",
+    "mesh_depth",
     "axis_params",
     "axis_occupancy",
     "axis_choices",

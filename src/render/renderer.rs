@@ -6,6 +6,7 @@ use crate::gpu::cache::{self, GpuCache};
 use crate::gpu::timing::Timer;
 use crate::gpu::GpuContext;
 use crate::graph::exec::{Executor, Inputs};
+use crate::hypertexture::mesh::MeshGrid;
 use crate::io::Image;
 use crate::methods::{axis_slices, view_slices};
 use crate::render::{wgsl_root, Blueprint, ObjectPlan, Part};
@@ -66,6 +67,16 @@ impl Renderer {
             min_filter: wgpu::FilterMode::Linear,
             ..Default::default()
         });
+        // Mesh objects' grids, baked once per mesh and grid while the cache holds them.
+        let grids: Vec<Option<MeshGrid>> = blueprint
+            .objects
+            .iter()
+            .map(|o| {
+                let Some(m) = &o.ray_march else { return Ok(None) };
+                let Some(key) = m.mesh_grid_key() else { return Ok(None) };
+                cache.grid(key, || Ok(m.bake_mesh_grid(ctx)?.expect("a mesh object"))).map(Some)
+            })
+            .collect::<Result<_>>()?;
         let mut frame = Inputs::default();
         frame
             .buffers
@@ -76,7 +87,9 @@ impl Renderer {
         let objects = blueprint
             .instances
             .iter()
-            .map(|&(i, part)| instance_inputs(ctx, &blueprint, &blueprint.objects[i], part, &baked))
+            .map(|&(i, part)| {
+                instance_inputs(ctx, &blueprint, &blueprint.objects[i], part, &baked, grids[i].as_ref())
+            })
             .collect();
         let exec = Executor::new(ctx, blueprint.graph.clone(), &blueprint.plan, blueprint.size, cache)?;
         let timer = Timer::new(ctx, blueprint.plan.passes.len() as u32);
@@ -194,6 +207,7 @@ fn instance_inputs(
     o: &ObjectPlan,
     part: Part,
     baked: &[bake::Baked],
+    grid: Option<&MeshGrid>,
 ) -> Inputs {
     let mut inputs = Inputs::default();
     inputs.constants.push(("per_pixel_lighting".into(), o.per_pixel as u32 as f64));
@@ -212,7 +226,7 @@ fn instance_inputs(
         }
         Part::RayMarch => {
             if let Some(m) = &o.ray_march {
-                m.add_inputs(ctx, &mut inputs, bp.size);
+                m.add_inputs(ctx, &mut inputs, bp.size, grid);
             }
         }
         Part::Reference => {

@@ -3,8 +3,12 @@
 //! ranges are checked while parsing; list lengths and control-point order by [`check`] (positioned
 //! through [`Mark`]s).
 
+use std::sync::Arc;
+
 use glam::{DMat4, DVec3};
 use serde::Deserialize;
+
+use crate::hypertexture::mesh::MeshShape;
 
 use super::values::{self as v, Mark};
 
@@ -14,6 +18,8 @@ pub const MAX_NOISES: usize = 8;
 pub const MAX_POINTS: usize = 64;
 /// Most values of a sampled table.
 pub const MAX_TABLE: usize = 256;
+/// Most rows (densities) of a 2D shape transfer function.
+pub const MAX_ROWS: usize = 64;
 
 /// `hypertextures: { "name": (object: .., field: .., noises: [..], color: ..) }`.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
@@ -61,6 +67,20 @@ pub enum SoftObject {
         #[serde(deserialize_with = "v::positive3")]
         size: DVec3,
     },
+    /// A closed triangle mesh (OBJ, relative to the scene file) baked into a grid of
+    /// `resolution^3` samples: inside distance to the surface over the largest inside distance.
+    Mesh {
+        path: Mark<String>,
+        #[serde(default = "default_grid", deserialize_with = "v::grid_resolution")]
+        resolution: u32,
+        /// Loaded and checked by `scene::load`.
+        #[serde(skip)]
+        shape: Option<Arc<MeshShape>>,
+    },
+}
+
+fn default_grid() -> u32 {
+    64
 }
 
 impl SoftObject {
@@ -71,6 +91,9 @@ impl SoftObject {
             SoftObject::Ellipsoid { radii } => *radii,
             SoftObject::Torus { major, minor } => DVec3::new(major + minor, major + minor, *minor),
             SoftObject::Box { size } => *size * 0.5,
+            SoftObject::Mesh { shape, .. } => {
+                return shape.as_ref().map_or((DVec3::ZERO, DVec3::ZERO), |s| (s.lo, s.hi));
+            }
         };
         (-h, h)
     }
@@ -168,7 +191,35 @@ pub enum ShapeTransfer {
     Curve(Mark<Vec<Mark<CurvePoint>>>),
     /// Values at evenly spaced x from 0 to 1, joined linearly.
     Table(Mark<TableValues>),
+    /// A 2D shape transfer function (the paper's eq. 6, Figure 7): rows of values at evenly
+    /// spaced noise values from 0 to 1, the rows at evenly spaced object densities O(x) from 0
+    /// (first row) to 1 (last), joined bilinearly.
+    Grid(Mark<GridRows>),
+    /// A 2D shape transfer function from a grayscale PNG image (relative to the scene file; its
+    /// first channel): columns are noise values from 0 (left) to 1, rows densities from 0 (top)
+    /// to 1, as a `Grid` whose rows are the image's.
+    Image {
+        path: Mark<String>,
+        /// Filled by `scene::load` from the image.
+        #[serde(skip)]
+        rows: Vec<Vec<f64>>,
+    },
 }
+
+impl ShapeTransfer {
+    /// The rows of a 2D function (`Grid` or `Image`); `None` for 1D ones.
+    pub fn rows(&self) -> Option<&[Vec<f64>]> {
+        match self {
+            ShapeTransfer::Grid(rows) => Some(&rows.0),
+            ShapeTransfer::Image { rows, .. } => Some(rows),
+            _ => None,
+        }
+    }
+}
+
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(transparent)]
+pub struct GridRows(#[serde(deserialize_with = "v::unit_rows")] pub Vec<Vec<f64>>);
 
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
 pub struct CurvePoint(
@@ -267,6 +318,23 @@ pub(super) fn check(h: &Hypertexture, fail: &mut dyn FnMut(usize, String)) {
                 let n = values.0.len();
                 if !(2..=MAX_TABLE).contains(&n) {
                     fail(values.seq, format!("expected a table of 2 to {MAX_TABLE} values, found {n}"));
+                }
+            }
+            // Its size is checked when the image is loaded.
+            ShapeTransfer::Image { .. } => {}
+            ShapeTransfer::Grid(rows) => {
+                let n = rows.0.len();
+                let width = rows.0.first().map_or(0, Vec::len);
+                if !(2..=MAX_ROWS).contains(&n) {
+                    fail(rows.seq, format!("expected a grid of 2 to {MAX_ROWS} rows (densities), found {n}"));
+                } else if !(2..=MAX_TABLE).contains(&width) {
+                    fail(rows.seq, format!("expected grid rows of 2 to {MAX_TABLE} values, found {width}"));
+                } else if let Some(i) = rows.0.iter().position(|r| r.len() != width) {
+                    let found = rows.0[i].len();
+                    fail(
+                        rows.seq,
+                        format!("grid row {} has {found} values: expected every row as long as the first ({width})", i + 1),
+                    );
                 }
             }
         }

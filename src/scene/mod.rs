@@ -33,10 +33,17 @@ fn options() -> ron::Options {
 }
 
 impl Scene {
-    /// The files (meshes, images) and slice-stack folders the scene refers to, resolved.
+    /// The files (meshes, images, hypertexture meshes) and slice-stack folders the scene refers to,
+    /// resolved.
     pub fn asset_paths(&self) -> Vec<std::path::PathBuf> {
-        let stacks = self.assets.stacks.keys();
-        self.assets.meshes.keys().chain(self.assets.images.keys()).chain(stacks).cloned().collect()
+        let a = &self.assets;
+        a.meshes
+            .keys()
+            .chain(a.images.keys())
+            .chain(a.stacks.keys())
+            .chain(a.shapes.keys())
+            .cloned()
+            .collect()
     }
 
     /// A height image the scene refers to (by its path as written), as `load` read it.
@@ -78,6 +85,19 @@ pub fn parse(source: &str, path: &Path) -> Result<Scene> {
     }
     if let Some(e) = found.other {
         return Err(e);
+    }
+    for h in scene.hypertextures.values_mut() {
+        if let hypertexture::SoftObject::Mesh { path, shape, .. } = &mut h.object.value {
+            *shape = found.assets.shapes.get(&dir.join(&path.value)).cloned();
+        }
+        for noise in h.noises.value.iter_mut() {
+            if let hypertexture::ShapeTransfer::Image { path, rows } = &mut noise.shape {
+                if let Some(img) = found.assets.images.get(&dir.join(&path.value)) {
+                    let at = |x: usize, y: usize| img.data[(y * img.width + x) * img.channels] as f64;
+                    *rows = (0..img.height).map(|y| (0..img.width).map(|x| at(x, y)).collect()).collect();
+                }
+            }
+        }
     }
     scene.assets = found.assets;
     scene.source = source.to_string();

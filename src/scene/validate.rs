@@ -6,6 +6,7 @@ use super::types::{HeightScale, Method, Node, Scene, Surface, TexelSource};
 use super::values::Mark;
 use crate::bake::stack::{self, SliceStack};
 use crate::error::Error;
+use crate::hypertexture::mesh::MeshShape;
 use crate::mesh::{obj, Mesh};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -18,6 +19,8 @@ pub struct Assets {
     pub meshes: BTreeMap<PathBuf, Arc<Mesh>>,
     pub images: BTreeMap<PathBuf, Arc<HeightImage>>,
     pub stacks: BTreeMap<PathBuf, Arc<SliceStack>>,
+    /// Hypertexture mesh objects, welded and checked.
+    pub shapes: BTreeMap<PathBuf, Arc<MeshShape>>,
 }
 
 /// What the checks found: messages for marks (positioned by a second parse), and the first error
@@ -62,6 +65,34 @@ impl Checker<'_> {
                 self.other(e);
                 None
             }
+        }
+    }
+
+    /// A hypertexture's mesh object: loaded, welded and checked for closure.
+    fn mesh_object(&mut self, path: &Mark<String>) {
+        let full = self.f.assets.dir.join(&path.value);
+        if self.f.assets.shapes.contains_key(&full) {
+            return;
+        }
+        let Some(mesh) = self.mesh(path) else { return };
+        match MeshShape::new(&mesh, &full) {
+            Ok(shape) => {
+                self.f.assets.shapes.insert(full, Arc::new(shape));
+            }
+            Err(msg) => self.fail(path, msg),
+        }
+    }
+
+    /// A 2D shape transfer function's image: 2 to 256 columns (noise), 2 to 64 rows (density).
+    fn shape_image(&mut self, path: &Mark<String>) {
+        use super::hypertexture::{MAX_ROWS, MAX_TABLE};
+        let Some(img) = self.image(path) else { return };
+        if !(2..=MAX_TABLE).contains(&img.width) || !(2..=MAX_ROWS).contains(&img.height) {
+            let msg = format!(
+                "expected an image of 2 to {MAX_TABLE} columns (noise) and 2 to {MAX_ROWS} rows (density), {} is {}x{}",
+                path.value, img.width, img.height
+            );
+            self.fail(path, msg);
         }
     }
 
@@ -238,6 +269,11 @@ impl Checker<'_> {
             return;
         };
         if let Some(Method::RayMarch(rm)) = ray_march.map(|m| &m.value) {
+            // Mesh objects get their bounds from the mesh, loaded before the nodes are checked.
+            let mut model = model.clone();
+            if let super::hypertexture::SoftObject::Mesh { path, shape, .. } = &mut model.object.value {
+                *shape = self.f.assets.shapes.get(&self.f.assets.dir.join(&path.value)).cloned();
+            }
             let diagonal = super::hypertexture::diagonal(&model.world_corners(world));
             let samples = diagonal / rm.step();
             if samples > MAX_SAMPLES_PER_RAY {
@@ -284,6 +320,16 @@ pub(super) fn check(scene: &Scene, dir: &Path) -> Findings {
             TexelSource::Slices { dir } => c.stack(dir, t.resolution),
             TexelSource::Sequence { texels, .. } => c.sequence(texels, t.resolution),
             _ => {}
+        }
+    }
+    for h in scene.hypertextures.values() {
+        if let super::hypertexture::SoftObject::Mesh { path, .. } = &h.object.value {
+            c.mesh_object(path);
+        }
+        for noise in h.noises.iter() {
+            if let super::hypertexture::ShapeTransfer::Image { path, .. } = &noise.shape {
+                c.shape_image(path);
+            }
         }
     }
     for n in &scene.nodes {

@@ -64,6 +64,12 @@ checked_u32!(Frequency, 1, 1024, "a frequency (lattice cells per tile)");
 checked_u32!(Cells, 1, 4096, "a cell count");
 checked_u32!(Around, 3, 4096, "a segment count");
 checked_u32!(PoleToPole, 2, 4096, "a segment count");
+checked_u32!(
+    GridResolution,
+    4,
+    crate::hypertexture::mesh::MAX_RESOLUTION,
+    "a mesh grid resolution (samples per axis)"
+);
 
 // `deserialize_with` adapters: public types stay plain (f64, DVec3, [f32; 3], u32).
 macro_rules! adapter {
@@ -80,6 +86,10 @@ adapter!(finite, f64, Finite, |v| v.0);
 adapter!(positive3, DVec3, [Positive; 3], |v| DVec3::new(v[0].0, v[1].0, v[2].0));
 adapter!(rgba, [f64; 4], [Unit; 4], |v| v.map(|x| x.0));
 adapter!(unit_list, Vec<f64>, Vec<Unit>, |v| v.into_iter().map(|x| x.0).collect());
+adapter!(unit_rows, Vec<Vec<f64>>, Vec<Vec<Unit>>, |v| v
+    .into_iter()
+    .map(|r| r.into_iter().map(|x| x.0).collect())
+    .collect());
 adapter!(opt_positive, Option<f64>, Option<Positive>, |v| v.map(|x| x.0));
 adapter!(non_negative, f64, NonNegative, |v| v.0);
 adapter!(unit, f64, Unit, |v| v.0);
@@ -106,6 +116,7 @@ adapter!(opt_size2, Option<[u32; 2]>, Option<[OutputSize; 2]>, |v| v.map(|s| s.m
 adapter!(planes, u32, PlaneCount, |v| v.0);
 adapter!(resolution, [u32; 3], [Resolution; 3], |v| v.map(|x| x.0));
 adapter!(octaves, u32, Octaves, |v| v.0);
+adapter!(grid_resolution, u32, GridResolution, |v| v.0);
 adapter!(frequency, u32, Frequency, |v| v.0);
 adapter!(cells, [u32; 2], [Cells; 2], |v| v.map(|x| x.0));
 adapter!(sphere_segments, [u32; 2], (Around, PoleToPole), |v| [v.0 .0, v.1 .0]);

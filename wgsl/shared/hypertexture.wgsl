@@ -5,9 +5,9 @@
 #include "shared/transfer.wgsl"
 
 // O(x - k V/|V|) with k combining the noises in order from 0: noise i gives
-// t_i = T_i((1 + noise(f_i (x + r_i V))) / 2) and then k += a_i t_i (Sum) or
-// k = k (1 - t_i) + a_i t_i (Blend); the noise is 4D when `animated`. Noise i's shape table is
-// table i. One loop iteration per noise.
+// t_i = T_i((1 + noise(f_i (x + r_i V))) / 2) (2D functions: T_i(.., O(x)), eq. 6) and then
+// k += a_i t_i (Sum) or k = k (1 - t_i) + a_i t_i (Blend); the noise is 4D when `animated`.
+// One loop iteration per noise.
 // Evaluations of `hyper_density` that ran the noises, for benchmarks (per invocation).
 var<private> noised_evaluations: u32;
 // Benchmarks only: every noise reads 0 (and is compiled out), to measure what noise costs.
@@ -25,6 +25,8 @@ fn hyper_density(x: vec3<f32>) -> f32 {
     noised_evaluations += 1u;
     let v = vector_field(x);
     let dir = unit_or_zero(v);
+    // The second entry of 2D shape transfer functions (eq. 6): the object's density at x.
+    let density = object_density(x);
     var k = 0.0;
     for (var i = 0u; i < hyper.kinds.z; i++) {
         let n = hyper_noises[i];
@@ -35,7 +37,7 @@ fn hyper_density(x: vec3<f32>) -> f32 {
         } else if (!noise_off) {
             value = simplex3(q, n.seed);
         }
-        let t = transfer_lookup(i, 0.5 + 0.5 * value);
+        let t = shape_lookup(n, 0.5 + 0.5 * value, density);
         if (n.blend != 0u) {
             k = k * (1.0 - t) + n.amplitude * t;
         } else {
@@ -45,10 +47,29 @@ fn hyper_density(x: vec3<f32>) -> f32 {
     return object_density(x - k * dir);
 }
 
+// A noise's shape transfer function at noise value u: its table, or with rows (a 2D function,
+// eq. 6) its two rows around the object density o, joined linearly: bilinear over the grid.
+fn shape_lookup(n: HyperNoise, u: f32, o: f32) -> f32 {
+    if (n.rows <= 1u) {
+        return transfer_lookup(n.table, u);
+    }
+    let r = clamp(o, 0.0, 1.0) * f32(n.rows - 1u);
+    let row = min(u32(r), n.rows - 2u);
+    let a = transfer_lookup(n.table + row, u);
+    let b = transfer_lookup(n.table + row + 1u, u);
+    return mix(a, b, r - f32(row));
+}
+
+// The first of the colour transfer's four tables: after the last noise's shape tables.
+fn color_tables() -> u32 {
+    let last = hyper_noises[hyper.kinds.z - 1u];
+    return last.table + max(last.rows, 1u);
+}
+
 // Colour (straight rgb) and opacity per opacity length at a density: the four tables after the
 // noises' shape tables.
 fn hyper_color(density: f32) -> vec4<f32> {
-    let first = hyper.kinds.z;
+    let first = color_tables();
     return vec4<f32>(
         transfer_lookup(first, density),
         transfer_lookup(first + 1u, density),
@@ -59,5 +80,5 @@ fn hyper_color(density: f32) -> vec4<f32> {
 
 // Opacity per opacity length at a density (the colour transfer's fourth table).
 fn hyper_opacity(density: f32) -> f32 {
-    return transfer_lookup(hyper.kinds.z + 3u, density);
+    return transfer_lookup(color_tables() + 3u, density);
 }

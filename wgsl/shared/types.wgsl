@@ -181,6 +181,15 @@ struct HyperParams {
     kinds: vec4<u32>,
     march: vec4<f32>,
     budget: vec4<u32>,
+    grid_min: vec4<f32>,
+    grid_max: vec4<f32>,
+}
+
+// A mesh object's grid bake (twin: MeshGridParams in src/types.rs).
+struct MeshGridParams {
+    lo: vec4<f32>,
+    hi: vec4<f32>,
+    counts: vec4<u32>,
 }
 
 struct HyperNoise {
@@ -190,8 +199,8 @@ struct HyperNoise {
     blend: u32,
     seed: u32,
     speed: f32,
-    _pad0: u32,
-    _pad1: u32,
+    table: u32,
+    rows: u32,
 }
 
 struct TransferFunction {

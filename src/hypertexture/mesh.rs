@@ -1,0 +1,283 @@
+//! Mesh objects of hypertextures (Gilet & Dischler 2009, section 5.3): a closed triangle mesh,
+//! welded and checked when the scene is loaded ([`MeshShape`]), baked by `bake_mesh_grid.wgsl`
+//! into a grid of `n^3` samples holding the vector to the closest surface point and the signed
+//! distance to the surface (positive inside), plus the largest inside distance. The density is
+//! `clamp(inside distance / largest inside distance, 0, 1)`, the soft primitives' falloff (a
+//! sphere's `1 - |x| / r` is its inside distance over its radius); the ray marcher samples the
+//! grid trilinearly for the density and the closest-surface field.
+//!
+//! A mesh made of several closed parts (edge-connected components) is their union, so parts may
+//! overlap (a teapot's spout and handle through its body): each sample keeps the part with the
+//! largest signed distance, which is exact outside the union and never counts a surface buried
+//! in another part as the object's boundary.
+
+use std::collections::HashMap;
+use std::hash::{Hash, Hasher};
+use std::path::Path;
+
+use glam::{DVec3, Vec3A};
+use obvhs::aabb::Aabb;
+
+use crate::error::Result;
+use crate::gpu::GpuContext;
+use crate::graph::exec::Inputs;
+use crate::mesh::Mesh;
+use crate::types::MeshGridParams;
+
+/// Most samples per axis of a mesh grid (16 bytes each: 32 MiB at 128).
+pub const MAX_RESOLUTION: u32 = 128;
+/// Most closed parts of one mesh (the bake walks each part's BVH per sample).
+pub const MAX_PARTS: usize = 16;
+
+/// A closed triangle mesh in its node's frame, vertices welded by position.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MeshShape {
+    pub positions: Vec<DVec3>,
+    pub triangles: Vec<[u32; 3]>,
+    pub lo: DVec3,
+    pub hi: DVec3,
+    /// Closed parts: (first triangle, triangle count); triangles are grouped by part.
+    pub parts: Vec<(u32, u32)>,
+    /// Of positions and triangles: the bake cache's key.
+    pub hash: u64,
+}
+
+/// Where a mesh grid's samples lie: `n` per axis at the vertices of the box `lo..hi`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GridSpec {
+    pub lo: DVec3,
+    pub hi: DVec3,
+    pub n: u32,
+}
+
+impl GridSpec {
+    /// The sample `(i, j, k)` in object space.
+    pub fn point(&self, i: u32, j: u32, k: u32) -> DVec3 {
+        let f = DVec3::new(i as f64, j as f64, k as f64) / (self.n - 1) as f64;
+        self.lo + (self.hi - self.lo) * f
+    }
+
+    pub fn params(&self, triangles: u32, nodes: u32, parts: u32) -> MeshGridParams {
+        let f = |v: DVec3| [v.x as f32, v.y as f32, v.z as f32, 0.0];
+        MeshGridParams { lo: f(self.lo), hi: f(self.hi), counts: [self.n, triangles, nodes, parts] }
+    }
+}
+
+impl MeshShape {
+    /// Welds `mesh` by position and checks that it is closed (every edge shared by an even
+    /// number of triangles, so ray parity says inside or outside) and encloses a volume. Errors
+    /// name `path` and the line of the offending face.
+    pub fn new(mesh: &Mesh, path: &Path) -> std::result::Result<Self, String> {
+        let mut ids: HashMap<[u64; 3], u32> = HashMap::new();
+        let mut positions = Vec::new();
+        let weld: Vec<u32> = mesh
+            .positions
+            .iter()
+            .map(|p| {
+                *ids.entry(p.to_array().map(f64::to_bits)).or_insert_with(|| {
+                    positions.push(*p);
+                    positions.len() as u32 - 1
+                })
+            })
+            .collect();
+        let mut triangles = Vec::new();
+        let mut lines = Vec::new();
+        for (t, tri) in mesh.triangles.iter().enumerate() {
+            let [a, b, c] = tri.map(|i| weld[i as usize]);
+            // A triangle with a repeated vertex bounds nothing.
+            if a != b && b != c && a != c {
+                triangles.push([a, b, c]);
+                lines.push(mesh.face_lines.get(t).copied().unwrap_or(0));
+            }
+        }
+        let at = |t: usize| match lines.get(t) {
+            Some(&l) if l > 0 => format!("{}:{l}:1", path.display()),
+            _ => path.display().to_string(),
+        };
+        if triangles.is_empty() {
+            return Err(format!("{}: degenerate mesh: every triangle repeats a vertex", path.display()));
+        }
+        let mut edges: HashMap<(u32, u32), (u32, usize)> = HashMap::new();
+        for (t, tri) in triangles.iter().enumerate() {
+            for e in 0..3 {
+                let (a, b) = (tri[e], tri[(e + 1) % 3]);
+                edges.entry((a.min(b), a.max(b))).or_insert((0, t)).0 += 1;
+            }
+        }
+        let mut open: Vec<_> = edges.iter().filter(|(_, (count, _))| count % 2 == 1).collect();
+        open.sort_by_key(|(_, (_, t))| *t);
+        if let Some(((a, b), (count, t))) = open.first() {
+            let (pa, pb) = (positions[*a as usize], positions[*b as usize]);
+            return Err(format!(
+                "{}: open mesh: the edge from ({}, {}, {}) to ({}, {}, {}) of this face belongs to {count} \
+                 triangle(s) ({} open edges in all): expected a closed mesh, every edge shared by two triangles",
+                at(*t),
+                pa.x,
+                pa.y,
+                pa.z,
+                pb.x,
+                pb.y,
+                pb.z,
+                open.len()
+            ));
+        }
+        let lo = positions.iter().fold(DVec3::INFINITY, |a, &p| a.min(p));
+        let hi = positions.iter().fold(DVec3::NEG_INFINITY, |a, &p| a.max(p));
+        // Parts: triangles joined by shared vertices (union-find), grouped in order of first face.
+        let mut root: Vec<u32> = (0..positions.len() as u32).collect();
+        fn find(root: &mut [u32], mut i: u32) -> u32 {
+            while root[i as usize] != i {
+                root[i as usize] = root[root[i as usize] as usize];
+                i = root[i as usize];
+            }
+            i
+        }
+        for t in &triangles {
+            for e in 1..3 {
+                let (a, b) = (find(&mut root, t[0]), find(&mut root, t[e]));
+                root[a.max(b) as usize] = a.min(b);
+            }
+        }
+        let mut part_of: HashMap<u32, usize> = HashMap::new();
+        let mut groups: Vec<Vec<usize>> = Vec::new();
+        for (t, tri) in triangles.iter().enumerate() {
+            let r = find(&mut root, tri[0]);
+            let g = *part_of.entry(r).or_insert_with(|| {
+                groups.push(Vec::new());
+                groups.len() - 1
+            });
+            groups[g].push(t);
+        }
+        if groups.len() > MAX_PARTS {
+            return Err(format!(
+                "{}: {} separate closed parts: expected at most {MAX_PARTS}",
+                path.display(),
+                groups.len()
+            ));
+        }
+        let extent = (hi - lo).max_element();
+        let mut parts = Vec::new();
+        let mut grouped = Vec::with_capacity(triangles.len());
+        for g in &groups {
+            let volume: f64 = g
+                .iter()
+                .map(|&t| {
+                    let [a, b, c] = triangles[t].map(|i| positions[i as usize] - lo);
+                    a.dot(b.cross(c)) / 6.0
+                })
+                .sum();
+            if volume.abs() <= 1e-9 * extent.powi(3) {
+                return Err(format!(
+                    "{}: degenerate mesh: the part of this face encloses no volume (bounds {:?} to {:?})",
+                    at(g[0]),
+                    lo.to_array(),
+                    hi.to_array()
+                ));
+            }
+            parts.push((grouped.len() as u32, g.len() as u32));
+            grouped.extend(g.iter().map(|&t| triangles[t]));
+        }
+        let triangles = grouped;
+        let mut h = std::collections::hash_map::DefaultHasher::new();
+        for p in &positions {
+            p.to_array().map(f64::to_bits).hash(&mut h);
+        }
+        triangles.hash(&mut h);
+        Ok(MeshShape { positions, triangles, lo, hi, parts, hash: h.finish() })
+    }
+
+    /// The grid of `n` samples per axis over the mesh's bounds enlarged by the largest shift (the
+    /// field is needed wherever a noise may shift a point from) and two cells.
+    pub fn grid(&self, n: u32, max_shift: f64) -> GridSpec {
+        let extent = (self.hi - self.lo).max_element() + 2.0 * max_shift;
+        let pad = max_shift + 2.0 * extent / (n - 1) as f64;
+        GridSpec { lo: self.lo - DVec3::splat(pad), hi: self.hi + DVec3::splat(pad), n }
+    }
+
+    pub fn triangle(&self, t: usize) -> [DVec3; 3] {
+        self.triangles[t].map(|i| self.positions[i as usize])
+    }
+}
+
+/// A baked mesh grid on the GPU: `n^3` samples (xyz: vector to the closest surface point; w:
+/// signed distance, positive inside) and the largest inside distance (f32 bits, one word).
+#[derive(Clone)]
+pub struct MeshGrid {
+    pub grid: wgpu::Buffer,
+    pub depth: wgpu::Buffer,
+}
+
+/// Runs `bake_mesh_grid.wgsl` for `shape` over `spec`: one thread per sample, closest points
+/// and ray crossings found through a BVH per part (`methods::reference::flat_bvh`).
+pub fn bake(ctx: &GpuContext, shape: &MeshShape, spec: &GridSpec) -> Result<MeshGrid> {
+    use crate::bake::{storage, uniform};
+    use crate::gpu::kernel::ComputeKernel;
+    // One BVH per part, concatenated: a part's root, then its nodes; leaves index the triangles
+    // (in each part's leaf order), inner nodes their first child, both offset to the whole.
+    let mut nodes = Vec::new();
+    let mut corners: Vec<[f32; 4]> = Vec::new();
+    let mut roots: Vec<[u32; 4]> = Vec::new();
+    for &(first, count) in &shape.parts {
+        let boxes: Vec<Aabb> = (first..first + count)
+            .map(|t| {
+                let pts = shape.triangle(t as usize).map(|p| Vec3A::new(p.x as f32, p.y as f32, p.z as f32));
+                let b = Aabb::from_points(&pts);
+                // Grown so that f32 rounding never loses a triangle.
+                let pad = Vec3A::splat(1e-5 * (b.max - b.min).max_element() + 1e-6);
+                Aabb::new(b.min - pad, b.max + pad)
+            })
+            .collect();
+        let (part_nodes, order) = crate::methods::reference::flat_bvh(&boxes);
+        let (node_base, tri_base) = (nodes.len() as u32, (corners.len() / 3) as u32);
+        roots.push([node_base, first, count, 0]);
+        nodes.extend(part_nodes.into_iter().map(|mut n| {
+            let leaf = n.min[3].to_bits() > 0;
+            let base = if leaf { tri_base } else { node_base };
+            n.max[3] = f32::from_bits(n.max[3].to_bits() + base);
+            n
+        }));
+        corners.extend(order.iter().flat_map(|&t| {
+            shape.triangle((first + t) as usize).map(|p| [p.x as f32, p.y as f32, p.z as f32, 0.0])
+        }));
+    }
+    let params = spec.params(shape.triangles.len() as u32, nodes.len() as u32, roots.len() as u32);
+    let mut inputs = Inputs::default();
+    let b = &mut inputs.buffers;
+    b.insert("grid_params".into(), uniform(ctx, "grid_params", bytemuck::bytes_of(&params)));
+    b.insert("mesh_parts".into(), storage(ctx, "mesh_parts", bytemuck::cast_slice(&roots)));
+    b.insert("mesh_nodes".into(), storage(ctx, "mesh_nodes", bytemuck::cast_slice(&nodes)));
+    b.insert("mesh_triangles".into(), storage(ctx, "mesh_triangles", bytemuck::cast_slice(&corners)));
+    let n = spec.n as u64;
+    let grid = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("mesh_grid"),
+        size: n * n * n * 16,
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+        mapped_at_creation: false,
+    });
+    let depth = storage(ctx, "mesh_depth", &[0u8; 16]);
+    b.insert("mesh_grid".into(), grid.clone());
+    b.insert("mesh_depth".into(), depth.clone());
+    let mut encoder = ctx.device.create_command_encoder(&Default::default());
+    ComputeKernel::load(ctx, &crate::render::wgsl_root(), "bake_mesh_grid.wgsl")?.dispatch(
+        ctx,
+        &mut encoder,
+        &inputs,
+        [spec.n; 3],
+    )?;
+    ctx.queue.submit([encoder.finish()]);
+    ctx.take_errors()?;
+    Ok(MeshGrid { grid, depth })
+}
+
+/// The samples and the largest inside distance of a baked grid (twin tests).
+pub fn read(ctx: &GpuContext, g: &MeshGrid) -> Result<(Vec<[f32; 4]>, f32)> {
+    let cells = bytemuck::pod_collect_to_vec(&ctx.read_buffer(&g.grid, 0, g.grid.size())?);
+    let depth: Vec<f32> = bytemuck::pod_collect_to_vec(&ctx.read_buffer(&g.depth, 0, 4)?);
+    Ok((cells, depth[0]))
+}
+
+/// Stand-ins bound for objects that are not meshes (the kernels declare the bindings).
+pub fn unused(ctx: &GpuContext) -> MeshGrid {
+    let b = |label| crate::bake::storage(ctx, label, &[0u8; 16]);
+    MeshGrid { grid: b("mesh_grid"), depth: b("mesh_depth") }
+}
