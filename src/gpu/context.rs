@@ -24,6 +24,9 @@ pub struct GpuContext {
     lost: Arc<Mutex<Option<String>>>,
 }
 
+/// How wgpu words an out-of-memory error.
+const OOM: &str = "Out of Memory";
+
 const NO_ADAPTER: &str = "no GPU adapter found: install software Vulkan \
     (Debian/Ubuntu: `apt-get install mesa-vulkan-drivers`) or a GPU driver with Vulkan support";
 
@@ -143,6 +146,11 @@ impl GpuContext {
         }
         let first = errors.remove(0);
         errors.clear();
+        if first == OOM {
+            return Err(Error::Gpu(format!(
+                "{first}: the GPU ran out of memory; try a smaller --size, fewer planes or smaller texels"
+            )));
+        }
         Err(Error::Gpu(first))
     }
 

@@ -77,7 +77,7 @@ pub fn tokens(text: &str) -> Vec<String> {
     while let Some(c) = chars.next() {
         let mut t = String::from(c);
         if c == '"' {
-            while let Some(n) = chars.next() {
+            for n in chars.by_ref() {
                 t.push(n);
                 if n == '"' {
                     break;
