@@ -25,6 +25,7 @@ use voltex::graph::{plan, Graph};
 use voltex::mesh::{obj, prism, BaseSurface};
 use voltex::methods::shell::Shell;
 use voltex::methods::view_slices;
+use voltex::render::{Blueprint, RenderOptions};
 use voltex::types::{Prism, ShellVertex};
 
 #[global_allocator]
@@ -86,6 +87,7 @@ fn fuzz<S: Strategy>(
         proptest::test_runner::TestRng::from_seed(proptest::test_runner::RngAlgorithm::ChaCha, &seed_bytes);
     let mut runner = proptest::test_runner::TestRunner::new_with_rng(config, rng);
     let tried = std::cell::Cell::new(0u64);
+    let start = std::time::Instant::now();
     let result = runner.run(&strategy, |value| {
         tried.set(tried.get() + 1);
         let start = Tracked::begin_case();
@@ -98,9 +100,10 @@ fn fuzz<S: Strategy>(
         Ok(())
     });
     eprintln!(
-        "fuzz {name}: {} inputs tried, {} accepted (seed {seed}, {cases} cases asked)",
+        "fuzz {name}: {} inputs tried, {} accepted (seed {seed}, {cases} cases asked, {:.1} s)",
         tried.get(),
-        ACCEPTED.with(|a| a.get())
+        ACCEPTED.with(|a| a.get()),
+        start.elapsed().as_secs_f64()
     );
     if let Err(e) = result {
         panic!("fuzz {name}: {e}");
@@ -166,12 +169,14 @@ fn ron_like() -> impl Strategy<Value = String> {
 fn scene_case(path: &Path, text: &str) -> Result<(), String> {
     match voltex::scene::parse(text, path) {
         Ok(scene) => match scene.objects() {
-            // Flattening builds the base surfaces and checks their prisms.
+            // Flattening builds the base surfaces and checks their prisms; the blueprint plans
+            // the scene against the default graph (CPU only: views, sweeps, bakes, memory).
             Ok(objects) => {
-                for o in &objects {
-                    let _ = prism::check(&o.surface);
+                let opts = RenderOptions { size: Some((32, 32)), ..Default::default() };
+                match Blueprint::with_objects(&scene, objects, &opts) {
+                    Ok(_) => accepted(),
+                    Err(e) => check_error(&e, path, text, false),
                 }
-                accepted()
             }
             Err(e) => check_error(&e, path, text, false),
         },
@@ -204,7 +209,7 @@ fn graph_case(path: &Path, text: &str) -> Result<(), String> {
 #[test]
 fn scene_files_mutated() {
     let paths = files(&root().join("scenes"), "ron");
-    fuzz("scene_files_mutated", 1500, mutated(paths), |(path, muts)| {
+    fuzz("scene_files_mutated", 15000, mutated(paths), |(path, muts)| {
         let text = mutate(&std::fs::read_to_string(&path).unwrap(), &muts);
         scene_case(&path, &text)
     });
@@ -213,13 +218,13 @@ fn scene_files_mutated() {
 #[test]
 fn scene_strings() {
     let path = root().join("scenes/fuzz.ron");
-    fuzz("scene_strings", 3000, prop_oneof![ron_like(), any::<String>()], |text| scene_case(&path, &text));
+    fuzz("scene_strings", 50000, prop_oneof![ron_like(), any::<String>()], |text| scene_case(&path, &text));
 }
 
 #[test]
 fn graph_files_mutated() {
     let paths = files(&root().join("graphs"), "ron");
-    fuzz("graph_files_mutated", 300, mutated(paths), |(path, muts)| {
+    fuzz("graph_files_mutated", 6000, mutated(paths), |(path, muts)| {
         let text = mutate(&std::fs::read_to_string(&path).unwrap(), &muts);
         graph_case(&path, &text)
     });
@@ -228,7 +233,7 @@ fn graph_files_mutated() {
 #[test]
 fn graph_strings() {
     let path = root().join("graphs/fuzz.ron");
-    fuzz("graph_strings", 3000, prop_oneof![ron_like(), any::<String>()], |text| graph_case(&path, &text));
+    fuzz("graph_strings", 50000, prop_oneof![ron_like(), any::<String>()], |text| graph_case(&path, &text));
 }
 
 /// One OBJ statement: mostly well formed, with bad numbers, indices and shapes mixed in.
@@ -329,7 +334,7 @@ fn obj_text() -> impl Strategy<Value = String> {
 #[test]
 fn obj_statements() {
     let text = prop_oneof![obj_text(), prop::collection::vec(obj_line(), 0..40).prop_map(|l| l.join("\n"))];
-    fuzz("obj_statements", 4000, text, |text| obj_case(&text));
+    fuzz("obj_statements", 50000, text, |text| obj_case(&text));
 }
 
 #[test]
@@ -339,7 +344,7 @@ fn obj_mutated() {
                 f 1/1/1 2/2/1 3/3/1 4/4/1\nf -4 -2 -1\nf 1//1 2//1 3//1\nf 1/1 2/2 3/3\n";
     let strategy =
         (prop::collection::vec(any::<Mutation>(), 1..6), prop_oneof![Just(String::new()), any::<String>()]);
-    fuzz("obj_mutated", 3000, strategy, |(muts, tail)| obj_case(&(mutate(quad, &muts) + &tail)));
+    fuzz("obj_mutated", 50000, strategy, |(muts, tail)| obj_case(&(mutate(quad, &muts) + &tail)));
 }
 
 /// A coordinate on a small grid (exact coincidences are likely), a float, or a special value.
@@ -450,7 +455,7 @@ fn surface() -> impl Strategy<Value = BaseSurface> {
 #[test]
 fn prism_builder() {
     let forward = (vec3(false), 1u32..600, -1.0f64..1.0);
-    fuzz("prism_builder", 6000, (surface(), forward), |(s, (f, planes, near))| {
+    fuzz("prism_builder", 50000, (surface(), forward), |(s, (f, planes, near))| {
         let report = prism::check(&s);
         if !report.is_ok() {
             return Ok(());
@@ -626,7 +631,7 @@ fn slice_case(input: &SliceInput) -> Result<(), String> {
 
 #[test]
 fn slice_classification() {
-    fuzz("slice_classification", 20000, slice_input(), |input| slice_case(&input));
+    fuzz("slice_classification", 100000, slice_input(), |input| slice_case(&input));
 }
 
 /// Minimised failures found by the fuzz targets above, kept as named tests.
@@ -657,6 +662,38 @@ mod fuzz_regressions {
         );
         let r = prism::check(&s);
         assert!(r.errors.iter().any(|e| e.contains("huge") && e.ends_with("vertices 0")), "{r:?}");
+    }
+
+    /// scene_files_mutated, seed 3: `eye: (1e39, ...)` in scenes/reference/torus_egg.ron. 1e39 is
+    /// finite in f64 but not in f32: the camera-relative prism bounds became infinite and the
+    /// Reference BVH builder panicked (index out of bounds in obvhs). Now every scene number is
+    /// bounded, with its position.
+    #[test]
+    fn camera_beyond_f32_is_an_error_at_its_position() {
+        let path = root().join("scenes/reference/torus_egg.ron");
+        let text = std::fs::read_to_string(&path).unwrap().replacen("eye: (0.0,", "eye: (1e39,", 1);
+        let e = voltex::scene::parse(&text, &path).unwrap_err().to_string();
+        let at = format!("{}:7:", path.display());
+        assert!(e.starts_with(&at) && e.contains("within ±1e15, found 1e39"), "{e}");
+        let text = std::fs::read_to_string(&path).unwrap().replacen("major: 0.28", "major: 1e39", 1);
+        let e = voltex::scene::parse(&text, &path).unwrap_err().to_string();
+        assert!(e.contains(":16:") && e.contains("within ±1e15, found 1e39"), "{e}");
+    }
+
+    /// The same overflow one step later: objects and camera each within bounds, but too far
+    /// apart for camera-relative f32 coordinates, is an error naming the object.
+    #[test]
+    fn object_too_far_from_the_camera_is_an_error() {
+        let path = root().join("scenes/reference/torus_egg.ron");
+        let text = std::fs::read_to_string(&path).unwrap().replacen("eye: (0.0,", "eye: (9e14,", 1).replacen(
+            "translate: (0.0,",
+            "translate: (-9e14,",
+            1,
+        );
+        let scene = voltex::scene::parse(&text, &path).unwrap();
+        let opts = RenderOptions { size: Some((32, 32)), ..Default::default() };
+        let e = Blueprint::new(&scene, &opts).err().expect("an error").to_string();
+        assert!(e.contains("object `torus` lies beyond ±1e15 of the camera"), "{e}");
     }
 
     /// Found reading the OBJ loader for the no-hang property: each word's column was counted from

@@ -136,7 +136,16 @@ pub fn run(args: &Args) -> Result<Outcome> {
         eprintln!("shard {}: no scenes", args.shard);
         Vec::new()
     } else {
-        run_scenes(GpuContext::new()?, args, &scenes)?
+        match run_scenes(GpuContext::new()?, args, &scenes) {
+            Ok(records) => records,
+            Err(e) => {
+                // The report of what was checked before the run stopped, if it can be written.
+                if let Ok((found, unreadable)) = record::collect(&args.out) {
+                    let _ = report::write_index(&args.out, &found, &unreadable);
+                }
+                return Err(e);
+            }
+        }
     };
     let (found, unreadable) = record::collect(&args.out)?;
     let report = report::write_index(&args.out, &found, &unreadable)?;
