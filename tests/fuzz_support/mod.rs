@@ -1,6 +1,8 @@
 //! Helpers of the fuzz targets: token-level mutations of example files, the error-position
 //! property, and an allocator that records the peak of live bytes per thread.
 
+pub mod slice;
+
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 use std::path::Path;
