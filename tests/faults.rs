@@ -130,6 +130,28 @@ fn regress_records_the_scene_a_fault_hit_and_goes_on() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+#[test]
+fn regress_stops_cleanly_when_no_new_device_opens() {
+    let dir = temp("no_device");
+    let scene_dir = dir.join("scenes");
+    scenes(&scene_dir, 3);
+    let out = dir.join("out");
+    let run = voltex(
+        &["regress", s(&scene_dir), "--out", s(&out), "--size", "32x32"],
+        Some("device-lost@pass:1,no-device@open:2"),
+    );
+    let err = stderr(&run);
+    assert_eq!(run.status.code(), Some(1), "{err}");
+    assert!(err.contains("error: GPU device lost") && err.contains("opening a new device failed"), "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+    // The scene that lost the device is recorded and reported; the others were not started.
+    assert_eq!(record(&out, "a").status, Status::BrokenScene);
+    assert!(!out.join("b").exists() && !out.join("c").exists());
+    let index = std::fs::read_to_string(out.join("index.html")).unwrap();
+    assert!(index.contains("a.ron"), "{index}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// A scene folder whose references all differ from what `regress --update` will write, the old
 /// reference bytes, and the render the update writes (read from a complete update of a copy).
 struct UpdateSetup {
@@ -303,4 +325,18 @@ fn preview_session_re_renders_the_last_good_state_on_a_new_device() {
         session.error
     );
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Found by `regress_stops_cleanly_when_no_new_device_opens`: the bake's parameter buffers were
+/// made with wgpu's `create_buffer_init`, which panics on a lost device. Now building a renderer
+/// (bakes included) on a lost device is an error.
+#[test]
+fn building_a_renderer_on_a_lost_device_is_an_error() {
+    let scene = voltex::scene::load(&root().join("scenes/view_slices/flat_box.ron")).unwrap();
+    let options = RenderOptions { size: Some((32, 32)), ..Default::default() };
+    let bp = voltex::render::Blueprint::new(&scene, &options).unwrap();
+    let ctx = GpuContext::new().unwrap();
+    ctx.device.destroy();
+    let err = voltex::render::Renderer::new(&ctx, bp).err().expect("no renderer on a lost device");
+    assert!(matches!(err, voltex::Error::DeviceLost(_)), "{err}");
 }

@@ -33,6 +33,9 @@ const NO_ADAPTER: &str = "no GPU adapter found: install software Vulkan \
 impl GpuContext {
     /// Opens the first adapter: `WGPU_BACKEND` if set, else Vulkan, else GL.
     pub fn new() -> Result<Self> {
+        if super::fault::at_open() {
+            return Err(Error::Gpu(format!("{NO_ADAPTER} (VOLTEX_FAULT=no-device)")));
+        }
         let tries: Vec<wgpu::Backends> = match wgpu::Backends::from_env() {
             Some(b) => vec![b],
             None => vec![wgpu::Backends::VULKAN, wgpu::Backends::GL],
@@ -94,6 +97,15 @@ impl GpuContext {
         self.lost.lock().unwrap().clone()
     }
 
+    /// The error for a failed GPU operation: [`Error::DeviceLost`] if the device is gone (its lost
+    /// callback runs at the next poll, so poll once without waiting), else [`Error::Gpu`].
+    fn gpu_error(&self, message: String) -> Error {
+        if self.lost().is_none() {
+            let _ = self.device.poll(wgpu::PollType::Poll);
+        }
+        self.check_alive().err().unwrap_or(Error::Gpu(message))
+    }
+
     /// Fails with [`Error::DeviceLost`] once the device is lost.
     pub fn check_alive(&self) -> Result<()> {
         match self.lost() {
@@ -120,7 +132,7 @@ impl GpuContext {
                 };
                 self.errors.lock().unwrap().push(e.to_string());
             }
-            Some(Fault::Abort) | None => {}
+            Some(Fault::Abort | Fault::NoDevice) | None => {}
         }
     }
 
@@ -146,12 +158,13 @@ impl GpuContext {
         }
         let first = errors.remove(0);
         errors.clear();
+        drop(errors);
         if first == OOM {
             return Err(Error::Gpu(format!(
                 "{first}: the GPU ran out of memory; try a smaller --size, fewer planes or smaller texels"
             )));
         }
-        Err(Error::Gpu(first))
+        Err(self.gpu_error(first))
     }
 
     /// Runs `f` inside a validation error scope, turning wgpu validation errors into `Error::Gpu`.
@@ -161,7 +174,7 @@ impl GpuContext {
         let value = f();
         match pollster::block_on(scope.pop()) {
             None => self.check_alive().map(|()| value),
-            Some(e) => Err(Error::Gpu(format!("{what}: {e}"))),
+            Some(e) => Err(self.gpu_error(format!("{what}: {e}"))),
         }
     }
 
@@ -170,7 +183,7 @@ impl GpuContext {
         self.device
             .poll(wgpu::PollType::wait_indefinitely())
             .map(|_| ())
-            .map_err(|e| Error::Gpu(format!("waiting for the GPU: {e}")))
+            .map_err(|e| self.gpu_error(format!("waiting for the GPU: {e}")))
     }
 
     /// Copies a buffer back to the CPU (tests, timestamps, readback of images).
@@ -195,9 +208,7 @@ impl GpuContext {
         self.check_alive()?;
         let bytes = slice
             .get_mapped_range()
-            .map_err(|e| {
-                self.check_alive().err().unwrap_or(Error::Gpu(format!("mapping a readback buffer: {e}")))
-            })?
+            .map_err(|e| self.gpu_error(format!("mapping a readback buffer: {e}")))?
             .to_vec();
         staging.unmap();
         self.take_errors()?;

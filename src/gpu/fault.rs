@@ -8,6 +8,7 @@
 //!   Vulkan, which overcommits).
 //! - `abort@write:N`: aborts the process, as a kill would, in the N-th atomic file write after
 //!   the temporary file is complete and before it is renamed over the target.
+//! - `no-device@open:N`: the N-th headless device this process opens fails to open (no adapter).
 //!
 //! Without the variable every hook is one relaxed atomic load.
 
@@ -19,16 +20,19 @@ pub enum Fault {
     DeviceLost,
     OutOfMemory,
     Abort,
+    NoDevice,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Point {
     Pass,
     Write,
+    Open,
 }
 
 static PASSES: AtomicU64 = AtomicU64::new(0);
 static WRITES: AtomicU64 = AtomicU64::new(0);
+static OPENS: AtomicU64 = AtomicU64::new(0);
 
 /// Parses `VOLTEX_FAULT`; an unknown entry is reported once and ignored.
 fn planned() -> &'static [(Fault, Point, u64)] {
@@ -42,7 +46,7 @@ fn planned() -> &'static [(Fault, Point, u64)] {
                 if parsed.is_none() {
                     eprintln!(
                         "warning: VOLTEX_FAULT entry `{entry}` ignored: expected device-lost@pass:N, \
-                         oom@pass:N or abort@write:N"
+                         oom@pass:N, abort@write:N or no-device@open:N"
                     );
                 }
                 parsed
@@ -58,11 +62,13 @@ fn parse(entry: &str) -> Option<(Fault, Point, u64)> {
         "device-lost" => Fault::DeviceLost,
         "oom" => Fault::OutOfMemory,
         "abort" => Fault::Abort,
+        "no-device" => Fault::NoDevice,
         _ => return None,
     };
-    let point = match point {
-        "pass" if fault != Fault::Abort => Point::Pass,
-        "write" if fault == Fault::Abort => Point::Write,
+    let point = match (point, fault) {
+        ("pass", Fault::DeviceLost | Fault::OutOfMemory) => Point::Pass,
+        ("write", Fault::Abort) => Point::Write,
+        ("open", Fault::NoDevice) => Point::Open,
         _ => return None,
     };
     Some((fault, point, n.parse().ok().filter(|&n| n >= 1)?))
@@ -90,6 +96,11 @@ pub fn at_write() {
     }
 }
 
+/// Called when a headless device is about to be opened: whether it must fail.
+pub fn at_open() -> bool {
+    hit(Point::Open, &OPENS) == Some(Fault::NoDevice)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -99,7 +110,16 @@ mod tests {
         assert_eq!(parse("device-lost@pass:3"), Some((Fault::DeviceLost, Point::Pass, 3)));
         assert_eq!(parse("oom@pass:1"), Some((Fault::OutOfMemory, Point::Pass, 1)));
         assert_eq!(parse("abort@write:2"), Some((Fault::Abort, Point::Write, 2)));
-        for bad in ["oom", "oom@pass:0", "oom@write:1", "abort@pass:1", "lost@pass:1", "oom@pass:x"] {
+        assert_eq!(parse("no-device@open:2"), Some((Fault::NoDevice, Point::Open, 2)));
+        for bad in [
+            "oom",
+            "oom@pass:0",
+            "oom@write:1",
+            "abort@pass:1",
+            "lost@pass:1",
+            "oom@pass:x",
+            "no-device@pass:1",
+        ] {
             assert_eq!(parse(bad), None, "{bad}");
         }
     }

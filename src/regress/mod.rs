@@ -225,6 +225,8 @@ fn run_scenes(ctx: GpuContext, args: &Args, scenes: &[SceneEntry]) -> Result<Vec
                         });
                     if ctx.lost().is_some() {
                         if let Err(e) = shared.replace(&ctx) {
+                            // No device to go on with: hand out no more scenes.
+                            stop.store(true, Ordering::Relaxed);
                             result = result.and(Err(e));
                         }
                     }
