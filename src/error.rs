@@ -34,6 +34,10 @@ pub enum Error {
     /// The GPU, its adapter or its limits.
     #[error("GPU: {0}")]
     Gpu(String),
+    /// The GPU device was lost (driver reset, removed GPU, `VOLTEX_FAULT`): nothing more can run on
+    /// it; a new device must be opened.
+    #[error("GPU device lost: {0}")]
+    DeviceLost(String),
     /// Invalid input that has no single position (for example a mesh-wide check).
     #[error("{0}")]
     Invalid(String),

@@ -71,3 +71,39 @@ fn window_shows_the_scene_and_follows_its_file() {
     assert!(blue(&b) > blue(&a));
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// `VOLTEX_FAULT` destroys the device in the first frame: the window opens a new device and
+/// shows the scene rendered on it (frames are recorded only after a successful render).
+#[test]
+fn window_recovers_from_a_lost_device() {
+    let dir = std::env::temp_dir().join(format!("voltex-window-lost-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let record = dir.join("frames");
+    use std::os::unix::process::CommandExt;
+    let mut child = Command::new("xvfb-run")
+        .process_group(0)
+        .args(["-a", "-s", "-screen 0 1280x800x24", BIN, "preview"])
+        .arg(root.join("scenes/view_slices/flat_box.ron"))
+        .args(["--size", "64x64", "--quit-after", "60", "--record"])
+        .arg(&record)
+        .env("VOLTEX_ROOT", root)
+        .env("VOLTEX_FAULT", "device-lost@pass:1")
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let first = record.join("frame-0.png");
+    wait_for(&first, &mut child);
+    let _ = Command::new("kill").args(["-TERM", "--", &format!("-{}", child.id())]).status();
+    let out = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("VOLTEX_FAULT: destroying the GPU device"), "{err}");
+    assert!(err.contains("GPU device lost") && err.contains("opening a new one"), "{err}");
+    let (w, h, pixels) = voltex::io::png::read_rgba8(&first).unwrap();
+    // The box covers the middle of the frame: bright, not the black background.
+    let centre = pixels[(h / 2 * w + w / 2) as usize];
+    assert!(centre[0] > 100 && centre[1] > 80, "centre pixel {centre:?}; stderr: {err}");
+    std::fs::remove_dir_all(&dir).ok();
+}

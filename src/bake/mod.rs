@@ -7,8 +7,6 @@ pub mod stack;
 
 use std::path::Path;
 
-use wgpu::util::DeviceExt;
-
 use crate::cpu::bake::PackedShapes;
 use crate::error::{Error, Result};
 use crate::gpu::kernel::ComputeKernel;
@@ -255,11 +253,24 @@ pub fn level_view(t: &wgpu::Texture, level: u32) -> wgpu::TextureView {
 }
 
 pub fn uniform(ctx: &GpuContext, label: &str, bytes: &[u8]) -> wgpu::Buffer {
-    ctx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+    filled(ctx, label, bytes, wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST)
+}
+
+/// A buffer holding `bytes` (padded to 4). Written through the queue: wgpu's
+/// `create_buffer_init` maps the buffer at creation and panics when the device is lost.
+fn filled(ctx: &GpuContext, label: &str, bytes: &[u8], usage: wgpu::BufferUsages) -> wgpu::Buffer {
+    let mut data = bytes.to_vec();
+    data.resize(bytes.len().next_multiple_of(4), 0);
+    let buffer = ctx.device.create_buffer(&wgpu::BufferDescriptor {
         label: Some(label),
-        contents: bytes,
-        usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-    })
+        size: data.len() as u64,
+        usage,
+        mapped_at_creation: false,
+    });
+    if !data.is_empty() {
+        ctx.queue.write_buffer(&buffer, 0, &data);
+    }
+    buffer
 }
 
 /// An uninitialised storage buffer of `size` bytes (at least 16: empty bindings are invalid),
@@ -277,9 +288,6 @@ pub fn work_buffer(ctx: &GpuContext, label: &str, size: u64, extra: wgpu::Buffer
 }
 
 pub fn storage(ctx: &GpuContext, label: &str, bytes: &[u8]) -> wgpu::Buffer {
-    ctx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: Some(label),
-        contents: bytes,
-        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
-    })
+    let usage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC;
+    filled(ctx, label, bytes, usage)
 }

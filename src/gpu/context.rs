@@ -1,8 +1,11 @@
 //! Headless GPU context: Vulkan first (software Vulkan, lavapipe, on machines without a GPU), wgpu's
-//! GL backend as fallback. Uncaptured wgpu errors are collected instead of panicking.
+//! GL backend as fallback. Uncaptured wgpu errors are collected instead of panicking, and a lost
+//! device is remembered so that every later wait, readback or error check fails with
+//! [`Error::DeviceLost`] instead of touching the dead device.
 
 use std::sync::{Arc, Mutex};
 
+use super::fault::Fault;
 use crate::error::{Error, Result};
 
 /// Features voltex uses when the adapter has them (none is required).
@@ -17,7 +20,12 @@ pub struct GpuContext {
     pub features: wgpu::Features,
     pub limits: wgpu::Limits,
     errors: Arc<Mutex<Vec<String>>>,
+    /// Why the device was lost, once it is.
+    lost: Arc<Mutex<Option<String>>>,
 }
+
+/// How wgpu words an out-of-memory error.
+const OOM: &str = "Out of Memory";
 
 const NO_ADAPTER: &str = "no GPU adapter found: install software Vulkan \
     (Debian/Ubuntu: `apt-get install mesa-vulkan-drivers`) or a GPU driver with Vulkan support";
@@ -25,6 +33,9 @@ const NO_ADAPTER: &str = "no GPU adapter found: install software Vulkan \
 impl GpuContext {
     /// Opens the first adapter: `WGPU_BACKEND` if set, else Vulkan, else GL.
     pub fn new() -> Result<Self> {
+        if super::fault::at_open() {
+            return Err(Error::Gpu(format!("{NO_ADAPTER} (VOLTEX_FAULT=no-device)")));
+        }
         let tries: Vec<wgpu::Backends> = match wgpu::Backends::from_env() {
             Some(b) => vec![b],
             None => vec![wgpu::Backends::VULKAN, wgpu::Backends::GL],
@@ -69,7 +80,60 @@ impl GpuContext {
         device.on_uncaptured_error(Arc::new(move |e: wgpu::Error| {
             sink.lock().unwrap().push(e.to_string());
         }));
-        Ok(Self { device, queue, info, features, limits, errors })
+        let lost = Arc::new(Mutex::new(None));
+        let note = lost.clone();
+        device.set_device_lost_callback(move |reason, message| {
+            let why = match reason {
+                wgpu::DeviceLostReason::Destroyed => "destroyed",
+                wgpu::DeviceLostReason::Unknown => "lost by the driver",
+            };
+            note.lock().unwrap().get_or_insert(format!("{why}: {message}"));
+        });
+        Ok(Self { device, queue, info, features, limits, errors, lost })
+    }
+
+    /// `Some(reason)` once the device is lost.
+    pub fn lost(&self) -> Option<String> {
+        self.lost.lock().unwrap().clone()
+    }
+
+    /// The error for a failed GPU operation: [`Error::DeviceLost`] if the device is gone (its lost
+    /// callback runs at the next poll, so poll once without waiting), else [`Error::Gpu`].
+    fn gpu_error(&self, message: String) -> Error {
+        if self.lost().is_none() {
+            let _ = self.device.poll(wgpu::PollType::Poll);
+        }
+        self.check_alive().err().unwrap_or(Error::Gpu(message))
+    }
+
+    /// Fails with [`Error::DeviceLost`] once the device is lost.
+    pub fn check_alive(&self) -> Result<()> {
+        match self.lost() {
+            Some(why) => Err(Error::DeviceLost(format!("{} ({why})", self.info.name))),
+            None => Ok(()),
+        }
+    }
+
+    /// Applies the fault `VOLTEX_FAULT` plans for the next graph pass, if any (see [`fault`]).
+    ///
+    /// [`fault`]: super::fault
+    pub fn fault_at_pass(&self) {
+        match super::fault::at_pass() {
+            Some(Fault::DeviceLost) => {
+                eprintln!("VOLTEX_FAULT: destroying the GPU device");
+                self.device.destroy();
+                // The callback may run later, at a poll; the device is gone now.
+                self.lost.lock().unwrap().get_or_insert("destroyed: VOLTEX_FAULT=device-lost".into());
+            }
+            Some(Fault::OutOfMemory) => {
+                eprintln!("VOLTEX_FAULT: raising an out-of-memory error");
+                let e = wgpu::Error::OutOfMemory {
+                    source: Box::new(std::io::Error::other("allocation refused by VOLTEX_FAULT=oom")),
+                };
+                self.errors.lock().unwrap().push(e.to_string());
+            }
+            Some(Fault::Abort | Fault::NoDevice) | None => {}
+        }
     }
 
     /// One line naming the adapter, for metadata and reports.
@@ -87,30 +151,39 @@ impl GpuContext {
 
     /// Fails with the first wgpu error raised outside an error scope since the last call.
     pub fn take_errors(&self) -> Result<()> {
+        self.check_alive()?;
         let mut errors = self.errors.lock().unwrap();
         if errors.is_empty() {
             return Ok(());
         }
         let first = errors.remove(0);
         errors.clear();
-        Err(Error::Gpu(first))
+        drop(errors);
+        if first == OOM {
+            return Err(Error::Gpu(format!(
+                "{first}: the GPU ran out of memory; try a smaller --size, fewer planes or smaller texels"
+            )));
+        }
+        Err(self.gpu_error(first))
     }
 
     /// Runs `f` inside a validation error scope, turning wgpu validation errors into `Error::Gpu`.
     pub fn scoped<T>(&self, what: &str, f: impl FnOnce() -> T) -> Result<T> {
+        self.check_alive()?;
         let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
         let value = f();
         match pollster::block_on(scope.pop()) {
-            None => Ok(value),
-            Some(e) => Err(Error::Gpu(format!("{what}: {e}"))),
+            None => self.check_alive().map(|()| value),
+            Some(e) => Err(self.gpu_error(format!("{what}: {e}"))),
         }
     }
 
     pub fn wait(&self) -> Result<()> {
+        self.check_alive()?;
         self.device
             .poll(wgpu::PollType::wait_indefinitely())
             .map(|_| ())
-            .map_err(|e| Error::Gpu(format!("waiting for the GPU: {e}")))
+            .map_err(|e| self.gpu_error(format!("waiting for the GPU: {e}")))
     }
 
     /// Copies a buffer back to the CPU (tests, timestamps, readback of images).
@@ -132,9 +205,10 @@ impl GpuContext {
         let slice = staging.slice(..);
         slice.map_async(wgpu::MapMode::Read, |_| {});
         self.wait()?;
+        self.check_alive()?;
         let bytes = slice
             .get_mapped_range()
-            .map_err(|e| Error::Gpu(format!("mapping a readback buffer: {e}")))?
+            .map_err(|e| self.gpu_error(format!("mapping a readback buffer: {e}")))?
             .to_vec();
         staging.unmap();
         self.take_errors()?;

@@ -2,6 +2,7 @@
 
 pub mod cache;
 pub mod context;
+pub mod fault;
 pub mod kernel;
 pub mod reflect;
 pub mod shader;

@@ -290,6 +290,7 @@ impl Executor {
             ctx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
         let mut written: Vec<String> = Vec::new();
         for index in 0..plan.passes.len() {
+            ctx.fault_at_pass();
             self.record(ctx, plan, index, frame, objects, &mut encoder, timer, &mut written)?;
         }
         timer.resolve(&mut encoder);

@@ -19,6 +19,9 @@ impl PrismReport {
 
 /// Heights sampled along the prism for the twist test.
 const TWIST_W: [f64; 5] = [0.0, 0.25, 0.5, 0.75, 1.0];
+/// Largest coordinate of a position, height vector or prism corner: kernels square f32
+/// distances, which overflow near 1e19.
+pub const MAX_COORD: f64 = 1e15;
 /// A triangle is degenerate when its smallest altitude is below this fraction of its longest edge.
 const SLIVER: f64 = 1e-3;
 
@@ -48,13 +51,20 @@ pub fn check(s: &BaseSurface) -> PrismReport {
         r.errors.push(format!("triangle {t} references a missing vertex"));
         return r;
     }
+    // Kernels work in f32 (camera-relative): beyond MAX_COORD products overflow to infinity.
+    let usable = |v: DVec3| v.is_finite() && v.abs().max_element() <= MAX_COORD;
     let bad_v: Vec<usize> = (0..s.positions.len())
-        .filter(|&i| !s.positions[i].is_finite() || !s.heights[i].is_finite())
+        .filter(|&i| {
+            !usable(s.positions[i]) || !usable(s.heights[i]) || !usable(s.positions[i] + s.heights[i])
+        })
         .collect();
     let bad_uv: Vec<usize> =
         (0..s.triangles.len()).filter(|&t| s.corner_uvs[t].iter().any(|uv| !uv.is_finite())).collect();
     if !bad_v.is_empty() {
-        r.errors.push(format!("non-finite position or height at vertices {}", list(&bad_v)));
+        r.errors.push(format!(
+            "non-finite or huge (beyond ±{MAX_COORD:e}) position or height at vertices {}",
+            list(&bad_v)
+        ));
     }
     if !bad_uv.is_empty() {
         r.errors.push(format!("non-finite uv at triangles {}", list(&bad_uv)));

@@ -10,7 +10,8 @@ use crate::types::{SliceParams, SliceVertex};
 pub fn sweep(shell: &Shell, forward: [f32; 3], planes: u32, near: f64) -> SliceParams {
     let (lo, hi) = shell.depth_range(forward);
     let lo = lo.max(near);
-    let hi = hi.max(lo + 1e-9);
+    // A flat range still gets distinct planes, far from the origin too.
+    let hi = hi.max(lo + 1e-9 * lo.abs().max(1.0));
     let spacing = (hi - lo) / planes as f64;
     SliceParams {
         plane_normal: [forward[0], forward[1], forward[2], 0.0],

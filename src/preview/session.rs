@@ -1,6 +1,7 @@
 //! The preview's reload machinery, without a window: a scene file turned into a renderer, rebuilt
 //! on demand through a [`GpuCache`] so that an edit re-makes only what it changed, and the last
-//! good renderer kept (and shown) whenever a rebuild fails.
+//! good renderer kept (and shown) whenever a rebuild fails. After a lost device, [`Session::recover`]
+//! rebuilds the last good scene on a new one.
 
 use std::path::{Path, PathBuf};
 
@@ -65,16 +66,38 @@ impl Session {
                 self.logged = None;
                 Outcome::Rebuilt(self.cache.stats)
             }
-            Err(e) => {
-                let msg = e.to_string();
-                if self.logged.as_deref() != Some(&msg) {
-                    eprintln!("error: {msg}");
-                    self.logged = Some(msg.clone());
-                }
-                self.error = Some(msg.clone());
-                Outcome::Failed(msg)
-            }
+            Err(e) => self.failed(e),
         }
+    }
+
+    /// After the device was lost: drops everything made on it and rebuilds the last good scene
+    /// (not the file, which may be broken by now) on `ctx`, a new device. Without a good scene
+    /// yet, rebuilds from the file. The current error, if any, stays.
+    pub fn recover(&mut self, ctx: &GpuContext) -> Outcome {
+        self.renderer = None;
+        self.cache = GpuCache::default();
+        let Some(scene) = self.scene.as_ref() else { return self.rebuild(ctx) };
+        self.cache.begin();
+        let built = Blueprint::new(scene, &self.options)
+            .and_then(|bp| Renderer::with_cache(ctx, bp, &mut self.cache));
+        match built {
+            Ok(renderer) => {
+                self.cache.retain_used();
+                self.renderer = Some(renderer);
+                Outcome::Rebuilt(self.cache.stats)
+            }
+            Err(e) => self.failed(e),
+        }
+    }
+
+    fn failed(&mut self, e: crate::Error) -> Outcome {
+        let msg = e.to_string();
+        if self.logged.as_deref() != Some(&msg) {
+            eprintln!("error: {msg}");
+            self.logged = Some(msg.clone());
+        }
+        self.error = Some(msg.clone());
+        Outcome::Failed(msg)
     }
 
     /// Renders a frame with the last good renderer (`None` before any build succeeded).

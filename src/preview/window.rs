@@ -47,6 +47,8 @@ struct App {
 
 struct State {
     window: Arc<Window>,
+    /// Kept to open a new device on it after a device loss.
+    adapter: wgpu::Adapter,
     surface: wgpu::Surface<'static>,
     config: wgpu::SurfaceConfiguration,
     ctx: GpuContext,
@@ -95,6 +97,9 @@ impl ApplicationHandler for App {
             WindowEvent::RedrawRequested => {
                 if let Err(e) = s.redraw(&self.args) {
                     s.status = format!("error: {e}");
+                }
+                if s.ctx.lost().is_some() {
+                    s.recover_device();
                 }
             }
             WindowEvent::ModifiersChanged(m) => s.modifiers = m.state(),
@@ -148,6 +153,28 @@ impl ApplicationHandler for App {
 }
 
 impl State {
+    /// A lost device: opens a new one on the same adapter, remakes the surface configuration and
+    /// the presenter, and re-renders the last good scene on it.
+    fn recover_device(&mut self) {
+        let why = self.ctx.lost().unwrap_or_default();
+        eprintln!("GPU device lost ({why}); opening a new one");
+        match GpuContext::open(self.adapter.clone())
+            .and_then(|ctx| Presenter::new(&ctx, self.config.format).map(|p| (ctx, p)))
+        {
+            Ok((ctx, presenter)) => {
+                self.surface.configure(&ctx.device, &self.config);
+                self.session.recover(&ctx);
+                self.reference = None;
+                self.ctx = ctx;
+                self.presenter = presenter;
+                self.dirty = true;
+                self.status = format!("GPU device lost ({why}); re-created it");
+                self.window.request_redraw();
+            }
+            Err(e) => self.status = format!("error: GPU device lost and no new one: {e}"),
+        }
+    }
+
     fn new(event_loop: &ActiveEventLoop, args: &PreviewArgs) -> Result<Self> {
         let window = Arc::new(
             event_loop
@@ -192,6 +219,7 @@ impl State {
             watcher.ignore.push(std::fs::canonicalize(dir).unwrap_or(dir.clone()));
         }
         Ok(State {
+            adapter,
             window,
             surface,
             config,

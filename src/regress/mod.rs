@@ -13,6 +13,11 @@
 //! `--jobs N` runs N scenes on threads sharing one [`GpuContext`]. wgpu errors raised outside an
 //! error scope are collected per device, so with N > 1 such an error may be reported on the
 //! scene that happened to look next; rerun the scene alone to be sure which one raised it.
+//!
+//! GPU faults: an out-of-memory error is the scene's problem (a broken scene) and the run goes
+//! on. A lost device makes the scenes that were on it broken scenes ("GPU device lost"); a new
+//! device is opened for the scenes not yet started, and if none can be opened the run stops with
+//! an error after writing the records and the report of what was checked.
 
 mod check;
 mod discover;
@@ -27,7 +32,7 @@ use std::collections::BTreeSet;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
-use std::sync::mpsc;
+use std::sync::{mpsc, Arc, RwLock};
 
 use crate::gpu::GpuContext;
 use crate::io::atomic::check_writable_dir;
@@ -131,8 +136,16 @@ pub fn run(args: &Args) -> Result<Outcome> {
         eprintln!("shard {}: no scenes", args.shard);
         Vec::new()
     } else {
-        let ctx = GpuContext::new()?;
-        run_scenes(&ctx, args, &scenes)?
+        match run_scenes(GpuContext::new()?, args, &scenes) {
+            Ok(records) => records,
+            Err(e) => {
+                // The report of what was checked before the run stopped, if it can be written.
+                if let Ok((found, unreadable)) = record::collect(&args.out) {
+                    let _ = report::write_index(&args.out, &found, &unreadable);
+                }
+                return Err(e);
+            }
+        }
     };
     let (found, unreadable) = record::collect(&args.out)?;
     let report = report::write_index(&args.out, &found, &unreadable)?;
@@ -164,9 +177,34 @@ enum Event {
     Done(usize, Box<Result<Record>>),
 }
 
+/// The device the workers share; replaced by a new one when it is lost.
+struct SharedContext(RwLock<Arc<GpuContext>>);
+
+impl SharedContext {
+    fn current(&self) -> Arc<GpuContext> {
+        self.0.read().unwrap().clone()
+    }
+
+    /// After `used` was lost: a new device, opened once however many workers saw the loss.
+    fn replace(&self, used: &Arc<GpuContext>) -> Result<()> {
+        let mut current = self.0.write().unwrap();
+        if Arc::ptr_eq(&current, used) {
+            *current = Arc::new(GpuContext::new().map_err(|e| {
+                Error::DeviceLost(format!(
+                    "{}; opening a new device failed: {e}",
+                    used.lost().unwrap_or_default()
+                ))
+            })?);
+        }
+        Ok(())
+    }
+}
+
 /// Checks `scenes` on `args.jobs` threads sharing `ctx`. A failure to write into the output folder
-/// (or a reference) stops handing out scenes and is returned once the running ones finish.
-fn run_scenes(ctx: &GpuContext, args: &Args, scenes: &[SceneEntry]) -> Result<Vec<Record>> {
+/// (or a reference), or to open a new device after one was lost, stops handing out scenes and is
+/// returned once the running ones finish.
+fn run_scenes(ctx: GpuContext, args: &Args, scenes: &[SceneEntry]) -> Result<Vec<Record>> {
+    let shared = SharedContext(RwLock::new(Arc::new(ctx)));
     let mut progress = Progress::new(scenes.len());
     let (next, stop) = (AtomicUsize::new(0), AtomicBool::new(false));
     let mut records: Vec<Option<Record>> = vec![None; scenes.len()];
@@ -174,16 +212,24 @@ fn run_scenes(ctx: &GpuContext, args: &Args, scenes: &[SceneEntry]) -> Result<Ve
     std::thread::scope(|s| {
         let (tx, rx) = mpsc::channel();
         for _ in 0..(args.jobs as usize).min(scenes.len()) {
-            let (tx, next, stop) = (tx.clone(), &next, &stop);
+            let (tx, next, stop, shared) = (tx.clone(), &next, &stop, &shared);
             s.spawn(move || {
                 while !stop.load(Ordering::Relaxed) {
                     let i = next.fetch_add(1, Ordering::Relaxed);
                     let Some(entry) = scenes.get(i) else { break };
                     let _ = tx.send(Event::Started(i));
-                    let result = catch_unwind(AssertUnwindSafe(|| check::check(ctx, args, entry)))
+                    let ctx = shared.current();
+                    let mut result = catch_unwind(AssertUnwindSafe(|| check::check(&ctx, args, entry)))
                         .unwrap_or_else(|p| {
                             Err(Error::Invalid(format!("{}: {}", entry.rel, panic_text(&p))))
                         });
+                    if ctx.lost().is_some() {
+                        if let Err(e) = shared.replace(&ctx) {
+                            // No device to go on with: hand out no more scenes.
+                            stop.store(true, Ordering::Relaxed);
+                            result = result.and(Err(e));
+                        }
+                    }
                     let _ = tx.send(Event::Done(i, Box::new(result)));
                 }
             });

@@ -356,6 +356,17 @@ impl ObjectPlan {
         bakes: &mut Vec<BakePlan>,
     ) -> Result<Self> {
         let shell = Shell::new(&object.surface, view.eye);
+        // Kernels take camera-relative f32 corners and square their distances.
+        let limit = crate::mesh::prism::MAX_COORD as f32;
+        let in_range = |c: &[f32; 4]| c[..3].iter().all(|x| x.abs() <= limit);
+        if !shell.vertices.iter().all(|v| in_range(&v.bottom) && in_range(&v.top)) {
+            return Err(Error::Invalid(format!(
+                "{}: object `{}` lies beyond ±{:e} of the camera: move the camera closer",
+                scene.path.display(),
+                object.name,
+                crate::mesh::prism::MAX_COORD
+            )));
+        }
         let base = object.base_color.map(|_| shell::base_vertices(&object.surface, view.eye));
         let mut plan = ObjectPlan {
             shell,

@@ -6,6 +6,10 @@ use serde::de::{Deserialize, Deserializer, Error};
 use std::cell::RefCell;
 use std::collections::BTreeMap;
 
+/// Largest magnitude of any number in a scene: beyond it, f32 kernels (and f32 fields such as
+/// texel shapes) overflow (the prism checks' `MAX_COORD`).
+pub const MAX_MAGNITUDE: f64 = crate::mesh::prism::MAX_COORD;
+
 macro_rules! checked_f64 {
     ($name:ident, $ok:expr, $what:literal) => {
         #[derive(Clone, Copy)]
@@ -14,7 +18,12 @@ macro_rules! checked_f64 {
             fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
                 let v = f64::deserialize(d)?;
                 let ok: fn(f64) -> bool = $ok;
-                if v.is_finite() && ok(v) {
+                if v.is_finite() && v.abs() > MAX_MAGNITUDE {
+                    Err(D::Error::custom(format!(
+                        concat!("expected ", $what, " within ±{:e}, found {:e}"),
+                        MAX_MAGNITUDE, v
+                    )))
+                } else if v.is_finite() && ok(v) {
                     Ok($name(v))
                 } else {
                     Err(D::Error::custom(format!(concat!("expected ", $what, ", found {}"), v)))
