@@ -51,9 +51,20 @@ fn window_shows_the_scene_and_follows_its_file() {
     wait_for(&first, &mut child);
     let t = Instant::now();
     std::fs::write(&scene, text.replacen("color: (0.8, 0.6, 0.4)", "color: (0.2, 0.4, 0.9)", 1)).unwrap();
-    let second = record.join("frame-1.png");
-    wait_for(&second, &mut child);
-    eprintln!("window: save to recorded frame in {:.0} ms", t.elapsed().as_secs_f64() * 1e3);
+    // A watcher may see the file half written (truncated, then filled) and redraw the last good
+    // state first; the change shows in one of the next frames.
+    let (_, _, a) = voltex::io::png::read_rgba8(&first).unwrap();
+    let mut n = 1;
+    let second = loop {
+        let next = record.join(format!("frame-{n}.png"));
+        wait_for(&next, &mut child);
+        let (_, _, b) = voltex::io::png::read_rgba8(&next).unwrap();
+        if n == 4 || a.iter().zip(&b).filter(|(p, q)| p != q).count() > a.len() / 10 {
+            break next;
+        }
+        n += 1;
+    };
+    eprintln!("window: save to recorded frame {n} in {:.0} ms", t.elapsed().as_secs_f64() * 1e3);
     let _ = Command::new("kill").args(["-TERM", "--", &format!("-{}", child.id())]).status();
     let out = child.wait_with_output().unwrap();
     let (w, h, a) = voltex::io::png::read_rgba8(&first).unwrap();
