@@ -56,6 +56,21 @@ impl Scene {
         self.assets.stacks.get(&self.assets.dir.join(path)).map(|s| s.as_ref())
     }
 
+    /// A mesh texel's pattern (by its path as written): closed parts when `fill` and the mesh is
+    /// closed, else the whole mesh as one open part (`filled` false).
+    pub fn texel_mesh(
+        &self,
+        path: &str,
+        fill: bool,
+    ) -> Option<(std::sync::Arc<crate::hypertexture::mesh::MeshShape>, bool)> {
+        let full = self.assets.dir.join(path);
+        let closed = self.assets.texel_meshes.get(&(full.clone(), true)).filter(|_| fill);
+        match closed {
+            Some(s) => Some((s.clone(), true)),
+            None => self.assets.texel_meshes.get(&(full, false)).map(|s| (s.clone(), false)),
+        }
+    }
+
     /// The scene file's text.
     pub fn source(&self) -> &str {
         &self.source
@@ -100,6 +115,7 @@ pub fn parse(source: &str, path: &Path) -> Result<Scene> {
         }
     }
     scene.assets = found.assets;
+    scene.warnings = found.warnings;
     scene.source = source.to_string();
     Ok(scene)
 }
