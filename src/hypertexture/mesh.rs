@@ -193,7 +193,8 @@ fn weld(mesh: &Mesh, path: &Path) -> std::result::Result<Welded, String> {
         .positions
         .iter()
         .map(|p| {
-            *ids.entry(p.to_array().map(f64::to_bits)).or_insert_with(|| {
+            // `+ 0.0` makes -0 and 0 one coordinate (OBJ writers print both).
+            *ids.entry(p.to_array().map(|c| (c + 0.0).to_bits())).or_insert_with(|| {
                 positions.push(*p);
                 positions.len() as u32 - 1
             })
