@@ -253,11 +253,11 @@ fn unfilled_mesh_is_a_shell() {
     assert_shell(&volume, 0.35);
 }
 
-fn scene_text(source: &str, resolution: u32) -> String {
+fn scene_text(source: &str, resolution: &str) -> String {
     format!(
         "#![enable(implicit_some)]\nScene(\n    output: (width: 32, height: 32),\n    camera: (eye: (0.0, -2.3, 1.9), \
          target: (0.0, 0.0, 0.45), fov_y: 40.0),\n    lights: [Directional(direction: (-0.5, 0.7, -0.6))],\n    texels: {{\n        \
-         \"m\": (\n            resolution: ({resolution}, {resolution}, {resolution}),\n            source: {source},\n        ),\n    }},\n    \
+         \"m\": (\n            resolution: {resolution},\n            source: {source},\n        ),\n    }},\n    \
          nodes: [(name: \"m\", surface: Plane(size: (1.0, 1.0), cells: (1, 1)), height: (length: 1.0), texel: \"m\", \
          method: AxisSlices(depth: 1.0, pixels: 1.0))],\n)\n"
     )
@@ -278,7 +278,8 @@ fn line_of(text: &str, needle: &str) -> usize {
 #[test]
 fn open_mesh_falls_back_to_a_shell_with_a_warning() {
     let obj_text = sphere_obj(0.35, true);
-    let text = scene_text(&mesh_source("open.obj", "(-0.5, -0.5, -0.5)", "(0.5, 0.5, 0.5)", true), N);
+    let text =
+        scene_text(&mesh_source("open.obj", "(-0.5, -0.5, -0.5)", "(0.5, 0.5, 0.5)", true), "(32, 32, 32)");
     let dir = folder("open", &[("open.obj", &obj_text), ("scene.ron", &text)]);
     let s = scene::load(&dir.join("scene.ron")).unwrap();
     assert_eq!(s.warnings.len(), 1, "{:?}", s.warnings);
@@ -313,7 +314,8 @@ fn open_mesh_falls_back_to_a_shell_with_a_warning() {
 
 #[test]
 fn bounds_that_cut_the_pattern_warn() {
-    let text = scene_text(&mesh_source("sphere.obj", "(-0.5, -0.5, 0.0)", "(0.5, 0.5, 0.5)", true), N);
+    let text =
+        scene_text(&mesh_source("sphere.obj", "(-0.5, -0.5, 0.0)", "(0.5, 0.5, 0.5)", true), "(32, 32, 32)");
     let dir = folder("cut", &[("sphere.obj", &sphere_obj(0.35, false)), ("scene.ron", &text)]);
     let s = scene::load(&dir.join("scene.ron")).unwrap();
     assert_eq!(s.warnings.len(), 1, "{:?}", s.warnings);
@@ -325,7 +327,7 @@ fn bounds_that_cut_the_pattern_warn() {
 }
 
 /// Loading `source` (a mesh texel of `resolution`) fails at the line holding `at` with `expected`.
-fn fails(tag: &str, source: &str, resolution: u32, at: &str, expected: &str) {
+fn fails(tag: &str, source: &str, resolution: &str, at: &str, expected: &str) {
     let text = scene_text(source, resolution);
     let dir = folder(tag, &[("sphere.obj", &sphere_obj(0.35, false)), ("scene.ron", &text)]);
     let path = dir.join("scene.ron");
@@ -337,15 +339,23 @@ fn fails(tag: &str, source: &str, resolution: u32, at: &str, expected: &str) {
 #[test]
 fn bad_mesh_texels_are_reported_at_their_position() {
     let box_ = |lo, hi| mesh_source("sphere.obj", lo, hi, true);
-    fails("flat", &box_("(-0.5, -0.5, 0.5)", "(0.5, 0.5, 0.5)"), N, "bounds:", "expected `lo` below `hi`");
-    fails("inf", &box_("(-0.5, -0.5, -1e999)", "(0.5, 0.5, 0.5)"), N, "bounds:", "expected a finite number");
-    let missing = mesh_source("nowhere.obj", "(-0.5, -0.5, -0.5)", "(0.5, 0.5, 0.5)", true);
-    fails("missing", &missing, N, "path:", "does not exist");
     fails(
-        "large",
-        &box_("(-0.5, -0.5, -0.5)", "(0.5, 0.5, 0.5)"),
-        256,
-        "path:",
-        "expected a cubic resolution",
+        "flat",
+        &box_("(-0.5, -0.5, 0.5)", "(0.5, 0.5, 0.5)"),
+        "(32, 32, 32)",
+        "bounds:",
+        "expected `lo` below `hi`",
     );
+    fails(
+        "inf",
+        &box_("(-0.5, -0.5, -1e999)", "(0.5, 0.5, 0.5)"),
+        "(32, 32, 32)",
+        "bounds:",
+        "expected a finite number",
+    );
+    let missing = mesh_source("nowhere.obj", "(-0.5, -0.5, -0.5)", "(0.5, 0.5, 0.5)", true);
+    fails("missing", &missing, "(32, 32, 32)", "path:", "does not exist");
+    let unit = box_("(-0.5, -0.5, -0.5)", "(0.5, 0.5, 0.5)");
+    fails("large", &unit, "(256, 256, 256)", "path:", "expected a cubic resolution");
+    fails("flat-res", &unit, "(32, 32, 16)", "path:", "expected a cubic resolution");
 }
