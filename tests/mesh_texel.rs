@@ -319,11 +319,9 @@ fn bounds_that_cut_the_pattern_warn() {
     let dir = folder("cut", &[("sphere.obj", &sphere_obj(0.35, false)), ("scene.ron", &text)]);
     let s = scene::load(&dir.join("scene.ron")).unwrap();
     assert_eq!(s.warnings.len(), 1, "{:?}", s.warnings);
-    assert!(
-        s.warnings[0].contains("sphere.obj") && s.warnings[0].contains("cut the pattern"),
-        "{:?}",
-        s.warnings
-    );
+    let at = format!("{}:{}:", dir.join("scene.ron").display(), line_of(&text, "bounds:"));
+    let w = &s.warnings[0];
+    assert!(w.starts_with(&at) && w.contains("sphere.obj") && w.contains("cut the pattern"), "{w}");
 }
 
 /// Loading `source` (a mesh texel of `resolution`) fails at the line holding `at` with `expected`.

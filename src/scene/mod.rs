@@ -115,7 +115,20 @@ pub fn parse(source: &str, path: &Path) -> Result<Scene> {
         }
     }
     scene.assets = found.assets;
-    scene.warnings = found.warnings;
+    // A warning at a mark is positioned like an error: by a parse that stops there.
+    scene.warnings = (found.warnings.into_iter())
+        .map(|(seq, msg)| match seq {
+            Some(seq) => {
+                let again: ron::error::SpannedResult<Scene> =
+                    values::with_marking(BTreeMap::from([(seq, msg.clone())]), || options().from_str(source));
+                match again {
+                    Err(e) => located(path, e).to_string(),
+                    Ok(_) => format!("{}: {msg}", path.display()),
+                }
+            }
+            None => msg,
+        })
+        .collect();
     scene.source = source.to_string();
     Ok(scene)
 }

@@ -31,7 +31,8 @@ pub(super) struct Findings {
     pub fail: BTreeMap<usize, String>,
     pub other: Option<Error>,
     pub assets: Assets,
-    pub warnings: Vec<String>,
+    /// Warnings, with the mark to position them at where they have one.
+    pub warnings: Vec<(Option<usize>, String)>,
 }
 
 struct Checker<'a> {
@@ -125,9 +126,9 @@ impl Checker<'_> {
                     self.f.assets.texel_meshes.insert((full.clone(), true), Arc::new(shape));
                 }
                 Err(msg) => {
-                    self.f.warnings.push(format!(
+                    self.f.warnings.push((None, format!(
                         "{msg}; texel \"{name}\" cannot be filled by parity without flooding: drawn as a one-voxel shell (`fill: false`)"
-                    ));
+                    )));
                     filled = false;
                 }
             }
@@ -142,14 +143,15 @@ impl Checker<'_> {
         }
         let shape = &self.f.assets.texel_meshes[&(full.clone(), filled)];
         if (0..3).any(|a| shape.lo[a] < lo[a] || shape.hi[a] > hi[a]) {
-            self.f.warnings.push(format!(
-                "{}: texel \"{name}\": the bounds {:?} to {:?} cut the pattern, which spans {:?} to {:?}: the texel holds only the part inside",
-                full.display(),
+            let msg = format!(
+                "texel \"{name}\": the bounds {:?} to {:?} cut the pattern {}, which spans {:?} to {:?}: the texel holds only the part inside",
                 lo.to_array(),
                 hi.to_array(),
+                full.display(),
                 shape.lo.to_array(),
                 shape.hi.to_array()
-            ));
+            );
+            self.f.warnings.push((Some(bounds.seq), msg));
         }
     }
 
