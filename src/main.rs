@@ -448,6 +448,9 @@ fn render_one(
 ) -> Result<()> {
     let png_path = exr_path.with_extension("png");
     let bp = Blueprint::new(scene, opts)?;
+    for w in scene.warnings.iter().filter(|_| warn) {
+        eprintln!("warning: {w}");
+    }
     for o in bp.objects.iter().filter(|_| warn) {
         for w in &o.object.report.warnings {
             eprintln!("warning: {}: object `{}`: {w}", scene.path.display(), o.object.name);

@@ -356,6 +356,20 @@ pub struct MeshGridParams {
     pub counts: [u32; 4],
 }
 
+/// What `bake_mesh_texel.wgsl` turns a mesh grid into: a texel's premultiplied colour (Meyer &
+/// Neyret 1998, section 3.2: a pattern mesh sliced with its shading baked in).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct MeshTexelParams {
+    /// rgb the albedo, w the opacity.
+    pub color: [f32; 4],
+    /// xyz the size of the bounds box (object space; texel normals are object normals times it),
+    /// w one voxel in object units (the coverage ramp's width).
+    pub extent: [f32; 4],
+    /// x: samples per axis, y: 1 fills the inside, 0 draws a one-voxel shell around the surface.
+    pub mode: [u32; 4],
+}
+
 /// One noise of a hypertexture: `t = T((1 + simplex(frequency (x + shift V))) / 2)`, combined
 /// into `k` by `k += amplitude t` or, with `blend`, `k = k (1 - t) + amplitude t`. In animated
 /// hypertextures the noise is 4D, its fourth coordinate `speed` times the frame's time.

@@ -12,7 +12,9 @@ use crate::error::{Error, Result};
 use crate::gpu::kernel::ComputeKernel;
 use crate::gpu::GpuContext;
 use crate::graph::exec::Inputs;
-use crate::types::{BakeParams, HeightImageParams, HeightfieldParams};
+use crate::hypertexture::mesh::{GridSpec, MeshShape};
+use crate::types::{BakeParams, HeightImageParams, HeightfieldParams, MeshTexelParams};
+use glam::DVec3;
 
 /// What a bake kernel evaluates.
 #[derive(Debug)]
@@ -22,6 +24,47 @@ pub enum BakeSource {
     HeightImage(HeightImageParams, Heights),
     /// A slice stack's texels (rgba8, premultiplied, baked shading), uploaded as they are.
     Stack(StackTexels),
+    /// A pattern mesh sampled at the voxel centres (`bake_mesh_grid.wgsl`), then coloured.
+    Mesh(MeshTexel),
+}
+
+/// A mesh texel's pattern, where its voxel centres lie, and its colouring; shown in `Debug` (the
+/// bake cache's key) by the mesh's digest.
+#[derive(Clone)]
+pub struct MeshTexel {
+    pub shape: std::sync::Arc<MeshShape>,
+    pub spec: GridSpec,
+    pub params: MeshTexelParams,
+}
+
+impl MeshTexel {
+    /// Voxel `(i, j, k)` of an `n^3` texel samples the centre of its cell of the box `lo..hi`:
+    /// the grid's vertices from half a voxel inside the box.
+    pub fn new(
+        shape: std::sync::Arc<MeshShape>,
+        lo: DVec3,
+        hi: DVec3,
+        n: u32,
+        color: [f32; 3],
+        opacity: f32,
+        fill: bool,
+    ) -> Self {
+        let half = (hi - lo) / (2.0 * n as f64);
+        let spec = GridSpec { lo: lo + half, hi: hi - half, n };
+        let e = hi - lo;
+        let params = MeshTexelParams {
+            color: [color[0], color[1], color[2], opacity],
+            extent: [e.x as f32, e.y as f32, e.z as f32, (e.max_element() / n as f64) as f32],
+            mode: [n, fill as u32, 0, 0],
+        };
+        MeshTexel { shape, spec, params }
+    }
+}
+
+impl std::fmt::Debug for MeshTexel {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "MeshTexel(mesh {:016x}, {:?}, {:?})", self.shape.hash, self.spec, self.params)
+    }
 }
 
 /// The heights of a height image (row-major from the top row), shown in `Debug` (and so in the
@@ -84,6 +127,7 @@ pub struct Baker {
     implicit: Option<ComputeKernel>,
     heightfield: Option<ComputeKernel>,
     height_image: Option<ComputeKernel>,
+    mesh: Option<ComputeKernel>,
     axis: Option<ComputeKernel>,
     wgsl_root: std::path::PathBuf,
 }
@@ -94,6 +138,7 @@ impl Baker {
             implicit: None,
             heightfield: None,
             height_image: None,
+            mesh: None,
             axis: None,
             wgsl_root: wgsl_root.to_path_buf(),
         }
@@ -207,6 +252,28 @@ impl Baker {
                     },
                     wgpu::Extent3d { width: w, height: h, depth_or_array_layers: d },
                 );
+            }
+            BakeSource::Mesh(m) => {
+                if req.resolution != [m.spec.n; 3] {
+                    return Err(Error::Invalid(format!(
+                        "a mesh texel of {} samples per axis was expected, the request is {:?}",
+                        m.spec.n, req.resolution
+                    )));
+                }
+                let grid = crate::hypertexture::mesh::bake(ctx, &m.shape, &m.spec)?;
+                inputs
+                    .buffers
+                    .insert("bake_params".into(), uniform(ctx, "bake_params", bytemuck::bytes_of(&params)));
+                inputs
+                    .buffers
+                    .insert("mesh_texel".into(), uniform(ctx, "mesh_texel", bytemuck::bytes_of(&m.params)));
+                inputs.buffers.insert("mesh_grid".into(), grid.grid);
+                Self::kernel(&mut self.mesh, ctx, &root, "bake_mesh_texel.wgsl")?.dispatch(
+                    ctx,
+                    &mut encoder,
+                    &inputs,
+                    req.resolution,
+                )?;
             }
         }
         let axis = match req.axis_slices {

@@ -3,6 +3,7 @@
 pub mod axis_slices;
 pub mod bake;
 pub mod bake_mesh_grid;
+pub mod bake_mesh_texel;
 pub mod bake_transfer;
 pub mod hypertexture;
 pub mod noise_simplex;

@@ -68,35 +68,11 @@ impl MeshShape {
     /// number of triangles, so ray parity says inside or outside) and encloses a volume. Errors
     /// name `path` and the line of the offending face.
     pub fn new(mesh: &Mesh, path: &Path) -> std::result::Result<Self, String> {
-        let mut ids: HashMap<[u64; 3], u32> = HashMap::new();
-        let mut positions = Vec::new();
-        let weld: Vec<u32> = mesh
-            .positions
-            .iter()
-            .map(|p| {
-                *ids.entry(p.to_array().map(f64::to_bits)).or_insert_with(|| {
-                    positions.push(*p);
-                    positions.len() as u32 - 1
-                })
-            })
-            .collect();
-        let mut triangles = Vec::new();
-        let mut lines = Vec::new();
-        for (t, tri) in mesh.triangles.iter().enumerate() {
-            let [a, b, c] = tri.map(|i| weld[i as usize]);
-            // A triangle with a repeated vertex bounds nothing.
-            if a != b && b != c && a != c {
-                triangles.push([a, b, c]);
-                lines.push(mesh.face_lines.get(t).copied().unwrap_or(0));
-            }
-        }
+        let (positions, triangles, lines) = weld(mesh, path)?;
         let at = |t: usize| match lines.get(t) {
             Some(&l) if l > 0 => format!("{}:{l}:1", path.display()),
             _ => path.display().to_string(),
         };
-        if triangles.is_empty() {
-            return Err(format!("{}: degenerate mesh: every triangle repeats a vertex", path.display()));
-        }
         let mut edges: HashMap<(u32, u32), (u32, usize)> = HashMap::new();
         for (t, tri) in triangles.iter().enumerate() {
             for e in 0..3 {
@@ -178,12 +154,19 @@ impl MeshShape {
             grouped.extend(g.iter().map(|&t| triangles[t]));
         }
         let triangles = grouped;
-        let mut h = std::collections::hash_map::DefaultHasher::new();
-        for p in &positions {
-            p.to_array().map(f64::to_bits).hash(&mut h);
-        }
-        triangles.hash(&mut h);
-        Ok(MeshShape { positions, triangles, lo, hi, parts, hash: h.finish() })
+        let hash = digest(&positions, &triangles);
+        Ok(MeshShape { positions, triangles, lo, hi, parts, hash })
+    }
+
+    /// The welded mesh as one part, closed or not: only its unsigned distance means anything
+    /// (a mesh texel's shell). Errors only when no triangle is left.
+    pub fn open(mesh: &Mesh, path: &Path) -> std::result::Result<Self, String> {
+        let (positions, triangles, _) = weld(mesh, path)?;
+        let lo = positions.iter().fold(DVec3::INFINITY, |a, &p| a.min(p));
+        let hi = positions.iter().fold(DVec3::NEG_INFINITY, |a, &p| a.max(p));
+        let parts = vec![(0, triangles.len() as u32)];
+        let hash = digest(&positions, &triangles);
+        Ok(MeshShape { positions, triangles, lo, hi, parts, hash })
     }
 
     /// The grid of `n` samples per axis over the mesh's bounds enlarged by the largest shift (the
@@ -197,6 +180,49 @@ impl MeshShape {
     pub fn triangle(&self, t: usize) -> [DVec3; 3] {
         self.triangles[t].map(|i| self.positions[i as usize])
     }
+}
+
+/// Positions welded (equal coordinates become one vertex) and triangles that still bound
+/// something, with the OBJ line of each.
+type Welded = (Vec<DVec3>, Vec<[u32; 3]>, Vec<u32>);
+
+fn weld(mesh: &Mesh, path: &Path) -> std::result::Result<Welded, String> {
+    let mut ids: HashMap<[u64; 3], u32> = HashMap::new();
+    let mut positions = Vec::new();
+    let weld: Vec<u32> = mesh
+        .positions
+        .iter()
+        .map(|p| {
+            // `+ 0.0` makes -0 and 0 one coordinate (OBJ writers print both).
+            *ids.entry(p.to_array().map(|c| (c + 0.0).to_bits())).or_insert_with(|| {
+                positions.push(*p);
+                positions.len() as u32 - 1
+            })
+        })
+        .collect();
+    let mut triangles = Vec::new();
+    let mut lines = Vec::new();
+    for (t, tri) in mesh.triangles.iter().enumerate() {
+        let [a, b, c] = tri.map(|i| weld[i as usize]);
+        // A triangle with a repeated vertex bounds nothing.
+        if a != b && b != c && a != c {
+            triangles.push([a, b, c]);
+            lines.push(mesh.face_lines.get(t).copied().unwrap_or(0));
+        }
+    }
+    if triangles.is_empty() {
+        return Err(format!("{}: degenerate mesh: every triangle repeats a vertex", path.display()));
+    }
+    Ok((positions, triangles, lines))
+}
+
+fn digest(positions: &[DVec3], triangles: &[[u32; 3]]) -> u64 {
+    let mut h = std::collections::hash_map::DefaultHasher::new();
+    for p in positions {
+        p.to_array().map(f64::to_bits).hash(&mut h);
+    }
+    triangles.hash(&mut h);
+    h.finish()
 }
 
 /// A baked mesh grid on the GPU: `n^3` samples (xyz: vector to the closest surface point; w:

@@ -88,6 +88,7 @@ fn render(ctx: &GpuContext, opts: &Args, entry: &SceneEntry, rec: &mut Record) -
         .or(scene.regress.size.map(|[w, h]| (w, h)))
         .unwrap_or((scene.output.width, scene.output.height));
     let bp = Blueprint::new(&scene, &RenderOptions { size: Some(size), ..Default::default() })?;
+    rec.warnings.extend(scene.warnings.iter().cloned());
     for o in &bp.objects {
         for w in &o.object.report.warnings {
             rec.warnings.push(format!("object `{}`: {w}", o.object.name));

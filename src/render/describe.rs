@@ -132,6 +132,7 @@ impl Blueprint {
                 BakeSource::Heightfield(_) => "bake_heightfield.wgsl",
                 BakeSource::HeightImage(..) => "bake_height_image.wgsl",
                 BakeSource::Stack(_) => "slice stack (uploaded)",
+                BakeSource::Mesh(_) => "bake_mesh_grid.wgsl + bake_mesh_texel.wgsl",
             };
             s += &format!(
                 "  {:<16} {}x{}x{}  {kind}  lighting {}\n",

@@ -1,6 +1,6 @@
 //! Scene texels as bake requests: only texels some object draws, each (texel, lighting) once.
 
-use crate::bake::{BakeRequest, BakeSource, Heights, StackTexels};
+use crate::bake::{BakeRequest, BakeSource, Heights, MeshTexel, StackTexels};
 use crate::cpu::bake::{pack_shapes, Shape as BakeShape};
 use crate::error::{Error, Result};
 use crate::render::{BakePlan, Lighting};
@@ -99,6 +99,13 @@ pub(super) fn bake_index(
                 "{}: texel \"{texel}\" is a sequence: bake its frames instead",
                 scene.path.display()
             )))
+        }
+        TexelSource::Mesh { path, bounds, color, opacity, fill } => {
+            let (shape, filled) = scene.texel_mesh(&path.value, *fill).ok_or_else(|| {
+                Error::Invalid(format!("{}: mesh {} was not loaded", scene.path.display(), path.value))
+            })?;
+            let n = t.resolution[0];
+            BakeSource::Mesh(MeshTexel::new(shape, bounds.lo, bounds.hi, n, *color, *opacity, filled))
         }
         TexelSource::Constant { color, opacity } => {
             BakeSource::Implicit(pack_shapes(&[(BakeShape::Constant, *color, *opacity)]))

@@ -56,6 +56,21 @@ impl Scene {
         self.assets.stacks.get(&self.assets.dir.join(path)).map(|s| s.as_ref())
     }
 
+    /// A mesh texel's pattern (by its path as written): closed parts when `fill` and the mesh is
+    /// closed, else the whole mesh as one open part (`filled` false).
+    pub fn texel_mesh(
+        &self,
+        path: &str,
+        fill: bool,
+    ) -> Option<(std::sync::Arc<crate::hypertexture::mesh::MeshShape>, bool)> {
+        let full = self.assets.dir.join(path);
+        let closed = self.assets.texel_meshes.get(&(full.clone(), true)).filter(|_| fill);
+        match closed {
+            Some(s) => Some((s.clone(), true)),
+            None => self.assets.texel_meshes.get(&(full, false)).map(|s| (s.clone(), false)),
+        }
+    }
+
     /// The scene file's text.
     pub fn source(&self) -> &str {
         &self.source
@@ -100,6 +115,20 @@ pub fn parse(source: &str, path: &Path) -> Result<Scene> {
         }
     }
     scene.assets = found.assets;
+    // A warning at a mark is positioned like an error: by a parse that stops there.
+    scene.warnings = (found.warnings.into_iter())
+        .map(|(seq, msg)| match seq {
+            Some(seq) => {
+                let again: ron::error::SpannedResult<Scene> =
+                    values::with_marking(BTreeMap::from([(seq, msg.clone())]), || options().from_str(source));
+                match again {
+                    Err(e) => located(path, e).to_string(),
+                    Ok(_) => format!("{}: {msg}", path.display()),
+                }
+            }
+            None => msg,
+        })
+        .collect();
     scene.source = source.to_string();
     Ok(scene)
 }

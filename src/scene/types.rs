@@ -40,6 +40,9 @@ pub struct Scene {
     /// The file's text, to position errors found after parsing (e.g. by the prism checks).
     #[serde(skip)]
     pub(super) source: String,
+    /// What loading found questionable but drew anyway (each names its file), for the user.
+    #[serde(skip)]
+    pub warnings: Vec<String>,
 }
 
 fn default_ambient() -> f32 {
@@ -201,6 +204,22 @@ pub enum TexelSource {
         #[serde(deserialize_with = "v::positive")]
         fps: f64,
     },
+    /// A pattern mesh (Meyer & Neyret 1998, section 3.2): the OBJ at `path` inside the box
+    /// `bounds` (object space of the OBJ), which maps onto texel space [0,1]^3. Each voxel samples
+    /// the mesh at its centre (`bake_mesh_grid.wgsl`, ray parity voted over three directions):
+    /// `fill` covers the inside (a closed mesh is needed: an open one falls back to the shell
+    /// with a warning); `fill: false` draws a one-voxel shell around the surface (sparse
+    /// patterns, leaves). The resolution must be cubic, at most the mesh grid's 128.
+    Mesh {
+        path: Mark<String>,
+        bounds: Mark<MeshBounds>,
+        #[serde(default = "white", deserialize_with = "v::color")]
+        color: [f32; 3],
+        #[serde(default = "one_f32", deserialize_with = "v::unit_f32")]
+        opacity: f32,
+        #[serde(default = "yes")]
+        fill: bool,
+    },
     /// A uniform volume (analytic tests).
     Constant {
         #[serde(deserialize_with = "v::color")]
@@ -208,6 +227,16 @@ pub enum TexelSource {
         #[serde(default = "one_f32", deserialize_with = "v::unit_f32")]
         opacity: f32,
     },
+}
+
+/// `(lo: (x, y, z), hi: (x, y, z))`: a box of a mesh's object space.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MeshBounds {
+    #[serde(deserialize_with = "v::vec3")]
+    pub lo: DVec3,
+    #[serde(deserialize_with = "v::vec3")]
+    pub hi: DVec3,
 }
 
 fn one_u32() -> u32 {

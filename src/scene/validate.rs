@@ -2,7 +2,7 @@
 //! of the files the scene refers to (OBJ meshes, height images).
 
 use super::image::HeightImage;
-use super::types::{HeightScale, Method, Node, Scene, Surface, TexelSource};
+use super::types::{HeightScale, MeshBounds, Method, Node, Scene, Surface, Texel, TexelSource};
 use super::values::Mark;
 use crate::bake::stack::{self, SliceStack};
 use crate::error::Error;
@@ -21,6 +21,8 @@ pub struct Assets {
     pub stacks: BTreeMap<PathBuf, Arc<SliceStack>>,
     /// Hypertexture mesh objects, welded and checked.
     pub shapes: BTreeMap<PathBuf, Arc<MeshShape>>,
+    /// Mesh texels' patterns by (path, filled): closed parts when filled, else one open part.
+    pub texel_meshes: BTreeMap<(PathBuf, bool), Arc<MeshShape>>,
 }
 
 /// What the checks found: messages for marks (positioned by a second parse), and the first error
@@ -29,6 +31,8 @@ pub(super) struct Findings {
     pub fail: BTreeMap<usize, String>,
     pub other: Option<Error>,
     pub assets: Assets,
+    /// Warnings, with the mark to position them at where they have one.
+    pub warnings: Vec<(Option<usize>, String)>,
 }
 
 struct Checker<'a> {
@@ -80,6 +84,74 @@ impl Checker<'_> {
                 self.f.assets.shapes.insert(full, Arc::new(shape));
             }
             Err(msg) => self.fail(path, msg),
+        }
+    }
+
+    /// A mesh texel: a cubic resolution the mesh grid allows, a box with volume, the pattern
+    /// loaded and welded. Filling needs a closed mesh: an open one is drawn as a shell with a
+    /// warning (filling by parity would flood the volume), as is a box that cuts the pattern.
+    fn texel_mesh(
+        &mut self,
+        name: &str,
+        t: &Texel,
+        path: &Mark<String>,
+        bounds: &Mark<MeshBounds>,
+        fill: bool,
+    ) {
+        use crate::hypertexture::mesh::MAX_RESOLUTION;
+        let [n, ny, nz] = t.resolution;
+        if n != ny || n != nz || !(2..=MAX_RESOLUTION).contains(&n) {
+            let msg = format!(
+                "texel \"{name}\" is a mesh: expected a cubic resolution (n, n, n) with n in 2..={MAX_RESOLUTION}, found {:?}",
+                t.resolution
+            );
+            return self.fail(path, msg);
+        }
+        let (lo, hi) = (bounds.lo, bounds.hi);
+        if let Some(a) = (0..3).find(|&a| lo[a] >= hi[a]) {
+            let msg = format!(
+                "expected `lo` below `hi` on every axis, found {} >= {} on {}",
+                lo[a],
+                hi[a],
+                ["x", "y", "z"][a]
+            );
+            return self.fail(bounds, msg);
+        }
+        let full = self.f.assets.dir.join(&path.value);
+        let Some(mesh) = self.mesh(path) else { return };
+        let mut filled = fill;
+        if fill && !self.f.assets.texel_meshes.contains_key(&(full.clone(), true)) {
+            match MeshShape::new(&mesh, &full) {
+                Ok(shape) => {
+                    self.f.assets.texel_meshes.insert((full.clone(), true), Arc::new(shape));
+                }
+                Err(msg) => {
+                    self.f.warnings.push((None, format!(
+                        "{msg}; texel \"{name}\" cannot be filled by parity without flooding: drawn as a one-voxel shell (`fill: false`)"
+                    )));
+                    filled = false;
+                }
+            }
+        }
+        if !filled && !self.f.assets.texel_meshes.contains_key(&(full.clone(), false)) {
+            match MeshShape::open(&mesh, &full) {
+                Ok(shape) => {
+                    self.f.assets.texel_meshes.insert((full.clone(), false), Arc::new(shape));
+                }
+                Err(msg) => return self.fail(path, msg),
+            }
+        }
+        let shape = &self.f.assets.texel_meshes[&(full.clone(), filled)];
+        if (0..3).any(|a| shape.lo[a] < lo[a] || shape.hi[a] > hi[a]) {
+            let msg = format!(
+                "texel \"{name}\": the bounds {:?} to {:?} cut the pattern {}, which spans {:?} to {:?}: the texel holds only the part inside",
+                lo.to_array(),
+                hi.to_array(),
+                full.display(),
+                shape.lo.to_array(),
+                shape.hi.to_array()
+            );
+            self.f.warnings.push((Some(bounds.seq), msg));
         }
     }
 
@@ -300,6 +372,7 @@ pub(super) fn check(scene: &Scene, dir: &Path) -> Findings {
             fail: BTreeMap::new(),
             other: None,
             assets: Assets { dir: dir.to_path_buf(), ..Assets::default() },
+            warnings: Vec::new(),
         },
     };
     let cam = &scene.camera;
@@ -314,8 +387,9 @@ pub(super) fn check(scene: &Scene, dir: &Path) -> Findings {
             c.f.fail.entry(seq).or_insert(msg);
         });
     }
-    for t in scene.texels.values() {
+    for (name, t) in &scene.texels {
         match &t.source {
+            TexelSource::Mesh { path, bounds, fill, .. } => c.texel_mesh(name, t, path, bounds, *fill),
             TexelSource::ImageHeight { image, channel, .. } => c.image_channel(image, *channel, image),
             TexelSource::Slices { dir } => c.stack(dir, t.resolution),
             TexelSource::Sequence { texels, .. } => c.sequence(texels, t.resolution),

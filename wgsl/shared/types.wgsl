@@ -192,6 +192,13 @@ struct MeshGridParams {
     counts: vec4<u32>,
 }
 
+// A mesh texel's colouring of a mesh grid (twin: MeshTexelParams in src/types.rs).
+struct MeshTexelParams {
+    color: vec4<f32>,
+    extent: vec4<f32>,
+    mode: vec4<u32>,
+}
+
 struct HyperNoise {
     amplitude: f32,
     frequency: f32,
