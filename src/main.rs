@@ -258,6 +258,7 @@ impl Overrides {
 }
 
 fn main() -> ExitCode {
+    default_sigpipe();
     private_runtime_dir();
     let cli = Cli::parse();
     let result = match cli.command {
@@ -360,6 +361,23 @@ fn compare(actual: &Path, reference: &Path, diff: Option<&Path>) -> voltex::Resu
         println!("heat map            {}", path.display());
     }
     Ok(())
+}
+
+/// Like other command-line tools, end quietly when the reader of stdout goes away
+/// (`voltex compare a.exr b.exr | head -1`): Rust ignores SIGPIPE, so printing would panic.
+fn default_sigpipe() {
+    #[cfg(target_os = "linux")]
+    {
+        extern "C" {
+            fn signal(signum: i32, handler: usize) -> usize;
+        }
+        const SIGPIPE: i32 = 13;
+        const SIG_DFL: usize = 0;
+        // SAFETY: restores the default disposition before any thread starts.
+        unsafe {
+            signal(SIGPIPE, SIG_DFL);
+        }
+    }
 }
 
 /// Mesa prints "XDG_RUNTIME_DIR is invalid" on every device unless that variable names a private
