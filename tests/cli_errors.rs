@@ -538,3 +538,14 @@ fn compare_images() {
     assert_eq!(out.status.code(), Some(1));
     assert!(stderr(&out).contains("nothing.exr"), "{}", stderr(&out));
 }
+
+/// A reader that stops early (`| head`) ends voltex quietly, as other tools end, not in a panic.
+#[test]
+fn closed_stdout_is_no_panic() {
+    let golden = root().join("tests/golden");
+    let (a, b) = (golden.join("view_slices_torus_egg.exr"), golden.join("view_slices_terrain.exr"));
+    let line = format!("'{BIN}' compare '{}' '{}' | head -c 0", a.display(), b.display());
+    let out = Command::new("sh").args(["-c", &line]).env("VOLTEX_ROOT", root()).output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!err.contains("panicked") && !err.contains("Broken pipe"), "{err}");
+}
