@@ -386,6 +386,12 @@ pub struct HyperNoise {
     /// the rows of a 2D one (`Grid`), one table per density from 0 to 1.
     pub table: u32,
     pub rows: u32,
+    /// Per-axis factors of `frequency` (xyz; 1 unless periodic) that make each period a whole
+    /// number of noise tiles.
+    pub scale: [f32; 4],
+    /// Periodic noise: `(a, b, c)` with periods of 3a, 3b, 3c noise cells along x, y, z (0: not
+    /// periodic). See `simplex3_tiled` in `wgsl/shared/simplex.wgsl`.
+    pub tile: [u32; 4],
 }
 
 /// A transfer function to sample into a table: `count` control points from `first`; `kind` 0 is

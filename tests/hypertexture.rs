@@ -9,7 +9,7 @@ use glam::DVec3;
 use voltex::cpu::bake::pcg_hash;
 use voltex::cpu::bake_transfer::bake_transfer;
 use voltex::cpu::hypertexture::Model;
-use voltex::cpu::noise_simplex::{simplex3, simplex4};
+use voltex::cpu::noise_simplex::{simplex3, simplex3_tiled, simplex4};
 use voltex::cpu::ray_march::{ray_march, MarchView};
 use voltex::gpu::GpuContext;
 use voltex::methods::ray_march::{probe, RayMarchPlan};
@@ -37,6 +37,7 @@ const EXAMPLES: &[&str] = &[
     "fig6_clouds.ron",
     "fig8_vector_fields.ron",
     "fig7_2d_transfer.ron",
+    "periodic_noise.ron",
 ];
 
 fn sized(w: u32, h: u32) -> RenderOptions {
@@ -119,6 +120,49 @@ fn simplex_noise_kernel_matches_twin() {
     );
     assert!(max < 1e-4 && max4 < 1e-4, "max difference {max}, 4D {max4}");
     assert!(lo < -0.7 && hi > 0.7);
+}
+
+/// Periodic noise: the kernel's `simplex3_tiled` against its twin, and both repeat after each
+/// period (3a, 3b, 3c cells) while the plain noise does not.
+#[test]
+fn periodic_noise_repeats() {
+    let scene = scene::load(&example("periodic_noise.ron")).unwrap();
+    let bp = blueprint(&scene, &sized(8, 8));
+    let plan = plans(&bp)[0];
+    let noise = plan.packed.noises[0];
+    // frequency 2.5 x period 1.2 = 3 cells: one tile of 3 cells per axis, the frequency unchanged.
+    assert_eq!((noise.tile, noise.scale), ([1, 1, 1, 0], [1.0, 1.0, 1.0, 1.0]));
+    let tile = [2, 3, 5];
+    let mut rng = Rng(11);
+    let base: Vec<DVec3> = (0..1024).map(|_| rng.in_box(DVec3::splat(-20.0), DVec3::splat(20.0))).collect();
+    let shifts = [DVec3::new(6.0, 0.0, 0.0), DVec3::new(0.0, 9.0, 0.0), DVec3::new(0.0, 0.0, 15.0)];
+    let mut points: Vec<[f32; 4]> = base.iter().map(|&p| point(p, 3)).collect();
+    for s in shifts {
+        points.extend(base.iter().map(|&p| point(p + s, 3)));
+    }
+    let mut packed = plan.clone();
+    packed.packed.noises[0].tile = [tile[0] as u32, tile[1] as u32, tile[2] as u32, 0];
+    let gpu = probe(&ctx().lock().unwrap_or_else(|e| e.into_inner()), &packed, &points).unwrap();
+    let value = |i: usize| gpu.values[4 * i + 2][1] as f64;
+    let n = base.len();
+    let (mut twin, mut repeat, mut twin_repeat, mut plain): (f64, f64, f64, f64) = (0.0, 0.0, 0.0, 0.0);
+    for (i, &p) in base.iter().enumerate() {
+        let cpu = simplex3_tiled(
+            DVec3::new(points[i][0] as f64, points[i][1] as f64, points[i][2] as f64),
+            3,
+            tile,
+        );
+        twin = twin.max((value(i) - cpu).abs());
+        for (k, s) in shifts.iter().enumerate() {
+            repeat = repeat.max((value(i) - value((k + 1) * n + i)).abs());
+            twin_repeat =
+                twin_repeat.max((simplex3_tiled(p, 3, tile) - simplex3_tiled(p + *s, 3, tile)).abs());
+            plain = plain.max((simplex3(p, 3) - simplex3(p + *s, 3)).abs());
+        }
+    }
+    eprintln!("periodic simplex: GPU vs twin {twin:.1e}; after a period: GPU {repeat:.1e}, twin {twin_repeat:.1e}; plain noise {plain:.2}");
+    assert!(twin < 1e-4 && repeat < 1e-4 && twin_repeat < 1e-9, "{twin} {repeat} {twin_repeat}");
+    assert!(plain > 0.5, "the plain noise does not repeat there");
 }
 
 /// Transfer tables (Hermite curves, sampled tables, ramps, steps) of every example hypertexture:
@@ -592,6 +636,10 @@ fn bad_noises_are_reported_at_their_position() {
     bad(10, noise, "-0.2", ">= 0");
     let noise = "                (shape: Table([0.0, 1.0]), amplitude: 0.2, frequency: 1.0, shift: 2.0),";
     bad(10, noise, "2.0)", "[0, 1]");
+    let noise = "                (shape: Table([0.0, 1.0]), amplitude: 0.2, frequency: 1.0, period: (1.0, 0.0, 1.0)),";
+    bad(10, noise, "(1.0, 0.0", "positive finite periods");
+    let noise = "                (shape: Table([0.0, 1.0]), amplitude: 0.2, frequency: 1.0, speed: 1.0, period: (1.0, 1.0, 1.0)),";
+    bad(10, noise, "(1.0, 1.0, 1.0)", "cannot be animated");
     let nine = "(shape: Table([0.0, 1.0]), amplitude: 0.1, frequency: 1.0), ".repeat(9);
     let mut lines: Vec<String> = BASE.lines().map(String::from).collect();
     lines[9] = format!("                {nine}");

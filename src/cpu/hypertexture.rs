@@ -5,7 +5,7 @@
 use glam::{DVec2, DVec3, DVec4};
 
 use super::bake_transfer::TRANSFER_SIZE;
-use super::noise_simplex::{simplex3, simplex4};
+use super::noise_simplex::{simplex3, simplex3_tiled, simplex4};
 use crate::hypertexture::{
     FIELD_CONSTANT, FIELD_FROM_CENTRE, FIELD_SWIRL, OBJECT_BOX, OBJECT_ELLIPSOID, OBJECT_MESH, OBJECT_TORUS,
 };
@@ -200,11 +200,12 @@ impl Model<'_> {
         let time = self.params.march[3] as f64;
         let density = self.object_density(x);
         for n in noises {
-            let q = (x + v * n.shift as f64) * n.frequency as f64;
+            let scale = DVec3::new(n.scale[0] as f64, n.scale[1] as f64, n.scale[2] as f64);
+            let q = (x + v * n.shift as f64) * n.frequency as f64 * scale;
             let noise = if animated {
                 simplex4(DVec4::new(q.x, q.y, q.z, n.speed as f64 * time), n.seed)
             } else {
-                simplex3(q, n.seed)
+                simplex3_tiled(q, n.seed, n.tile.map(|t| t as i32)[..3].try_into().unwrap())
             };
             let t = self.shape_lookup(n, 0.5 + 0.5 * noise, density);
             let a = n.amplitude as f64;

@@ -21,16 +21,30 @@ pub fn simplex_gradient(c: [i32; 3], seed: u32, x: DVec3) -> f64 {
     (if h & 1 == 0 { u } else { -u }) + (if h & 2 == 0 { v } else { -v })
 }
 
-fn simplex_corner(c: [i32; 3], seed: u32, x: DVec3) -> f64 {
+/// `simplex_wrap`: the class of corner `c` modulo the periods (3a, 3b, 3c) of `tile` (0: none).
+pub fn simplex_wrap(c: [i32; 3], tile: [i32; 3]) -> [i32; 3] {
+    if tile[0] <= 0 {
+        return c;
+    }
+    let w = [5 * c[0] - c[1] - c[2], 5 * c[1] - c[2] - c[0], 5 * c[2] - c[0] - c[1]];
+    [0, 1, 2].map(|i| w[i].rem_euclid(18 * tile[i]))
+}
+
+fn simplex_corner(c: [i32; 3], seed: u32, x: DVec3, tile: [i32; 3]) -> f64 {
     let t = 0.6 - x.dot(x);
     if t <= 0.0 {
         return 0.0;
     }
-    t * t * t * t * simplex_gradient(c, seed, x)
+    t * t * t * t * simplex_gradient(simplex_wrap(c, tile), seed, x)
 }
 
 /// Simplex noise of `p` in [-1, 1].
 pub fn simplex3(p: DVec3, seed: u32) -> f64 {
+    simplex3_tiled(p, seed, [0; 3])
+}
+
+/// Simplex noise repeating every (3a, 3b, 3c) cells for `tile` = (a, b, c) > 0.
+pub fn simplex3_tiled(p: DVec3, seed: u32, tile: [i32; 3]) -> f64 {
     let skew = (p.x + p.y + p.z) / 3.0;
     let cell = (p + DVec3::splat(skew)).floor();
     let unskew = (cell.x + cell.y + cell.z) / 6.0;
@@ -46,10 +60,10 @@ pub fn simplex3(p: DVec3, seed: u32) -> f64 {
     let x3 = x0 - DVec3::splat(0.5);
     let c = [cell.x as i32, cell.y as i32, cell.z as i32];
     let add = |o: DVec3| [c[0] + o.x as i32, c[1] + o.y as i32, c[2] + o.z as i32];
-    let n = simplex_corner(c, seed, x0)
-        + simplex_corner(add(i1), seed, x1)
-        + simplex_corner(add(i2), seed, x2)
-        + simplex_corner(add(DVec3::ONE), seed, x3);
+    let n = simplex_corner(c, seed, x0, tile)
+        + simplex_corner(add(i1), seed, x1, tile)
+        + simplex_corner(add(i2), seed, x2, tile)
+        + simplex_corner(add(DVec3::ONE), seed, x3, tile);
     (32.0 * n).clamp(-1.0, 1.0)
 }
 

@@ -105,7 +105,10 @@ pub fn pack(h: &Hypertexture) -> Packed {
     for n in h.noises.iter() {
         let table = p.functions.len() as u32;
         let rows = n.shape.rows().map_or(1, |r| r.len() as u32);
+        let (scale, tile) = n.tiling();
         p.noises.push(HyperNoise {
+            scale,
+            tile,
             amplitude: n.amplitude as f32,
             frequency: n.frequency as f32,
             shift: n.shift as f32,

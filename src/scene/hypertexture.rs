@@ -174,6 +174,30 @@ pub struct Noise {
     /// Animation: noise cycles per second along time (4D noise; 0: still).
     #[serde(default, deserialize_with = "v::finite")]
     pub speed: f64,
+    /// Periodic noise: it repeats every `(x, y, z)` (node frame), the frequency adjusted per axis
+    /// so that each period holds a whole multiple of 3 noise cells (see `simplex3_tiled`).
+    #[serde(default)]
+    pub period: Option<Mark<[f64; 3]>>,
+}
+
+/// The largest noise-cell count per period (keeps the wrapped corner class in i32).
+pub const MAX_PERIOD_CELLS: f64 = 3.0 * 4096.0;
+
+impl Noise {
+    /// Per-axis frequency factors and tile counts `(a, b, c)` of a periodic noise (periods of
+    /// 3a, 3b, 3c cells): ones and zeros when it is not periodic.
+    pub fn tiling(&self) -> ([f32; 4], [u32; 4]) {
+        let Some(period) = &self.period else { return ([1.0; 4], [0; 4]) };
+        let mut scale = [1.0f32; 4];
+        let mut tile = [0u32; 4];
+        for i in 0..3 {
+            let cells = self.frequency * period.value[i];
+            let a = (cells / 3.0).round().max(1.0);
+            tile[i] = a as u32;
+            scale[i] = (3.0 * a / cells) as f32;
+        }
+        (scale, tile)
+    }
 }
 
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
@@ -310,6 +334,24 @@ pub(super) fn check(h: &Hypertexture, fail: &mut dyn FnMut(usize, String)) {
         fail(h.noises.seq, format!("expected 1 to {MAX_NOISES} noises, found {n}"));
     }
     for noise in h.noises.iter() {
+        if let Some(p) = &noise.period {
+            if p.value.iter().any(|&x| !(x.is_finite() && x > 0.0)) {
+                fail(p.seq, "expected positive finite periods (x, y, z)".into());
+            } else if p.value.iter().any(|&x| noise.frequency * x > MAX_PERIOD_CELLS) {
+                fail(
+                    p.seq,
+                    format!(
+                        "expected periods of at most {MAX_PERIOD_CELLS} noise cells (frequency x period)"
+                    ),
+                );
+            } else if noise.speed != 0.0 {
+                fail(
+                    p.seq,
+                    "a periodic noise cannot be animated: expected `speed: 0` (4D noise has no period)"
+                        .into(),
+                );
+            }
+        }
         match &noise.shape {
             ShapeTransfer::Curve(points) => {
                 check_points(points, MAX_POINTS, |p| p.0, "curve", fail);

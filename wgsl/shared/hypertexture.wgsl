@@ -31,11 +31,11 @@ fn hyper_density(x: vec3<f32>) -> f32 {
     for (var i = 0u; i < hyper.kinds.z; i++) {
         let n = hyper_noises[i];
         var value = 0.0;
-        let q = (x + n.shift * v) * n.frequency;
+        let q = (x + n.shift * v) * n.frequency * n.scale.xyz;
         if (animated && !noise_off) {
             value = simplex4(vec4<f32>(q, n.speed * hyper.march.w), n.seed);
         } else if (!noise_off) {
-            value = simplex3(q, n.seed);
+            value = simplex3_tiled(q, n.seed, vec3<i32>(n.tile.xyz));
         }
         let t = shape_lookup(n, 0.5 + 0.5 * value, density);
         if (n.blend != 0u) {

@@ -12,19 +12,38 @@ fn simplex_gradient(c: vec3<i32>, seed: u32, x: vec3<f32>) -> f32 {
     return select(-u, u, (h & 1u) == 0u) + select(-v, v, (h & 2u) == 0u);
 }
 
+// Periodic noise: a point moved by 3a cells along x moves its skewed lattice coordinates by the
+// whole vector (4a, a, a) (likewise b along y, c along z), so the noise repeats if corners that
+// differ by those vectors get one gradient. They do when hashed by their class: with
+// w = (5x - y - z, 5y - z - x, 5z - x - y), two corners differ by such vectors exactly when their
+// w agree modulo (18a, 18b, 18c) (18 w / (18a, 18b, 18c) are the coordinates in that basis).
+fn simplex_wrap(c: vec3<i32>, tile: vec3<i32>) -> vec3<i32> {
+    if (tile.x <= 0) {
+        return c;
+    }
+    let w = vec3<i32>(5 * c.x - c.y - c.z, 5 * c.y - c.z - c.x, 5 * c.z - c.x - c.y);
+    let m = 18 * tile;
+    return ((w % m) + m) % m;
+}
+
 // One corner's contribution: (0.6 - |x|^2)^4 (g . x) inside its sphere of influence.
-fn simplex_corner(c: vec3<i32>, seed: u32, x: vec3<f32>) -> f32 {
+fn simplex_corner(c: vec3<i32>, seed: u32, x: vec3<f32>, tile: vec3<i32>) -> f32 {
     let t = 0.6 - dot(x, x);
     if (t <= 0.0) {
         return 0.0;
     }
     let t2 = t * t;
-    return t2 * t2 * simplex_gradient(c, seed, x);
+    return t2 * t2 * simplex_gradient(simplex_wrap(c, tile), seed, x);
 }
 
 // Simplex noise of `p` in [-1, 1] (32 times the corner sum, clamped). No loops: lavapipe counts
 // loop iterations per invocation (see ray_march.wgsl).
 fn simplex3(p: vec3<f32>, seed: u32) -> f32 {
+    return simplex3_tiled(p, seed, vec3<i32>(0));
+}
+
+// Simplex noise repeating every (3a, 3b, 3c) cells when `tile` = (a, b, c) > 0 (0: not periodic).
+fn simplex3_tiled(p: vec3<f32>, seed: u32, tile: vec3<i32>) -> f32 {
     let skew = (p.x + p.y + p.z) * (1.0 / 3.0);
     let cell = floor(p + vec3<f32>(skew));
     let unskew = (cell.x + cell.y + cell.z) * (1.0 / 6.0);
@@ -38,8 +57,8 @@ fn simplex3(p: vec3<f32>, seed: u32) -> f32 {
     let x2 = x0 - i2 + vec3<f32>(1.0 / 3.0);
     let x3 = x0 - vec3<f32>(0.5);
     let c = vec3<i32>(cell);
-    let n = simplex_corner(c, seed, x0) + simplex_corner(c + vec3<i32>(i1), seed, x1)
-        + simplex_corner(c + vec3<i32>(i2), seed, x2) + simplex_corner(c + vec3<i32>(1), seed, x3);
+    let n = simplex_corner(c, seed, x0, tile) + simplex_corner(c + vec3<i32>(i1), seed, x1, tile)
+        + simplex_corner(c + vec3<i32>(i2), seed, x2, tile) + simplex_corner(c + vec3<i32>(1), seed, x3, tile);
     return clamp(32.0 * n, -1.0, 1.0);
 }
 

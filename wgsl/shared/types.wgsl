@@ -208,6 +208,8 @@ struct HyperNoise {
     speed: f32,
     table: u32,
     rows: u32,
+    scale: vec4<f32>,
+    tile: vec4<u32>,
 }
 
 struct TransferFunction {
