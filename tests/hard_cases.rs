@@ -10,7 +10,6 @@
 use std::path::PathBuf;
 use std::sync::{Mutex, OnceLock};
 
-use glam::DVec3;
 use voltex::cpu::bake_transfer::bake_transfer;
 use voltex::cpu::hypertexture::Model;
 use voltex::cpu::ray_march::{ray_march, MarchView};
@@ -382,15 +381,7 @@ fn layers_and_twins(name: &str) -> Vec<(String, Layer, Layer)> {
     assert_eq!(bad, 0, "{name}: {bad} pixels hold NaN or infinity");
     let f = r.blueprint.frame;
     let light = [0, 1, 2].map(|c| f.light_color[c] as f64);
-    let v3 = |a: [f32; 4]| DVec3::new(a[0] as f64, a[1] as f64, a[2] as f64);
-    let view = MarchView {
-        width: r.blueprint.size.0,
-        height: r.blueprint.size.1,
-        forward: v3(f.forward),
-        light_dir: v3(f.light_dir),
-        ambient: f.light_dir[3] as f64,
-        light_color: light,
-    };
+    let view = MarchView::of_frame(&f, r.blueprint.size);
     let mut out = Vec::new();
     for instance in 0..r.blueprint.instances.len() {
         let (o, part) = r.blueprint.instances[instance];

@@ -260,15 +260,7 @@ fn layer_and_twin(scene: &scene::Scene, opts: &RenderOptions) -> (Vec<[f64; 4]>,
     let o = r.blueprint.objects.iter().find(|o| o.ray_march.is_some()).unwrap();
     let plan = o.ray_march.as_ref().unwrap();
     let tables = twin_tables(plan);
-    let v3 = |a: [f32; 4]| DVec3::new(a[0] as f64, a[1] as f64, a[2] as f64);
-    let view = MarchView {
-        width: r.blueprint.size.0,
-        height: r.blueprint.size.1,
-        forward: v3(f.forward),
-        light_dir: v3(f.light_dir),
-        ambient: f.light_dir[3] as f64,
-        light_color: light,
-    };
+    let view = MarchView::of_frame(f, r.blueprint.size);
     let cpu = ray_march(&view, model(plan, &tables), plan.shade);
     (gpu, cpu, plan.dispatches)
 }

@@ -299,15 +299,7 @@ fn layer_and_twin(scene: &scene::Scene, opts: &RenderOptions) -> (Vec<[f64; 4]>,
         .map(|s| std::array::from_fn(|c| s.color[c] as f64 * if c < 3 { light[c] } else { 1.0 }))
         .collect();
     let tables = bake_transfer(&plan.packed.functions, &plan.packed.points);
-    let v3 = |a: [f32; 4]| DVec3::new(a[0] as f64, a[1] as f64, a[2] as f64);
-    let view = MarchView {
-        width: r.blueprint.size.0,
-        height: r.blueprint.size.1,
-        forward: v3(f.forward),
-        light_dir: v3(f.light_dir),
-        ambient: f.light_dir[3] as f64,
-        light_color: light,
-    };
+    let view = MarchView::of_frame(f, r.blueprint.size);
     let model = Model {
         params: &plan.params,
         noises: &plan.packed.noises,

@@ -23,6 +23,21 @@ pub struct MarchView {
     pub light_color: [f64; 3],
 }
 
+impl MarchView {
+    /// The view of a frame of `width` x `height` pixels, as the kernel reads it from `frame`.
+    pub fn of_frame(frame: &crate::types::FrameParams, (width, height): (u32, u32)) -> Self {
+        let v3 = |a: [f32; 4]| DVec3::new(a[0] as f64, a[1] as f64, a[2] as f64);
+        MarchView {
+            width,
+            height,
+            forward: v3(frame.forward),
+            light_dir: v3(frame.light_dir),
+            ambient: frame.light_dir[3] as f64,
+            light_color: [0, 1, 2].map(|c| frame.light_color[c] as f64),
+        }
+    }
+}
+
 /// Shading switches (the kernel's overrides).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Shade {
