@@ -44,6 +44,12 @@ fn frames_are_renders_at_their_time() {
             String::from_utf8_lossy(&out.stderr)
         );
     }
+    let out = voltex(&["render", s(&scene), "--frames", "0..1", "--fps", "0", "-o", s(&seq)]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--fps 0: expected a positive frame rate"));
+    let out = voltex(&["render", s(&scene), "--criteria", "0,1", "-o", s(&seq)]);
+    assert_eq!(out.status.code(), Some(2), "clap rejects it");
+    assert!(String::from_utf8_lossy(&out.stderr).contains("each in (0, 1024]"));
     // A motion with a zero wavelength is an error at its line:col.
     let text = std::fs::read_to_string(&scene).unwrap().replace("wavelength: 1.2", "wavelength: 0.0");
     let bad = dir.join("bad.ron");
