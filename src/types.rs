@@ -352,8 +352,11 @@ pub struct HyperParams {
 pub struct MeshGridParams {
     pub lo: [f32; 4],
     pub hi: [f32; 4],
-    /// x: samples per axis, y: triangles, z: BVH nodes, w: closed parts.
+    /// x: samples along x, y: triangles, z: BVH nodes, w: closed parts.
     pub counts: [u32; 4],
+    /// xyz: samples per axis; w: 1 to test inside by ray parity, 0 for a shell (every distance
+    /// negative).
+    pub size: [u32; 4],
 }
 
 /// What `bake_mesh_texel.wgsl` turns a mesh grid into: a texel's premultiplied colour (Meyer &
@@ -366,7 +369,7 @@ pub struct MeshTexelParams {
     /// xyz the size of the bounds box (object space; texel normals are object normals times it),
     /// w one voxel in object units (the coverage ramp's width).
     pub extent: [f32; 4],
-    /// x: samples per axis, y: 1 fills the inside, 0 draws a one-voxel shell around the surface.
+    /// y: 1 fills the inside, 0 draws a one-voxel shell around the surface (x, z, w unused).
     pub mode: [u32; 4],
 }
 

@@ -405,9 +405,16 @@ fn triangle_counts_and_times() {
     eprintln!(
         "scene | prisms | finest | drawn: culling+LOD / no culling / no LOD | draw ms: same three | frame ms (wall): same three"
     );
-    for name in
-        ["pear", "pear_grazing", "two_pears", "pears_on_sphere", "heightfield_plane", "heightfield_sphere"]
-    {
+    for name in [
+        "pear",
+        "pear_grazing",
+        "two_pears",
+        "pears_on_sphere",
+        "heightfield_plane",
+        "heightfield_sphere",
+        "pear_mesh",
+        "bushes",
+    ] {
         let text = std::fs::read_to_string(example(&format!("{name}.ron"))).unwrap();
         let off = text
             .replace("AxisSlices(", "AxisSlices(empty_culling: false, ")

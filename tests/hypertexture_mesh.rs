@@ -156,9 +156,9 @@ fn bake_kernel_matches_twin() {
             assert_eq!(shape.parts.len(), 2);
             // On the second box's end face buried in the first (x = -0.2): 0.5 to the first
             // box's faces, not 0 to the buried face; inside the second box only: 0.3.
-            let (_, d) = voltex::cpu::bake_mesh_grid::sample(&shape, DVec3::new(-0.2, 0.0, 0.0));
+            let (_, d) = voltex::cpu::bake_mesh_grid::sample(&shape, DVec3::new(-0.2, 0.0, 0.0), true);
             assert!((d - 0.5).abs() < 1e-12, "{d}");
-            let (_, d) = voltex::cpu::bake_mesh_grid::sample(&shape, DVec3::new(0.6, 0.0, 0.0));
+            let (_, d) = voltex::cpu::bake_mesh_grid::sample(&shape, DVec3::new(0.6, 0.0, 0.0), true);
             assert!((d - 0.3).abs() < 1e-12, "{d}");
         }
     }

@@ -106,33 +106,37 @@ fn load(dir: &Path, name: &str) -> voltex::mesh::Mesh {
     obj::load(&dir.join(name)).unwrap()
 }
 
-/// Bakes `source` as an `N^3` texel: (rgba8 volume, rgba8snorm normals when per pixel).
-fn bake(source: BakeSource, per_pixel: bool) -> (Vec<u8>, Vec<u8>) {
+/// Bakes `source` as a texel of `resolution`: (rgba8 volume, rgba8snorm normals when per pixel).
+fn bake_res(source: BakeSource, resolution: [u32; 3], per_pixel: bool) -> (Vec<u8>, Vec<u8>) {
     let ctx = ctx().lock().unwrap();
-    let req = BakeRequest {
-        resolution: [N; 3],
-        source,
-        per_pixel,
-        light: LIGHT,
-        ambient: AMBIENT,
-        axis_slices: false,
-    };
+    let req =
+        BakeRequest { resolution, source, per_pixel, light: LIGHT, ambient: AMBIENT, axis_slices: false };
     let t = std::time::Instant::now();
     let baked = Baker::new(&root().join("wgsl")).bake(&ctx, &req).unwrap();
     let volume = read_texture(&ctx, &baked.volume, 4).unwrap();
-    eprintln!("{N}^3 bake: {:.0} ms ({})", t.elapsed().as_secs_f64() * 1e3, ctx.adapter_line());
+    eprintln!("{resolution:?} bake: {:.0} ms ({})", t.elapsed().as_secs_f64() * 1e3, ctx.adapter_line());
     let normals = read_texture(&ctx, &baked.normals, 4).unwrap();
     (volume, normals)
 }
 
-fn mesh_texel(shape: MeshShape, fill: bool) -> MeshTexel {
-    MeshTexel::new(Arc::new(shape), DVec3::splat(-0.5), DVec3::splat(0.5), N, COLOR, 1.0, fill)
+/// [`bake_res`] at `N^3`.
+fn bake(source: BakeSource, per_pixel: bool) -> (Vec<u8>, Vec<u8>) {
+    bake_res(source, [N; 3], per_pixel)
 }
 
-/// Texel-space centre of voxel `v` (x fastest).
+fn mesh_texel(shape: MeshShape, fill: bool, resolution: [u32; 3]) -> MeshTexel {
+    MeshTexel::new(Arc::new(shape), DVec3::splat(-0.5), DVec3::splat(0.5), resolution, COLOR, 1.0, fill)
+}
+
+/// Texel-space centre of voxel `v` (x fastest) of a texel of resolution `n`.
+fn centre_of(v: usize, n: [u32; 3]) -> DVec3 {
+    let [x, y, _] = n.map(|n| n as usize);
+    let i = DVec3::new((v % x) as f64, (v / x % y) as f64, (v / (x * y)) as f64);
+    (i + 0.5) / DVec3::from_array(n.map(f64::from))
+}
+
 fn centre(v: usize) -> DVec3 {
-    let n = N as usize;
-    (DVec3::new((v % n) as f64, (v / n % n) as f64, (v / (n * n)) as f64) + 0.5) / N as f64
+    centre_of(v, [N; 3])
 }
 
 /// (largest, mean) absolute alpha difference in units of 1/255.
@@ -145,15 +149,24 @@ fn alpha_diff(a: &[u8], b: &[u8]) -> (i32, f64) {
 fn kernel_matches_twin_on_the_same_grid() {
     let dir = folder("twin", &[("sphere.obj", &sphere_obj(0.35, false))]);
     let shape = MeshShape::new(&load(&dir, "sphere.obj"), &dir.join("sphere.obj")).unwrap();
-    for (fill, per_pixel) in [(true, false), (true, true), (false, false)] {
-        let texel = mesh_texel(shape.clone(), fill);
+    // Cubic and not: a flat texel's voxels are not cubes (the normals scale per axis).
+    let flat = [40, 24, 12];
+    for (fill, per_pixel, res) in [
+        (true, false, [N; 3]),
+        (true, true, [N; 3]),
+        (false, false, [N; 3]),
+        (true, true, flat),
+        (false, false, flat),
+    ] {
+        let texel = mesh_texel(shape.clone(), fill, res);
         let cells = {
             let ctx = ctx().lock().unwrap();
             mesh::read(&ctx, &mesh::bake(&ctx, &texel.shape, &texel.spec).unwrap()).unwrap().0
         };
-        let params = bake_params([N; 3], 0, LIGHT, AMBIENT);
+        assert_eq!(cells.len(), res.iter().product::<u32>() as usize);
+        let params = bake_params(res, 0, LIGHT, AMBIENT);
         let twin = bake_mesh_texel(&params, &texel.params, &cells, per_pixel);
-        let (volume, normals) = bake(BakeSource::Mesh(texel), per_pixel);
+        let (volume, normals) = bake_res(BakeSource::Mesh(texel), res, per_pixel);
         let (mut worst, mut worst_n) = (0i32, 0.0f32);
         for (v, (rgba, normal)) in twin.iter().enumerate() {
             for c in 0..4 {
@@ -167,7 +180,7 @@ fn kernel_matches_twin_on_the_same_grid() {
             }
         }
         eprintln!(
-            "fill {fill}, per pixel {per_pixel}: kernel vs twin rgba8 {worst}/255, normals {worst_n:.4}"
+            "{res:?}, fill {fill}, per pixel {per_pixel}: kernel vs twin rgba8 {worst}/255, normals {worst_n:.4}"
         );
         assert!(worst <= 1, "fill {fill}, per pixel {per_pixel}: {worst}/255 apart");
         assert!(worst_n <= 2.0 / 127.0, "normals {worst_n} apart");
@@ -179,7 +192,7 @@ fn sphere_mesh_matches_the_implicit_sphere_without_holes() {
     let r = 0.35;
     let dir = folder("sphere", &[("sphere.obj", &sphere_obj(r, false))]);
     let shape = MeshShape::new(&load(&dir, "sphere.obj"), &dir.join("sphere.obj")).unwrap();
-    let (mesh, _) = bake(BakeSource::Mesh(mesh_texel(shape, true)), false);
+    let (mesh, _) = bake(BakeSource::Mesh(mesh_texel(shape, true, [N; 3])), false);
     let sphere = Shape::Sphere { center: [0.5; 3], radius: r as f32 };
     let (implicit, _) = bake(BakeSource::Implicit(pack_shapes(&[(sphere, COLOR, 1.0)])), false);
     let (worst, mean) = alpha_diff(&mesh, &implicit);
@@ -203,7 +216,7 @@ fn torus_mesh_keeps_its_hole_empty() {
     let (major, minor) = (0.3, 0.12);
     let dir = folder("torus", &[("torus.obj", &torus_obj(major, minor))]);
     let shape = MeshShape::new(&load(&dir, "torus.obj"), &dir.join("torus.obj")).unwrap();
-    let (mesh, _) = bake(BakeSource::Mesh(mesh_texel(shape, true)), false);
+    let (mesh, _) = bake(BakeSource::Mesh(mesh_texel(shape, true, [N; 3])), false);
     let torus = Shape::Torus { center: [0.5; 3], major: major as f32, minor: minor as f32 };
     let (implicit, _) = bake(BakeSource::Implicit(pack_shapes(&[(torus, COLOR, 1.0)])), false);
     let (worst, mean) = alpha_diff(&mesh, &implicit);
@@ -227,12 +240,13 @@ fn torus_mesh_keeps_its_hole_empty() {
     assert!(hole > 100 && tube > 100, "{hole} hole voxels, {tube} tube voxels checked");
 }
 
-/// Voxels of a shell: empty deep inside and far out, covered near the surface.
-fn assert_shell(volume: &[u8], r: f64) {
-    let voxel = 1.0 / N as f64;
+/// Voxels of a shell of texel resolution `n`: empty deep inside and far out, covered near the
+/// surface (within a voxel's largest side).
+fn assert_shell(volume: &[u8], r: f64, n: [u32; 3]) {
+    let voxel = 1.0 / n.iter().min().copied().unwrap() as f64;
     let mut near = 0;
-    for v in 0..(N * N * N) as usize {
-        let d = ((centre(v) - DVec3::splat(0.5)).length() - r).abs();
+    for v in 0..n.iter().product::<u32>() as usize {
+        let d = ((centre_of(v, n) - DVec3::splat(0.5)).length() - r).abs();
         let a = volume[4 * v + 3];
         if d > 1.1 * voxel {
             assert_eq!(a, 0, "voxel {v}, {:.2} voxels from the surface, is covered", d / voxel);
@@ -249,8 +263,11 @@ fn assert_shell(volume: &[u8], r: f64) {
 fn unfilled_mesh_is_a_shell() {
     let dir = folder("shell", &[("sphere.obj", &sphere_obj(0.35, false))]);
     let shape = MeshShape::open(&load(&dir, "sphere.obj"), &dir.join("sphere.obj")).unwrap();
-    let (volume, _) = bake(BakeSource::Mesh(mesh_texel(shape, false)), false);
-    assert_shell(&volume, 0.35);
+    // Cubic, and flat with voxels twice as tall as wide (foliage texels, 256 x 256 x 64).
+    for n in [[N; 3], [2 * N, 2 * N, N]] {
+        let (volume, _) = bake_res(BakeSource::Mesh(mesh_texel(shape.clone(), false, n)), n, false);
+        assert_shell(&volume, 0.35, n);
+    }
 }
 
 fn scene_text(source: &str, resolution: &str) -> String {
@@ -291,9 +308,9 @@ fn open_mesh_falls_back_to_a_shell_with_a_warning() {
     assert!(obj_text.lines().nth(line - 1).unwrap().starts_with("f "), "line {line} is no face: {w}");
     let (shape, filled) = s.texel_mesh("open.obj", true).unwrap();
     assert!(!filled);
-    let texel = MeshTexel::new(shape, DVec3::splat(-0.5), DVec3::splat(0.5), N, COLOR, 1.0, filled);
+    let texel = MeshTexel::new(shape, DVec3::splat(-0.5), DVec3::splat(0.5), [N; 3], COLOR, 1.0, filled);
     let (volume, _) = bake(BakeSource::Mesh(texel), false);
-    assert_shell(&volume, 0.35);
+    assert_shell(&volume, 0.35, [N; 3]);
     // `voltex render` draws it and says why on stderr.
     let mut cmd = Command::new(env!("CARGO_BIN_EXE_voltex"));
     cmd.args([
@@ -354,6 +371,6 @@ fn bad_mesh_texels_are_reported_at_their_position() {
     let missing = mesh_source("nowhere.obj", "(-0.5, -0.5, -0.5)", "(0.5, 0.5, 0.5)", true);
     fails("missing", &missing, "(32, 32, 32)", "path:", "does not exist");
     let unit = box_("(-0.5, -0.5, -0.5)", "(0.5, 0.5, 0.5)");
-    fails("large", &unit, "(256, 256, 256)", "path:", "expected a cubic resolution");
-    fails("flat-res", &unit, "(32, 32, 16)", "path:", "expected a cubic resolution");
+    fails("large", &unit, "(512, 512, 128)", "path:", "at most 16777216 in all");
+    fails("flat-res", &unit, "(32, 32, 1)", "path:", "expected at least 2 voxels per axis");
 }

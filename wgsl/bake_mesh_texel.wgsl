@@ -20,9 +20,9 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     if (any(id >= bake_params.resolution.xyz)) {
         return;
     }
-    let n = mesh_texel.mode.x;
+    let n = bake_params.resolution.xyz;
     let fill = mesh_texel.mode.y != 0u;
-    let cell = mesh_grid[id.x + n * (id.y + n * id.z)];
+    let cell = mesh_grid[id.x + n.x * (id.y + n.y * id.z)];
     let voxel = mesh_texel.extent.w;
     // Filled: the usual coverage ramp across the surface. Shell: one voxel thick, centred on the
     // surface, so an open or sparse pattern (leaves) never needs an inside.

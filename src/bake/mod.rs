@@ -38,24 +38,26 @@ pub struct MeshTexel {
 }
 
 impl MeshTexel {
-    /// Voxel `(i, j, k)` of an `n^3` texel samples the centre of its cell of the box `lo..hi`:
-    /// the grid's vertices from half a voxel inside the box.
+    /// Voxel `(i, j, k)` of a texel of `n` voxels per axis samples the centre of its cell of the
+    /// box `lo..hi`: the grid's vertices from half a voxel inside the box. A shell (`fill:
+    /// false`) needs no inside, so the grid skips the parity test.
     pub fn new(
         shape: std::sync::Arc<MeshShape>,
         lo: DVec3,
         hi: DVec3,
-        n: u32,
+        n: [u32; 3],
         color: [f32; 3],
         opacity: f32,
         fill: bool,
     ) -> Self {
-        let half = (hi - lo) / (2.0 * n as f64);
-        let spec = GridSpec { lo: lo + half, hi: hi - half, n };
         let e = hi - lo;
+        let voxel = e / DVec3::from_array(n.map(f64::from));
+        let spec = GridSpec { lo: lo + voxel / 2.0, hi: hi - voxel / 2.0, n, parity: fill };
         let params = MeshTexelParams {
             color: [color[0], color[1], color[2], opacity],
-            extent: [e.x as f32, e.y as f32, e.z as f32, (e.max_element() / n as f64) as f32],
-            mode: [n, fill as u32, 0, 0],
+            // w: the largest voxel side, so that a shell has no gaps along any axis.
+            extent: [e.x as f32, e.y as f32, e.z as f32, voxel.max_element() as f32],
+            mode: [0, fill as u32, 0, 0],
         };
         MeshTexel { shape, spec, params }
     }
@@ -254,9 +256,9 @@ impl Baker {
                 );
             }
             BakeSource::Mesh(m) => {
-                if req.resolution != [m.spec.n; 3] {
+                if req.resolution != m.spec.n {
                     return Err(Error::Invalid(format!(
-                        "a mesh texel of {} samples per axis was expected, the request is {:?}",
+                        "a mesh texel of {:?} samples was expected, the request is {:?}",
                         m.spec.n, req.resolution
                     )));
                 }

@@ -89,8 +89,9 @@ pub fn inside(shape: &MeshShape, triangles: std::ops::Range<usize>, p: DVec3) ->
 }
 
 /// The sample at p: (vector to the closest surface point, signed distance) of the union of the
-/// parts (the part with the largest signed distance).
-pub fn sample(shape: &MeshShape, p: DVec3) -> (DVec3, f64) {
+/// parts (the part with the largest signed distance); without `parity` every distance is
+/// negative (a shell).
+pub fn sample(shape: &MeshShape, p: DVec3, parity: bool) -> (DVec3, f64) {
     let mut out = (DVec3::ZERO, f64::NEG_INFINITY);
     for &(first, count) in &shape.parts {
         let range = first as usize..(first + count) as usize;
@@ -104,7 +105,7 @@ pub fn sample(shape: &MeshShape, p: DVec3) -> (DVec3, f64) {
             }
         }
         let dist = best.0.sqrt();
-        let signed = if inside(shape, range, p) { dist } else { -dist };
+        let signed = if parity && inside(shape, range, p) { dist } else { -dist };
         if signed > out.1 {
             out = (best.1 - p, signed);
         }
@@ -115,13 +116,13 @@ pub fn sample(shape: &MeshShape, p: DVec3) -> (DVec3, f64) {
 /// Every sample of the grid (x fastest, then y, then z) as (vector xyz, signed distance), and the
 /// largest inside distance.
 pub fn bake_mesh_grid(shape: &MeshShape, spec: &GridSpec) -> (Vec<[f64; 4]>, f64) {
-    let n = spec.n;
-    let mut cells = Vec::with_capacity((n * n * n) as usize);
+    let [nx, ny, nz] = spec.n;
+    let mut cells = Vec::with_capacity(spec.samples() as usize);
     let mut depth: f64 = 0.0;
-    for k in 0..n {
-        for j in 0..n {
-            for i in 0..n {
-                let (v, d) = sample(shape, spec.point(i, j, k));
+    for k in 0..nz {
+        for j in 0..ny {
+            for i in 0..nx {
+                let (v, d) = sample(shape, spec.point(i, j, k), spec.parity);
                 depth = depth.max(d);
                 cells.push([v.x, v.y, v.z, d]);
             }

@@ -129,7 +129,7 @@ pub fn run(size: (u32, u32), frames: usize, quick: bool) -> Result<()> {
             times.push(t.elapsed().as_secs_f64() * 1e3);
         }
         println!(
-            "mesh grid bake, {name}: {} triangles in {} part(s), {}^3 samples: {:.1} ms (wall, with readback; median of 3 \
+            "mesh grid bake, {name}: {} triangles in {} part(s), {:?} samples: {:.1} ms (wall, with readback; median of 3 \
              after one that compiles the kernel: {:.1} ms)",
             shape.triangles.len(),
             shape.parts.len(),

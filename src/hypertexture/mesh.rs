@@ -26,6 +26,8 @@ use crate::types::MeshGridParams;
 
 /// Most samples per axis of a mesh grid (16 bytes each: 32 MiB at 128).
 pub const MAX_RESOLUTION: u32 = 128;
+/// Most voxels of a mesh texel (its grid: 256 MiB, e.g. 256^3).
+pub const MAX_TEXEL_SAMPLES: u64 = 1 << 24;
 /// Most closed parts of one mesh (the bake walks each part's BVH per sample).
 pub const MAX_PARTS: usize = 16;
 
@@ -42,24 +44,39 @@ pub struct MeshShape {
     pub hash: u64,
 }
 
-/// Where a mesh grid's samples lie: `n` per axis at the vertices of the box `lo..hi`.
+/// Where a mesh grid's samples lie: `n[a]` along axis `a` at the vertices of the box `lo..hi`.
+/// `parity: false` skips the inside test (open patterns drawn as shells): every distance is
+/// then negative.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct GridSpec {
     pub lo: DVec3,
     pub hi: DVec3,
-    pub n: u32,
+    pub n: [u32; 3],
+    pub parity: bool,
 }
 
 impl GridSpec {
     /// The sample `(i, j, k)` in object space.
     pub fn point(&self, i: u32, j: u32, k: u32) -> DVec3 {
-        let f = DVec3::new(i as f64, j as f64, k as f64) / (self.n - 1) as f64;
+        let [x, y, z] = self.n.map(|n| (n - 1) as f64);
+        let f = DVec3::new(i as f64 / x, j as f64 / y, k as f64 / z);
         self.lo + (self.hi - self.lo) * f
+    }
+
+    /// Samples in all.
+    pub fn samples(&self) -> u64 {
+        self.n.iter().map(|&n| n as u64).product()
     }
 
     pub fn params(&self, triangles: u32, nodes: u32, parts: u32) -> MeshGridParams {
         let f = |v: DVec3| [v.x as f32, v.y as f32, v.z as f32, 0.0];
-        MeshGridParams { lo: f(self.lo), hi: f(self.hi), counts: [self.n, triangles, nodes, parts] }
+        let [x, y, z] = self.n;
+        MeshGridParams {
+            lo: f(self.lo),
+            hi: f(self.hi),
+            counts: [x, triangles, nodes, parts],
+            size: [x, y, z, self.parity as u32],
+        }
     }
 }
 
@@ -174,7 +191,7 @@ impl MeshShape {
     pub fn grid(&self, n: u32, max_shift: f64) -> GridSpec {
         let extent = (self.hi - self.lo).max_element() + 2.0 * max_shift;
         let pad = max_shift + 2.0 * extent / (n - 1) as f64;
-        GridSpec { lo: self.lo - DVec3::splat(pad), hi: self.hi + DVec3::splat(pad), n }
+        GridSpec { lo: self.lo - DVec3::splat(pad), hi: self.hi + DVec3::splat(pad), n: [n; 3], parity: true }
     }
 
     pub fn triangle(&self, t: usize) -> [DVec3; 3] {
@@ -225,7 +242,7 @@ fn digest(positions: &[DVec3], triangles: &[[u32; 3]]) -> u64 {
     h.finish()
 }
 
-/// A baked mesh grid on the GPU: `n^3` samples (xyz: vector to the closest surface point; w:
+/// A baked mesh grid on the GPU: its samples (xyz: vector to the closest surface point; w:
 /// signed distance, positive inside) and the largest inside distance (f32 bits, one word).
 #[derive(Clone)]
 pub struct MeshGrid {
@@ -273,10 +290,19 @@ pub fn bake(ctx: &GpuContext, shape: &MeshShape, spec: &GridSpec) -> Result<Mesh
     b.insert("mesh_parts".into(), storage(ctx, "mesh_parts", bytemuck::cast_slice(&roots)));
     b.insert("mesh_nodes".into(), storage(ctx, "mesh_nodes", bytemuck::cast_slice(&nodes)));
     b.insert("mesh_triangles".into(), storage(ctx, "mesh_triangles", bytemuck::cast_slice(&corners)));
-    let n = spec.n as u64;
+    let bytes = spec.samples() * 16;
+    let limit = ctx.limits.max_storage_buffer_binding_size.min(ctx.limits.max_buffer_size);
+    if bytes > limit {
+        return Err(crate::error::Error::Invalid(format!(
+            "a mesh grid of {:?} samples needs {} MiB in one storage buffer, beyond this adapter's limit of {} MiB",
+            spec.n,
+            bytes >> 20,
+            limit >> 20
+        )));
+    }
     let grid = ctx.device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("mesh_grid"),
-        size: n * n * n * 16,
+        size: bytes,
         usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
         mapped_at_creation: false,
     });
@@ -288,7 +314,7 @@ pub fn bake(ctx: &GpuContext, shape: &MeshShape, spec: &GridSpec) -> Result<Mesh
         ctx,
         &mut encoder,
         &inputs,
-        [spec.n; 3],
+        spec.n,
     )?;
     ctx.queue.submit([encoder.finish()]);
     ctx.take_errors()?;

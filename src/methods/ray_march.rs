@@ -103,7 +103,7 @@ pub fn plan(
     };
     let mut params = params;
     if let Some((_, g)) = &packed.mesh {
-        params.grid_min = [g.lo.x as f32, g.lo.y as f32, g.lo.z as f32, g.n as f32];
+        params.grid_min = [g.lo.x as f32, g.lo.y as f32, g.lo.z as f32, g.n[0] as f32];
         params.grid_max = [g.hi.x as f32, g.hi.y as f32, g.hi.z as f32, 0.0];
     }
     Ok(RayMarchPlan {
@@ -151,7 +151,7 @@ impl RayMarchPlan {
             + self.packed.noises.len() * 32
             + self.packed.points.len() * 16
             + self.packed.functions.len() * (16 + 4 * TRANSFER_SIZE)) as u64
-            + self.packed.mesh.as_ref().map_or(0, |(_, g)| (g.n as u64).pow(3) * 16)
+            + self.packed.mesh.as_ref().map_or(0, |(_, g)| g.samples() * 16)
             + size.0 as u64 * size.1 as u64 * std::mem::size_of::<MarchState>() as u64
     }
 

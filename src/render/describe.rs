@@ -118,11 +118,11 @@ impl Blueprint {
             s += "  (none)\n";
         }
         for (name, (shape, spec)) in grids {
+            let [x, y, z] = spec.n;
             s += &format!(
-                "  {name:<16} {n}x{n}x{n}  bake_mesh_grid.wgsl  mesh grid of {} triangles in {} part(s)\n",
+                "  {name:<16} {x}x{y}x{z}  bake_mesh_grid.wgsl  mesh grid of {} triangles in {} part(s)\n",
                 shape.triangles.len(),
                 shape.parts.len(),
-                n = spec.n
             );
         }
         for b in &self.bakes {

@@ -104,8 +104,15 @@ pub(super) fn bake_index(
             let (shape, filled) = scene.texel_mesh(&path.value, *fill).ok_or_else(|| {
                 Error::Invalid(format!("{}: mesh {} was not loaded", scene.path.display(), path.value))
             })?;
-            let n = t.resolution[0];
-            BakeSource::Mesh(MeshTexel::new(shape, bounds.lo, bounds.hi, n, *color, *opacity, filled))
+            BakeSource::Mesh(MeshTexel::new(
+                shape,
+                bounds.lo,
+                bounds.hi,
+                t.resolution,
+                *color,
+                *opacity,
+                filled,
+            ))
         }
         TexelSource::Constant { color, opacity } => {
             BakeSource::Implicit(pack_shapes(&[(BakeShape::Constant, *color, *opacity)]))

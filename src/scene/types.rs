@@ -209,7 +209,8 @@ pub enum TexelSource {
     /// the mesh at its centre (`bake_mesh_grid.wgsl`, ray parity voted over three directions):
     /// `fill` covers the inside (a closed mesh is needed: an open one falls back to the shell
     /// with a warning); `fill: false` draws a one-voxel shell around the surface (sparse
-    /// patterns, leaves). The resolution must be cubic, at most the mesh grid's 128.
+    /// patterns, leaves; no inside test). Any resolution of at least 2 voxels per axis and at
+    /// most 2^24 in all.
     Mesh {
         path: Mark<String>,
         bounds: Mark<MeshBounds>,

@@ -87,7 +87,7 @@ impl Checker<'_> {
         }
     }
 
-    /// A mesh texel: a cubic resolution the mesh grid allows, a box with volume, the pattern
+    /// A mesh texel: a resolution the mesh grid allows, a box with volume, the pattern
     /// loaded and welded. Filling needs a closed mesh: an open one is drawn as a shell with a
     /// warning (filling by parity would flood the volume), as is a box that cuts the pattern.
     fn texel_mesh(
@@ -98,11 +98,12 @@ impl Checker<'_> {
         bounds: &Mark<MeshBounds>,
         fill: bool,
     ) {
-        use crate::hypertexture::mesh::MAX_RESOLUTION;
-        let [n, ny, nz] = t.resolution;
-        if n != ny || n != nz || !(2..=MAX_RESOLUTION).contains(&n) {
+        use crate::hypertexture::mesh::MAX_TEXEL_SAMPLES;
+        let samples: u64 = t.resolution.iter().map(|&n| n as u64).product();
+        if t.resolution.contains(&1) || samples > MAX_TEXEL_SAMPLES {
             let msg = format!(
-                "texel \"{name}\" is a mesh: expected a cubic resolution (n, n, n) with n in 2..={MAX_RESOLUTION}, found {:?}",
+                "texel \"{name}\" is a mesh: expected at least 2 voxels per axis and at most {MAX_TEXEL_SAMPLES} in all \
+                 (the bake's grid holds 16 bytes per voxel), found {:?}",
                 t.resolution
             );
             return self.fail(path, msg);

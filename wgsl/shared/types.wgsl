@@ -190,6 +190,7 @@ struct MeshGridParams {
     lo: vec4<f32>,
     hi: vec4<f32>,
     counts: vec4<u32>,
+    size: vec4<u32>,
 }
 
 // A mesh texel's colouring of a mesh grid (twin: MeshTexelParams in src/types.rs).
