@@ -165,7 +165,7 @@ fn kernel_matches_twin_on_the_same_grid() {
         };
         assert_eq!(cells.len(), res.iter().product::<u32>() as usize);
         let params = bake_params(res, 0, LIGHT, AMBIENT);
-        let twin = bake_mesh_texel(&params, &texel.params, &cells, per_pixel);
+        let twin = bake_mesh_texel(&params, &texel.params, &cells, None, per_pixel);
         let (volume, normals) = bake_res(BakeSource::Mesh(texel), res, per_pixel);
         let (mut worst, mut worst_n) = (0i32, 0.0f32);
         for (v, (rgba, normal)) in twin.iter().enumerate() {
@@ -185,6 +185,93 @@ fn kernel_matches_twin_on_the_same_grid() {
         assert!(worst <= 1, "fill {fill}, per pixel {per_pixel}: {worst}/255 apart");
         assert!(worst_n <= 2.0 / 127.0, "normals {worst_n} apart");
     }
+}
+
+/// `text` (an OBJ about the origin) with a colour per vertex: `0.5 + 0.5 * direction`.
+fn with_direction_colors(text: &str) -> String {
+    let line = |l: &str| match l.strip_prefix("v ") {
+        Some(rest) => {
+            let p: Vec<f64> = rest.split(' ').map(|x| x.parse().unwrap()).collect();
+            let d = DVec3::new(p[0], p[1], p[2]).normalize() * 0.5 + 0.5;
+            format!("{l} {} {} {}", d.x, d.y, d.z)
+        }
+        None => l.to_string(),
+    };
+    text.lines().map(line).collect::<Vec<_>>().join("\n") + "\n"
+}
+
+#[test]
+fn coloured_mesh_fills_with_the_colour_of_the_nearest_surface() {
+    // Vertex colours 0.5 + 0.5 * direction on a sphere: every voxel inside must take the colour
+    // of its nearest surface point (the colour of its own direction), whatever the scan order;
+    // so colours vary continuously except at the centre, where every direction is nearest.
+    let r = 0.35;
+    let dir = folder("colored", &[("sphere.obj", &with_direction_colors(&sphere_obj(r, false)))]);
+    let m = load(&dir, "sphere.obj");
+    assert!(m.colors.is_some(), "vertex colours read from `v x y z r g b`");
+    let shape = MeshShape::new(&m, &dir.join("sphere.obj")).unwrap();
+    // The grid's colours against the twin's (brute force, f64) on a grid off the sphere's
+    // symmetry planes (on them, mirror-image triangles tie and f32 and f64 pick either).
+    let spec = mesh::GridSpec {
+        lo: DVec3::new(-0.4123, -0.3871, -0.4017),
+        hi: DVec3::new(0.3953, 0.4209, 0.3889),
+        n: [17, 19, 13],
+        parity: true,
+    };
+    let colors = {
+        let ctx = ctx().lock().unwrap();
+        let grid = mesh::bake(&ctx, &shape, &spec).unwrap();
+        let colors = grid.colors.as_ref().expect("a coloured grid");
+        bytemuck::pod_collect_to_vec::<u8, [f32; 4]>(&ctx.read_buffer(colors, 0, colors.size()).unwrap())
+    };
+    let mut worst_grid = 0.0f64;
+    let [nx, ny, _] = spec.n;
+    for (v, gpu) in colors.iter().enumerate() {
+        let v = v as u32;
+        let p = spec.point(v % nx, v / nx % ny, v / (nx * ny));
+        let twin = voltex::cpu::bake_mesh_grid::sample_color(&shape, p, true).unwrap();
+        for c in 0..3 {
+            worst_grid = worst_grid.max((gpu[c] as f64 - twin[c]).abs());
+        }
+    }
+    let texel = mesh_texel(shape.clone(), true, [N; 3]);
+    let (cells, colors) = {
+        let ctx = ctx().lock().unwrap();
+        let grid = mesh::bake(&ctx, &texel.shape, &texel.spec).unwrap();
+        let colors = grid.colors.as_ref().unwrap();
+        let colors: Vec<[f32; 4]> =
+            bytemuck::pod_collect_to_vec(&ctx.read_buffer(colors, 0, colors.size()).unwrap());
+        (mesh::read(&ctx, &grid).unwrap().0, colors)
+    };
+    // The texel (albedo, per-pixel lighting) against its twin and against the expected colours.
+    let params = bake_params([N; 3], 0, LIGHT, AMBIENT);
+    let twin = bake_mesh_texel(&params, &texel.params, &cells, Some(&colors), true);
+    let (volume, _) = bake(BakeSource::Mesh(texel), true);
+    let mut worst_twin = 0;
+    for (v, (rgba, _)) in twin.iter().enumerate() {
+        for c in 0..4 {
+            worst_twin = worst_twin.max((volume[4 * v + c] as i32 - (rgba[c] * 255.0).round() as i32).abs());
+        }
+    }
+    let (mut worst, mut checked) = (0.0f64, 0);
+    for v in 0..(N * N * N) as usize {
+        let p = centre(v) - DVec3::splat(0.5);
+        if volume[4 * v + 3] < 255 || p.length() < 2.0 / N as f64 {
+            continue;
+        }
+        let expected = p.normalize() * 0.5 + 0.5;
+        for c in 0..3 {
+            let got = volume[4 * v + c] as f64 / 255.0 / COLOR[c] as f64;
+            worst = worst.max((got - expected[c]).abs());
+        }
+        checked += 1;
+    }
+    eprintln!(
+        "coloured sphere: grid vs twin {worst_grid:.2e}, texel vs twin {worst_twin}/255, inside vs nearest surface colour {worst:.4} over {checked} voxels"
+    );
+    assert!(worst_grid < 1e-3, "grid colours {worst_grid} from the twin's");
+    assert!(worst_twin <= 1, "texel {worst_twin}/255 from the twin's");
+    assert!(checked > 1000 && worst < 0.03, "{checked} voxels, worst {worst}");
 }
 
 #[test]

@@ -3,8 +3,9 @@
 1998, section 6 and Figure 11 right: "an AMAP generated bush of 3,500 triangles ... sparse
 triangles, no filling is done"). AMAP is not available, so this grows a bush of its own: a trunk
 splitting recursively into tapered four-sided branches (open tubes), with rhombic leaves (two
-triangles each) scattered along the outer branches, about 3,500 triangles in all. Nothing is
-closed: the texel draws it as a one-voxel shell (`fill: false`).
+triangles each) scattered along the outer branches, about 3,500 triangles in all, coloured per
+vertex (bark, leaves of varied greens). Nothing is closed: the texel draws it as a one-voxel
+shell (`fill: false`).
 
 Provenance and licence: our own shape, defined by the numbers and the seeded generator in this
 file (written for voltex, under the project's licence). Object space: z up, the bush inside the
@@ -24,6 +25,9 @@ TRUNK_LENGTH, TRUNK_RADIUS = 0.17, 0.014
 # Leaves per branch of the last two levels, and a leaf's length and width.
 LEAVES = {LEVELS - 1: 7, LEVELS: 13}
 LEAF_LENGTH, LEAF_WIDTH = 0.05, 0.022
+# Vertex colours (OBJ `v x y z r g b`): bark, and leaves between a dark and a light green.
+BARK = (0.42, 0.3, 0.18)
+LEAF_DARK, LEAF_LIGHT = (0.2, 0.42, 0.12), (0.45, 0.65, 0.2)
 
 
 class Lcg:
@@ -72,9 +76,10 @@ class Obj:
         self.count = 0
         self.triangles = 0
 
-    def vertex(self, p):
+    def vertex(self, p, color):
         self.count += 1
-        self.lines.append("v %.4f %.4f %.4f" % tuple(0.0 if abs(c) < 5e-5 else c for c in p))
+        xyz = tuple(0.0 if abs(c) < 5e-5 else c for c in p)
+        self.lines.append("v %.4f %.4f %.4f %.3f %.3f %.3f" % (xyz + tuple(color)))
         return self.count
 
     def face(self, *v):
@@ -88,7 +93,7 @@ def tube(obj, a, b, ra, rb):
     ring = []
     for end, r in ((a, ra), (b, rb)):
         ring.append([obj.vertex(add(end, add(scale(u, r * math.cos(k * math.pi / 2)),
-                                               scale(v, r * math.sin(k * math.pi / 2)))))
+                                               scale(v, r * math.sin(k * math.pi / 2)))), BARK)
                      for k in range(4)])
     for k in range(4):
         i, j = k, (k + 1) % 4
@@ -109,8 +114,12 @@ def leaf(obj, rng, at, along):
         return
     mid = add(at, scale(d, 0.45 * length))
     half = scale(across, 0.5 * LEAF_WIDTH * length / LEAF_LENGTH)
-    a, b, c, e = (obj.vertex(at), obj.vertex(add(mid, half)), obj.vertex(tip),
-                  obj.vertex(add(mid, scale(half, -1.0))))
+    # Leaves vary in hue; the stalk end is darker than the tip.
+    green = rng.uniform(0.0, 1.0)
+    base = tuple(a + (b - a) * green for a, b in zip(LEAF_DARK, LEAF_LIGHT))
+    tip_color = tuple(min(1.0, c * 1.25) for c in base)
+    a, b, c, e = (obj.vertex(at, base), obj.vertex(add(mid, half), base), obj.vertex(tip, tip_color),
+                  obj.vertex(add(mid, scale(half, -1.0)), base))
     obj.face(a, b, c)
     obj.face(a, c, e)
 

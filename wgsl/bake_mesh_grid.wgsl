@@ -1,4 +1,4 @@
-// Bakes a closed mesh into a hypertexture mesh object's grid: per sample the vector to the closest surface point and the signed distance (positive inside, by ray parity voted over three directions) of the union of its closed parts, and the largest inside distance; CPU twin src/cpu/bake_mesh_grid.rs.
+// Bakes a mesh into a grid (hypertexture mesh objects, mesh texels): per sample the vector to the closest surface point and the signed distance (positive inside, by ray parity voted over three directions; no parity for shells) of the union of its closed parts, the largest inside distance, and for coloured meshes the colour at the closest point; CPU twin src/cpu/bake_mesh_grid.rs.
 #include "shared/types.wgsl"
 
 @group(0) @binding(0) var<uniform> grid_params: MeshGridParams;
@@ -22,6 +22,12 @@ struct BvhNode {
 @group(0) @binding(3) var<storage, read_write> mesh_grid: array<vec4<f32>>;
 // The largest inside distance, as u32 bits (non-negative floats order as their bits).
 @group(0) @binding(4) var<storage, read_write> mesh_depth: array<atomic<u32>>;
+// Coloured meshes (mesh texels of OBJs with vertex colours): the corners' colours in the order
+// of mesh_triangles, and per sample the colour at its closest surface point.
+@group(0) @binding(6) var<storage, read> mesh_corner_colors: array<vec4<f32>>;
+@group(0) @binding(7) var<storage, read_write> mesh_colors: array<vec4<f32>>;
+
+override colored: bool = false;
 
 const STACK_SIZE: u32 = 64u;
 // Parity rays leave along these directions (twin: DIRECTIONS): skewed off the axes so that they
@@ -101,11 +107,17 @@ fn box_distance2(p: vec3<f32>, node: BvhNode) -> f32 {
     return dot(q, q);
 }
 
-// The closest surface point to p: the BVH walked nearer child first, skipping boxes farther than
-// the best so far.
-fn closest_point(p: vec3<f32>, root: u32) -> vec3<f32> {
+struct Closest {
+    point: vec3<f32>,
+    triangle: u32,
+}
+
+// The closest surface point to p and its triangle: the BVH walked nearer child first, skipping
+// boxes farther than the best so far.
+fn closest_point(p: vec3<f32>, root: u32) -> Closest {
     var best = 3.4e38;
     var point = p;
+    var triangle = 0u;
     var stack: array<u32, STACK_SIZE>;
     stack[0] = root;
     var top = 1u;
@@ -125,6 +137,7 @@ fn closest_point(p: vec3<f32>, root: u32) -> vec3<f32> {
                 if (d2 < best) {
                     best = d2;
                     point = q;
+                    triangle = t;
                 }
             }
         } else if (top + 2u <= STACK_SIZE) {
@@ -134,7 +147,29 @@ fn closest_point(p: vec3<f32>, root: u32) -> vec3<f32> {
             top += 2u;
         }
     }
-    return point;
+    return Closest(point, triangle);
+}
+
+// The colour at q, a point of triangle t: its corners' colours by barycentric weights.
+fn color_at(q: vec3<f32>, t: u32) -> vec4<f32> {
+    let a = corner(t, 0u);
+    let e1 = corner(t, 1u) - a;
+    let e2 = corner(t, 2u) - a;
+    let e = q - a;
+    let d11 = dot(e1, e1);
+    let d12 = dot(e1, e2);
+    let d22 = dot(e2, e2);
+    let det = d11 * d22 - d12 * d12;
+    var w = vec3<f32>(1.0 / 3.0);
+    if (det > 1e-30 * d11 * d22) {
+        let v = (d22 * dot(e, e1) - d12 * dot(e, e2)) / det;
+        let u = (d11 * dot(e, e2) - d12 * dot(e, e1)) / det;
+        w = clamp(vec3<f32>(1.0 - v - u, v, u), vec3<f32>(0.0), vec3<f32>(1.0));
+        w /= max(w.x + w.y + w.z, 1e-30);
+    }
+    let c = mesh_corner_colors[3u * t] * w.x + mesh_corner_colors[3u * t + 1u] * w.y
+        + mesh_corner_colors[3u * t + 2u] * w.z;
+    return vec4<f32>(c.rgb, 1.0);
 }
 
 // Whether the ray o + t d (t > 0) crosses triangle t (Moller-Trumbore).
@@ -199,9 +234,11 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let parity = grid_params.size.w != 0u;
     // The union of the parts: the largest signed distance of any part.
     var best = vec4<f32>(0.0, 0.0, 0.0, -3.4e38);
+    var best_closest = Closest(p, 0u);
     for (var part = 0u; part < grid_params.counts.w; part++) {
         let root = mesh_parts[part].x;
-        let q = closest_point(p, root);
+        let closest = closest_point(p, root);
+        let q = closest.point;
         var votes = 0u;
         if (parity) {
             votes = (crossings(p, DIR0, root) & 1u) + (crossings(p, DIR1, root) & 1u)
@@ -211,9 +248,14 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         let signed = select(-dist, dist, votes >= 2u);
         if (signed > best.w) {
             best = vec4<f32>(q - p, signed);
+            best_closest = closest;
         }
     }
-    mesh_grid[id.x + n.x * (id.y + n.y * id.z)] = best;
+    let index = id.x + n.x * (id.y + n.y * id.z);
+    mesh_grid[index] = best;
+    if (colored) {
+        mesh_colors[index] = color_at(best_closest.point, best_closest.triangle);
+    }
     let inside = best.w > 0.0;
     let dist = best.w;
     if (inside) {

@@ -14,6 +14,12 @@ override per_pixel_lighting: bool = false;
 @group(0) @binding(2) var<storage, read> mesh_grid: array<vec4<f32>>;
 @group(0) @binding(3) var volume: texture_storage_3d<rgba8unorm, write>;
 @group(0) @binding(4) var normals: texture_storage_3d<rgba8snorm, write>;
+// Coloured meshes: per voxel the colour at the closest surface point, tinted by the texel's
+// colour (a stand-in otherwise). The inside takes the colour of its nearest surface, which no
+// scan order can bias.
+@group(0) @binding(5) var<storage, read> mesh_colors: array<vec4<f32>>;
+
+override colored: bool = false;
 
 @compute @workgroup_size(4, 4, 4)
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {
@@ -22,7 +28,8 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let n = bake_params.resolution.xyz;
     let fill = mesh_texel.mode.y != 0u;
-    let cell = mesh_grid[id.x + n.x * (id.y + n.y * id.z)];
+    let index = id.x + n.x * (id.y + n.y * id.z);
+    let cell = mesh_grid[index];
     let voxel = mesh_texel.extent.w;
     // Filled: the usual coverage ramp across the surface. Shell: one voxel thick, centred on the
     // surface, so an open or sparse pattern (leaves) never needs an inside.
@@ -38,6 +45,9 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let normal = gradient_normal(away * mesh_texel.extent.xyz);
     let alpha = clamp(mesh_texel.color.w * coverage, 0.0, 1.0);
     var rgb = mesh_texel.color.rgb;
+    if (colored) {
+        rgb *= mesh_colors[index].rgb;
+    }
     if (!per_pixel_lighting) {
         rgb = shade_lambert(rgb, normal, bake_params.light);
     }

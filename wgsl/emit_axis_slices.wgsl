@@ -7,6 +7,17 @@
 @group(0) @binding(3) var<storage, read> axis_occupancy: array<u32>;
 @group(0) @binding(4) var<storage, read> axis_choices: array<AxisChoice>;
 @group(0) @binding(5) var<storage, read_write> axis_vertices: array<AxisVertex>;
+// `draw_order: Slices`: triangles per (direction, layer), one stride of layers per direction,
+// for group_axis_slices.wgsl (a stand-in otherwise).
+@group(0) @binding(6) var<storage, read_write> axis_layer_counts: array<atomic<u32>>;
+
+override grouped_slices: bool = false;
+
+fn count_layer(direction: u32, layer: u32, triangles: u32) {
+    if (grouped_slices) {
+        atomicAdd(&axis_layer_counts[direction * (arrayLength(&axis_layer_counts) / 3u) + layer], triangles);
+    }
+}
 
 #include "shared/axis_slices.wgsl"
 
@@ -31,7 +42,8 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         if (!slice_occupied(c, g)) {
             continue;
         }
-        let layer = f32(layer0 + slice_layer(g, n));
+        let layer_index = layer0 + slice_layer(g, n);
+        let layer = f32(layer_index);
         if (c.direction == 2u) {
             let w = (f32(g) + 0.5) / f32(n);
             for (var i = 0u; i < 3u; i++) {
@@ -39,6 +51,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
                 axis_vertices[at + i] = AxisVertex(vec4<f32>(p, thickness), vec4<f32>(f.uv[i], layer, 2.0), vec4<f32>(axis.xyz, 0.0));
             }
             at += 3u;
+            count_layer(2u, layer_index, 1u);
             continue;
         }
         // The line (s or t) = x across the uv triangle: two edge crossings (half-open edges).
@@ -70,5 +83,6 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
             axis_vertices[at + i] = AxisVertex(vec4<f32>(v.xyz, thickness), tex, vec4<f32>(axis.xyz, 0.0));
         }
         at += 6u;
+        count_layer(c.direction, layer_index, 2u);
     }
 }

@@ -270,6 +270,9 @@ impl Baker {
                     .buffers
                     .insert("mesh_texel".into(), uniform(ctx, "mesh_texel", bytemuck::bytes_of(&m.params)));
                 inputs.buffers.insert("mesh_grid".into(), grid.grid);
+                let colors = grid.colors.unwrap_or_else(|| storage(ctx, "mesh_colors", &[0u8; 16]));
+                inputs.buffers.insert("mesh_colors".into(), colors);
+                inputs.constants.push(("colored".into(), m.shape.colors.is_some() as u32 as f64));
                 Self::kernel(&mut self.mesh, ctx, &root, "bake_mesh_texel.wgsl")?.dispatch(
                     ctx,
                     &mut encoder,

@@ -1,7 +1,7 @@
 //! CPU twin (f64) of `wgsl/bake_mesh_grid.wgsl`: per grid sample the vector to the closest
 //! surface point and the signed distance (positive inside, ray parity voted over three skewed
-//! directions) of the union of the mesh's closed parts, by brute force over every triangle
-//! (ground truth: no BVH to get wrong).
+//! directions) of the union of the mesh's closed parts and, for coloured meshes, the colour there,
+//! by brute force over every triangle (ground truth: no BVH to get wrong).
 
 use glam::DVec3;
 
@@ -92,25 +92,52 @@ pub fn inside(shape: &MeshShape, triangles: std::ops::Range<usize>, p: DVec3) ->
 /// parts (the part with the largest signed distance); without `parity` every distance is
 /// negative (a shell).
 pub fn sample(shape: &MeshShape, p: DVec3, parity: bool) -> (DVec3, f64) {
-    let mut out = (DVec3::ZERO, f64::NEG_INFINITY);
+    let (v, d, _) = closest(shape, p, parity);
+    (v, d)
+}
+
+/// [`sample`] with the closest triangle.
+fn closest(shape: &MeshShape, p: DVec3, parity: bool) -> (DVec3, f64, usize) {
+    let mut out = (DVec3::ZERO, f64::NEG_INFINITY, 0);
     for &(first, count) in &shape.parts {
         let range = first as usize..(first + count) as usize;
-        let mut best = (f64::INFINITY, p);
+        let mut best = (f64::INFINITY, p, 0);
         for t in range.clone() {
             let [a, b, c] = shape.triangle(t);
             let q = on_triangle(p, a, b, c);
             let d2 = (q - p).length_squared();
             if d2 < best.0 {
-                best = (d2, q);
+                best = (d2, q, t);
             }
         }
         let dist = best.0.sqrt();
         let signed = if parity && inside(shape, range, p) { dist } else { -dist };
         if signed > out.1 {
-            out = (best.1 - p, signed);
+            out = (best.1 - p, signed, best.2);
         }
     }
     out
+}
+
+/// A coloured mesh's colour at the closest surface point to p: the closest triangle's corner
+/// colours by barycentric weights (`None` for a mesh without colours).
+pub fn sample_color(shape: &MeshShape, p: DVec3, parity: bool) -> Option<[f64; 3]> {
+    let colors = shape.colors.as_ref()?;
+    let (v, _, t) = closest(shape, p, parity);
+    let [a, b, c] = shape.triangle(t);
+    let (e1, e2, e) = (b - a, c - a, p + v - a);
+    let (d11, d12, d22) = (e1.dot(e1), e1.dot(e2), e2.dot(e2));
+    let det = d11 * d22 - d12 * d12;
+    let mut w = [1.0 / 3.0; 3];
+    if det > 1e-30 * d11 * d22 {
+        let v = (d22 * e.dot(e1) - d12 * e.dot(e2)) / det;
+        let u = (d11 * e.dot(e2) - d12 * e.dot(e1)) / det;
+        let clamped = [1.0 - v - u, v, u].map(|x: f64| x.clamp(0.0, 1.0));
+        let sum = clamped.iter().sum::<f64>().max(1e-30);
+        w = clamped.map(|x| x / sum);
+    }
+    let corner = colors[t];
+    Some([0, 1, 2].map(|ch| (0..3).map(|k| corner[k][ch] as f64 * w[k]).sum()))
 }
 
 /// Every sample of the grid (x fastest, then y, then z) as (vector xyz, signed distance), and the

@@ -5,11 +5,13 @@
 use super::bake::{gradient_normal, shade_lambert};
 use crate::types::{BakeParams, MeshTexelParams};
 
-/// One voxel: (premultiplied rgba, texel-space normal).
+/// One voxel: (premultiplied rgba, texel-space normal); `color`: a coloured mesh's colour at the
+/// closest surface point (tints the texel's).
 pub fn bake_mesh_texel_voxel(
     params: &BakeParams,
     texel: &MeshTexelParams,
     cell: [f32; 4],
+    color: Option<[f32; 3]>,
     per_pixel: bool,
 ) -> ([f32; 4], [f32; 3]) {
     let voxel = texel.extent[3];
@@ -23,18 +25,25 @@ pub fn bake_mesh_texel_voxel(
     };
     let normal = gradient_normal([0, 1, 2].map(|a| away[a] * texel.extent[a]));
     let alpha = (texel.color[3] * coverage).clamp(0.0, 1.0);
-    let albedo = [texel.color[0], texel.color[1], texel.color[2]];
+    let tint = color.unwrap_or([1.0; 3]);
+    let albedo = [0, 1, 2].map(|c| texel.color[c] * tint[c]);
     let rgb = if per_pixel { albedo } else { shade_lambert(albedo, normal, params.light) };
     let rgb = rgb.map(|c| c.clamp(0.0, 1.0) * alpha);
     ([rgb[0], rgb[1], rgb[2], alpha], normal)
 }
 
-/// Every voxel of an `n^3` texel (x fastest) from the grid's samples in the same order.
+/// Every voxel of a texel (x fastest) from the grid's samples (and colours) in the same order.
 pub fn bake_mesh_texel(
     params: &BakeParams,
     texel: &MeshTexelParams,
     cells: &[[f32; 4]],
+    colors: Option<&[[f32; 4]]>,
     per_pixel: bool,
 ) -> Vec<([f32; 4], [f32; 3])> {
-    cells.iter().map(|&c| bake_mesh_texel_voxel(params, texel, c, per_pixel)).collect()
+    let color = |v: usize| colors.map(|c| [c[v][0], c[v][1], c[v][2]]);
+    cells
+        .iter()
+        .enumerate()
+        .map(|(v, &c)| bake_mesh_texel_voxel(params, texel, c, color(v), per_pixel))
+        .collect()
 }

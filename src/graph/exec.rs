@@ -37,6 +37,7 @@ pub const COUNTS: &[&str] = &[
     "reference_dispatches",
     "ray_march_dispatches",
     "transfer_functions",
+    "axis_triangles",
 ];
 
 struct Texture {

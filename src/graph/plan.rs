@@ -18,6 +18,7 @@ pub const OBJECT_FILTERS: &[&str] = &[
     "AxisSlices",
     "AxisSlicesBinary",
     "AxisSlicesBlended",
+    "AxisSlicesBySlice",
     "RayMarch",
 ];
 

@@ -40,6 +40,8 @@ pub struct MeshShape {
     pub hi: DVec3,
     /// Closed parts: (first triangle, triangle count); triangles are grouped by part.
     pub parts: Vec<(u32, u32)>,
+    /// Per triangle, its corners' colours (OBJ vertex colours), when the mesh has any.
+    pub colors: Option<Vec<[[f32; 3]; 3]>>,
     /// Of positions and triangles: the bake cache's key.
     pub hash: u64,
 }
@@ -85,7 +87,7 @@ impl MeshShape {
     /// number of triangles, so ray parity says inside or outside) and encloses a volume. Errors
     /// name `path` and the line of the offending face.
     pub fn new(mesh: &Mesh, path: &Path) -> std::result::Result<Self, String> {
-        let (positions, triangles, lines) = weld(mesh, path)?;
+        let (positions, triangles, lines, sources) = weld(mesh, path)?;
         let at = |t: usize| match lines.get(t) {
             Some(&l) if l > 0 => format!("{}:{l}:1", path.display()),
             _ => path.display().to_string(),
@@ -151,6 +153,7 @@ impl MeshShape {
         let extent = (hi - lo).max_element();
         let mut parts = Vec::new();
         let mut grouped = Vec::with_capacity(triangles.len());
+        let mut order = Vec::with_capacity(triangles.len());
         for g in &groups {
             let volume: f64 = g
                 .iter()
@@ -169,21 +172,24 @@ impl MeshShape {
             }
             parts.push((grouped.len() as u32, g.len() as u32));
             grouped.extend(g.iter().map(|&t| triangles[t]));
+            order.extend(g.iter().map(|&t| sources[t]));
         }
         let triangles = grouped;
-        let hash = digest(&positions, &triangles);
-        Ok(MeshShape { positions, triangles, lo, hi, parts, hash })
+        let colors = corner_colors(mesh, &order);
+        let hash = digest(&positions, &triangles, &colors);
+        Ok(MeshShape { positions, triangles, lo, hi, parts, colors, hash })
     }
 
     /// The welded mesh as one part, closed or not: only its unsigned distance means anything
     /// (a mesh texel's shell). Errors only when no triangle is left.
     pub fn open(mesh: &Mesh, path: &Path) -> std::result::Result<Self, String> {
-        let (positions, triangles, _) = weld(mesh, path)?;
+        let (positions, triangles, _, sources) = weld(mesh, path)?;
         let lo = positions.iter().fold(DVec3::INFINITY, |a, &p| a.min(p));
         let hi = positions.iter().fold(DVec3::NEG_INFINITY, |a, &p| a.max(p));
         let parts = vec![(0, triangles.len() as u32)];
-        let hash = digest(&positions, &triangles);
-        Ok(MeshShape { positions, triangles, lo, hi, parts, hash })
+        let colors = corner_colors(mesh, &sources);
+        let hash = digest(&positions, &triangles, &colors);
+        Ok(MeshShape { positions, triangles, lo, hi, parts, colors, hash })
     }
 
     /// The grid of `n` samples per axis over the mesh's bounds enlarged by the largest shift (the
@@ -200,8 +206,16 @@ impl MeshShape {
 }
 
 /// Positions welded (equal coordinates become one vertex) and triangles that still bound
-/// something, with the OBJ line of each.
-type Welded = (Vec<DVec3>, Vec<[u32; 3]>, Vec<u32>);
+/// something, with the OBJ line of each and its index in the mesh.
+type Welded = (Vec<DVec3>, Vec<[u32; 3]>, Vec<u32>, Vec<usize>);
+
+/// Per triangle of `mesh` in `order`, its corners' vertex colours (before welding, so that a
+/// seam keeps both sides' colours).
+fn corner_colors(mesh: &Mesh, order: &[usize]) -> Option<Vec<[[f32; 3]; 3]>> {
+    let colors = mesh.colors.as_ref()?;
+    let corner = |v: u32| colors[v as usize].map(|c| c as f32);
+    Some(order.iter().map(|&t| mesh.triangles[t].map(corner)).collect())
+}
 
 fn weld(mesh: &Mesh, path: &Path) -> std::result::Result<Welded, String> {
     let mut ids: HashMap<[u64; 3], u32> = HashMap::new();
@@ -219,26 +233,31 @@ fn weld(mesh: &Mesh, path: &Path) -> std::result::Result<Welded, String> {
         .collect();
     let mut triangles = Vec::new();
     let mut lines = Vec::new();
+    let mut sources = Vec::new();
     for (t, tri) in mesh.triangles.iter().enumerate() {
         let [a, b, c] = tri.map(|i| weld[i as usize]);
         // A triangle with a repeated vertex bounds nothing.
         if a != b && b != c && a != c {
             triangles.push([a, b, c]);
             lines.push(mesh.face_lines.get(t).copied().unwrap_or(0));
+            sources.push(t);
         }
     }
     if triangles.is_empty() {
         return Err(format!("{}: degenerate mesh: every triangle repeats a vertex", path.display()));
     }
-    Ok((positions, triangles, lines))
+    Ok((positions, triangles, lines, sources))
 }
 
-fn digest(positions: &[DVec3], triangles: &[[u32; 3]]) -> u64 {
+fn digest(positions: &[DVec3], triangles: &[[u32; 3]], colors: &Option<Vec<[[f32; 3]; 3]>>) -> u64 {
     let mut h = std::collections::hash_map::DefaultHasher::new();
     for p in positions {
         p.to_array().map(f64::to_bits).hash(&mut h);
     }
     triangles.hash(&mut h);
+    for c in colors.iter().flatten().flatten().flatten() {
+        c.to_bits().hash(&mut h);
+    }
     h.finish()
 }
 
@@ -248,6 +267,9 @@ fn digest(positions: &[DVec3], triangles: &[[u32; 3]]) -> u64 {
 pub struct MeshGrid {
     pub grid: wgpu::Buffer,
     pub depth: wgpu::Buffer,
+    /// Coloured meshes: per sample the colour at its closest surface point (rgb, w = 1),
+    /// interpolated from the closest triangle's corners.
+    pub colors: Option<wgpu::Buffer>,
 }
 
 /// Runs `bake_mesh_grid.wgsl` for `shape` over `spec`: one thread per sample, closest points
@@ -259,6 +281,7 @@ pub fn bake(ctx: &GpuContext, shape: &MeshShape, spec: &GridSpec) -> Result<Mesh
     // (in each part's leaf order), inner nodes their first child, both offset to the whole.
     let mut nodes = Vec::new();
     let mut corners: Vec<[f32; 4]> = Vec::new();
+    let mut corner_colors: Vec<[f32; 4]> = Vec::new();
     let mut roots: Vec<[u32; 4]> = Vec::new();
     for &(first, count) in &shape.parts {
         let boxes: Vec<Aabb> = (first..first + count)
@@ -282,6 +305,10 @@ pub fn bake(ctx: &GpuContext, shape: &MeshShape, spec: &GridSpec) -> Result<Mesh
         corners.extend(order.iter().flat_map(|&t| {
             shape.triangle((first + t) as usize).map(|p| [p.x as f32, p.y as f32, p.z as f32, 0.0])
         }));
+        if let Some(colors) = &shape.colors {
+            let rgba = |c: [f32; 3]| [c[0], c[1], c[2], 1.0];
+            corner_colors.extend(order.iter().flat_map(|&t| colors[(first + t) as usize].map(rgba)));
+        }
     }
     let params = spec.params(shape.triangles.len() as u32, nodes.len() as u32, roots.len() as u32);
     let mut inputs = Inputs::default();
@@ -309,6 +336,24 @@ pub fn bake(ctx: &GpuContext, shape: &MeshShape, spec: &GridSpec) -> Result<Mesh
     let depth = storage(ctx, "mesh_depth", &[0u8; 16]);
     b.insert("mesh_grid".into(), grid.clone());
     b.insert("mesh_depth".into(), depth.clone());
+    // Colours only for coloured meshes (override `colored`); 16-byte stand-ins otherwise.
+    let colored = !corner_colors.is_empty();
+    let colors = colored.then(|| {
+        ctx.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("mesh_colors"),
+            size: bytes,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        })
+    });
+    corner_colors.resize(corner_colors.len().max(1), [0.0; 4]);
+    b.insert(
+        "mesh_corner_colors".into(),
+        storage(ctx, "mesh_corner_colors", bytemuck::cast_slice(&corner_colors)),
+    );
+    let stand_in = || storage(ctx, "mesh_colors", &[0u8; 16]);
+    b.insert("mesh_colors".into(), colors.clone().unwrap_or_else(stand_in));
+    inputs.constants.push(("colored".into(), colored as u32 as f64));
     let mut encoder = ctx.device.create_command_encoder(&Default::default());
     ComputeKernel::load(ctx, &crate::render::wgsl_root(), "bake_mesh_grid.wgsl")?.dispatch(
         ctx,
@@ -318,7 +363,7 @@ pub fn bake(ctx: &GpuContext, shape: &MeshShape, spec: &GridSpec) -> Result<Mesh
     )?;
     ctx.queue.submit([encoder.finish()]);
     ctx.take_errors()?;
-    Ok(MeshGrid { grid, depth })
+    Ok(MeshGrid { grid, depth, colors })
 }
 
 /// The samples and the largest inside distance of a baked grid (twin tests).
@@ -331,5 +376,5 @@ pub fn read(ctx: &GpuContext, g: &MeshGrid) -> Result<(Vec<[f32; 4]>, f32)> {
 /// Stand-ins bound for objects that are not meshes (the kernels declare the bindings).
 pub fn unused(ctx: &GpuContext) -> MeshGrid {
     let b = |label| crate::bake::storage(ctx, label, &[0u8; 16]);
-    MeshGrid { grid: b("mesh_grid"), depth: b("mesh_depth") }
+    MeshGrid { grid: b("mesh_grid"), depth: b("mesh_depth"), colors: None }
 }

@@ -59,6 +59,7 @@ pub fn plane(size: [f64; 2], cells: [u32; 2], jitter: f64, seed: u32) -> Mesh {
         corner_uvs,
         vertex_uvs: vec![],
         attribute: None,
+        colors: None,
         face_lines: vec![],
     };
     m.vertex_uvs = m.vertex_uvs_from_corners();
@@ -129,6 +130,7 @@ fn parametric(nu: usize, nv: usize, wrap_v: bool, pos: impl Fn(f64, f64) -> DVec
         corner_uvs,
         vertex_uvs: vec![],
         attribute: None,
+        colors: None,
         face_lines: vec![],
     };
     m.vertex_uvs = m.vertex_uvs_from_corners();

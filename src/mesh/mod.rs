@@ -73,6 +73,8 @@ pub struct Mesh {
     pub vertex_uvs: Vec<DVec2>,
     /// Optional scalar per vertex (OBJ: first colour channel of `v x y z r g b`).
     pub attribute: Option<Vec<f64>>,
+    /// Optional colour per vertex (OBJ: `v x y z r g b`; white where a vertex has none).
+    pub colors: Option<Vec<[f64; 3]>>,
     /// OBJ: the line of the `f` statement of each triangle, for errors (empty when generated).
     pub face_lines: Vec<u32>,
 }

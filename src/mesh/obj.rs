@@ -30,7 +30,7 @@ fn words(line: &str) -> impl Iterator<Item = (usize, &str)> {
 pub fn parse(text: &str, path: &Path) -> Result<Mesh> {
     let at = |line: usize, col: usize, msg: String| Error::at(FileLoc::new(path, line, col), msg);
     let mut positions: Vec<DVec3> = Vec::new();
-    let mut colors: Vec<Option<f64>> = Vec::new();
+    let mut colors: Vec<Option<[f64; 3]>> = Vec::new();
     let mut uvs: Vec<DVec2> = Vec::new();
     let mut normal_count = 0usize;
     // Faces as corners (v index, optional vt index) with the line of the face for late checks.
@@ -59,7 +59,7 @@ pub fn parse(text: &str, path: &Path) -> Result<Mesh> {
                 let v: Vec<f64> = args.iter().map(number).collect::<Result<_>>()?;
                 positions.push(DVec3::new(v[0], v[1], v[2]));
                 // `v x y z w` (4 numbers) is a homogeneous weight, not a colour.
-                colors.push(if v.len() >= 6 { Some(v[3]) } else { None });
+                colors.push(if v.len() >= 6 { Some([v[3], v[4], v[5]]) } else { None });
             }
             "vt" => {
                 if args.is_empty() {
@@ -143,10 +143,11 @@ pub fn parse(text: &str, path: &Path) -> Result<Mesh> {
             })
         })
         .collect();
-    let attribute = if colors.iter().any(Option::is_some) {
-        Some(colors.iter().map(|c| c.unwrap_or(0.0)).collect())
+    let (attribute, colors) = if colors.iter().any(Option::is_some) {
+        let attribute = colors.iter().map(|c| c.map_or(0.0, |c| c[0])).collect();
+        (Some(attribute), Some(colors.iter().map(|c| c.unwrap_or([1.0; 3])).collect()))
     } else {
-        None
+        (None, None)
     };
     let mut m = Mesh {
         normals: area_weighted_normals(&positions, &triangles),
@@ -155,6 +156,7 @@ pub fn parse(text: &str, path: &Path) -> Result<Mesh> {
         corner_uvs,
         vertex_uvs: vec![],
         attribute,
+        colors,
         face_lines,
     };
     m.vertex_uvs = m.vertex_uvs_from_corners();

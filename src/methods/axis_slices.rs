@@ -6,7 +6,7 @@ use crate::bake::axis_slices::AxisBaked;
 use crate::cpu::axis_slices::{self as twin, AxisFrame};
 use crate::error::{Error, Result};
 use crate::methods::shell::Shell;
-use crate::scene::{AxisSlices, SliceBlend, SliceDirections};
+use crate::scene::{AxisSlices, DrawOrder, SliceBlend, SliceDirections};
 use crate::types::{AxisParams, AxisVertex, Prism};
 
 /// Slice-vertex budget of one object: the storage-binding size every WebGPU adapter offers.
@@ -19,6 +19,9 @@ pub struct AxisPlan {
     /// Slice-vertex capacity: every prism at its finest level in its largest direction.
     pub capacity: u64,
     pub blended: bool,
+    /// Drawn grouped by slice image (`draw_order: Slices`): the vertex buffer holds a second,
+    /// grouped copy after the emitted slices.
+    pub grouped: bool,
     pub method: AxisSlices,
 }
 
@@ -65,6 +68,7 @@ impl AxisPlan {
             prisms,
             capacity: capacity.max(3),
             blended: m.blend == SliceBlend::Blended,
+            grouped: m.draw_order == DrawOrder::Slices,
             method: *m,
         })
     }
@@ -113,7 +117,19 @@ pub fn add_inputs(
     b.insert("axis_choices".into(), buffer("axis_choices", choices, wgpu::BufferUsages::empty()));
     b.insert("axis_draw_args".into(), buffer("axis_draw_args", 16, wgpu::BufferUsages::INDIRECT));
     let bytes = plan.capacity * std::mem::size_of::<AxisVertex>() as u64;
-    b.insert("axis_vertices".into(), buffer("axis_vertices", bytes, wgpu::BufferUsages::empty()));
+    let copies = if plan.grouped { 2 } else { 1 };
+    b.insert("axis_vertices".into(), buffer("axis_vertices", copies * bytes, wgpu::BufferUsages::empty()));
+    // One counter per slice image (the stride: the most layers of any direction); a stand-in
+    // when not grouped.
+    let stride = plan.params.resolution[..3].iter().map(|&r| twin::array_layers(r)).max().unwrap_or(1);
+    let counters = if plan.grouped { 3 * stride as u64 } else { 3 };
+    b.insert(
+        "axis_layer_counts".into(),
+        buffer("axis_layer_counts", 4 * counters, wgpu::BufferUsages::empty()),
+    );
+    if plan.grouped {
+        inputs.counts.insert("axis_triangles".into(), (plan.capacity / 3) as u32);
+    }
     for (name, t) in ["axis_slices_s", "axis_slices_t", "axis_slices_w"].iter().zip(&baked.arrays) {
         let view = t.create_view(&wgpu::TextureViewDescriptor {
             dimension: Some(wgpu::TextureViewDimension::D2Array),
@@ -137,6 +153,7 @@ pub fn add_inputs(
         .insert("axis_sampler_side".into(), sampler("axis_sampler_side", wgpu::AddressMode::ClampToEdge));
     inputs.counts.insert("prisms".into(), plan.prisms.len() as u32);
     inputs.constants.push(("blended_slices".into(), plan.blended as u32 as f64));
+    inputs.constants.push(("grouped_slices".into(), plan.grouped as u32 as f64));
 }
 
 /// Reads back the per-prism choices and the drawn vertices after a frame (tests, `bench`).

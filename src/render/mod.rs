@@ -70,6 +70,7 @@ pub const DEFAULT_AXIS_SLICES: AxisSlices = AxisSlices {
     blend: crate::scene::SliceBlend::Binary,
     back_face_culling: false,
     empty_culling: true,
+    draw_order: crate::scene::DrawOrder::Texels,
 };
 
 /// Plane count when an object is switched to view slicing from a method without planes.
@@ -471,8 +472,14 @@ fn instances(
                 Part::Base => (vec!["BaseSurface"], 0),
                 Part::Slices(c) => (vec!["ViewSlices"], c as u32),
                 Part::AxisSlices => {
-                    let blended = o.axis.as_ref().is_some_and(|a| a.blended);
-                    (vec!["AxisSlices", if blended { "AxisSlicesBlended" } else { "AxisSlicesBinary" }], 0)
+                    let (blended, grouped) =
+                        o.axis.as_ref().map_or((false, false), |a| (a.blended, a.grouped));
+                    let mut filters =
+                        vec!["AxisSlices", if blended { "AxisSlicesBlended" } else { "AxisSlicesBinary" }];
+                    if grouped {
+                        filters.push("AxisSlicesBySlice");
+                    }
+                    (filters, 0)
                 }
                 Part::RayMarch => (vec!["RayMarch"], 0),
                 Part::Reference => unreachable!("reference instances are added once, above"),
@@ -524,6 +531,7 @@ pub const INSTANCE_RESOURCES: &[&str] = &[
     "axis_choices",
     "axis_draw_args",
     "axis_vertices",
+    "axis_layer_counts",
     "axis_slices_s",
     "axis_slices_t",
     "axis_slices_w",

@@ -607,6 +607,20 @@ pub struct AxisSlices {
     /// Skip slices (and so texels) whose slice image is empty.
     #[serde(default = "yes")]
     pub empty_culling: bool,
+    /// `Texels`: texel by texel, back to front; `Slices`: grouped by slice image (section 4.3,
+    /// for the texture cache), binary alpha only.
+    #[serde(default)]
+    pub draw_order: DrawOrder,
+}
+
+/// The order in which `AxisSlices` draws its slices.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
+pub enum DrawOrder {
+    /// Prisms back to front, each prism's slices back to front (needed by blending).
+    #[default]
+    Texels,
+    /// All slices sampling one slice image together (depth test and alpha test keep the image).
+    Slices,
 }
 
 fn one_f64() -> f64 {

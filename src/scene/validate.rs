@@ -2,7 +2,9 @@
 //! of the files the scene refers to (OBJ meshes, height images).
 
 use super::image::HeightImage;
-use super::types::{HeightScale, MeshBounds, Method, Node, Scene, Surface, Texel, TexelSource};
+use super::types::{
+    DrawOrder, HeightScale, MeshBounds, Method, Node, Scene, SliceBlend, Surface, Texel, TexelSource,
+};
 use super::values::Mark;
 use crate::bake::stack::{self, SliceStack};
 use crate::error::Error;
@@ -258,6 +260,15 @@ impl Checker<'_> {
         let world = parent * n.transform.matrix();
         self.hypertexture_node(n, &world);
         if let Some(m) = n.method.as_ref().filter(|m| !matches!(m.value, Method::RayMarch(_))) {
+            if let Method::AxisSlices(a) = &m.value {
+                if a.draw_order == DrawOrder::Slices && a.blend == SliceBlend::Blended {
+                    self.fail(m, format!(
+                        "node \"{}\": `draw_order: Slices` needs `blend: Binary` (blended slices must stay back to front \
+                         within each texel)",
+                        n.name
+                    ));
+                }
+            }
             if n.texel.is_none() {
                 self.fail(m, format!("node \"{}\" has a method: expected a `texel`", n.name));
             } else if n.surface.is_none() {
