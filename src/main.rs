@@ -168,12 +168,12 @@ enum Command {
         /// Output folder (default: out/pareto/<scene name>).
         #[arg(long)]
         out: Option<PathBuf>,
-        /// What errors are measured against: `reference` or `view-slices:PLANES`.
+        /// What errors are measured against: `reference`, `view-slices:PLANES` or `ray-march:STEP`.
         #[arg(long, default_value = "reference")]
         truth: voltex::pareto::Truth,
-        /// Methods to sweep.
+        /// Methods to sweep (ray-march: the step of every hypertexture object).
         #[arg(long, value_enum, value_delimiter = ',', default_values = ["view-slices", "reference"])]
-        methods: Vec<MethodArg>,
+        methods: Vec<SweepArg>,
         /// ViewSlices plane counts (each with the trivial reject on and off).
         #[arg(long, value_delimiter = ',', default_values_t = voltex::pareto::DEFAULT_PLANES)]
         planes: Vec<u32>,
@@ -183,6 +183,9 @@ enum Command {
         /// AxisSlices criteria: d (voxels) = p (pixels) = each value.
         #[arg(long, value_delimiter = ',', default_values_t = voltex::pareto::DEFAULT_CRITERIA)]
         criteria: Vec<f64>,
+        /// RayMarch steps (world units).
+        #[arg(long, value_delimiter = ',', default_values_t = voltex::pareto::DEFAULT_RAY_STEPS)]
+        ray_steps: Vec<f64>,
     },
 }
 
@@ -287,8 +290,8 @@ fn main() -> ExitCode {
             voltex::bench::run(&scenes, &planes, size, frames, reference_planes)
         }
         Command::BenchHyper { size, frames, quick } => voltex::hypertexture::bench::run(size, frames, quick),
-        Command::Pareto { scene, size, frames, out, truth, methods, planes, steps, criteria } => {
-            let methods = methods.into_iter().map(method_kind).collect();
+        Command::Pareto { scene, size, frames, out, truth, methods, planes, steps, criteria, ray_steps } => {
+            let methods = methods.into_iter().map(sweep).collect();
             voltex::pareto::run(&voltex::pareto::Args {
                 scene,
                 size,
@@ -299,6 +302,7 @@ fn main() -> ExitCode {
                 planes,
                 steps,
                 criteria,
+                ray_steps,
             })
         }
     };
@@ -494,6 +498,25 @@ fn render_one(
         println!("  {pass:<20} {ms:>9.3} ms");
     }
     Ok(())
+}
+
+/// The methods `pareto` sweeps: those of `--method`, and the hypertextures' ray marching.
+#[derive(clap::ValueEnum, Clone, Copy)]
+enum SweepArg {
+    ViewSlices,
+    Reference,
+    AxisSlices,
+    RayMarch,
+}
+
+fn sweep(m: SweepArg) -> voltex::pareto::Sweep {
+    use voltex::pareto::Sweep;
+    match m {
+        SweepArg::ViewSlices => Sweep::Method(MethodKind::ViewSlices),
+        SweepArg::Reference => Sweep::Method(MethodKind::Reference),
+        SweepArg::AxisSlices => Sweep::Method(MethodKind::AxisSlices),
+        SweepArg::RayMarch => Sweep::RayMarch,
+    }
 }
 
 fn method_kind(m: MethodArg) -> MethodKind {

@@ -238,3 +238,56 @@ fn axis_slices_criteria_sweep() {
     assert!(text(&bad).contains("--criteria 0"), "{}", text(&bad));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `--methods ray-march` sweeps the hypertextures' step against a converged march: the finer
+/// step is closer to the truth; a bad step or truth fails before rendering, and a scene without
+/// hypertextures has nothing to sweep.
+#[test]
+fn ray_march_step_sweep() {
+    let dir = temp_dir("ray");
+    let out = dir.join("result");
+    let out_s = out.to_str().unwrap().to_string();
+    let scene = root().join("scenes/hypertextures/fig4_craters.ron").to_str().unwrap().to_string();
+    let args = [
+        &scene,
+        "--size",
+        "32x32",
+        "--frames",
+        "1",
+        "--methods",
+        "ray-march",
+        "--ray-steps",
+        "0.06,0.01",
+        "--truth",
+        "ray-march:0.0025",
+        "--out",
+        &out_s,
+    ];
+    let run = pareto(&args);
+    let log = text(&run);
+    assert_eq!(run.status.code(), Some(0), "{log}");
+    assert!(log.contains("truth: RayMarch, step 0.0025"), "{log}");
+    let (header, rows) = read_csv(&out.join("pareto.csv"));
+    let col = |name: &str| header.iter().position(|h| h == name).unwrap();
+    let get = |k: &str| {
+        let r = rows.iter().find(|r| r[col("knobs")] == k).unwrap_or_else(|| panic!("no {k}: {rows:?}"));
+        assert_eq!(r[col("method")], "RayMarch");
+        r[col("flip")].parse::<f64>().unwrap()
+    };
+    assert_eq!(rows.len(), 2, "{rows:?}");
+    let (fine, coarse) = (get("step=0.01"), get("step=0.06"));
+    println!("RayMarch FLIP {fine:.4} at step 0.01, {coarse:.4} at step 0.06");
+    assert!(fine < coarse, "a finer step is closer to the converged march");
+    for (flag, value, expected) in
+        [("--ray-steps", "0", "--ray-steps 0"), ("--truth", "ray-march:-1", "expected a positive step")]
+    {
+        let bad = pareto(&[&scene, "--methods", "ray-march", flag, value, "--out", &out_s]);
+        assert!(bad.status.code().is_some_and(|c| c != 0), "{}", text(&bad));
+        assert!(text(&bad).contains(expected), "{flag} {value}: {}", text(&bad));
+    }
+    let texels = root().join("scenes/meyer_neyret/pear.ron").to_str().unwrap().to_string();
+    let none = pareto(&[&texels, "--methods", "ray-march", "--out", &out_s]);
+    assert_eq!(none.status.code(), Some(1));
+    assert!(text(&none).contains("no hypertexture"), "{}", text(&none));
+    let _ = std::fs::remove_dir_all(&dir);
+}

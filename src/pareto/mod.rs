@@ -29,6 +29,16 @@ pub const DEFAULT_PLANES: [u32; 8] = [16, 32, 64, 128, 256, 512, 1024, 2048];
 pub const DEFAULT_STEP_FACTORS: [f64; 4] = [4.0, 8.0, 16.0, 32.0];
 /// Default `AxisSlices` criteria swept: `d = p` = each value (smaller: more slices).
 pub const DEFAULT_CRITERIA: [f64; 6] = [0.25, 0.5, 1.0, 2.0, 4.0, 8.0];
+/// Default `RayMarch` steps swept (world units): the paper's HQ (0.002) and IE (0.015) among them.
+pub const DEFAULT_RAY_STEPS: [f64; 5] = [0.002, 0.004, 0.008, 0.015, 0.03];
+
+/// A method whose knobs the sweep varies: the three texel methods switch every textured object
+/// to themselves; `RayMarch` varies the step of every hypertexture object.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Sweep {
+    Method(MethodKind),
+    RayMarch,
+}
 
 /// What errors are measured against.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -37,14 +47,24 @@ pub enum Truth {
     Reference,
     /// Every textured object sliced by `ViewSlices` with this many planes (a converged slicing).
     ViewSlices(u32),
+    /// Every hypertexture ray-marched (and every textured object ray cast by `Reference`) with
+    /// this step in world units: a converged march.
+    RayMarch(f64),
 }
 
 impl FromStr for Truth {
     type Err = String;
     fn from_str(s: &str) -> std::result::Result<Self, String> {
-        const EXPECTED: &str = "expected `reference` or `view-slices:PLANES`, e.g. view-slices:4096";
+        const EXPECTED: &str =
+            "expected `reference`, `view-slices:PLANES` or `ray-march:STEP`, e.g. view-slices:4096 or ray-march:0.0005";
         if s == "reference" {
             return Ok(Truth::Reference);
+        }
+        if let Some(step) = s.strip_prefix("ray-march:") {
+            return match step.parse::<f64>() {
+                Ok(v) if v.is_finite() && v > 0.0 => Ok(Truth::RayMarch(v)),
+                _ => Err(format!("`{step}`: expected a positive step in world units")),
+            };
         }
         let n = s.strip_prefix("view-slices:").ok_or(EXPECTED)?;
         match n.parse::<u32>() {
@@ -59,6 +79,7 @@ impl fmt::Display for Truth {
         match self {
             Truth::Reference => write!(f, "Reference, default step"),
             Truth::ViewSlices(n) => write!(f, "ViewSlices, {n} planes"),
+            Truth::RayMarch(step) => write!(f, "RayMarch, step {step}"),
         }
     }
 }
@@ -77,6 +98,12 @@ impl Truth {
                 trivial_reject: Some(true),
                 ..Default::default()
             },
+            Truth::RayMarch(step) => RenderOptions {
+                size,
+                method: Some(MethodKind::Reference),
+                step: Some(step),
+                ..Default::default()
+            },
         }
     }
 }
@@ -92,13 +119,15 @@ pub struct Args {
     pub out: Option<PathBuf>,
     pub truth: Truth,
     /// Methods to sweep.
-    pub methods: Vec<MethodKind>,
+    pub methods: Vec<Sweep>,
     /// `ViewSlices` plane counts (each with the trivial reject on and off).
     pub planes: Vec<u32>,
     /// `Reference` steps as multiples of the default step.
     pub steps: Vec<f64>,
     /// `AxisSlices` criteria, `d = p` (voxels and pixels).
     pub criteria: Vec<f64>,
+    /// `RayMarch` steps (world units).
+    pub ray_steps: Vec<f64>,
 }
 
 /// One point of the sweep.
@@ -121,6 +150,9 @@ impl Args {
             return Err(Error::Invalid(format!(
                 "--steps {f}: expected positive multiples of the default step"
             )));
+        }
+        if let Some(&s) = self.ray_steps.iter().find(|&&s| !(s.is_finite() && s > 0.0)) {
+            return Err(Error::Invalid(format!("--ray-steps {s}: expected positive steps in world units")));
         }
         if let Some(&c) = self.criteria.iter().find(|&&c| !(c > 0.0 && c <= 1024.0)) {
             return Err(Error::Invalid(format!("--criteria {c}: expected values in (0, 1024]")));
@@ -200,19 +232,39 @@ pub fn reference(args: &Args, default_step: f64) -> Vec<Setting> {
         .collect()
 }
 
+/// `RayMarch`: every hypertexture object marched with each step (textured objects keep their
+/// methods).
+pub fn ray_march(args: &Args) -> Vec<Setting> {
+    let mut steps = unique(args.ray_steps.iter().copied());
+    steps.sort_by(f64::total_cmp);
+    steps
+        .into_iter()
+        .map(|step| Setting {
+            method: "RayMarch",
+            knobs: format!("step={step}"),
+            tag: format!("{step}"),
+            options: RenderOptions { size: Some(args.size), step: Some(step), ..Default::default() },
+        })
+        .collect()
+}
+
 /// Every setting of the methods asked for, with notes on what cannot be swept.
 pub fn sweep(scene: &Scene, args: &Args) -> Result<(Vec<Setting>, Vec<String>)> {
     let mut settings = Vec::new();
     let mut notes = Vec::new();
     for &m in &args.methods {
         match m {
-            MethodKind::ViewSlices => settings.extend(view_slices(args)),
-            MethodKind::Reference => match reference_default_step(scene, args.size) {
+            Sweep::Method(MethodKind::ViewSlices) => settings.extend(view_slices(args)),
+            Sweep::Method(MethodKind::Reference) => match reference_default_step(scene, args.size) {
                 Ok(Some(step)) => settings.extend(reference(args, step)),
                 Ok(None) => notes.push("Reference: not measured: no textured object".into()),
                 Err(e) => notes.push(format!("Reference: not measured: {e}")),
             },
-            MethodKind::AxisSlices => settings.extend(axis_slices(args)),
+            Sweep::Method(MethodKind::AxisSlices) => settings.extend(axis_slices(args)),
+            Sweep::RayMarch if scene.hypertextures.is_empty() => {
+                notes.push("RayMarch: not measured: no hypertexture".into())
+            }
+            Sweep::RayMarch => settings.extend(ray_march(args)),
         }
     }
     Ok((settings, notes))
