@@ -385,3 +385,24 @@ fn bad_meshes_are_reported_at_their_position() {
     assert!(at(&err) && err.contains("open.obj:5:1: open mesh"), "{err}");
     assert!(!dir.join("out.exr").exists() && !dir.join("out.png").exists());
 }
+
+/// The Figure 11 bunny (a stand-in written by `tools/gen_bunny.py`): one closed part in which
+/// every edge joins exactly two triangles (a manifold, as marching tetrahedra make), small
+/// enough to commit, sitting on z = 0 and about 1.8 tall.
+#[test]
+fn bunny_stand_in_is_one_closed_manifold_part() {
+    let path = voltex::project_root().join("scenes/hypertextures/meshes/bunny.obj");
+    let m = voltex::mesh::obj::load(&path).unwrap();
+    let shape = MeshShape::new(&m, &path).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(shape.parts.len(), 1);
+    assert!((5_000..=10_000).contains(&shape.triangles.len()), "{} triangles", shape.triangles.len());
+    let mut edges = std::collections::HashMap::new();
+    for t in &shape.triangles {
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            *edges.entry((a.min(b), a.max(b))).or_insert(0u32) += 1;
+        }
+    }
+    assert!(edges.values().all(|&n| n == 2), "an edge not shared by exactly two triangles");
+    assert!(shape.lo.z.abs() < 0.01 && (shape.hi.z - 1.8).abs() < 0.1, "{:?} {:?}", shape.lo, shape.hi);
+}

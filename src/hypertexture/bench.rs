@@ -1,6 +1,6 @@
 //! `voltex bench-hyper`: the set-up of the paper's Figure 11 on the current adapter: one
-//! hypertexture (three noises) on five objects (three soft primitives, the cube and teapot meshes
-//! of the Figure 11 scenes, whose grid bakes it also times) covering most of the window, HQ and
+//! hypertexture (three noises) on six objects (three soft primitives, the cube, teapot and bunny
+//! stand-in meshes of the Figure 11 scenes, whose grid bakes it also times) covering most of the window, HQ and
 //! IE steps, no shading, Phong, and Phong with shadow rays. Per setting: the median wall time of a frame after
 //! warm-up, the density evaluations the frame made and those that ran the noises (counted by the
 //! kernel: points farther than the largest shift from the object skip them), and the share of the
@@ -22,8 +22,8 @@ use crate::graph::exec::Inputs;
 use crate::render::{Blueprint, Part, RenderOptions, Renderer};
 use crate::types::MarchState;
 
-/// The paper's objects: soft primitives standing in for its bunny, and the cube and teapot meshes
-/// of the Figure 11 example scenes (`{meshes}`: their folder) : (name, object, node transform),
+/// The paper's objects: soft primitives, and the cube, teapot and bunny (a stand-in of our own)
+/// meshes of the Figure 11 example scenes (`{meshes}`: their folder) : (name, object, node transform),
 /// each covering about 3/4 of the window.
 const OBJECTS: &[(&str, &str, &str)] = &[
     ("sphere", "Sphere(radius: 1.0)", "(rotate: (0.0, 0.0, 0.0))"),
@@ -34,6 +34,11 @@ const OBJECTS: &[(&str, &str, &str)] = &[
         "teapot mesh",
         "Mesh(path: \"{meshes}/teapot.obj\")",
         "(translate: (-0.03, 0.0, -0.4), rotate: (0.0, 0.0, -20.0), scale: (0.42, 0.42, 0.42))",
+    ),
+    (
+        "bunny mesh",
+        "Mesh(path: \"{meshes}/bunny.obj\")",
+        "(translate: (0.04, 0.0, -0.8), rotate: (0.0, 0.0, -30.0), scale: (0.84, 0.84, 0.84))",
     ),
 ];
 const QUALITIES: &[&str] = &["HQ", "IE"];
