@@ -155,6 +155,45 @@ impl Checker<'_> {
         }
     }
 
+    /// A hypertexture texel: a known hypertexture, a box with volume, a volume the bake can
+    /// afford.
+    fn texel_hypertexture(
+        &mut self,
+        texel: &str,
+        resolution: [u32; 3],
+        name: &Mark<String>,
+        bounds: Option<&Mark<MeshBounds>>,
+    ) {
+        if !self.scene.hypertextures.contains_key(&name.value) {
+            let names: Vec<String> = self.scene.hypertextures.keys().map(|k| format!("\"{k}\"")).collect();
+            let expected = if names.is_empty() {
+                "no hypertextures are defined in `hypertextures`".to_string()
+            } else {
+                format!("expected one of {}", names.join(", "))
+            };
+            return self.fail(name, format!("unknown hypertexture \"{}\": {expected}", name.value));
+        }
+        let voxels: u64 = resolution.iter().map(|&r| r as u64).product();
+        if voxels > MAX_HYPERTEXTURE_VOXELS {
+            let msg = format!(
+                "texel \"{texel}\": a resolution of {resolution:?} is {voxels} voxels: a hypertexture bake takes at most \
+                 {MAX_HYPERTEXTURE_VOXELS} (256^3)"
+            );
+            return self.fail(name, msg);
+        }
+        if let Some(b) = bounds {
+            if let Some(a) = (0..3).find(|&a| b.lo[a] >= b.hi[a]) {
+                let msg = format!(
+                    "expected `lo` below `hi` on every axis, found {} >= {} on {}",
+                    b.lo[a],
+                    b.hi[a],
+                    ["x", "y", "z"][a]
+                );
+                self.fail(b, msg);
+            }
+        }
+    }
+
     /// A 2D shape transfer function's image: 2 to 256 columns (noise), 2 to 64 rows (density).
     fn shape_image(&mut self, path: &Mark<String>) {
         use super::hypertexture::{MAX_ROWS, MAX_TABLE};
@@ -362,6 +401,9 @@ impl Checker<'_> {
     }
 }
 
+/// Most voxels of a texel baked from a hypertexture (seven density evaluations each).
+pub const MAX_HYPERTEXTURE_VOXELS: u64 = 1 << 24;
+
 /// More samples than this along one ray means a step far finer than any scene needs.
 pub const MAX_SAMPLES_PER_RAY: f64 = 1e5;
 
@@ -393,6 +435,9 @@ pub(super) fn check(scene: &Scene, dir: &Path) -> Findings {
             TexelSource::ImageHeight { image, channel, .. } => c.image_channel(image, *channel, image),
             TexelSource::Slices { dir } => c.stack(dir, t.resolution),
             TexelSource::Sequence { texels, .. } => c.sequence(texels, t.resolution),
+            TexelSource::Hypertexture { name: h, bounds } => {
+                c.texel_hypertexture(name, t.resolution, h, bounds.as_ref())
+            }
             _ => {}
         }
     }
