@@ -3,10 +3,10 @@
 //! evaluates the density and colour transfer at each voxel centre, after `bake_transfer.wgsl`
 //! has sampled the transfer functions (and, for mesh objects, `bake_mesh_grid.wgsl` the mesh).
 //!
-//! Opacity: a voxel stores the transfer function's opacity as it is, the opacity per the
-//! hypertexture's opacity length; the texel's `opacity_length` (by default the hypertexture's,
-//! see `scene::Texel::opacity_length`) makes a slab of voxels as opaque as RayMarch makes the same
-//! stretch of object space when one box unit is drawn one world unit long.
+//! Opacity: a voxel stores the transfer function's opacity as it is, the opacity reached over the
+//! hypertexture's opacity length, a world length for RayMarch whatever the node's scale; the
+//! texel takes that same length (`scene::Texel::opacity_length`), so a slab of voxels is as opaque
+//! as RayMarch makes the same world length of the hypertexture drawn at the texel's scale.
 
 use glam::DVec3;
 

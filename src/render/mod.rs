@@ -388,6 +388,7 @@ impl ObjectPlan {
             return Ok(plan);
         };
         let time = opts.time.unwrap_or(scene.time);
+        let texel = plan.object.texel.clone().unwrap_or_default();
         let vs = match method {
             Method::ViewSlices(vs) => vs,
             Method::RayMarch(rm) => {
@@ -402,7 +403,6 @@ impl ObjectPlan {
                 return Ok(plan);
             }
             Method::AxisSlices(a) => {
-                let texel = plan.object.texel.clone().unwrap_or_default();
                 let bake = texels::bake_index_axis(scene, &texel, light, time, bakes)?;
                 plan.bake = Some(bake);
                 let res = bakes[bake].request.resolution;
@@ -414,7 +414,6 @@ impl ObjectPlan {
             Method::Reference(r) => {
                 plan.per_pixel = r.lighting == LightingMode::PerPixel;
                 plan.frames = plan.per_pixel.then(|| shell::vertex_frames(&plan.object.surface));
-                let texel = plan.object.texel.clone().unwrap_or_default();
                 let bake = texels::bake_index(scene, &texel, plan.per_pixel, light, time, bakes)?;
                 plan.bake = Some(bake);
                 let step =
@@ -437,7 +436,6 @@ impl ObjectPlan {
         view_slices::check_budget(&plan.chunks, &plan.object.name, planes)?;
         plan.sweep = Some(sweep);
         plan.frames = plan.per_pixel.then(|| shell::vertex_frames(&plan.object.surface));
-        let texel = plan.object.texel.clone().unwrap_or_default();
         plan.bake = Some(texels::bake_index(scene, &texel, plan.per_pixel, light, time, bakes)?);
         Ok(plan)
     }

@@ -146,8 +146,8 @@ pub const DEFAULT_OPACITY_LENGTH: f32 = 0.05;
 impl Texel {
     /// The world length over which a voxel's stored alpha is reached: as given, else for a
     /// hypertexture source the hypertexture's own opacity length (a baked voxel stores the
-    /// transfer function's opacity, which RayMarch reaches over that length of its object
-    /// space), else [`DEFAULT_OPACITY_LENGTH`].
+    /// transfer function's opacity, which RayMarch reaches over that world length), else
+    /// [`DEFAULT_OPACITY_LENGTH`].
     pub fn opacity_length(&self, hypertextures: &BTreeMap<String, super::Hypertexture>) -> f32 {
         let own = match &self.source {
             TexelSource::Hypertexture { name, .. } => {
@@ -239,8 +239,10 @@ pub enum TexelSource {
     /// of the box `bounds` of its object space (default: its enlarged bounds, every detail
     /// inside), which maps onto texel space [0,1]^3: colour and opacity from its transfer
     /// function, shading from its density gradient (`bake_hypertexture.wgsl`). Animated noises
-    /// are baked at the scene's time. Without an `opacity_length`, the texel takes the
-    /// hypertexture's: right when one unit of the box is drawn one world unit long.
+    /// are baked at the scene's time. The texel's `opacity_length` is the hypertexture's (both
+    /// are world lengths, and a voxel stores the transfer function's opacity): drawn at any
+    /// scale, the texel is as opaque as RayMarch draws the hypertexture at that scale. Another
+    /// length given in the file is used, with a warning.
     Hypertexture {
         name: Mark<String>,
         #[serde(default)]

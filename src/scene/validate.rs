@@ -156,15 +156,17 @@ impl Checker<'_> {
     }
 
     /// A hypertexture texel: a known hypertexture, a box with volume, a volume the bake can
-    /// afford.
+    /// afford; an opacity length other than the hypertexture's warns (the texel would not be as
+    /// opaque as RayMarch draws the hypertexture).
     fn texel_hypertexture(
         &mut self,
         texel: &str,
-        resolution: [u32; 3],
+        t: &Texel,
         name: &Mark<String>,
         bounds: Option<&Mark<MeshBounds>>,
     ) {
-        if !self.scene.hypertextures.contains_key(&name.value) {
+        let resolution = t.resolution;
+        let Some(h) = self.scene.hypertextures.get(&name.value) else {
             let names: Vec<String> = self.scene.hypertextures.keys().map(|k| format!("\"{k}\"")).collect();
             let expected = if names.is_empty() {
                 "no hypertextures are defined in `hypertextures`".to_string()
@@ -172,6 +174,18 @@ impl Checker<'_> {
                 format!("expected one of {}", names.join(", "))
             };
             return self.fail(name, format!("unknown hypertexture \"{}\": {expected}", name.value));
+        };
+        if let Some(given) = t.opacity_length_given {
+            let own = h.opacity_length as f32;
+            if (given / own - 1.0).abs() > 1e-4 {
+                let msg = format!(
+                    "texel \"{texel}\": an opacity_length of {given} makes the baked hypertexture \"{}\" {} opaque \
+                     than RayMarch draws it (its opacity_length is {own}; leave the texel's out to take it)",
+                    name.value,
+                    if given < own { "more" } else { "less" }
+                );
+                self.f.warnings.push((Some(name.seq), msg));
+            }
         }
         let voxels: u64 = resolution.iter().map(|&r| r as u64).product();
         if voxels > MAX_HYPERTEXTURE_VOXELS {
@@ -435,9 +449,7 @@ pub(super) fn check(scene: &Scene, dir: &Path) -> Findings {
             TexelSource::ImageHeight { image, channel, .. } => c.image_channel(image, *channel, image),
             TexelSource::Slices { dir } => c.stack(dir, t.resolution),
             TexelSource::Sequence { texels, .. } => c.sequence(texels, t.resolution),
-            TexelSource::Hypertexture { name: h, bounds } => {
-                c.texel_hypertexture(name, t.resolution, h, bounds.as_ref())
-            }
+            TexelSource::Hypertexture { name: h, bounds } => c.texel_hypertexture(name, t, h, bounds.as_ref()),
             _ => {}
         }
     }
