@@ -22,7 +22,8 @@ pub fn bake_hypertexture_voxel(
     let h = model.params;
     let v = |a: [f32; 4]| DVec3::new(a[0] as f64, a[1] as f64, a[2] as f64);
     let (lo, extent) = (v(h.bounds_min), v(h.bounds_max) - v(h.bounds_min));
-    let res = DVec3::new(params.resolution[0] as f64, params.resolution[1] as f64, params.resolution[2] as f64);
+    let res =
+        DVec3::new(params.resolution[0] as f64, params.resolution[1] as f64, params.resolution[2] as f64);
     let centre = DVec3::new(voxel[0] as f64, voxel[1] as f64, voxel[2] as f64) + 0.5;
     let x = lo + extent * centre / res;
     let rgba = model.hyper_color(model.hyper_density(x));

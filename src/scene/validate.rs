@@ -449,7 +449,9 @@ pub(super) fn check(scene: &Scene, dir: &Path) -> Findings {
             TexelSource::ImageHeight { image, channel, .. } => c.image_channel(image, *channel, image),
             TexelSource::Slices { dir } => c.stack(dir, t.resolution),
             TexelSource::Sequence { texels, .. } => c.sequence(texels, t.resolution),
-            TexelSource::Hypertexture { name: h, bounds } => c.texel_hypertexture(name, t, h, bounds.as_ref()),
+            TexelSource::Hypertexture { name: h, bounds } => {
+                c.texel_hypertexture(name, t, h, bounds.as_ref())
+            }
             _ => {}
         }
     }
