@@ -164,6 +164,53 @@ fn bounds_and_time_match_twin() {
     assert_ne!(format!("{:?}", hyper_texel(&still, 0.0)), format!("{:?}", hyper_texel(&other, 0.0)));
 }
 
+/// A mesh object (a box OBJ): its grid is baked before the texel, which matches the twin reading
+/// the same grid.
+#[test]
+fn mesh_object_matches_twin() {
+    let dir = std::env::temp_dir().join(format!("voltex-hyper-texel-mesh-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let cube = "v -0.5 -0.4 -0.3\nv 0.5 -0.4 -0.3\nv 0.5 0.4 -0.3\nv -0.5 0.4 -0.3\nv -0.5 -0.4 0.3\nv 0.5 -0.4 0.3\n\
+                v 0.5 0.4 0.3\nv -0.5 0.4 0.3\nf 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n";
+    std::fs::write(dir.join("box.obj"), cube).unwrap();
+    let hyper = PUFF.replace("Sphere(radius: 0.5)", "Mesh(path: \"box.obj\", resolution: 24)");
+    let text = format!(
+        "#![enable(implicit_some)]\nScene(output: (width: 16, height: 16), camera: (eye: (0.0, -3.0, 1.0), target: (0.0, 0.0, 0.0)), \
+         hypertextures: {{ \"h\": {hyper} }}, texels: {{ \"t\": (resolution: (16, 16, 16), source: Hypertexture(name: \"h\")) }})\n"
+    );
+    std::fs::write(dir.join("mesh.ron"), text).unwrap();
+    let scene = scene::load(&dir.join("mesh.ron")).unwrap();
+    let ht = hyper_texel(&scene, 0.0);
+    let (shape, spec) = ht.packed.mesh.clone().expect("a mesh object");
+    let (volume, _) = bake(&ht, [16; 3], false);
+    let (cells, depth) = {
+        let ctx = ctx().lock().unwrap();
+        let grid = voltex::hypertexture::mesh::bake(&ctx, &shape, &spec).unwrap();
+        voltex::hypertexture::mesh::read(&ctx, &grid).unwrap()
+    };
+    let tables = bake_transfer(&ht.packed.functions, &ht.packed.points);
+    let model =
+        Model { params: &ht.params, noises: &ht.packed.noises, tables: &tables, grid: Some((&cells, depth)) };
+    let params = bake_params([16; 3], 0, LIGHT, AMBIENT);
+    let (mut worst, mut off, mut matter) = (0.0f32, 0, 0);
+    for v in every([16; 3]) {
+        let i = 4 * (v[0] + 16 * (v[1] + 16 * v[2])) as usize;
+        let (rgba, _) = bake_hypertexture_voxel(&params, &model, v, false);
+        let d = (0..4).map(|c| (volume[i + c] as f32 - rgba[c] * 255.0).abs()).fold(0.0, f32::max);
+        worst = worst.max(d);
+        off += (d > 2.0) as usize;
+        matter += (volume[i + 3] > 128) as usize;
+    }
+    eprintln!("mesh object: worst {worst}/255, {off} voxels off by > 2/255, {matter} more than half opaque");
+    // The grid's f32 trilinear weights against f64 ones: a few voxels on steep stretches of the
+    // ramp differ by a few levels.
+    assert!(
+        off * 500 <= 4096 && worst <= 16.0 && matter > 100,
+        "worst {worst}/255, {off} off, {matter} opaque"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
+
 /// A volume of more than `VOXELS_PER_DISPATCH` voxels is baked in slabs of layers: the layers on
 /// both sides of a slab boundary and the last one match the twin.
 #[test]
