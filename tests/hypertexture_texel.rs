@@ -231,6 +231,44 @@ fn slabs_of_layers_match_twin() {
     assert!(off * 500 <= 6 * 128 * 128 && worst <= 16.0, "{off} voxels off, worst {worst}/255");
 }
 
+/// A slab with periodic noises baked over one period tiles: the box moved by a whole period
+/// along x or y bakes the same texel (to 8-bit rounding), while without `period` it does not.
+#[test]
+fn periodic_slab_tiles() {
+    let slab = |period: &str| {
+        format!(
+            "(object: Box(size: (4000.0, 4000.0, 0.1)), field: Constant(direction: (0.0, 0.0, 1.0)), noises: [(shape: \
+             Curve([(0.0, 0.0, 0.0), (1.0, 1.0, 1.0)]), amplitude: 0.25, frequency: 6.0{period}), (shape: Table([0.0, 1.0]), \
+             amplitude: 0.1, frequency: 15.0, seed: 7{period})], color: Ramp([(0.0, (0.3, 0.5, 0.1, 0.0)), (0.2, (0.3, 0.5, \
+             0.1, 0.0)), (0.4, (0.4, 0.6, 0.2, 0.9)), (1.0, (0.1, 0.2, 0.1, 1.0))]), opacity_length: 0.01)"
+        )
+    };
+    let texel = |lo: [f64; 2]| {
+        format!(
+            "(resolution: (16, 16, 8), source: Hypertexture(name: \"h\", bounds: (lo: ({}, {}, -0.05), hi: ({}, {}, 0.4))))",
+            lo[0],
+            lo[1],
+            lo[0] + 1.0,
+            lo[1] + 1.0
+        )
+    };
+    let volume = |period: &str, lo: [f64; 2]| {
+        bake(&hyper_texel(&scene_with(&slab(period), &texel(lo)), 0.0), [16, 16, 8], false).0
+    };
+    let worst = |a: &[u8], b: &[u8]| a.iter().zip(b).map(|(x, y)| x.abs_diff(*y)).max().unwrap();
+    let periodic = ", period: (1.0, 1.0, 1.0)";
+    let home = volume(periodic, [-0.5, -0.5]);
+    assert!(home.chunks(4).filter(|p| p[3] > 128).count() > 200, "some matter");
+    for lo in [[0.5, -0.5], [-0.5, 1.5]] {
+        let moved = volume(periodic, lo);
+        eprintln!("periodic, box at {lo:?}: worst {}/255", worst(&home, &moved));
+        assert!(worst(&home, &moved) <= 1, "box at {lo:?}");
+    }
+    let (plain, moved) = (volume("", [-0.5, -0.5]), volume("", [0.5, -0.5]));
+    eprintln!("not periodic: worst {}/255", worst(&plain, &moved));
+    assert!(worst(&plain, &moved) > 64);
+}
+
 // ---- opacity: a texel is as opaque as RayMarch draws its hypertexture ----
 
 /// A box of constant colour and opacity (no distortion), seen from straight above at `scale`,
