@@ -56,7 +56,7 @@ fn bake(ht: &HyperTexel, resolution: [u32; 3], per_pixel: bool) -> (Vec<u8>, Vec
     let ctx = ctx().lock().unwrap();
     let req = BakeRequest {
         resolution,
-        source: BakeSource::Hypertexture(ht.clone()),
+        source: BakeSource::Hypertexture(Box::new(ht.clone())),
         per_pixel,
         light: LIGHT,
         ambient: AMBIENT,

@@ -28,7 +28,7 @@ pub enum BakeSource {
     /// A pattern mesh sampled at the voxel centres (`bake_mesh_grid.wgsl`), then coloured.
     Mesh(MeshTexel),
     /// A hypertexture sampled at the voxel centres of a box of its object space.
-    Hypertexture(hypertexture::HyperTexel),
+    Hypertexture(Box<hypertexture::HyperTexel>),
 }
 
 /// A mesh texel's pattern, where its voxel centres lie, and its colouring; shown in `Debug` (the

@@ -115,7 +115,7 @@ pub(super) fn bake_index(
                 Error::Invalid(format!("{}: unknown hypertexture `{}`", scene.path.display(), name.value))
             })?;
             let bounds = bounds.as_ref().map(|b| (b.lo, b.hi));
-            BakeSource::Hypertexture(HyperTexel::new(h, bounds, t.resolution, time))
+            BakeSource::Hypertexture(Box::new(HyperTexel::new(h, bounds, t.resolution, time)))
         }
         TexelSource::Constant { color, opacity } => {
             BakeSource::Implicit(pack_shapes(&[(BakeShape::Constant, *color, *opacity)]))
