@@ -352,6 +352,33 @@ fn bake_command_writes_the_slice_stack() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
+/// An animated hypertexture texel drawn by `voltex render --frames`: each frame bakes it at its
+/// own time (frames 0 and 2 at 1 fps differ), and a repeated time gives the same image.
+#[test]
+fn render_frames_bake_animated_texels_at_their_time() {
+    let dir = std::env::temp_dir().join(format!("voltex-hyper-texel-frames-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let animated = PUFF.replace("frequency: 4.0)", "frequency: 4.0, speed: 0.5)");
+    let text = format!(
+        "#![enable(implicit_some)]\nScene(output: (width: 24, height: 24), camera: (eye: (0.0, -3.0, 1.0), target: (0.0, 0.0, 0.0)), \
+         hypertextures: {{ \"h\": {animated} }}, texels: {{ \"t\": (resolution: (16, 16, 16), source: Hypertexture(name: \"h\")) }}, \
+         nodes: [(name: \"s\", transform: (translate: (0.0, 0.0, -0.7)), surface: Plane(size: (1.4, 1.4), cells: (1, 1)), \
+         height: (length: 1.4), texel: \"t\", method: ViewSlices(planes: 64))])\n"
+    );
+    std::fs::write(dir.join("anim.ron"), text).unwrap();
+    let (out, scene) = (dir.join("anim.exr"), dir.join("anim.ron"));
+    let args = ["render", common::s(&scene), "-o", common::s(&out), "--frames", "0..2", "--fps", "1"];
+    common::ok(common::voltex(&args));
+    let frame = |n: u32| voltex::io::exr::read(&dir.join(format!("anim_{n:04}.exr"))).unwrap().0.pixels;
+    let (f0, f2) = (frame(0), frame(2));
+    let differ = f0.iter().zip(&f2).filter(|(a, b)| (a[0] - b[0]).abs() > 0.01).count();
+    assert!(differ > 20, "{differ} pixels differ between frames 0 and 2");
+    let single = dir.join("single.exr");
+    common::ok(common::voltex(&["render", common::s(&scene), "-o", common::s(&single), "--time", "2"]));
+    assert_eq!(voltex::io::exr::read(&single).unwrap().0.pixels, f2, "--time 2 renders frame 2");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
 /// The scene with the texel line replaced: the error is at line 7 where `at` starts, mentions
 /// `word`, and `voltex render` exits 1 writing nothing.
 #[track_caller]
