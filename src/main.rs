@@ -434,10 +434,23 @@ fn render_frames(
     let stem = path.file_stem().unwrap_or_default().to_string_lossy().to_string();
     let ctx = GpuContext::new()?;
     let mut cache = GpuCache::default();
+    // A texel baked from an animated hypertexture is baked anew every frame: keep only what the
+    // last frame used, or the bakes pile up (a sequence's frames are then re-baked when they
+    // come back).
+    let animated = scene.texels.values().any(|t| match &t.source {
+        scene::TexelSource::Hypertexture { name, .. } => {
+            scene.hypertextures.get(&name.value).is_some_and(|h| h.noises.iter().any(|n| n.speed != 0.0))
+        }
+        _ => false,
+    });
     for n in first..=last {
         let frame_opts = RenderOptions { time: Some(n as f64 / fps), ..opts.clone() };
         let exr = path.with_file_name(format!("{stem}_{n:04}.exr"));
+        cache.begin();
         render_one(&ctx, &scene, &frame_opts, &exr, &mut cache, n == first)?;
+        if animated {
+            cache.retain_used();
+        }
     }
     Ok(())
 }

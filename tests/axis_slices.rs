@@ -271,12 +271,17 @@ fn gpu_and_twin(scene: &Path, opts: &RenderOptions) -> usize {
     checked
 }
 
+/// Example scenes of the folder drawn without AxisSlices (the hypertexture texel compared with
+/// ViewSlices against RayMarch).
+const NOT_AXIS_SLICES: &[&str] = &["hypertexture_texel.ron", "hypertexture_texel_marched.ron"];
+
 #[test]
 fn kernels_match_their_twins_on_every_example_scene() {
     let mut scenes: Vec<PathBuf> = std::fs::read_dir(example(""))
         .unwrap()
         .map(|e| e.unwrap().path())
         .filter(|p| p.extension().is_some_and(|e| e == "ron"))
+        .filter(|p| !NOT_AXIS_SLICES.iter().any(|n| p.ends_with(n)))
         .collect();
     scenes.sort();
     assert!(scenes.len() >= 4);

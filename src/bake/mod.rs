@@ -3,6 +3,7 @@
 //! uses it. Only texels some object draws are baked, each (texel, lighting) pair once.
 
 pub mod axis_slices;
+pub mod hypertexture;
 pub mod stack;
 
 use std::path::Path;
@@ -26,6 +27,8 @@ pub enum BakeSource {
     Stack(StackTexels),
     /// A pattern mesh sampled at the voxel centres (`bake_mesh_grid.wgsl`), then coloured.
     Mesh(MeshTexel),
+    /// A hypertexture sampled at the voxel centres of a box of its object space.
+    Hypertexture(Box<hypertexture::HyperTexel>),
 }
 
 /// A mesh texel's pattern, where its voxel centres lie, and its colouring; shown in `Debug` (the
@@ -130,6 +133,8 @@ pub struct Baker {
     heightfield: Option<ComputeKernel>,
     height_image: Option<ComputeKernel>,
     mesh: Option<ComputeKernel>,
+    hyper: Option<ComputeKernel>,
+    transfer: Option<ComputeKernel>,
     axis: Option<ComputeKernel>,
     wgsl_root: std::path::PathBuf,
 }
@@ -141,6 +146,8 @@ impl Baker {
             heightfield: None,
             height_image: None,
             mesh: None,
+            hyper: None,
+            transfer: None,
             axis: None,
             wgsl_root: wgsl_root.to_path_buf(),
         }
@@ -279,6 +286,11 @@ impl Baker {
                     &inputs,
                     req.resolution,
                 )?;
+            }
+            BakeSource::Hypertexture(ht) => {
+                let transfer = Self::kernel(&mut self.transfer, ctx, &root, "bake_transfer.wgsl")?;
+                let hyper = Self::kernel(&mut self.hyper, ctx, &root, "bake_hypertexture.wgsl")?;
+                ht.bake(ctx, (transfer, hyper), &mut encoder, &mut inputs, params)?;
             }
         }
         let axis = match req.axis_slices {

@@ -2,6 +2,7 @@
 
 pub mod axis_slices;
 pub mod bake;
+pub mod bake_hypertexture;
 pub mod bake_mesh_grid;
 pub mod bake_mesh_texel;
 pub mod bake_transfer;

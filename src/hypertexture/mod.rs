@@ -12,7 +12,7 @@ use glam::DVec3;
 use crate::cpu::bake_transfer::{HERMITE, LINEAR, TRANSFER_SIZE};
 use crate::scene::hypertexture::{ColorTransfer, Field, Operator, ShapeTransfer, SoftObject};
 use crate::scene::Hypertexture;
-use crate::types::{HyperNoise, TransferFunction, TransferPoint};
+use crate::types::{HyperNoise, HyperParams, TransferFunction, TransferPoint};
 
 /// `HyperParams::kinds[0]` (mirrored in wgsl/shared/fields.wgsl).
 pub const OBJECT_SPHERE: u32 = 0;
@@ -42,6 +42,8 @@ pub struct Packed {
     /// Object-space bounds enlarged by the largest shift.
     pub bounds: (DVec3, DVec3),
     pub opacity_length: f64,
+    /// The largest shift the noises reach (object space).
+    pub max_shift: f64,
     /// Mesh objects: the mesh and where its grid samples lie.
     pub mesh: Option<(std::sync::Arc<mesh::MeshShape>, mesh::GridSpec)>,
 }
@@ -75,6 +77,7 @@ pub fn pack(h: &Hypertexture) -> Packed {
         points: Vec::new(),
         bounds: h.bounds(),
         opacity_length: h.opacity_length,
+        max_shift: h.max_shift(),
         mesh,
     };
     let base = match &h.field {
@@ -160,6 +163,29 @@ pub fn animated(noises: &[HyperNoise]) -> bool {
 }
 
 impl Packed {
+    /// The `HyperParams` the hypertexture fixes at `time` (object, field, noise count, reach of
+    /// the noises, mesh grid, enlarged bounds, opacity length); the camera and march fields are
+    /// the method's to fill.
+    pub fn params(&self, time: f64) -> HyperParams {
+        let (lo, hi) = self.bounds;
+        let mut params = HyperParams {
+            bounds_min: [lo.x as f32, lo.y as f32, lo.z as f32, 0.0],
+            bounds_max: [hi.x as f32, hi.y as f32, hi.z as f32, self.opacity_length as f32],
+            object: self.object,
+            field: self.field,
+            field_center: self.field_center,
+            perturb: self.perturb,
+            kinds: self.kinds,
+            march: [0.0, 0.0, (self.max_shift * (1.0 + 1e-4) + 1e-6) as f32, time as f32],
+            ..Default::default()
+        };
+        if let Some((_, g)) = &self.mesh {
+            params.grid_min = [g.lo.x as f32, g.lo.y as f32, g.lo.z as f32, g.n[0] as f32];
+            params.grid_max = [g.hi.x as f32, g.hi.y as f32, g.hi.z as f32, 0.0];
+        }
+        params
+    }
+
     /// Values at evenly spaced x from 0 to 1, joined linearly.
     fn table(&mut self, values: &[f64]) {
         let last = (values.len() - 1).max(1) as f64;

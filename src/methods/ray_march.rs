@@ -84,28 +84,14 @@ pub fn plan(
     }
     // Camera-relative world to the node's frame.
     let to_local = (to_world.inverse() * DMat4::from_translation(camera.eye)).as_mat4();
-    let (lo, hi) = packed.bounds;
-    let params = HyperParams {
-        to_local: to_local.to_cols_array_2d(),
-        right: [camera.right.x as f32, camera.right.y as f32, camera.right.z as f32, camera.near as f32],
-        up: [camera.up.x as f32, camera.up.y as f32, camera.up.z as f32, camera.far as f32],
-        bounds_min: [lo.x as f32, lo.y as f32, lo.z as f32, step as f32],
-        bounds_max: [hi.x as f32, hi.y as f32, hi.z as f32, packed.opacity_length as f32],
-        object: packed.object,
-        field: packed.field,
-        field_center: packed.field_center,
-        perturb: packed.perturb,
-        kinds: packed.kinds,
-        march: [shadow_step as f32, step as f32, (h.max_shift() * (1.0 + 1e-4) + 1e-6) as f32, time as f32],
-        budget: [evals, shadow_samples, worst, 0],
-        grid_min: [0.0; 4],
-        grid_max: [0.0; 4],
-    };
-    let mut params = params;
-    if let Some((_, g)) = &packed.mesh {
-        params.grid_min = [g.lo.x as f32, g.lo.y as f32, g.lo.z as f32, g.n[0] as f32];
-        params.grid_max = [g.hi.x as f32, g.hi.y as f32, g.hi.z as f32, 0.0];
-    }
+    let mut params = packed.params(time);
+    params.to_local = to_local.to_cols_array_2d();
+    params.right = [camera.right.x as f32, camera.right.y as f32, camera.right.z as f32, camera.near as f32];
+    params.up = [camera.up.x as f32, camera.up.y as f32, camera.up.z as f32, camera.far as f32];
+    params.bounds_min[3] = step as f32;
+    params.march[0] = shadow_step as f32;
+    params.march[1] = step as f32;
+    params.budget = [evals, shadow_samples, worst, 0];
     Ok(RayMarchPlan {
         hypertexture: node.name.clone(),
         packed,

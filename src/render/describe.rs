@@ -133,6 +133,10 @@ impl Blueprint {
                 BakeSource::HeightImage(..) => "bake_height_image.wgsl",
                 BakeSource::Stack(_) => "slice stack (uploaded)",
                 BakeSource::Mesh(_) => "bake_mesh_grid.wgsl + bake_mesh_texel.wgsl",
+                BakeSource::Hypertexture(ref h) if h.packed.mesh.is_some() => {
+                    "bake_transfer.wgsl + bake_mesh_grid.wgsl + bake_hypertexture.wgsl"
+                }
+                BakeSource::Hypertexture(_) => "bake_transfer.wgsl + bake_hypertexture.wgsl",
             };
             s += &format!(
                 "  {:<16} {}x{}x{}  {kind}  lighting {}\n",

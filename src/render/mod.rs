@@ -174,7 +174,7 @@ pub struct Blueprint {
 /// The bake of `texel` with the scene's first light baked in (what `voltex bake` writes out).
 pub fn baked_texel(scene: &Scene, texel: &str) -> Result<BakePlan> {
     let mut bakes = Vec::new();
-    texels::bake_index(scene, texel, false, &Lighting::of(scene), &mut bakes)?;
+    texels::bake_index(scene, texel, false, &Lighting::of(scene), scene.time, &mut bakes)?;
     Ok(bakes.remove(0))
 }
 
@@ -388,6 +388,8 @@ impl ObjectPlan {
         let Some(method) = chosen.or(plan.object.method.as_ref()).map(|m| opts.apply(m)) else {
             return Ok(plan);
         };
+        let time = opts.time.unwrap_or(scene.time);
+        let texel = plan.object.texel.clone().unwrap_or_default();
         let vs = match method {
             Method::ViewSlices(vs) => vs,
             Method::RayMarch(rm) => {
@@ -397,14 +399,12 @@ impl ObjectPlan {
                 let h = scene.hypertextures.get(&node.name).ok_or_else(|| {
                     Error::Invalid(format!("{}: unknown hypertexture `{}`", scene.path.display(), node.name))
                 })?;
-                let time = opts.time.unwrap_or(scene.time);
                 plan.ray_march =
                     Some(ray_march::plan(&plan.object.name, node, h, &rm, &view.camera(), time)?);
                 return Ok(plan);
             }
             Method::AxisSlices(a) => {
-                let texel = plan.object.texel.clone().unwrap_or_default();
-                let bake = texels::bake_index_axis(scene, &texel, light, bakes)?;
+                let bake = texels::bake_index_axis(scene, &texel, light, time, bakes)?;
                 plan.bake = Some(bake);
                 let res = bakes[bake].request.resolution;
                 let name = &plan.object.name;
@@ -415,8 +415,7 @@ impl ObjectPlan {
             Method::Reference(r) => {
                 plan.per_pixel = r.lighting == LightingMode::PerPixel;
                 plan.frames = plan.per_pixel.then(|| shell::vertex_frames(&plan.object.surface));
-                let texel = plan.object.texel.clone().unwrap_or_default();
-                let bake = texels::bake_index(scene, &texel, plan.per_pixel, light, bakes)?;
+                let bake = texels::bake_index(scene, &texel, plan.per_pixel, light, time, bakes)?;
                 plan.bake = Some(bake);
                 let step =
                     r.step.unwrap_or_else(|| reference::default_step(&plan, bakes[bake].request.resolution));
@@ -438,8 +437,7 @@ impl ObjectPlan {
         view_slices::check_budget(&plan.chunks, &plan.object.name, planes)?;
         plan.sweep = Some(sweep);
         plan.frames = plan.per_pixel.then(|| shell::vertex_frames(&plan.object.surface));
-        let texel = plan.object.texel.clone().unwrap_or_default();
-        plan.bake = Some(texels::bake_index(scene, &texel, plan.per_pixel, light, bakes)?);
+        plan.bake = Some(texels::bake_index(scene, &texel, plan.per_pixel, light, time, bakes)?);
         Ok(plan)
     }
 }

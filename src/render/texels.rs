@@ -1,5 +1,6 @@
 //! Scene texels as bake requests: only texels some object draws, each (texel, lighting) once.
 
+use crate::bake::hypertexture::HyperTexel;
 use crate::bake::{BakeRequest, BakeSource, Heights, MeshTexel, StackTexels};
 use crate::cpu::bake::{pack_shapes, Shape as BakeShape};
 use crate::error::{Error, Result};
@@ -7,12 +8,14 @@ use crate::render::{BakePlan, Lighting};
 use crate::scene::{Scene, Shape, TexelSource};
 use crate::types::{HeightImageParams, HeightfieldParams};
 
-/// Index of the bake for `texel` with the given lighting, added if new.
+/// Index of the bake for `texel` with the given lighting, added if new; `time`: the frame's
+/// (animated hypertextures are baked at it).
 pub(super) fn bake_index(
     scene: &Scene,
     texel: &str,
     per_pixel: bool,
     light: &Lighting,
+    time: f64,
     bakes: &mut Vec<BakePlan>,
 ) -> Result<usize> {
     if let Some(i) = bakes.iter().position(|b| b.texel == texel && b.request.per_pixel == per_pixel) {
@@ -114,6 +117,13 @@ pub(super) fn bake_index(
                 filled,
             ))
         }
+        TexelSource::Hypertexture { name, bounds } => {
+            let h = scene.hypertextures.get(&name.value).ok_or_else(|| {
+                Error::Invalid(format!("{}: unknown hypertexture `{}`", scene.path.display(), name.value))
+            })?;
+            let bounds = bounds.as_ref().map(|b| (b.lo, b.hi));
+            BakeSource::Hypertexture(Box::new(HyperTexel::new(h, bounds, t.resolution, time)))
+        }
         TexelSource::Constant { color, opacity } => {
             BakeSource::Implicit(pack_shapes(&[(BakeShape::Constant, *color, *opacity)]))
         }
@@ -130,7 +140,7 @@ pub(super) fn bake_index(
             ambient: light.ambient,
             axis_slices: false,
         },
-        opacity_length: t.opacity_length,
+        opacity_length: t.opacity_length(&scene.hypertextures),
     });
     Ok(bakes.len() - 1)
 }
@@ -140,9 +150,10 @@ pub(super) fn bake_index_axis(
     scene: &Scene,
     texel: &str,
     light: &Lighting,
+    time: f64,
     bakes: &mut Vec<BakePlan>,
 ) -> Result<usize> {
-    let i = bake_index(scene, texel, false, light, bakes)?;
+    let i = bake_index(scene, texel, false, light, time, bakes)?;
     bakes[i].request.axis_slices = true;
     Ok(i)
 }

@@ -74,7 +74,7 @@ fn defaults() {
     .unwrap();
     assert_eq!(s.ambient, 0.2);
     assert_eq!(s.camera.up, DVec3::Z);
-    assert_eq!(s.texels["t"].opacity_length, 0.05);
+    assert_eq!(s.texels["t"].opacity_length(&s.hypertextures), 0.05);
     let n = &s.nodes[0];
     assert_eq!((n.height.length, n.uv_tiling), (0.1, [1.0, 1.0]));
     assert_eq!(n.transform, Transform::default());

@@ -134,14 +134,29 @@ fn one_f32() -> f32 {
 pub struct Texel {
     #[serde(deserialize_with = "v::resolution")]
     pub resolution: [u32; 3],
-    /// World length over which a voxel's stored alpha is reached.
-    #[serde(default = "default_opacity_length", deserialize_with = "v::positive_f32")]
-    pub opacity_length: f32,
+    /// World length over which a voxel's stored alpha is reached (see [`Texel::opacity_length`]).
+    #[serde(default, rename = "opacity_length", deserialize_with = "v::opt_positive_f32")]
+    pub opacity_length_given: Option<f32>,
     pub source: TexelSource,
 }
 
-fn default_opacity_length() -> f32 {
-    0.05
+/// A texel's opacity length when the file gives none (and its source has no length of its own).
+pub const DEFAULT_OPACITY_LENGTH: f32 = 0.05;
+
+impl Texel {
+    /// The world length over which a voxel's stored alpha is reached: as given, else for a
+    /// hypertexture source the hypertexture's own opacity length (a baked voxel stores the
+    /// transfer function's opacity, which RayMarch reaches over that world length), else
+    /// [`DEFAULT_OPACITY_LENGTH`].
+    pub fn opacity_length(&self, hypertextures: &BTreeMap<String, super::Hypertexture>) -> f32 {
+        let own = match &self.source {
+            TexelSource::Hypertexture { name, .. } => {
+                hypertextures.get(&name.value).map(|h| h.opacity_length as f32)
+            }
+            _ => None,
+        };
+        self.opacity_length_given.or(own).unwrap_or(DEFAULT_OPACITY_LENGTH)
+    }
 }
 
 #[derive(Debug, Clone, PartialEq, Deserialize)]
@@ -220,6 +235,19 @@ pub enum TexelSource {
         opacity: f32,
         #[serde(default = "yes")]
         fill: bool,
+    },
+    /// A hypertexture of `hypertextures` (Meyer & Neyret 1998, 3.3) sampled at the voxel centres
+    /// of the box `bounds` of its object space (default: its enlarged bounds, every detail
+    /// inside), which maps onto texel space [0,1]^3: colour and opacity from its transfer
+    /// function, shading from its density gradient (`bake_hypertexture.wgsl`). Animated noises
+    /// are baked at the scene's time. The texel's `opacity_length` is the hypertexture's (both
+    /// are world lengths, and a voxel stores the transfer function's opacity): drawn at any
+    /// scale, the texel is as opaque as RayMarch draws the hypertexture at that scale. Another
+    /// length given in the file is used, with a warning.
+    Hypertexture {
+        name: Mark<String>,
+        #[serde(default)]
+        bounds: Option<Mark<MeshBounds>>,
     },
     /// A uniform volume (analytic tests).
     Constant {

@@ -158,6 +158,59 @@ impl Checker<'_> {
         }
     }
 
+    /// A hypertexture texel: a known hypertexture, a box with volume, a volume the bake can
+    /// afford; an opacity length other than the hypertexture's warns (the texel would not be as
+    /// opaque as RayMarch draws the hypertexture).
+    fn texel_hypertexture(
+        &mut self,
+        texel: &str,
+        t: &Texel,
+        name: &Mark<String>,
+        bounds: Option<&Mark<MeshBounds>>,
+    ) {
+        let resolution = t.resolution;
+        let Some(h) = self.scene.hypertextures.get(&name.value) else {
+            let names: Vec<String> = self.scene.hypertextures.keys().map(|k| format!("\"{k}\"")).collect();
+            let expected = if names.is_empty() {
+                "no hypertextures are defined in `hypertextures`".to_string()
+            } else {
+                format!("expected one of {}", names.join(", "))
+            };
+            return self.fail(name, format!("unknown hypertexture \"{}\": {expected}", name.value));
+        };
+        if let Some(given) = t.opacity_length_given {
+            let own = h.opacity_length as f32;
+            if (given / own - 1.0).abs() > 1e-4 {
+                let msg = format!(
+                    "texel \"{texel}\": an opacity_length of {given} makes the baked hypertexture \"{}\" {} opaque \
+                     than RayMarch draws it (its opacity_length is {own}; leave the texel's out to take it)",
+                    name.value,
+                    if given < own { "more" } else { "less" }
+                );
+                self.f.warnings.push((Some(name.seq), msg));
+            }
+        }
+        let voxels: u64 = resolution.iter().map(|&r| r as u64).product();
+        if voxels > MAX_HYPERTEXTURE_VOXELS {
+            let msg = format!(
+                "texel \"{texel}\": a resolution of {resolution:?} is {voxels} voxels: a hypertexture bake takes at most \
+                 {MAX_HYPERTEXTURE_VOXELS} (256^3)"
+            );
+            return self.fail(name, msg);
+        }
+        if let Some(b) = bounds {
+            if let Some(a) = (0..3).find(|&a| b.lo[a] >= b.hi[a]) {
+                let msg = format!(
+                    "expected `lo` below `hi` on every axis, found {} >= {} on {}",
+                    b.lo[a],
+                    b.hi[a],
+                    ["x", "y", "z"][a]
+                );
+                self.fail(b, msg);
+            }
+        }
+    }
+
     /// A 2D shape transfer function's image: 2 to 256 columns (noise), 2 to 64 rows (density).
     fn shape_image(&mut self, path: &Mark<String>) {
         use super::hypertexture::{MAX_ROWS, MAX_TABLE};
@@ -374,6 +427,9 @@ impl Checker<'_> {
     }
 }
 
+/// Most voxels of a texel baked from a hypertexture (seven density evaluations each).
+pub const MAX_HYPERTEXTURE_VOXELS: u64 = 1 << 24;
+
 /// More samples than this along one ray means a step far finer than any scene needs.
 pub const MAX_SAMPLES_PER_RAY: f64 = 1e5;
 
@@ -405,6 +461,9 @@ pub(super) fn check(scene: &Scene, dir: &Path) -> Findings {
             TexelSource::ImageHeight { image, channel, .. } => c.image_channel(image, *channel, image),
             TexelSource::Slices { dir } => c.stack(dir, t.resolution),
             TexelSource::Sequence { texels, .. } => c.sequence(texels, t.resolution),
+            TexelSource::Hypertexture { name: h, bounds } => {
+                c.texel_hypertexture(name, t, h, bounds.as_ref())
+            }
             _ => {}
         }
     }

@@ -110,6 +110,7 @@ adapter!(slice_pixels, f64, SlicePixels, |v| v.0);
 adapter!(max_angle, f64, MaxAngle, |v| v.0);
 adapter!(finite_f32, f32, Finite, |v| v.0 as f32);
 adapter!(positive_f32, f32, Positive, |v| v.0 as f32);
+adapter!(opt_positive_f32, Option<f32>, Option<Positive>, |v| v.map(|x| x.0 as f32));
 adapter!(non_negative_f32, f32, NonNegative, |v| v.0 as f32);
 adapter!(unit_f32, f32, Unit, |v| v.0 as f32);
 adapter!(vec3, DVec3, [Finite; 3], |v| DVec3::new(v[0].0, v[1].0, v[2].0));
