@@ -251,7 +251,7 @@ pub struct AxisParams {
     /// between slices (pixels); z: maximum view angle the criteria are evaluated at (radians);
     /// w: focal length in pixels (half the image height over tan(fov_y / 2)).
     pub criteria: [f32; 4],
-    /// xyz: unit camera forward; w: unused.
+    /// xyz: unit camera forward; w: 1 when the eye is inside a prism of the shell, else 0.
     pub forward: [f32; 4],
     /// x: allowed directions (bit i for direction i); y: vertex capacity; z: back-face culling
     /// (0/1); w: empty-texel culling (0/1).

@@ -579,3 +579,69 @@ fn triangle_counts_and_times() {
         );
     }
 }
+
+/// A fog slab (height 1) with the eye at height `EYE_Z` looking 30 degrees off straight up
+/// (`TARGET_Z` = `EYE_Z` + cos 30), drawn with `METHOD`.
+const INSIDE_FOG: &str = r#"Scene(
+    output: (width: 32, height: 32),
+    camera: (eye: (0.1, 0.07, EYE_Z), target: (0.1, 0.57, TARGET_Z), up: (0.0, 1.0, 0.0), fov_y: 20.0),
+    background: (0.1, 0.2, 0.3),
+    ambient: 1.0,
+    texels: { "fog": (resolution: (8, 8, 8), opacity_length: 1.0, source: Constant(color: (0.8, 0.6, 0.4), opacity: 0.5)) },
+    nodes: [(name: "slab", surface: Plane(size: (4.0, 4.0), cells: (4, 4)), height: (length: 1.0), texel: "fog",
+             method: METHOD)],
+)"#;
+
+fn inside_fog(z: f32) -> String {
+    let target = z + 30f32.to_radians().cos();
+    INSIDE_FOG.replace("EYE_Z", &format!("{z:?}")).replace("TARGET_Z", &format!("{target:?}"))
+}
+
+/// The eye inside the shell: the choice and the slices of every prism equal their twins (with the
+/// slab holding the eye split in two), and the fog seen from inside has the analytic
+/// transmittance `(1 - a)^(L / opacity_length)` over the path `L` from the eye to the slab's top,
+/// at heights on and off the slice planes, as the Reference has it. Before the eye was handled,
+/// the slab holding the eye was drawn whole or, behind the eye, not at all.
+#[test]
+fn eye_inside_the_shell_sees_the_analytic_transmittance() {
+    let axis = "AxisSlices(blend: Blended)";
+    let camera_inside = voltex::project_root().join("scenes/hard_cases/camera_inside.ron");
+    let opts = RenderOptions { method: Some(MethodKind::AxisSlices), ..Default::default() };
+    assert!(gpu_and_twin(&camera_inside, &opts) > 0);
+    let scene = scene::load(&camera_inside).unwrap();
+    let bp = Blueprint::new(&scene, &opts).unwrap();
+    let plan = bp.objects[0].axis.as_ref().unwrap();
+    assert_eq!(plan.params.forward[3], 1.0, "the eye is inside the shell");
+    for z in [0.3f32, 0.4375, 0.81] {
+        let source = inside_fog(z);
+        let img = render(&source.replace("METHOD", axis), &RenderOptions::default());
+        let reference = render(
+            &source.replace("METHOD", axis),
+            &RenderOptions { method: Some(MethodKind::Reference), ..Default::default() },
+        );
+        // The four centre pixels: rays within 0.5 degrees of the axis.
+        let centre = |img: &Image| {
+            let at = |x: u32, y: u32| img.pixels[(y * img.width + x) as usize][0];
+            (at(15, 15) + at(16, 15) + at(15, 16) + at(16, 16)) / 4.0
+        };
+        let length = (1.0 - z) / 30f32.to_radians().cos();
+        let t = 0.5f32.powf(length);
+        let analytic = 0.8 * (1.0 - t) + 0.1 * t;
+        let (a, r) = (centre(&img), centre(&reference));
+        eprintln!("eye at height {z}: AxisSlices {a:.4}, Reference {r:.4}, analytic {analytic:.4}");
+        assert!((a - analytic).abs() < 0.01, "height {z}: AxisSlices {a} against {analytic}");
+        assert!((r - analytic).abs() < 0.01, "height {z}: Reference {r} against {analytic}");
+        let bp = Blueprint::new(
+            &scene::parse(&source.replace("METHOD", axis), Path::new("inline.ron")).unwrap(),
+            &RenderOptions::default(),
+        )
+        .unwrap();
+        assert_eq!(bp.objects[0].axis.as_ref().unwrap().params.forward[3], 1.0);
+    }
+    // The eye above the shell: the flag is off, the kernels keep the paper's criteria.
+    let above = inside_fog(1.5).replace("METHOD", axis);
+    let bp =
+        Blueprint::new(&scene::parse(&above, Path::new("inline.ron")).unwrap(), &RenderOptions::default())
+            .unwrap();
+    assert_eq!(bp.objects[0].axis.as_ref().unwrap().params.forward[3], 0.0);
+}

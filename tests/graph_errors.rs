@@ -119,6 +119,7 @@ fn frame_graph_parses_and_plans() {
         &["ViewSlices", "BaseSurface"],
         &["Reference"],
         &["AxisSlices", "AxisSlicesBinary"],
+        &["AxisSlices", "AxisSlicesBinary", "AxisSlicesBySlice"],
         &["AxisSlices", "AxisSlicesBlended"],
         &["RayMarch"],
     ];
@@ -130,6 +131,8 @@ fn frame_graph_parses_and_plans() {
             "choose_axis_slices",
             "scan_axis_slices",
             "emit_axis_slices",
+            "scan_axis_layers",
+            "group_axis_slices",
             "draw_axis_slices",
             "count_slices",
             "scan_plane_offsets",

@@ -22,10 +22,18 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (axis_params.flags.z != 0u && back_facing(&f)) {
         c.culled = 1u;
     } else {
+        let n = f32(level_slices(axis_params.resolution[c.direction], c.level));
+        let xe = eye_slice(&f, c);
         for (var j = 0u; j < c.count; j++) {
             let g = slice_position(c, j);
-            if (slice_occupied(c, g)) {
-                c.vertex_count += slice_vertex_count(&f, c, g);
+            if (!slice_occupied(c, g)) {
+                continue;
+            }
+            if (splits_at_eye(g, xe)) {
+                let parts = split_slab(g, xe, n);
+                c.vertex_count += slice_vertex_count(&f, c, parts.x) + slice_vertex_count(&f, c, parts.y);
+            } else {
+                c.vertex_count += slice_vertex_count(&f, c, (f32(g) + 0.5) / n);
             }
         }
     }

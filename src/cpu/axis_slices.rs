@@ -123,9 +123,94 @@ pub fn level_for(r: u32, needed: f32) -> u32 {
     level
 }
 
+/// The eye's texture coordinate (s, t or w) in the prism's frame: the eye is the origin of the
+/// camera-relative positions, and a coordinate grows by 1 over the axis' thickness from the
+/// centre (s, t: the mean corner uv; w: 1/2). A huge negative value for an unusable direction.
+pub fn eye_coordinate(f: &AxisFrame, d: usize) -> f32 {
+    let axis = f.axes[d];
+    if axis.w <= 0.0 || (d < 2 && !f.has_uv) {
+        return -3.0e38;
+    }
+    let mid = if d < 2 { (f.uv[0][d] + f.uv[1][d] + f.uv[2][d]) / 3.0 } else { 0.5 };
+    mid - f.centre.dot(axis.truncate()) / axis.w
+}
+
+/// The eye inside the shell (the host's test, `forward[3]`) and within this prism's height
+/// range: rays from the eye may leave the layer through its top or bottom before reaching a
+/// coarse slab's one slice, so the criteria (made for an eye outside) give way to the finest level.
+pub fn eye_in_layer(f: &AxisFrame, params: &AxisParams) -> bool {
+    let w = eye_coordinate(f, 2);
+    params.forward[3] != 0.0 && (0.0..=1.0).contains(&w)
+}
+
+/// The eye in the prism's box of texture coordinates widened by one finest slice: there the
+/// camera's forward, not the direction to the centre, says which way the rays go.
+pub fn eye_near(f: &AxisFrame, params: &AxisParams) -> bool {
+    (0..2).all(|d| {
+        let c = f.uv.map(|uv| uv[d]);
+        let (lo, hi) = (c[0].min(c[1]).min(c[2]), c[0].max(c[1]).max(c[2]));
+        let margin = 1.0 / params.resolution[d] as f32;
+        let e = eye_coordinate(f, d);
+        !(e < lo - margin || e > hi + margin)
+    })
+}
+
+/// The eye's position in slices of the chosen level (slice g spans `[g, g + 1]`) when the eye is
+/// in the prism's layer, else a huge negative value: slices are then drawn farthest from the eye
+/// first on both of its sides, and the slab holding the eye is split at it.
+pub fn eye_slice(f: &AxisFrame, params: &AxisParams, c: &AxisChoice) -> f32 {
+    if !eye_in_layer(f, params) {
+        return -3.0e38;
+    }
+    let e = eye_coordinate(f, c.direction as usize);
+    if e < -1.0e30 {
+        return e;
+    }
+    e * level_slices(params.resolution[c.direction as usize], c.level) as f32
+}
+
+/// Whether slab `g` holds the eye at `xe` (in slices): a ray from the eye sees only the part on
+/// its own side, so each part is drawn as its own slice.
+pub fn splits_at_eye(g: i32, xe: f32) -> bool {
+    xe > g as f32 && xe < (g + 1) as f32
+}
+
+/// The two parts of slab `g` split at `xe`: texture coordinates of their middles and their
+/// thicknesses in slices, for `n` slices per tile.
+pub fn split_slab(g: i32, xe: f32, n: f32) -> ([f32; 2], [f32; 2]) {
+    let below = xe - g as f32;
+    let above = (g + 1) as f32 - xe;
+    ([(g as f32 + 0.5 * below) / n, (xe + 0.5 * above) / n], [below, above])
+}
+
+/// The slices of a choice in draw order: back to front, or with the eye in the layer, the two
+/// ends of the remaining range, farthest from the eye first (each side of the eye back to front).
+pub fn draw_order(c: &AxisChoice, xe: f32) -> Vec<i32> {
+    let (mut lo, mut hi) = (c.first, c.first + c.count as i32 - 1);
+    (0..c.count)
+        .map(|j| {
+            if xe <= -1.0e30 {
+                return slice_position(c, j);
+            }
+            if (lo as f32 + 0.5 - xe).abs() > (hi as f32 + 0.5 - xe).abs() {
+                lo += 1;
+                lo - 1
+            } else {
+                hi -= 1;
+                hi + 1
+            }
+        })
+        .collect()
+}
+
 /// Direction, level and slice range of a prism; `vertex_count` and the offset are left at 0.
 pub fn choose_axis(f: &AxisFrame, params: &AxisParams) -> AxisChoice {
-    let view = f.centre.normalize();
+    let inside = eye_in_layer(f, params);
+    let view = if inside && eye_near(f, params) {
+        Vec4::from(params.forward).truncate()
+    } else {
+        f.centre.normalize()
+    };
     let (mut best, mut best_score) = (2usize, 3.4e38f32);
     for k in 0..3 {
         let d = (k + 2) % 3;
@@ -141,7 +226,7 @@ pub fn choose_axis(f: &AxisFrame, params: &AxisParams) -> AxisChoice {
     let r = params.resolution[best];
     let z = f.centre.dot(Vec4::from(params.forward).truncate());
     let needed = needed_slices(params, r, axis.truncate().dot(view).abs(), axis.w, z);
-    let level = level_for(r, needed);
+    let level = if inside { 0 } else { level_for(r, needed) };
     let n = level_slices(r, level);
     let (mut first, mut count) = (0, n);
     if best < 2 {
@@ -220,50 +305,61 @@ pub fn emit_axis_slices(
     let r = params.resolution[d];
     let n = level_slices(r, c.level);
     let layer0 = level_layer(r, c.level);
-    let axis = f.axes[d];
-    let normal = axis.truncate().extend(0.0).to_array();
-    let thickness = axis.w / n as f32;
+    let slab = f.axes[d].w / n as f32;
+    let xe = eye_slice(f, params, c);
     let mut out = Vec::new();
-    for j in 0..c.count {
-        let g = slice_position(c, j);
+    for g in draw_order(c, xe) {
         if !occupied(c, params, occupancy, g) {
             continue;
         }
-        let layer = (layer0 + slice_layer(g, n)) as f32;
-        let x = (g as f32 + 0.5) / n as f32;
-        if d == 2 {
-            for i in 0..3 {
-                let p = f.bottom[i].lerp(f.top[i], x);
-                out.push(AxisVertex {
-                    position: p.extend(thickness).to_array(),
-                    texcoord: [f.uv[i].x, f.uv[i].y, layer, 2.0],
-                    normal,
-                });
-            }
-            continue;
-        }
-        let hits = crossings(f, d, x);
-        if hits.len() < 2 {
-            continue;
-        }
-        let other = 1 - d;
-        let ends: Vec<(Vec3, f32, f32)> = hits[..2]
-            .iter()
-            .flat_map(|&(a, b, l)| {
-                let u = f.uv[a][other] + (f.uv[b][other] - f.uv[a][other]) * l;
-                [(f.bottom[a].lerp(f.bottom[b], l), u, 0.0), (f.top[a].lerp(f.top[b], l), u, 1.0)]
-            })
-            .collect();
-        for k in [0, 2, 3, 0, 3, 1] {
-            let (p, u, v) = ends[k];
-            out.push(AxisVertex {
-                position: p.extend(thickness).to_array(),
-                texcoord: [u, v, layer, d as f32],
-                normal,
-            });
+        let layer = layer0 + slice_layer(g, n);
+        if splits_at_eye(g, xe) {
+            let (x, parts) = split_slab(g, xe, n as f32);
+            emit_slice(f, d, x[0], parts[0] * slab, layer, &mut out);
+            emit_slice(f, d, x[1], parts[1] * slab, layer, &mut out);
+        } else {
+            emit_slice(f, d, (g as f32 + 0.5) / n as f32, slab, layer, &mut out);
         }
     }
     out
+}
+
+/// The slice of direction `d` at texture coordinate `x` standing for a slab `thickness` (world)
+/// thick: a triangle (w) or a ruled quad (s, t; nothing when the line misses the uv triangle).
+fn emit_slice(f: &AxisFrame, d: usize, x: f32, thickness: f32, layer: u32, out: &mut Vec<AxisVertex>) {
+    let normal = f.axes[d].truncate().extend(0.0).to_array();
+    let layer = layer as f32;
+    if d == 2 {
+        for i in 0..3 {
+            let p = f.bottom[i].lerp(f.top[i], x);
+            out.push(AxisVertex {
+                position: p.extend(thickness).to_array(),
+                texcoord: [f.uv[i].x, f.uv[i].y, layer, 2.0],
+                normal,
+            });
+        }
+        return;
+    }
+    let hits = crossings(f, d, x);
+    if hits.len() < 2 {
+        return;
+    }
+    let other = 1 - d;
+    let ends: Vec<(Vec3, f32, f32)> = hits[..2]
+        .iter()
+        .flat_map(|&(a, b, l)| {
+            let u = f.uv[a][other] + (f.uv[b][other] - f.uv[a][other]) * l;
+            [(f.bottom[a].lerp(f.bottom[b], l), u, 0.0), (f.top[a].lerp(f.top[b], l), u, 1.0)]
+        })
+        .collect();
+    for k in [0, 2, 3, 0, 3, 1] {
+        let (p, u, v) = ends[k];
+        out.push(AxisVertex {
+            position: p.extend(thickness).to_array(),
+            texcoord: [u, v, layer, d as f32],
+            normal,
+        });
+    }
 }
 
 /// Twin of `bake_axis_slices`: every level of every direction from an RGBA8 premultiplied volume

@@ -42,7 +42,7 @@ impl AxisPlan {
         let mut params = AxisParams {
             resolution: [resolution[0], resolution[1], resolution[2], shell.prisms.len() as u32],
             criteria: [m.depth as f32, m.pixels as f32, m.max_angle.to_radians() as f32, focal as f32],
-            forward: [forward[0], forward[1], forward[2], 0.0],
+            forward: [forward[0], forward[1], forward[2], eye_inside(shell) as u32 as f32],
             flags: [directions, 0, m.back_face_culling as u32, m.empty_culling as u32],
         };
         let distance = |p: &Prism| {
@@ -79,7 +79,33 @@ impl AxisPlan {
     }
 }
 
-/// Upper bound of a prism's vertices: its finest level in whichever allowed direction has most.
+/// Whether the eye (the origin of the camera-relative shell) is inside a prism of the shell: the
+/// kernels then slice the prisms whose layer holds the eye at the finest level and split the slab
+/// holding the eye at it (`eye_in_layer` in `wgsl/shared/axis_slices.wgsl`).
+pub fn eye_inside(shell: &Shell) -> bool {
+    use crate::cpu::prism_map::{inverse, PrismCorners};
+    use glam::{DVec3, Vec4Swizzles};
+    shell.prisms.iter().any(|p| {
+        let s = glam::Vec4::from(p.sphere);
+        if s.xyz().length() > s.w {
+            return false;
+        }
+        let v = |i: usize, top: bool| {
+            let x = &shell.vertices[p.vertices[i] as usize];
+            let c = if top { x.top } else { x.bottom };
+            DVec3::new(c[0] as f64, c[1] as f64, c[2] as f64)
+        };
+        let corners = PrismCorners {
+            bottom: [v(0, false), v(1, false), v(2, false)],
+            top: [v(0, true), v(1, true), v(2, true)],
+            ids: [p.vertices[0], p.vertices[1], p.vertices[2]],
+        };
+        inverse(DVec3::ZERO, &corners).is_some()
+    })
+}
+
+/// Upper bound of a prism's vertices: its finest level in whichever allowed direction has most,
+/// plus one slice (the slab holding the eye is drawn as two).
 fn finest_vertices(shell: &Shell, index: usize, params: &AxisParams) -> u64 {
     let f = AxisFrame::of_shell(shell, index);
     (0..3)
@@ -87,12 +113,12 @@ fn finest_vertices(shell: &Shell, index: usize, params: &AxisParams) -> u64 {
         .map(|d| {
             let r = params.resolution[d];
             if d == 2 {
-                return 3 * r as u64;
+                return 3 * (r as u64 + 1);
             }
             let c = f.uv.map(|uv| uv[d]);
             let (lo, hi) = (c[0].min(c[1]).min(c[2]), c[0].max(c[1]).max(c[2]));
             let span = ((hi - lo) * r as f32).ceil() as u64 + 2;
-            6 * span.min(twin::MAX_PRISM_SLICES as u64)
+            6 * (span.min(twin::MAX_PRISM_SLICES as u64) + 1)
         })
         .max()
         .unwrap_or(0)

@@ -112,9 +112,55 @@ fn direction_score(f: ptr<function, AxisFrame>, d: u32, view: vec3<f32>) -> f32 
     return (1.0 / (c * c) - 1.0) * h * h;
 }
 
+// The eye's texture coordinate (s, t or w) in the prism's frame: positions are camera-relative,
+// so the eye is the origin, and the coordinate grows by 1 over the axis' thickness from the
+// centre (s, t: the mean corner uv; w: 1/2). A huge negative value for an unusable direction.
+fn eye_coordinate(f: ptr<function, AxisFrame>, d: u32) -> f32 {
+    let axis = (*f).axes[d];
+    if (axis.w <= 0.0 || (d < 2u && !(*f).has_uv)) {
+        return -3.0e38;
+    }
+    var mid = 0.5;
+    if (d < 2u) {
+        mid = ((*f).uv[0][d] + (*f).uv[1][d] + (*f).uv[2][d]) / 3.0;
+    }
+    return mid - dot((*f).centre, axis.xyz) / axis.w;
+}
+
+// The eye inside the shell (the host's test, forward.w) and within this prism's height range:
+// rays from the eye run inside the layer and may leave it through its top or bottom before
+// reaching a coarse slab's one slice, so the criteria (made for an eye outside) do not apply.
+fn eye_in_layer(f: ptr<function, AxisFrame>) -> bool {
+    let w = eye_coordinate(f, 2u);
+    return axis_params.forward.w != 0.0 && w >= 0.0 && w <= 1.0;
+}
+
+// The eye in the prism's box of texture coordinates widened by one finest slice: the direction
+// from the eye to the centre says nothing of the rays through it, the camera's forward does.
+fn eye_near(f: ptr<function, AxisFrame>) -> bool {
+    for (var d = 0u; d < 2u; d++) {
+        var lo = (*f).uv[0][d];
+        var hi = lo;
+        for (var i = 1u; i < 3u; i++) {
+            lo = min(lo, (*f).uv[i][d]);
+            hi = max(hi, (*f).uv[i][d]);
+        }
+        let margin = 1.0 / f32(axis_params.resolution[d]);
+        let e = eye_coordinate(f, d);
+        if (e < lo - margin || e > hi + margin) {
+            return false;
+        }
+    }
+    return true;
+}
+
 // Direction, level and slice range of a prism (vertex_count and offset filled by the caller).
 fn choose_axis(f: ptr<function, AxisFrame>) -> AxisChoice {
-    let view = normalize((*f).centre);
+    let inside = eye_in_layer(f);
+    var view = normalize((*f).centre);
+    if (inside && eye_near(f)) {
+        view = axis_params.forward.xyz;
+    }
     var best = 2u;
     var best_score = 3.4e38;
     // w first so that it wins ties, then s, t.
@@ -139,9 +185,10 @@ fn choose_axis(f: ptr<function, AxisFrame>) -> AxisChoice {
     let needed_pixels = axis.w * sin(a) * axis_params.criteria.w / (z * axis_params.criteria.y);
     let needed = clamp(min(needed_depth, needed_pixels), 1.0, f32(r));
     // The coarsest power-of-two level that still has at least `needed` slices.
+    // Inside the layer: the finest level (every voxel slice).
     var level = 0u;
     let levels = level_count(r);
-    while (level + 1u < levels && f32(level_slices(r, level + 1u)) >= needed) {
+    while (!inside && level + 1u < levels && f32(level_slices(r, level + 1u)) >= needed) {
         level++;
     }
     let n = level_slices(r, level);
@@ -193,14 +240,12 @@ fn slice_occupied(c: AxisChoice, g: i32) -> bool {
     return axis_occupancy[occupancy_base(c.direction, c.level) + slice_layer(g, n)] != 0u;
 }
 
-// Triangle-list vertices of one slice: 3 for a w slice, 6 for a ruled quad (0 if the line
-// misses the uv triangle).
-fn slice_vertex_count(f: ptr<function, AxisFrame>, c: AxisChoice, g: i32) -> u32 {
+// Triangle-list vertices of one slice at texture coordinate x: 3 for a w slice, 6 for a ruled
+// quad (0 if the line misses the uv triangle).
+fn slice_vertex_count(f: ptr<function, AxisFrame>, c: AxisChoice, x: f32) -> u32 {
     if (c.direction == 2u) {
         return 3u;
     }
-    let n = level_slices(axis_params.resolution[c.direction], c.level);
-    let x = (f32(g) + 0.5) / f32(n);
     var crossings = 0u;
     for (var e = 0u; e < 3u; e++) {
         let a = (*f).uv[e][c.direction];
@@ -210,4 +255,32 @@ fn slice_vertex_count(f: ptr<function, AxisFrame>, c: AxisChoice, g: i32) -> u32
         }
     }
     return select(0u, 6u, crossings == 2u);
+}
+
+// The eye's position in units of the chosen level's slices (slice g spans [g, g + 1]) when the
+// eye is in the prism's layer, else a huge negative value: slices are then drawn farthest from
+// the eye first (on both of its sides) and the slab holding the eye is split at the eye.
+fn eye_slice(f: ptr<function, AxisFrame>, c: AxisChoice) -> f32 {
+    if (!eye_in_layer(f)) {
+        return -3.0e38;
+    }
+    let e = eye_coordinate(f, c.direction);
+    if (e < -1.0e30) {
+        return e;
+    }
+    return e * f32(level_slices(axis_params.resolution[c.direction], c.level));
+}
+
+// Slab g split at the eye (xe inside it): a ray from the eye sees only the part on its own side,
+// so each part is drawn as its own slice at its middle with its own thickness (in slices).
+fn splits_at_eye(g: i32, xe: f32) -> bool {
+    return xe > f32(g) && xe < f32(g + 1);
+}
+
+// The two parts of slab g split at xe: texture coordinates of their middles (x, y) and their
+// thicknesses in slices (z, w), for `n` slices per tile.
+fn split_slab(g: i32, xe: f32, n: f32) -> vec4<f32> {
+    let below = xe - f32(g);
+    let above = f32(g + 1) - xe;
+    return vec4<f32>((f32(g) + 0.5 * below) / n, (xe + 0.5 * above) / n, below, above);
 }

@@ -141,7 +141,7 @@ struct ReferenceState {
 struct AxisParams {
     resolution: vec4<u32>,
     criteria: vec4<f32>,
-    forward: vec4<f32>,
+    forward: vec4<f32>, // w: 1 when the eye is inside a prism of the shell
     flags: vec4<u32>,
 }
 
