@@ -37,6 +37,9 @@ pub const COUNTS: &[&str] = &[
     "reference_dispatches",
     "ray_march_dispatches",
     "transfer_functions",
+    "surface_splats",
+    "peel_blocks",
+    "peel_phases",
 ];
 
 struct Texture {

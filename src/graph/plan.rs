@@ -19,6 +19,7 @@ pub const OBJECT_FILTERS: &[&str] = &[
     "AxisSlicesBinary",
     "AxisSlicesBlended",
     "RayMarch",
+    "RayMarchPeeling",
 ];
 
 /// What the planner needs to know of a scene object.

@@ -1,0 +1,104 @@
+// Depth peeling (Gilet & Dischler 2009, section 5.2): one thread per surface splat and footprint block intersects the rays of its screen footprint with the splat's disk and keeps per pixel the nearest entry (front-facing) or exit (back-facing) beyond the previous boundary. CPU twin: src/cpu/peel_segments.rs.
+#include "shared/types.wgsl"
+#include "shared/segments.wgsl"
+
+// The pass is dispatched twice per peel (`peel_phases`): entries, then exits. Phase p reads
+// boundary slot p of each pixel (final since the previous dispatch) and lowers slot p + 1 with
+// atomicMin on the f32 bits (t > 0, so the bits order as the numbers do). Which phase a dispatch
+// is comes from a ticket: every workgroup takes one, and each dispatch takes exactly as many as
+// it has workgroups, so ticket / workgroups is the dispatch's index.
+// A footprint is cut into blocks of `segments.counts.w` pixels (one per invocation along y) so
+// that no invocation loops more than lavapipe's 65535 iterations.
+
+@group(0) @binding(0) var<uniform> frame: FrameParams;
+@group(0) @binding(1) var<uniform> hyper: HyperParams;
+@group(0) @binding(2) var<uniform> segments: SegmentParams;
+@group(0) @binding(3) var<storage, read> surface_splats: array<Splat>;
+@group(0) @binding(4) var<storage, read_write> segment_bounds: array<atomic<u32>>;
+@group(0) @binding(5) var<storage, read_write> peel_tickets: array<atomic<u32>>;
+
+var<workgroup> ticket: u32;
+
+// Screen coordinate range (lo, hi) along unit axis `a` (scaled by `scale`, the half extent at
+// unit depth) of a sphere at camera-relative c with radius r in front of the camera (depth z - r > 0):
+// x / z is monotonic in z for fixed x, so the extremes are at the depth range's ends.
+fn screen_range(c: vec3<f32>, r: f32, z: f32, axis: vec3<f32>, scale: f32) -> vec2<f32> {
+    let a = dot(c, axis);
+    let lo = min((a - r) / (z - r), (a - r) / (z + r));
+    let hi = max((a + r) / (z - r), (a + r) / (z + r));
+    return vec2<f32>(lo, hi) / scale;
+}
+
+@compute @workgroup_size(64, 1, 1)
+fn main(
+    @builtin(global_invocation_id) id: vec3<u32>,
+    @builtin(local_invocation_index) local: u32,
+    @builtin(num_workgroups) groups: vec3<u32>,
+) {
+    if (local == 0u) {
+        ticket = atomicAdd(&peel_tickets[0], 1u);
+    }
+    let phase = workgroupUniformLoad(&ticket) / (groups.x * groups.y * groups.z);
+    if (id.x >= segments.counts.x || phase >= 2u * segments.counts.z) {
+        return;
+    }
+    let splat = surface_splats[id.x];
+    let centre = splat.center.xyz;
+    let normal = splat.normal.xyz;
+    let radius = splat.center.w;
+    let size = vec2<u32>(frame.viewport.xy);
+    // The footprint: the screen rectangle of the disk's bounding sphere (the whole screen when
+    // the sphere reaches the eye's plane).
+    let c = (segments.from_local * vec4<f32>(centre, 1.0)).xyz;
+    let r = radius * segments.surface.y;
+    let forward = frame.forward.xyz;
+    let z = dot(c, forward);
+    if (z + r <= hyper.right.w) {
+        return;
+    }
+    var lo = vec2<i32>(0, 0);
+    var hi = vec2<i32>(size) - vec2<i32>(1);
+    if (z - r > 0.5 * hyper.right.w) {
+        let width = length(hyper.right.xyz);
+        let height = length(hyper.up.xyz);
+        let sx = screen_range(c, r, z, hyper.right.xyz / width, width);
+        let sy = screen_range(c, r, z, hyper.up.xyz / height, height);
+        let w = f32(size.x);
+        let h = f32(size.y);
+        // Clamped as floats first: far outside the screen they may not fit an i32.
+        let limit = vec2<f32>(size);
+        let a = clamp(floor(vec2<f32>((sx.x + 1.0) * 0.5 * w, (1.0 - sy.y) * 0.5 * h) - 0.5), vec2<f32>(-1.0), limit);
+        let b = clamp(ceil(vec2<f32>((sx.y + 1.0) * 0.5 * w, (1.0 - sy.x) * 0.5 * h) - 0.5), vec2<f32>(-1.0), limit);
+        lo = max(lo, vec2<i32>(a));
+        hi = min(hi, vec2<i32>(b));
+    }
+    if (any(hi < lo)) {
+        return;
+    }
+    let columns = u32(hi.x - lo.x + 1);
+    let pixels = columns * u32(hi.y - lo.y + 1);
+    let first = id.y * segments.counts.w;
+    let last = min(first + segments.counts.w, pixels);
+    let entering = (phase & 1u) == 0u;
+    let origin = hyper.to_local[3].xyz;
+    let stride = segment_stride();
+    for (var i = first; i < last; i++) {
+        let p = vec2<u32>(u32(lo.x) + i % columns, u32(lo.y) + i / columns);
+        let d = (hyper.to_local * vec4<f32>(pixel_direction(p), 0.0)).xyz;
+        let facing = dot(d, normal);
+        // Entries go through front faces (against the outward normal), exits through back faces.
+        if ((facing < 0.0) != entering || facing == 0.0) {
+            continue;
+        }
+        let t = dot(centre - origin, normal) / facing;
+        let off = origin + d * t - centre;
+        if (dot(off, off) > radius * radius) {
+            continue;
+        }
+        let slot = (p.y * size.x + p.x) * stride + 1u + phase;
+        let previous = bitcast<f32>(atomicLoad(&segment_bounds[slot]));
+        if (t > previous) {
+            atomicMin(&segment_bounds[slot + 1u], bitcast<u32>(t));
+        }
+    }
+}
