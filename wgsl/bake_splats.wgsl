@@ -6,8 +6,8 @@
 // within half a cell diagonal of it holds some of it: the centre is moved onto the surface by two
 // Newton steps along the gradient (central differences). Every point of the surface lies in some
 // such cell, within a diagonal of that cell's splat, so disks of SURFACE_RADIUS cells (a little
-// over sqrt(3)) leave no gaps. Interior spheres cover their cell and grow with depth up to
-// INTERIOR_RADIUS cells.
+// over sqrt(3)) leave no gaps. Interior spheres cover their cell, with radii growing with depth
+// up to INTERIOR_RADIUS cells, or a block of cells deeper inside.
 const HALF_DIAGONAL: f32 = 0.8660254;
 const SURFACE_RADIUS: f32 = 1.8;
 const INTERIOR_RADIUS: f32 = 2.0;
@@ -59,9 +59,24 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
             surface_splats[slot] = Splat(vec4<f32>(p, SURFACE_RADIUS * cell), vec4<f32>(g / len, 0.0));
         }
     }
-    if (s < 0.0) {
-        let slot = atomicAdd(&splat_counts[1], 1u);
-        let r = clamp(-s, HALF_DIAGONAL * cell, INTERIOR_RADIUS * cell);
-        interior_splats[slot] = Splat(vec4<f32>(x, r), vec4<f32>(0.0));
+    if (s >= 0.0) {
+        return;
     }
+    // Deeper inside, blocks of 8^3, 4^3 or 2^3 cells whose circumscribed sphere lies inside the
+    // splat surface are one sphere each, made by the block's first cell: every cell of a block
+    // finds the same block, so each cell is covered once by the largest that fits.
+    for (var m = 3u; m > 0u; m--) {
+        let k = 1u << m;
+        let corner = id & vec3<u32>(~(k - 1u));
+        let centre = segments.lattice_min.xyz + (vec3<f32>(corner) + 0.5 * f32(k)) * cell;
+        let r = f32(k) * cell * HALF_DIAGONAL;
+        if (level(centre) <= -r) {
+            if (all(id == corner)) {
+                interior_splats[atomicAdd(&splat_counts[1], 1u)] = Splat(vec4<f32>(centre, r), vec4<f32>(0.0));
+            }
+            return;
+        }
+    }
+    let r = clamp(-s, HALF_DIAGONAL * cell, INTERIOR_RADIUS * cell);
+    interior_splats[atomicAdd(&splat_counts[1], 1u)] = Splat(vec4<f32>(x, r), vec4<f32>(0.0));
 }

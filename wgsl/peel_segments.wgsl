@@ -1,5 +1,6 @@
 // Depth peeling (Gilet & Dischler 2009, section 5.2): one thread per surface splat and footprint block intersects the rays of its screen footprint with the splat's disk and keeps per pixel the nearest entry (front-facing) or exit (back-facing) beyond the previous boundary. CPU twin: src/cpu/peel_segments.rs.
 #include "shared/types.wgsl"
+#include "shared/fields.wgsl"
 #include "shared/segments.wgsl"
 
 // The pass is dispatched twice per peel (`peel_phases`): entries, then exits. Phase p reads
@@ -9,6 +10,13 @@
 // it has workgroups, so ticket / workgroups is the dispatch's index.
 // A footprint is cut into blocks of `segments.counts.w` pixels (one per invocation along y) so
 // that no invocation loops more than lavapipe's 65535 iterations.
+// Disks are tangent to the splat surface: outside it where it is convex, cutting into it where it
+// is concave. A ray grazing a concave part can leave such a disk's inner side while still deep
+// inside (a false exit that would clip detail), so an exit counts only where the disk lies on or
+// outside the surface; a true exit missed there makes the segment longer, never shorter. Entries
+// need no such test: any disk point lies outside the support (the surface is half a cell beyond
+// it, more than a disk cuts in).
+const EXIT_SLACK: f32 = 1e-3;
 
 @group(0) @binding(0) var<uniform> frame: FrameParams;
 @group(0) @binding(1) var<uniform> hyper: HyperParams;
@@ -16,6 +24,8 @@
 @group(0) @binding(3) var<storage, read> surface_splats: array<Splat>;
 @group(0) @binding(4) var<storage, read_write> segment_bounds: array<atomic<u32>>;
 @group(0) @binding(5) var<storage, read_write> peel_tickets: array<atomic<u32>>;
+@group(0) @binding(6) var<storage, read> mesh_grid: array<vec4<f32>>;
+@group(0) @binding(7) var<storage, read> mesh_depth: array<u32>;
 
 var<workgroup> ticket: u32;
 
@@ -96,9 +106,16 @@ fn main(
             continue;
         }
         let slot = (p.y * size.x + p.x) * stride + 1u + phase;
-        let previous = bitcast<f32>(atomicLoad(&segment_bounds[slot]));
-        if (t > previous) {
-            atomicMin(&segment_bounds[slot + 1u], bitcast<u32>(t));
+        // The first entry may lie before the ray's start (the splat surface reaches beyond the
+        // bounds by its margin): the marcher clips it.
+        let previous = select(bitcast<f32>(atomicLoad(&segment_bounds[slot])), 0.0, phase == 0u);
+        let nearest = bitcast<f32>(atomicLoad(&segment_bounds[slot + 1u]));
+        if (t <= previous || t >= nearest) {
+            continue;
         }
+        if (!entering && support_distance(origin + d * t) - segments.surface.x < -EXIT_SLACK * segments.lattice_min.w) {
+            continue;
+        }
+        atomicMin(&segment_bounds[slot + 1u], bitcast<u32>(t));
     }
 }

@@ -119,8 +119,17 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let worst = i32(hyper.budget.z);
     // Most samples of the bounds are far from the object: their density is 0.
     let empty = hyper_color(0.0);
-    // The bounds are one segment; with depth peeling, segment i is [entry i, exit i] of this
-    // pixel (an exit not found: the bounds' exit), clipped to [t0, t1].
+    // Whole steps over [t0, t1], sampled at their middles.
+    var n = 0u;
+    var h = 0.0;
+    if (t1 > t0) {
+        let step = hyper.bounds_min.w;
+        n = u32(max(ceil((t1 - t0) / step), 1.0));
+        h = (t1 - t0) / f32(n);
+    }
+    // The bounds are one segment. With depth peeling, segment i is [entry i, exit i] of this
+    // pixel (an exit not found: the bounds' exit), and only the samples above inside it are
+    // taken: the same samples as the bounds march, less those in empty space.
     var segment = 0u;
     var segment_count = 1u;
     let base = pixel * segment_stride();
@@ -128,29 +137,22 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         segment = segment_bounds[base];
         segment_count = segments.counts.z;
     }
-    var n = 0u;
     while (segment < segment_count && transmittance >= MIN_TRANSMITTANCE && budget >= worst) {
-        var a = t0;
-        var b = t1;
+        var end = n;
         if (peeling) {
             let entry = segment_bounds[base + 2u + 2u * segment];
-            if (entry == NO_DEPTH) {
+            if (entry == NO_DEPTH || n == 0u) {
                 segment = segment_count;
                 break;
             }
-            a = max(a, bitcast<f32>(entry));
-            b = min(b, bitcast<f32>(segment_bounds[base + 3u + 2u * segment]));
+            // Samples t0 + (k + 0.5) h within [entry, exit].
+            let first = ceil((bitcast<f32>(entry) - t0) / h - 0.5);
+            let last = floor((bitcast<f32>(segment_bounds[base + 3u + 2u * segment]) - t0) / h - 0.5);
+            k = max(k, u32(clamp(first, 0.0, f32(n))));
+            end = u32(clamp(last + 1.0, 0.0, f32(n)));
         }
-        n = 0u;
-        var h = 0.0;
-        if (b > a) {
-            // Whole steps over [a, b], sampled at their middles.
-            let step = hyper.bounds_min.w;
-            n = u32(max(ceil((b - a) / step), 1.0));
-            h = (b - a) / f32(n);
-        }
-        while (k < n && transmittance >= MIN_TRANSMITTANCE && budget >= worst) {
-            let x = origin + dir * (a + (f32(k) + 0.5) * h);
+        while (k < end && transmittance >= MIN_TRANSMITTANCE && budget >= worst) {
+            let x = origin + dir * (t0 + (f32(k) + 0.5) * h);
             let density = hyper_density(x);
             var rgba = empty;
             if (density > 0.0) {
@@ -170,13 +172,10 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
             }
             k++;
         }
-        if (k < n) {
+        if (k < end) {
             break;
         }
         segment++;
-        if (peeling) {
-            k = 0u;
-        }
     }
     if (peeling) {
         segment_bounds[base] = segment;

@@ -49,11 +49,32 @@ pub fn bake_splats(model: &Model, lattice: &Lattice) -> (Vec<Splat>, Vec<Splat>)
                     }
                 }
                 if s < 0.0 {
-                    let r = (-s).clamp(HALF_DIAGONAL * cell, INTERIOR_RADIUS * cell);
-                    interior.push(splat(x, r, DVec3::ZERO));
+                    interior.extend(interior_splat(lattice, &level, [i, j, k], s));
                 }
             }
         }
     }
     (surface, interior)
+}
+
+/// The interior splat cell `id` makes, if any (`s`: its centre's level, negative): the sphere of
+/// the largest block of 8^3, 4^3 or 2^3 cells around it that fits inside the splat surface (made
+/// by the block's first cell only), else its own.
+fn interior_splat(lattice: &Lattice, level: &impl Fn(DVec3) -> f64, id: [u32; 3], s: f64) -> Option<Splat> {
+    let cell = lattice.cell;
+    for m in (1..=3).rev() {
+        let k = 1u32 << m;
+        let corner = id.map(|c| c & !(k - 1));
+        let centre = lattice.min
+            + (DVec3::new(corner[0] as f64, corner[1] as f64, corner[2] as f64) + 0.5 * k as f64) * cell;
+        let r = k as f64 * cell * HALF_DIAGONAL;
+        if level(centre) <= -r {
+            return (id == corner).then(|| splat(centre, r, DVec3::ZERO));
+        }
+    }
+    Some(splat(
+        lattice.centre(id[0], id[1], id[2]),
+        (-s).clamp(HALF_DIAGONAL * cell, INTERIOR_RADIUS * cell),
+        DVec3::ZERO,
+    ))
 }

@@ -1,12 +1,17 @@
 //! CPU twin (f64) of `wgsl/begin_segments.wgsl` and `wgsl/peel_segments.wgsl`: per pixel, the
 //! ray's start and then, peel after peel, the nearest front-facing surface splat beyond the last
-//! boundary (an entry) and the nearest back-facing one beyond that (an exit). It tests every
+//! boundary (an entry) and the nearest back-facing one beyond that, where the disk lies on or
+//! outside the splat surface (an exit). It tests every
 //! splat against every ray, so it also checks that the kernel's footprints miss no hit.
 
 use glam::{DMat4, DVec3};
 
 use super::hypertexture::Model;
 use crate::types::{FrameParams, SegmentParams, Splat};
+
+/// Mirrors the kernel's: exits count only where the disk is on or outside the splat surface
+/// (in cells).
+pub const EXIT_SLACK: f64 = 1e-3;
 
 fn v3(a: [f32; 4]) -> DVec3 {
     DVec3::new(a[0] as f64, a[1] as f64, a[2] as f64)
@@ -54,7 +59,8 @@ pub fn peel_segments(
         slots[1] = start;
     }
     for phase in 0..2 * passes {
-        let previous = slots[phase];
+        // The first entry may lie before the start (the marcher clips it).
+        let previous = if phase == 0 { 0.0 } else { slots[phase] };
         if previous.is_infinite() {
             continue;
         }
@@ -66,9 +72,14 @@ pub fn peel_segments(
                 continue;
             }
             let t = (c - origin).dot(n) / facing;
-            if (origin + dir * t - c).length_squared() <= r * r && t > previous {
-                slots[phase + 1] = slots[phase + 1].min(t);
+            if (origin + dir * t - c).length_squared() > r * r || t <= previous || t >= slots[phase + 1] {
+                continue;
             }
+            let level = model.support_distance(origin + dir * t) - segments.surface[0] as f64;
+            if !entering && level < -EXIT_SLACK * segments.lattice_min[3] as f64 {
+                continue;
+            }
+            slots[phase + 1] = t;
         }
     }
     slots

@@ -85,9 +85,9 @@ pub fn plan(
             Some((passes, Lattice::new(h.bounds(), max_shift(h), splat_grid)))
         }
     };
-    // Every unfinished ray advances at least `evals / worst` samples per dispatch; segments
-    // lie inside the bounds, each rounded up to whole steps.
-    let samples = (diagonal / step).ceil() + 1.0 + peel.map_or(0.0, |p| p.0 as f64);
+    // Every unfinished ray advances at least `evals / worst` samples per dispatch (segments
+    // take a subset of the bounds' samples).
+    let samples = (diagonal / step).ceil() + 1.0;
     let dispatches = (samples / (evals / worst) as f64).ceil() + 1.0;
     if dispatches > MAX_DISPATCHES as f64 {
         return Err(Error::Invalid(format!(

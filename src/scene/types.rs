@@ -528,6 +528,7 @@ pub const MAX_SPLAT_GRID: u32 = 96;
 
 /// The segments of a ray that `RayMarch` marches.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum Segments {
     /// From the entry to the exit of the object's enlarged bounds.
     #[default]
