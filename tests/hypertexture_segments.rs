@@ -207,8 +207,21 @@ fn sphere_splats_cover_the_enlarged_sphere() {
 /// Renders `scene` and returns the linear image, the marcher's states and `segment_bounds` (when
 /// the object is depth-peeled), with the blueprint.
 fn render(scene: &scene::Scene, opts: &RenderOptions) -> (Image, Vec<MarchState>, Vec<u32>, Blueprint) {
+    render_blocks(scene, opts, None)
+}
+
+/// `render`, with footprints cut into blocks of `block` pixels (default: `FOOTPRINT_BLOCK`).
+fn render_blocks(
+    scene: &scene::Scene,
+    opts: &RenderOptions,
+    block: Option<u32>,
+) -> (Image, Vec<MarchState>, Vec<u32>, Blueprint) {
     let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
-    let mut r = Renderer::new(&ctx, Blueprint::new(scene, opts).unwrap()).unwrap();
+    let mut bp = Blueprint::new(scene, opts).unwrap();
+    for m in bp.objects.iter_mut().filter_map(|o| o.ray_march.as_mut()) {
+        m.segments.counts[3] = block.unwrap_or(m.segments.counts[3]);
+    }
+    let mut r = Renderer::new(&ctx, bp).unwrap();
     let image = r.render(&ctx).unwrap().image;
     let instance = r.blueprint.instances.iter().position(|p| p.1 == Part::RayMarch).unwrap();
     let states =
@@ -227,14 +240,18 @@ fn evaluations(states: &[MarchState]) -> f64 {
 const TORUS: &str = "Torus(major: 1.0, minor: 0.3)";
 
 /// A torus seen edge-on, four passes: the kernel's boundaries equal the twin's (which tests every
-/// splat against every ray) on every pixel; the ray through the middle crosses both sides of the
-/// tube: two segments, where the splat surface (tube radius 0.3 + 0.16 + half a cell) says.
+/// splat against every ray) on every pixel, also with footprints cut into blocks of 50 pixels
+/// (several invocations per splat); the ray through the middle crosses both sides of the tube:
+/// two segments, where the splat surface (tube radius 0.3 + 0.16 + half a cell) says.
 #[test]
 fn peel_kernel_matches_twin_and_torus_has_two_segments() {
     let method = "RayMarch(step: 0.02, segments: DepthPeeling(passes: 4))";
     let scene = scene_of(TORUS, SOLID, 0.05, "(0.0, -4.0, 0.0)", method);
     let opts = sized(48, 48);
     let (_, _, bounds, bp) = render(&scene, &opts);
+    let (_, _, blocked, _) = render_blocks(&scene, &opts, Some(50));
+    let words = |b: &[u32]| b.chunks(10).flat_map(|p| p[1..].to_vec()).collect::<Vec<u32>>();
+    assert_eq!(words(&bounds), words(&blocked), "blocks of 50 footprint pixels change nothing");
     let plan = plan_of(&bp);
     let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
     let set = plan.bake_splats(&ctx, None).unwrap();

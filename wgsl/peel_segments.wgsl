@@ -9,7 +9,7 @@
 // is comes from a ticket: every workgroup takes one, and each dispatch takes exactly as many as
 // it has workgroups, so ticket / workgroups is the dispatch's index.
 // A footprint is cut into blocks of `segments.counts.w` pixels (one per invocation along y) so
-// that no invocation loops more than lavapipe's 65535 iterations.
+// that no invocation loops more than lavapipe's 65535 iterations (the loop body has no loops).
 // Disks are tangent to the splat surface: outside it where it is convex, cutting into it where it
 // is concave. A ray grazing a concave part can leave such a disk's inner side while still deep
 // inside (a false exit that would clip detail), so an exit counts only where the disk lies on or
@@ -56,6 +56,14 @@ fn main(
     let centre = splat.center.xyz;
     let normal = splat.normal.xyz;
     let radius = splat.center.w;
+    // A ray from the eye o through a point q of the disk faces it as (q - o) . n = (centre - o) . n
+    // does: the whole splat is front- or back-facing, and only one phase of two wants it.
+    let origin = hyper.to_local[3].xyz;
+    let offset = dot(centre - origin, normal);
+    let entering = (phase & 1u) == 0u;
+    if ((offset < 0.0) != entering || offset == 0.0) {
+        return;
+    }
     let size = vec2<u32>(frame.viewport.xy);
     // The footprint: the screen rectangle of the disk's bounding sphere (the whole screen when
     // the sphere reaches the eye's plane).
@@ -89,31 +97,53 @@ fn main(
     let pixels = columns * u32(hi.y - lo.y + 1);
     let first = id.y * segments.counts.w;
     let last = min(first + segments.counts.w, pixels);
-    let entering = (phase & 1u) == 0u;
-    let origin = hyper.to_local[3].xyz;
     let stride = segment_stride();
+    // Pixel rays unnormalised, D = forward + right sx + up sy, in object space: affine in sx, sy.
+    let to_local = mat3x3<f32>(hyper.to_local[0].xyz, hyper.to_local[1].xyz, hyper.to_local[2].xyz);
+    let along = to_local * frame.forward.xyz;
+    let across = to_local * hyper.right.xyz;
+    let down = to_local * hyper.up.xyz;
+    // Footprint pixel i is (lo.x + i % columns, lo.y + i / columns), stepped without divisions.
+    var p = vec2<u32>(u32(lo.x) + first % columns, u32(lo.y) + first / columns);
     for (var i = first; i < last; i++) {
-        let p = vec2<u32>(u32(lo.x) + i % columns, u32(lo.y) + i / columns);
-        let d = (hyper.to_local * vec4<f32>(pixel_direction(p), 0.0)).xyz;
-        let facing = dot(d, normal);
-        // Entries go through front faces (against the outward normal), exits through back faces.
-        if ((facing < 0.0) != entering || facing == 0.0) {
-            continue;
-        }
-        let t = dot(centre - origin, normal) / facing;
-        let off = origin + d * t - centre;
-        if (dot(off, off) > radius * radius) {
-            continue;
+        if (i > first) {
+            p.x++;
+            if (p.x > u32(hi.x)) {
+                p = vec2<u32>(u32(lo.x), p.y + 1u);
+            }
         }
         let slot = (p.y * size.x + p.x) * stride + 1u + phase;
         // The first entry may lie before the ray's start (the splat surface reaches beyond the
-        // bounds by its margin): the marcher clips it.
-        let previous = select(bitcast<f32>(atomicLoad(&segment_bounds[slot])), 0.0, phase == 0u);
+        // bounds by its margin): the marcher clips it. Past the first, a pixel whose previous
+        // boundary was not found is done.
+        var previous = 0.0;
+        if (phase > 0u) {
+            previous = bitcast<f32>(atomicLoad(&segment_bounds[slot]));
+            if (previous == bitcast<f32>(NO_DEPTH)) {
+                continue;
+            }
+        }
+        let sx = 2.0 * (f32(p.x) + 0.5) * frame.viewport.z - 1.0;
+        let sy = 1.0 - 2.0 * (f32(p.y) + 0.5) * frame.viewport.w;
+        let ray = along + across * sx + down * sy;
+        // o + ray u meets the disk's plane in front of the eye (u > 0) where ray . n has the
+        // offset's sign.
+        let facing = dot(ray, normal);
+        if (facing * offset <= 0.0) {
+            continue;
+        }
+        let u = offset / facing;
+        let off = origin + ray * u - centre;
+        if (dot(off, off) > radius * radius) {
+            continue;
+        }
+        // The parameter along the unit world direction (the marcher's t).
+        let t = u * length(forward + hyper.right.xyz * sx + hyper.up.xyz * sy);
         let nearest = bitcast<f32>(atomicLoad(&segment_bounds[slot + 1u]));
         if (t <= previous || t >= nearest) {
             continue;
         }
-        if (!entering && support_distance(origin + d * t) - segments.surface.x < -EXIT_SLACK * segments.lattice_min.w) {
+        if (!entering && support_distance(origin + ray * u) - segments.surface.x < -EXIT_SLACK * segments.lattice_min.w) {
             continue;
         }
         atomicMin(&segment_bounds[slot + 1u], bitcast<u32>(t));

@@ -15,7 +15,7 @@ use crate::types::{HyperParams, SegmentParams, Splat};
 
 /// Footprint pixels one invocation of `peel_segments.wgsl` tests at most (lavapipe ends every
 /// loop of an invocation after 65535 iterations).
-pub const FOOTPRINT_BLOCK: u32 = 4096;
+pub const FOOTPRINT_BLOCK: u32 = 32768;
 
 /// Where the splats come from: the lattice and the splat surface's level.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -269,7 +269,7 @@ impl RayMarchPlan {
             inputs.buffers.insert("interior_splats".into(), set.interior.clone());
             inputs.counts.insert("surface_splats".into(), set.counts[0]);
             inputs.counts.insert("peel_phases".into(), 2 * passes);
-            inputs.counts.insert("peel_blocks".into(), (size.0 * size.1).div_ceil(FOOTPRINT_BLOCK));
+            inputs.counts.insert("peel_blocks".into(), (size.0 * size.1).div_ceil(segments.counts[3].max(1)));
             bounds_bytes = Self::segment_bytes(size, *passes);
         }
         inputs.buffers.insert("segments".into(), uniform(ctx, "segments", bytemuck::bytes_of(&segments)));
