@@ -352,32 +352,29 @@ fn one_pass_loses_the_far_side_of_a_concave_object() {
     assert!(one_coverage < 0.95 * four_coverage);
 }
 
-/// The Figure 11 teapot (a concave mesh: the handle's hole, the spout): four passes give the
-/// image of the whole-bounds march, with fewer density evaluations (few fewer: the teapot is
-/// opaque, so rays end soon after they enter it either way; what segments skip is the empty
-/// space in front of it).
+/// The example scene `teapot_depth_peeling.ron` (the Figure 11 teapot, a concave mesh: the
+/// handle's hole, the spout, semi-transparent so far walls show): its four passes give the image
+/// of the whole-bounds march, with fewer density evaluations (6% fewer: most are the Phong
+/// gradients of samples inside the teapot, which both take).
 #[test]
-fn teapot_matches_the_bounds_march() {
-    let scene = scene::load(&voltex::project_root().join("scenes/hypertextures/fig11_teapot.ron")).unwrap();
-    let march = |passes: u32| {
+fn teapot_example_matches_the_bounds_march() {
+    let path = voltex::project_root().join("scenes/hypertextures/teapot_depth_peeling.ron");
+    let scene = scene::load(&path).unwrap();
+    let march = |bounds: bool| {
         let mut opts = sized(96, 64);
-        let method = scene::RayMarch {
-            shading: scene::Shading::Phong,
-            segments: scene::Segments::DepthPeeling { passes, splat_grid: 32 },
-            ..Default::default()
-        };
-        if passes > 0 {
+        if bounds {
+            let method = scene::RayMarch { shading: scene::Shading::Phong, ..Default::default() };
             opts.object_methods = vec![("teapot".into(), scene::Method::RayMarch(method))];
         }
         let (image, states, _, _) = render(&scene, &opts);
         (image, evaluations(&states))
     };
-    let (bounds, b) = march(0);
-    let (peeled, a) = march(4);
+    let (peeled, a) = march(false);
+    let (bounds, b) = march(true);
     let flip = voltex::metrics::flip(&peeled, &bounds).unwrap().mean;
     eprintln!(
         "teapot, DepthPeeling(passes: 4) vs Bounds: FLIP {flip:.5}; density evaluations {a:.0} vs {b:.0}"
     );
     assert!(flip < 0.002, "FLIP {flip}");
-    assert!(a < 0.95 * b, "{a} vs {b} evaluations");
+    assert!(a < 0.97 * b, "{a} vs {b} evaluations");
 }
