@@ -121,6 +121,7 @@ fn frame_graph_parses_and_plans() {
         &["AxisSlices", "AxisSlicesBinary"],
         &["AxisSlices", "AxisSlicesBlended"],
         &["RayMarch"],
+        &["RayMarch", "RayMarchPeeling"],
     ];
     let p = plan(&g, &wgsl_root(), &objects(all)).unwrap();
     assert_eq!(
@@ -139,6 +140,8 @@ fn frame_graph_parses_and_plans() {
             "trace_reference",
             "composite_reference",
             "bake_transfer",
+            "begin_segments",
+            "peel_segments",
             "ray_march",
             "composite_ray_march",
             "composite"

@@ -12,7 +12,8 @@
 //! wrong once a render pass has run in the process, and every frame ends with raster passes.
 //! A second table compares the segment strategies (section 5): the whole enlarged bounds against
 //! depth peeling over the object's surface splats, per object at the IE step with Phong: frame
-//! time, density evaluations and FLIP against a converged render (the bounds march with a step of
+//! time, density evaluations (Phong's included), samples along the rays (the evaluations of the
+//! same frame unshaded) and FLIP against a converged render (the bounds march with a step of
 //! 0.001).
 
 use std::path::Path;
@@ -120,9 +121,10 @@ const SEGMENTS: &[(&str, &str)] = &[("Bounds", "Bounds"), ("DepthPeeling(4)", "D
 /// against a converged render.
 pub fn segments_table(ctx: &GpuContext, size: (u32, u32), frames: usize, quick: bool) -> Result<()> {
     println!(
-        "\n| object | segments | dispatches | frame ms (wall) | M density evals | M noise evals | FLIP vs converged |"
+        "\n| object | segments | dispatches | frame ms (wall) | M density evals | M noise evals | M samples | FLIP vs \
+         converged |"
     );
-    println!("|---|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|---|");
     let opts = RenderOptions { size: Some(size), ..Default::default() };
     let objects = if quick { &OBJECTS[..1] } else { OBJECTS };
     for (name, object, transform) in objects {
@@ -144,13 +146,19 @@ pub fn segments_table(ctx: &GpuContext, size: (u32, u32), frames: usize, quick: 
             let (evals, noised, _) = run.counts(ctx)?;
             let image = run.renderer.render(ctx)?.image;
             let flip = crate::metrics::flip(&image, &truth)?.mean;
+            // Unshaded, every density evaluation is a sample along a ray.
+            let unshaded = parse(&format!("RayMarch(quality: IE, shading: None, segments: {segments})"))?;
+            let mut unshaded = Renderer::new(ctx, Blueprint::new(&unshaded, &opts)?)?;
+            unshaded.render_timed(ctx)?;
+            let (samples, _, _) = Timed { renderer: unshaded, times: Vec::new() }.counts(ctx)?;
             let plan = run.renderer.blueprint.objects.iter().find_map(|o| o.ray_march.clone());
             let dispatches = plan.map_or(0, |p| p.dispatches);
             println!(
-                "| {name} | {label} | {dispatches} | {:.1} | {:.2} | {:.2} | {flip:.4} |",
+                "| {name} | {label} | {dispatches} | {:.1} | {:.2} | {:.2} | {:.3} | {flip:.4} |",
                 median(run.times.clone()),
                 evals / 1e6,
-                noised / 1e6
+                noised / 1e6,
+                samples / 1e6
             );
         }
     }

@@ -20,6 +20,8 @@ pub const FOOTPRINT_BLOCK: u32 = 32768;
 /// Where the splats come from: the lattice and the splat surface's level.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Lattice {
+    /// Cells along the bounds' longest axis (the scene's `splat_grid`).
+    pub grid: u32,
     pub min: DVec3,
     pub cell: f64,
     pub counts: [u32; 3],
@@ -38,7 +40,7 @@ impl Lattice {
         let pad = DVec3::splat(level + cell);
         let (lo, hi) = (bounds.0 - pad, bounds.1 + pad);
         let counts = ((hi - lo) / cell).ceil().to_array().map(|c| c as u32);
-        Lattice { min: lo, cell, counts, level }
+        Lattice { grid, min: lo, cell, counts, level }
     }
 
     pub fn cells(&self) -> u32 {

@@ -183,8 +183,7 @@ impl RayMarchPlan {
             None => String::new(),
             Some((passes, l)) => format!(
                 ", segments: DepthPeeling(passes: {passes}, splat_grid: {}, splat_spacing: {:.6})",
-                ((self.packed.bounds.1 - self.packed.bounds.0).max_element() / l.cell).round(),
-                l.cell
+                l.grid, l.cell
             ),
         };
         format!(
@@ -203,7 +202,7 @@ impl RayMarchPlan {
             + size.0 as u64 * size.1 as u64 * std::mem::size_of::<MarchState>() as u64
             + std::mem::size_of::<SegmentParams>() as u64
             + self.peel.as_ref().map_or(0, |(passes, lattice)| {
-                splats::bytes(lattice.cells()) + Self::segment_bytes(size, *passes) + 4
+                splats::bytes(lattice.cells()) + Self::segment_bytes(size, *passes) + 16
             })
     }
 
