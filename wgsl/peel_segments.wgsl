@@ -29,7 +29,7 @@ const EXIT_SLACK: f32 = 1e-3;
 
 var<workgroup> ticket: u32;
 
-// Screen coordinate range (lo, hi) along unit axis `a` (scaled by `scale`, the half extent at
+// Screen coordinate range (lo, hi) along unit `axis` (scaled by `scale`, the half extent at
 // unit depth) of a sphere at camera-relative c with radius r in front of the camera (depth z - r > 0):
 // x / z is monotonic in z for fixed x, so the extremes are at the depth range's ends.
 fn screen_range(c: vec3<f32>, r: f32, z: f32, axis: vec3<f32>, scale: f32) -> vec2<f32> {
