@@ -155,6 +155,9 @@ enum Command {
         /// Only the first object (sphere).
         #[arg(long)]
         quick: bool,
+        /// Only the table of segment strategies (bounds against depth peeling).
+        #[arg(long)]
+        segments: bool,
     },
     /// Speed against error: sweep each method's quality knobs, time every setting with GPU
     /// timestamps, measure its error against a truth image, write pareto.csv and pareto.svg.
@@ -289,7 +292,9 @@ fn main() -> ExitCode {
         Command::Bench { scenes, planes, size, frames, reference_planes } => {
             voltex::bench::run(&scenes, &planes, size, frames, reference_planes)
         }
-        Command::BenchHyper { size, frames, quick } => voltex::hypertexture::bench::run(size, frames, quick),
+        Command::BenchHyper { size, frames, quick, segments } => {
+            voltex::hypertexture::bench::run(size, frames, quick, segments)
+        }
         Command::Pareto { scene, size, frames, out, truth, methods, planes, steps, criteria, ray_steps } => {
             let methods = methods.into_iter().map(sweep).collect();
             voltex::pareto::run(&voltex::pareto::Args {

@@ -429,3 +429,34 @@ pub struct MarchState {
     /// of the evaluations that ran the noises (y and w for benchmarks).
     pub resume: [f32; 4],
 }
+
+/// Splat sets and depth-peeled segments of a RayMarch object (`bake_splats.wgsl`,
+/// `begin_segments.wgsl`, `peel_segments.wgsl`, `ray_march.wgsl`); twin: `SegmentParams` in
+/// wgsl/shared/types.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct SegmentParams {
+    /// Object space to camera-relative world (the inverse of `HyperParams::to_local`).
+    pub from_local: [[f32; 4]; 4],
+    /// xyz: the splat lattice's lowest corner (object space); w: its cell size.
+    pub lattice_min: [f32; 4],
+    /// xyz: lattice cells per axis; w: splat capacity of each set (the cell count).
+    pub lattice: [u32; 4],
+    /// x: the support distance of the splat surface (the largest shift plus a margin); y: the
+    /// largest factor by which `from_local` scales lengths; zw: unused.
+    pub surface: [f32; 4],
+    /// x: surface splats; y: interior splats; z: depth-peeling passes; w: footprint pixels one
+    /// invocation of `peel_segments.wgsl` tests at most.
+    pub counts: [u32; 4],
+}
+
+/// A splat of a hypertexture object's splat set (object space): a surface splat is a disk with
+/// an outward normal, an interior splat a sphere (normal zero).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct Splat {
+    /// xyz: centre; w: radius.
+    pub center: [f32; 4],
+    /// xyz: unit outward normal (surface splats); w: unused.
+    pub normal: [f32; 4],
+}

@@ -122,6 +122,7 @@ fn frame_graph_parses_and_plans() {
         &["AxisSlices", "AxisSlicesBinary", "AxisSlicesBySlice"],
         &["AxisSlices", "AxisSlicesBlended"],
         &["RayMarch"],
+        &["RayMarch", "RayMarchPeeling"],
     ];
     let p = plan(&g, &wgsl_root(), &objects(all)).unwrap();
     assert_eq!(
@@ -142,6 +143,8 @@ fn frame_graph_parses_and_plans() {
             "trace_reference",
             "composite_reference",
             "bake_transfer",
+            "begin_segments",
+            "peel_segments",
             "ray_march",
             "composite_ray_march",
             "composite"

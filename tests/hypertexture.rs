@@ -688,6 +688,12 @@ fn bad_objects_fields_and_methods_are_reported_at_their_position() {
     bad(15, &node("RayMarch(step: 1e-9)"), "RayMarch", "expected a step of at least");
     bad(15, &node("RayMarch(shading: Gouraud)"), "Gouraud", "PhongShadows");
     bad(15, &node("ViewSlices(planes: 10)"), "ViewSlices", "expected RayMarch");
+    bad(15, &node("RayMarch(segments: DepthPeeling(passes: 0))"), "0)", "depth-peeling pass count in 1..=8");
+    bad(15, &node("RayMarch(segments: DepthPeeling(passes: 9))"), "9)", "depth-peeling pass count in 1..=8");
+    bad(15, &node("RayMarch(segments: DepthPeeling(splat_grid: 2))"), "2)", "splat lattice size");
+    bad(15, &node("RayMarch(segments: DepthPeeling(passes: -1))"), "1))", "out of bounds");
+    bad(15, &node("RayMarch(segments: DepthPeeling(layers: 2))"), "layers", "passes");
+    bad(15, &node("RayMarch(segments: Slabs)"), "Slabs", "DepthPeeling");
     bad(15, "    nodes: [(name: \"n\", hypertexture: \"g\")],", "\"g\"", "expected one of \"h\"");
     bad(15, "    nodes: [(name: \"n\", method: RayMarch())],", "RayMarch", "expected `hypertexture");
     let both =

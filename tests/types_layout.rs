@@ -46,6 +46,8 @@ fn wgsl_structs_match_rust() {
         layout!(TransferFunction; first, count, kind, _pad),
         layout!(TransferPoint; x, y, slope, _pad),
         layout!(MarchState; color, resume),
+        layout!(SegmentParams; from_local, lattice_min, lattice, surface, counts),
+        layout!(Splat; center, normal),
     ];
     let mut seen = 0;
     for (_, ty) in kernel.module.types.iter() {

@@ -1,12 +1,16 @@
-// Hypertexture ray marching (Gilet & Dischler 2009): one thread per pixel marches the object's enlarged bounds front to back, resumable across dispatches; CPU twin src/cpu/ray_march.rs.
+// Hypertexture ray marching (Gilet & Dischler 2009): one thread per pixel marches the object's enlarged bounds, or the segments depth peeling found, front to back, resumable across dispatches; CPU twin src/cpu/ray_march.rs.
 #include "shared/types.wgsl"
 #include "shared/hypertexture.wgsl"
+#include "shared/segments.wgsl"
 
 // Shading, compiled out when off (set per object from `RayMarch(shading: ...)`): Phong with the
 // density gradient by central differences (six more density evaluations), and a secondary ray
 // towards the light for shadows.
 override phong: bool = false;
 override shadows: bool = false;
+// `RayMarch(segments: DepthPeeling(..))`: march only the segments in `segment_bounds`
+// (peel_segments.wgsl), in order, instead of the whole span of the bounds.
+override peeling: bool = false;
 
 // Work per dispatch is bounded by `hyper.budget` (density evaluations): the pass is dispatched
 // `ray_march_dispatches` times and each pixel resumes from `ray_march_state`. Lavapipe ends every
@@ -26,18 +30,9 @@ const DEPTH_SLACK: f32 = 2e-3;
 // Mesh objects: the baked grid and its largest inside distance (f32 bits); stand-ins otherwise.
 @group(0) @binding(6) var<storage, read> mesh_grid: array<vec4<f32>>;
 @group(0) @binding(7) var<storage, read> mesh_depth: array<u32>;
-
-// Parameters (entry, exit) where the ray o + t d (object space) is inside the enlarged bounds;
-// entry > exit when it misses. Zero direction components are nudged, never divided by.
-fn bounds_span(o: vec3<f32>, d: vec3<f32>) -> vec2<f32> {
-    let tiny = vec3<f32>(1e-30);
-    let safe = select(d, select(-tiny, tiny, d >= vec3<f32>(0.0)), abs(d) < tiny);
-    let a = (hyper.bounds_min.xyz - o) / safe;
-    let b = (hyper.bounds_max.xyz - o) / safe;
-    let lo = min(a, b);
-    let hi = max(a, b);
-    return vec2<f32>(max(max(lo.x, lo.y), lo.z), min(min(hi.x, hi.y), hi.z));
-}
+// Depth peeling's segments (stand-ins without it); the marcher keeps its segment in word 0.
+@group(0) @binding(8) var<uniform> segments: SegmentParams;
+@group(0) @binding(9) var<storage, read_write> segment_bounds: array<u32>;
 
 // The step-corrected opacity shared by every method: 1 - (1 - a)^(step / opacity_length).
 fn step_alpha(a: f32, step: f32) -> f32 {
@@ -101,10 +96,8 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     if (state.resume.z != 0.0) {
         return;
     }
-    let sx = 2.0 * (f32(id.x) + 0.5) * frame.viewport.z - 1.0;
-    let sy = 1.0 - 2.0 * (f32(id.y) + 0.5) * frame.viewport.w;
     let forward = frame.forward.xyz;
-    let d = normalize(forward + hyper.right.xyz * sx + hyper.up.xyz * sy);
+    let d = pixel_direction(id.xy);
     let cos_d = dot(d, forward);
     let near = hyper.right.w;
     let far = hyper.up.w;
@@ -122,40 +115,72 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     var rgb = state.color.rgb;
     var transmittance = 1.0 - state.color.a;
     var k = u32(state.resume.x);
-    var n = 0u;
-    var h = 0.0;
-    if (t1 > t0) {
-        // Whole steps over [t0, t1], sampled at their middles.
-        let step = hyper.bounds_min.w;
-        n = u32(max(ceil((t1 - t0) / step), 1.0));
-        h = (t1 - t0) / f32(n);
-    }
     var budget = i32(hyper.budget.x);
     let worst = i32(hyper.budget.z);
     // Most samples of the bounds are far from the object: their density is 0.
     let empty = hyper_color(0.0);
-    while (k < n && transmittance >= MIN_TRANSMITTANCE && budget >= worst) {
-        let x = origin + dir * (t0 + (f32(k) + 0.5) * h);
-        let density = hyper_density(x);
-        var rgba = empty;
-        if (density > 0.0) {
-            rgba = hyper_color(density);
-        }
-        budget -= 1;
-        if (rgba.a > 1e-6) {
-            let alpha = step_alpha(rgba.a, h);
-            var colour = rgba.rgb;
-            if (phong) {
-                let shaded = shade(x, d, colour);
-                colour = shaded.xyz;
-                budget -= i32(shaded.w);
-            }
-            rgb += colour * alpha * transmittance;
-            transmittance *= 1.0 - alpha;
-        }
-        k++;
+    // Whole steps over [t0, t1], sampled at their middles.
+    var n = 0u;
+    var h = 0.0;
+    if (t1 > t0) {
+        let step = hyper.bounds_min.w;
+        n = u32(max(ceil((t1 - t0) / step), 1.0));
+        h = (t1 - t0) / f32(n);
     }
-    let finished = k >= n || transmittance < MIN_TRANSMITTANCE;
+    // The bounds are one segment. With depth peeling, segment i is [entry i, exit i] of this
+    // pixel (an exit not found: the bounds' exit), and only the samples above inside it are
+    // taken: the same samples as the bounds march, less those in empty space.
+    var segment = 0u;
+    var segment_count = 1u;
+    let base = pixel * segment_stride();
+    if (peeling) {
+        segment = segment_bounds[base];
+        segment_count = segments.counts.z;
+    }
+    while (segment < segment_count && transmittance >= MIN_TRANSMITTANCE && budget >= worst) {
+        var end = n;
+        if (peeling) {
+            let entry = segment_bounds[base + 2u + 2u * segment];
+            if (entry == NO_DEPTH || n == 0u) {
+                segment = segment_count;
+                break;
+            }
+            // Samples t0 + (k + 0.5) h within [entry, exit].
+            let first = ceil((bitcast<f32>(entry) - t0) / h - 0.5);
+            let last = floor((bitcast<f32>(segment_bounds[base + 3u + 2u * segment]) - t0) / h - 0.5);
+            k = max(k, u32(clamp(first, 0.0, f32(n))));
+            end = u32(clamp(last + 1.0, 0.0, f32(n)));
+        }
+        while (k < end && transmittance >= MIN_TRANSMITTANCE && budget >= worst) {
+            let x = origin + dir * (t0 + (f32(k) + 0.5) * h);
+            let density = hyper_density(x);
+            var rgba = empty;
+            if (density > 0.0) {
+                rgba = hyper_color(density);
+            }
+            budget -= 1;
+            if (rgba.a > 1e-6) {
+                let alpha = step_alpha(rgba.a, h);
+                var colour = rgba.rgb;
+                if (phong) {
+                    let shaded = shade(x, d, colour);
+                    colour = shaded.xyz;
+                    budget -= i32(shaded.w);
+                }
+                rgb += colour * alpha * transmittance;
+                transmittance *= 1.0 - alpha;
+            }
+            k++;
+        }
+        if (k < end) {
+            break;
+        }
+        segment++;
+    }
+    if (peeling) {
+        segment_bounds[base] = segment;
+    }
+    let finished = segment >= segment_count || transmittance < MIN_TRANSMITTANCE;
     // resume: next sample, density evaluations so far, finished, evaluations that ran the noises.
     let evaluations = state.resume.y + f32(i32(hyper.budget.x) - budget);
     ray_march_state[pixel] = MarchState(

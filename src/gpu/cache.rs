@@ -9,6 +9,7 @@ use std::hash::{Hash, Hasher};
 
 use crate::bake::Baked;
 use crate::hypertexture::mesh::MeshGrid;
+use crate::hypertexture::splats::SplatSet;
 
 /// What a build created (not found in the cache).
 #[derive(Debug, Default, Clone, Copy, PartialEq, Eq)]
@@ -37,6 +38,7 @@ pub struct GpuCache {
     pipelines: HashMap<u64, Pipeline>,
     bakes: HashMap<u64, Baked>,
     grids: HashMap<u64, MeshGrid>,
+    splats: HashMap<u64, SplatSet>,
     /// Keys used since the last `begin`, so that `retain_used` can drop what a rebuild left behind.
     used: HashSet<u64>,
     pub stats: CacheStats,
@@ -65,6 +67,7 @@ impl GpuCache {
         self.pipelines.retain(|k, _| used.contains(k));
         self.bakes.retain(|k, _| used.contains(k));
         self.grids.retain(|k, _| used.contains(k));
+        self.splats.retain(|k, _| used.contains(k));
     }
 
     pub fn module(
@@ -127,5 +130,21 @@ impl GpuCache {
         self.stats.bakes += 1;
         self.grids.insert(key, g.clone());
         Ok(g)
+    }
+
+    /// A depth-peeled hypertexture object's splat set (counted as a bake).
+    pub fn splats(
+        &mut self,
+        key: u64,
+        make: impl FnOnce() -> crate::Result<SplatSet>,
+    ) -> crate::Result<SplatSet> {
+        self.used.insert(key);
+        if let Some(s) = self.splats.get(&key) {
+            return Ok(s.clone());
+        }
+        let s = make()?;
+        self.stats.bakes += 1;
+        self.splats.insert(key, s.clone());
+        Ok(s)
     }
 }

@@ -38,6 +38,9 @@ pub const COUNTS: &[&str] = &[
     "ray_march_dispatches",
     "transfer_functions",
     "axis_triangles",
+    "surface_splats",
+    "peel_blocks",
+    "peel_phases",
 ];
 
 struct Texture {

@@ -20,6 +20,7 @@ pub const OBJECT_FILTERS: &[&str] = &[
     "AxisSlicesBlended",
     "AxisSlicesBySlice",
     "RayMarch",
+    "RayMarchPeeling",
 ];
 
 /// What the planner needs to know of a scene object.

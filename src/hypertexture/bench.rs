@@ -10,7 +10,11 @@
 //!
 //! Frames are timed by wall clock after `device.poll`: lavapipe's compute timestamps come back
 //! wrong once a render pass has run in the process, and every frame ends with raster passes.
-//! Only the segment strategy "enlarged bounds" exists so far (depth peeling and splats come later).
+//! A second table compares the segment strategies (section 5): the whole enlarged bounds against
+//! depth peeling over the object's surface splats, per object at the IE step with Phong: frame
+//! time, density evaluations (Phong's included), samples along the rays (the evaluations of the
+//! same frame unshaded) and FLIP against a converged render (the bounds march with a step of
+//! 0.001).
 
 use std::path::Path;
 use std::time::Instant;
@@ -50,6 +54,11 @@ const NOISES: &str = "[(shape: Curve([(0.0, 0.0, 0.0), (0.2, 1.0, 0.0), (0.8, 1.
 const NOISE_COUNT: f64 = 3.0;
 
 fn scene_text(object: &str, transform: &str, quality: &str, shading: &str) -> String {
+    method_scene(object, transform, &format!("RayMarch(quality: {quality}, shading: {shading})"))
+}
+
+/// The benchmark scene with `method` on its object.
+fn method_scene(object: &str, transform: &str, method: &str) -> String {
     let meshes = crate::project_root().join("scenes/hypertextures/meshes");
     let object = object.replace("{meshes}", &meshes.display().to_string());
     format!(
@@ -57,7 +66,7 @@ fn scene_text(object: &str, transform: &str, quality: &str, shading: &str) -> St
          fov_y: 40.0), ambient: 0.2, lights: [Directional(direction: (-0.5, 0.6, -0.7))], hypertextures: {{ \"h\": \
          (object: {object}, noises: {NOISES}, color: Step(threshold: 0.35, color: (0.8, 0.72, 0.62)), \
          opacity_length: 0.01) }}, nodes: [(name: \"object\", transform: {transform}, hypertexture: \"h\", \
-         method: RayMarch(quality: {quality}, shading: {shading}))])"
+         method: {method})])"
     )
 }
 
@@ -110,8 +119,66 @@ impl Timed {
     }
 }
 
-pub fn run(size: (u32, u32), frames: usize, quick: bool) -> Result<()> {
+/// Segment strategies compared by `segments_table`.
+const SEGMENTS: &[(&str, &str)] = &[("Bounds", "Bounds"), ("DepthPeeling(4)", "DepthPeeling(passes: 4)")];
+
+/// The segment strategies on every object (IE, Phong): frame time, density evaluations and FLIP
+/// against a converged render.
+pub fn segments_table(ctx: &GpuContext, size: (u32, u32), frames: usize, quick: bool) -> Result<()> {
+    println!(
+        "\n| object | segments | dispatches | frame ms (wall) | M density evals | M noise evals | M samples | FLIP vs \
+         converged |"
+    );
+    println!("|---|---|---|---|---|---|---|---|");
+    let opts = RenderOptions { size: Some(size), ..Default::default() };
+    let objects = if quick { &OBJECTS[..1] } else { OBJECTS };
+    for (name, object, transform) in objects {
+        let parse = |method: &str| {
+            crate::scene::parse(&method_scene(object, transform, method), Path::new("bench-hyper.ron"))
+        };
+        let truth = parse("RayMarch(step: 0.001, shading: Phong)")?;
+        let truth = Renderer::new(ctx, Blueprint::new(&truth, &opts)?)?.render(ctx)?.image;
+        for (label, segments) in SEGMENTS {
+            let scene = parse(&format!("RayMarch(quality: IE, shading: Phong, segments: {segments})"))?;
+            let mut run =
+                Timed { renderer: Renderer::new(ctx, Blueprint::new(&scene, &opts)?)?, times: Vec::new() };
+            run.renderer.render_timed(ctx)?;
+            for _ in 0..frames {
+                let t = Instant::now();
+                run.renderer.render_timed(ctx)?;
+                run.times.push(t.elapsed().as_secs_f64() * 1e3);
+            }
+            let (evals, noised, _) = run.counts(ctx)?;
+            let image = run.renderer.render(ctx)?.image;
+            let flip = crate::metrics::flip(&image, &truth)?.mean;
+            // Unshaded, every density evaluation is a sample along a ray.
+            let unshaded = parse(&format!("RayMarch(quality: IE, shading: None, segments: {segments})"))?;
+            let mut unshaded = Renderer::new(ctx, Blueprint::new(&unshaded, &opts)?)?;
+            unshaded.render_timed(ctx)?;
+            let (samples, _, _) = Timed { renderer: unshaded, times: Vec::new() }.counts(ctx)?;
+            let plan = run.renderer.blueprint.objects.iter().find_map(|o| o.ray_march.clone());
+            let dispatches = plan.map_or(0, |p| p.dispatches);
+            println!(
+                "| {name} | {label} | {dispatches} | {:.1} | {:.2} | {:.2} | {:.3} | {flip:.4} |",
+                median(run.times.clone()),
+                evals / 1e6,
+                noised / 1e6,
+                samples / 1e6
+            );
+        }
+    }
+    Ok(())
+}
+
+pub fn run(size: (u32, u32), frames: usize, quick: bool, segments_only: bool) -> Result<()> {
     let ctx = GpuContext::new()?;
+    if segments_only {
+        println!(
+            "bench-hyper segments on {}: {size:?}, median of {frames} frame(s) after one warm-up",
+            ctx.adapter_line()
+        );
+        return segments_table(&ctx, size, frames, quick);
+    }
     let rate = noise_rate(&ctx)?;
     println!(
         "bench-hyper on {}: {size:?}, median of {frames} frame(s) after one warm-up; simplex noise alone: {:.0} M \
@@ -194,5 +261,5 @@ pub fn run(size: (u32, u32), frames: usize, quick: bool) -> Result<()> {
             }
         }
     }
-    Ok(())
+    segments_table(&ctx, size, frames, quick)
 }

@@ -6,6 +6,7 @@
 
 pub mod bench;
 pub mod mesh;
+pub mod splats;
 
 use glam::DVec3;
 

@@ -1,7 +1,8 @@
 //! Host side of the `RayMarch` method (hypertextures, Gilet & Dischler 2009): per object, the
 //! packed hypertexture with the camera and march settings (`HyperParams`), its transfer functions
-//! for `bake_transfer.wgsl`, and how many dispatches of `ray_march.wgsl` a frame needs so that
-//! every ray finishes while no dispatch exceeds its work budget.
+//! for `bake_transfer.wgsl`, how many dispatches of `ray_march.wgsl` a frame needs so that
+//! every ray finishes while no dispatch exceeds its work budget, and with depth peeling the
+//! object's splat lattice and the segment buffers (`begin_segments.wgsl`, `peel_segments.wgsl`).
 
 use glam::{DMat4, DVec3};
 
@@ -11,10 +12,11 @@ use crate::error::{Error, Result};
 use crate::gpu::GpuContext;
 use crate::graph::exec::Inputs;
 use crate::hypertexture::mesh::{self, MeshGrid};
+use crate::hypertexture::splats::{self, Lattice, SplatSet, FOOTPRINT_BLOCK};
 use crate::hypertexture::{self, Packed};
 use crate::scene::hypertexture::diagonal;
-use crate::scene::{Hypertexture, RayMarch, Shading};
-use crate::types::{HyperParams, MarchState};
+use crate::scene::{Hypertexture, RayMarch, Segments, Shading};
+use crate::types::{HyperParams, MarchState, SegmentParams};
 
 /// Loop iterations one invocation may run per dispatch. Lavapipe silently ends every loop of an
 /// invocation after 65535 iterations in all; a density evaluation costs one iteration per noise
@@ -51,6 +53,10 @@ pub struct RayMarchPlan {
     pub corners: [DVec3; 8],
     /// Benchmarks: `false` compiles the noises out (override `noise_off`).
     pub noise: bool,
+    /// Depth peeling: its passes and the splat lattice (`None`: the bounds are the segment).
+    pub peel: Option<(u32, Lattice)>,
+    /// The camera and splat lattice as `bake_splats.wgsl` and the peeling kernels see them.
+    pub segments: SegmentParams,
 }
 
 /// `name`: the object's; `node`: its hypertexture's name and frame.
@@ -73,7 +79,14 @@ pub fn plan(
     let evals = LOOP_BUDGET / (packed.noises.len() as u32 + 1);
     let shadow_samples = ((diagonal / shadow_step).ceil() as u32).clamp(1, MAX_SHADOW_SAMPLES);
     let worst = 1 + 6 * shade.phong as u32 + shadow_samples * shade.shadows as u32;
-    // Every unfinished ray advances at least `evals / worst` samples per dispatch.
+    let peel = match method.segments {
+        Segments::Bounds => None,
+        Segments::DepthPeeling { passes, splat_grid } => {
+            Some((passes, Lattice::new(h.bounds(), max_shift(h), splat_grid)))
+        }
+    };
+    // Every unfinished ray advances at least `evals / worst` samples per dispatch (segments
+    // take a subset of the bounds' samples).
     let samples = (diagonal / step).ceil() + 1.0;
     let dispatches = (samples / (evals / worst) as f64).ceil() + 1.0;
     if dispatches > MAX_DISPATCHES as f64 {
@@ -92,6 +105,20 @@ pub fn plan(
     params.march[0] = shadow_step as f32;
     params.march[1] = step as f32;
     params.budget = [evals, shadow_samples, worst, 0];
+    let from_local = DMat4::from_translation(-camera.eye) * *to_world;
+    let scale = [from_local.x_axis, from_local.y_axis, from_local.z_axis]
+        .iter()
+        .map(|c| c.truncate().length())
+        .fold(0.0, f64::max);
+    let mut segments = SegmentParams {
+        from_local: from_local.as_mat4().to_cols_array_2d(),
+        surface: [0.0, scale as f32, 0.0, 0.0],
+        counts: [0, 0, peel.map_or(0, |p| p.0), FOOTPRINT_BLOCK],
+        ..Default::default()
+    };
+    if let Some((_, lattice)) = &peel {
+        lattice.write(&mut segments);
+    }
     Ok(RayMarchPlan {
         hypertexture: node.name.clone(),
         packed,
@@ -102,7 +129,14 @@ pub fn plan(
         dispatches: dispatches as u32,
         corners,
         noise: true,
+        peel,
+        segments,
     })
+}
+
+/// The largest shift of a hypertexture's noises as the kernels test it (rounding slack added).
+fn max_shift(h: &Hypertexture) -> f64 {
+    h.max_shift() * (1.0 + 1e-4) + 1e-6
 }
 
 impl RayMarchPlan {
@@ -118,6 +152,9 @@ impl RayMarchPlan {
         if hypertexture::animated(&self.packed.noises) {
             c.push(("animated".into(), 1.0));
         }
+        if self.peel.is_some() {
+            c.push(("peeling".into(), 1.0));
+        }
         c
     }
 
@@ -128,7 +165,17 @@ impl RayMarchPlan {
             (true, false) => "Phong",
             (true, true) => "PhongShadows",
         };
-        format!("RayMarch(step: {:.6}, shading: {shading}, shadow_step: {:.6})", self.step, self.shadow_step)
+        let segments = match &self.peel {
+            None => String::new(),
+            Some((passes, l)) => format!(
+                ", segments: DepthPeeling(passes: {passes}, splat_grid: {}, splat_spacing: {:.6})",
+                l.grid, l.cell
+            ),
+        };
+        format!(
+            "RayMarch(step: {:.6}, shading: {shading}, shadow_step: {:.6}{segments})",
+            self.step, self.shadow_step
+        )
     }
 
     /// GPU bytes of the object's buffers (state per pixel included).
@@ -139,6 +186,40 @@ impl RayMarchPlan {
             + self.packed.functions.len() * (16 + 4 * TRANSFER_SIZE)) as u64
             + self.packed.mesh.as_ref().map_or(0, |(_, g)| g.samples() * 16)
             + size.0 as u64 * size.1 as u64 * std::mem::size_of::<MarchState>() as u64
+            + std::mem::size_of::<SegmentParams>() as u64
+            + self.peel.as_ref().map_or(0, |(passes, lattice)| {
+                splats::bytes(lattice.cells()) + Self::segment_bytes(size, *passes) + 16
+            })
+    }
+
+    /// Bytes of the per-pixel segment boundaries (`segment_bounds`).
+    fn segment_bytes(size: (u32, u32), passes: u32) -> u64 {
+        size.0 as u64 * size.1 as u64 * (2 * passes as u64 + 2) * 4
+    }
+
+    /// The splat set's cache key (its object and lattice), for depth-peeled objects.
+    pub fn splat_key(&self) -> Option<u64> {
+        let p = &self.params;
+        let l = &self.segments;
+        self.peel.as_ref().map(|_| {
+            crate::gpu::cache::key(&(
+                "splats",
+                self.mesh_grid_key(),
+                p.object,
+                p.kinds[0],
+                p.grid_min,
+                p.grid_max,
+                l.lattice_min,
+                l.lattice,
+                l.surface[0],
+            ))
+        })
+    }
+
+    /// Bakes the splat set of a depth-peeled object (`bake_splats.wgsl`); `grid`: its mesh grid.
+    pub fn bake_splats(&self, ctx: &GpuContext, grid: Option<&MeshGrid>) -> Result<SplatSet> {
+        let unused = mesh::unused(ctx);
+        splats::bake(ctx, &self.params, &self.segments, grid.unwrap_or(&unused))
     }
 
     /// The mesh grid's cache key and a function that bakes it, for mesh objects.
@@ -152,16 +233,32 @@ impl RayMarchPlan {
     }
 
     /// Buffers, counts and constants of the object's graph instance; `grid`: the baked mesh
-    /// grid of a mesh object.
+    /// grid of a mesh object; `splats`: the splat set of a depth-peeled one.
     pub fn add_inputs(
         &self,
         ctx: &GpuContext,
         inputs: &mut Inputs,
         size: (u32, u32),
         grid: Option<&MeshGrid>,
+        splats: Option<&SplatSet>,
     ) {
         use crate::bake::{storage, uniform};
         let grid = grid.cloned().unwrap_or_else(|| mesh::unused(ctx));
+        // Segments: the splats and per-pixel boundaries (stand-ins without depth peeling).
+        let mut segments = self.segments;
+        let mut bounds_bytes = 16;
+        if let (Some((passes, _)), Some(set)) = (&self.peel, splats) {
+            segments.counts[0] = set.counts[0];
+            segments.counts[1] = set.counts[1];
+            inputs.buffers.insert("surface_splats".into(), set.surface.clone());
+            inputs.buffers.insert("interior_splats".into(), set.interior.clone());
+            inputs.counts.insert("surface_splats".into(), set.counts[0]);
+            inputs.counts.insert("peel_phases".into(), 2 * passes);
+            inputs.counts.insert("peel_blocks".into(), (size.0 * size.1).div_ceil(segments.counts[3].max(1)));
+            bounds_bytes = Self::segment_bytes(size, *passes);
+        }
+        inputs.buffers.insert("segments".into(), uniform(ctx, "segments", bytemuck::bytes_of(&segments)));
+        inputs.buffers.insert("peel_tickets".into(), storage(ctx, "peel_tickets", &[0u8; 16]));
         inputs.buffers.insert("mesh_grid".into(), grid.grid);
         inputs.buffers.insert("mesh_depth".into(), grid.depth);
         inputs.counts.insert("ray_march_dispatches".into(), self.dispatches);
@@ -185,6 +282,7 @@ impl RayMarchPlan {
         for (name, bytes) in [
             ("transfer_tables", words as u64 * 4),
             ("ray_march_state", size.0 as u64 * size.1 as u64 * std::mem::size_of::<MarchState>() as u64),
+            ("segment_bounds", bounds_bytes),
         ] {
             let buffer = ctx.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(name),
@@ -214,7 +312,7 @@ pub fn probe(ctx: &GpuContext, plan: &RayMarchPlan, points: &[[f32; 4]]) -> Resu
     let root = crate::render::wgsl_root();
     let mut inputs = Inputs::default();
     let grid = plan.bake_mesh_grid(ctx)?;
-    plan.add_inputs(ctx, &mut inputs, (1, 1), grid.as_ref());
+    plan.add_inputs(ctx, &mut inputs, (1, 1), grid.as_ref(), None);
     let b = &mut inputs.buffers;
     b.insert("probe_points".into(), storage(ctx, "probe_points", bytemuck::cast_slice(points)));
     let zeros = vec![0u8; points.len() * 64];

@@ -90,7 +90,7 @@ impl Blueprint {
                     format!(
                         "object {name}: hypertexture parameters, transfer tables, per-pixel march state{}",
                         if m.packed.mesh.is_some() { ", mesh grid" } else { "" }
-                    ),
+                    ) + if m.peel.is_some() { ", splat sets, per-pixel segment bounds" } else { "" },
                     m.bytes(self.size),
                 ));
             }
@@ -114,7 +114,12 @@ impl Blueprint {
             .iter()
             .filter_map(|o| Some((&o.object.name, o.ray_march.as_ref()?.packed.mesh.as_ref()?)))
             .collect();
-        if self.bakes.is_empty() && grids.is_empty() {
+        let splats: Vec<_> = self
+            .objects
+            .iter()
+            .filter_map(|o| Some((&o.object.name, o.ray_march.as_ref()?.peel.as_ref()?.1)))
+            .collect();
+        if self.bakes.is_empty() && grids.is_empty() && splats.is_empty() {
             s += "  (none)\n";
         }
         for (name, (shape, spec)) in grids {
@@ -123,6 +128,14 @@ impl Blueprint {
                 "  {name:<16} {x}x{y}x{z}  bake_mesh_grid.wgsl  mesh grid of {} triangles in {} part(s)\n",
                 shape.triangles.len(),
                 shape.parts.len(),
+            );
+        }
+        for (name, l) in splats {
+            let [x, y, z] = l.counts;
+            s += &format!(
+                "  {name:<16} {x}x{y}x{z}  bake_splats.wgsl  surface and interior splats, cell {:.4}, surface at \
+                 support distance {:.4}\n",
+                l.cell, l.level
             );
         }
         for b in &self.bakes {

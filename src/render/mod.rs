@@ -479,6 +479,9 @@ fn instances(
                     }
                     (filters, 0)
                 }
+                Part::RayMarch if o.ray_march.as_ref().is_some_and(|m| m.peel.is_some()) => {
+                    (vec!["RayMarch", "RayMarchPeeling"], 0)
+                }
                 Part::RayMarch => (vec!["RayMarch"], 0),
                 Part::Reference => unreachable!("reference instances are added once, above"),
             };
@@ -524,6 +527,11 @@ pub const INSTANCE_RESOURCES: &[&str] = &[
     "ray_march_state",
     "mesh_grid",
     "mesh_depth",
+    "segments",
+    "segment_bounds",
+    "surface_splats",
+    "interior_splats",
+    "peel_tickets",
     "axis_params",
     "axis_occupancy",
     "axis_choices",

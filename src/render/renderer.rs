@@ -7,6 +7,7 @@ use crate::gpu::timing::Timer;
 use crate::gpu::GpuContext;
 use crate::graph::exec::{Executor, Inputs};
 use crate::hypertexture::mesh::MeshGrid;
+use crate::hypertexture::splats::SplatSet;
 use crate::io::Image;
 use crate::methods::{axis_slices, view_slices};
 use crate::render::{wgsl_root, Blueprint, ObjectPlan, Part};
@@ -77,6 +78,17 @@ impl Renderer {
                 cache.grid(key, || Ok(m.bake_mesh_grid(ctx)?.expect("a mesh object"))).map(Some)
             })
             .collect::<Result<_>>()?;
+        // Depth-peeled objects' splat sets, baked once per object and lattice.
+        let splat_sets: Vec<Option<SplatSet>> = blueprint
+            .objects
+            .iter()
+            .zip(&grids)
+            .map(|(o, grid)| {
+                let Some(m) = &o.ray_march else { return Ok(None) };
+                let Some(key) = m.splat_key() else { return Ok(None) };
+                cache.splats(key, || m.bake_splats(ctx, grid.as_ref())).map(Some)
+            })
+            .collect::<Result<_>>()?;
         let mut frame = Inputs::default();
         frame
             .buffers
@@ -88,7 +100,8 @@ impl Renderer {
             .instances
             .iter()
             .map(|&(i, part)| {
-                instance_inputs(ctx, &blueprint, &blueprint.objects[i], part, &baked, grids[i].as_ref())
+                let gpu = (grids[i].as_ref(), splat_sets[i].as_ref());
+                instance_inputs(ctx, &blueprint, &blueprint.objects[i], part, &baked, gpu)
             })
             .collect();
         let exec = Executor::new(ctx, blueprint.graph.clone(), &blueprint.plan, blueprint.size, cache)?;
@@ -207,7 +220,7 @@ fn instance_inputs(
     o: &ObjectPlan,
     part: Part,
     baked: &[bake::Baked],
-    grid: Option<&MeshGrid>,
+    (grid, splats): (Option<&MeshGrid>, Option<&SplatSet>),
 ) -> Inputs {
     let mut inputs = Inputs::default();
     inputs.constants.push(("per_pixel_lighting".into(), o.per_pixel as u32 as f64));
@@ -226,7 +239,7 @@ fn instance_inputs(
         }
         Part::RayMarch => {
             if let Some(m) = &o.ray_march {
-                m.add_inputs(ctx, &mut inputs, bp.size, grid);
+                m.add_inputs(ctx, &mut inputs, bp.size, grid, splats);
             }
         }
         Part::Reference => {

@@ -545,6 +545,41 @@ pub struct RayMarch {
     /// Step of shadow rays (world units; default twice the ray step).
     #[serde(default, deserialize_with = "v::opt_positive")]
     pub shadow_step: Option<f64>,
+    /// Which stretches of each ray are marched (Gilet & Dischler 2009, section 5).
+    #[serde(default)]
+    pub segments: Segments,
+}
+
+/// Most depth-peeling passes (segments per ray).
+pub const MAX_PEEL_PASSES: u32 = 8;
+/// Largest splat lattice (cells along the bounds' longest axis).
+pub const MAX_SPLAT_GRID: u32 = 96;
+
+/// The segments of a ray that `RayMarch` marches.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum Segments {
+    /// From the entry to the exit of the object's enlarged bounds.
+    #[default]
+    Bounds,
+    /// Up to `passes` exact entry/exit intervals of the ray with the object's surface splats
+    /// (disks on the boundary enlarged by the largest shift), found by depth peeling; concave
+    /// objects give several per ray. `splat_grid`: lattice cells along the bounds' longest axis
+    /// from which the splats are made (their spacing).
+    DepthPeeling {
+        #[serde(default = "default_passes", deserialize_with = "v::peel_passes")]
+        passes: u32,
+        #[serde(default = "default_splat_grid", deserialize_with = "v::splat_grid")]
+        splat_grid: u32,
+    },
+}
+
+fn default_passes() -> u32 {
+    4
+}
+
+fn default_splat_grid() -> u32 {
+    32
 }
 
 impl RayMarch {

@@ -73,6 +73,13 @@ checked_u32!(Frequency, 1, 1024, "a frequency (lattice cells per tile)");
 checked_u32!(Cells, 1, 4096, "a cell count");
 checked_u32!(Around, 3, 4096, "a segment count");
 checked_u32!(PoleToPole, 2, 4096, "a segment count");
+checked_u32!(PeelPasses, 1, super::types::MAX_PEEL_PASSES, "a depth-peeling pass count");
+checked_u32!(
+    SplatGrid,
+    4,
+    super::types::MAX_SPLAT_GRID,
+    "a splat lattice size (cells along the longest axis)"
+);
 checked_u32!(
     GridResolution,
     4,
@@ -127,6 +134,8 @@ adapter!(planes, u32, PlaneCount, |v| v.0);
 adapter!(resolution, [u32; 3], [Resolution; 3], |v| v.map(|x| x.0));
 adapter!(octaves, u32, Octaves, |v| v.0);
 adapter!(grid_resolution, u32, GridResolution, |v| v.0);
+adapter!(peel_passes, u32, PeelPasses, |v| v.0);
+adapter!(splat_grid, u32, SplatGrid, |v| v.0);
 adapter!(frequency, u32, Frequency, |v| v.0);
 adapter!(cells, [u32; 2], [Cells; 2], |v| v.map(|x| x.0));
 adapter!(sphere_segments, [u32; 2], (Around, PoleToPole), |v| [v.0 .0, v.1 .0]);

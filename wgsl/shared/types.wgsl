@@ -231,3 +231,17 @@ struct MarchState {
     color: vec4<f32>,
     resume: vec4<f32>,
 }
+
+// Splat sets and depth-peeled segments (twins: SegmentParams, Splat in src/types.rs).
+struct SegmentParams {
+    from_local: mat4x4<f32>,
+    lattice_min: vec4<f32>,
+    lattice: vec4<u32>,
+    surface: vec4<f32>,
+    counts: vec4<u32>,
+}
+
+struct Splat {
+    center: vec4<f32>,
+    normal: vec4<f32>,
+}
