@@ -189,6 +189,9 @@ enum Command {
         /// RayMarch steps (world units).
         #[arg(long, value_delimiter = ',', default_values_t = voltex::pareto::DEFAULT_RAY_STEPS)]
         ray_steps: Vec<f64>,
+        /// RayMarch segment strategies, each swept over every step: bounds, depth-peeling (4 passes).
+        #[arg(long, value_enum, value_delimiter = ',', default_values = ["bounds"])]
+        ray_segments: Vec<SegmentsArg>,
     },
 }
 
@@ -295,8 +298,21 @@ fn main() -> ExitCode {
         Command::BenchHyper { size, frames, quick, segments } => {
             voltex::hypertexture::bench::run(size, frames, quick, segments)
         }
-        Command::Pareto { scene, size, frames, out, truth, methods, planes, steps, criteria, ray_steps } => {
+        Command::Pareto {
+            scene,
+            size,
+            frames,
+            out,
+            truth,
+            methods,
+            planes,
+            steps,
+            criteria,
+            ray_steps,
+            ray_segments,
+        } => {
             let methods = methods.into_iter().map(sweep).collect();
+            let ray_segments = ray_segments.into_iter().map(segments).collect();
             voltex::pareto::run(&voltex::pareto::Args {
                 scene,
                 size,
@@ -308,6 +324,7 @@ fn main() -> ExitCode {
                 steps,
                 criteria,
                 ray_steps,
+                ray_segments,
             })
         }
     };
@@ -534,6 +551,23 @@ fn sweep(m: SweepArg) -> voltex::pareto::Sweep {
         SweepArg::Reference => Sweep::Method(MethodKind::Reference),
         SweepArg::AxisSlices => Sweep::Method(MethodKind::AxisSlices),
         SweepArg::RayMarch => Sweep::RayMarch,
+    }
+}
+
+/// RayMarch segment strategies `pareto` sweeps (depth peeling with its default passes and grid).
+#[derive(clap::ValueEnum, Clone, Copy)]
+enum SegmentsArg {
+    Bounds,
+    DepthPeeling,
+}
+
+fn segments(s: SegmentsArg) -> voltex::scene::Segments {
+    match s {
+        SegmentsArg::Bounds => voltex::scene::Segments::Bounds,
+        SegmentsArg::DepthPeeling => voltex::scene::Segments::DepthPeeling {
+            passes: voltex::scene::DEFAULT_PEEL_PASSES,
+            splat_grid: voltex::scene::DEFAULT_SPLAT_GRID,
+        },
     }
 }
 

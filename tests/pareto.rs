@@ -239,8 +239,8 @@ fn axis_slices_criteria_sweep() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-/// `--methods ray-march` sweeps the hypertextures' step against a converged march: the finer
-/// step is closer to the truth; a bad step or truth fails before rendering, and a scene without
+/// `--methods ray-march` sweeps the hypertextures' step and segments against a converged
+/// march: the finer step is closer to the truth, depth peeling as close as the bounds march; a bad step or truth fails before rendering, and a scene without
 /// hypertextures has nothing to sweep.
 #[test]
 fn ray_march_step_sweep() {
@@ -258,6 +258,8 @@ fn ray_march_step_sweep() {
         "ray-march",
         "--ray-steps",
         "0.06,0.01",
+        "--ray-segments",
+        "bounds,depth-peeling",
         "--truth",
         "ray-march:0.0025",
         "--out",
@@ -274,10 +276,13 @@ fn ray_march_step_sweep() {
         assert_eq!(r[col("method")], "RayMarch");
         r[col("flip")].parse::<f64>().unwrap()
     };
-    assert_eq!(rows.len(), 2, "{rows:?}");
-    let (fine, coarse) = (get("step=0.01"), get("step=0.06"));
-    println!("RayMarch FLIP {fine:.4} at step 0.01, {coarse:.4} at step 0.06");
+    assert_eq!(rows.len(), 4, "{rows:?}");
+    let (fine, coarse) = (get("step=0.01 segments=Bounds"), get("step=0.06 segments=Bounds"));
+    let peeled = get("step=0.01 segments=DepthPeeling(4)");
+    println!("RayMarch FLIP {fine:.4} at step 0.01, {coarse:.4} at step 0.06, {peeled:.4} depth-peeled at 0.01");
     assert!(fine < coarse, "a finer step is closer to the converged march");
+    // Depth peeling takes the bounds march's samples where there is matter: the same error.
+    assert!((peeled - fine).abs() < 0.002, "depth peeling {peeled} against bounds {fine}");
     for (flag, value, expected) in
         [("--ray-steps", "0", "--ray-steps 0"), ("--truth", "ray-march:-1", "expected a positive step")]
     {

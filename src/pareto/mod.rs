@@ -19,7 +19,7 @@ use crate::error::{Error, Result};
 use crate::gpu::GpuContext;
 use crate::io::{atomic, Image};
 use crate::render::{Blueprint, MethodKind, RenderOptions};
-use crate::scene::{Scene, MAX_PLANES};
+use crate::scene::{Scene, Segments, MAX_PLANES};
 use report::Row;
 
 /// Default plane counts of the `ViewSlices` sweep.
@@ -128,6 +128,8 @@ pub struct Args {
     pub criteria: Vec<f64>,
     /// `RayMarch` steps (world units).
     pub ray_steps: Vec<f64>,
+    /// `RayMarch` segment strategies, each swept over every step.
+    pub ray_segments: Vec<Segments>,
 }
 
 /// One point of the sweep.
@@ -232,20 +234,32 @@ pub fn reference(args: &Args, default_step: f64) -> Vec<Setting> {
         .collect()
 }
 
-/// `RayMarch`: every hypertexture object marched with each step (textured objects keep their
-/// methods).
+/// `RayMarch`: every hypertexture object marched with each step and segment strategy (textured
+/// objects keep their methods).
 pub fn ray_march(args: &Args) -> Vec<Setting> {
     let mut steps = unique(args.ray_steps.iter().copied());
     steps.sort_by(f64::total_cmp);
-    steps
-        .into_iter()
-        .map(|step| Setting {
-            method: "RayMarch",
-            knobs: format!("step={step}"),
-            tag: format!("{step}"),
-            options: RenderOptions { size: Some(args.size), step: Some(step), ..Default::default() },
-        })
-        .collect()
+    let mut v = Vec::new();
+    for segments in unique(args.ray_segments.iter().copied()) {
+        let (name, short) = match segments {
+            Segments::Bounds => ("Bounds".to_string(), ""),
+            Segments::DepthPeeling { passes, .. } => (format!("DepthPeeling({passes})"), " peel"),
+        };
+        for &step in &steps {
+            v.push(Setting {
+                method: "RayMarch",
+                knobs: format!("step={step} segments={name}"),
+                tag: format!("{step}{short}"),
+                options: RenderOptions {
+                    size: Some(args.size),
+                    step: Some(step),
+                    segments: Some(segments),
+                    ..Default::default()
+                },
+            });
+        }
+    }
+    v
 }
 
 /// Every setting of the methods asked for, with notes on what cannot be swept.

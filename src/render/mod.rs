@@ -37,6 +37,8 @@ pub struct RenderOptions {
     pub method: Option<MethodKind>,
     /// Ray step for `Reference` and `RayMarch` objects (world units).
     pub step: Option<f64>,
+    /// Segment strategy of every `RayMarch` object (the Pareto sweep).
+    pub segments: Option<crate::scene::Segments>,
     /// Methods replacing those of named objects (the preview's per-object switch), before
     /// `method` and the knob overrides apply.
     pub object_methods: Vec<(String, Method)>,
@@ -81,7 +83,11 @@ impl RenderOptions {
     pub fn apply(&self, method: &Method) -> Method {
         if let Method::RayMarch(rm) = method {
             // Hypertextures have no texel for other methods: only the step changes.
-            return Method::RayMarch(RayMarch { step: self.step.or(rm.step), ..*rm });
+            return Method::RayMarch(RayMarch {
+                step: self.step.or(rm.step),
+                segments: self.segments.unwrap_or(rm.segments),
+                ..*rm
+            });
         }
         let lighting = method.lighting();
         let kind = self.method.unwrap_or(match method {

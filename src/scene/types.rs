@@ -574,12 +574,16 @@ pub enum Segments {
     },
 }
 
+/// `DepthPeeling`'s defaults: passes (segments per ray) and splat lattice cells.
+pub const DEFAULT_PEEL_PASSES: u32 = 4;
+pub const DEFAULT_SPLAT_GRID: u32 = 32;
+
 fn default_passes() -> u32 {
-    4
+    DEFAULT_PEEL_PASSES
 }
 
 fn default_splat_grid() -> u32 {
-    32
+    DEFAULT_SPLAT_GRID
 }
 
 impl RayMarch {
