@@ -189,7 +189,21 @@ enum Command {
         /// RayMarch steps (world units).
         #[arg(long, value_delimiter = ',', default_values_t = voltex::pareto::DEFAULT_RAY_STEPS)]
         ray_steps: Vec<f64>,
+        /// RayMarch with an adaptive stride: STEP:MAX_STEP pairs (world units), e.g.
+        /// 0.002:0.03,0.002:0.06 (default: none).
+        #[arg(long, value_delimiter = ',', value_parser = parse_adaptive)]
+        ray_adaptive: Vec<(f64, f64)>,
     },
+}
+
+fn parse_adaptive(s: &str) -> std::result::Result<(f64, f64), String> {
+    let bad = || format!("`{s}`: expected STEP:MAX_STEP, positive world units with MAX_STEP >= STEP");
+    let (step, max) = s.split_once(':').ok_or_else(bad)?;
+    let value = |v: &str| v.trim().parse::<f64>().ok().filter(|v| v.is_finite() && *v > 0.0);
+    match (value(step), value(max)) {
+        (Some(step), Some(max)) if max >= step => Ok((step, max)),
+        _ => Err(bad()),
+    }
 }
 
 fn parse_criteria(s: &str) -> std::result::Result<(f64, f64), String> {
@@ -295,7 +309,19 @@ fn main() -> ExitCode {
         Command::BenchHyper { size, frames, quick, segments } => {
             voltex::hypertexture::bench::run(size, frames, quick, segments)
         }
-        Command::Pareto { scene, size, frames, out, truth, methods, planes, steps, criteria, ray_steps } => {
+        Command::Pareto {
+            scene,
+            size,
+            frames,
+            out,
+            truth,
+            methods,
+            planes,
+            steps,
+            criteria,
+            ray_steps,
+            ray_adaptive,
+        } => {
             let methods = methods.into_iter().map(sweep).collect();
             voltex::pareto::run(&voltex::pareto::Args {
                 scene,
@@ -308,6 +334,7 @@ fn main() -> ExitCode {
                 steps,
                 criteria,
                 ray_steps,
+                ray_adaptive,
             })
         }
     };

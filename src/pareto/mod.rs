@@ -128,6 +128,8 @@ pub struct Args {
     pub criteria: Vec<f64>,
     /// `RayMarch` steps (world units).
     pub ray_steps: Vec<f64>,
+    /// `RayMarch` with an adaptive stride: `(step, max_step)` pairs (world units).
+    pub ray_adaptive: Vec<(f64, f64)>,
 }
 
 /// One point of the sweep.
@@ -153,6 +155,13 @@ impl Args {
         }
         if let Some(&s) = self.ray_steps.iter().find(|&&s| !(s.is_finite() && s > 0.0)) {
             return Err(Error::Invalid(format!("--ray-steps {s}: expected positive steps in world units")));
+        }
+        if let Some(&(s, m)) =
+            self.ray_adaptive.iter().find(|&&(s, m)| !(s.is_finite() && s > 0.0 && m.is_finite() && m >= s))
+        {
+            return Err(Error::Invalid(format!(
+                "--ray-adaptive {s}:{m}: expected STEP:MAX_STEP, positive world units with MAX_STEP >= STEP"
+            )));
         }
         if let Some(&c) = self.criteria.iter().find(|&&c| !(c > 0.0 && c <= 1024.0)) {
             return Err(Error::Invalid(format!("--criteria {c}: expected values in (0, 1024]")));
@@ -232,20 +241,36 @@ pub fn reference(args: &Args, default_step: f64) -> Vec<Setting> {
         .collect()
 }
 
-/// `RayMarch`: every hypertexture object marched with each step (textured objects keep their
-/// methods).
+/// `RayMarch`: every hypertexture object marched with each fixed step, then with each adaptive
+/// stride (textured objects keep their methods).
 pub fn ray_march(args: &Args) -> Vec<Setting> {
     let mut steps = unique(args.ray_steps.iter().copied());
     steps.sort_by(f64::total_cmp);
-    steps
-        .into_iter()
-        .map(|step| Setting {
-            method: "RayMarch",
-            knobs: format!("step={step}"),
-            tag: format!("{step}"),
-            options: RenderOptions { size: Some(args.size), step: Some(step), ..Default::default() },
-        })
-        .collect()
+    let fixed = steps.into_iter().map(|step| Setting {
+        method: "RayMarch",
+        knobs: format!("step={step}"),
+        tag: format!("{step}"),
+        options: RenderOptions {
+            size: Some(args.size),
+            step: Some(step),
+            max_step: Some(None),
+            ..Default::default()
+        },
+    });
+    let mut pairs = args.ray_adaptive.clone();
+    pairs.dedup();
+    let adaptive = pairs.into_iter().map(|(step, max_step)| Setting {
+        method: "RayMarch",
+        knobs: format!("step={step} max_step={max_step}"),
+        tag: format!("{step}<{max_step}"),
+        options: RenderOptions {
+            size: Some(args.size),
+            step: Some(step),
+            max_step: Some(Some(max_step)),
+            ..Default::default()
+        },
+    });
+    fixed.chain(adaptive).collect()
 }
 
 /// Every setting of the methods asked for, with notes on what cannot be swept.

@@ -37,6 +37,9 @@ pub struct RenderOptions {
     pub method: Option<MethodKind>,
     /// Ray step for `Reference` and `RayMarch` objects (world units).
     pub step: Option<f64>,
+    /// RayMarch objects: an adaptive stride up to this step (world units; the Pareto sweep);
+    /// `Some(None)` turns it off.
+    pub max_step: Option<Option<f64>>,
     /// Methods replacing those of named objects (the preview's per-object switch), before
     /// `method` and the knob overrides apply.
     pub object_methods: Vec<(String, Method)>,
@@ -81,7 +84,11 @@ impl RenderOptions {
     pub fn apply(&self, method: &Method) -> Method {
         if let Method::RayMarch(rm) = method {
             // Hypertextures have no texel for other methods: only the step changes.
-            return Method::RayMarch(RayMarch { step: self.step.or(rm.step), ..*rm });
+            let adaptive = match self.max_step {
+                Some(m) => m.map(|max_step| crate::scene::Adaptive { max_step }),
+                None => rm.adaptive,
+            };
+            return Method::RayMarch(RayMarch { step: self.step.or(rm.step), adaptive, ..*rm });
         }
         let lighting = method.lighting();
         let kind = self.method.unwrap_or(match method {
