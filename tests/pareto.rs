@@ -240,7 +240,8 @@ fn axis_slices_criteria_sweep() {
 }
 
 /// `--methods ray-march` sweeps the hypertextures' step against a converged march: the finer
-/// step is closer to the truth; a bad step or truth fails before rendering, and a scene without
+/// step is closer to the truth, the adaptive stride nearly as close with fewer density
+/// evaluations; a bad step, adaptive pair or truth fails before rendering, and a scene without
 /// hypertextures has nothing to sweep.
 #[test]
 fn ray_march_step_sweep() {
@@ -258,6 +259,8 @@ fn ray_march_step_sweep() {
         "ray-march",
         "--ray-steps",
         "0.06,0.01",
+        "--ray-adaptive",
+        "0.01:0.06",
         "--truth",
         "ray-march:0.0025",
         "--out",
@@ -269,18 +272,33 @@ fn ray_march_step_sweep() {
     assert!(log.contains("truth: RayMarch, step 0.0025"), "{log}");
     let (header, rows) = read_csv(&out.join("pareto.csv"));
     let col = |name: &str| header.iter().position(|h| h == name).unwrap();
-    let get = |k: &str| {
+    let value = |k: &str, c: &str| {
         let r = rows.iter().find(|r| r[col("knobs")] == k).unwrap_or_else(|| panic!("no {k}: {rows:?}"));
         assert_eq!(r[col("method")], "RayMarch");
-        r[col("flip")].parse::<f64>().unwrap()
+        r[col(c)].parse::<f64>().unwrap()
     };
-    assert_eq!(rows.len(), 2, "{rows:?}");
-    let (fine, coarse) = (get("step=0.01"), get("step=0.06"));
-    println!("RayMarch FLIP {fine:.4} at step 0.01, {coarse:.4} at step 0.06");
+    let get = |k: &str| value(k, "flip");
+    assert_eq!(rows.len(), 3, "{rows:?}");
+    let (fine, coarse, adaptive) = (get("step=0.01"), get("step=0.06"), get("step=0.01 max_step=0.06"));
+    let evaluations = |k: &str| value(k, "evaluations");
+    let (fine_n, coarse_n, adaptive_n) =
+        (evaluations("step=0.01"), evaluations("step=0.06"), evaluations("step=0.01 max_step=0.06"));
+    println!(
+        "RayMarch FLIP {fine:.4} at step 0.01 ({fine_n} density evaluations), {coarse:.4} at step 0.06 \
+         ({coarse_n}), {adaptive:.4} adaptive 0.01 to 0.06 ({adaptive_n})"
+    );
     assert!(fine < coarse, "a finer step is closer to the converged march");
-    for (flag, value, expected) in
-        [("--ray-steps", "0", "--ray-steps 0"), ("--truth", "ray-march:-1", "expected a positive step")]
-    {
+    // The adaptive stride skips empty space: fewer evaluations than its fine step, and the
+    // error of the fine step rather than the coarse one.
+    assert!(coarse_n < adaptive_n && adaptive_n < fine_n, "{coarse_n} {adaptive_n} {fine_n}");
+    assert!(adaptive < 0.5 * (fine + coarse), "{adaptive} vs {fine} and {coarse}");
+    for (flag, value, expected) in [
+        ("--ray-steps", "0", "--ray-steps 0"),
+        ("--truth", "ray-march:-1", "expected a positive step"),
+        ("--ray-adaptive", "0.01:0.005", "MAX_STEP >= STEP"),
+        ("--ray-adaptive", "0.01", "expected STEP:MAX_STEP"),
+        ("--ray-adaptive", "0.01:inf", "expected STEP:MAX_STEP"),
+    ] {
         let bad = pareto(&[&scene, "--methods", "ray-march", flag, value, "--out", &out_s]);
         assert!(bad.status.code().is_some_and(|c| c != 0), "{}", text(&bad));
         assert!(text(&bad).contains(expected), "{flag} {value}: {}", text(&bad));
