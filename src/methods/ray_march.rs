@@ -174,8 +174,14 @@ impl RayMarchPlan {
                 l.grid, l.cell
             ),
         };
+        let stride = self.params.budget[3];
+        let adaptive = if stride > 1 {
+            format!(", adaptive: strides up to {stride} steps ({:.6})", stride as f64 * self.step)
+        } else {
+            String::new()
+        };
         format!(
-            "RayMarch(step: {:.6}, shading: {shading}, shadow_step: {:.6}{segments})",
+            "RayMarch(step: {:.6}, shading: {shading}, shadow_step: {:.6}{segments}{adaptive})",
             self.step, self.shadow_step
         )
     }
