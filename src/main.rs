@@ -192,7 +192,21 @@ enum Command {
         /// RayMarch segment strategies, each swept over every step: bounds, depth-peeling (4 passes).
         #[arg(long, value_enum, value_delimiter = ',', default_values = ["bounds"])]
         ray_segments: Vec<SegmentsArg>,
+        /// RayMarch with an adaptive stride: STEP:MAX_STEP pairs (world units), e.g.
+        /// 0.002:0.03,0.002:0.06 (default: none).
+        #[arg(long, value_delimiter = ',', value_parser = parse_adaptive)]
+        ray_adaptive: Vec<(f64, f64)>,
     },
+}
+
+fn parse_adaptive(s: &str) -> std::result::Result<(f64, f64), String> {
+    let bad = || format!("`{s}`: expected STEP:MAX_STEP, positive world units with MAX_STEP >= STEP");
+    let (step, max) = s.split_once(':').ok_or_else(bad)?;
+    let value = |v: &str| v.trim().parse::<f64>().ok().filter(|v| v.is_finite() && *v > 0.0);
+    match (value(step), value(max)) {
+        (Some(step), Some(max)) if max >= step => Ok((step, max)),
+        _ => Err(bad()),
+    }
 }
 
 fn parse_criteria(s: &str) -> std::result::Result<(f64, f64), String> {
@@ -310,6 +324,7 @@ fn main() -> ExitCode {
             criteria,
             ray_steps,
             ray_segments,
+            ray_adaptive,
         } => {
             let methods = methods.into_iter().map(sweep).collect();
             let ray_segments = ray_segments.into_iter().map(segments).collect();
@@ -325,6 +340,7 @@ fn main() -> ExitCode {
                 criteria,
                 ray_steps,
                 ray_segments,
+                ray_adaptive,
             })
         }
     };

@@ -337,7 +337,8 @@ pub struct HyperParams {
     /// w: the frame's time (seconds, animated hypertextures).
     pub march: [f32; 4],
     /// Work of one dispatch, in density evaluations: x the budget, y the most samples of a shadow
-    /// ray, z the most one sample may cost (so a sample is begun only when it fits).
+    /// ray, z the most one sample may cost (so a sample is begun only when it fits), w the
+    /// longest adaptive stride in steps (0 or 1: off).
     pub budget: [u32; 4],
     /// Mesh objects: xyz the lower corner of the baked grid (object space), w samples per axis.
     pub grid_min: [f32; 4],
@@ -425,7 +426,8 @@ pub struct TransferPoint {
 pub struct MarchState {
     /// rgb: premultiplied colour gathered so far; a: coverage (1 - transmittance).
     pub color: [f32; 4],
-    /// x: index of the next sample; y: density evaluations so far; z: 1 once finished; w: those
+    /// x: index of the next sample; y: density evaluations so far; z: 1 once finished, else
+    /// 1 - the stride that reached sample x (adaptive stride; 0 when off); w: those
     /// of the evaluations that ran the noises (y and w for benchmarks).
     pub resume: [f32; 4],
 }

@@ -363,6 +363,71 @@ fn images_match_twin() {
     assert!(mean < 1e-4 && off < 0.01);
 }
 
+/// The adaptive stride: kernel and twin take the same samples, the kernel resuming its stride
+/// across dispatches (a budget of 97 evaluations per dispatch makes the longest rays resume
+/// four times and more); with strides of up to 8 steps in empty space the image stays close to the fixed
+/// step's at clearly fewer density evaluations; a stride of 1 is the fixed march, bit for bit.
+#[test]
+fn adaptive_stride_matches_twin() {
+    // The kernel's layer, its per-pixel states, and the twin's layer, with a small budget.
+    let run = |scene: &scene::Scene| {
+        let mut bp = blueprint(scene, &sized(32, 32));
+        let plan = bp.objects.iter_mut().find_map(|o| o.ray_march.as_mut()).unwrap();
+        let budget = plan.params.budget[0];
+        plan.params.budget[0] = 97;
+        plan.dispatches *= budget / 97 + 1;
+        let plan = plan.clone();
+        let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
+        let mut r = Renderer::new(&ctx, bp).unwrap();
+        r.render(&ctx).unwrap();
+        let instance = r.blueprint.instances.iter().position(|p| p.1 == Part::RayMarch).unwrap();
+        let bytes = r.read_instance_buffer(&ctx, instance, "ray_march_state").unwrap();
+        drop(ctx);
+        let states = bytemuck::pod_collect_to_vec::<u8, MarchState>(&bytes);
+        let f = &r.blueprint.frame;
+        let light = [0, 1, 2].map(|c| f.light_color[c] as f64);
+        let gpu: Vec<[f64; 4]> = states
+            .iter()
+            .map(|s| std::array::from_fn(|c| s.color[c] as f64 * if c < 3 { light[c] } else { 1.0 }))
+            .collect();
+        let tables = twin_tables(&plan);
+        let view = MarchView::of_frame(f, r.blueprint.size);
+        let cpu = ray_march(&view, model(&plan, &tables), plan.shade);
+        (gpu, states, cpu)
+    };
+    let (fixed_gpu, fixed_states, fixed_cpu) = run(&one(CLOUD, "RayMarch(step: 0.005, shading: Phong)"));
+    let fixed_evals: f64 = fixed_states.iter().map(|s| s.resume[1] as f64).sum();
+    for method in [
+        "RayMarch(step: 0.005, shading: Phong, adaptive: (max_step: 0.04))",
+        "RayMarch(step: 0.005, adaptive: (max_step: 0.04))",
+    ] {
+        let (gpu, states, cpu) = run(&one(CLOUD, method));
+        let (max, mean, off) = compare(&gpu, &cpu);
+        let evals: f64 = states.iter().map(|s| s.resume[1] as f64).sum();
+        let most = states.iter().map(|s| s.resume[1]).fold(0.0, f32::max);
+        eprintln!(
+            "{method}: kernel vs twin max {max:.2e}, mean {mean:.2e}, {:.2}% off; {evals} density evaluations \
+             (fixed step, Phong: {fixed_evals}), at most {most} per ray",
+            off * 100.0
+        );
+        assert!(most > 4.0 * 97.0, "{method}: rays resume across dispatches");
+        assert!(states.iter().all(|s| s.resume[2] == 1.0), "{method}: every ray finished");
+        assert!(mean < 1e-5 && max < 1e-3, "{method}: max {max}, mean {mean}, off {off}");
+        if method.contains("Phong") {
+            let (_, mean_fixed, _) = compare(&gpu, &fixed_gpu);
+            let (_, mean_twins, _) = compare(&cpu, &fixed_cpu);
+            eprintln!(
+                "  mean difference to the fixed step {mean_fixed:.2e} (kernel), {mean_twins:.2e} (twins)"
+            );
+            assert!(evals < 0.7 * fixed_evals, "{evals} vs {fixed_evals}");
+            assert!(mean_fixed < 2e-3 && mean_twins < 2e-3, "{mean_fixed} {mean_twins}");
+        }
+    }
+    // max_step below two steps: stride 1, the fixed march.
+    let (gpu, _, _) = run(&one(CLOUD, "RayMarch(step: 0.005, shading: Phong, adaptive: (max_step: 0.009))"));
+    assert!(gpu == fixed_gpu, "a stride of at most 1 step changes the image");
+}
+
 /// With every amplitude 0 the density is the soft object's, exactly, whatever the noises and the
 /// field; drawn as an iso-surface it is a sphere whose silhouette is known per pixel.
 #[test]
@@ -686,6 +751,11 @@ fn bad_objects_fields_and_methods_are_reported_at_their_position() {
     let node = |m: &str| format!("    nodes: [(name: \"n\", hypertexture: \"h\", method: {m})],");
     bad(15, &node("RayMarch(step: 0.0)"), "0.0", "positive");
     bad(15, &node("RayMarch(step: 1e-9)"), "RayMarch", "expected a step of at least");
+    bad(15, &node("RayMarch(step: 0.02, adaptive: (max_step: 0.01))"), "RayMarch", "below the step 0.02");
+    bad(15, &node("RayMarch(adaptive: (max_step: inf))"), "inf)", "positive finite");
+    bad(15, &node("RayMarch(adaptive: (max_step: NaN))"), "NaN)", "positive finite");
+    bad(15, &node("RayMarch(adaptive: (max_step: 0.0))"), "0.0)", "positive finite");
+    bad(15, &node("RayMarch(adaptive: (stride: 4))"), "stride", "max_step");
     bad(15, &node("RayMarch(shading: Gouraud)"), "Gouraud", "PhongShadows");
     bad(15, &node("ViewSlices(planes: 10)"), "ViewSlices", "expected RayMarch");
     bad(15, &node("RayMarch(segments: DepthPeeling(passes: 0))"), "0)", "depth-peeling pass count in 1..=8");

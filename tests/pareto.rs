@@ -239,8 +239,10 @@ fn axis_slices_criteria_sweep() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-/// `--methods ray-march` sweeps the hypertextures' step and segments against a converged
-/// march: the finer step is closer to the truth, depth peeling as close as the bounds march; a bad step or truth fails before rendering, and a scene without
+/// `--methods ray-march` sweeps the hypertextures' step, segments and adaptive strides against a
+/// converged march: the finer step is closer to the truth, depth peeling as close as the bounds
+/// march, the adaptive stride nearly as close with fewer density evaluations; a bad step,
+/// adaptive pair or truth fails before rendering, and a scene without
 /// hypertextures has nothing to sweep.
 #[test]
 fn ray_march_step_sweep() {
@@ -260,6 +262,8 @@ fn ray_march_step_sweep() {
         "0.06,0.01",
         "--ray-segments",
         "bounds,depth-peeling",
+        "--ray-adaptive",
+        "0.01:0.06",
         "--truth",
         "ray-march:0.0025",
         "--out",
@@ -271,21 +275,38 @@ fn ray_march_step_sweep() {
     assert!(log.contains("truth: RayMarch, step 0.0025"), "{log}");
     let (header, rows) = read_csv(&out.join("pareto.csv"));
     let col = |name: &str| header.iter().position(|h| h == name).unwrap();
-    let get = |k: &str| {
+    let value = |k: &str, c: &str| {
         let r = rows.iter().find(|r| r[col("knobs")] == k).unwrap_or_else(|| panic!("no {k}: {rows:?}"));
         assert_eq!(r[col("method")], "RayMarch");
-        r[col("flip")].parse::<f64>().unwrap()
+        r[col(c)].parse::<f64>().unwrap()
     };
-    assert_eq!(rows.len(), 4, "{rows:?}");
-    let (fine, coarse) = (get("step=0.01 segments=Bounds"), get("step=0.06 segments=Bounds"));
+    let get = |k: &str| value(k, "flip");
+    assert_eq!(rows.len(), 6, "{rows:?}");
+    let bounds = |k: &str| format!("{k} segments=Bounds");
+    let (fine, coarse, adaptive) =
+        (get(&bounds("step=0.01")), get(&bounds("step=0.06")), get(&bounds("step=0.01 max_step=0.06")));
+    let evaluations = |k: &str| value(&bounds(k), "evaluations");
+    let (fine_n, coarse_n, adaptive_n) =
+        (evaluations("step=0.01"), evaluations("step=0.06"), evaluations("step=0.01 max_step=0.06"));
     let peeled = get("step=0.01 segments=DepthPeeling(4)");
-    println!("RayMarch FLIP {fine:.4} at step 0.01, {coarse:.4} at step 0.06, {peeled:.4} depth-peeled at 0.01");
+    println!(
+        "RayMarch FLIP {fine:.4} at step 0.01 ({fine_n} density evaluations), {coarse:.4} at step 0.06 \
+         ({coarse_n}), {adaptive:.4} adaptive 0.01 to 0.06 ({adaptive_n}), {peeled:.4} depth-peeled at 0.01"
+    );
     assert!(fine < coarse, "a finer step is closer to the converged march");
+    // The adaptive stride skips empty space: fewer evaluations than its fine step, and the
+    // error of the fine step rather than the coarse one.
+    assert!(coarse_n < adaptive_n && adaptive_n < fine_n, "{coarse_n} {adaptive_n} {fine_n}");
+    assert!(adaptive < 0.5 * (fine + coarse), "{adaptive} vs {fine} and {coarse}");
     // Depth peeling takes the bounds march's samples where there is matter: the same error.
     assert!((peeled - fine).abs() < 0.002, "depth peeling {peeled} against bounds {fine}");
-    for (flag, value, expected) in
-        [("--ray-steps", "0", "--ray-steps 0"), ("--truth", "ray-march:-1", "expected a positive step")]
-    {
+    for (flag, value, expected) in [
+        ("--ray-steps", "0", "--ray-steps 0"),
+        ("--truth", "ray-march:-1", "expected a positive step"),
+        ("--ray-adaptive", "0.01:0.005", "MAX_STEP >= STEP"),
+        ("--ray-adaptive", "0.01", "expected STEP:MAX_STEP"),
+        ("--ray-adaptive", "0.01:inf", "expected STEP:MAX_STEP"),
+    ] {
         let bad = pareto(&[&scene, "--methods", "ray-march", flag, value, "--out", &out_s]);
         assert!(bad.status.code().is_some_and(|c| c != 0), "{}", text(&bad));
         assert!(text(&bad).contains(expected), "{flag} {value}: {}", text(&bad));

@@ -93,7 +93,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let pixel = id.y * size.x + id.x;
     let state = ray_march_state[pixel];
-    if (state.resume.z != 0.0) {
+    if (state.resume.z > 0.0) {
         return;
     }
     let forward = frame.forward.xyz;
@@ -115,6 +115,12 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     var rgb = state.color.rgb;
     var transmittance = 1.0 - state.color.a;
     var k = u32(state.resume.x);
+    // Adaptive stride (`RayMarch(adaptive: ..)`): sample k was reached from sample k - stride;
+    // in empty space the stride doubles up to `hyper.budget.w` fine steps, and a strided sample
+    // that finds matter is dropped for the samples after k - stride, taken one by one. Only
+    // stride-1 samples are composited, so each weighs one fine step h.
+    var stride = u32(-state.resume.z) + 1u;
+    let max_stride = max(hyper.budget.w, 1u);
     var budget = i32(hyper.budget.x);
     let worst = i32(hyper.budget.z);
     // Most samples of the bounds are far from the object: their density is 0.
@@ -148,7 +154,11 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
             // Samples t0 + (k + 0.5) h within [entry, exit].
             let first = ceil((bitcast<f32>(entry) - t0) / h - 0.5);
             let last = floor((bitcast<f32>(segment_bounds[base + 3u + 2u * segment]) - t0) / h - 0.5);
-            k = max(k, u32(clamp(first, 0.0, f32(n))));
+            let first_k = u32(clamp(first, 0.0, f32(n)));
+            if (k < first_k) {
+                k = first_k;
+                stride = 1u;
+            }
             end = u32(clamp(last + 1.0, 0.0, f32(n)));
         }
         while (k < end && transmittance >= MIN_TRANSMITTANCE && budget >= worst) {
@@ -159,6 +169,11 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
                 rgba = hyper_color(density);
             }
             budget -= 1;
+            if (density > 0.0 && stride > 1u) {
+                k = k + 1u - stride;
+                stride = 1u;
+                continue;
+            }
             if (rgba.a > 1e-6) {
                 let alpha = step_alpha(rgba.a, h);
                 var colour = rgba.rgb;
@@ -170,21 +185,31 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
                 rgb += colour * alpha * transmittance;
                 transmittance *= 1.0 - alpha;
             }
-            k++;
+            stride = select(1u, min(2u * stride, max_stride), density <= 0.0);
+            // The last sample of a stretch is always taken.
+            if (k + stride >= end && k + 1u < end) {
+                stride = end - 1u - k;
+            }
+            k += stride;
         }
         if (k < end) {
             break;
         }
+        // A stride may overshoot the stretch: the next one begins afresh at its first sample.
+        k = end;
+        stride = 1u;
         segment++;
     }
     if (peeling) {
         segment_bounds[base] = segment;
     }
     let finished = segment >= segment_count || transmittance < MIN_TRANSMITTANCE;
-    // resume: next sample, density evaluations so far, finished, evaluations that ran the noises.
+    // resume: next sample, density evaluations so far, 1 once finished else 1 - stride,
+    // evaluations that ran the noises.
     let evaluations = state.resume.y + f32(i32(hyper.budget.x) - budget);
+    let progress = select(1.0 - f32(stride), 1.0, finished);
     ray_march_state[pixel] = MarchState(
         vec4<f32>(rgb, 1.0 - transmittance),
-        vec4<f32>(f32(k), evaluations, select(0.0, 1.0, finished), state.resume.w + f32(noised_evaluations)),
+        vec4<f32>(f32(k), evaluations, progress, state.resume.w + f32(noised_evaluations)),
     );
 }

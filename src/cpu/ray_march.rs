@@ -1,8 +1,9 @@
 //! CPU twin (f64) of `wgsl/ray_march.wgsl`: per pixel, the ray's span inside the hypertexture's
 //! enlarged bounds is cut into whole steps sampled at their middles, composited front to back with
 //! the shared step-corrected opacity until the transmittance falls below 1e-4; Phong shading from
-//! the density gradient by central differences and shadow rays towards the light. It marches each
-//! ray in one go, so it also checks the kernel's resumption across dispatches.
+//! the density gradient by central differences and shadow rays towards the light; with an
+//! adaptive stride (`HyperParams::budget` w) the same strided samples as the kernel. It marches
+//! each ray in one go, so it also checks the kernel's resumption across dispatches.
 
 use glam::{DMat4, DVec3, DVec4};
 
@@ -125,12 +126,23 @@ impl Ray<'_> {
         if t1 > t0 {
             let n = ((t1 - t0) / p.bounds_min[3] as f64).ceil().max(1.0) as u64;
             let h = (t1 - t0) / n as f64;
-            for k in 0..n {
-                if transmittance < MIN_TRANSMITTANCE {
-                    break;
-                }
+            // Adaptive stride as in the kernel: sample k was reached from k - stride.
+            let max_stride = p.budget[3].max(1) as u64;
+            let (mut k, mut stride) = (0u64, 1u64);
+            while k < n && transmittance >= MIN_TRANSMITTANCE {
                 let x = origin + dir * (t0 + (k as f64 + 0.5) * h);
-                let rgba = self.model.hyper_color(self.model.hyper_density(x));
+                let density = self.model.hyper_density(x);
+                if density > 0.0 && stride > 1 {
+                    k = k + 1 - stride;
+                    stride = 1;
+                    continue;
+                }
+                stride = if density > 0.0 { 1 } else { (2 * stride).min(max_stride) };
+                if k + stride >= n && k + 1 < n {
+                    stride = n - 1 - k;
+                }
+                k += stride;
+                let rgba = self.model.hyper_color(density);
                 if rgba[3] <= 1e-6 {
                     continue;
                 }

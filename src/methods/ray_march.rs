@@ -87,7 +87,9 @@ pub fn plan(
     };
     // Every unfinished ray advances at least `evals / worst` samples per dispatch (segments
     // take a subset of the bounds' samples).
-    let samples = (diagonal / step).ceil() + 1.0;
+    // An adaptive stride evaluates a sample at most twice (a strided one dropped for matter).
+    let adaptive = method.max_stride() > 1;
+    let samples = ((diagonal / step).ceil() + 1.0) * if adaptive { 2.0 } else { 1.0 };
     let dispatches = (samples / (evals / worst) as f64).ceil() + 1.0;
     if dispatches > MAX_DISPATCHES as f64 {
         return Err(Error::Invalid(format!(
@@ -104,7 +106,7 @@ pub fn plan(
     params.bounds_min[3] = step as f32;
     params.march[0] = shadow_step as f32;
     params.march[1] = step as f32;
-    params.budget = [evals, shadow_samples, worst, 0];
+    params.budget = [evals, shadow_samples, worst, method.max_stride()];
     let from_local = DMat4::from_translation(-camera.eye) * *to_world;
     let scale = [from_local.x_axis, from_local.y_axis, from_local.z_axis]
         .iter()
@@ -172,8 +174,14 @@ impl RayMarchPlan {
                 l.grid, l.cell
             ),
         };
+        let stride = self.params.budget[3];
+        let adaptive = if stride > 1 {
+            format!(", adaptive: strides up to {stride} steps ({:.6})", stride as f64 * self.step)
+        } else {
+            String::new()
+        };
         format!(
-            "RayMarch(step: {:.6}, shading: {shading}, shadow_step: {:.6}{segments})",
+            "RayMarch(step: {:.6}, shading: {shading}, shadow_step: {:.6}{segments}{adaptive})",
             self.step, self.shadow_step
         )
     }

@@ -17,7 +17,8 @@ use crate::error::Result;
 use crate::gpu::GpuContext;
 use crate::graph::PassDecl;
 use crate::io::Image;
-use crate::render::{Blueprint, Renderer};
+use crate::render::{Blueprint, Part, Renderer};
+use crate::types::MarchState;
 
 /// Frames rendered and thrown away before the timed ones...
 pub const WARM_UP_FRAMES: usize = 2;
@@ -40,6 +41,8 @@ pub struct Frames {
     /// Median wall-clock ms of a whole frame: record, submit, wait until the GPU is idle, read the
     /// timestamps back.
     pub wall_ms: f64,
+    /// Density evaluations of RayMarch objects in one frame (0 without any).
+    pub evaluations: f64,
 }
 
 pub fn median(mut v: Vec<f64>) -> f64 {
@@ -82,9 +85,22 @@ pub fn full_frames(ctx: &GpuContext, bp: Blueprint, frames: usize) -> Result<Fra
     let mut r = Renderer::new(ctx, bp)?;
     let t = Instant::now();
     let image = r.render(ctx)?.image;
+    let evaluations = evaluations(ctx, &r)?;
     let (times, wall_ms) = timed(ctx, &mut r, frames, Some(t.elapsed().as_secs_f64() * 1e3))?;
     let raster = times.into_iter().filter(|(n, _)| raster.contains(n)).collect();
-    Ok(Frames { image, raster, wall_ms })
+    Ok(Frames { image, raster, wall_ms, evaluations })
+}
+
+/// Density evaluations of the frame just rendered, over every RayMarch object (their
+/// `ray_march_state`): what an adaptive stride saves, independent of the machine's load.
+fn evaluations(ctx: &GpuContext, r: &Renderer) -> Result<f64> {
+    let mut sum = 0.0;
+    for (i, _) in r.blueprint.instances.iter().enumerate().filter(|(_, p)| p.1 == Part::RayMarch) {
+        let states: Vec<MarchState> =
+            bytemuck::pod_collect_to_vec(&r.read_instance_buffer(ctx, i, "ray_march_state")?);
+        sum += states.iter().map(|s| s.resume[1] as f64).sum::<f64>();
+    }
+    Ok(sum)
 }
 
 /// Just the image (the truth).

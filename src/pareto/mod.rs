@@ -130,6 +130,8 @@ pub struct Args {
     pub ray_steps: Vec<f64>,
     /// `RayMarch` segment strategies, each swept over every step.
     pub ray_segments: Vec<Segments>,
+    /// `RayMarch` with an adaptive stride: `(step, max_step)` pairs (world units).
+    pub ray_adaptive: Vec<(f64, f64)>,
 }
 
 /// One point of the sweep.
@@ -155,6 +157,13 @@ impl Args {
         }
         if let Some(&s) = self.ray_steps.iter().find(|&&s| !(s.is_finite() && s > 0.0)) {
             return Err(Error::Invalid(format!("--ray-steps {s}: expected positive steps in world units")));
+        }
+        if let Some(&(s, m)) =
+            self.ray_adaptive.iter().find(|&&(s, m)| !(s.is_finite() && s > 0.0 && m.is_finite() && m >= s))
+        {
+            return Err(Error::Invalid(format!(
+                "--ray-adaptive {s}:{m}: expected STEP:MAX_STEP, positive world units with MAX_STEP >= STEP"
+            )));
         }
         if let Some(&c) = self.criteria.iter().find(|&&c| !(c > 0.0 && c <= 1024.0)) {
             return Err(Error::Invalid(format!("--criteria {c}: expected values in (0, 1024]")));
@@ -234,25 +243,34 @@ pub fn reference(args: &Args, default_step: f64) -> Vec<Setting> {
         .collect()
 }
 
-/// `RayMarch`: every hypertexture object marched with each step and segment strategy (textured
-/// objects keep their methods).
+/// `RayMarch`: every hypertexture object marched with each segment strategy, at each fixed step
+/// and then with each adaptive stride (textured objects keep their methods).
 pub fn ray_march(args: &Args) -> Vec<Setting> {
     let mut steps = unique(args.ray_steps.iter().copied());
     steps.sort_by(f64::total_cmp);
+    let mut pairs = args.ray_adaptive.clone();
+    pairs.dedup();
     let mut v = Vec::new();
     for segments in unique(args.ray_segments.iter().copied()) {
         let (name, short) = match segments {
             Segments::Bounds => ("Bounds".to_string(), ""),
             Segments::DepthPeeling { passes, .. } => (format!("DepthPeeling({passes})"), " peel"),
         };
-        for &step in &steps {
+        let fixed = steps.iter().map(|&step| (step, None));
+        let adaptive = pairs.iter().map(|&(step, max_step)| (step, Some(max_step)));
+        for (step, max_step) in fixed.chain(adaptive) {
+            let (knob, tag) = match max_step {
+                None => (String::new(), String::new()),
+                Some(m) => (format!(" max_step={m}"), format!("<{m}")),
+            };
             v.push(Setting {
                 method: "RayMarch",
-                knobs: format!("step={step} segments={name}"),
-                tag: format!("{step}{short}"),
+                knobs: format!("step={step}{knob} segments={name}"),
+                tag: format!("{step}{tag}{short}"),
                 options: RenderOptions {
                     size: Some(args.size),
                     step: Some(step),
+                    max_step: Some(max_step),
                     segments: Some(segments),
                     ..Default::default()
                 },

@@ -15,6 +15,8 @@ pub(super) struct Row {
     compute_wall_ms: f64,
     flip: f64,
     rel_rmse: f64,
+    /// Density evaluations of RayMarch objects per frame.
+    evaluations: f64,
     method_front: bool,
     overall_front: bool,
 }
@@ -35,6 +37,7 @@ impl Row {
         Ok(Row {
             passes,
             wall_ms: frames.wall_ms,
+            evaluations: frames.evaluations,
             compute_wall_ms: compute.wall_ms,
             flip: crate::metrics::flip(&frames.image, truth)?.mean,
             rel_rmse: crate::metrics::relative_rmse(&frames.image, truth)?,
@@ -86,14 +89,14 @@ fn num(v: Option<f64>) -> String {
 pub(super) fn csv(rows: &[Row]) -> String {
     let mut s = String::from(
         "method,knobs,planes,trivial_reject,step,gpu_ms,compute_ms,raster_ms,wall_ms,compute_wall_ms,\
-         flip,rel_rmse,method_front,overall_front,passes\n",
+         flip,rel_rmse,evaluations,method_front,overall_front,passes\n",
     );
     for r in rows {
         let o = &r.setting.options;
         let sum = |compute: bool| r.passes.iter().filter(|p| p.compute == compute).map(|p| p.ms).sum::<f64>();
         let passes: Vec<String> = r.passes.iter().map(|p| format!("{}={:.4}", p.name, p.ms)).collect();
         s.push_str(&format!(
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
             r.setting.method,
             r.setting.knobs,
             o.planes.map(|p| p.to_string()).unwrap_or_default(),
@@ -106,6 +109,7 @@ pub(super) fn csv(rows: &[Row]) -> String {
             num(Some(r.compute_wall_ms)),
             num(Some(r.flip)),
             num(Some(r.rel_rmse)),
+            r.evaluations,
             r.method_front,
             r.overall_front,
             passes.join(";"),
@@ -191,18 +195,19 @@ pub(super) fn print_report(args: &Args, ctx: &GpuContext, rows: &[Row], notes: &
         let mut ids = ids;
         ids.sort_by(|&a, &b| rows[a].time().total_cmp(&rows[b].time()));
         println!("\n{title}");
-        println!("| method | knobs | GPU ms | wall ms | FLIP | rel RMSE |");
-        println!("|---|---|---|---|---|---|");
+        println!("| method | knobs | GPU ms | wall ms | FLIP | rel RMSE | density evaluations |");
+        println!("|---|---|---|---|---|---|---|");
         for i in ids {
             let r = &rows[i];
             println!(
-                "| {} | {} | {:.2} | {:.2} | {:.4} | {:.4} |",
+                "| {} | {} | {:.2} | {:.2} | {:.4} | {:.4} | {:.3e} |",
                 r.setting.method,
                 r.setting.knobs,
                 r.gpu_ms(),
                 r.wall_ms,
                 r.flip,
-                r.rel_rmse
+                r.rel_rmse,
+                r.evaluations
             );
         }
     };

@@ -39,6 +39,9 @@ pub struct RenderOptions {
     pub step: Option<f64>,
     /// Segment strategy of every `RayMarch` object (the Pareto sweep).
     pub segments: Option<crate::scene::Segments>,
+    /// RayMarch objects: an adaptive stride up to this step (world units; the Pareto sweep);
+    /// `Some(None)` turns it off.
+    pub max_step: Option<Option<f64>>,
     /// Methods replacing those of named objects (the preview's per-object switch), before
     /// `method` and the knob overrides apply.
     pub object_methods: Vec<(String, Method)>,
@@ -83,9 +86,14 @@ impl RenderOptions {
     pub fn apply(&self, method: &Method) -> Method {
         if let Method::RayMarch(rm) = method {
             // Hypertextures have no texel for other methods: only the step changes.
+            let adaptive = match self.max_step {
+                Some(m) => m.map(|max_step| crate::scene::Adaptive { max_step }),
+                None => rm.adaptive,
+            };
             return Method::RayMarch(RayMarch {
                 step: self.step.or(rm.step),
                 segments: self.segments.unwrap_or(rm.segments),
+                adaptive,
                 ..*rm
             });
         }

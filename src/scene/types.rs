@@ -548,8 +548,25 @@ pub struct RayMarch {
     /// Which stretches of each ray are marched (Gilet & Dischler 2009, section 5).
     #[serde(default)]
     pub segments: Segments,
+    /// An adaptive stride (the paper's future work, section 7): longer strides in empty space,
+    /// the fine `step` where there is matter (default: off, every step sampled).
+    #[serde(default)]
+    pub adaptive: Option<Adaptive>,
 }
 
+/// `RayMarch(adaptive: (max_step: ..))`: on the lattice of `step`, strides of 1, 2, 4, ... steps
+/// while the density is 0, at most `max_step` (world units, at least `step`) long; a strided
+/// sample that finds matter goes back to the sample before it and continues step by step.
+/// Features thinner than a stride between two empty samples are missed.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Adaptive {
+    #[serde(deserialize_with = "v::positive")]
+    pub max_step: f64,
+}
+
+/// Longest adaptive stride, in steps.
+pub const MAX_STRIDE: u32 = 1 << 12;
 /// Most depth-peeling passes (segments per ray).
 pub const MAX_PEEL_PASSES: u32 = 8;
 /// Largest splat lattice (cells along the bounds' longest axis).
@@ -589,6 +606,12 @@ fn default_splat_grid() -> u32 {
 impl RayMarch {
     pub fn step(&self) -> f64 {
         self.step.unwrap_or(self.quality.step())
+    }
+
+    /// The longest stride in fine steps (1: the adaptive stride is off); `max_step` below the
+    /// step is refused by validation.
+    pub fn max_stride(&self) -> u32 {
+        self.adaptive.map_or(1, |a| (a.max_step / self.step()).floor().clamp(1.0, MAX_STRIDE as f64) as u32)
     }
 }
 

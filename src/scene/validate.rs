@@ -423,6 +423,14 @@ impl Checker<'_> {
                 );
                 self.fail(ray_march.unwrap(), msg);
             }
+            if let Some(a) = rm.adaptive.filter(|a| a.max_step < rm.step()) {
+                let msg = format!(
+                    "RayMarch(adaptive: (max_step: {})) is below the step {}: expected a max_step of at least the step",
+                    a.max_step,
+                    rm.step()
+                );
+                self.fail(ray_march.unwrap(), msg);
+            }
         }
     }
 }
