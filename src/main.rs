@@ -161,42 +161,46 @@ enum Command {
     },
     /// Speed against error: sweep each method's quality knobs, time every setting with GPU
     /// timestamps, measure its error against a truth image, write pareto.csv and pareto.svg.
-    Pareto {
-        scene: PathBuf,
-        #[arg(long, value_parser = parse_size, default_value = "256x256")]
-        size: (u32, u32),
-        /// Timed frames per setting (after warm-up); medians are reported.
-        #[arg(long, default_value_t = 5)]
-        frames: usize,
-        /// Output folder (default: out/pareto/<scene name>).
-        #[arg(long)]
-        out: Option<PathBuf>,
-        /// What errors are measured against: `reference`, `view-slices:PLANES` or `ray-march:STEP`.
-        #[arg(long, default_value = "reference")]
-        truth: voltex::pareto::Truth,
-        /// Methods to sweep (ray-march: the step of every hypertexture object).
-        #[arg(long, value_enum, value_delimiter = ',', default_values = ["view-slices", "reference"])]
-        methods: Vec<SweepArg>,
-        /// ViewSlices plane counts (each with the trivial reject on and off).
-        #[arg(long, value_delimiter = ',', default_values_t = voltex::pareto::DEFAULT_PLANES)]
-        planes: Vec<u32>,
-        /// Reference ray steps, as multiples of the default step.
-        #[arg(long, value_delimiter = ',', default_values_t = voltex::pareto::DEFAULT_STEP_FACTORS)]
-        steps: Vec<f64>,
-        /// AxisSlices criteria: d (voxels) = p (pixels) = each value.
-        #[arg(long, value_delimiter = ',', default_values_t = voltex::pareto::DEFAULT_CRITERIA)]
-        criteria: Vec<f64>,
-        /// RayMarch steps (world units).
-        #[arg(long, value_delimiter = ',', default_values_t = voltex::pareto::DEFAULT_RAY_STEPS)]
-        ray_steps: Vec<f64>,
-        /// RayMarch segment strategies, each swept over every step: bounds, depth-peeling (4 passes).
-        #[arg(long, value_enum, value_delimiter = ',', default_values = ["bounds"])]
-        ray_segments: Vec<SegmentsArg>,
-        /// RayMarch with an adaptive stride: STEP:MAX_STEP pairs (world units), e.g.
-        /// 0.002:0.03,0.002:0.06 (default: none).
-        #[arg(long, value_delimiter = ',', value_parser = parse_adaptive)]
-        ray_adaptive: Vec<(f64, f64)>,
-    },
+    Pareto(ParetoCmd),
+}
+
+/// `voltex pareto`'s arguments (see `voltex::pareto::Args`).
+#[derive(clap::Args)]
+struct ParetoCmd {
+    scene: PathBuf,
+    #[arg(long, value_parser = parse_size, default_value = "256x256")]
+    size: (u32, u32),
+    /// Timed frames per setting (after warm-up); medians are reported.
+    #[arg(long, default_value_t = 5)]
+    frames: usize,
+    /// Output folder (default: out/pareto/<scene name>).
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// What errors are measured against: `reference`, `view-slices:PLANES` or `ray-march:STEP`.
+    #[arg(long, default_value = "reference")]
+    truth: voltex::pareto::Truth,
+    /// Methods to sweep (ray-march: the step of every hypertexture object).
+    #[arg(long, value_enum, value_delimiter = ',', default_values = ["view-slices", "reference"])]
+    methods: Vec<SweepArg>,
+    /// ViewSlices plane counts (each with the trivial reject on and off).
+    #[arg(long, value_delimiter = ',', default_values_t = voltex::pareto::DEFAULT_PLANES)]
+    planes: Vec<u32>,
+    /// Reference ray steps, as multiples of the default step.
+    #[arg(long, value_delimiter = ',', default_values_t = voltex::pareto::DEFAULT_STEP_FACTORS)]
+    steps: Vec<f64>,
+    /// AxisSlices criteria: d (voxels) = p (pixels) = each value.
+    #[arg(long, value_delimiter = ',', default_values_t = voltex::pareto::DEFAULT_CRITERIA)]
+    criteria: Vec<f64>,
+    /// RayMarch steps (world units).
+    #[arg(long, value_delimiter = ',', default_values_t = voltex::pareto::DEFAULT_RAY_STEPS)]
+    ray_steps: Vec<f64>,
+    /// RayMarch segment strategies, each swept over every step: bounds, depth-peeling (4 passes).
+    #[arg(long, value_enum, value_delimiter = ',', default_values = ["bounds"])]
+    ray_segments: Vec<SegmentsArg>,
+    /// RayMarch with an adaptive stride: STEP:MAX_STEP pairs (world units), e.g.
+    /// 0.002:0.03,0.002:0.06 (default: none).
+    #[arg(long, value_delimiter = ',', value_parser = parse_adaptive)]
+    ray_adaptive: Vec<(f64, f64)>,
 }
 
 fn parse_adaptive(s: &str) -> std::result::Result<(f64, f64), String> {
@@ -312,37 +316,20 @@ fn main() -> ExitCode {
         Command::BenchHyper { size, frames, quick, segments } => {
             voltex::hypertexture::bench::run(size, frames, quick, segments)
         }
-        Command::Pareto {
-            scene,
-            size,
-            frames,
-            out,
-            truth,
-            methods,
-            planes,
-            steps,
-            criteria,
-            ray_steps,
-            ray_segments,
-            ray_adaptive,
-        } => {
-            let methods = methods.into_iter().map(sweep).collect();
-            let ray_segments = ray_segments.into_iter().map(segments).collect();
-            voltex::pareto::run(&voltex::pareto::Args {
-                scene,
-                size,
-                frames,
-                out,
-                truth,
-                methods,
-                planes,
-                steps,
-                criteria,
-                ray_steps,
-                ray_segments,
-                ray_adaptive,
-            })
-        }
+        Command::Pareto(p) => voltex::pareto::run(&voltex::pareto::Args {
+            scene: p.scene,
+            size: p.size,
+            frames: p.frames,
+            out: p.out,
+            truth: p.truth,
+            methods: p.methods.into_iter().map(sweep).collect(),
+            planes: p.planes,
+            steps: p.steps,
+            criteria: p.criteria,
+            ray_steps: p.ray_steps,
+            ray_segments: p.ray_segments.into_iter().map(segments).collect(),
+            ray_adaptive: p.ray_adaptive,
+        }),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
