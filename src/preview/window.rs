@@ -513,8 +513,13 @@ impl State {
                             Method::AxisSlices(a)
                         }
                         Method::RayMarch(mut h) => {
-                            let step = h.step();
-                            h.step = Some(if finer { step / 2.0 } else { step * 2.0 });
+                            // The adaptive stride's longest step scales with the step, so the
+                            // stride stays on rather than vanishing below two steps.
+                            let scale = if finer { 0.5 } else { 2.0 };
+                            h.step = Some(h.step() * scale);
+                            if let Some(a) = &mut h.adaptive {
+                                a.max_step *= scale;
+                            }
                             Method::RayMarch(h)
                         }
                     };
@@ -560,7 +565,15 @@ impl State {
 
 fn describe(m: &Method) -> String {
     match m {
-        Method::RayMarch(h) => format!("RayMarch(step: {:.5}, shading: {:?})", h.step(), h.shading),
+        Method::RayMarch(h) => {
+            let adaptive = h.adaptive.map_or(String::new(), |a| format!(", max_step: {:.5}", a.max_step));
+            format!(
+                "RayMarch(step: {:.5}{adaptive}, shading: {:?}, segments: {:?})",
+                h.step(),
+                h.shading,
+                h.segments
+            )
+        }
         Method::AxisSlices(a) => {
             format!("AxisSlices(depth: {}, pixels: {}, {:?})", a.depth, a.pixels, a.directions)
         }
