@@ -1,7 +1,8 @@
 //! `voltex bench-hyper`: the set-up of the paper's Figure 11 on the current adapter: one
 //! hypertexture (three noises) on six objects (three soft primitives, the cube, teapot and bunny
 //! stand-in meshes of the Figure 11 scenes, whose grid bakes it also times) covering most of the window, HQ and
-//! IE steps, no shading, Phong, and Phong with shadow rays. Per setting: the median wall time of a frame after
+//! IE steps, no shading, Phong, and Phong with shadow rays, each with both segment strategies (the
+//! enlarged bounds and depth peeling). Per setting: the median wall time of a frame after
 //! warm-up, the density evaluations the frame made and those that ran the noises (counted by the
 //! kernel: points farther than the largest shift from the object skip them), and the share of the
 //! frame that those noise evaluations alone would take at the rate `bench_simplex.wgsl` measures
@@ -53,8 +54,9 @@ const NOISES: &str = "[(shape: Curve([(0.0, 0.0, 0.0), (0.2, 1.0, 0.0), (0.8, 1.
     shift: 0.5, seed: 1), (shape: Table([1.0, 0.0, 1.0]), amplitude: 0.025, frequency: 12.0, shift: 0.5, seed: 2)]";
 const NOISE_COUNT: f64 = 3.0;
 
-fn scene_text(object: &str, transform: &str, quality: &str, shading: &str) -> String {
-    method_scene(object, transform, &format!("RayMarch(quality: {quality}, shading: {shading})"))
+fn scene_text(object: &str, transform: &str, quality: &str, shading: &str, segments: &str) -> String {
+    let method = format!("RayMarch(quality: {quality}, shading: {shading}, segments: {segments})");
+    method_scene(object, transform, &method)
 }
 
 /// The benchmark scene with `method` on its object.
@@ -187,8 +189,10 @@ pub fn run(size: (u32, u32), frames: usize, quick: bool, segments_only: bool) ->
         rate / 1e6
     );
     for (name, object, transform) in OBJECTS.iter().filter(|o| o.1.starts_with("Mesh")) {
-        let scene =
-            crate::scene::parse(&scene_text(object, transform, "IE", "None"), Path::new("bench-hyper.ron"))?;
+        let scene = crate::scene::parse(
+            &scene_text(object, transform, "IE", "None", "Bounds"),
+            Path::new("bench-hyper.ron"),
+        )?;
         let bp = Blueprint::new(&scene, &RenderOptions { size: Some(size), ..Default::default() })?;
         let plan = bp.objects.iter().find_map(|o| o.ray_march.as_ref()).expect("a RayMarch object");
         let (shape, spec) = plan.packed.mesh.as_ref().expect("a mesh object");
@@ -211,15 +215,17 @@ pub fn run(size: (u32, u32), frames: usize, quick: bool, segments_only: bool) ->
         );
     }
     println!(
-        "\n| object | quality | step | shading | dispatches | coverage | frame ms (wall) | fps | M density evals | M \
-         noise evals | noise alone ms | noise share (rate) | noise share (A/B) |"
+        "\n| object | quality | step | shading | segments | dispatches | coverage | frame ms (wall) | fps | M density \
+         evals | M noise evals | noise alone ms | noise share (rate) | noise share (A/B) |"
     );
-    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
     let objects = if quick { &OBJECTS[..1] } else { OBJECTS };
     for (name, object, transform) in objects {
         for quality in QUALITIES {
-            for shading in SHADINGS {
-                let text = scene_text(object, transform, quality, shading);
+            for (shading, (label, segments)) in
+                SHADINGS.iter().flat_map(|s| SEGMENTS.iter().map(move |g| (s, g)))
+            {
+                let text = scene_text(object, transform, quality, shading, segments);
                 let scene = crate::scene::parse(&text, Path::new("bench-hyper.ron"))?;
                 let opts = RenderOptions { size: Some(size), ..Default::default() };
                 let mut runs = Vec::new();
@@ -247,8 +253,8 @@ pub fn run(size: (u32, u32), frames: usize, quick: bool, segments_only: bool) ->
                 // Time per density evaluation with and without the noises.
                 let ab = 1.0 - (ms_off / evals_off) / (ms / evals);
                 println!(
-                    "| {name} | {quality} | {} | {shading} | {} | {:.0}% | {ms:.1} | {:.2} | {:.1} | {:.1} | {noise_ms:.1} | \
-                     {:.0}% | {:.0}% |",
+                    "| {name} | {quality} | {} | {shading} | {label} | {} | {:.0}% | {ms:.1} | {:.2} | {:.1} | {:.1} | \
+                     {noise_ms:.1} | {:.0}% | {:.0}% |",
                     plan.step,
                     plan.dispatches,
                     covered * 100.0,
