@@ -552,6 +552,8 @@ pub struct RayMarch {
 
 /// Most depth-peeling passes (segments per ray).
 pub const MAX_PEEL_PASSES: u32 = 8;
+/// Most depth slabs per pixel of EWA-style splatting.
+pub const MAX_SPLAT_SLABS: u32 = 64;
 /// Largest splat lattice (cells along the bounds' longest axis).
 pub const MAX_SPLAT_GRID: u32 = 96;
 
@@ -572,6 +574,20 @@ pub enum Segments {
         #[serde(default = "default_splat_grid", deserialize_with = "v::splat_grid")]
         splat_grid: u32,
     },
+    /// EWA-style splatting (section 5.1): every interior splat (a sphere) marches the stretch of
+    /// each pixel ray of its footprint inside it, weighted by a Gaussian of the ray's distance to
+    /// its centre; contributions are summed per depth slab (`slabs` along each ray's span in the
+    /// bounds) and the slabs composited front to back.
+    Splatting {
+        #[serde(default = "default_slabs", deserialize_with = "v::splat_slabs")]
+        slabs: u32,
+        #[serde(default = "default_splat_grid", deserialize_with = "v::splat_grid")]
+        splat_grid: u32,
+    },
+}
+
+fn default_slabs() -> u32 {
+    16
 }
 
 fn default_passes() -> u32 {
