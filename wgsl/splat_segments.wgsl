@@ -1,4 +1,4 @@
-// EWA-style splatting (Gilet & Dischler 2009, section 5.1): one thread per interior splat (a sphere) and work row marches, for each pixel of its screen footprint, the ray's samples inside the sphere and adds them, weighted by a truncated Gaussian of the ray's distance to the centre, to the pixel's depth slabs. CPU twin: src/cpu/splat_segments.rs.
+// EWA-style splatting (Gilet & Dischler 2009, section 5.1): one workgroup per interior splat (a sphere) and block of its screen footprint marches, for each pixel of the block, the ray's samples inside the sphere and adds them, weighted by a truncated Gaussian of the ray's distance to the centre, to the pixel's depth slabs. CPU twin: src/cpu/splat_segments.rs.
 #include "shared/types.wgsl"
 #include "shared/hypertexture.wgsl"
 #include "shared/segments.wgsl"
@@ -6,9 +6,11 @@
 
 // The samples are the bounds march's own, t0 + (k + 1/2) h (shared/march.wgsl), so every splat
 // covering a sample sees the same density there; what the weights blend is each splat's share
-// of a slab. Work row y is (block, piece): footprint pixels [block * pixels, ..) and piece of
-// each chord's samples, sized on the host (`segments.splatting`) so that no invocation runs more
-// than lavapipe's 65535 loop iterations (samples x evaluations per sample).
+// of a slab. Workgroup (splat, y): y is (block, piece), a block of 64 x `pixels` footprint
+// pixels (lane l takes pixels l, l + 64, ...: neighbouring lanes march neighbouring rays, whose
+// work is alike) and a piece of each chord's samples, sized on the host (`segments.splatting`)
+// so that no invocation runs more than lavapipe's 65535 loop iterations (samples x evaluations
+// per sample).
 // Standard deviation of the screen-space Gaussian, in units of the sphere's projected radius;
 // it is cut at that radius (weight exp(-2) there), so rim-only coverage keeps a usable weight.
 const SIGMA: f32 = 0.5;
@@ -41,11 +43,11 @@ fn add_slab(base: u32, j: u32, first: u32, count: u32, samples: u32, weight: f32
 }
 
 @compute @workgroup_size(64, 1, 1)
-fn main(@builtin(global_invocation_id) id: vec3<u32>) {
-    if (id.x >= segments.counts.y) {
+fn main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
+    if (group.x >= segments.counts.y) {
         return;
     }
-    let splat = interior_splats[id.x];
+    let splat = interior_splats[group.x];
     let centre = splat.center.xyz;
     let radius = splat.center.w;
     let rect = footprint(centre, radius);
@@ -56,23 +58,24 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let pixels = columns * u32(rect.w - rect.y + 1);
     let pieces = segments.splatting.z;
     let per_piece = segments.splatting.w;
-    let piece = id.y % pieces;
-    let first_pixel = (id.y / pieces) * segments.splatting.y;
-    let last_pixel = min(first_pixel + segments.splatting.y, pixels);
+    let piece = group.y % pieces;
+    let first_pixel = (group.y / pieces) * 64u * segments.splatting.y + lane;
+    let last_pixel = min(first_pixel + 64u * segments.splatting.y, pixels);
     let size = vec2<u32>(frame.viewport.xy);
     let slabs = segments.splatting.x;
     let origin = hyper.to_local[3].xyz;
     let empty = hyper_color(0.0);
     let oc = origin - centre;
-    for (var i = first_pixel; i < last_pixel; i++) {
+    for (var i = first_pixel; i < last_pixel; i += 64u) {
         let p = vec2<u32>(u32(rect.x) + i % columns, u32(rect.y) + i / columns);
         let d = pixel_direction(p);
         let dir = (hyper.to_local * vec4<f32>(d, 0.0)).xyz;
         let range = march_range(p, d, origin, dir);
         let n = u32(range.z);
         // The chord |origin + dir t - centre| <= radius; 1 - q^2 = disc / (a r^2) with q the
-        // ray's distance to the centre over the radius (the pixel's distance to the sphere's
-        // projected centre in units of its projected radius, for a sphere seen at any angle).
+        // ray's distance to the centre over the radius: sin of the ray's angle to the centre over
+        // sin of the sphere's angular radius (the pixel's distance to the projected centre in
+        // projected radii, up to perspective).
         let a = dot(dir, dir);
         let b = dot(dir, oc);
         let disc = b * b - a * (dot(oc, oc) - radius * radius);

@@ -42,7 +42,7 @@ pub const COUNTS: &[&str] = &[
     "peel_blocks",
     "peel_phases",
     "interior_splats",
-    "splat_rows",
+    "splat_blocks",
 ];
 
 struct Texture {

@@ -3,7 +3,7 @@
 //! for `bake_transfer.wgsl`, how many dispatches of `ray_march.wgsl` a frame needs so that
 //! every ray finishes while no dispatch exceeds its work budget, and with depth peeling the
 //! object's splat lattice and the segment buffers (`begin_segments.wgsl`, `peel_segments.wgsl`),
-//! or with EWA-style splatting the work rows of `splat_segments.wgsl` and the per-pixel depth
+//! or with EWA-style splatting the work blocks of `splat_segments.wgsl` and the per-pixel depth
 //! slabs `resolve_splats.wgsl` composites.
 
 use glam::{DMat4, DVec3};
@@ -184,10 +184,10 @@ fn splat_work(
     let samples = samples.max(1);
     let pieces = chord.div_ceil(samples);
     let pixels = if pieces > 1 { 1 } else { samples / chord };
-    let rows = (size.0 * size.1).div_ceil(pixels) * pieces;
-    if rows > MAX_SPLAT_ROWS {
+    let blocks = splat_blocks(size, pixels, pieces);
+    if blocks > MAX_SPLAT_BLOCKS {
         return Err(Error::Invalid(format!(
-            "object \"{name}\": Splatting needs {rows} work rows per splat at {}x{} (at most {MAX_SPLAT_ROWS}): use a \
+            "object \"{name}\": Splatting needs {blocks} workgroups per splat at {}x{} (at most {MAX_SPLAT_BLOCKS}): use a \
              larger `step`, a finer `splat_grid`, less shading or a smaller image",
             size.0, size.1
         )));
@@ -195,8 +195,14 @@ fn splat_work(
     Ok([slabs, pixels, pieces, samples])
 }
 
-/// Rows of `splat_segments.wgsl` (its workgroups along y: the adapters' dispatch limit).
-pub const MAX_SPLAT_ROWS: u32 = 65535;
+/// Workgroups per splat of `splat_segments.wgsl`: blocks of 64 lanes x `pixels` footprint
+/// pixels over the whole screen (the largest footprint), times the pieces of each chord.
+pub fn splat_blocks(size: (u32, u32), pixels: u32, pieces: u32) -> u32 {
+    (size.0 * size.1).div_ceil(64 * pixels.max(1)) * pieces
+}
+
+/// Workgroups per splat of `splat_segments.wgsl` (along y: the adapters' dispatch limit).
+pub const MAX_SPLAT_BLOCKS: u32 = 65535;
 
 /// The largest shift of a hypertexture's noises as the kernels test it (rounding slack added).
 fn max_shift(h: &Hypertexture) -> f64 {
@@ -341,7 +347,7 @@ impl RayMarchPlan {
             inputs.buffers.insert("interior_splats".into(), set.interior.clone());
             inputs.counts.insert("interior_splats".into(), set.counts[1]);
             let [_, pixels, pieces, _] = segments.splatting;
-            inputs.counts.insert("splat_rows".into(), (size.0 * size.1).div_ceil(pixels.max(1)) * pieces);
+            inputs.counts.insert("splat_blocks".into(), splat_blocks(size, pixels, pieces));
             slabs_bytes = slab_bytes(size, *slabs);
         }
         inputs.buffers.insert("segments".into(), uniform(ctx, "segments", bytemuck::bytes_of(&segments)));
