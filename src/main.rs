@@ -155,7 +155,7 @@ enum Command {
         /// Only the first object (sphere).
         #[arg(long)]
         quick: bool,
-        /// Only the table of segment strategies (bounds against depth peeling).
+        /// Only the table of segment strategies (bounds, depth peeling, EWA-style splatting).
         #[arg(long)]
         segments: bool,
     },
