@@ -1,7 +1,8 @@
 //! EWA-style splatting segments (Gilet & Dischler 2009, section 5.1): the kernels against their
 //! f64 twin (also with chords cut into pieces and footprints into small blocks), images against
 //! the whole-bounds march on a semi-transparent soft sphere (close, no holes between splats, and
-//! a single slab, which does not order the splats, clearly worse), and bad knobs.
+//! a single slab, which does not order the splats, clearly worse; also transformed and seen from
+//! inside), and bad knobs.
 
 use std::path::Path;
 use std::sync::{Mutex, OnceLock};
@@ -34,11 +35,16 @@ const HAZE: &str =
     "Ramp([(0.0, (0.9, 0.8, 0.7, 0.0)), (0.2, (0.9, 0.8, 0.7, 0.3)), (1.0, (0.3, 0.5, 0.9, 0.6))])";
 
 fn scene_text(method: &str) -> String {
+    placed_text(("(0.0, -4.0, 1.0)", "(0.0, 0.0, 0.0)"), "()", method)
+}
+
+/// The test scene with the camera's (eye, target) and the node's transform.
+fn placed_text((eye, target): (&str, &str), transform: &str, method: &str) -> String {
     format!(
-        "#![enable(implicit_some)]\nScene(\n    output: (width: 48, height: 48),\n    camera: (eye: (0.0, -4.0, 1.0), \
-         target: (0.0, 0.0, 0.0), up: (0.0, 0.0, 1.0), fov_y: 40.0),\n    lights: [Directional(direction: (-0.5, 0.6, \
+        "#![enable(implicit_some)]\nScene(\n    output: (width: 48, height: 48),\n    camera: (eye: {eye}, target: \
+         {target}, up: (0.0, 0.0, 1.0), fov_y: 40.0),\n    lights: [Directional(direction: (-0.5, 0.6, \
          -0.7))],\n    hypertextures: {{ \"h\": (object: Sphere(radius: 1.0), noises: {BUMPS}, color: {HAZE}, \
-         opacity_length: 0.3) }},\n    nodes: [(name: \"n\", transform: (), hypertexture: \"h\", method: {method})],\n)\n"
+         opacity_length: 0.3) }},\n    nodes: [(name: \"n\", transform: {transform}, hypertexture: \"h\", method: {method})],\n)\n"
     )
 }
 
@@ -148,6 +154,35 @@ fn soft_sphere_is_close_to_the_bounds_march() {
     assert!(f1 > 2.0 * f16 && f1 > 0.03, "one slab: FLIP {f1}");
     assert_eq!(holes, 0, "{holes} pixels lose their matter");
     assert!(worst < 0.1, "coverage differs by {worst}");
+}
+
+/// A sphere rotated and scaled unevenly (footprints and Gaussians follow the node's transform)
+/// and the eye inside the object (every footprint reaching the eye's plane is the whole screen,
+/// chords start at the near plane): close to the bounds march, and no holes.
+#[test]
+fn transformed_and_inside_views_are_close_to_the_bounds_march() {
+    let opts = sized(48, 48);
+    let views = [
+        (("(0.5, -4.0, 1.0)", "(0.0, 0.0, 0.0)"), "(rotate: (30.0, 10.0, 50.0), scale: (1.5, 0.6, 1.0))"),
+        (("(0.0, -0.4, 0.2)", "(0.0, -2.0, 0.0)"), "()"),
+    ];
+    for (camera, transform) in views {
+        let march = |segments: &str| {
+            let text = placed_text(camera, transform, &format!("RayMarch(step: 0.02, segments: {segments})"));
+            render(&scene::parse(&text, Path::new("test.ron")).unwrap(), &opts, None)
+        };
+        let (bounds, bounds_states, _) = march("Bounds");
+        let (splatted, states, _) = march("Splatting(slabs: 16, splat_grid: 16)");
+        let flip = voltex::metrics::flip(&splatted, &bounds).unwrap().mean;
+        let holes = states
+            .iter()
+            .zip(&bounds_states)
+            .filter(|(s, b)| b.color[3] > 0.05 && s.color[3] < 0.5 * b.color[3])
+            .count();
+        eprintln!("eye {}, transform {transform}: FLIP {flip:.4}, {holes} holes", camera.0);
+        assert!(flip < 0.02, "FLIP {flip}");
+        assert_eq!(holes, 0);
+    }
 }
 
 /// Knobs out of range are errors at their line:col; slabs that do not fit a storage binding are
