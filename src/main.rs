@@ -155,7 +155,7 @@ enum Command {
         /// Only the first object (sphere).
         #[arg(long)]
         quick: bool,
-        /// Only the table of segment strategies (bounds against depth peeling).
+        /// Only the table of segment strategies (bounds, depth peeling, EWA-style splatting).
         #[arg(long)]
         segments: bool,
     },
@@ -194,7 +194,8 @@ struct ParetoCmd {
     /// RayMarch steps (world units).
     #[arg(long, value_delimiter = ',', default_values_t = voltex::pareto::DEFAULT_RAY_STEPS)]
     ray_steps: Vec<f64>,
-    /// RayMarch segment strategies, each swept over every step: bounds, depth-peeling (4 passes).
+    /// RayMarch segment strategies, each swept over every step: bounds, depth-peeling (4 passes),
+    /// splatting (16 slabs).
     #[arg(long, value_enum, value_delimiter = ',', default_values = ["bounds"])]
     ray_segments: Vec<SegmentsArg>,
     /// RayMarch with an adaptive stride: STEP:MAX_STEP pairs (world units), e.g.
@@ -557,11 +558,12 @@ fn sweep(m: SweepArg) -> voltex::pareto::Sweep {
     }
 }
 
-/// RayMarch segment strategies `pareto` sweeps (depth peeling with its default passes and grid).
+/// RayMarch segment strategies `pareto` sweeps (with their default passes, slabs and grid).
 #[derive(clap::ValueEnum, Clone, Copy)]
 enum SegmentsArg {
     Bounds,
     DepthPeeling,
+    Splatting,
 }
 
 fn segments(s: SegmentsArg) -> voltex::scene::Segments {
@@ -569,6 +571,10 @@ fn segments(s: SegmentsArg) -> voltex::scene::Segments {
         SegmentsArg::Bounds => voltex::scene::Segments::Bounds,
         SegmentsArg::DepthPeeling => voltex::scene::Segments::DepthPeeling {
             passes: voltex::scene::DEFAULT_PEEL_PASSES,
+            splat_grid: voltex::scene::DEFAULT_SPLAT_GRID,
+        },
+        SegmentsArg::Splatting => voltex::scene::Segments::Splatting {
+            slabs: voltex::scene::DEFAULT_SPLAT_SLABS,
             splat_grid: voltex::scene::DEFAULT_SPLAT_GRID,
         },
     }

@@ -433,7 +433,7 @@ pub struct MarchState {
 }
 
 /// Splat sets and depth-peeled segments of a RayMarch object (`bake_splats.wgsl`,
-/// `begin_segments.wgsl`, `peel_segments.wgsl`, `ray_march.wgsl`); twin: `SegmentParams` in
+/// `begin_segments.wgsl`, `peel_segments.wgsl`, `splat_segments.wgsl`, `ray_march.wgsl`); twin: `SegmentParams` in
 /// wgsl/shared/types.wgsl.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
@@ -450,6 +450,9 @@ pub struct SegmentParams {
     /// x: surface splats; y: interior splats; z: depth-peeling passes; w: footprint pixels one
     /// invocation of `peel_segments.wgsl` tests at most.
     pub counts: [u32; 4],
+    /// EWA-style splatting (`splat_segments.wgsl`, `resolve_splats.wgsl`): x: depth slabs per
+    /// pixel; y: footprint pixels per block; z: pieces each chord is cut into; w: samples per piece.
+    pub splatting: [u32; 4],
 }
 
 /// A splat of a hypertexture object's splat set (object space): a surface splat is a disk with

@@ -123,6 +123,7 @@ fn frame_graph_parses_and_plans() {
         &["AxisSlices", "AxisSlicesBlended"],
         &["RayMarch"],
         &["RayMarch", "RayMarchPeeling"],
+        &["RayMarch", "RayMarchSplatting"],
     ];
     let p = plan(&g, &wgsl_root(), &objects(all)).unwrap();
     assert_eq!(
@@ -146,6 +147,8 @@ fn frame_graph_parses_and_plans() {
             "begin_segments",
             "peel_segments",
             "ray_march",
+            "splat_segments",
+            "resolve_splats",
             "composite_ray_march",
             "composite"
         ]

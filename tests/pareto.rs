@@ -261,7 +261,7 @@ fn ray_march_step_sweep() {
         "--ray-steps",
         "0.06,0.01",
         "--ray-segments",
-        "bounds,depth-peeling",
+        "bounds,depth-peeling,splatting",
         "--ray-adaptive",
         "0.01:0.06",
         "--truth",
@@ -281,7 +281,7 @@ fn ray_march_step_sweep() {
         r[col(c)].parse::<f64>().unwrap()
     };
     let get = |k: &str| value(k, "flip");
-    assert_eq!(rows.len(), 6, "{rows:?}");
+    assert_eq!(rows.len(), 9, "{rows:?}");
     let bounds = |k: &str| format!("{k} segments=Bounds");
     let (fine, coarse, adaptive) =
         (get(&bounds("step=0.01")), get(&bounds("step=0.06")), get(&bounds("step=0.01 max_step=0.06")));
@@ -300,6 +300,15 @@ fn ray_march_step_sweep() {
     assert!(adaptive < 0.5 * (fine + coarse), "{adaptive} vs {fine} and {coarse}");
     // Depth peeling takes the bounds march's samples where there is matter: the same error.
     assert!((peeled - fine).abs() < 0.002, "depth peeling {peeled} against bounds {fine}");
+    // Splatting reconstructs from overlapping spheres and slab means: converging with the step
+    // too, and more costly (each sample once per sphere covering it).
+    let (splat_fine, splat_coarse) =
+        (get("step=0.01 segments=Splatting(16)"), get("step=0.06 segments=Splatting(16)"));
+    let splat_n = value("step=0.01 segments=Splatting(16)", "evaluations");
+    println!(
+        "Splatting FLIP {splat_fine:.4} at step 0.01 ({splat_n} evaluations), {splat_coarse:.4} at 0.06"
+    );
+    assert!(splat_fine < splat_coarse && splat_n > fine_n, "{splat_fine} {splat_coarse} {splat_n} {fine_n}");
     for (flag, value, expected) in [
         ("--ray-steps", "0", "--ray-steps 0"),
         ("--truth", "ray-march:-1", "expected a positive step"),

@@ -46,7 +46,7 @@ fn wgsl_structs_match_rust() {
         layout!(TransferFunction; first, count, kind, _pad),
         layout!(TransferPoint; x, y, slope, _pad),
         layout!(MarchState; color, resume),
-        layout!(SegmentParams; from_local, lattice_min, lattice, surface, counts),
+        layout!(SegmentParams; from_local, lattice_min, lattice, surface, counts, splatting),
         layout!(Splat; center, normal),
     ];
     let mut seen = 0;

@@ -29,16 +29,6 @@ const EXIT_SLACK: f32 = 1e-3;
 
 var<workgroup> ticket: u32;
 
-// Screen coordinate range (lo, hi) along unit `axis` (scaled by `scale`, the half extent at
-// unit depth) of a sphere at camera-relative c with radius r in front of the camera (depth z - r > 0):
-// x / z is monotonic in z for fixed x, so the extremes are at the depth range's ends.
-fn screen_range(c: vec3<f32>, r: f32, z: f32, axis: vec3<f32>, scale: f32) -> vec2<f32> {
-    let a = dot(c, axis);
-    let lo = min((a - r) / (z - r), (a - r) / (z + r));
-    let hi = max((a + r) / (z - r), (a + r) / (z + r));
-    return vec2<f32>(lo, hi) / scale;
-}
-
 @compute @workgroup_size(64, 1, 1)
 fn main(
     @builtin(global_invocation_id) id: vec3<u32>,
@@ -65,31 +55,9 @@ fn main(
         return;
     }
     let size = vec2<u32>(frame.viewport.xy);
-    // The footprint: the screen rectangle of the disk's bounding sphere (the whole screen when
-    // the sphere reaches the eye's plane).
-    let c = (segments.from_local * vec4<f32>(centre, 1.0)).xyz;
-    let r = radius * segments.surface.y;
-    let forward = frame.forward.xyz;
-    let z = dot(c, forward);
-    if (z + r <= hyper.right.w) {
-        return;
-    }
-    var lo = vec2<i32>(0, 0);
-    var hi = vec2<i32>(size) - vec2<i32>(1);
-    if (z - r > 0.5 * hyper.right.w) {
-        let width = length(hyper.right.xyz);
-        let height = length(hyper.up.xyz);
-        let sx = screen_range(c, r, z, hyper.right.xyz / width, width);
-        let sy = screen_range(c, r, z, hyper.up.xyz / height, height);
-        let w = f32(size.x);
-        let h = f32(size.y);
-        // Clamped as floats first: far outside the screen they may not fit an i32.
-        let limit = vec2<f32>(size);
-        let a = clamp(floor(vec2<f32>((sx.x + 1.0) * 0.5 * w, (1.0 - sy.y) * 0.5 * h) - 0.5), vec2<f32>(-1.0), limit);
-        let b = clamp(ceil(vec2<f32>((sx.y + 1.0) * 0.5 * w, (1.0 - sy.x) * 0.5 * h) - 0.5), vec2<f32>(-1.0), limit);
-        lo = max(lo, vec2<i32>(a));
-        hi = min(hi, vec2<i32>(b));
-    }
+    let rect = footprint(centre, radius);
+    let lo = rect.xy;
+    let hi = rect.zw;
     if (any(hi < lo)) {
         return;
     }
@@ -138,7 +106,7 @@ fn main(
             continue;
         }
         // The parameter along the unit world direction (the marcher's t).
-        let t = u * length(forward + hyper.right.xyz * sx + hyper.up.xyz * sy);
+        let t = u * length(frame.forward.xyz + hyper.right.xyz * sx + hyper.up.xyz * sy);
         let nearest = bitcast<f32>(atomicLoad(&segment_bounds[slot + 1u]));
         if (t <= previous || t >= nearest) {
             continue;

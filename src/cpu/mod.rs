@@ -13,4 +13,5 @@ pub mod peel_segments;
 pub mod prism_map;
 pub mod ray_march;
 pub mod slice_prisms;
+pub mod splat_segments;
 pub mod trace_reference;

@@ -41,6 +41,8 @@ pub const COUNTS: &[&str] = &[
     "surface_splats",
     "peel_blocks",
     "peel_phases",
+    "interior_splats",
+    "splat_blocks",
 ];
 
 struct Texture {

@@ -21,6 +21,7 @@ pub const OBJECT_FILTERS: &[&str] = &[
     "AxisSlicesBySlice",
     "RayMarch",
     "RayMarchPeeling",
+    "RayMarchSplatting",
 ];
 
 /// What the planner needs to know of a scene object.

@@ -12,7 +12,8 @@
 //! Frames are timed by wall clock after `device.poll`: lavapipe's compute timestamps come back
 //! wrong once a render pass has run in the process, and every frame ends with raster passes.
 //! A second table compares the segment strategies (section 5): the whole enlarged bounds against
-//! depth peeling over the object's surface splats, per object at the IE step with Phong: frame
+//! depth peeling over the object's surface splats and EWA-style splatting of its interior
+//! splats, per object at the IE step with Phong: frame
 //! time, density evaluations (Phong's included), samples along the rays (the evaluations of the
 //! same frame unshaded) and FLIP against a converged render (the bounds march with a step of
 //! 0.001).
@@ -122,7 +123,11 @@ impl Timed {
 }
 
 /// Segment strategies compared by `segments_table`.
-const SEGMENTS: &[(&str, &str)] = &[("Bounds", "Bounds"), ("DepthPeeling(4)", "DepthPeeling(passes: 4)")];
+const SEGMENTS: &[(&str, &str)] = &[
+    ("Bounds", "Bounds"),
+    ("DepthPeeling(4)", "DepthPeeling(passes: 4)"),
+    ("Splatting(16)", "Splatting(slabs: 16)"),
+];
 
 /// The segment strategies on every object (IE, Phong): frame time, density evaluations and FLIP
 /// against a converged render.
@@ -159,7 +164,11 @@ pub fn segments_table(ctx: &GpuContext, size: (u32, u32), frames: usize, quick: 
             unshaded.render_timed(ctx)?;
             let (samples, _, _) = Timed { renderer: unshaded, times: Vec::new() }.counts(ctx)?;
             let plan = run.renderer.blueprint.objects.iter().find_map(|o| o.ray_march.clone());
-            let dispatches = plan.map_or(0, |p| p.dispatches);
+            // Splatting runs no marcher: its two passes are dispatched once each.
+            let dispatches = plan.map_or("-".into(), |p| match p.splatting {
+                Some(_) => "1 + 1".to_string(),
+                None => p.dispatches.to_string(),
+            });
             println!(
                 "| {name} | {label} | {dispatches} | {:.1} | {:.2} | {:.2} | {:.3} | {flip:.4} |",
                 median(run.times.clone()),

@@ -2,7 +2,9 @@
 //! packed hypertexture with the camera and march settings (`HyperParams`), its transfer functions
 //! for `bake_transfer.wgsl`, how many dispatches of `ray_march.wgsl` a frame needs so that
 //! every ray finishes while no dispatch exceeds its work budget, and with depth peeling the
-//! object's splat lattice and the segment buffers (`begin_segments.wgsl`, `peel_segments.wgsl`).
+//! object's splat lattice and the segment buffers (`begin_segments.wgsl`, `peel_segments.wgsl`),
+//! or with EWA-style splatting the work blocks of `splat_segments.wgsl` and the per-pixel depth
+//! slabs `resolve_splats.wgsl` composites.
 
 use glam::{DMat4, DVec3};
 
@@ -55,6 +57,8 @@ pub struct RayMarchPlan {
     pub noise: bool,
     /// Depth peeling: its passes and the splat lattice (`None`: the bounds are the segment).
     pub peel: Option<(u32, Lattice)>,
+    /// EWA-style splatting: its depth slabs and the splat lattice.
+    pub splatting: Option<(u32, Lattice)>,
     /// The camera and splat lattice as `bake_splats.wgsl` and the peeling kernels see them.
     pub segments: SegmentParams,
 }
@@ -67,6 +71,7 @@ pub fn plan(
     method: &RayMarch,
     camera: &Camera,
     time: f64,
+    size: (u32, u32),
 ) -> Result<RayMarchPlan> {
     let packed = hypertexture::pack(h);
     let to_world = &node.to_world;
@@ -79,18 +84,18 @@ pub fn plan(
     let evals = LOOP_BUDGET / (packed.noises.len() as u32 + 1);
     let shadow_samples = ((diagonal / shadow_step).ceil() as u32).clamp(1, MAX_SHADOW_SAMPLES);
     let worst = 1 + 6 * shade.phong as u32 + shadow_samples * shade.shadows as u32;
-    let peel = match method.segments {
-        Segments::Bounds => None,
-        Segments::DepthPeeling { passes, splat_grid } => {
-            Some((passes, Lattice::new(h.bounds(), max_shift(h), splat_grid)))
-        }
+    let lattice = |grid| Lattice::new(h.bounds(), max_shift(h), grid);
+    let (peel, splatting) = match method.segments {
+        Segments::Bounds => (None, None),
+        Segments::DepthPeeling { passes, splat_grid } => (Some((passes, lattice(splat_grid))), None),
+        Segments::Splatting { slabs, splat_grid } => (None, Some((slabs, lattice(splat_grid)))),
     };
     // Every unfinished ray advances at least `evals / worst` samples per dispatch (segments
     // take a subset of the bounds' samples).
     // An adaptive stride evaluates a sample at most twice (a strided one dropped for matter).
     let adaptive = method.max_stride() > 1;
     let samples = ((diagonal / step).ceil() + 1.0) * if adaptive { 2.0 } else { 1.0 };
-    let dispatches = (samples / (evals / worst) as f64).ceil() + 1.0;
+    let mut dispatches = (samples / (evals / worst) as f64).ceil() + 1.0;
     if dispatches > MAX_DISPATCHES as f64 {
         return Err(Error::Invalid(format!(
             "object \"{name}\": a RayMarch step of {step} needs {dispatches} dispatches per frame (at most \
@@ -118,8 +123,13 @@ pub fn plan(
         counts: [0, 0, peel.map_or(0, |p| p.0), FOOTPRINT_BLOCK],
         ..Default::default()
     };
-    if let Some((_, lattice)) = &peel {
+    if let Some((_, lattice)) = peel.as_ref().or(splatting.as_ref()) {
         lattice.write(&mut segments);
+    }
+    if let Some((slabs, lattice)) = &splatting {
+        segments.splatting = splat_work(name, *slabs, lattice, scale * step.recip(), evals / worst, size)?;
+        // The slabs are resolved into the march state: the marcher has nothing to do.
+        dispatches = 0.0;
     }
     Ok(RayMarchPlan {
         hypertexture: node.name.clone(),
@@ -132,9 +142,69 @@ pub fn plan(
         corners,
         noise: true,
         peel,
+        splatting,
         segments,
     })
 }
+
+/// Bytes of the per-pixel depth slabs of EWA-style splatting (`splat_slabs`): a header of three
+/// words and seven per slab (see `wgsl/shared/segments.wgsl`).
+pub fn slab_bytes(size: (u32, u32), slabs: u32) -> u64 {
+    size.0 as u64 * size.1 as u64 * (3 + 7 * slabs as u64) * 4
+}
+
+/// Largest storage buffer a kernel may bind (lavapipe's limit, and wgpu's default).
+const MAX_BINDING_BYTES: u64 = 128 << 20;
+
+/// The work of `splat_segments.wgsl` (`SegmentParams::splatting`): slabs, footprint pixels per
+/// block, pieces per chord, samples per piece. A chord through the largest interior splat (a
+/// block of 8^3 cells: radius 4 sqrt(3) cells) has at most `2 r / step + 2` samples; one
+/// invocation marches at most `samples` (the marcher's per-dispatch budget), so long chords are
+/// cut into pieces and short ones share an invocation. `per_length`: object-space length to
+/// samples (world scale over step).
+fn splat_work(
+    name: &str,
+    slabs: u32,
+    lattice: &Lattice,
+    per_length: f64,
+    samples: u32,
+    size: (u32, u32),
+) -> Result<[u32; 4]> {
+    let bytes = slab_bytes(size, slabs);
+    if bytes > MAX_BINDING_BYTES {
+        return Err(Error::Invalid(format!(
+            "object \"{name}\": Splatting with {slabs} slabs at {}x{} needs {} MiB of depth slabs (at most {}): use fewer \
+             `slabs` or a smaller image",
+            size.0,
+            size.1,
+            bytes >> 20,
+            MAX_BINDING_BYTES >> 20
+        )));
+    }
+    let radius = 4.0 * 3f64.sqrt() * lattice.cell;
+    let chord = (2.0 * radius * per_length).ceil() as u32 + 2;
+    let samples = samples.max(1);
+    let pieces = chord.div_ceil(samples);
+    let pixels = if pieces > 1 { 1 } else { samples / chord };
+    let blocks = splat_blocks(size, pixels, pieces);
+    if blocks > MAX_SPLAT_BLOCKS {
+        return Err(Error::Invalid(format!(
+            "object \"{name}\": Splatting needs {blocks} workgroups per splat at {}x{} (at most {MAX_SPLAT_BLOCKS}): use a \
+             larger `step`, a finer `splat_grid`, less shading or a smaller image",
+            size.0, size.1
+        )));
+    }
+    Ok([slabs, pixels, pieces, samples])
+}
+
+/// Workgroups per splat of `splat_segments.wgsl`: blocks of 64 lanes x `pixels` footprint
+/// pixels over the whole screen (the largest footprint), times the pieces of each chord.
+pub fn splat_blocks(size: (u32, u32), pixels: u32, pieces: u32) -> u32 {
+    (size.0 * size.1).div_ceil(64 * pixels.max(1)) * pieces
+}
+
+/// Workgroups per splat of `splat_segments.wgsl` (along y: the adapters' dispatch limit).
+pub const MAX_SPLAT_BLOCKS: u32 = 65535;
 
 /// The largest shift of a hypertexture's noises as the kernels test it (rounding slack added).
 fn max_shift(h: &Hypertexture) -> f64 {
@@ -167,12 +237,16 @@ impl RayMarchPlan {
             (true, false) => "Phong",
             (true, true) => "PhongShadows",
         };
-        let segments = match &self.peel {
-            None => String::new(),
-            Some((passes, l)) => format!(
+        let segments = match (&self.peel, &self.splatting) {
+            (Some((passes, l)), _) => format!(
                 ", segments: DepthPeeling(passes: {passes}, splat_grid: {}, splat_spacing: {:.6})",
                 l.grid, l.cell
             ),
+            (_, Some((slabs, l))) => format!(
+                ", segments: Splatting(slabs: {slabs}, splat_grid: {}, splat_spacing: {:.6})",
+                l.grid, l.cell
+            ),
+            _ => String::new(),
         };
         let stride = self.params.budget[3];
         let adaptive = if stride > 1 {
@@ -198,6 +272,15 @@ impl RayMarchPlan {
             + self.peel.as_ref().map_or(0, |(passes, lattice)| {
                 splats::bytes(lattice.cells()) + Self::segment_bytes(size, *passes) + 16
             })
+            + self
+                .splatting
+                .as_ref()
+                .map_or(0, |(slabs, lattice)| splats::bytes(lattice.cells()) + slab_bytes(size, *slabs))
+    }
+
+    /// The splat lattice of a depth-peeled or splatted object.
+    pub fn lattice(&self) -> Option<Lattice> {
+        self.peel.or(self.splatting).map(|(_, l)| l)
     }
 
     /// Bytes of the per-pixel segment boundaries (`segment_bounds`).
@@ -209,7 +292,7 @@ impl RayMarchPlan {
     pub fn splat_key(&self) -> Option<u64> {
         let p = &self.params;
         let l = &self.segments;
-        self.peel.as_ref().map(|_| {
+        self.lattice().map(|_| {
             crate::gpu::cache::key(&(
                 "splats",
                 self.mesh_grid_key(),
@@ -224,7 +307,7 @@ impl RayMarchPlan {
         })
     }
 
-    /// Bakes the splat set of a depth-peeled object (`bake_splats.wgsl`); `grid`: its mesh grid.
+    /// Bakes the splat set of a depth-peeled or splatted object (`bake_splats.wgsl`); `grid`: its mesh grid.
     pub fn bake_splats(&self, ctx: &GpuContext, grid: Option<&MeshGrid>) -> Result<SplatSet> {
         let unused = mesh::unused(ctx);
         splats::bake(ctx, &self.params, &self.segments, grid.unwrap_or(&unused))
@@ -265,6 +348,16 @@ impl RayMarchPlan {
             inputs.counts.insert("peel_blocks".into(), (size.0 * size.1).div_ceil(segments.counts[3].max(1)));
             bounds_bytes = Self::segment_bytes(size, *passes);
         }
+        let mut slabs_bytes = 16;
+        if let (Some((slabs, _)), Some(set)) = (&self.splatting, splats) {
+            segments.counts[0] = set.counts[0];
+            segments.counts[1] = set.counts[1];
+            inputs.buffers.insert("interior_splats".into(), set.interior.clone());
+            inputs.counts.insert("interior_splats".into(), set.counts[1]);
+            let [_, pixels, pieces, _] = segments.splatting;
+            inputs.counts.insert("splat_blocks".into(), splat_blocks(size, pixels, pieces));
+            slabs_bytes = slab_bytes(size, *slabs);
+        }
         inputs.buffers.insert("segments".into(), uniform(ctx, "segments", bytemuck::bytes_of(&segments)));
         inputs.buffers.insert("peel_tickets".into(), storage(ctx, "peel_tickets", &[0u8; 16]));
         inputs.buffers.insert("mesh_grid".into(), grid.grid);
@@ -291,6 +384,7 @@ impl RayMarchPlan {
             ("transfer_tables", words as u64 * 4),
             ("ray_march_state", size.0 as u64 * size.1 as u64 * std::mem::size_of::<MarchState>() as u64),
             ("segment_bounds", bounds_bytes),
+            ("splat_slabs", slabs_bytes),
         ] {
             let buffer = ctx.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(name),

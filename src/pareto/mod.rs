@@ -255,6 +255,7 @@ pub fn ray_march(args: &Args) -> Vec<Setting> {
         let (name, short) = match segments {
             Segments::Bounds => ("Bounds".to_string(), ""),
             Segments::DepthPeeling { passes, .. } => (format!("DepthPeeling({passes})"), " peel"),
+            Segments::Splatting { slabs, .. } => (format!("Splatting({slabs})"), " splat"),
         };
         let fixed = steps.iter().map(|&step| (step, None));
         let adaptive = pairs.iter().map(|&(step, max_step)| (step, Some(max_step)));

@@ -90,7 +90,8 @@ impl Blueprint {
                     format!(
                         "object {name}: hypertexture parameters, transfer tables, per-pixel march state{}",
                         if m.packed.mesh.is_some() { ", mesh grid" } else { "" }
-                    ) + if m.peel.is_some() { ", splat sets, per-pixel segment bounds" } else { "" },
+                    ) + if m.peel.is_some() { ", splat sets, per-pixel segment bounds" } else { "" }
+                        + if m.splatting.is_some() { ", splat sets, per-pixel depth slabs" } else { "" },
                     m.bytes(self.size),
                 ));
             }
@@ -117,7 +118,7 @@ impl Blueprint {
         let splats: Vec<_> = self
             .objects
             .iter()
-            .filter_map(|o| Some((&o.object.name, o.ray_march.as_ref()?.peel.as_ref()?.1)))
+            .filter_map(|o| Some((&o.object.name, o.ray_march.as_ref()?.lattice()?)))
             .collect();
         if self.bakes.is_empty() && grids.is_empty() && splats.is_empty() {
             s += "  (none)\n";

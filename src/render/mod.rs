@@ -414,7 +414,7 @@ impl ObjectPlan {
                     Error::Invalid(format!("{}: unknown hypertexture `{}`", scene.path.display(), node.name))
                 })?;
                 plan.ray_march =
-                    Some(ray_march::plan(&plan.object.name, node, h, &rm, &view.camera(), time)?);
+                    Some(ray_march::plan(&plan.object.name, node, h, &rm, &view.camera(), time, view.size)?);
                 return Ok(plan);
             }
             Method::AxisSlices(a) => {
@@ -496,6 +496,9 @@ fn instances(
                 Part::RayMarch if o.ray_march.as_ref().is_some_and(|m| m.peel.is_some()) => {
                     (vec!["RayMarch", "RayMarchPeeling"], 0)
                 }
+                Part::RayMarch if o.ray_march.as_ref().is_some_and(|m| m.splatting.is_some()) => {
+                    (vec!["RayMarch", "RayMarchSplatting"], 0)
+                }
                 Part::RayMarch => (vec!["RayMarch"], 0),
                 Part::Reference => unreachable!("reference instances are added once, above"),
             };
@@ -546,6 +549,7 @@ pub const INSTANCE_RESOURCES: &[&str] = &[
     "surface_splats",
     "interior_splats",
     "peel_tickets",
+    "splat_slabs",
     "axis_params",
     "axis_occupancy",
     "axis_choices",

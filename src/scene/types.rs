@@ -569,6 +569,8 @@ pub struct Adaptive {
 pub const MAX_STRIDE: u32 = 1 << 12;
 /// Most depth-peeling passes (segments per ray).
 pub const MAX_PEEL_PASSES: u32 = 8;
+/// Most depth slabs per pixel of EWA-style splatting.
+pub const MAX_SPLAT_SLABS: u32 = 64;
 /// Largest splat lattice (cells along the bounds' longest axis).
 pub const MAX_SPLAT_GRID: u32 = 96;
 
@@ -589,6 +591,23 @@ pub enum Segments {
         #[serde(default = "default_splat_grid", deserialize_with = "v::splat_grid")]
         splat_grid: u32,
     },
+    /// EWA-style splatting (section 5.1): every interior splat (a sphere) marches the stretch of
+    /// each pixel ray of its footprint inside it, weighted by a Gaussian of the ray's distance to
+    /// its centre; contributions are summed per depth slab (`slabs` along each ray's span in the
+    /// bounds) and the slabs composited front to back.
+    Splatting {
+        #[serde(default = "default_slabs", deserialize_with = "v::splat_slabs")]
+        slabs: u32,
+        #[serde(default = "default_splat_grid", deserialize_with = "v::splat_grid")]
+        splat_grid: u32,
+    },
+}
+
+/// `Splatting`'s default depth slabs.
+pub const DEFAULT_SPLAT_SLABS: u32 = 16;
+
+fn default_slabs() -> u32 {
+    DEFAULT_SPLAT_SLABS
 }
 
 /// `DepthPeeling`'s defaults: passes (segments per ray) and splat lattice cells.

@@ -80,6 +80,7 @@ checked_u32!(
     super::types::MAX_SPLAT_GRID,
     "a splat lattice size (cells along the longest axis)"
 );
+checked_u32!(SplatSlabs, 1, super::types::MAX_SPLAT_SLABS, "a depth slab count");
 checked_u32!(
     GridResolution,
     4,
@@ -136,6 +137,7 @@ adapter!(octaves, u32, Octaves, |v| v.0);
 adapter!(grid_resolution, u32, GridResolution, |v| v.0);
 adapter!(peel_passes, u32, PeelPasses, |v| v.0);
 adapter!(splat_grid, u32, SplatGrid, |v| v.0);
+adapter!(splat_slabs, u32, SplatSlabs, |v| v.0);
 adapter!(frequency, u32, Frequency, |v| v.0);
 adapter!(cells, [u32; 2], [Cells; 2], |v| v.map(|x| x.0));
 adapter!(sphere_segments, [u32; 2], (Around, PoleToPole), |v| [v.0 .0, v.1 .0]);

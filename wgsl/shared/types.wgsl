@@ -239,6 +239,7 @@ struct SegmentParams {
     lattice: vec4<u32>,
     surface: vec4<f32>,
     counts: vec4<u32>,
+    splatting: vec4<u32>,
 }
 
 struct Splat {
