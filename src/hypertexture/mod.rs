@@ -164,6 +164,12 @@ pub fn animated(noises: &[HyperNoise]) -> bool {
 }
 
 impl Packed {
+    /// The largest shift as the kernels test it (rounding slack added): no point farther from
+    /// the object can have density, which the march and the splat lattice both rely on.
+    pub fn tested_shift(&self) -> f64 {
+        self.max_shift * (1.0 + 1e-4) + 1e-6
+    }
+
     /// The `HyperParams` the hypertexture fixes at `time` (object, field, noise count, reach of
     /// the noises, mesh grid, enlarged bounds, opacity length); the camera and march fields are
     /// the method's to fill.
@@ -177,7 +183,7 @@ impl Packed {
             field_center: self.field_center,
             perturb: self.perturb,
             kinds: self.kinds,
-            march: [0.0, 0.0, (self.max_shift * (1.0 + 1e-4) + 1e-6) as f32, time as f32],
+            march: [0.0, 0.0, self.tested_shift() as f32, time as f32],
             ..Default::default()
         };
         if let Some((_, g)) = &self.mesh {

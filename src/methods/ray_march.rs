@@ -84,7 +84,7 @@ pub fn plan(
     let evals = LOOP_BUDGET / (packed.noises.len() as u32 + 1);
     let shadow_samples = ((diagonal / shadow_step).ceil() as u32).clamp(1, MAX_SHADOW_SAMPLES);
     let worst = 1 + 6 * shade.phong as u32 + shadow_samples * shade.shadows as u32;
-    let lattice = |grid| Lattice::new(h.bounds(), max_shift(h), grid);
+    let lattice = |grid| Lattice::new(h.bounds(), packed.tested_shift(), grid);
     let (peel, splatting) = match method.segments {
         Segments::Bounds => (None, None),
         Segments::DepthPeeling { passes, splat_grid } => (Some((passes, lattice(splat_grid))), None),
@@ -205,11 +205,6 @@ pub fn splat_blocks(size: (u32, u32), pixels: u32, pieces: u32) -> u32 {
 
 /// Workgroups per splat of `splat_segments.wgsl` (along y: the adapters' dispatch limit).
 pub const MAX_SPLAT_BLOCKS: u32 = 65535;
-
-/// The largest shift of a hypertexture's noises as the kernels test it (rounding slack added).
-fn max_shift(h: &Hypertexture) -> f64 {
-    h.max_shift() * (1.0 + 1e-4) + 1e-6
-}
 
 impl RayMarchPlan {
     /// Values of the kernel's override constants.
