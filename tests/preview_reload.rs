@@ -241,3 +241,24 @@ fn reload_sequence() {
     drop(w);
     std::fs::remove_dir_all(&root).ok();
 }
+
+/// Another process opening and reading a watched file is not a change; a write is.
+#[test]
+fn reads_of_watched_files_are_not_changes() {
+    let dir = std::env::temp_dir().join(format!("voltex-watch-read-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("scene.ron");
+    std::fs::write(&file, SCENE).unwrap();
+    let w = Watcher::new(std::slice::from_ref(&dir)).unwrap();
+    std::thread::sleep(Duration::from_millis(200));
+    let status =
+        std::process::Command::new("cat").arg(&file).stdout(std::process::Stdio::null()).status().unwrap();
+    assert!(status.success());
+    let _ = std::fs::read(&file).unwrap();
+    let seen = w.changes(Duration::from_millis(800));
+    assert!(seen.is_empty(), "reads reported as changes: {seen:?}");
+    std::fs::write(&file, SCENE.replace("planes: 24", "planes: 25")).unwrap();
+    wait_for(&w, &file);
+    std::fs::remove_dir_all(&dir).ok();
+}

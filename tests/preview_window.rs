@@ -118,3 +118,52 @@ fn window_recovers_from_a_lost_device() {
     assert!(centre[0] > 100 && centre[1] > 80, "centre pixel {centre:?}; stderr: {err}");
     std::fs::remove_dir_all(&dir).ok();
 }
+
+fn frames_in(dir: &Path) -> usize {
+    std::fs::read_dir(dir)
+        .map(|d| {
+            d.filter_map(|e| e.ok()).filter(|e| e.path().extension().is_some_and(|x| x == "png")).count()
+        })
+        .unwrap_or(0)
+}
+
+/// One save (`touch`) rebuilds once and the preview then settles: the rebuild's own reads of
+/// the files it watches must not come back as changes (they once made it rebuild for ever).
+#[test]
+fn window_settles_after_one_save() {
+    let dir = std::env::temp_dir().join(format!("voltex-window-idle-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let scene = dir.join("scene.ron");
+    std::fs::copy(root.join("scenes/view_slices/flat_box.ron"), &scene).unwrap();
+    let record = dir.join("frames");
+    use std::os::unix::process::CommandExt;
+    let mut child = Command::new("xvfb-run")
+        .process_group(0)
+        .args(["-a", "-s", "-screen 0 1280x800x24", BIN, "preview"])
+        .arg(&scene)
+        .args(["--size", "32x32", "--quit-after", "60", "--record"])
+        .arg(&record)
+        .env("VOLTEX_ROOT", root)
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    wait_for(&record.join("frame-0.png"), &mut child);
+    std::thread::sleep(Duration::from_secs(2));
+    let idle = frames_in(&record);
+    let status = Command::new("touch").arg(&scene).status().unwrap();
+    assert!(status.success());
+    std::thread::sleep(Duration::from_secs(6));
+    let after_save = frames_in(&record);
+    std::thread::sleep(Duration::from_secs(4));
+    let settled = frames_in(&record);
+    let _ = Command::new("kill").args(["-TERM", "--", &format!("-{}", child.id())]).status();
+    let out = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(idle, 1, "an idle preview draws one frame; stderr: {err}");
+    assert!(after_save - idle <= 2, "one save drew {} frames; stderr: {err}", after_save - idle);
+    assert_eq!(settled, after_save, "still drawing 6 s after the save; stderr: {err}");
+    std::fs::remove_dir_all(&dir).ok();
+}

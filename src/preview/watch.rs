@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 use std::sync::mpsc::{channel, Receiver, RecvTimeoutError};
 use std::time::{Duration, Instant};
 
+use notify::event::{AccessKind, AccessMode, EventKind};
 use notify::{RecommendedWatcher, RecursiveMode};
 use notify_debouncer_full::{new_debouncer, DebounceEventResult, Debouncer, RecommendedCache};
 
@@ -64,7 +65,7 @@ impl Watcher {
             let left = deadline.saturating_duration_since(Instant::now());
             match self.events.recv_timeout(if out.is_empty() { left } else { Duration::ZERO }) {
                 Ok(Ok(events)) => {
-                    for e in events {
+                    for e in events.iter().filter(|e| changes_content(&e.event.kind)) {
                         let ours = |p: &PathBuf| self.ignore.iter().any(|d| p.starts_with(d));
                         out.extend(e.event.paths.iter().filter(|p| relevant(p) && !ours(p)).cloned());
                     }
@@ -80,6 +81,18 @@ impl Watcher {
         out.sort();
         out.dedup();
         out
+    }
+}
+
+/// Whether an event can change what a rebuild reads: creations, modifications (renames and
+/// metadata included: `touch` is a save), removals, and a writer closing the file. Opens and
+/// reads are not: the rebuild's own reads of the files it watches come back as such events, and
+/// counting them made a preview rebuild for ever after one save.
+pub fn changes_content(kind: &EventKind) -> bool {
+    match kind {
+        EventKind::Create(_) | EventKind::Modify(_) | EventKind::Remove(_) => true,
+        EventKind::Access(AccessKind::Close(AccessMode::Write)) => true,
+        EventKind::Access(_) | EventKind::Any | EventKind::Other => false,
     }
 }
 
