@@ -162,6 +162,13 @@ const CASES: &[Case] = &[
     },
     Case { scene: "single_slice", flip: &[(View, 0.02), (Axis, 0.07)], same_as: &[], same_bound: &[] },
     Case { scene: "criteria_finest", flip: &[(Axis, 0.015)], same_as: &[], same_bound: &[] },
+    // Occlusion culling at a silhouette: identical with culling off.
+    Case {
+        scene: "culling_silhouette",
+        flip: &[(Axis, 0.1)],
+        same_as: &[("occlusion_culling: true", "occlusion_culling: false")],
+        same_bound: &[(Axis, 0.0)],
+    },
     // The coarsest level: one slab per tile, a large error by design.
     Case { scene: "criteria_coarsest", flip: &[(Axis, 0.16)], same_as: &[], same_bound: &[] },
     Case {

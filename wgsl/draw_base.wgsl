@@ -1,4 +1,4 @@
-// Draws a base surface opaque with depth, lit by the frame's light (vertex pulling, 3 per triangle).
+// Draws a base surface opaque with depth (also into base_depth), lit by the frame's light (vertex pulling, 3 per triangle).
 #include "shared/types.wgsl"
 
 @group(0) @binding(0) var<uniform> frame: FrameParams;
@@ -21,8 +21,14 @@ fn vs_main(@builtin(vertex_index) index: u32) -> VsOut {
     return out;
 }
 
+struct FsOut {
+    @location(0) color: vec4<f32>,
+    // The depth again, readable by compute passes (occlusion culling) that run between draws.
+    @location(1) depth: f32,
+}
+
 @fragment
-fn fs_main(in: VsOut) -> @location(0) vec4<f32> {
+fn fs_main(in: VsOut) -> FsOut {
     var n = normalize(in.normal);
     // Two-sided: light the side facing the camera.
     if dot(n, in.rel) > 0.0 {
@@ -31,5 +37,5 @@ fn fs_main(in: VsOut) -> @location(0) vec4<f32> {
     let ambient = frame.light_dir.w;
     let diffuse = max(dot(n, frame.light_dir.xyz), 0.0);
     let rgb = object.base_color.rgb * (ambient + (1.0 - ambient) * diffuse) * frame.light_color.rgb;
-    return vec4<f32>(rgb, 1.0);
+    return FsOut(vec4<f32>(rgb, 1.0), in.clip.z);
 }

@@ -247,13 +247,87 @@ pub fn choose_axis(f: &AxisFrame, params: &AxisParams) -> AxisChoice {
     }
 }
 
-/// Whether both the base and the top triangle face away from the eye.
-pub fn back_facing(f: &AxisFrame) -> bool {
-    let w = f.axes[2].truncate();
-    let orient = |n: Vec3| if n.dot(w) < 0.0 { -n } else { n };
-    let nb = orient((f.bottom[1] - f.bottom[0]).cross(f.bottom[2] - f.bottom[0]));
-    let nt = orient((f.top[1] - f.top[0]).cross(f.top[2] - f.top[0]));
-    nb.dot(f.bottom[0]) > 0.0 && nt.dot(f.top[0]) > 0.0
+/// The opaque base surfaces' depth as `draw_base` leaves it in `base_depth`, with the frame's
+/// projection: what the occlusion culling reads.
+pub struct Occluders<'a> {
+    pub view_proj: glam::Mat4,
+    pub size: (u32, u32),
+    /// Row-major, top row first: NDC depth of the nearest base surface, 1 where there is none.
+    pub depth: &'a [f32],
+}
+
+/// Largest screen rectangle (pixels) the occlusion test reads; larger prisms are drawn.
+pub const MAX_OCCLUSION_PIXELS: i32 = 4096;
+
+/// Tolerance of the coverage test (pixels): wider than the rasteriser's sub-pixel snapping.
+const COVER_TOLERANCE: f32 = 1.0 / 64.0;
+
+fn edge_function(a: Vec2, b: Vec2, p: Vec2) -> f32 {
+    (b.x - a.x) * (p.y - a.y) - (b.y - a.y) * (p.x - a.x)
+}
+
+/// Twin of `in_triangle`: `p` in triangle abc widened by the tolerance; no area covers nothing.
+fn in_triangle(a: Vec2, b: Vec2, c: Vec2, p: Vec2) -> bool {
+    let area = edge_function(a, b, c);
+    if area == 0.0 {
+        return false;
+    }
+    let s = area.signum();
+    [(a, b), (b, c), (c, a)]
+        .iter()
+        .all(|&(u, v)| s * edge_function(u, v, p) >= -COVER_TOLERANCE * (v - u).length())
+}
+
+/// Twin of `in_projection`: `p` in the projected base or top triangle or a side's hull.
+fn in_projection(q: &[Vec2; 6], p: Vec2) -> bool {
+    in_triangle(q[0], q[1], q[2], p)
+        || in_triangle(q[3], q[4], q[5], p)
+        || (0..3).any(|i| {
+            let j = (i + 1) % 3;
+            let (a, b, c, d) = (q[i], q[j], q[j + 3], q[i + 3]);
+            in_triangle(a, b, c, p)
+                || in_triangle(a, c, d, p)
+                || in_triangle(a, b, d, p)
+                || in_triangle(b, c, d, p)
+        })
+}
+
+/// Twin of `hidden_behind_base` (wgsl/shared/occlusion.wgsl): whether every pixel centre in the
+/// prism's projection already holds a base surface nearer than its nearest corner, so that no
+/// fragment of its slices can pass the depth test.
+pub fn hidden_behind_base(f: &AxisFrame, occ: &Occluders) -> bool {
+    let size = glam::Vec2::new(occ.size.0 as f32, occ.size.1 as f32);
+    let (mut lo, mut hi, mut near) = (Vec2::splat(3.4e38), Vec2::splat(-3.4e38), 3.4e38f32);
+    let mut q = [Vec2::ZERO; 6];
+    for (k, p) in f.bottom.iter().chain(&f.top).enumerate() {
+        let c = occ.view_proj * p.extend(1.0);
+        if c.w <= 0.0 {
+            return false;
+        }
+        let ndc = c.truncate() / c.w;
+        let px = Vec2::new((ndc.x * 0.5 + 0.5) * size.x, (0.5 - ndc.y * 0.5) * size.y)
+            .clamp(Vec2::splat(-1e7), Vec2::splat(1e7));
+        q[k] = px;
+        lo = lo.min(px);
+        hi = hi.max(px);
+        near = near.min(ndc.z);
+    }
+    near -= 1e-6 * (1.0 + near.abs());
+    let first = (lo - 0.5).ceil().as_ivec2().max(glam::IVec2::ZERO);
+    let last = (hi - 0.5).floor().as_ivec2().min(size.as_ivec2() - 1);
+    if last.x < first.x || last.y < first.y {
+        return true;
+    }
+    let span = last - first + 1;
+    if span.x * span.y > MAX_OCCLUSION_PIXELS {
+        return false;
+    }
+    (first.y..=last.y).all(|y| {
+        (first.x..=last.x).all(|x| {
+            let centre = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
+            !in_projection(&q, centre) || occ.depth[(y as u32 * occ.size.0 + x as u32) as usize] < near
+        })
+    })
 }
 
 /// The j-th slice position drawn (back to front).
@@ -283,10 +357,16 @@ fn crossings(f: &AxisFrame, direction: usize, x: f32) -> Vec<(usize, usize, f32)
         .collect()
 }
 
-/// Twin of `choose_axis_slices`: the choice with its vertex count (culling applied).
-pub fn choose_axis_slices(f: &AxisFrame, params: &AxisParams, occupancy: &[u32]) -> AxisChoice {
+/// Twin of `choose_axis_slices`: the choice with its vertex count (occlusion culling applied
+/// when switched on and `occluders` are given).
+pub fn choose_axis_slices(
+    f: &AxisFrame,
+    params: &AxisParams,
+    occupancy: &[u32],
+    occluders: Option<&Occluders>,
+) -> AxisChoice {
     let mut c = choose_axis(f, params);
-    if params.flags[2] != 0 && back_facing(f) {
+    if params.flags[2] != 0 && occluders.is_some_and(|o| hidden_behind_base(f, o)) {
         c.culled = 1;
         return c;
     }

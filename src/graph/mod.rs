@@ -42,6 +42,7 @@ pub enum Format {
     Rgba8Unorm,
     Rgba16Float,
     Rgba32Float,
+    R32Float,
     Depth32Float,
 }
 
@@ -51,12 +52,13 @@ impl Format {
             Format::Rgba8Unorm => wgpu::TextureFormat::Rgba8Unorm,
             Format::Rgba16Float => wgpu::TextureFormat::Rgba16Float,
             Format::Rgba32Float => wgpu::TextureFormat::Rgba32Float,
+            Format::R32Float => wgpu::TextureFormat::R32Float,
             Format::Depth32Float => wgpu::TextureFormat::Depth32Float,
         }
     }
     pub fn bytes_per_pixel(self) -> u64 {
         match self {
-            Format::Rgba8Unorm | Format::Depth32Float => 4,
+            Format::Rgba8Unorm | Format::R32Float | Format::Depth32Float => 4,
             Format::Rgba16Float => 8,
             Format::Rgba32Float => 16,
         }

@@ -43,7 +43,7 @@ impl AxisPlan {
             resolution: [resolution[0], resolution[1], resolution[2], shell.prisms.len() as u32],
             criteria: [m.depth as f32, m.pixels as f32, m.max_angle.to_radians() as f32, focal as f32],
             forward: [forward[0], forward[1], forward[2], eye_inside(shell) as u32 as f32],
-            flags: [directions, 0, m.back_face_culling as u32, m.empty_culling as u32],
+            flags: [directions, 0, m.occlusion_culling as u32, m.empty_culling as u32],
         };
         let distance = |p: &Prism| {
             let c = p.sphere;

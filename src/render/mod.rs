@@ -56,6 +56,8 @@ pub struct RenderOptions {
     pub axis_criteria: Option<(f64, f64)>,
     /// Time of the frame in seconds (animated hypertextures; default: the scene's).
     pub time: Option<f64>,
+    /// AxisSlices occlusion culling for every AxisSlices object (`--occlusion-culling`).
+    pub occlusion_culling: Option<bool>,
 }
 
 /// A method without its knobs, to switch every object to it (`--method`).
@@ -73,7 +75,7 @@ pub const DEFAULT_AXIS_SLICES: AxisSlices = AxisSlices {
     max_angle: 80.0,
     directions: crate::scene::SliceDirections::Three,
     blend: crate::scene::SliceBlend::Binary,
-    back_face_culling: false,
+    occlusion_culling: false,
     empty_culling: true,
     draw_order: crate::scene::DrawOrder::Texels,
 };
@@ -121,7 +123,8 @@ impl RenderOptions {
             (MethodKind::AxisSlices, m) => {
                 let a = if let Method::AxisSlices(a) = m { *a } else { DEFAULT_AXIS_SLICES };
                 let (depth, pixels) = self.axis_criteria.unwrap_or((a.depth, a.pixels));
-                Method::AxisSlices(AxisSlices { depth, pixels, ..a })
+                let occlusion_culling = self.occlusion_culling.unwrap_or(a.occlusion_culling);
+                Method::AxisSlices(AxisSlices { depth, pixels, occlusion_culling, ..a })
             }
         }
     }

@@ -174,15 +174,17 @@ impl Renderer {
         self.exec.texture(&self.blueprint.graph.file.outputs[0])
     }
 
-    /// Reads a graph texture (Rgba32Float) back as a linear image.
+    /// Reads a graph texture back as a linear image: Rgba32Float as it is, R32Float as grey with
+    /// alpha 1.
     pub fn read_texture(&self, ctx: &GpuContext, name: &str) -> Result<Image> {
         let texture =
             self.exec.texture(name).ok_or_else(|| Error::Invalid(format!("output `{name}` was pruned")))?;
-        if texture.format() != wgpu::TextureFormat::Rgba32Float {
+        let grey = texture.format() == wgpu::TextureFormat::R32Float;
+        if texture.format() != wgpu::TextureFormat::Rgba32Float && !grey {
             return Err(self
                 .blueprint
                 .graph
-                .error_at(name, format!("output `{name}` must be Rgba32Float to be read back")));
+                .error_at(name, format!("output `{name}` must be Rgba32Float or R32Float to be read back")));
         }
         let (w, h) = self.blueprint.size;
         let mut enc = ctx.device.create_command_encoder(&Default::default());
@@ -202,8 +204,14 @@ impl Renderer {
         let bytes = ctx.map_read(&self.readback)?;
         let mut pixels = Vec::with_capacity((w * h) as usize);
         for y in 0..h as usize {
-            let row = &bytes[y * padded_row(w) as usize..][..w as usize * 16];
-            pixels.extend(bytemuck::pod_collect_to_vec::<u8, [f32; 4]>(row));
+            if grey {
+                let row = &bytes[y * padded_row(w) as usize..][..w as usize * 4];
+                pixels
+                    .extend(bytemuck::pod_collect_to_vec::<u8, f32>(row).into_iter().map(|v| [v, v, v, 1.0]));
+            } else {
+                let row = &bytes[y * padded_row(w) as usize..][..w as usize * 16];
+                pixels.extend(bytemuck::pod_collect_to_vec::<u8, [f32; 4]>(row));
+            }
         }
         Image::from_pixels(w, h, pixels)
     }

@@ -710,9 +710,11 @@ pub struct AxisSlices {
     pub directions: SliceDirections,
     #[serde(default)]
     pub blend: SliceBlend,
-    /// Skip prisms whose base and top triangles both face away (approximate: see README).
-    #[serde(default)]
-    pub back_face_culling: bool,
+    /// Skip prisms hidden behind the opaque base surfaces: exact (every pixel a prism's corners
+    /// can cover already holds a nearer base surface), so it never changes the image.
+    /// `occlusion_culling` is the field's former name.
+    #[serde(default, alias = "occlusion_culling")]
+    pub occlusion_culling: bool,
     /// Skip slices (and so texels) whose slice image is empty.
     #[serde(default = "yes")]
     pub empty_culling: bool,

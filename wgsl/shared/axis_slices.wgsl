@@ -215,17 +215,6 @@ fn choose_axis(f: ptr<function, AxisFrame>) -> AxisChoice {
     return out;
 }
 
-// Whether both the base and the top triangle face away from the eye (switchable culling; exact
-// only where the pattern stays inside its prism and the base surface is opaque).
-fn back_facing(f: ptr<function, AxisFrame>) -> bool {
-    let w = (*f).axes[2].xyz;
-    var nb = cross((*f).bottom[1] - (*f).bottom[0], (*f).bottom[2] - (*f).bottom[0]);
-    var nt = cross((*f).top[1] - (*f).top[0], (*f).top[2] - (*f).top[0]);
-    nb = select(nb, -nb, dot(nb, w) < 0.0);
-    nt = select(nt, -nt, dot(nt, w) < 0.0);
-    return dot(nb, (*f).bottom[0]) > 0.0 && dot(nt, (*f).top[0]) > 0.0;
-}
-
 // The j-th slice position drawn (back to front) of a choice.
 fn slice_position(c: AxisChoice, j: u32) -> i32 {
     let k = select(j, c.count - 1u - j, c.reverse == 1u);
