@@ -6,6 +6,7 @@
 pub mod bake;
 pub mod cpu;
 pub mod error;
+pub mod fault;
 pub mod gpu;
 pub mod graph;
 pub mod hypertexture;
@@ -30,3 +31,8 @@ pub fn project_root() -> std::path::PathBuf {
 }
 pub mod bench;
 pub mod render;
+
+/// The kernels' folder, `wgsl/` under the project root.
+pub fn wgsl_root() -> std::path::PathBuf {
+    project_root().join("wgsl")
+}

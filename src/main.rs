@@ -365,7 +365,7 @@ fn bake(scene_path: &Path, texels: &[String], out: Option<PathBuf>) -> voltex::R
         let baked = baker.bake(&ctx, &plan.request)?;
         let volume = voltex::bake::axis_slices::read_texture(&ctx, &baked.volume, 4)?;
         let dir = out.join(&plan.texel);
-        voltex::bake::stack::write(&dir, plan.request.resolution, &volume)?;
+        voltex::io::stack::write(&dir, plan.request.resolution, &volume)?;
         let [w, h, d] = plan.request.resolution;
         println!("{} ({w}x{h}x{d}, {:.0} ms)", dir.display(), start.elapsed().as_secs_f64() * 1e3);
     }

@@ -465,3 +465,15 @@ pub struct Splat {
     /// xyz: unit outward normal (surface splats); w: unused.
     pub normal: [f32; 4],
 }
+
+/// `HyperParams::kinds[0]` (mirrored in wgsl/shared/fields.wgsl).
+pub const OBJECT_SPHERE: u32 = 0;
+pub const OBJECT_ELLIPSOID: u32 = 1;
+pub const OBJECT_TORUS: u32 = 2;
+pub const OBJECT_BOX: u32 = 3;
+pub const OBJECT_MESH: u32 = 4;
+/// `HyperParams::kinds[1]`.
+pub const FIELD_CLOSEST_SURFACE: u32 = 0;
+pub const FIELD_FROM_CENTRE: u32 = 1;
+pub const FIELD_CONSTANT: u32 = 2;
+pub const FIELD_SWIRL: u32 = 3;

@@ -22,8 +22,8 @@ use fuzz_support::{check_error, mutate, Mutation, Tracked};
 use glam::{DVec2, DVec3};
 use proptest::prelude::*;
 use voltex::graph::{plan, Graph};
+use voltex::mesh::shell::Shell;
 use voltex::mesh::{obj, prism, BaseSurface};
-use voltex::methods::shell::Shell;
 use voltex::methods::view_slices;
 use voltex::render::{Blueprint, RenderOptions};
 

@@ -8,11 +8,12 @@ use glam::{DVec2, DVec3};
 use voltex::cpu::slice_prisms;
 use voltex::gpu::timing::Timer;
 use voltex::gpu::GpuContext;
-use voltex::graph::exec::{Executor, Inputs};
+use voltex::gpu::Inputs;
+use voltex::graph::exec::Executor;
 use voltex::graph::plan::{self, ObjectInfo};
 use voltex::graph::Graph;
+use voltex::mesh::shell::Shell;
 use voltex::mesh::BaseSurface;
-use voltex::methods::shell::Shell;
 use voltex::methods::view_slices;
 use voltex::types::{SliceParams, SliceVertex};
 

@@ -13,8 +13,9 @@ use voltex::bake::{BakeRequest, BakeSource, Baker, MeshTexel};
 use voltex::cpu::bake::{bake_params, pack_shapes, Shape};
 use voltex::cpu::bake_mesh_texel::bake_mesh_texel;
 use voltex::gpu::GpuContext;
-use voltex::hypertexture::mesh::{self, MeshShape};
+use voltex::hypertexture::mesh;
 use voltex::mesh::obj;
+use voltex::mesh::shape::MeshShape;
 use voltex::scene;
 
 const N: u32 = 32;
@@ -212,7 +213,7 @@ fn coloured_mesh_fills_with_the_colour_of_the_nearest_surface() {
     let shape = MeshShape::new(&m, &dir.join("sphere.obj")).unwrap();
     // The grid's colours against the twin's (brute force, f64) on a grid off the sphere's
     // symmetry planes (on them, mirror-image triangles tie and f32 and f64 pick either).
-    let spec = mesh::GridSpec {
+    let spec = voltex::mesh::shape::GridSpec {
         lo: DVec3::new(-0.4123, -0.3871, -0.4017),
         hi: DVec3::new(0.3953, 0.4209, 0.3889),
         n: [17, 19, 13],

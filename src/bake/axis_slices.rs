@@ -6,7 +6,7 @@ use crate::cpu::axis_slices::{array_layers, level_count, level_layer, level_slic
 use crate::error::{Error, Result};
 use crate::gpu::kernel::ComputeKernel;
 use crate::gpu::GpuContext;
-use crate::graph::exec::Inputs;
+use crate::gpu::Inputs;
 use crate::types::AxisBake;
 
 #[derive(Clone)]
@@ -91,7 +91,7 @@ pub fn bake(
             let mut inputs = Inputs::default();
             inputs.buffers.insert(
                 "axis_bake".into(),
-                crate::bake::uniform(ctx, "axis_bake", bytemuck::bytes_of(&params)),
+                crate::gpu::buffers::uniform(ctx, "axis_bake", bytemuck::bytes_of(&params)),
             );
             inputs.buffers.insert("axis_occupancy".into(), occupancy.clone());
             inputs.views.insert("volume".into(), source.clone());

@@ -14,7 +14,7 @@ use crate::cpu::bake_transfer::TRANSFER_SIZE;
 use crate::error::Result;
 use crate::gpu::kernel::ComputeKernel;
 use crate::gpu::GpuContext;
-use crate::graph::exec::Inputs;
+use crate::gpu::Inputs;
 use crate::hypertexture::{self, mesh, Packed};
 use crate::scene::Hypertexture;
 use crate::types::HyperParams;
@@ -73,7 +73,7 @@ impl HyperTexel {
         inputs: &mut Inputs,
         params: crate::types::BakeParams,
     ) -> Result<()> {
-        use super::{storage, uniform};
+        use crate::gpu::buffers::{storage, uniform};
         let grid = match &self.packed.mesh {
             Some((shape, spec)) => mesh::bake(ctx, shape, spec)?,
             None => mesh::unused(ctx),
@@ -96,7 +96,7 @@ impl HyperTexel {
         let words = (p.functions.len() * TRANSFER_SIZE) as u64;
         b.insert(
             "transfer_tables".into(),
-            super::work_buffer(ctx, "transfer_tables", words * 4, wgpu::BufferUsages::empty()),
+            crate::gpu::buffers::work_buffer(ctx, "transfer_tables", words * 4, wgpu::BufferUsages::empty()),
         );
         let (transfer, bake) = kernels;
         transfer.dispatch(ctx, encoder, inputs, [TRANSFER_SIZE as u32, p.functions.len() as u32, 1])?;

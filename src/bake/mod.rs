@@ -4,16 +4,16 @@
 
 pub mod axis_slices;
 pub mod hypertexture;
-pub mod stack;
 
 use std::path::Path;
 
 use crate::cpu::bake::PackedShapes;
 use crate::error::{Error, Result};
+use crate::gpu::buffers::{storage, uniform};
 use crate::gpu::kernel::ComputeKernel;
 use crate::gpu::GpuContext;
-use crate::graph::exec::Inputs;
-use crate::hypertexture::mesh::{GridSpec, MeshShape};
+use crate::gpu::Inputs;
+use crate::mesh::shape::{GridSpec, MeshShape};
 use crate::types::{BakeParams, HeightImageParams, HeightfieldParams, MeshTexelParams};
 use glam::DVec3;
 
@@ -334,44 +334,4 @@ pub fn level_view(t: &wgpu::Texture, level: u32) -> wgpu::TextureView {
         mip_level_count: Some(1),
         ..Default::default()
     })
-}
-
-pub fn uniform(ctx: &GpuContext, label: &str, bytes: &[u8]) -> wgpu::Buffer {
-    filled(ctx, label, bytes, wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST)
-}
-
-/// A buffer holding `bytes` (padded to 4). Written through the queue: wgpu's
-/// `create_buffer_init` maps the buffer at creation and panics when the device is lost.
-fn filled(ctx: &GpuContext, label: &str, bytes: &[u8], usage: wgpu::BufferUsages) -> wgpu::Buffer {
-    let mut data = bytes.to_vec();
-    data.resize(bytes.len().next_multiple_of(4), 0);
-    let buffer = ctx.device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some(label),
-        size: data.len() as u64,
-        usage,
-        mapped_at_creation: false,
-    });
-    if !data.is_empty() {
-        ctx.queue.write_buffer(&buffer, 0, &data);
-    }
-    buffer
-}
-
-/// An uninitialised storage buffer of `size` bytes (at least 16: empty bindings are invalid),
-/// copyable both ways, with `extra` usages (e.g. INDIRECT).
-pub fn work_buffer(ctx: &GpuContext, label: &str, size: u64, extra: wgpu::BufferUsages) -> wgpu::Buffer {
-    ctx.device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some(label),
-        size: size.max(16),
-        usage: wgpu::BufferUsages::STORAGE
-            | wgpu::BufferUsages::COPY_DST
-            | wgpu::BufferUsages::COPY_SRC
-            | extra,
-        mapped_at_creation: false,
-    })
-}
-
-pub fn storage(ctx: &GpuContext, label: &str, bytes: &[u8]) -> wgpu::Buffer {
-    let usage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC;
-    filled(ctx, label, bytes, usage)
 }

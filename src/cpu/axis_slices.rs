@@ -54,7 +54,7 @@ impl AxisFrame {
     }
 
     /// The frame of prism `index` of a shell (camera-relative, as uploaded).
-    pub fn of_shell(shell: &crate::methods::shell::Shell, index: usize) -> Self {
+    pub fn of_shell(shell: &crate::mesh::shell::Shell, index: usize) -> Self {
         let p = &shell.prisms[index];
         let v = |i: usize| &shell.vertices[p.vertices[i] as usize];
         let b = |i: usize| Vec4::from(v(i).bottom).truncate();

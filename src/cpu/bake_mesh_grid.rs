@@ -5,7 +5,7 @@
 
 use glam::DVec3;
 
-use crate::hypertexture::mesh::{GridSpec, MeshShape};
+use crate::mesh::shape::{GridSpec, MeshShape};
 
 /// Mirrors DIR0..DIR2 of the kernel.
 pub const DIRECTIONS: [[f64; 3]; 3] =

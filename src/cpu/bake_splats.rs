@@ -4,8 +4,7 @@
 use glam::DVec3;
 
 use super::hypertexture::Model;
-use crate::hypertexture::splats::Lattice;
-use crate::types::Splat;
+use crate::types::{SegmentParams, Splat};
 
 /// Mirrors the kernel's constants (in cells).
 pub const HALF_DIAGONAL: f64 = 0.8660254;
@@ -77,4 +76,49 @@ fn interior_splat(lattice: &Lattice, level: &impl Fn(DVec3) -> f64, id: [u32; 3]
         (-s).clamp(HALF_DIAGONAL * cell, INTERIOR_RADIUS * cell),
         DVec3::ZERO,
     ))
+}
+
+/// Where the splats come from: the lattice and the splat surface's level.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Lattice {
+    /// Cells along the bounds' longest axis (the scene's `splat_grid`).
+    pub grid: u32,
+    pub min: DVec3,
+    pub cell: f64,
+    pub counts: [u32; 3],
+    /// Support distance of the splat surface.
+    pub level: f64,
+}
+
+impl Lattice {
+    /// `bounds`: the enlarged bounds; `shift`: the largest shift (as the kernels test it);
+    /// `grid`: cells along the longest axis.
+    pub fn new(bounds: (DVec3, DVec3), shift: f64, grid: u32) -> Self {
+        let cell = (bounds.1 - bounds.0).max_element() / grid as f64;
+        let level = shift + 0.5 * cell;
+        // Beyond the bounds by the level and a cell: mesh support distances are lower bounds
+        // (the splat surface may lie farther out than the bounds' enlargement).
+        let pad = DVec3::splat(level + cell);
+        let (lo, hi) = (bounds.0 - pad, bounds.1 + pad);
+        let counts = ((hi - lo) / cell).ceil().to_array().map(|c| c as u32);
+        Lattice { grid, min: lo, cell, counts, level }
+    }
+
+    pub fn cells(&self) -> u32 {
+        self.counts.iter().product()
+    }
+
+    /// The centre of cell `(i, j, k)` (object space).
+    pub fn centre(&self, i: u32, j: u32, k: u32) -> DVec3 {
+        self.min + (DVec3::new(i as f64, j as f64, k as f64) + 0.5) * self.cell
+    }
+
+    /// Fills the lattice fields of `params`.
+    pub fn write(&self, params: &mut SegmentParams) {
+        let m = self.min;
+        params.lattice_min = [m.x as f32, m.y as f32, m.z as f32, self.cell as f32];
+        let c = self.counts;
+        params.lattice = [c[0], c[1], c[2], self.cells()];
+        params.surface[0] = self.level as f32;
+    }
 }

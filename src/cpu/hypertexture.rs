@@ -6,10 +6,10 @@ use glam::{DVec2, DVec3, DVec4};
 
 use super::bake_transfer::TRANSFER_SIZE;
 use super::noise_simplex::{simplex3, simplex3_tiled, simplex4};
-use crate::hypertexture::{
+use crate::types::{HyperNoise, HyperParams};
+use crate::types::{
     FIELD_CONSTANT, FIELD_FROM_CENTRE, FIELD_SWIRL, OBJECT_BOX, OBJECT_ELLIPSOID, OBJECT_MESH, OBJECT_TORUS,
 };
-use crate::types::{HyperNoise, HyperParams};
 
 /// Vectors shorter than this have no direction (mirrors `TINY`).
 pub const TINY: f64 = 1e-12;
@@ -196,7 +196,7 @@ impl Model<'_> {
     pub fn distortion(&self, x: DVec3, v: DVec3) -> f64 {
         let mut k = 0.0;
         let noises = &self.noises[..self.params.kinds[2] as usize];
-        let animated = crate::hypertexture::animated(noises);
+        let animated = animated(noises);
         let time = self.params.march[3] as f64;
         let density = self.object_density(x);
         for n in noises {
@@ -247,4 +247,10 @@ impl Model<'_> {
         let first = self.color_tables();
         std::array::from_fn(|c| transfer_lookup(self.tables, first + c as u32, density))
     }
+}
+
+/// Whether a hypertexture's noises are 4D (some noise has a speed): the kernels' override
+/// `animated`.
+pub fn animated(noises: &[HyperNoise]) -> bool {
+    noises.iter().any(|n| n.speed != 0.0)
 }

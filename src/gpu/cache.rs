@@ -1,15 +1,12 @@
 //! GPU objects kept across rebuilds of a frame (the preview's hot reload): shader modules by the
 //! hash of their expanded source, pipeline layouts by their bindings, pipelines by everything that
-//! defines them, baked texels by their request, and hypertexture mesh grids by their mesh and
-//! grid. A rebuild asks the cache first, so an edit recompiles or rebakes only what it changed;
+//! defines them, and bakes (texels, hypertexture mesh grids, splat sets: any type) by their
+//! request. A rebuild asks the cache first, so an edit recompiles or rebakes only what it changed;
 //! `stats` counts what was actually made.
 
+use std::any::{Any, TypeId};
 use std::collections::{HashMap, HashSet};
 use std::hash::{Hash, Hasher};
-
-use crate::bake::Baked;
-use crate::hypertexture::mesh::MeshGrid;
-use crate::hypertexture::splats::SplatSet;
 
 /// What a build created (not found in the cache).
 #[derive(Debug, Default, Clone, Copy, PartialEq, Eq)]
@@ -31,17 +28,24 @@ pub struct Layout {
     pub pipeline: wgpu::PipelineLayout,
 }
 
+/// Entries by their type and key.
+type Slot = (TypeId, u64);
+
 #[derive(Default)]
 pub struct GpuCache {
-    modules: HashMap<u64, wgpu::ShaderModule>,
-    layouts: HashMap<u64, Layout>,
-    pipelines: HashMap<u64, Pipeline>,
-    bakes: HashMap<u64, Baked>,
-    grids: HashMap<u64, MeshGrid>,
-    splats: HashMap<u64, SplatSet>,
-    /// Keys used since the last `begin`, so that `retain_used` can drop what a rebuild left behind.
-    used: HashSet<u64>,
+    entries: HashMap<Slot, Box<dyn Any + Send>>,
+    /// Entries used since the last `begin`, so that `retain_used` can drop what a rebuild left behind.
+    used: HashSet<Slot>,
     pub stats: CacheStats,
+}
+
+/// Which count of `CacheStats` making an entry adds to.
+#[derive(Clone, Copy)]
+enum Made {
+    Module,
+    Layout,
+    Pipeline,
+    Bake,
 }
 
 /// A key from anything printable (the descriptors' fields, in order).
@@ -62,12 +66,30 @@ impl GpuCache {
     /// own handles, so nothing it draws with goes away).
     pub fn retain_used(&mut self) {
         let used = &self.used;
-        self.modules.retain(|k, _| used.contains(k));
-        self.layouts.retain(|k, _| used.contains(k));
-        self.pipelines.retain(|k, _| used.contains(k));
-        self.bakes.retain(|k, _| used.contains(k));
-        self.grids.retain(|k, _| used.contains(k));
-        self.splats.retain(|k, _| used.contains(k));
+        self.entries.retain(|k, _| used.contains(k));
+    }
+
+    /// The entry of type `T` under `key`, made (and counted) if absent.
+    fn get_or_make<T: Clone + Send + 'static>(
+        &mut self,
+        key: u64,
+        made: Made,
+        make: impl FnOnce() -> crate::Result<T>,
+    ) -> crate::Result<T> {
+        let slot = (TypeId::of::<T>(), key);
+        self.used.insert(slot);
+        if let Some(v) = self.entries.get(&slot).and_then(|v| v.downcast_ref::<T>()) {
+            return Ok(v.clone());
+        }
+        let v = make()?;
+        match made {
+            Made::Module => self.stats.modules += 1,
+            Made::Pipeline => self.stats.pipelines += 1,
+            Made::Bake => self.stats.bakes += 1,
+            Made::Layout => {}
+        }
+        self.entries.insert(slot, Box::new(v.clone()));
+        Ok(v)
     }
 
     pub fn module(
@@ -75,19 +97,11 @@ impl GpuCache {
         key: u64,
         make: impl FnOnce() -> crate::Result<wgpu::ShaderModule>,
     ) -> crate::Result<wgpu::ShaderModule> {
-        self.used.insert(key);
-        if let Some(m) = self.modules.get(&key) {
-            return Ok(m.clone());
-        }
-        let m = make()?;
-        self.stats.modules += 1;
-        self.modules.insert(key, m.clone());
-        Ok(m)
+        self.get_or_make(key, Made::Module, make)
     }
 
     pub fn layout(&mut self, key: u64, make: impl FnOnce() -> Layout) -> Layout {
-        self.used.insert(key);
-        self.layouts.entry(key).or_insert_with(make).clone()
+        self.get_or_make(key, Made::Layout, || Ok(make())).expect("making a layout cannot fail")
     }
 
     pub fn pipeline(
@@ -95,56 +109,15 @@ impl GpuCache {
         key: u64,
         make: impl FnOnce() -> crate::Result<Pipeline>,
     ) -> crate::Result<Pipeline> {
-        self.used.insert(key);
-        if let Some(p) = self.pipelines.get(&key) {
-            return Ok(p.clone());
-        }
-        let p = make()?;
-        self.stats.pipelines += 1;
-        self.pipelines.insert(key, p.clone());
-        Ok(p)
+        self.get_or_make(key, Made::Pipeline, make)
     }
 
-    pub fn bake(&mut self, key: u64, make: impl FnOnce() -> crate::Result<Baked>) -> crate::Result<Baked> {
-        self.used.insert(key);
-        if let Some(b) = self.bakes.get(&key) {
-            return Ok(b.clone());
-        }
-        let b = make()?;
-        self.stats.bakes += 1;
-        self.bakes.insert(key, b.clone());
-        Ok(b)
-    }
-
-    /// A hypertexture mesh object's grid (counted as a bake).
-    pub fn grid(
+    /// A bake of any kind (a texel, a mesh grid, a splat set), counted in `stats.bakes`.
+    pub fn bake<T: Clone + Send + 'static>(
         &mut self,
         key: u64,
-        make: impl FnOnce() -> crate::Result<MeshGrid>,
-    ) -> crate::Result<MeshGrid> {
-        self.used.insert(key);
-        if let Some(g) = self.grids.get(&key) {
-            return Ok(g.clone());
-        }
-        let g = make()?;
-        self.stats.bakes += 1;
-        self.grids.insert(key, g.clone());
-        Ok(g)
-    }
-
-    /// A depth-peeled hypertexture object's splat set (counted as a bake).
-    pub fn splats(
-        &mut self,
-        key: u64,
-        make: impl FnOnce() -> crate::Result<SplatSet>,
-    ) -> crate::Result<SplatSet> {
-        self.used.insert(key);
-        if let Some(s) = self.splats.get(&key) {
-            return Ok(s.clone());
-        }
-        let s = make()?;
-        self.stats.bakes += 1;
-        self.splats.insert(key, s.clone());
-        Ok(s)
+        make: impl FnOnce() -> crate::Result<T>,
+    ) -> crate::Result<T> {
+        self.get_or_make(key, Made::Bake, make)
     }
 }

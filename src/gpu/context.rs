@@ -5,8 +5,8 @@
 
 use std::sync::{Arc, Mutex};
 
-use super::fault::Fault;
 use crate::error::{Error, Result};
+use crate::fault::Fault;
 
 /// Features voltex uses when the adapter has them (none is required).
 pub const OPTIONAL_FEATURES: wgpu::Features = wgpu::Features::TIMESTAMP_QUERY
@@ -33,7 +33,7 @@ const NO_ADAPTER: &str = "no GPU adapter found: install software Vulkan \
 impl GpuContext {
     /// Opens the first adapter: `WGPU_BACKEND` if set, else Vulkan, else GL.
     pub fn new() -> Result<Self> {
-        if super::fault::at_open() {
+        if crate::fault::at_open() {
             return Err(Error::Gpu(format!("{NO_ADAPTER} (VOLTEX_FAULT=no-device)")));
         }
         let tries: Vec<wgpu::Backends> = match wgpu::Backends::from_env() {
@@ -116,9 +116,9 @@ impl GpuContext {
 
     /// Applies the fault `VOLTEX_FAULT` plans for the next graph pass, if any (see [`fault`]).
     ///
-    /// [`fault`]: super::fault
+    /// [`fault`]: crate::fault
     pub fn fault_at_pass(&self) {
-        match super::fault::at_pass() {
+        match crate::fault::at_pass() {
             Some(Fault::DeviceLost) => {
                 eprintln!("VOLTEX_FAULT: destroying the GPU device");
                 self.device.destroy();

@@ -6,10 +6,10 @@ use std::collections::HashMap;
 use std::path::Path;
 
 use crate::error::{Error, Result};
+use crate::gpu::inputs::{override_values, Inputs};
 use crate::gpu::reflect::{self, Binding, BindingKind};
 use crate::gpu::shader;
 use crate::gpu::GpuContext;
-use crate::graph::exec::{override_values, Inputs};
 
 pub struct ComputeKernel {
     pub name: String,

@@ -1,11 +1,13 @@
 //! Device, shader loading and validation, reflection, timestamps.
 
+pub mod buffers;
 pub mod cache;
 pub mod context;
-pub mod fault;
+pub mod inputs;
 pub mod kernel;
 pub mod reflect;
 pub mod shader;
 pub mod timing;
 
 pub use context::GpuContext;
+pub use inputs::Inputs;

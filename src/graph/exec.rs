@@ -6,25 +6,12 @@ use std::collections::HashMap;
 
 use crate::error::{Error, Result};
 use crate::gpu::cache::{self, GpuCache, Layout, Pipeline};
+use crate::gpu::inputs::override_values;
 use crate::gpu::reflect::{self, BindingKind};
 use crate::gpu::timing::Timer;
-use crate::gpu::GpuContext;
+use crate::gpu::{GpuContext, Inputs};
 use crate::graph::plan::{self, Plan, PlannedPass};
 use crate::graph::{Blend, Clear, Dispatch, Draw, Graph, PassDecl, ResourceDecl, TextureSize};
-
-/// Resources, counts and override constants of one instance: the frame, or one object.
-#[derive(Default)]
-pub struct Inputs {
-    pub buffers: HashMap<String, wgpu::Buffer>,
-    pub views: HashMap<String, wgpu::TextureView>,
-    pub samplers: HashMap<String, wgpu::Sampler>,
-    pub counts: HashMap<String, u32>,
-    /// Values for WGSL `override` constants, by name.
-    pub constants: Vec<(String, f64)>,
-    /// View depth of each plane of a slice sweep, back to front: draws of instances whose depth
-    /// ranges overlap are interleaved plane by plane (`Draw::DepthSorted`).
-    pub plane_depths: Vec<f64>,
-}
 
 /// Count names the runtime provides (per object or per frame).
 pub const COUNTS: &[&str] = &[
@@ -569,23 +556,6 @@ fn texture_format(
         return wgpu::TextureFormat::Rgba16Float;
     }
     format
-}
-
-/// Values of a kernel's `override` constants, looked up by name in `sources` (first match wins);
-/// the name of one without a default that no source sets as the error.
-pub fn override_values<'a>(
-    kernel: &crate::gpu::shader::Kernel,
-    sources: &[&'a Inputs],
-) -> std::result::Result<Vec<(&'a str, f64)>, String> {
-    let mut out = Vec::new();
-    for (name, has_default) in reflect::overrides(kernel) {
-        match sources.iter().flat_map(|s| &s.constants).find(|(n, _)| *n == name) {
-            Some((n, v)) => out.push((n.as_str(), *v)),
-            None if !has_default => return Err(name),
-            None => {}
-        }
-    }
-    Ok(out)
 }
 
 /// A pass's constants for an instance: the instance's values first, then the frame's.

@@ -11,21 +11,15 @@ pub mod splats;
 use glam::DVec3;
 
 use crate::cpu::bake_transfer::{HERMITE, LINEAR, TRANSFER_SIZE};
+pub use crate::cpu::hypertexture::animated;
 use crate::scene::hypertexture::{ColorTransfer, Field, Operator, ShapeTransfer, SoftObject};
 use crate::scene::Hypertexture;
 use crate::types::{HyperNoise, HyperParams, TransferFunction, TransferPoint};
 
-/// `HyperParams::kinds[0]` (mirrored in wgsl/shared/fields.wgsl).
-pub const OBJECT_SPHERE: u32 = 0;
-pub const OBJECT_ELLIPSOID: u32 = 1;
-pub const OBJECT_TORUS: u32 = 2;
-pub const OBJECT_BOX: u32 = 3;
-pub const OBJECT_MESH: u32 = 4;
-/// `HyperParams::kinds[1]`.
-pub const FIELD_CLOSEST_SURFACE: u32 = 0;
-pub const FIELD_FROM_CENTRE: u32 = 1;
-pub const FIELD_CONSTANT: u32 = 2;
-pub const FIELD_SWIRL: u32 = 3;
+pub use crate::types::{
+    FIELD_CLOSEST_SURFACE, FIELD_CONSTANT, FIELD_FROM_CENTRE, FIELD_SWIRL, OBJECT_BOX, OBJECT_ELLIPSOID,
+    OBJECT_MESH, OBJECT_SPHERE, OBJECT_TORUS,
+};
 
 /// The parts of `HyperParams` a hypertexture fixes (the camera, frame and march settings are
 /// added by `methods::ray_march`), its noises and its transfer functions.
@@ -46,7 +40,7 @@ pub struct Packed {
     /// The largest shift the noises reach (object space).
     pub max_shift: f64,
     /// Mesh objects: the mesh and where its grid samples lie.
-    pub mesh: Option<(std::sync::Arc<mesh::MeshShape>, mesh::GridSpec)>,
+    pub mesh: Option<(std::sync::Arc<crate::mesh::shape::MeshShape>, crate::mesh::shape::GridSpec)>,
 }
 
 fn f4(v: DVec3, w: f64) -> [f32; 4] {
@@ -155,12 +149,6 @@ pub fn pack(h: &Hypertexture) -> Packed {
         }
     }
     p
-}
-
-/// Whether a hypertexture's noises are 4D (some noise has a speed): the kernels' override
-/// `animated`.
-pub fn animated(noises: &[HyperNoise]) -> bool {
-    noises.iter().any(|n| n.speed != 0.0)
 }
 
 impl Packed {

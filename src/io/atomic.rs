@@ -66,7 +66,7 @@ fn finish(tmp: &Path, path: &Path, dir: &Path) -> Result<()> {
     let file = fs::File::open(tmp).map_err(|e| Error::file(path, format!("writer produced no file: {e}")))?;
     file.sync_all().map_err(|e| Error::file(path, format!("cannot flush to disk: {e}")))?;
     drop(file);
-    crate::gpu::fault::at_write();
+    crate::fault::at_write();
     fs::rename(tmp, path).map_err(|e| Error::file(path, format!("cannot replace file: {e}")))?;
     // Make the rename itself durable; not all platforms can open a folder, so best effort.
     if let Ok(d) = fs::File::open(dir) {

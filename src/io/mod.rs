@@ -5,6 +5,7 @@
 pub mod atomic;
 pub mod exr;
 pub mod png;
+pub mod stack;
 
 use crate::{Error, Result};
 

@@ -1,10 +1,13 @@
 //! Base surfaces: triangle meshes whose welded vertices carry height vectors, the generators and OBJ
 //! loader that make them, and the prism checks that say whether their extrusions are usable.
 
+pub mod bvh;
 pub mod generate;
 pub mod motion;
 pub mod obj;
 pub mod prism;
+pub mod shape;
+pub mod shell;
 
 use glam::{DMat4, DVec2, DVec3};
 

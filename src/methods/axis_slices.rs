@@ -5,7 +5,7 @@
 use crate::bake::axis_slices::AxisBaked;
 use crate::cpu::axis_slices::{self as twin, AxisFrame};
 use crate::error::{Error, Result};
-use crate::methods::shell::Shell;
+use crate::mesh::shell::Shell;
 use crate::scene::{AxisSlices, DrawOrder, SliceBlend, SliceDirections};
 use crate::types::{AxisParams, AxisVertex, Prism};
 
@@ -127,13 +127,13 @@ fn finest_vertices(shell: &Shell, index: usize, params: &AxisParams) -> u64 {
 /// Adds the buffers, views and samplers of one object's axis slicing to `inputs`.
 pub fn add_inputs(
     ctx: &crate::gpu::GpuContext,
-    inputs: &mut crate::graph::exec::Inputs,
+    inputs: &mut crate::gpu::Inputs,
     shell: &Shell,
     plan: &AxisPlan,
     baked: &AxisBaked,
 ) {
-    use crate::bake::{storage, uniform};
-    let buffer = |label: &str, size: u64, extra| crate::bake::work_buffer(ctx, label, size, extra);
+    use crate::gpu::buffers::{storage, uniform};
+    let buffer = |label: &str, size: u64, extra| crate::gpu::buffers::work_buffer(ctx, label, size, extra);
     let b = &mut inputs.buffers;
     b.insert("axis_params".into(), uniform(ctx, "axis_params", bytemuck::bytes_of(&plan.params)));
     b.insert("shell_vertices".into(), storage(ctx, "shell_vertices", bytemuck::cast_slice(&shell.vertices)));
@@ -185,7 +185,7 @@ pub fn add_inputs(
 /// Reads back the per-prism choices and the drawn vertices after a frame (tests, `bench`).
 pub fn read_back(
     ctx: &crate::gpu::GpuContext,
-    inputs: &crate::graph::exec::Inputs,
+    inputs: &crate::gpu::Inputs,
     prisms: usize,
 ) -> Result<(Vec<crate::types::AxisChoice>, Vec<AxisVertex>)> {
     let choices = ctx.read_buffer(&inputs.buffers["axis_choices"], 0, (prisms * 32) as u64)?;

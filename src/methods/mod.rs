@@ -4,5 +4,4 @@
 pub mod axis_slices;
 pub mod ray_march;
 pub mod reference;
-pub mod shell;
 pub mod view_slices;

@@ -12,7 +12,7 @@ use crate::cpu::bake_transfer::TRANSFER_SIZE;
 use crate::cpu::ray_march::Shade;
 use crate::error::{Error, Result};
 use crate::gpu::GpuContext;
-use crate::graph::exec::Inputs;
+use crate::gpu::Inputs;
 use crate::hypertexture::mesh::{self, MeshGrid};
 use crate::hypertexture::splats::{self, Lattice, SplatSet, FOOTPRINT_BLOCK};
 use crate::hypertexture::{self, Packed};
@@ -328,7 +328,7 @@ impl RayMarchPlan {
         grid: Option<&MeshGrid>,
         splats: Option<&SplatSet>,
     ) {
-        use crate::bake::{storage, uniform};
+        use crate::gpu::buffers::{storage, uniform};
         let grid = grid.cloned().unwrap_or_else(|| mesh::unused(ctx));
         // Segments: the splats and per-pixel boundaries (stand-ins without depth peeling).
         let mut segments = self.segments;
@@ -404,9 +404,9 @@ pub struct Probed {
 /// Runs `bake_transfer.wgsl` and then `probe_hypertexture.wgsl` at `points` (object space; w: a
 /// noise seed as f32 bits) for this object: the kernels' side of the twin tests.
 pub fn probe(ctx: &GpuContext, plan: &RayMarchPlan, points: &[[f32; 4]]) -> Result<Probed> {
-    use crate::bake::storage;
+    use crate::gpu::buffers::storage;
     use crate::gpu::kernel::ComputeKernel;
-    let root = crate::render::wgsl_root();
+    let root = crate::wgsl_root();
     let mut inputs = Inputs::default();
     let grid = plan.bake_mesh_grid(ctx)?;
     plan.add_inputs(ctx, &mut inputs, (1, 1), grid.as_ref(), None);

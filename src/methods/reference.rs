@@ -5,15 +5,14 @@
 
 use glam::{DVec3, Vec3A};
 use obvhs::aabb::Aabb;
-use obvhs::bvh2::builder::build_bvh2;
-use obvhs::BvhBuildParams;
 
 use crate::cpu::prism_map::PrismCorners;
 use crate::cpu::trace_reference::{PerPixel, TraceObject, TraceView, Volume};
 use crate::error::{Error, Result};
 use crate::gpu::GpuContext;
-use crate::graph::exec::Inputs;
-use crate::methods::shell;
+use crate::gpu::Inputs;
+use crate::mesh::bvh::flat_bvh;
+use crate::mesh::shell;
 use crate::render::{Blueprint, ObjectPlan};
 use crate::types::{
     ReferenceNode, ReferenceObject, ReferenceParams, ReferencePrism, ReferenceState, ShellVertex, VertexFrame,
@@ -92,23 +91,6 @@ pub fn default_step(o: &ObjectPlan, resolution: [u32; 3]) -> f64 {
     let dt = mean(&|f| f.dt);
     let extent = (h / resolution[2] as f64).min(ds / resolution[0] as f64).min(dt / resolution[1] as f64);
     0.5 * extent.max(1e-9)
-}
-
-/// A BVH2 over `boxes` (obvhs) flattened for the kernels, and the primitive order its leaves
-/// index: a node's `min.w` is its primitive count as u32 bits (0: inner node), `max.w` its first
-/// primitive (leaf, in that order) or its first child (inner; the second follows it).
-pub fn flat_bvh(boxes: &[Aabb]) -> (Vec<ReferenceNode>, Vec<u32>) {
-    let mut time = Default::default();
-    let bvh = build_bvh2(boxes, BvhBuildParams::medium_build(), &mut time);
-    let nodes = bvh
-        .nodes
-        .iter()
-        .map(|n| ReferenceNode {
-            min: [n.aabb.min.x, n.aabb.min.y, n.aabb.min.z, f32::from_bits(n.prim_count)],
-            max: [n.aabb.max.x, n.aabb.max.y, n.aabb.max.z, f32::from_bits(n.first_index)],
-        })
-        .collect();
-    (nodes, bvh.primitive_indices)
 }
 
 /// Words per row of a volume copied out of a texture (rows padded to 256 bytes).
@@ -226,7 +208,7 @@ impl ReferenceSet {
             mapped_at_creation: false,
         });
         inputs.buffers.insert("reference_state".into(), state);
-        use crate::bake::{storage, uniform};
+        use crate::gpu::buffers::{storage, uniform};
         let b = &mut inputs.buffers;
         b.insert(
             "reference_params".into(),

@@ -2,7 +2,7 @@
 //! buffers its kernels (`count_slices`, `scan_plane_offsets`, `emit_slices`) and `draw_slices` use.
 
 use crate::error::{Error, Result};
-use crate::methods::shell::Shell;
+use crate::mesh::shell::Shell;
 use crate::types::{SliceParams, SliceVertex};
 
 /// The plane sweep: `planes` planes orthogonal to the view direction spanning the shell's depth
@@ -144,14 +144,14 @@ pub fn check_capacity(capacity: u64, max_binding: u64, object: &str, planes: u32
 /// Adds the buffers and counts of one sliced shell to `inputs` (the names the kernels use).
 pub fn add_inputs(
     ctx: &crate::gpu::GpuContext,
-    inputs: &mut crate::graph::exec::Inputs,
+    inputs: &mut crate::gpu::Inputs,
     shell: &Shell,
     params: &SliceParams,
     capacity: u64,
     trivial_reject: bool,
 ) {
-    use crate::bake::{storage, uniform};
-    let buffer = |label: &str, size: u64, extra| crate::bake::work_buffer(ctx, label, size, extra);
+    use crate::gpu::buffers::{storage, uniform};
+    let buffer = |label: &str, size: u64, extra| crate::gpu::buffers::work_buffer(ctx, label, size, extra);
     let b = &mut inputs.buffers;
     b.insert("slice_params".into(), uniform(ctx, "slice_params", bytemuck::bytes_of(params)));
     b.insert("shell_vertices".into(), storage(ctx, "shell_vertices", bytemuck::cast_slice(&shell.vertices)));
@@ -179,7 +179,7 @@ pub fn add_inputs(
 /// `emit_slices`, `plane_cursors[k]` is the end of plane k's range.
 pub fn read_back(
     ctx: &crate::gpu::GpuContext,
-    inputs: &crate::graph::exec::Inputs,
+    inputs: &crate::gpu::Inputs,
     plane_count: u32,
 ) -> Result<Vec<Vec<SliceVertex>>> {
     let args = ctx.read_buffer(&inputs.buffers["draw_args"], 0, 16)?;

@@ -15,10 +15,10 @@ use crate::bake::BakeRequest;
 use crate::error::{Error, Result};
 use crate::graph::plan::{self, ObjectInfo, Plan};
 use crate::graph::Graph;
+use crate::mesh::shell::{self, Shell};
 use crate::methods::axis_slices::AxisPlan;
 use crate::methods::ray_march::{self, RayMarchPlan};
 use crate::methods::reference::{self, ReferenceSet};
-use crate::methods::shell::{self, Shell};
 use crate::methods::view_slices::{self, SliceChunk};
 use crate::scene::{
     AxisSlices, Camera, Light, Lighting as LightingMode, Method, RayMarch, Reference, Scene, SceneObject,
@@ -199,9 +199,7 @@ pub fn default_graph() -> PathBuf {
     crate::project_root().join("graphs/frame.ron")
 }
 
-pub fn wgsl_root() -> PathBuf {
-    crate::project_root().join("wgsl")
-}
+pub use crate::wgsl_root;
 
 impl Blueprint {
     pub fn new(scene: &Scene, opts: &RenderOptions) -> Result<Self> {

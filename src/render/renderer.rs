@@ -4,8 +4,9 @@ use crate::bake::{self, Baker};
 use crate::error::{Error, Result};
 use crate::gpu::cache::{self, GpuCache};
 use crate::gpu::timing::Timer;
-use crate::gpu::GpuContext;
-use crate::graph::exec::{Executor, Inputs};
+use crate::gpu::Inputs;
+use crate::gpu::{buffers, GpuContext};
+use crate::graph::exec::Executor;
 use crate::hypertexture::mesh::MeshGrid;
 use crate::hypertexture::splats::SplatSet;
 use crate::io::Image;
@@ -75,7 +76,7 @@ impl Renderer {
             .map(|o| {
                 let Some(m) = &o.ray_march else { return Ok(None) };
                 let Some(key) = m.mesh_grid_key() else { return Ok(None) };
-                cache.grid(key, || Ok(m.bake_mesh_grid(ctx)?.expect("a mesh object"))).map(Some)
+                cache.bake(key, || Ok(m.bake_mesh_grid(ctx)?.expect("a mesh object"))).map(Some)
             })
             .collect::<Result<_>>()?;
         // Depth-peeled objects' splat sets, baked once per object and lattice.
@@ -86,13 +87,13 @@ impl Renderer {
             .map(|(o, grid)| {
                 let Some(m) = &o.ray_march else { return Ok(None) };
                 let Some(key) = m.splat_key() else { return Ok(None) };
-                cache.splats(key, || m.bake_splats(ctx, grid.as_ref())).map(Some)
+                cache.bake(key, || m.bake_splats(ctx, grid.as_ref())).map(Some)
             })
             .collect::<Result<_>>()?;
         let mut frame = Inputs::default();
         frame
             .buffers
-            .insert("frame".into(), bake::uniform(ctx, "frame", bytemuck::bytes_of(&blueprint.frame)));
+            .insert("frame".into(), buffers::uniform(ctx, "frame", bytemuck::bytes_of(&blueprint.frame)));
         frame.samplers.insert("volume_sampler".into(), sampler);
         frame.counts.insert("width".into(), blueprint.size.0);
         frame.counts.insert("height".into(), blueprint.size.1);
@@ -235,13 +236,13 @@ fn instance_inputs(
     let opacity_length = o.bake.map(|b| bp.bakes[b].opacity_length).unwrap_or(1.0);
     let c = o.object.base_color.unwrap_or([0.0; 3]);
     let params = ObjectParams { base_color: [c[0], c[1], c[2], 1.0], opacity_length, _pad: [0.0; 3] };
-    inputs.buffers.insert("object".into(), bake::uniform(ctx, "object", bytemuck::bytes_of(&params)));
+    inputs.buffers.insert("object".into(), buffers::uniform(ctx, "object", bytemuck::bytes_of(&params)));
     match part {
         Part::Base => {
             let base = o.base.as_deref().unwrap_or_default();
             inputs.buffers.insert(
                 "base_vertices".into(),
-                bake::storage(ctx, "base_vertices", bytemuck::cast_slice(base)),
+                buffers::storage(ctx, "base_vertices", bytemuck::cast_slice(base)),
             );
             inputs.counts.insert("base_vertices".into(), base.len() as u32);
         }
@@ -263,7 +264,7 @@ fn instance_inputs(
             let frames = o.frames.as_deref().unwrap_or(&[VertexFrame { ds: [0.0; 4], dt: [0.0; 4] }]);
             inputs.buffers.insert(
                 "vertex_frames".into(),
-                bake::storage(ctx, "vertex_frames", bytemuck::cast_slice(frames)),
+                buffers::storage(ctx, "vertex_frames", bytemuck::cast_slice(frames)),
             );
             if let Some(b) = o.bake {
                 inputs.views.insert("volume".into(), baked[b].volume.create_view(&Default::default()));

@@ -8,7 +8,7 @@ use std::sync::Arc;
 use glam::{DMat4, DVec3};
 use serde::Deserialize;
 
-use crate::hypertexture::mesh::MeshShape;
+use crate::mesh::shape::MeshShape;
 
 use super::values::{self as v, Mark};
 

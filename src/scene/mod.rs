@@ -52,7 +52,7 @@ impl Scene {
     }
 
     /// A slice stack the scene refers to (by its path as written), as `load` read it.
-    pub fn stack(&self, path: &str) -> Option<&crate::bake::stack::SliceStack> {
+    pub fn stack(&self, path: &str) -> Option<&crate::io::stack::SliceStack> {
         self.assets.stacks.get(&self.assets.dir.join(path)).map(|s| s.as_ref())
     }
 
@@ -62,7 +62,7 @@ impl Scene {
         &self,
         path: &str,
         fill: bool,
-    ) -> Option<(std::sync::Arc<crate::hypertexture::mesh::MeshShape>, bool)> {
+    ) -> Option<(std::sync::Arc<crate::mesh::shape::MeshShape>, bool)> {
         let full = self.assets.dir.join(path);
         let closed = self.assets.texel_meshes.get(&(full.clone(), true)).filter(|_| fill);
         match closed {

@@ -6,9 +6,9 @@ use super::types::{
     DrawOrder, HeightScale, MeshBounds, Method, Node, Scene, SliceBlend, Surface, Texel, TexelSource,
 };
 use super::values::Mark;
-use crate::bake::stack::{self, SliceStack};
 use crate::error::Error;
-use crate::hypertexture::mesh::MeshShape;
+use crate::io::stack::{self, SliceStack};
+use crate::mesh::shape::MeshShape;
 use crate::mesh::{obj, Mesh};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -100,7 +100,7 @@ impl Checker<'_> {
         bounds: &Mark<MeshBounds>,
         fill: bool,
     ) {
-        use crate::hypertexture::mesh::MAX_TEXEL_SAMPLES;
+        use crate::mesh::shape::MAX_TEXEL_SAMPLES;
         let samples: u64 = t.resolution.iter().map(|&n| n as u64).product();
         if t.resolution.contains(&1) || samples > MAX_TEXEL_SAMPLES {
             let msg = format!(

@@ -84,7 +84,7 @@ checked_u32!(SplatSlabs, 1, super::types::MAX_SPLAT_SLABS, "a depth slab count")
 checked_u32!(
     GridResolution,
     4,
-    crate::hypertexture::mesh::MAX_RESOLUTION,
+    crate::mesh::shape::MAX_RESOLUTION,
     "a mesh grid resolution (samples per axis)"
 );
 
