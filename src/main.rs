@@ -359,7 +359,7 @@ fn bake(scene_path: &Path, texels: &[String], out: Option<PathBuf>) -> voltex::R
     std::fs::create_dir_all(&out).map_err(|e| voltex::Error::file(&out, e))?;
     io::atomic::check_writable_dir(&out)?;
     let ctx = GpuContext::new()?;
-    let mut baker = voltex::bake::Baker::new(&voltex::render::wgsl_root());
+    let mut baker = voltex::bake::Baker::new(&voltex::gpu::sources::Sources::project()?);
     for plan in plans {
         let start = std::time::Instant::now();
         let baked = baker.bake(&ctx, &plan.request)?;

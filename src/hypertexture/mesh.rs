@@ -19,6 +19,7 @@ use glam::{DVec3, Vec3A};
 use obvhs::aabb::Aabb;
 
 use crate::error::Result;
+use crate::gpu::sources::Sources;
 use crate::gpu::GpuContext;
 use crate::graph::exec::Inputs;
 use crate::mesh::Mesh;
@@ -355,7 +356,7 @@ pub fn bake(ctx: &GpuContext, shape: &MeshShape, spec: &GridSpec) -> Result<Mesh
     b.insert("mesh_colors".into(), colors.clone().unwrap_or_else(stand_in));
     inputs.constants.push(("colored".into(), colored as u32 as f64));
     let mut encoder = ctx.device.create_command_encoder(&Default::default());
-    ComputeKernel::load(ctx, &crate::render::wgsl_root(), "bake_mesh_grid.wgsl")?.dispatch(
+    ComputeKernel::load(ctx, &Sources::project()?, "bake_mesh_grid.wgsl")?.dispatch(
         ctx,
         &mut encoder,
         &inputs,

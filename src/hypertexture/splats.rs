@@ -8,6 +8,7 @@
 use glam::DVec3;
 
 use crate::error::Result;
+use crate::gpu::sources::Sources;
 use crate::gpu::GpuContext;
 use crate::graph::exec::Inputs;
 use crate::hypertexture::mesh::MeshGrid;
@@ -107,7 +108,7 @@ pub fn bake(
     b.insert("splat_counts".into(), storage(ctx, "splat_counts", &[0u8; 16]));
     let mut encoder = ctx.device.create_command_encoder(&Default::default());
     let l = segments.lattice;
-    ComputeKernel::load(ctx, &crate::render::wgsl_root(), "bake_splats.wgsl")?.dispatch(
+    ComputeKernel::load(ctx, &Sources::project()?, "bake_splats.wgsl")?.dispatch(
         ctx,
         &mut encoder,
         &inputs,
