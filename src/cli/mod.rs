@@ -18,7 +18,14 @@ use voltex::render::{MethodKind, RenderOptions};
 use voltex::Result;
 
 #[derive(Parser)]
-#[command(name = "voltex", version, about = "Volumetric textures and hypertextures on wgpu")]
+#[command(
+    name = "voltex",
+    version,
+    about = "Volumetric textures and hypertextures on wgpu",
+    after_help = "Kernels (wgsl/) and graphs (graphs/) are built in; files on disk win: a shader is looked \
+                  up beside the --graph file, then in $VOLTEX_ROOT/wgsl (default: the source tree voltex \
+                  was built from, when it exists), then in the built-in copy."
+)]
 pub struct Cli {
     #[command(subcommand)]
     pub command: Command,
