@@ -23,6 +23,16 @@ fn run(bin: &Path, cwd: &Path, voltex_root: &Path, args: &[&str]) -> Output {
     if std::env::var_os("XDG_RUNTIME_DIR").is_none() {
         cmd.env("XDG_RUNTIME_DIR", std::env::temp_dir());
     }
+    // A binary just copied can be briefly "busy": another test thread forking at that moment
+    // inherits the copy's open file until it execs. Try again.
+    for _ in 0..50 {
+        match cmd.output() {
+            Err(e) if e.kind() == std::io::ErrorKind::ExecutableFileBusy => {
+                std::thread::sleep(std::time::Duration::from_millis(100))
+            }
+            out => return out.unwrap(),
+        }
+    }
     cmd.output().unwrap()
 }
 
