@@ -114,9 +114,9 @@ impl Session {
     }
 
     /// Folders to watch, recursively: the scene's folder, those of the files it refers to, and the
-    /// folders on disk that the graph and its shaders are read from (the graph's folder, the
-    /// project's `wgsl/` and `graphs/`; embedded files are not watched). Editors save by renaming,
-    /// so files are not watched alone.
+    /// folders on disk that the graph and its shaders are read from (the graph's folder and the
+    /// project's `wgsl/`; embedded files are not watched). Editors save by renaming, so files are
+    /// not watched alone.
     pub fn watch_dirs(&self) -> Vec<PathBuf> {
         let parent = |p: &Path| p.parent().map(Path::to_path_buf).unwrap_or_else(|| PathBuf::from("."));
         let mut dirs = vec![parent(&self.scene_path)];

@@ -183,8 +183,6 @@ pub struct Blueprint {
     /// The Reference objects' BVH, shells and atlas layout (if any object uses the method).
     pub reference: Option<ReferenceSet>,
     pub graph: Graph,
-    /// Where the graph's shaders were looked up (its folder first when it is a file).
-    pub sources: Sources,
     pub plan: Plan,
 }
 
@@ -272,7 +270,6 @@ impl Blueprint {
             bakes,
             reference,
             graph,
-            sources,
             plan,
         })
     }
