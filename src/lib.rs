@@ -22,8 +22,9 @@ pub mod types;
 
 pub use error::{Error, FileLoc, Result};
 
-/// The project's root folder, where `wgsl/`, `graphs/` and `scenes/` live. `VOLTEX_ROOT` overrides
-/// it (for an installed binary).
+/// The project's root folder, where `wgsl/`, `graphs/` and `scenes/` live: `VOLTEX_ROOT`, else the
+/// source tree voltex was built from. Shaders and graphs are read through
+/// [`gpu::sources::Sources`], which falls back to the copies built into the binary.
 pub fn project_root() -> std::path::PathBuf {
     std::env::var_os("VOLTEX_ROOT")
         .map(Into::into)
@@ -31,8 +32,3 @@ pub fn project_root() -> std::path::PathBuf {
 }
 pub mod bench;
 pub mod render;
-
-/// The kernels' folder, `wgsl/` under the project root.
-pub fn wgsl_root() -> std::path::PathBuf {
-    project_root().join("wgsl")
-}

@@ -136,7 +136,7 @@ fn slice_image_bake_matches_its_twin() {
         axis_slices: true,
     };
     let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
-    let baked = Baker::new(&voltex::project_root().join("wgsl")).bake(&ctx, &request).unwrap();
+    let baked = Baker::new(&voltex::gpu::sources::Sources::project().unwrap()).bake(&ctx, &request).unwrap();
     let volume = voltex::bake::axis_slices::read_texture(&ctx, &baked.volume, 4).unwrap();
     let axis = baked.axis.unwrap();
     let gpu: Vec<Vec<f32>> = axis
@@ -194,7 +194,7 @@ fn height_image_bake_matches_its_twin() {
         axis_slices: false,
     };
     let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
-    let baked = Baker::new(&voltex::project_root().join("wgsl")).bake(&ctx, &request).unwrap();
+    let baked = Baker::new(&voltex::gpu::sources::Sources::project().unwrap()).bake(&ctx, &request).unwrap();
     let gpu = voltex::bake::axis_slices::read_texture(&ctx, &baked.volume, 4).unwrap();
     drop(ctx);
     let params = voltex::cpu::bake::bake_params(res, 0, light, ambient);

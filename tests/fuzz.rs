@@ -196,7 +196,7 @@ fn graph_case(path: &Path, text: &str) -> Result<(), String> {
                     order: 0,
                 })
                 .collect();
-            match plan::plan(&graph, &voltex::render::wgsl_root(), &objects) {
+            match plan::plan(&graph, &voltex::gpu::sources::Sources::project().unwrap(), &objects) {
                 Ok(_) => accepted(),
                 Err(e) => check_error(&e, path, text, false),
             }

@@ -5,7 +5,8 @@ mod common;
 
 use std::path::{Path, PathBuf};
 
-use voltex::graph::plan::{plan, ObjectInfo, Plan};
+use voltex::gpu::sources::Sources;
+use voltex::graph::plan::{ObjectInfo, Plan};
 use voltex::graph::Graph;
 
 fn root() -> PathBuf {
@@ -14,6 +15,11 @@ fn root() -> PathBuf {
 
 fn wgsl_root() -> PathBuf {
     root().join("wgsl")
+}
+
+/// Plans `g` with its shaders read from the folder `wgsl` only.
+fn plan(g: &Graph, wgsl: &Path, objects: &[ObjectInfo]) -> voltex::Result<Plan> {
+    voltex::graph::plan::plan(g, &Sources::folder(wgsl), objects)
 }
 
 fn temp_dir(test: &str) -> PathBuf {

@@ -62,7 +62,7 @@ fn bake(ht: &HyperTexel, resolution: [u32; 3], per_pixel: bool) -> (Vec<u8>, Vec
         ambient: AMBIENT,
         axis_slices: false,
     };
-    let baked = Baker::new(&voltex::render::wgsl_root()).bake(&ctx, &req).unwrap();
+    let baked = Baker::new(&voltex::gpu::sources::Sources::project().unwrap()).bake(&ctx, &req).unwrap();
     let volume = read_texture(&ctx, &baked.volume, 4).unwrap();
     let normals = if per_pixel { read_texture(&ctx, &baked.normals, 4).unwrap() } else { Vec::new() };
     (volume, normals)

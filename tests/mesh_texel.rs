@@ -113,7 +113,8 @@ fn bake_res(source: BakeSource, resolution: [u32; 3], per_pixel: bool) -> (Vec<u
     let req =
         BakeRequest { resolution, source, per_pixel, light: LIGHT, ambient: AMBIENT, axis_slices: false };
     let t = std::time::Instant::now();
-    let baked = Baker::new(&root().join("wgsl")).bake(&ctx, &req).unwrap();
+    let baked =
+        Baker::new(&voltex::gpu::sources::Sources::folder(&root().join("wgsl"))).bake(&ctx, &req).unwrap();
     let volume = read_texture(&ctx, &baked.volume, 4).unwrap();
     eprintln!("{resolution:?} bake: {:.0} ms ({})", t.elapsed().as_secs_f64() * 1e3, ctx.adapter_line());
     let normals = read_texture(&ctx, &baked.normals, 4).unwrap();

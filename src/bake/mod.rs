@@ -5,7 +5,7 @@
 pub mod axis_slices;
 pub mod hypertexture;
 
-use std::path::Path;
+use crate::gpu::sources::Sources;
 
 use crate::cpu::bake::PackedShapes;
 use crate::error::{Error, Result};
@@ -136,11 +136,12 @@ pub struct Baker {
     hyper: Option<ComputeKernel>,
     transfer: Option<ComputeKernel>,
     axis: Option<ComputeKernel>,
-    wgsl_root: std::path::PathBuf,
+    sources: Sources,
 }
 
 impl Baker {
-    pub fn new(wgsl_root: &Path) -> Self {
+    /// A baker whose kernels are looked up in `sources` (usually [`Sources::project`]).
+    pub fn new(sources: &Sources) -> Self {
         Self {
             implicit: None,
             heightfield: None,
@@ -149,18 +150,18 @@ impl Baker {
             hyper: None,
             transfer: None,
             axis: None,
-            wgsl_root: wgsl_root.to_path_buf(),
+            sources: sources.clone(),
         }
     }
 
     fn kernel<'a>(
         slot: &'a mut Option<ComputeKernel>,
         ctx: &GpuContext,
-        root: &Path,
+        sources: &Sources,
         name: &str,
     ) -> Result<&'a mut ComputeKernel> {
         if slot.is_none() {
-            *slot = Some(ComputeKernel::load(ctx, root, name)?);
+            *slot = Some(ComputeKernel::load(ctx, sources, name)?);
         }
         Ok(slot.as_mut().unwrap())
     }
@@ -182,7 +183,7 @@ impl Baker {
         inputs.views.insert("volume".into(), level_view(&volume, 0));
         inputs.views.insert("normals".into(), level_view(&normals, 0));
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
-        let root = self.wgsl_root.clone();
+        let root = self.sources.clone();
         match &req.source {
             BakeSource::Implicit(packed) => {
                 let params = BakeParams {

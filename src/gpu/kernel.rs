@@ -3,12 +3,12 @@
 
 use std::borrow::Cow;
 use std::collections::HashMap;
-use std::path::Path;
 
 use crate::error::{Error, Result};
 use crate::gpu::inputs::{override_values, Inputs};
 use crate::gpu::reflect::{self, Binding, BindingKind};
 use crate::gpu::shader;
+use crate::gpu::sources::Sources;
 use crate::gpu::GpuContext;
 
 pub struct ComputeKernel {
@@ -23,8 +23,8 @@ pub struct ComputeKernel {
 }
 
 impl ComputeKernel {
-    pub fn load(ctx: &GpuContext, wgsl_root: &Path, name: &str) -> Result<Self> {
-        let kernel = shader::load(wgsl_root, name)?;
+    pub fn load(ctx: &GpuContext, sources: &Sources, name: &str) -> Result<Self> {
+        let kernel = shader::load_from(sources, name)?;
         let bindings = reflect::bindings(&kernel, &["main"])?;
         if bindings.iter().any(|b| b.group != 0) {
             return Err(Error::Invalid(format!("{name}: bake kernels bind everything in @group(0)")));

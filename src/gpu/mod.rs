@@ -1,4 +1,4 @@
-//! Device, shader loading and validation, reflection, timestamps.
+//! Device, shader lookup (embedded defaults and folders on disk), loading and validation, reflection, timestamps.
 
 pub mod buffers;
 pub mod cache;
@@ -7,6 +7,7 @@ pub mod inputs;
 pub mod kernel;
 pub mod reflect;
 pub mod shader;
+pub mod sources;
 pub mod timing;
 
 pub use context::GpuContext;

@@ -5,9 +5,11 @@
 use std::path::{Path, PathBuf};
 
 use crate::error::{Error, FileLoc, Result};
+use crate::gpu::sources::{Source, Sources};
 
 /// A validated WGSL kernel: the naga module (handed to wgpu as IR, parsed once), its validation
-/// info (used for reflection), and every file it was assembled from (for hot reload).
+/// info (used for reflection), and every file it was assembled from (on disk, or
+/// `<embedded>/wgsl/...`).
 pub struct Kernel {
     /// Path relative to the WGSL root, e.g. `emit_slices.wgsl`.
     pub name: String,
@@ -25,15 +27,22 @@ struct Expanded {
     files: Vec<PathBuf>,
 }
 
-fn expand(root: &Path, rel: &Path, out: &mut Expanded, from: Option<FileLoc>) -> Result<()> {
-    let path = root.join(rel);
+fn expand(sources: &Sources, rel: &str, out: &mut Expanded, from: Option<FileLoc>) -> Result<()> {
+    let found = sources.shader(rel).map_err(|e| match &from {
+        Some(loc) => Error::at(loc.clone(), format!("cannot include {rel}: {e}")),
+        None => e,
+    })?;
+    let Some(Source { path, text, .. }) = found else {
+        return Err(match &from {
+            Some(loc) => {
+                Error::at(loc.clone(), format!("cannot include {rel}: not found in {}", sources.describe()))
+            }
+            None => Error::Invalid(format!("shader `{rel}` not found in {}", sources.describe())),
+        });
+    };
     if out.files.contains(&path) {
         return Ok(()); // each include once: shared files carry no guards
     }
-    let text = std::fs::read_to_string(&path).map_err(|e| match &from {
-        Some(loc) => Error::at(loc.clone(), format!("cannot include {}: {e}", path.display())),
-        None => Error::file(&path, format!("cannot read WGSL: {e}")),
-    })?;
     out.files.push(path.clone());
     let file_index = out.files.len() - 1;
     for (i, line) in text.lines().enumerate() {
@@ -47,7 +56,7 @@ fn expand(root: &Path, rel: &Path, out: &mut Expanded, from: Option<FileLoc>) ->
                     "expected #include \"shared/name.wgsl\"",
                 ));
             }
-            expand(root, Path::new(name), out, Some(FileLoc::new(&path, i + 1, col)))?;
+            expand(sources, name, out, Some(FileLoc::new(&path, i + 1, col)))?;
             continue;
         }
         out.text.push_str(line);
@@ -70,10 +79,15 @@ pub fn capabilities() -> naga::valid::Capabilities {
     naga::valid::Capabilities::empty()
 }
 
-/// Loads, expands and validates `root/rel`.
+/// Loads, expands and validates `root/rel`, reading only files under the folder `root`.
 pub fn load(root: &Path, rel: &str) -> Result<Kernel> {
+    load_from(&Sources::folder(root), rel)
+}
+
+/// Loads, expands and validates the shader `rel` and its includes, each looked up in `sources`.
+pub fn load_from(sources: &Sources, rel: &str) -> Result<Kernel> {
     let mut ex = Expanded { text: String::new(), origin: Vec::new(), files: Vec::new() };
-    expand(root, Path::new(rel), &mut ex, None)?;
+    expand(sources, rel, &mut ex, None)?;
     load_expanded(rel, ex)
 }
 

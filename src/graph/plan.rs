@@ -2,12 +2,12 @@
 //! from reads and writes, and pruning of passes and resources the scene does not need.
 
 use std::collections::{BTreeMap, BTreeSet};
-use std::path::Path;
 use std::sync::Arc;
 
 use crate::error::{Error, Result};
 use crate::gpu::reflect::{self, Binding};
 use crate::gpu::shader::{self, Kernel};
+use crate::gpu::sources::Sources;
 use crate::graph::{Draw, Graph, Instances, PassDecl, ResourceDecl};
 
 /// Object filters a pass can be instanced over.
@@ -54,7 +54,9 @@ pub struct Plan {
     pub pruned: Vec<String>,
 }
 
-pub fn plan(graph: &Graph, wgsl_root: &Path, objects: &[ObjectInfo]) -> Result<Plan> {
+/// Plans `graph` for `objects`, its shaders looked up in `sources` (the graph's folder first when
+/// the caller put it there: see [`Sources::beside`]).
+pub fn plan(graph: &Graph, sources: &Sources, objects: &[ObjectInfo]) -> Result<Plan> {
     let mut kernels: BTreeMap<String, Arc<Kernel>> = BTreeMap::new();
     let mut candidates = Vec::new();
     let mut pruned = Vec::new();
@@ -79,13 +81,13 @@ pub fn plan(graph: &Graph, wgsl_root: &Path, objects: &[ObjectInfo]) -> Result<P
         let kernel = match kernels.get(decl.shader()) {
             Some(k) => k.clone(),
             None => {
-                if !wgsl_root.join(decl.shader()).is_file() {
+                if sources.shader(decl.shader())?.is_none() {
                     return Err(graph.error_at(
                         decl.shader(),
-                        format!("shader `{}` not found in {}", decl.shader(), wgsl_root.display()),
+                        format!("shader `{}` not found in {}", decl.shader(), sources.describe()),
                     ));
                 }
-                let k = Arc::new(shader::load(wgsl_root, decl.shader())?);
+                let k = Arc::new(shader::load_from(sources, decl.shader())?);
                 kernels.insert(decl.shader().to_string(), k.clone());
                 k
             }

@@ -6,6 +6,7 @@
 //! describes, pushed out a little so that disks, which cut inside concave parts, clip no detail.
 
 use crate::error::Result;
+use crate::gpu::sources::Sources;
 use crate::gpu::GpuContext;
 use crate::gpu::Inputs;
 use crate::hypertexture::mesh::MeshGrid;
@@ -62,7 +63,7 @@ pub fn bake(
     b.insert("splat_counts".into(), storage(ctx, "splat_counts", &[0u8; 16]));
     let mut encoder = ctx.device.create_command_encoder(&Default::default());
     let l = segments.lattice;
-    ComputeKernel::load(ctx, &crate::wgsl_root(), "bake_splats.wgsl")?.dispatch(
+    ComputeKernel::load(ctx, &Sources::project()?, "bake_splats.wgsl")?.dispatch(
         ctx,
         &mut encoder,
         &inputs,

@@ -406,7 +406,7 @@ pub struct Probed {
 pub fn probe(ctx: &GpuContext, plan: &RayMarchPlan, points: &[[f32; 4]]) -> Result<Probed> {
     use crate::gpu::buffers::storage;
     use crate::gpu::kernel::ComputeKernel;
-    let root = crate::wgsl_root();
+    let root = crate::gpu::sources::Sources::project()?;
     let mut inputs = Inputs::default();
     let grid = plan.bake_mesh_grid(ctx)?;
     plan.add_inputs(ctx, &mut inputs, (1, 1), grid.as_ref(), None);

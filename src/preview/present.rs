@@ -7,8 +7,8 @@ use std::borrow::Cow;
 use bytemuck::{Pod, Zeroable};
 
 use crate::error::Result;
+use crate::gpu::sources::Sources;
 use crate::gpu::{shader, GpuContext};
-use crate::render::wgsl_root;
 
 /// Uniform of `present.wgsl`.
 #[repr(C)]
@@ -45,7 +45,7 @@ pub struct Presenter {
 
 impl Presenter {
     pub fn new(ctx: &GpuContext, format: wgpu::TextureFormat) -> Result<Self> {
-        let kernel = shader::load(&wgsl_root(), "present.wgsl")?;
+        let kernel = shader::load_from(&Sources::project()?, "present.wgsl")?;
         let module = ctx.scoped("present.wgsl", || {
             ctx.device.create_shader_module(wgpu::ShaderModuleDescriptor {
                 label: Some("present"),

@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 
 use crate::gpu::cache::{CacheStats, GpuCache};
 use crate::gpu::GpuContext;
-use crate::render::{default_graph, wgsl_root, Blueprint, Frame, RenderOptions, Renderer};
+use crate::render::{shader_sources, Blueprint, Frame, RenderOptions, Renderer};
 use crate::scene::{self, Scene};
 use crate::Result;
 
@@ -113,12 +113,19 @@ impl Session {
         self.scene.as_ref()
     }
 
-    /// Folders to watch, recursively: the scene's folder, those of the files it refers to, the
-    /// graph's folder and the WGSL root (editors save by renaming, so files are not watched alone).
+    /// Folders to watch, recursively: the scene's folder, those of the files it refers to, and the
+    /// folders on disk that the graph and its shaders are read from (the graph's folder and the
+    /// project's `wgsl/`; embedded files are not watched). Editors save by renaming, so files are
+    /// not watched alone.
     pub fn watch_dirs(&self) -> Vec<PathBuf> {
         let parent = |p: &Path| p.parent().map(Path::to_path_buf).unwrap_or_else(|| PathBuf::from("."));
-        let graph = self.options.graph.clone().unwrap_or_else(default_graph);
-        let mut dirs = vec![parent(&self.scene_path), parent(&graph), wgsl_root()];
+        let mut dirs = vec![parent(&self.scene_path)];
+        if let Some(graph) = &self.options.graph {
+            dirs.push(parent(graph));
+        }
+        dirs.extend(
+            shader_sources(self.options.graph.as_deref()).map(|s| s.watched_dirs()).unwrap_or_default(),
+        );
         if let Some(scene) = &self.scene {
             dirs.extend(scene.asset_paths().iter().map(|p| parent(p)));
         }

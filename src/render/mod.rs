@@ -7,12 +7,13 @@ mod texels;
 
 pub use renderer::{Frame, Renderer};
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use glam::{DMat4, DVec3, DVec4};
 
 use crate::bake::BakeRequest;
 use crate::error::{Error, Result};
+use crate::gpu::sources::Sources;
 use crate::graph::plan::{self, ObjectInfo, Plan};
 use crate::graph::Graph;
 use crate::mesh::shell::{self, Shell};
@@ -195,11 +196,38 @@ pub fn baked_texel(scene: &Scene, texel: &str) -> Result<BakePlan> {
     Ok(bakes.remove(0))
 }
 
-pub fn default_graph() -> PathBuf {
-    crate::project_root().join("graphs/frame.ron")
+/// The default graph's name under `graphs/`.
+pub const DEFAULT_GRAPH: &str = "frame.ron";
+
+/// Where a render's shaders are looked up: beside the graph file `graph` (`--graph`), or beside
+/// the project's `graphs/frame.ron` when that is read from disk, then in the project's sources
+/// (see [`Sources`]). Reads no graph (the preview's watch list needs it when the graph is broken).
+pub fn shader_sources(graph: Option<&Path>) -> Result<Sources> {
+    let project = Sources::project()?;
+    Ok(match graph {
+        Some(path) => project.beside(path),
+        None => match project.graph(DEFAULT_GRAPH)? {
+            Some(g) if g.on_disk => project.beside(&g.path),
+            _ => project,
+        },
+    })
 }
 
-pub use crate::wgsl_root;
+/// The graph a render uses, `graph` (`--graph`) or else the project's `graphs/frame.ron` (the
+/// file when present, else the embedded copy), and where its shaders are looked up.
+pub fn load_graph(graph: Option<&Path>) -> Result<(Graph, Sources)> {
+    let sources = shader_sources(graph)?;
+    let graph = match graph {
+        Some(path) => Graph::load(path)?,
+        None => {
+            let g = Sources::project()?.graph(DEFAULT_GRAPH)?.ok_or_else(|| {
+                Error::Invalid(format!("the default graph `graphs/{DEFAULT_GRAPH}` is missing"))
+            })?;
+            Graph::parse(&g.path, g.text)?
+        }
+    };
+    Ok((graph, sources))
+}
 
 impl Blueprint {
     pub fn new(scene: &Scene, opts: &RenderOptions) -> Result<Self> {
@@ -221,10 +249,10 @@ impl Blueprint {
             .into_iter()
             .map(|o| ObjectPlan::new(scene, o, &view, &light, opts, &mut bakes))
             .collect::<Result<Vec<_>>>()?;
-        let graph = Graph::load(opts.graph.as_deref().unwrap_or(&default_graph()))?;
+        let (graph, sources) = load_graph(opts.graph.as_deref())?;
         let reference = reference_set(&objects, &bakes, &view);
         let (instances, infos) = instances(&objects, reference.as_ref(), view.eye);
-        let plan = plan::plan(&graph, &wgsl_root(), &infos)?;
+        let plan = plan::plan(&graph, &sources, &infos)?;
         check_bindings(&graph, &plan)?;
         let samples_texels =
             plan.passes.iter().flat_map(|p| &p.bindings).any(|b| TEXEL_BINDINGS.contains(&b.name.as_str()));

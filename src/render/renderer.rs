@@ -3,6 +3,7 @@
 use crate::bake::{self, Baker};
 use crate::error::{Error, Result};
 use crate::gpu::cache::{self, GpuCache};
+use crate::gpu::sources::Sources;
 use crate::gpu::timing::Timer;
 use crate::gpu::Inputs;
 use crate::gpu::{buffers, GpuContext};
@@ -11,7 +12,7 @@ use crate::hypertexture::mesh::MeshGrid;
 use crate::hypertexture::splats::SplatSet;
 use crate::io::Image;
 use crate::methods::{axis_slices, view_slices};
-use crate::render::{wgsl_root, Blueprint, ObjectPlan, Part};
+use crate::render::{Blueprint, ObjectPlan, Part};
 use crate::types::{ObjectParams, VertexFrame};
 
 /// A rendered frame.
@@ -54,7 +55,7 @@ impl Renderer {
         if let Some(set) = &blueprint.reference {
             set.check_limits(ctx.limits.max_storage_buffer_binding_size)?;
         }
-        let mut baker = Baker::new(&wgsl_root());
+        let mut baker = Baker::new(&Sources::project()?);
         let baked: Vec<bake::Baked> = blueprint
             .bakes
             .iter()

@@ -1,0 +1,204 @@
+//! The `voltex` command line: the clap structs shared by subcommands (the top-level parser,
+//! [`Overrides`], value parsers) and one module per subcommand, each with its arguments and `run`.
+
+pub mod bake;
+pub mod bench;
+pub mod compare;
+pub mod info;
+pub mod pareto;
+pub mod plan;
+pub mod preview;
+pub mod render;
+
+use std::path::{Path, PathBuf};
+
+use clap::{Parser, Subcommand};
+
+use voltex::render::{MethodKind, RenderOptions};
+use voltex::Result;
+
+#[derive(Parser)]
+#[command(
+    name = "voltex",
+    version,
+    about = "Volumetric textures and hypertextures on wgpu",
+    after_help = "Kernels (wgsl/) and graphs (graphs/) are built in; files on disk win: a shader is looked \
+                  up beside the --graph file, then in $VOLTEX_ROOT/wgsl (default: the source tree voltex \
+                  was built from, when it exists), then in the built-in copy."
+)]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+#[derive(Subcommand)]
+pub enum Command {
+    /// Render a scene headless to EXR (linear, with metadata) and a tonemapped PNG.
+    Render(render::RenderArgs),
+    /// Bake texels on the GPU and write each as a slice stack: OUT/<texel>/slice_000.png onwards
+    /// (RGBA, premultiplied, the scene's first light baked in), readable as `Slices(dir: ..)`.
+    Bake(bake::BakeArgs),
+    /// Compare two EXR images: FLIP, relative RMSE, largest difference and non-finite pixels;
+    /// optionally write a FLIP heat map (no GPU needed).
+    Compare(compare::CompareArgs),
+    /// Print the bakes, passes, pipelines and GPU memory a scene will use (no GPU needed).
+    Plan(plan::PlanArgs),
+    /// Open a window showing the scene, redrawn whenever the scene, its files, a graph or a kernel
+    /// changes (keys and mouse: see the overlay and the README).
+    Preview(preview::PreviewArgs),
+    /// Render every scene under a folder and compare it with its reference image (<stem>.ref.exr).
+    Regress(voltex::regress::Args),
+    /// Print the adapter, backend, driver, the features voltex uses and limits.
+    Info,
+    /// Benchmark view-aligned slicing (the 2002 paper's Table 1 set-up) with GPU timestamps.
+    Bench(bench::BenchArgs),
+    /// Benchmark hypertexture ray marching (the 2009 paper's Figure 11 set-up): frame times and
+    /// the share of noise evaluation.
+    BenchHyper(bench::BenchHyperArgs),
+    /// Speed against error: sweep each method's quality knobs, time every setting with GPU
+    /// timestamps, measure its error against a truth image, write pareto.csv and pareto.svg.
+    Pareto(pareto::ParetoCmd),
+}
+
+#[derive(clap::Args, Clone, Default)]
+pub struct Overrides {
+    /// Output size, e.g. 128x128 (default: the scene's).
+    #[arg(long, value_parser = parse_size)]
+    size: Option<(u32, u32)>,
+    /// Plane count for every ViewSlices object (default: the scene's).
+    #[arg(long)]
+    planes: Option<u32>,
+    /// Turn the bounding-sphere trivial reject off (for measurement).
+    #[arg(long)]
+    no_trivial_reject: bool,
+    /// Render graph file (default: graphs/frame.ron).
+    #[arg(long)]
+    graph: Option<PathBuf>,
+    /// Render every textured object with this method (its lighting mode is kept).
+    #[arg(long, value_enum)]
+    method: Option<MethodArg>,
+    /// Render N x N samples per pixel and average them (anti-aliasing; e.g. 2 or 4).
+    #[arg(long)]
+    supersample: Option<u32>,
+    /// Ray step (world units) for Reference and RayMarch objects (default: the scene's, else half
+    /// a voxel for Reference).
+    #[arg(long, allow_negative_numbers = true)]
+    step: Option<f64>,
+    /// Time of the frame in seconds (animated hypertextures; default: the scene's `time`).
+    #[arg(long, allow_negative_numbers = true)]
+    time: Option<f64>,
+    /// AxisSlices criteria for every AxisSlices object: `D,P` (slice depth in voxels, apparent
+    /// slice distance in pixels) or one value for both (default: the scene's).
+    #[arg(long, value_parser = parse_criteria)]
+    criteria: Option<(f64, f64)>,
+}
+
+#[derive(clap::ValueEnum, Clone, Copy)]
+enum MethodArg {
+    ViewSlices,
+    Reference,
+    AxisSlices,
+}
+
+fn method_kind(m: MethodArg) -> MethodKind {
+    match m {
+        MethodArg::ViewSlices => MethodKind::ViewSlices,
+        MethodArg::Reference => MethodKind::Reference,
+        MethodArg::AxisSlices => MethodKind::AxisSlices,
+    }
+}
+
+impl Overrides {
+    pub fn options(&self) -> Result<RenderOptions> {
+        if let Some(p) = self.planes {
+            if p == 0 || p > voltex::scene::MAX_PLANES {
+                return Err(voltex::Error::Invalid(format!(
+                    "--planes {p}: expected a plane count in 1..={}",
+                    voltex::scene::MAX_PLANES
+                )));
+            }
+        }
+        if let Some(t) = self.time.filter(|t| !t.is_finite()) {
+            return Err(voltex::Error::Invalid(format!("--time {t}: expected a finite number of seconds")));
+        }
+        if let Some(n) = self.supersample {
+            if !(1..=8).contains(&n) {
+                return Err(voltex::Error::Invalid(format!(
+                    "--supersample {n}: expected 1 to 8 samples per axis"
+                )));
+            }
+        }
+        if let Some(s) = self.step {
+            if !(s.is_finite() && s > 0.0) {
+                return Err(voltex::Error::Invalid(format!("--step {s}: expected a positive world length")));
+            }
+        }
+        Ok(RenderOptions {
+            size: self.size,
+            graph: self.graph.clone(),
+            planes: self.planes,
+            trivial_reject: self.no_trivial_reject.then_some(false),
+            method: self.method.map(method_kind),
+            step: self.step,
+            supersample: self.supersample,
+            time: self.time,
+            axis_criteria: self.criteria,
+            ..Default::default()
+        })
+    }
+}
+
+fn parse_criteria(s: &str) -> std::result::Result<(f64, f64), String> {
+    let value = |v: &str| {
+        let bad = || "expected D,P or one value for both, each in (0, 1024]".to_string();
+        v.trim().parse::<f64>().ok().filter(|v| *v > 0.0 && *v <= 1024.0).ok_or_else(bad)
+    };
+    match s.split_once(',') {
+        Some((d, p)) => Ok((value(d)?, value(p)?)),
+        None => value(s).map(|v| (v, v)),
+    }
+}
+
+pub fn parse_size(s: &str) -> std::result::Result<(u32, u32), String> {
+    let (w, h) = s.split_once('x').ok_or("expected WIDTHxHEIGHT, e.g. 512x512")?;
+    let w: u32 = w.parse().map_err(|_| "expected WIDTHxHEIGHT, e.g. 512x512")?;
+    let h: u32 = h.parse().map_err(|_| "expected WIDTHxHEIGHT, e.g. 512x512")?;
+    if w == 0 || h == 0 || w > 16384 || h > 16384 {
+        return Err("expected a size between 1x1 and 16384x16384".into());
+    }
+    Ok((w, h))
+}
+
+/// Like other command-line tools, end quietly when the reader of stdout goes away
+/// (`voltex compare a.exr b.exr | head -1`): Rust ignores SIGPIPE, so printing would panic.
+pub fn default_sigpipe() {
+    #[cfg(target_os = "linux")]
+    {
+        extern "C" {
+            fn signal(signum: i32, handler: usize) -> usize;
+        }
+        const SIGPIPE: i32 = 13;
+        const SIG_DFL: usize = 0;
+        // SAFETY: restores the default disposition before any thread starts.
+        unsafe {
+            signal(SIGPIPE, SIG_DFL);
+        }
+    }
+}
+
+/// Mesa prints "XDG_RUNTIME_DIR is invalid" on every device unless that variable names a private
+/// folder; give it one (before any thread starts) so users see only voltex's own messages.
+pub fn private_runtime_dir() {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::{DirBuilderExt, MetadataExt};
+        if std::env::var_os("XDG_RUNTIME_DIR").is_some_and(|d| Path::new(&d).is_dir()) {
+            return;
+        }
+        let uid = std::fs::metadata("/proc/self").map(|m| m.uid()).unwrap_or(0);
+        let dir = std::env::temp_dir().join(format!("voltex-runtime-{uid}"));
+        if std::fs::DirBuilder::new().mode(0o700).create(&dir).is_ok() || dir.is_dir() {
+            std::env::set_var("XDG_RUNTIME_DIR", &dir);
+        }
+    }
+}

@@ -1,0 +1,116 @@
+//! `voltex pareto`: speed against error over each method's quality knobs.
+
+use std::path::PathBuf;
+
+use voltex::render::MethodKind;
+use voltex::Result;
+
+use super::parse_size;
+
+/// `voltex pareto`'s arguments (see `voltex::pareto::Args`).
+#[derive(clap::Args)]
+pub struct ParetoCmd {
+    scene: PathBuf,
+    #[arg(long, value_parser = parse_size, default_value = "256x256")]
+    size: (u32, u32),
+    /// Timed frames per setting (after warm-up); medians are reported.
+    #[arg(long, default_value_t = 5)]
+    frames: usize,
+    /// Output folder (default: out/pareto/<scene name>).
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// What errors are measured against: `reference`, `view-slices:PLANES` or `ray-march:STEP`.
+    #[arg(long, default_value = "reference")]
+    truth: voltex::pareto::Truth,
+    /// Methods to sweep (ray-march: the step of every hypertexture object).
+    #[arg(long, value_enum, value_delimiter = ',', default_values = ["view-slices", "reference"])]
+    methods: Vec<SweepArg>,
+    /// ViewSlices plane counts (each with the trivial reject on and off).
+    #[arg(long, value_delimiter = ',', default_values_t = voltex::pareto::DEFAULT_PLANES)]
+    planes: Vec<u32>,
+    /// Reference ray steps, as multiples of the default step.
+    #[arg(long, value_delimiter = ',', default_values_t = voltex::pareto::DEFAULT_STEP_FACTORS)]
+    steps: Vec<f64>,
+    /// AxisSlices criteria: d (voxels) = p (pixels) = each value.
+    #[arg(long, value_delimiter = ',', default_values_t = voltex::pareto::DEFAULT_CRITERIA)]
+    criteria: Vec<f64>,
+    /// RayMarch steps (world units).
+    #[arg(long, value_delimiter = ',', default_values_t = voltex::pareto::DEFAULT_RAY_STEPS)]
+    ray_steps: Vec<f64>,
+    /// RayMarch segment strategies, each swept over every step: bounds, depth-peeling (4 passes),
+    /// splatting (16 slabs).
+    #[arg(long, value_enum, value_delimiter = ',', default_values = ["bounds"])]
+    ray_segments: Vec<SegmentsArg>,
+    /// RayMarch with an adaptive stride: STEP:MAX_STEP pairs (world units), e.g.
+    /// 0.002:0.03,0.002:0.06 (default: none).
+    #[arg(long, value_delimiter = ',', value_parser = parse_adaptive)]
+    ray_adaptive: Vec<(f64, f64)>,
+}
+
+fn parse_adaptive(s: &str) -> std::result::Result<(f64, f64), String> {
+    let bad = || format!("`{s}`: expected STEP:MAX_STEP, positive world units with MAX_STEP >= STEP");
+    let (step, max) = s.split_once(':').ok_or_else(bad)?;
+    let value = |v: &str| v.trim().parse::<f64>().ok().filter(|v| v.is_finite() && *v > 0.0);
+    match (value(step), value(max)) {
+        (Some(step), Some(max)) if max >= step => Ok((step, max)),
+        _ => Err(bad()),
+    }
+}
+
+/// The methods `pareto` sweeps: those of `--method`, and the hypertextures' ray marching.
+#[derive(clap::ValueEnum, Clone, Copy)]
+enum SweepArg {
+    ViewSlices,
+    Reference,
+    AxisSlices,
+    RayMarch,
+}
+
+fn sweep(m: SweepArg) -> voltex::pareto::Sweep {
+    use voltex::pareto::Sweep;
+    match m {
+        SweepArg::ViewSlices => Sweep::Method(MethodKind::ViewSlices),
+        SweepArg::Reference => Sweep::Method(MethodKind::Reference),
+        SweepArg::AxisSlices => Sweep::Method(MethodKind::AxisSlices),
+        SweepArg::RayMarch => Sweep::RayMarch,
+    }
+}
+
+/// RayMarch segment strategies `pareto` sweeps (with their default passes, slabs and grid).
+#[derive(clap::ValueEnum, Clone, Copy)]
+enum SegmentsArg {
+    Bounds,
+    DepthPeeling,
+    Splatting,
+}
+
+fn segments(s: SegmentsArg) -> voltex::scene::Segments {
+    match s {
+        SegmentsArg::Bounds => voltex::scene::Segments::Bounds,
+        SegmentsArg::DepthPeeling => voltex::scene::Segments::DepthPeeling {
+            passes: voltex::scene::DEFAULT_PEEL_PASSES,
+            splat_grid: voltex::scene::DEFAULT_SPLAT_GRID,
+        },
+        SegmentsArg::Splatting => voltex::scene::Segments::Splatting {
+            slabs: voltex::scene::DEFAULT_SPLAT_SLABS,
+            splat_grid: voltex::scene::DEFAULT_SPLAT_GRID,
+        },
+    }
+}
+
+pub fn run(p: ParetoCmd) -> Result<()> {
+    voltex::pareto::run(&voltex::pareto::Args {
+        scene: p.scene,
+        size: p.size,
+        frames: p.frames,
+        out: p.out,
+        truth: p.truth,
+        methods: p.methods.into_iter().map(sweep).collect(),
+        planes: p.planes,
+        steps: p.steps,
+        criteria: p.criteria,
+        ray_steps: p.ray_steps,
+        ray_segments: p.ray_segments.into_iter().map(segments).collect(),
+        ray_adaptive: p.ray_adaptive,
+    })
+}

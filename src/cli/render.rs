@@ -1,0 +1,150 @@
+//! `voltex render`: a scene (or the frames of an animation) to EXR and PNG.
+
+use std::path::{Path, PathBuf};
+
+use voltex::gpu::cache::GpuCache;
+use voltex::gpu::GpuContext;
+use voltex::render::{Blueprint, RenderOptions, Renderer};
+use voltex::{io, scene, Result};
+
+use super::Overrides;
+
+#[derive(clap::Args)]
+pub struct RenderArgs {
+    scene: PathBuf,
+    /// Output EXR (default: out/<scene name>.exr); the PNG goes beside it. With --frames, the
+    /// first frame's path: frame N is written as <stem>_NNNN.exr beside it.
+    #[arg(short, long)]
+    output: Option<PathBuf>,
+    /// Render frames A to B (inclusive) of an animation, at time N / fps for frame N.
+    #[arg(long, value_parser = parse_frames, conflicts_with = "time")]
+    frames: Option<(u32, u32)>,
+    /// Frames per second of --frames.
+    #[arg(long, default_value_t = 24.0, requires = "frames")]
+    fps: f64,
+    #[command(flatten)]
+    overrides: Overrides,
+}
+
+fn parse_frames(s: &str) -> std::result::Result<(u32, u32), String> {
+    let bad = || "expected A..B, frame numbers with A <= B <= 99999, e.g. 0..47".to_string();
+    let (a, b) = s.split_once("..").ok_or_else(bad)?;
+    let (a, b): (u32, u32) = (a.trim().parse().map_err(|_| bad())?, b.trim().parse().map_err(|_| bad())?);
+    if a > b || b > 99_999 {
+        return Err(bad());
+    }
+    Ok((a, b))
+}
+
+pub fn run(args: RenderArgs) -> Result<()> {
+    let RenderArgs { scene, output, frames, fps, overrides } = args;
+    match frames {
+        None => render(&scene, output, &overrides),
+        Some(frames) => render_frames(&scene, output, frames, fps, &overrides),
+    }
+}
+
+fn render(scene_path: &Path, output: Option<PathBuf>, overrides: &Overrides) -> Result<()> {
+    let opts = overrides.options()?;
+    let scene = scene::load(scene_path)?;
+    let exr_path = output_path(scene_path, output)?;
+    let ctx = GpuContext::new()?;
+    render_one(&ctx, &scene, &opts, &exr_path, &mut GpuCache::default(), true)
+}
+
+/// `render --frames A..B`: one scene, one device, bakes shared between frames; frame N at time
+/// N / fps is written as `<stem>_NNNN.exr` (and `.png`) beside the output path.
+fn render_frames(
+    scene_path: &Path,
+    output: Option<PathBuf>,
+    (first, last): (u32, u32),
+    fps: f64,
+    overrides: &Overrides,
+) -> Result<()> {
+    if !(fps.is_finite() && fps > 0.0) {
+        return Err(voltex::Error::Invalid(format!("--fps {fps}: expected a positive frame rate")));
+    }
+    let opts = overrides.options()?;
+    let scene = scene::load(scene_path)?;
+    let path = output_path(scene_path, output)?;
+    let stem = path.file_stem().unwrap_or_default().to_string_lossy().to_string();
+    let ctx = GpuContext::new()?;
+    let mut cache = GpuCache::default();
+    // A texel baked from an animated hypertexture is baked anew every frame: keep only what the
+    // last frame used, or the bakes pile up (a sequence's frames are then re-baked when they
+    // come back).
+    let animated = scene.texels.values().any(|t| match &t.source {
+        scene::TexelSource::Hypertexture { name, .. } => {
+            scene.hypertextures.get(&name.value).is_some_and(|h| h.noises.iter().any(|n| n.speed != 0.0))
+        }
+        _ => false,
+    });
+    for n in first..=last {
+        let frame_opts = RenderOptions { time: Some(n as f64 / fps), ..opts.clone() };
+        let exr = path.with_file_name(format!("{stem}_{n:04}.exr"));
+        cache.begin();
+        render_one(&ctx, &scene, &frame_opts, &exr, &mut cache, n == first)?;
+        if animated {
+            cache.retain_used();
+        }
+    }
+    Ok(())
+}
+
+/// The EXR path to write (default `out/<stem>.exr`), its folder checked writable before any GPU
+/// work (`out/` is created when missing).
+fn output_path(scene_path: &Path, output: Option<PathBuf>) -> Result<PathBuf> {
+    let exr_path = output.unwrap_or_else(|| {
+        let stem = scene_path.file_stem().unwrap_or_default();
+        PathBuf::from("out").join(stem).with_extension("exr")
+    });
+    let dir = match exr_path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    if !dir.exists() && dir == Path::new("out") {
+        std::fs::create_dir_all(&dir).map_err(|e| voltex::Error::file(&dir, e))?;
+    }
+    io::atomic::check_writable_dir(&dir)?;
+    Ok(exr_path)
+}
+
+fn render_one(
+    ctx: &GpuContext,
+    scene: &scene::Scene,
+    opts: &RenderOptions,
+    exr_path: &Path,
+    cache: &mut GpuCache,
+    warn: bool,
+) -> Result<()> {
+    let png_path = exr_path.with_extension("png");
+    let bp = Blueprint::new(scene, opts)?;
+    for w in scene.warnings.iter().filter(|_| warn) {
+        eprintln!("warning: {w}");
+    }
+    for o in bp.objects.iter().filter(|_| warn) {
+        for w in &o.object.report.warnings {
+            eprintln!("warning: {}: object `{}`: {w}", scene.path.display(), o.object.name);
+        }
+    }
+    // Nothing is evicted: a sequence's frames come back, and a scene's bakes are bounded.
+    let mut renderer = Renderer::with_cache(ctx, bp, cache)?;
+    let frame = renderer.render(ctx)?;
+    let metadata = renderer.metadata(ctx, &frame);
+    let meta: Vec<(&str, String)> = metadata.iter().map(|(k, v)| (k.as_str(), v.clone())).collect();
+    io::exr::write(exr_path, &frame.image, &meta)?;
+    io::png::write_tonemapped(&png_path, &frame.image)?;
+    let gpu = frame.gpu_ms().map(|t| format!("{t:.2} ms GPU")).unwrap_or_else(|| "no GPU timestamps".into());
+    println!(
+        "{} and {} ({}x{}, {gpu}, {})",
+        exr_path.display(),
+        png_path.display(),
+        frame.image.width,
+        frame.image.height,
+        ctx.adapter_line()
+    );
+    for (pass, ms) in &frame.pass_times {
+        println!("  {pass:<20} {ms:>9.3} ms");
+    }
+    Ok(())
+}
