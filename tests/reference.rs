@@ -42,7 +42,7 @@ fn gpu_and_twin(scene: &Path, opts: &RenderOptions) -> Traced {
     let (texels, normals) = r.reference_atlases(&ctx).unwrap().unwrap();
     drop(ctx);
     let (view, objects) = twin_inputs(&r.blueprint, &texels, &normals);
-    let cpu = trace_reference::trace(&view, &objects);
+    let cpu = trace_reference::trace_reference(&view, &objects);
     let cpu = Image::from_pixels(view.width, view.height, cpu.iter().map(|p| p.map(|c| c as f32)).collect())
         .unwrap();
     let mut max_intervals = 0;
