@@ -80,7 +80,7 @@ pub fn run(
         for o in &r.blueprint.objects {
             let Some(params) = o.sweep else { continue };
             let t = Instant::now();
-            let out = crate::cpu::slice_prisms::slice_all(
+            let out = crate::cpu::slice_prisms::emit_slices(
                 &o.shell.vertices,
                 &o.shell.prisms,
                 &params,

@@ -3,25 +3,19 @@
 //! against its twin, brightness independent of the level, the error against the reference at a
 //! grazing view with three directions and with horizontal slices only, and bad knobs.
 
+mod common;
+
+use common::ctx;
 use std::path::{Path, PathBuf};
-use std::sync::{Mutex, OnceLock};
 
 use glam::{Vec2, Vec3};
 use voltex::bake::{BakeRequest, BakeSource, Baker};
 use voltex::cpu::axis_slices::{self as twin, AxisFrame};
 use voltex::cpu::bake::{pack_shapes, Shape};
-use voltex::gpu::GpuContext;
 use voltex::io::Image;
 use voltex::render::{Blueprint, MethodKind, Part, RenderOptions, Renderer};
 use voltex::scene;
 use voltex::types::AxisParams;
-
-fn ctx() -> &'static Mutex<GpuContext> {
-    static CTX: OnceLock<Mutex<GpuContext>> = OnceLock::new();
-    CTX.get_or_init(|| {
-        Mutex::new(GpuContext::new().expect("a GPU adapter (software Vulkan: mesa-vulkan-drivers)"))
-    })
-}
 
 fn example(name: &str) -> PathBuf {
     voltex::project_root().join("scenes/meyer_neyret").join(name)

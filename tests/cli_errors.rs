@@ -4,6 +4,8 @@
 
 mod common;
 
+use common::{entries, stderr};
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -51,19 +53,6 @@ fn line_col(text: &str, needle: &str) -> String {
     let line = before.matches('\n').count() + 1;
     let col = at - before.rfind('\n').map(|i| i + 1).unwrap_or(0) + 1;
     format!("{line}:{col}")
-}
-
-fn stderr(out: &Output) -> String {
-    String::from_utf8_lossy(&out.stderr).into_owned()
-}
-
-fn entries(dir: &Path) -> Vec<String> {
-    let mut v: Vec<String> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
-    v.sort();
-    v
 }
 
 /// Exit status 1, no panic, stderr contains every string of `words`, and `dir/out` is empty.

@@ -2,6 +2,9 @@
 //! `VOLTEX_FAULT`, see `src/gpu/fault.rs`), an update of references killed at any point, and
 //! output folders nobody (root included) can write into.
 
+mod common;
+
+use common::{entries, root, s, scratch_dir, stderr};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::time::Instant;
@@ -14,16 +17,9 @@ use voltex::render::RenderOptions;
 
 const BIN: &str = env!("CARGO_BIN_EXE_voltex");
 
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
-
 /// A fresh folder for a test.
 fn temp(test: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("voltex-faults-{}-{test}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+    scratch_dir(&format!("voltex-faults-{test}"))
 }
 
 fn flat_box() -> String {
@@ -49,23 +45,6 @@ fn voltex(args: &[&str], fault: Option<&str>) -> Output {
         cmd.env("VOLTEX_FAULT", f);
     }
     cmd.output().unwrap()
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
-
-fn entries(dir: &Path) -> Vec<String> {
-    let mut v: Vec<String> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
-    v.sort();
-    v
 }
 
 #[test]

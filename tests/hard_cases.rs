@@ -7,24 +7,18 @@
 //! the CPU twins (prism map inverse, ray intervals, slice polygons, axis choice) cover the
 //! degenerate prism geometries.
 
+mod common;
+
+use common::ctx;
 use std::path::PathBuf;
-use std::sync::{Mutex, OnceLock};
 
 use voltex::cpu::bake_transfer::bake_transfer;
 use voltex::cpu::hypertexture::Model;
 use voltex::cpu::ray_march::{ray_march, MarchView};
-use voltex::gpu::GpuContext;
 use voltex::io::Image;
 use voltex::render::{Blueprint, MethodKind, Part, RenderOptions, Renderer, DEFAULT_AXIS_SLICES};
 use voltex::scene::{self, AxisSlices, Method, SliceBlend};
 use voltex::types::MarchState;
-
-fn ctx() -> &'static Mutex<GpuContext> {
-    static CTX: OnceLock<Mutex<GpuContext>> = OnceLock::new();
-    CTX.get_or_init(|| {
-        Mutex::new(GpuContext::new().expect("a GPU adapter (software Vulkan: mesa-vulkan-drivers)"))
-    })
-}
 
 fn path(name: &str) -> PathBuf {
     voltex::project_root().join("scenes/hard_cases").join(format!("{name}.ron"))

@@ -2,8 +2,10 @@
 //! transfer tables, soft objects, vector fields, density, colour, whole images), the analytic
 //! checks of the paper's model, and bad input reported at its position.
 
+mod common;
+
+use common::{ctx, sized};
 use std::path::{Path, PathBuf};
-use std::sync::{Mutex, OnceLock};
 
 use glam::DVec3;
 use voltex::cpu::bake::pcg_hash;
@@ -11,18 +13,10 @@ use voltex::cpu::bake_transfer::bake_transfer;
 use voltex::cpu::hypertexture::Model;
 use voltex::cpu::noise_simplex::{simplex3, simplex3_tiled, simplex4};
 use voltex::cpu::ray_march::{ray_march, MarchView};
-use voltex::gpu::GpuContext;
 use voltex::methods::ray_march::{probe, RayMarchPlan};
 use voltex::render::{Blueprint, Part, RenderOptions, Renderer};
 use voltex::scene;
 use voltex::types::MarchState;
-
-fn ctx() -> &'static Mutex<GpuContext> {
-    static CTX: OnceLock<Mutex<GpuContext>> = OnceLock::new();
-    CTX.get_or_init(|| {
-        Mutex::new(GpuContext::new().expect("a GPU adapter (software Vulkan: mesa-vulkan-drivers)"))
-    })
-}
 
 fn example(name: &str) -> PathBuf {
     voltex::project_root().join("scenes/hypertextures").join(name)
@@ -74,10 +68,6 @@ fn figure13_scenes_use_the_tools_the_paper_names() {
             ),
         }
     }
-}
-
-fn sized(w: u32, h: u32) -> RenderOptions {
-    RenderOptions { size: Some((w, h)), ..Default::default() }
 }
 
 fn blueprint(scene: &scene::Scene, opts: &RenderOptions) -> Blueprint {
@@ -288,11 +278,7 @@ fn layer_and_twin(scene: &scene::Scene, opts: &RenderOptions) -> (Vec<[f64; 4]>,
     let bytes = r.read_instance_buffer(&ctx, instance, "ray_march_state").unwrap();
     drop(ctx);
     let f = &r.blueprint.frame;
-    let light = [f.light_color[0] as f64, f.light_color[1] as f64, f.light_color[2] as f64];
-    let gpu: Vec<[f64; 4]> = bytemuck::pod_collect_to_vec::<u8, MarchState>(&bytes)
-        .iter()
-        .map(|s| std::array::from_fn(|c| s.color[c] as f64 * if c < 3 { light[c] } else { 1.0 }))
-        .collect();
+    let gpu = common::lit_march_state(f, &bytes);
     let o = r.blueprint.objects.iter().find(|o| o.ray_march.is_some()).unwrap();
     let plan = o.ray_march.as_ref().unwrap();
     let tables = twin_tables(plan);
@@ -778,12 +764,8 @@ fn binary_reports_bad_hypertextures() {
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join("bad.ron");
     std::fs::write(&path, BASE.replace("frequency: 2.0)", "frequency: 0.0)")).unwrap();
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_voltex"))
-        .args(["render", path.to_str().unwrap(), "-o"])
-        .arg(dir.join("out.exr"))
-        .output()
-        .unwrap();
-    let err = String::from_utf8_lossy(&out.stderr);
+    let out = common::voltex(&["render", common::s(&path), "-o", common::s(&dir.join("out.exr"))]);
+    let err = common::stderr(&out);
     assert_eq!(out.status.code(), Some(1), "{err}");
     assert!(err.contains("bad.ron:10:") && err.contains("positive"), "{err}");
     assert!(!dir.join("out.exr").exists());

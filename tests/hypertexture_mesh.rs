@@ -3,8 +3,10 @@
 //! ray marcher's mesh sampling against the twin's, whole images, the bake cache, and bad meshes
 //! reported at their position.
 
+mod common;
+
+use common::{ctx, sized};
 use std::path::{Path, PathBuf};
-use std::sync::{Mutex, OnceLock};
 
 use glam::DVec3;
 use voltex::cpu::bake_mesh_grid::{bake_mesh_grid, on_triangle};
@@ -12,20 +14,11 @@ use voltex::cpu::bake_transfer::bake_transfer;
 use voltex::cpu::hypertexture::Model;
 use voltex::cpu::ray_march::{ray_march, MarchView};
 use voltex::gpu::cache::GpuCache;
-use voltex::gpu::GpuContext;
 use voltex::hypertexture::mesh;
 use voltex::mesh::shape::MeshShape;
 use voltex::methods::ray_march::{probe, RayMarchPlan};
 use voltex::render::{Blueprint, Part, RenderOptions, Renderer};
 use voltex::scene;
-use voltex::types::MarchState;
-
-fn ctx() -> &'static Mutex<GpuContext> {
-    static CTX: OnceLock<Mutex<GpuContext>> = OnceLock::new();
-    CTX.get_or_init(|| {
-        Mutex::new(GpuContext::new().expect("a GPU adapter (software Vulkan: mesa-vulkan-drivers)"))
-    })
-}
 
 /// A closed UV sphere: `around` segments, `rings` bands from pole to pole, shared vertices.
 fn sphere_obj(radius: f64, around: usize, rings: usize) -> String {
@@ -95,10 +88,6 @@ fn mesh_scene(dir: &Path, object: &str, noises: &str, method: &str) -> scene::Sc
 
 fn plan_of(bp: &Blueprint) -> &RayMarchPlan {
     bp.objects.iter().find_map(|o| o.ray_march.as_ref()).unwrap()
-}
-
-fn sized(w: u32, h: u32) -> RenderOptions {
-    RenderOptions { size: Some((w, h)), ..Default::default() }
 }
 
 /// The grid of a 24 x 12 sphere, of a box made of 12 triangles and of the union of two
@@ -294,11 +283,7 @@ fn layer_and_twin(scene: &scene::Scene, opts: &RenderOptions) -> (Vec<[f64; 4]>,
     let (cells, depth) = mesh::read(&ctx, &plan.bake_mesh_grid(&ctx).unwrap().unwrap()).unwrap();
     drop(ctx);
     let f = &r.blueprint.frame;
-    let light = [f.light_color[0] as f64, f.light_color[1] as f64, f.light_color[2] as f64];
-    let gpu: Vec<[f64; 4]> = bytemuck::pod_collect_to_vec::<u8, MarchState>(&bytes)
-        .iter()
-        .map(|s| std::array::from_fn(|c| s.color[c] as f64 * if c < 3 { light[c] } else { 1.0 }))
-        .collect();
+    let gpu = common::lit_march_state(f, &bytes);
     let tables = bake_transfer(&plan.packed.functions, &plan.packed.points);
     let view = MarchView::of_frame(f, r.blueprint.size);
     let model = Model {
@@ -376,12 +361,8 @@ fn bad_meshes_are_reported_at_their_position() {
     // Through the binary: exit status 1, the position, no output written.
     let path = dir.join("scene.ron");
     std::fs::write(&path, scene_text("Mesh(path: \"open.obj\")", NOISE, "RayMarch()")).unwrap();
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_voltex"))
-        .args(["render", path.to_str().unwrap(), "-o"])
-        .arg(dir.join("out.exr"))
-        .output()
-        .unwrap();
-    let err = String::from_utf8_lossy(&out.stderr);
+    let out = common::voltex(&["render", common::s(&path), "-o", common::s(&dir.join("out.exr"))]);
+    let err = common::stderr(&out);
     assert_eq!(out.status.code(), Some(1), "{err}");
     assert!(at(&err) && err.contains("open.obj:5:1: open mesh"), "{err}");
     assert!(!dir.join("out.exr").exists() && !dir.join("out.png").exists());

@@ -3,31 +3,21 @@
 //! twin and the torus's known ones, images against the whole-bounds march, and the limit of too
 //! few passes on a concave object.
 
+mod common;
+
+use common::{ctx, sized};
 use std::path::Path;
-use std::sync::{Mutex, OnceLock};
 
 use glam::DVec3;
 use voltex::cpu::bake_splats::bake_splats;
 use voltex::cpu::hypertexture::Model;
 use voltex::cpu::peel_segments::peel_segments;
-use voltex::gpu::GpuContext;
 use voltex::hypertexture::{mesh, splats};
 use voltex::io::Image;
 use voltex::methods::ray_march::RayMarchPlan;
 use voltex::render::{Blueprint, Part, RenderOptions, Renderer};
 use voltex::scene;
 use voltex::types::{MarchState, Splat};
-
-fn ctx() -> &'static Mutex<GpuContext> {
-    static CTX: OnceLock<Mutex<GpuContext>> = OnceLock::new();
-    CTX.get_or_init(|| {
-        Mutex::new(GpuContext::new().expect("a GPU adapter (software Vulkan: mesa-vulkan-drivers)"))
-    })
-}
-
-fn sized(w: u32, h: u32) -> RenderOptions {
-    RenderOptions { size: Some((w, h)), ..Default::default() }
-}
 
 fn plan_of(bp: &Blueprint) -> &RayMarchPlan {
     bp.objects.iter().find_map(|o| o.ray_march.as_ref()).unwrap()
@@ -397,11 +387,7 @@ fn teapot_example_matches_the_bounds_march() {
 #[test]
 fn transformed_and_inside_views_match_the_bounds_march() {
     let opts = sized(48, 48);
-    let views = [
-        (("(0.5, -4.0, 1.0)", "(0.0, 0.0, 0.0)"), "(rotate: (30.0, 10.0, 50.0), scale: (1.5, 0.6, 1.0))"),
-        (("(0.0, -0.4, 0.2)", "(0.0, -2.0, 0.0)"), "()"),
-    ];
-    for (camera, transform) in views {
+    for (camera, transform) in common::TRANSFORMED_AND_INSIDE_VIEWS {
         let march = |segments: &str| {
             let method = format!("RayMarch(step: 0.01{segments})");
             let (image, states, _, _) =

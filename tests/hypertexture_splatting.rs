@@ -4,29 +4,19 @@
 //! a single slab, which does not order the splats, clearly worse; also transformed and seen from
 //! inside), and bad knobs.
 
+mod common;
+
+use common::{ctx, sized};
 use std::path::Path;
-use std::sync::{Mutex, OnceLock};
 
 use voltex::cpu::bake_transfer::bake_transfer;
 use voltex::cpu::hypertexture::Model;
 use voltex::cpu::splat_segments::splat_segments;
-use voltex::gpu::GpuContext;
 use voltex::hypertexture::splats;
 use voltex::io::Image;
 use voltex::render::{Blueprint, Part, RenderOptions, Renderer};
 use voltex::scene;
 use voltex::types::MarchState;
-
-fn ctx() -> &'static Mutex<GpuContext> {
-    static CTX: OnceLock<Mutex<GpuContext>> = OnceLock::new();
-    CTX.get_or_init(|| {
-        Mutex::new(GpuContext::new().expect("a GPU adapter (software Vulkan: mesa-vulkan-drivers)"))
-    })
-}
-
-fn sized(w: u32, h: u32) -> RenderOptions {
-    RenderOptions { size: Some((w, h)), ..Default::default() }
-}
 
 const BUMPS: &str = "[(shape: Curve([(0.0, 0.0, 0.0), (1.0, 1.0, 0.0)]), amplitude: 0.12, frequency: 3.0, \
     shift: 0.5), (shape: Table([1.0, 0.0, 1.0]), amplitude: 0.04, frequency: 8.0, seed: 2)]";
@@ -162,11 +152,7 @@ fn soft_sphere_is_close_to_the_bounds_march() {
 #[test]
 fn transformed_and_inside_views_are_close_to_the_bounds_march() {
     let opts = sized(48, 48);
-    let views = [
-        (("(0.5, -4.0, 1.0)", "(0.0, 0.0, 0.0)"), "(rotate: (30.0, 10.0, 50.0), scale: (1.5, 0.6, 1.0))"),
-        (("(0.0, -0.4, 0.2)", "(0.0, -2.0, 0.0)"), "()"),
-    ];
-    for (camera, transform) in views {
+    for (camera, transform) in common::TRANSFORMED_AND_INSIDE_VIEWS {
         let march = |segments: &str| {
             let text = placed_text(camera, transform, &format!("RayMarch(step: 0.02, segments: {segments})"));
             render(&scene::parse(&text, Path::new("test.ron")).unwrap(), &opts, None)

@@ -5,8 +5,8 @@
 
 mod common;
 
+use common::ctx;
 use std::path::Path;
-use std::sync::{Mutex, OnceLock};
 
 use voltex::bake::axis_slices::read_texture;
 use voltex::bake::hypertexture::HyperTexel;
@@ -15,19 +15,11 @@ use voltex::cpu::bake::bake_params;
 use voltex::cpu::bake_hypertexture::bake_hypertexture_voxel;
 use voltex::cpu::bake_transfer::bake_transfer;
 use voltex::cpu::hypertexture::Model;
-use voltex::gpu::GpuContext;
 use voltex::render::{Blueprint, RenderOptions, Renderer};
 use voltex::scene;
 
 const LIGHT: [f32; 3] = [-0.4, 0.5, 0.75];
 const AMBIENT: f32 = 0.3;
-
-fn ctx() -> &'static Mutex<GpuContext> {
-    static CTX: OnceLock<Mutex<GpuContext>> = OnceLock::new();
-    CTX.get_or_init(|| {
-        Mutex::new(GpuContext::new().expect("a GPU adapter (software Vulkan: mesa-vulkan-drivers)"))
-    })
-}
 
 /// A scene with hypertexture `h` and texel `t` (both RON) and no nodes.
 fn scene_with(hypertexture: &str, texel: &str) -> scene::Scene {

@@ -3,16 +3,18 @@
 //! torus hole empty), shells (`fill: false`), open meshes falling back to a shell with a warning,
 //! and bad bounds or files reported at their position.
 
+mod common;
+
+use common::ctx;
 use std::path::{Path, PathBuf};
 use std::process::Command;
-use std::sync::{Arc, Mutex, OnceLock};
+use std::sync::Arc;
 
 use glam::DVec3;
 use voltex::bake::axis_slices::read_texture;
 use voltex::bake::{BakeRequest, BakeSource, Baker, MeshTexel};
 use voltex::cpu::bake::{bake_params, pack_shapes, Shape};
 use voltex::cpu::bake_mesh_texel::bake_mesh_texel;
-use voltex::gpu::GpuContext;
 use voltex::hypertexture::mesh;
 use voltex::mesh::obj;
 use voltex::mesh::shape::MeshShape;
@@ -22,13 +24,6 @@ const N: u32 = 32;
 const LIGHT: [f32; 3] = [-0.4, 0.5, 0.75];
 const AMBIENT: f32 = 0.3;
 const COLOR: [f32; 3] = [0.8, 0.6, 0.3];
-
-fn ctx() -> &'static Mutex<GpuContext> {
-    static CTX: OnceLock<Mutex<GpuContext>> = OnceLock::new();
-    CTX.get_or_init(|| {
-        Mutex::new(GpuContext::new().expect("a GPU adapter (software Vulkan: mesa-vulkan-drivers)"))
-    })
-}
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))

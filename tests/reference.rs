@@ -1,23 +1,17 @@
 //! The reference renderer: the GPU kernel against its f64 CPU twin on every example scene, the
 //! exact answer on an analytic box of fog (sides included), and brightness independent of the step.
 
+mod common;
+
+use common::ctx;
 use std::path::{Path, PathBuf};
-use std::sync::{Mutex, OnceLock};
 
 use glam::DVec3;
 use voltex::cpu::{prism_map, trace_reference};
-use voltex::gpu::GpuContext;
 use voltex::io::Image;
 use voltex::methods::reference::twin_inputs;
 use voltex::render::{Blueprint, MethodKind, RenderOptions, Renderer};
 use voltex::scene;
-
-fn ctx() -> &'static Mutex<GpuContext> {
-    static CTX: OnceLock<Mutex<GpuContext>> = OnceLock::new();
-    CTX.get_or_init(|| {
-        Mutex::new(GpuContext::new().expect("a GPU adapter (software Vulkan: mesa-vulkan-drivers)"))
-    })
-}
 
 fn reference(size: u32) -> RenderOptions {
     RenderOptions { size: Some((size, size)), method: Some(MethodKind::Reference), ..Default::default() }
@@ -48,7 +42,7 @@ fn gpu_and_twin(scene: &Path, opts: &RenderOptions) -> Traced {
     let (texels, normals) = r.reference_atlases(&ctx).unwrap().unwrap();
     drop(ctx);
     let (view, objects) = twin_inputs(&r.blueprint, &texels, &normals);
-    let cpu = trace_reference::trace(&view, &objects);
+    let cpu = trace_reference::trace_reference(&view, &objects);
     let cpu = Image::from_pixels(view.width, view.height, cpu.iter().map(|p| p.map(|c| c as f32)).collect())
         .unwrap();
     let mut max_intervals = 0;

@@ -4,23 +4,14 @@
 
 mod common;
 
+use common::ctx;
 use std::path::Path;
-use std::sync::{Mutex, OnceLock};
 
 use common::golden::{check_golden, Threshold};
 use glam::DVec3;
-use voltex::gpu::GpuContext;
 use voltex::io::Image;
 use voltex::render::{Blueprint, RenderOptions, Renderer};
 use voltex::scene::{self, Scene};
-
-/// One device for the whole test binary; renders are serialised (two cores, one lavapipe).
-fn ctx() -> &'static Mutex<GpuContext> {
-    static CTX: OnceLock<Mutex<GpuContext>> = OnceLock::new();
-    CTX.get_or_init(|| {
-        Mutex::new(GpuContext::new().expect("a GPU adapter (software Vulkan: mesa-vulkan-drivers)"))
-    })
-}
 
 fn render_blueprint(bp: Blueprint) -> Image {
     let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());

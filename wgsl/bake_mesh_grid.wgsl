@@ -1,5 +1,6 @@
 // Bakes a mesh into a grid (hypertexture mesh objects, mesh texels): per sample the vector to the closest surface point and the signed distance (positive inside, by ray parity voted over three directions; no parity for shells) of the union of its closed parts, the largest inside distance, and for coloured meshes the colour at the closest point; CPU twin src/cpu/bake_mesh_grid.rs.
 #include "shared/types.wgsl"
+#include "shared/bvh.wgsl"
 
 @group(0) @binding(0) var<uniform> grid_params: MeshGridParams;
 // The bytes of a `ReferenceNode` (methods::reference::flat_bvh) read with integer counts: a
@@ -118,12 +119,9 @@ fn closest_point(p: vec3<f32>, root: u32) -> Closest {
     var best = 3.4e38;
     var point = p;
     var triangle = 0u;
-    var stack: array<u32, STACK_SIZE>;
-    stack[0] = root;
-    var top = 1u;
-    while (top > 0u) {
-        top -= 1u;
-        let node = mesh_nodes[stack[top]];
+    var stack = bvh_stack(root, false);
+    while (stack.top > 0u) {
+        let node = mesh_nodes[bvh_pop(&stack)];
         if (box_distance2(p, node) >= best) {
             continue;
         }
@@ -140,11 +138,9 @@ fn closest_point(p: vec3<f32>, root: u32) -> Closest {
                     triangle = t;
                 }
             }
-        } else if (top + 2u <= STACK_SIZE) {
+        } else {
             let near_first = box_distance2(p, mesh_nodes[first]) <= box_distance2(p, mesh_nodes[first + 1u]);
-            stack[top] = select(first, first + 1u, near_first);
-            stack[top + 1u] = select(first + 1u, first, near_first);
-            top += 2u;
+            bvh_push(&stack, select(first, first + 1u, near_first), select(first + 1u, first, near_first));
         }
     }
     return Closest(point, triangle);
@@ -194,12 +190,9 @@ fn crosses(o: vec3<f32>, d: vec3<f32>, t: u32) -> bool {
 fn crossings(o: vec3<f32>, d: vec3<f32>, root: u32) -> u32 {
     let inv = 1.0 / d;
     var hits = 0u;
-    var stack: array<u32, STACK_SIZE>;
-    stack[0] = root;
-    var top = 1u;
-    while (top > 0u) {
-        top -= 1u;
-        let node = mesh_nodes[stack[top]];
+    var stack = bvh_stack(root, false);
+    while (stack.top > 0u) {
+        let node = mesh_nodes[bvh_pop(&stack)];
         let a = (node.lo - o) * inv;
         let b = (node.hi - o) * inv;
         let lo = min(a, b);
@@ -213,10 +206,8 @@ fn crossings(o: vec3<f32>, d: vec3<f32>, root: u32) -> u32 {
             for (var i = 0u; i < count; i++) {
                 hits += u32(crosses(o, d, first + i));
             }
-        } else if (top + 2u <= STACK_SIZE) {
-            stack[top] = first;
-            stack[top + 1u] = first + 1u;
-            top += 2u;
+        } else {
+            bvh_push(&stack, first, first + 1u);
         }
     }
     return hits;

@@ -12,12 +12,12 @@
 
 @compute @workgroup_size(8, 8, 1)
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {
-    let size = vec2<u32>(frame.viewport.xy);
-    if (id.x >= size.x || id.y >= size.y) {
+    let pixel = viewport_pixel(id.xy);
+    if (pixel == NO_PIXEL) {
         return;
     }
     let stride = segment_stride();
-    let base = (id.y * size.x + id.x) * stride;
+    let base = pixel * stride;
     let d = pixel_direction(id.xy);
     let origin = hyper.to_local[3].xyz;
     let dir = (hyper.to_local * vec4<f32>(d, 0.0)).xyz;

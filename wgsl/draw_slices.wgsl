@@ -1,6 +1,7 @@
 // Draws view-aligned slice polygons with trilinear texel sampling, step-corrected opacity, premultiplied.
 #include "shared/types.wgsl"
 #include "shared/shading.wgsl"
+#include "shared/barycentrics.wgsl"
 
 // Per-pixel (Phong) lighting from the baked normals instead of the shading baked into the texel.
 override per_pixel_lighting: bool = false;
@@ -26,22 +27,6 @@ struct VsOut {
     @location(4) n_w: vec3<f32>,
 }
 
-// Barycentrics of p (in the triangle's plane) in the triangle q0 q1 q2; (1/3, 1/3, 1/3) if degenerate.
-// Area ratios against n = e1 x e2 (rounding grows as 1/sin of the smallest angle, not 1/sin^2).
-fn barycentrics(p: vec3<f32>, q0: vec3<f32>, q1: vec3<f32>, q2: vec3<f32>) -> vec3<f32> {
-    let e1 = q1 - q0;
-    let e2 = q2 - q0;
-    let e = p - q0;
-    let n = cross(e1, e2);
-    let nn = dot(n, n);
-    if (nn <= 1e-12 * dot(e1, e1) * dot(e2, e2)) {
-        return vec3<f32>(1.0 / 3.0);
-    }
-    let b1 = dot(cross(e, e2), n) / nn;
-    let b2 = dot(cross(e1, e), n) / nn;
-    return vec3<f32>(1.0 - b1 - b2, b1, b2);
-}
-
 @vertex
 fn vs_main(@builtin(vertex_index) index: u32) -> VsOut {
     let v = slice_vertices[index];
@@ -59,7 +44,7 @@ fn vs_main(@builtin(vertex_index) index: u32) -> VsOut {
         let b = shell_vertices[ids.y];
         let c = shell_vertices[ids.z];
         let w = v.uvw.z;
-        let bary = barycentrics(v.position.xyz, mix(a.bottom.xyz, a.top.xyz, w), mix(b.bottom.xyz, b.top.xyz, w), mix(c.bottom.xyz, c.top.xyz, w));
+        let bary = barycentrics(v.position.xyz, mix(a.bottom.xyz, a.top.xyz, w), mix(b.bottom.xyz, b.top.xyz, w), mix(c.bottom.xyz, c.top.xyz, w), vec3<f32>(1.0 / 3.0));
         let fa = vertex_frames[ids.x];
         let fb = vertex_frames[ids.y];
         let fc = vertex_frames[ids.z];

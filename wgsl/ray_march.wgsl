@@ -28,11 +28,10 @@ override peeling: bool = false;
 
 @compute @workgroup_size(8, 8, 1)
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {
-    let size = vec2<u32>(frame.viewport.xy);
-    if (id.x >= size.x || id.y >= size.y) {
+    let pixel = viewport_pixel(id.xy);
+    if (pixel == NO_PIXEL) {
         return;
     }
-    let pixel = id.y * size.x + id.x;
     let state = ray_march_state[pixel];
     if (state.resume.z > 0.0) {
         return;

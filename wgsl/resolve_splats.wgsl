@@ -16,11 +16,10 @@ const MIN_TRANSMITTANCE: f32 = 1e-4;
 
 @compute @workgroup_size(8, 8, 1)
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {
-    let size = vec2<u32>(frame.viewport.xy);
-    if (id.x >= size.x || id.y >= size.y) {
+    let pixel = viewport_pixel(id.xy);
+    if (pixel == NO_PIXEL) {
         return;
     }
-    let pixel = id.y * size.x + id.x;
     let base = pixel * slab_stride();
     let n = splat_slabs[base + 2u];
     var rgb = vec3<f32>(0.0);

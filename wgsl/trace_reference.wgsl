@@ -2,6 +2,7 @@
 #include "shared/types.wgsl"
 #include "shared/prism_map.wgsl"
 #include "shared/shading.wgsl"
+#include "shared/bvh.wgsl"
 
 // Work per dispatch, in samples (a window's collection counts WINDOW_COST): the pass is dispatched
 // `reference_dispatches` times and each pixel resumes from `reference_state`. Lavapipe ends every
@@ -128,12 +129,9 @@ fn collect(d: vec3<f32>, t_start: f32) {
     seg_count = 0u;
     cut = FAR;
     let inv = 1.0 / d;
-    var stack: array<u32, STACK_SIZE>;
-    var top = select(0u, 1u, reference_params.counts.x > 0u);
-    stack[0] = 0u;
-    while (top > 0u) {
-        top -= 1u;
-        let node = reference_nodes[stack[top]];
+    var stack = bvh_stack(0u, reference_params.counts.x == 0u);
+    while (stack.top > 0u) {
+        let node = reference_nodes[bvh_pop(&stack)];
         let span = slab(inv, node);
         if (span.x <= span.y && span.y >= t_start && span.x <= min(t_opaque, cut)) {
             let count = bitcast<u32>(node.min.w);
@@ -142,10 +140,8 @@ fn collect(d: vec3<f32>, t_start: f32) {
                 for (var i = 0u; i < count; i++) {
                     collect_prism(d, first + i, t_start);
                 }
-            } else if (top + 2u <= STACK_SIZE) {
-                stack[top] = first;
-                stack[top + 1u] = first + 1u;
-                top += 2u;
+            } else {
+                bvh_push(&stack, first, first + 1u);
             }
         }
     }

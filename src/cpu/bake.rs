@@ -395,36 +395,45 @@ impl Volume {
     }
 }
 
-/// Whole-volume CPU bakes (for comparisons): (rgba, normals with w = 0).
-pub fn bake_implicit_volume(
+/// Every voxel of a bake kernel's dispatch (x fastest), from its one-voxel twin:
+/// (rgba, normals with w = 0).
+pub fn bake_volume(
     params: &BakeParams,
-    shapes: &[ImplicitShape],
-    balls: &[[f32; 4]],
-    per_pixel: bool,
+    mut voxel: impl FnMut([u32; 3]) -> ([f32; 4], [f32; 3]),
 ) -> (Volume, Volume) {
     let size = xyz_u(params.resolution);
     let mut normals = Vec::new();
     let rgba = Volume::from_fn(size, |v| {
-        let (c, n) = bake_implicit_voxel(params, shapes, balls, v, per_pixel);
+        let (c, n) = voxel(v);
         normals.push([n[0], n[1], n[2], 0.0]);
         c
     });
     (rgba, Volume { size, texels: normals })
 }
 
-pub fn bake_heightfield_volume(
+/// Twin of `bake_implicit.wgsl`: the whole volume (rgba, normals with w = 0).
+pub fn bake_implicit(
     params: &BakeParams,
-    hf: &HeightfieldParams,
+    shapes: &[ImplicitShape],
+    balls: &[[f32; 4]],
     per_pixel: bool,
 ) -> (Volume, Volume) {
-    let size = xyz_u(params.resolution);
-    let mut normals = Vec::new();
-    let rgba = Volume::from_fn(size, |v| {
-        let (c, n) = bake_heightfield_voxel(params, hf, v, per_pixel);
-        normals.push([n[0], n[1], n[2], 0.0]);
-        c
-    });
-    (rgba, Volume { size, texels: normals })
+    bake_volume(params, |v| bake_implicit_voxel(params, shapes, balls, v, per_pixel))
+}
+
+/// Twin of `bake_heightfield.wgsl`: the whole volume (rgba, normals with w = 0).
+pub fn bake_heightfield(params: &BakeParams, hf: &HeightfieldParams, per_pixel: bool) -> (Volume, Volume) {
+    bake_volume(params, |v| bake_heightfield_voxel(params, hf, v, per_pixel))
+}
+
+/// Twin of `bake_height_image.wgsl`: the whole volume (rgba, normals with w = 0).
+pub fn bake_height_image(
+    params: &BakeParams,
+    hi: &HeightImageParams,
+    heights: &[f32],
+    per_pixel: bool,
+) -> (Volume, Volume) {
+    bake_volume(params, |v| bake_height_image_voxel(params, hi, heights, v, per_pixel))
 }
 
 fn xyz_u(v: [u32; 4]) -> [u32; 3] {

@@ -4,7 +4,7 @@
 
 use glam::DVec3;
 
-use super::bake::{gradient_normal, shade_lambert};
+use super::bake::{bake_volume, gradient_normal, shade_lambert, Volume};
 use super::hypertexture::Model;
 use crate::types::BakeParams;
 
@@ -42,4 +42,9 @@ pub fn bake_hypertexture_voxel(
     let rgb = if per_pixel { albedo } else { shade_lambert(albedo, normal, params.light) };
     let rgb = rgb.map(|c| c.clamp(0.0, 1.0) * alpha);
     ([rgb[0], rgb[1], rgb[2], alpha], normal)
+}
+
+/// Twin of `bake_hypertexture.wgsl`: the whole volume (rgba, normals with w = 0).
+pub fn bake_hypertexture(params: &BakeParams, model: &Model, per_pixel: bool) -> (Volume, Volume) {
+    bake_volume(params, |v| bake_hypertexture_voxel(params, model, v, per_pixel))
 }

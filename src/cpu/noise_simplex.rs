@@ -129,63 +129,69 @@ pub fn simplex4(p: DVec4, seed: u32) -> f64 {
 mod tests {
     use super::*;
 
-    /// The noise is continuous (no jump across simplex borders), spans most of [-1, 1] and has a
-    /// mean near 0; seeds give independent noises.
-    #[test]
-    fn simplex_is_continuous_bounded_and_seeded() {
-        let mut rng = 0x1234_5678u32;
-        let mut next = || {
-            rng = pcg_hash(rng);
-            rng as f64 / u32::MAX as f64
-        };
-        let (mut lo, mut hi, mut sum, mut jump, mut same): (f64, f64, f64, f64, usize) =
-            (1.0, -1.0, 0.0, 0.0, 0);
-        let n = 20000;
-        for _ in 0..n {
-            let p = DVec3::new(next(), next(), next()) * 40.0 - DVec3::splat(20.0);
-            let v = simplex3(p, 0);
-            lo = lo.min(v);
-            hi = hi.max(v);
-            sum += v;
-            let e = DVec3::new(next(), next(), next()).normalize() * 1e-6;
-            jump = jump.max((simplex3(p + e, 0) - v).abs());
-            same += ((simplex3(p, 1) - v).abs() < 1e-9) as usize;
-        }
-        eprintln!(
-            "simplex3: range [{lo:.3}, {hi:.3}], mean {:.4}, largest change over 1e-6: {jump:.2e}",
-            sum / n as f64
-        );
-        assert!(lo < -0.8 && hi > 0.8 && lo >= -1.0 && hi <= 1.0);
-        assert!((sum / n as f64).abs() < 0.02);
-        assert!(jump < 1e-4, "continuous: {jump}");
-        assert!(same < n / 100, "seed 1 differs from seed 0");
+    /// Range, mean and largest change over a 1e-6 step of a noise at 20000 random points:
+    /// `sample(next)` draws its point with `next` (uniform in [0, 1]) and returns (value, change).
+    struct Survey {
+        lo: f64,
+        hi: f64,
+        mean: f64,
+        jump: f64,
     }
 
-    /// 4D noise: continuous in space and time, spans most of [-1, 1], mean near 0.
-    #[test]
-    fn simplex4_is_continuous_and_bounded() {
-        let mut rng = 0x9e37_79b9u32;
+    const SAMPLES: usize = 20000;
+
+    fn survey(
+        name: &str,
+        seed: u32,
+        mut sample: impl FnMut(&mut dyn FnMut() -> f64) -> (f64, f64),
+    ) -> Survey {
+        let mut rng = seed;
         let mut next = || {
             rng = pcg_hash(rng);
             rng as f64 / u32::MAX as f64
         };
         let (mut lo, mut hi, mut sum, mut jump): (f64, f64, f64, f64) = (1.0, -1.0, 0.0, 0.0);
-        let n = 20000;
-        for _ in 0..n {
-            let p = DVec4::new(next(), next(), next(), next()) * 40.0 - DVec4::splat(20.0);
-            let v = simplex4(p, 3);
+        for _ in 0..SAMPLES {
+            let (v, change) = sample(&mut next);
             lo = lo.min(v);
             hi = hi.max(v);
             sum += v;
-            let e = DVec4::new(next(), next(), next(), next()).normalize() * 1e-6;
-            jump = jump.max((simplex4(p + e, 3) - v).abs());
+            jump = jump.max(change);
         }
-        eprintln!(
-            "simplex4: range [{lo:.3}, {hi:.3}], mean {:.4}, largest change over 1e-6: {jump:.2e}",
-            sum / n as f64
-        );
-        assert!(lo < -0.7 && hi > 0.7 && lo >= -1.0 && hi <= 1.0);
-        assert!((sum / n as f64).abs() < 0.02);
-        assert!(jump < 1e-4, "continuous: {jump}");
+        let mean = sum / SAMPLES as f64;
+        eprintln!("{name}: range [{lo:.3}, {hi:.3}], mean {mean:.4}, largest change over 1e-6: {jump:.2e}");
+        Survey { lo, hi, mean, jump }
+    }
+
+    /// The noise is continuous (no jump across simplex borders), spans most of [-1, 1] and has a
+    /// mean near 0; seeds give independent noises.
+    #[test]
+    fn simplex_is_continuous_bounded_and_seeded() {
+        let mut same = 0;
+        let s = survey("simplex3", 0x1234_5678, |next| {
+            let p = DVec3::new(next(), next(), next()) * 40.0 - DVec3::splat(20.0);
+            let v = simplex3(p, 0);
+            let e = DVec3::new(next(), next(), next()).normalize() * 1e-6;
+            same += ((simplex3(p, 1) - v).abs() < 1e-9) as usize;
+            (v, (simplex3(p + e, 0) - v).abs())
+        });
+        assert!(s.lo < -0.8 && s.hi > 0.8 && s.lo >= -1.0 && s.hi <= 1.0);
+        assert!(s.mean.abs() < 0.02);
+        assert!(s.jump < 1e-4, "continuous: {}", s.jump);
+        assert!(same < SAMPLES / 100, "seed 1 differs from seed 0");
+    }
+
+    /// 4D noise: continuous in space and time, spans most of [-1, 1], mean near 0.
+    #[test]
+    fn simplex4_is_continuous_and_bounded() {
+        let s = survey("simplex4", 0x9e37_79b9, |next| {
+            let p = DVec4::new(next(), next(), next(), next()) * 40.0 - DVec4::splat(20.0);
+            let v = simplex4(p, 3);
+            let e = DVec4::new(next(), next(), next(), next()).normalize() * 1e-6;
+            (v, (simplex4(p + e, 3) - v).abs())
+        });
+        assert!(s.lo < -0.7 && s.hi > 0.7 && s.lo >= -1.0 && s.hi <= 1.0);
+        assert!(s.mean.abs() < 0.02);
+        assert!(s.jump < 1e-4, "continuous: {}", s.jump);
     }
 }

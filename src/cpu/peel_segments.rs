@@ -36,6 +36,26 @@ pub fn bounds_span(model: &Model, o: DVec3, d: DVec3) -> (f64, f64) {
     (a.min(b).max_element(), a.max(b).min_element())
 }
 
+/// Pixel `(x, y)`'s ray as the segment kernels set it up: the object-space ray `origin + dir t`
+/// (world point `d t`, `d` its `pixel_direction`), its span (entry, exit) in the enlarged bounds, and
+/// where it starts (the entry or the near plane, whichever is farther).
+pub struct PixelRay {
+    pub origin: DVec3,
+    pub dir: DVec3,
+    pub span: (f64, f64),
+    pub start: f64,
+}
+
+pub fn pixel_ray(frame: &FrameParams, model: &Model, x: u32, y: u32) -> PixelRay {
+    let to_local = DMat4::from_cols_array_2d(&model.params.to_local.map(|c| c.map(|v| v as f64)));
+    let d = pixel_direction(frame, model, x, y);
+    let origin = to_local.w_axis.truncate();
+    let dir = to_local.transform_vector3(d);
+    let span = bounds_span(model, origin, dir);
+    let start = span.0.max(model.params.right[3] as f64 / d.dot(v3(frame.forward)));
+    PixelRay { origin, dir, span, start }
+}
+
 /// Boundary slots of pixel `(x, y)` after every peel: the start, then entry and exit of each
 /// segment (infinity where none was found).
 pub fn peel_segments(
@@ -47,12 +67,7 @@ pub fn peel_segments(
     y: u32,
 ) -> Vec<f64> {
     let passes = segments.counts[2] as usize;
-    let to_local = DMat4::from_cols_array_2d(&model.params.to_local.map(|c| c.map(|v| v as f64)));
-    let d = pixel_direction(frame, model, x, y);
-    let origin = to_local.w_axis.truncate();
-    let dir = to_local.transform_vector3(d);
-    let span = bounds_span(model, origin, dir);
-    let start = span.0.max(model.params.right[3] as f64 / d.dot(v3(frame.forward)));
+    let PixelRay { origin, dir, span, start } = pixel_ray(frame, model, x, y);
     let mut slots = vec![f64::INFINITY; 2 * passes + 1];
     slots[0] = start;
     if span.0 < span.1 && model.support_distance(origin + dir * start) < segments.surface[0] as f64 {

@@ -304,8 +304,9 @@ fn planes<'a>(
     })
 }
 
-/// Triangle-list vertices per plane, back to front (k ascending), prisms in index order.
-pub fn slice_all(
+/// Twin of `emit_slices`: triangle-list vertices per plane, back to front (k ascending), prisms
+/// in index order.
+pub fn emit_slices(
     vertices: &[ShellVertex],
     prisms: &[Prism],
     params: &SliceParams,
@@ -317,7 +318,7 @@ pub fn slice_all(
 }
 
 /// Twin of `count_slices`: the triangle-list vertex count of each plane.
-pub fn plane_counts(
+pub fn count_slices(
     vertices: &[ShellVertex],
     prisms: &[Prism],
     params: &SliceParams,

@@ -439,7 +439,7 @@ fn flat_shell_cross_section_area_at_30_degrees() {
         vertex_capacity: u32::MAX,
         _pad: [0; 3],
     };
-    let tris = &slice_all(&v, &prisms, &params, true)[0];
+    let tris = &emit_slices(&v, &prisms, &params, true)[0];
     let total: f64 =
         tris.chunks(3).map(|t| area(&t.iter().map(|q| xyz(q.position)).collect::<Vec<_>>())).sum();
     let expect = (2.0 * h * size) as f64;
@@ -471,9 +471,9 @@ fn counts_scan_and_slices_agree_and_trivial_reject_changes_nothing() {
         vertex_capacity: 1000,
         _pad: [0; 3],
     };
-    let slices = slice_all(&v, &prisms, &params, true);
-    assert_eq!(slices, slice_all(&v, &prisms, &params, false));
-    let counts = plane_counts(&v, &prisms, &params, true);
+    let slices = emit_slices(&v, &prisms, &params, true);
+    assert_eq!(slices, emit_slices(&v, &prisms, &params, false));
+    let counts = count_slices(&v, &prisms, &params, true);
     assert_eq!(counts, slices.iter().map(|s| s.len() as u32).collect::<Vec<_>>());
     assert!(counts.iter().filter(|&&c| c > 0).count() > 50);
     let (offsets, args) = scan_plane_offsets(&counts, params.vertex_capacity);
@@ -482,7 +482,7 @@ fn counts_scan_and_slices_agree_and_trivial_reject_changes_nothing() {
     assert_eq!(offsets[63] + counts[63], total);
     assert_eq!(args.vertex_count, total.min(1000));
     assert_eq!(args.instance_count, 1);
-    // Prism indices ascend within each plane (as slice_all promises).
+    // Prism indices ascend within each plane (as emit_slices promises).
     for s in &slices {
         let ids: Vec<u32> = s.iter().map(|q| q.position[3].to_bits()).collect();
         assert!(ids.windows(2).all(|w| w[0] <= w[1]));

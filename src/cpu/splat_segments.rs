@@ -6,10 +6,10 @@
 //! composited front to back. It tests every splat against every ray (the kernel only those of
 //! its footprint) and sums in f64 (the kernel in fixed point, per splat and slab).
 
-use glam::{DMat4, DVec3};
+use glam::DVec3;
 
 use super::hypertexture::Model;
-use super::peel_segments::{bounds_span, pixel_direction};
+use super::peel_segments::{pixel_ray, PixelRay};
 use super::ray_march::{MAX_ALPHA, MIN_TRANSMITTANCE};
 use crate::types::{FrameParams, SegmentParams, Splat};
 
@@ -38,13 +38,7 @@ pub fn splat_segments(
 ) -> [f64; 4] {
     let p = model.params;
     let slabs = segments.splatting[0] as u64;
-    let to_local = DMat4::from_cols_array_2d(&p.to_local.map(|c| c.map(|v| v as f64)));
-    let d = pixel_direction(frame, model, x, y);
-    let forward = DVec3::new(frame.forward[0] as f64, frame.forward[1] as f64, frame.forward[2] as f64);
-    let origin = to_local.w_axis.truncate();
-    let dir = to_local.transform_vector3(d);
-    let (entry, t1) = bounds_span(model, origin, dir);
-    let t0 = entry.max(p.right[3] as f64 / d.dot(forward));
+    let PixelRay { origin, dir, span: (_, t1), start: t0 } = pixel_ray(frame, model, x, y);
     if t1 <= t0 {
         return [0.0; 4];
     }

@@ -106,8 +106,9 @@ struct Segment {
     t1: f64,
 }
 
-/// The premultiplied layer (rgb, coverage) of the whole image, rows top to bottom.
-pub fn trace(view: &TraceView, objects: &[TraceObject]) -> Vec<[f64; 4]> {
+/// Twin of `trace_reference.wgsl`: the premultiplied layer (rgb, coverage) of the whole image,
+/// rows top to bottom.
+pub fn trace_reference(view: &TraceView, objects: &[TraceObject]) -> Vec<[f64; 4]> {
     let mut out = Vec::with_capacity((view.width * view.height) as usize);
     for y in 0..view.height {
         for x in 0..view.width {

@@ -51,10 +51,20 @@ pub fn plane(size: [f64; 2], cells: [u32; 2], jitter: f64, seed: u32) -> Mesh {
         }
     }
     let corner_uvs = triangles.iter().map(|t| t.map(|k| uv(positions[k as usize]))).collect();
-    let n = positions.len();
+    let normals = vec![DVec3::Z; positions.len()];
+    with_corner_uvs(positions, normals, triangles, corner_uvs)
+}
+
+/// A mesh of these triangles and corner uvs, vertex uvs derived from the corners.
+fn with_corner_uvs(
+    positions: Vec<DVec3>,
+    normals: Vec<DVec3>,
+    triangles: Vec<[u32; 3]>,
+    corner_uvs: Vec<[DVec2; 3]>,
+) -> Mesh {
     let mut m = Mesh {
         positions,
-        normals: vec![DVec3::Z; n],
+        normals,
         triangles,
         corner_uvs,
         vertex_uvs: vec![],
@@ -123,18 +133,8 @@ fn parametric(nu: usize, nv: usize, wrap_v: bool, pos: impl Fn(f64, f64) -> DVec
             }
         }
     }
-    let mut m = Mesh {
-        normals: vec![DVec3::ZERO; positions.len()],
-        positions,
-        triangles,
-        corner_uvs,
-        vertex_uvs: vec![],
-        attribute: None,
-        colors: None,
-        face_lines: vec![],
-    };
-    m.vertex_uvs = m.vertex_uvs_from_corners();
-    m
+    let normals = vec![DVec3::ZERO; positions.len()];
+    with_corner_uvs(positions, normals, triangles, corner_uvs)
 }
 
 /// UV sphere around the origin: `segments = (around z, pole to pole)`, at least (3, 2).

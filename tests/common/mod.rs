@@ -3,6 +3,7 @@
 #![allow(dead_code)]
 
 pub mod golden;
+pub mod window;
 
 /// Copies a folder tree (tests that edit copies of `wgsl/` and `graphs/`).
 pub fn copy_dir(from: &std::path::Path, to: &std::path::Path) {
@@ -43,3 +44,58 @@ pub fn ok(out: std::process::Output) -> String {
 pub fn s(p: &std::path::Path) -> &str {
     p.to_str().unwrap()
 }
+
+/// An empty scratch folder `<temp>/<name>-<pid>` (emptied if a previous run left it).
+pub fn scratch_dir(name: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// One device for the whole test binary; renders are serialised (two cores, one lavapipe).
+pub fn ctx() -> &'static std::sync::Mutex<voltex::gpu::GpuContext> {
+    static CTX: std::sync::OnceLock<std::sync::Mutex<voltex::gpu::GpuContext>> = std::sync::OnceLock::new();
+    CTX.get_or_init(|| {
+        std::sync::Mutex::new(
+            voltex::gpu::GpuContext::new().expect("a GPU adapter (software Vulkan: mesa-vulkan-drivers)"),
+        )
+    })
+}
+
+/// Default render options at this output size.
+pub fn sized(w: u32, h: u32) -> voltex::render::RenderOptions {
+    voltex::render::RenderOptions { size: Some((w, h)), ..Default::default() }
+}
+
+/// A run's standard error as text.
+pub fn stderr(out: &std::process::Output) -> String {
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+/// The names in a folder, sorted.
+pub fn entries(dir: &std::path::Path) -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    v.sort();
+    v
+}
+
+/// A RayMarch object's layer as its composite draws it: the colour of `ray_march_state` (its
+/// bytes) times the frame's light colour, and the coverage.
+pub fn lit_march_state(frame: &voltex::types::FrameParams, bytes: &[u8]) -> Vec<[f64; 4]> {
+    let light = frame.light_color.map(|c| c as f64);
+    bytemuck::pod_collect_to_vec::<u8, voltex::types::MarchState>(bytes)
+        .iter()
+        .map(|s| std::array::from_fn(|c| s.color[c] as f64 * if c < 3 { light[c] } else { 1.0 }))
+        .collect()
+}
+
+/// ((camera eye, look-at), node transform) pairs for RayMarch segment strategies compared with
+/// the bounds march: a sphere rotated and scaled unevenly, and the eye inside the object.
+pub const TRANSFORMED_AND_INSIDE_VIEWS: [((&str, &str), &str); 2] = [
+    (("(0.5, -4.0, 1.0)", "(0.0, 0.0, 0.0)"), "(rotate: (30.0, 10.0, 50.0), scale: (1.5, 0.6, 1.0))"),
+    (("(0.0, -0.4, 0.2)", "(0.0, -2.0, 0.0)"), "()"),
+];

@@ -1,5 +1,6 @@
 // Rays against prisms and the inverse prism map; f32 port of src/cpu/prism_map.rs, function for
 // function. Prism corners go by pointer (by-value arrays are slow on lavapipe).
+#include "shared/barycentrics.wgsl"
 
 // A point counts as inside a prism when its barycentrics are at least -INSIDE_EPS.
 const INSIDE_EPS: f32 = 1e-5;
@@ -171,21 +172,6 @@ fn bracketed_root(c: vec4<f32>, lo_in: f32, hi_in: f32) -> f32 {
     return w;
 }
 
-// Barycentrics of x (in the triangle's plane) in q0 q1 q2; x < -1 when the triangle is degenerate.
-// Area ratios against n = e1 x e2: rounding grows as 1/sin of the smallest angle, not 1/sin^2 as
-// with the normal equations (which lost every digit of a sliver's barycentrics in f32).
-fn section_barycentrics(x: vec3<f32>, q0: vec3<f32>, q1: vec3<f32>, q2: vec3<f32>) -> vec3<f32> {
-    let e1 = q1 - q0;
-    let e2 = q2 - q0;
-    let e = x - q0;
-    let n = cross(e1, e2);
-    let nn = dot(n, n);
-    let b1 = dot(cross(e, e2), n) / nn;
-    let b2 = dot(cross(e1, e), n) / nn;
-    let degenerate = nn <= 1e-12 * dot(e1, e1) * dot(e2, e2) || nn == 0.0;
-    return select(vec3<f32>(1.0 - b1 - b2, b1, b2), vec3<f32>(-2.0), degenerate);
-}
-
 // The inverse prism map: (b, w) with x = sum_i b_i (p_i + w h_i); w < 0 when x is outside.
 // [0, 1] is cut at the cubic's critical points into monotone pieces; the first root whose
 // barycentrics lie in the section wins. No division by the leading coefficient, so parallel
@@ -236,7 +222,7 @@ fn prism_inverse(x: vec3<f32>, p: ptr<function, PrismShape>) -> vec4<f32> {
         let q0 = mix((*p).bottom[0], (*p).top[0], w);
         let q1 = mix((*p).bottom[1], (*p).top[1], w);
         let q2 = mix((*p).bottom[2], (*p).top[2], w);
-        let b = section_barycentrics(x, q0, q1, q2);
+        let b = barycentrics(x, q0, q1, q2, vec3<f32>(-2.0));
         if (all(b >= vec3<f32>(-INSIDE_EPS))) {
             result = vec4<f32>(b, w);
             break;

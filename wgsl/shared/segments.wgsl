@@ -17,6 +17,15 @@ fn bounds_span(o: vec3<f32>, d: vec3<f32>) -> vec2<f32> {
     return vec2<f32>(max(max(lo.x, lo.y), lo.z), min(min(hi.x, hi.y), hi.z));
 }
 
+// No pixel: a thread of a workgroup past the viewport's edge.
+const NO_PIXEL: u32 = 0xffffffffu;
+
+// The index of pixel p in the viewport (rows top to bottom), or NO_PIXEL outside it.
+fn viewport_pixel(p: vec2<u32>) -> u32 {
+    let size = vec2<u32>(frame.viewport.xy);
+    return select(NO_PIXEL, p.y * size.x + p.x, all(p < size));
+}
+
 // The unit world direction (camera-relative) of the ray through the middle of pixel p.
 fn pixel_direction(p: vec2<u32>) -> vec3<f32> {
     let sx = 2.0 * (f32(p.x) + 0.5) * frame.viewport.z - 1.0;

@@ -1,0 +1,194 @@
+//! DESIGN.md convention 2: every kernel whose math matters has a CPU twin of the same name, and
+//! the kernels without one are listed here with the reason. A kernel is a WGSL file under `wgsl/`
+//! (any depth, `wgsl/shared/` includes excluded) with an `@compute`, `@vertex` or `@fragment`
+//! entry point; its twin is a `pub fn <file stem>` anywhere under `src/` in a module whose `//!`
+//! doc calls it a twin. No GPU needed.
+
+use std::collections::{BTreeMap, BTreeSet};
+use std::path::{Path, PathBuf};
+
+/// Kernels without a CPU twin of their name, and why. Kept true by the test below: a kernel that
+/// gains a twin or disappears must leave the list.
+const NO_TWIN: &[(&str, &str)] = &[
+    (
+        "begin_segments",
+        "depth peeling's first step (each pixel's start, no boundaries yet): the twin \
+         `peel_segments` (src/cpu/peel_segments.rs) returns a pixel's boundaries after this step \
+         and every peel, compared with both kernels' output in tests/hypertexture_segments.rs",
+    ),
+    (
+        "resolve_splats",
+        "splatting's second step (slabs composited front to back): the twin `splat_segments` \
+         (src/cpu/splat_segments.rs) returns the resolved pixel of both steps, compared in \
+         tests/hypertexture_splatting.rs",
+    ),
+    (
+        "probe_hypertexture",
+        "test probe, no math of its own: evaluates the functions of wgsl/shared/hypertexture.wgsl \
+         at given points so that tests/hypertexture.rs compares them with src/cpu/hypertexture.rs",
+    ),
+    (
+        "bench_simplex",
+        "benchmark only (`voltex bench-hyper` times it): loops over simplex3 of \
+         wgsl/shared/simplex.wgsl, whose twin is `simplex3` in src/cpu/noise_simplex.rs",
+    ),
+    (
+        "scan_axis_slices",
+        "bookkeeping: an exclusive prefix sum (wgsl/shared/scan.wgsl, as scan_plane_offsets, \
+         which has a twin) of per-prism vertex counts; tests/axis_slices.rs checks that every \
+         vertex counted is drawn",
+    ),
+    (
+        "scan_axis_layers",
+        "bookkeeping: an exclusive prefix sum (wgsl/shared/scan.wgsl) of per-layer triangle \
+         counts; tests/axis_slices.rs checks that grouping draws the same image",
+    ),
+    (
+        "group_axis_slices",
+        "bookkeeping: copies emitted triangles into their slice image's group, no arithmetic on \
+         them; tests/axis_slices.rs checks that grouping by slice image draws the same image",
+    ),
+    (
+        "composite",
+        "raster: blends the premultiplied accumulation over the background (one line); checked \
+         by the golden images (tests/render_scenes.rs, voltex regress)",
+    ),
+    (
+        "composite_ray_march",
+        "raster: blends the march state the ray_march twin computes over the frame (one line); \
+         checked by the golden images",
+    ),
+    (
+        "composite_reference",
+        "raster: copies the trace_reference layer (premultiplied-over blending by the pipeline); \
+         checked by tests/reference.rs and the golden images",
+    ),
+    (
+        "draw_base",
+        "raster: draws the opaque base surface with depth, lit two-sided by ambient plus Lambert \
+         (one line); checked by the golden images",
+    ),
+    (
+        "draw_slices",
+        "raster: draws what emit_slices produced (checked against its twin in \
+         tests/gpu_slicing.rs) with trilinear sampling and the step-corrected opacity; checked \
+         by the golden images",
+    ),
+    (
+        "draw_axis_slices",
+        "raster: draws what emit_axis_slices produced (checked against its twin in \
+         tests/axis_slices.rs) from the slice images bake_axis_slices made; checked by the \
+         golden images",
+    ),
+    (
+        "draw_slice_coverage",
+        "debug view: counts the slice polygons covering each pixel (additive white), no math",
+    ),
+    (
+        "present",
+        "preview window only: shows an image already computed (filmic tonemap, sRGB, difference \
+         heat map, overlay text); no headless output goes through it",
+    ),
+];
+
+fn root() -> &'static Path {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn files(dir: &Path, ext: &str, out: &mut Vec<PathBuf>) {
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let path = entry.unwrap().path();
+        if path.is_dir() {
+            files(&path, ext, out);
+        } else if path.extension().is_some_and(|e| e == ext) {
+            out.push(path);
+        }
+    }
+}
+
+/// The text without `//` comments.
+fn code(text: &str) -> String {
+    text.lines().map(|l| l.split("//").next().unwrap()).collect::<Vec<_>>().join("\n")
+}
+
+/// Kernel stems (file names without `.wgsl`) and their paths.
+fn kernels() -> BTreeMap<String, PathBuf> {
+    let wgsl = root().join("wgsl");
+    let mut paths = Vec::new();
+    files(&wgsl, "wgsl", &mut paths);
+    let mut kernels = BTreeMap::new();
+    for path in paths {
+        if path.strip_prefix(&wgsl).unwrap().starts_with("shared") {
+            continue;
+        }
+        let text = code(&std::fs::read_to_string(&path).unwrap());
+        if ["@compute", "@vertex", "@fragment"].iter().any(|e| text.contains(e)) {
+            let stem = path.file_stem().unwrap().to_str().unwrap().to_string();
+            if let Some(other) = kernels.insert(stem.clone(), path.clone()) {
+                panic!("two kernels named {stem}: {} and {}", other.display(), path.display());
+            }
+        }
+    }
+    kernels
+}
+
+/// Names of the `pub fn`s (any visibility qualifier) in the twin modules under `src/`.
+fn twin_functions() -> BTreeSet<String> {
+    let mut paths = Vec::new();
+    files(&root().join("src"), "rs", &mut paths);
+    let mut names = BTreeSet::new();
+    for path in paths {
+        let text = std::fs::read_to_string(&path).unwrap();
+        // A twin module says so in its module doc (host code such as `methods::ray_march`'s
+        // `bake_mesh_grid`, which dispatches the kernel, does not count).
+        let doc: String = text.lines().filter(|l| l.trim_start().starts_with("//!")).collect();
+        if !doc.to_lowercase().contains("twin") {
+            continue;
+        }
+        for line in code(&text).lines() {
+            let line = line.trim_start();
+            let Some(rest) = line.strip_prefix("pub") else { continue };
+            let rest = match rest.strip_prefix('(') {
+                Some(r) => r.split_once(')').map_or("", |(_, r)| r),
+                None => rest,
+            };
+            if let Some(rest) = rest.trim_start().strip_prefix("fn ") {
+                let name: String = rest.chars().take_while(|c| c.is_alphanumeric() || *c == '_').collect();
+                names.insert(name);
+            }
+        }
+    }
+    names
+}
+
+#[test]
+fn every_kernel_has_a_twin_of_its_name_or_a_listed_reason() {
+    let kernels = kernels();
+    assert!(kernels.len() >= 20, "found only {} kernels under wgsl/", kernels.len());
+    let twins = twin_functions();
+    let listed: BTreeMap<&str, &str> = NO_TWIN.iter().copied().collect();
+    assert_eq!(listed.len(), NO_TWIN.len(), "a kernel listed twice in NO_TWIN");
+    let mut problems = Vec::new();
+    for (stem, path) in &kernels {
+        let twin = twins.contains(stem);
+        match (twin, listed.get(stem.as_str())) {
+            (true, Some(_)) => {
+                problems.push(format!("{stem} has a twin `pub fn {stem}` now: remove it from NO_TWIN"))
+            }
+            (false, None) => problems.push(format!(
+                "{} has no CPU twin `pub fn {stem}` under src/ and is not in NO_TWIN",
+                path.display()
+            )),
+            (false, Some(reason)) if reason.trim().is_empty() => {
+                problems.push(format!("{stem}: empty reason in NO_TWIN"))
+            }
+            _ => {}
+        }
+    }
+    for stem in listed.keys() {
+        if !kernels.contains_key(*stem) {
+            problems.push(format!("NO_TWIN lists {stem}, which is no kernel under wgsl/"));
+        }
+    }
+    assert!(problems.is_empty(), "{}", problems.join("\n"));
+}
