@@ -9,7 +9,6 @@ use std::path::{Path, PathBuf};
 use glam::DVec3;
 use voltex::cpu::{prism_map, trace_reference};
 use voltex::io::Image;
-use voltex::methods::reference::twin_inputs;
 use voltex::render::{Blueprint, MethodKind, RenderOptions, Renderer};
 use voltex::scene;
 
@@ -41,7 +40,7 @@ fn gpu_and_twin(scene: &Path, opts: &RenderOptions) -> Traced {
     let gpu = r.read_texture(&ctx, "reference_rgba").unwrap();
     let (texels, normals) = r.reference_atlases(&ctx).unwrap().unwrap();
     drop(ctx);
-    let (view, objects) = twin_inputs(&r.blueprint, &texels, &normals);
+    let (view, objects) = r.blueprint.reference_twin_inputs(&texels, &normals);
     let cpu = trace_reference::trace_reference(&view, &objects);
     let cpu = Image::from_pixels(view.width, view.height, cpu.iter().map(|p| p.map(|c| c as f32)).collect())
         .unwrap();
@@ -103,7 +102,7 @@ fn box_of_fog_is_exact() {
     let scene = scene::load(&example("flat_box.ron")).unwrap();
     let eye = scene.camera.eye;
     let bp = Blueprint::new(&scene, &reference(size)).unwrap();
-    let (view, _) = twin_inputs(&bp, &[0; 4 * 8 * 8 * 64], &[0; 4]);
+    let (view, _) = bp.reference_twin_inputs(&[0; 4 * 8 * 8 * 64], &[0; 4]);
     // The bake stores 0.5 as rgba8: 127 or 128, as the adapter rounds (llvmpipe 128, NVIDIA 127).
     let a = t.texels[3] as f64 / 255.0;
     assert!((a - 0.5).abs() < 1.0 / 255.0, "stored opacity {a}");

@@ -46,5 +46,5 @@ pub struct BenchHyperArgs {
 
 pub fn run_hyper(args: BenchHyperArgs) -> Result<()> {
     let BenchHyperArgs { size, frames, quick, segments } = args;
-    voltex::hypertexture::bench::run(size, frames, quick, segments)
+    voltex::bench::hyper::run(size, frames, quick, segments)
 }

@@ -4,7 +4,6 @@
 //! noise or one per row of a 2D shape transfer function, then the red, green, blue and opacity
 //! tables of the colour transfer function).
 
-pub mod bench;
 pub mod mesh;
 pub mod splats;
 

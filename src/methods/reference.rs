@@ -13,9 +13,11 @@ use crate::gpu::GpuContext;
 use crate::gpu::Inputs;
 use crate::mesh::bvh::flat_bvh;
 use crate::mesh::shell;
-use crate::render::{Blueprint, ObjectPlan};
+use crate::mesh::shell::Shell;
+use crate::mesh::BaseSurface;
 use crate::types::{
-    ReferenceNode, ReferenceObject, ReferenceParams, ReferencePrism, ReferenceState, ShellVertex, VertexFrame,
+    FrameParams, ReferenceNode, ReferenceObject, ReferenceParams, ReferencePrism, ReferenceState,
+    ShellVertex, VertexFrame,
 };
 
 /// Everything the reference kernel reads, for all Reference objects of a frame.
@@ -46,8 +48,7 @@ pub const MAX_DISPATCHES: u32 = 20_000;
 
 /// A bound on the work along any ray through the object: a ray meets a shell in a few stretches
 /// (four, for a torus seen edge-on), each no longer than the shell's bounding diagonal.
-fn work_bound(o: &ObjectPlan, step: f64) -> f64 {
-    let s = &o.object.surface;
+fn work_bound(s: &BaseSurface, step: f64) -> f64 {
     let mut lo = DVec3::splat(f64::INFINITY);
     let mut hi = DVec3::splat(f64::NEG_INFINITY);
     for (p, h) in s.positions.iter().zip(&s.heights) {
@@ -67,8 +68,7 @@ fn work_bound(o: &ObjectPlan, step: f64) -> f64 {
 
 /// Half the smallest world extent of a voxel over the object (height along w; `dP/ds`, `dP/dt`
 /// lengths along s and t), averaged over its vertices.
-pub fn default_step(o: &ObjectPlan, resolution: [u32; 3]) -> f64 {
-    let s = &o.object.surface;
+pub fn default_step(s: &BaseSurface, resolution: [u32; 3]) -> f64 {
     let n = s.heights.len().max(1) as f64;
     let h = s.heights.iter().map(|h| h.length()).sum::<f64>() / n;
     let frames = shell::vertex_frames(s);
@@ -98,16 +98,33 @@ fn row_pitch(width: u32) -> u32 {
     (width * 4).div_ceil(256) * 64
 }
 
-/// `resolutions[i]` and `per_pixel[i]` are those of the bake each object samples.
-pub fn build(
-    objects: &[ObjectPlan],
-    members: &[usize],
-    resolutions: &[[u32; 3]],
-    opacity_lengths: &[f32],
-    params: ReferenceParams,
-) -> ReferenceSet {
+/// One object drawn by the Reference method, as the set needs it.
+pub struct Member<'a> {
+    /// Index of the object in the frame.
+    pub index: usize,
+    pub surface: &'a BaseSurface,
+    pub shell: &'a Shell,
+    /// Per-vertex texel frames (per-pixel lighting only).
+    pub frames: Option<&'a [VertexFrame]>,
+    /// The base surface is drawn opaque.
+    pub opaque: bool,
+    /// Ray step (world units).
+    pub step: f64,
+    /// The bake it samples: index, resolution and opacity length.
+    pub bake: usize,
+    pub resolution: [u32; 3],
+    pub opacity_length: f32,
+}
+
+impl Member<'_> {
+    fn per_pixel(&self) -> bool {
+        self.frames.is_some()
+    }
+}
+
+pub fn build(members: &[Member], params: ReferenceParams) -> ReferenceSet {
     let mut set = ReferenceSet {
-        objects: members.to_vec(),
+        objects: members.iter().map(|m| m.index).collect(),
         params,
         nodes: Vec::new(),
         prisms: Vec::new(),
@@ -122,12 +139,13 @@ pub fn build(
     let mut work = 0.0;
     let mut prisms = Vec::new();
     let mut boxes = Vec::new();
-    for (k, &i) in members.iter().enumerate() {
-        let o = &objects[i];
+    for (k, o) in members.iter().enumerate() {
         let first = set.vertices.len() as u32;
         set.vertices.extend_from_slice(&o.shell.vertices);
-        let frames = o.frames.clone().unwrap_or_else(|| vec![VertexFrame::default(); o.shell.vertices.len()]);
-        set.frames.extend(frames);
+        match o.frames {
+            Some(frames) => set.frames.extend_from_slice(frames),
+            None => set.frames.extend(std::iter::repeat_n(VertexFrame::default(), o.shell.vertices.len())),
+        }
         for p in &o.shell.prisms {
             let ids = [p.vertices[0], p.vertices[1], p.vertices[2]];
             let corners = ids.iter().flat_map(|&v| {
@@ -145,20 +163,18 @@ pub fn build(
                 uv2: p.uv2,
             });
         }
-        let res = resolutions[k];
+        let res = o.resolution;
         let pitch = row_pitch(res[0]);
         let words = pitch as u64 * res[1] as u64 * res[2] as u64;
-        let opaque = o.object.base_color.is_some();
-        let step = o.reference_step.unwrap_or(1.0);
-        work += work_bound(o, step);
+        work += work_bound(o.surface, o.step);
         set.table.push(ReferenceObject {
-            resolution: [res[0], res[1], res[2], o.per_pixel as u32 | (opaque as u32) << 1],
+            resolution: [res[0], res[1], res[2], o.per_pixel() as u32 | (o.opaque as u32) << 1],
             atlas: [set.atlas_words as u32, pitch, set.normal_words as u32, 0],
-            params: [opacity_lengths[k], step as f32, 0.0, 0.0],
+            params: [o.opacity_length, o.step as f32, 0.0, 0.0],
         });
-        set.copies.push((o.bake.unwrap_or(0), o.per_pixel));
+        set.copies.push((o.bake, o.per_pixel()));
         set.atlas_words += words;
-        if o.per_pixel {
+        if o.per_pixel() {
             set.normal_words += words;
         }
     }
@@ -273,13 +289,19 @@ impl ReferenceSet {
 /// The same frame for the f64 CPU twin: corners made camera-relative in f64 from the scene's
 /// surfaces, volumes decoded from the atlases the kernel read (`texel_atlas`, `normal_atlas`
 /// bytes as copied from the GPU).
-pub fn twin_inputs(bp: &Blueprint, texel_atlas: &[u8], normal_atlas: &[u8]) -> (TraceView, Vec<TraceObject>) {
-    let set = bp.reference.as_ref().expect("a frame with Reference objects");
-    let f = &bp.frame;
+/// `members` are those the set was built from; `size` and `eye` the frame's.
+pub fn twin_inputs(
+    set: &ReferenceSet,
+    members: &[Member],
+    (frame, size, eye): (&FrameParams, (u32, u32), DVec3),
+    texel_atlas: &[u8],
+    normal_atlas: &[u8],
+) -> (TraceView, Vec<TraceObject>) {
+    let f = frame;
     let v3 = |a: [f32; 4]| DVec3::new(a[0] as f64, a[1] as f64, a[2] as f64);
     let view = TraceView {
-        width: bp.size.0,
-        height: bp.size.1,
+        width: size.0,
+        height: size.1,
         forward: v3(f.forward),
         right: v3(set.params.right),
         up: v3(set.params.up),
@@ -310,10 +332,9 @@ pub fn twin_inputs(bp: &Blueprint, texel_atlas: &[u8], normal_atlas: &[u8]) -> (
         Volume { resolution: [w, h, d], texels }
     };
     let mut objects = Vec::new();
-    for (&i, entry) in set.objects.iter().zip(&set.table) {
-        let o = &bp.objects[i];
-        let s = &o.object.surface;
-        let rel = |p: DVec3| p - bp.eye;
+    for (o, entry) in members.iter().zip(&set.table) {
+        let s = o.surface;
+        let rel = |p: DVec3| p - eye;
         let prisms = s
             .triangles
             .iter()
@@ -327,7 +348,7 @@ pub fn twin_inputs(bp: &Blueprint, texel_atlas: &[u8], normal_atlas: &[u8]) -> (
                 }
             })
             .collect();
-        let per_pixel = o.per_pixel.then(|| {
+        let per_pixel = o.per_pixel().then(|| {
             let frames = shell::vertex_frames(s);
             PerPixel {
                 normals: decode(normal_atlas, entry, entry.atlas[2], true),
@@ -344,8 +365,8 @@ pub fn twin_inputs(bp: &Blueprint, texel_atlas: &[u8], normal_atlas: &[u8]) -> (
             volume: decode(texel_atlas, entry, entry.atlas[0], false),
             per_pixel,
             opacity_length: entry.params[0] as f64,
-            step: o.reference_step.unwrap_or(1.0),
-            opaque_base: o.object.base_color.is_some(),
+            step: o.step,
+            opaque_base: o.opaque,
         });
     }
     (view, objects)

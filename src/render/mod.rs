@@ -280,13 +280,10 @@ impl Blueprint {
 
 /// The BVH and tables of the frame's Reference objects.
 fn reference_set(objects: &[ObjectPlan], bakes: &[BakePlan], view: &View) -> Option<ReferenceSet> {
-    let members: Vec<usize> = (0..objects.len()).filter(|&i| objects[i].reference_step.is_some()).collect();
+    let members = reference_members(objects, bakes);
     if members.is_empty() {
         return None;
     }
-    let bake_of = |i: usize| &bakes[objects[i].bake.unwrap_or(0)];
-    let resolutions: Vec<[u32; 3]> = members.iter().map(|&i| bake_of(i).request.resolution).collect();
-    let lengths: Vec<f32> = members.iter().map(|&i| bake_of(i).opacity_length).collect();
     let camera = view.camera();
     let (r, u) = (camera.right.as_vec3(), camera.up.as_vec3());
     let params = ReferenceParams {
@@ -294,7 +291,41 @@ fn reference_set(objects: &[ObjectPlan], bakes: &[BakePlan], view: &View) -> Opt
         up: [u.x, u.y, u.z, view.far as f32],
         counts: [0; 4],
     };
-    Some(reference::build(objects, &members, &resolutions, &lengths, params))
+    Some(reference::build(&members, params))
+}
+
+/// The frame's Reference objects as the Reference method sees them.
+fn reference_members<'a>(objects: &'a [ObjectPlan], bakes: &[BakePlan]) -> Vec<reference::Member<'a>> {
+    let member = |(index, o): (usize, &'a ObjectPlan)| {
+        let step = o.reference_step?;
+        let bake = o.bake.unwrap_or(0);
+        Some(reference::Member {
+            index,
+            surface: &o.object.surface,
+            shell: &o.shell,
+            frames: o.frames.as_deref().filter(|_| o.per_pixel),
+            opaque: o.object.base_color.is_some(),
+            step,
+            bake,
+            resolution: bakes[bake].request.resolution,
+            opacity_length: bakes[bake].opacity_length,
+        })
+    };
+    objects.iter().enumerate().filter_map(member).collect()
+}
+
+impl Blueprint {
+    /// Inputs of the Reference method's f64 twin for this frame, from the atlases the kernel read.
+    pub fn reference_twin_inputs(
+        &self,
+        texel_atlas: &[u8],
+        normal_atlas: &[u8],
+    ) -> (crate::cpu::trace_reference::TraceView, Vec<crate::cpu::trace_reference::TraceObject>) {
+        let set = self.reference.as_ref().expect("a frame with Reference objects");
+        let members = reference_members(&self.objects, &self.bakes);
+        let frame = (&self.frame, self.size, self.eye);
+        reference::twin_inputs(set, &members, frame, texel_atlas, normal_atlas)
+    }
 }
 
 /// The camera, with the depth range of everything drawn for the projection's near and far planes.
@@ -460,8 +491,9 @@ impl ObjectPlan {
                 plan.frames = plan.per_pixel.then(|| shell::vertex_frames(&plan.object.surface));
                 let bake = texels::bake_index(scene, &texel, plan.per_pixel, light, time, bakes)?;
                 plan.bake = Some(bake);
-                let step =
-                    r.step.unwrap_or_else(|| reference::default_step(&plan, bakes[bake].request.resolution));
+                let step = r.step.unwrap_or_else(|| {
+                    reference::default_step(&plan.object.surface, bakes[bake].request.resolution)
+                });
                 plan.reference_step = Some(step);
                 return Ok(plan);
             }

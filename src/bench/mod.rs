@@ -6,6 +6,8 @@
 //! Lavapipe returns near-zero compute timestamps once a render pass has run in the process, so
 //! the slicing kernels are timed first, alone (graph `slices_only.ron`), before any full frame.
 
+pub mod hyper;
+
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 

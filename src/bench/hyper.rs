@@ -210,8 +210,8 @@ pub fn run(size: (u32, u32), frames: usize, quick: bool, segments_only: bool) ->
         // The first bake compiles the kernel.
         for _ in 0..4 {
             let t = Instant::now();
-            let grid = super::mesh::bake(&ctx, shape, spec)?;
-            super::mesh::read(&ctx, &grid)?;
+            let grid = crate::hypertexture::mesh::bake(&ctx, shape, spec)?;
+            crate::hypertexture::mesh::read(&ctx, &grid)?;
             times.push(t.elapsed().as_secs_f64() * 1e3);
         }
         println!(

@@ -1,0 +1,105 @@
+//! The library's top-level modules form layers that only import downwards (DESIGN.md, "Layout"):
+//! every `crate::MODULE` path in `src/` (grouped `crate::{..}` imports included) must name a
+//! module of a lower layer than the file's own. A new top-level module must be placed in
+//! `LAYERS`; an import that points upwards or sideways fails with the file that makes it.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+/// Lowest first. Modules of one layer may not import each other.
+const LAYERS: &[&[&str]] = &[
+    // Errors, fault injection, the Pod structs shared with WGSL.
+    &["error", "fault", "types"],
+    // Device, shader sources, reflection, caches; file formats; meshes, shells, BVHs.
+    &["gpu", "io", "mesh"],
+    // Render graphs; image metrics; scene files (no GPU).
+    &["graph", "metrics", "scene"],
+    // CPU twins shared by several methods.
+    &["cpu"],
+    // The hypertexture model (packing, mesh grids, splat sets).
+    &["hypertexture"],
+    // Texel bakes.
+    &["bake"],
+    // One folder per method.
+    &["methods"],
+    // Scene -> plan -> frame.
+    &["render"],
+    // Front ends of the library.
+    &["pareto", "preview", "regress"],
+    &["bench"],
+];
+
+fn layer_of(module: &str) -> Option<usize> {
+    LAYERS.iter().position(|l| l.contains(&module))
+}
+
+fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let path = entry.unwrap().path();
+        if path.is_dir() {
+            rust_files(&path, out);
+        } else if path.extension().is_some_and(|e| e == "rs") {
+            out.push(path);
+        }
+    }
+}
+
+/// Top-level modules a source text names through `crate::`.
+fn imports(text: &str) -> Vec<String> {
+    let mut out = Vec::new();
+    for (at, _) in text.match_indices("crate::") {
+        let rest = &text[at + "crate::".len()..];
+        let names: Vec<&str> = if let Some(group) = rest.strip_prefix('{') {
+            // `crate::{a::b, c}`: the first segment of each item at depth 0.
+            let end = group.find('}').unwrap_or(group.len());
+            group[..end].split(',').map(|item| item.trim().split("::").next().unwrap_or("")).collect()
+        } else {
+            vec![rest.split(|c: char| !(c.is_ascii_alphanumeric() || c == '_')).next().unwrap_or("")]
+        };
+        out.extend(names.into_iter().filter(|n| !n.is_empty()).map(str::to_string));
+    }
+    out
+}
+
+#[test]
+fn modules_import_only_lower_layers() {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let lib = std::fs::read_to_string(src.join("lib.rs")).unwrap();
+    let modules: Vec<&str> =
+        lib.lines().filter_map(|l| l.trim().strip_prefix("pub mod ")?.strip_suffix(';')).collect();
+    for m in &modules {
+        assert!(layer_of(m).is_some(), "module `{m}` is in no layer of tests/layers.rs: place it");
+    }
+    let mut files = Vec::new();
+    rust_files(&src, &mut files);
+    let mut wrong: BTreeMap<String, Vec<String>> = BTreeMap::new();
+    let mut edges = 0;
+    for file in &files {
+        let rel = file.strip_prefix(&src).unwrap();
+        let first = rel.components().next().unwrap().as_os_str().to_string_lossy();
+        let module = first.trim_end_matches(".rs");
+        // The binary (main.rs, cli/) sits above the library.
+        let Some(own) = layer_of(module) else { continue };
+        let text = std::fs::read_to_string(file).unwrap();
+        for target in imports(&text) {
+            let Some(layer) = layer_of(&target) else { continue };
+            if target == module {
+                continue;
+            }
+            edges += 1;
+            if layer >= own {
+                wrong.entry(format!("{module} -> {target}")).or_default().push(rel.display().to_string());
+            }
+        }
+    }
+    assert!(edges > 100, "only {edges} imports found: is the scan broken?");
+    let listing: Vec<String> = wrong.iter().map(|(e, f)| format!("{e} ({})", f.join(", "))).collect();
+    assert!(listing.is_empty(), "imports that do not point to a lower layer:\n{}", listing.join("\n"));
+}
+
+#[test]
+fn the_scan_sees_grouped_and_nested_imports() {
+    let text =
+        "use crate::gpu::{GpuContext, Inputs};\nuse crate::{Error, io::png};\nlet x = crate::render::f();";
+    assert_eq!(imports(text), ["gpu", "Error", "io", "render"]);
+}
