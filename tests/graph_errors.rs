@@ -32,7 +32,7 @@ fn temp_dir(test: &str) -> PathBuf {
 /// Passes of `graphs/frame.ron`, one snippet each, so tests can declare them in any order.
 const DRAW_BASE: &str = r#"Raster(
             name: "draw_base",
-            shader: "draw_base.wgsl",
+            shader: "base_surface/draw_base.wgsl",
             instances: Objects("BaseSurface"),
             targets: [(resource: "hdr")],
             depth: (resource: "depth", write: true),
@@ -40,26 +40,26 @@ const DRAW_BASE: &str = r#"Raster(
         )"#;
 const COUNT: &str = r#"Compute(
             name: "count_slices",
-            shader: "count_slices.wgsl",
+            shader: "view_slices/count_slices.wgsl",
             instances: Objects("ViewSlices"),
             clear: ["plane_cursors"],
             dispatch: Threads("prisms", "planes", "1"),
         )"#;
 const SCAN: &str = r#"Compute(
             name: "scan_plane_offsets",
-            shader: "scan_plane_offsets.wgsl",
+            shader: "view_slices/scan_plane_offsets.wgsl",
             instances: Objects("ViewSlices"),
             dispatch: Groups("1", "1", "1"),
         )"#;
 const EMIT: &str = r#"Compute(
             name: "emit_slices",
-            shader: "emit_slices.wgsl",
+            shader: "view_slices/emit_slices.wgsl",
             instances: Objects("ViewSlices"),
             dispatch: Threads("prisms", "planes", "1"),
         )"#;
 const DRAW_SLICES: &str = r#"Raster(
             name: "draw_slices",
-            shader: "draw_slices.wgsl",
+            shader: "view_slices/draw_slices.wgsl",
             instances: Objects("ViewSlices"),
             targets: [(resource: "hdr", blend: PremultipliedOver)],
             depth: (resource: "depth", write: false),

@@ -144,7 +144,7 @@ fn reload_sequence() {
     assert!(s.error.is_none());
 
     // Broken WGSL: error at the kernel's line; fixed: nothing rebuilt (the module was kept).
-    let draw = wgsl.join("draw_slices.wgsl");
+    let draw = wgsl.join("view_slices/draw_slices.wgsl");
     let (o, img) = step(&mut s, "broken", &draw, &|| {
         edit(&draw, "let a = clamp(texel.a, 0.0, 1.0);", "let a = clamp(texel.a, 0.0, 1.0)")
     });

@@ -204,7 +204,7 @@ impl Baker {
                 inputs
                     .buffers
                     .insert("balls".into(), storage(ctx, "balls", bytemuck::cast_slice(&packed.balls)));
-                Self::kernel(&mut self.implicit, ctx, &root, "bake_implicit.wgsl")?.dispatch(
+                Self::kernel(&mut self.implicit, ctx, &root, "bake/bake_implicit.wgsl")?.dispatch(
                     ctx,
                     &mut encoder,
                     &inputs,
@@ -218,7 +218,7 @@ impl Baker {
                 inputs
                     .buffers
                     .insert("heightfield".into(), uniform(ctx, "heightfield", bytemuck::bytes_of(hf)));
-                Self::kernel(&mut self.heightfield, ctx, &root, "bake_heightfield.wgsl")?.dispatch(
+                Self::kernel(&mut self.heightfield, ctx, &root, "bake/bake_heightfield.wgsl")?.dispatch(
                     ctx,
                     &mut encoder,
                     &inputs,
@@ -236,7 +236,7 @@ impl Baker {
                     "heights".into(),
                     storage(ctx, "heights", bytemuck::cast_slice(heights.0.as_slice())),
                 );
-                Self::kernel(&mut self.height_image, ctx, &root, "bake_height_image.wgsl")?.dispatch(
+                Self::kernel(&mut self.height_image, ctx, &root, "bake/bake_height_image.wgsl")?.dispatch(
                     ctx,
                     &mut encoder,
                     &inputs,
@@ -281,7 +281,7 @@ impl Baker {
                 let colors = grid.colors.unwrap_or_else(|| storage(ctx, "mesh_colors", &[0u8; 16]));
                 inputs.buffers.insert("mesh_colors".into(), colors);
                 inputs.constants.push(("colored".into(), m.shape.colors.is_some() as u32 as f64));
-                Self::kernel(&mut self.mesh, ctx, &root, "bake_mesh_texel.wgsl")?.dispatch(
+                Self::kernel(&mut self.mesh, ctx, &root, "bake/bake_mesh_texel.wgsl")?.dispatch(
                     ctx,
                     &mut encoder,
                     &inputs,
@@ -289,14 +289,14 @@ impl Baker {
                 )?;
             }
             BakeSource::Hypertexture(ht) => {
-                let transfer = Self::kernel(&mut self.transfer, ctx, &root, "bake_transfer.wgsl")?;
-                let hyper = Self::kernel(&mut self.hyper, ctx, &root, "bake_hypertexture.wgsl")?;
+                let transfer = Self::kernel(&mut self.transfer, ctx, &root, "ray_march/bake_transfer.wgsl")?;
+                let hyper = Self::kernel(&mut self.hyper, ctx, &root, "bake/bake_hypertexture.wgsl")?;
                 ht.bake(ctx, (transfer, hyper), &mut encoder, &mut inputs, params)?;
             }
         }
         let axis = match req.axis_slices {
             true => {
-                let kernel = Self::kernel(&mut self.axis, ctx, &root, "bake_axis_slices.wgsl")?;
+                let kernel = Self::kernel(&mut self.axis, ctx, &root, "axis_slices/bake_axis_slices.wgsl")?;
                 Some(axis_slices::bake(ctx, kernel, &mut encoder, &volume, req.resolution)?)
             }
             false => None,

@@ -83,7 +83,7 @@ fn median(mut v: Vec<f64>) -> f64 {
 pub fn noise_rate(ctx: &GpuContext) -> Result<f64> {
     const PER_THREAD: u32 = 1024;
     let threads = [4096u32, 16, 1];
-    let mut kernel = ComputeKernel::load(ctx, &Sources::project()?, "bench_simplex.wgsl")?;
+    let mut kernel = ComputeKernel::load(ctx, &Sources::project()?, "ray_march/bench_simplex.wgsl")?;
     let mut inputs = Inputs::default();
     let out = vec![0u8; (threads[0] * threads[1] * 4) as usize];
     inputs.buffers.insert("bench_out".into(), crate::gpu::buffers::storage(ctx, "bench_out", &out));

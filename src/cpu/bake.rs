@@ -1,10 +1,10 @@
-//! CPU twins of the bake kernels (`wgsl/bake_implicit.wgsl`, `wgsl/bake_heightfield.wgsl`) and of `wgsl/shared/{noise,shading}.wgsl`: same names, same
+//! CPU twins of the bake kernels (`wgsl/bake/bake_implicit.wgsl`, `wgsl/bake/bake_heightfield.wgsl`) and of `wgsl/shared/{noise,shading}.wgsl`: same names, same
 //! f32 math, so tests can compare GPU bakes against these voxel by voxel (up to 8-bit storage).
 //! Also the constructors that pack shapes into the GPU structs.
 
 use crate::types::{BakeParams, HeightImageParams, HeightfieldParams, ImplicitShape};
 
-/// `ImplicitShape::kind` values; mirrored as `SHAPE_*` consts in `wgsl/bake_implicit.wgsl`.
+/// `ImplicitShape::kind` values; mirrored as `SHAPE_*` consts in `wgsl/bake/bake_implicit.wgsl`.
 pub const SPHERE: u32 = 0;
 pub const TORUS: u32 = 1;
 pub const ELLIPSOID: u32 = 2;

@@ -1,4 +1,4 @@
-//! CPU twin of `wgsl/bake_hypertexture.wgsl`: one voxel of a texel baked from a hypertexture
+//! CPU twin of `wgsl/bake/bake_hypertexture.wgsl`: one voxel of a texel baked from a hypertexture
 //! (density and colour transfer at the voxel centre, shading from the density gradient by central
 //! differences), from the same packed parameters, in f64 (the hypertexture twin's precision).
 

@@ -1,4 +1,4 @@
-//! CPU twin (f64) of `wgsl/bake_mesh_grid.wgsl`: per grid sample the vector to the closest
+//! CPU twin (f64) of `wgsl/bake/bake_mesh_grid.wgsl`: per grid sample the vector to the closest
 //! surface point and the signed distance (positive inside, ray parity voted over three skewed
 //! directions) of the union of the mesh's closed parts and, for coloured meshes, the colour there,
 //! by brute force over every triangle (ground truth: no BVH to get wrong).

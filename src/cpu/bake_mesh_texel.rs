@@ -1,4 +1,4 @@
-//! CPU twin of `wgsl/bake_mesh_texel.wgsl`: a mesh grid sample at a voxel centre (vector to the
+//! CPU twin of `wgsl/bake/bake_mesh_texel.wgsl`: a mesh grid sample at a voxel centre (vector to the
 //! closest surface point, signed distance positive inside) as the voxel's premultiplied RGBA and
 //! outward normal in texel space.
 

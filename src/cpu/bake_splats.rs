@@ -1,4 +1,4 @@
-//! CPU twin (f64) of `wgsl/bake_splats.wgsl`: the splat set of a hypertexture object from its
+//! CPU twin (f64) of `wgsl/ray_march/bake_splats.wgsl`: the splat set of a hypertexture object from its
 //! lattice (see `hypertexture::splats`), in lattice order (the kernel appends in any order).
 
 use glam::DVec3;

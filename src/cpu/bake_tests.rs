@@ -279,9 +279,9 @@ fn bake_kernels_validate_and_match_the_contract() {
     use naga::{AddressSpace, TypeInner};
     let root = crate::project_root().join("wgsl");
     let kernels: [(&str, &[&str]); 3] = [
-        ("bake_implicit.wgsl", &["bake_params", "shapes", "balls", "volume", "normals"]),
-        ("bake_heightfield.wgsl", &["bake_params", "heightfield", "volume", "normals"]),
-        ("bake_height_image.wgsl", &["bake_params", "height_image", "heights", "volume", "normals"]),
+        ("bake/bake_implicit.wgsl", &["bake_params", "shapes", "balls", "volume", "normals"]),
+        ("bake/bake_heightfield.wgsl", &["bake_params", "heightfield", "volume", "normals"]),
+        ("bake/bake_height_image.wgsl", &["bake_params", "height_image", "heights", "volume", "normals"]),
     ];
     for (file, globals) in kernels {
         let k = crate::gpu::shader::load(&root, file).unwrap_or_else(|e| panic!("{e}"));

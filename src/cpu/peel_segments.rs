@@ -1,4 +1,4 @@
-//! CPU twin (f64) of `wgsl/begin_segments.wgsl` and `wgsl/peel_segments.wgsl`: per pixel, the
+//! CPU twin (f64) of `wgsl/ray_march/begin_segments.wgsl` and `wgsl/ray_march/peel_segments.wgsl`: per pixel, the
 //! ray's start and then, peel after peel, the nearest front-facing surface splat beyond the last
 //! boundary (an entry) and the nearest back-facing one beyond that, where the disk lies on or
 //! outside the splat surface (an exit). It tests every

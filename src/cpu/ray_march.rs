@@ -1,4 +1,4 @@
-//! CPU twin (f64) of `wgsl/ray_march.wgsl`: per pixel, the ray's span inside the hypertexture's
+//! CPU twin (f64) of `wgsl/ray_march/ray_march.wgsl`: per pixel, the ray's span inside the hypertexture's
 //! enlarged bounds is cut into whole steps sampled at their middles, composited front to back with
 //! the shared step-corrected opacity until the transmittance falls below 1e-4; Phong shading from
 //! the density gradient by central differences and shadow rays towards the light; with an

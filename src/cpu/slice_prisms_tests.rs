@@ -493,10 +493,10 @@ fn counts_scan_and_slices_agree_and_trivial_reject_changes_nothing() {
 fn kernels_validate_and_declare_the_bound_globals() {
     let root = crate::project_root().join("wgsl");
     for (file, globals) in [
-        ("count_slices.wgsl", &["slice_params", "shell_vertices", "prisms", "plane_cursors"][..]),
-        ("scan_plane_offsets.wgsl", &["slice_params", "plane_cursors", "draw_args"][..]),
+        ("view_slices/count_slices.wgsl", &["slice_params", "shell_vertices", "prisms", "plane_cursors"][..]),
+        ("view_slices/scan_plane_offsets.wgsl", &["slice_params", "plane_cursors", "draw_args"][..]),
         (
-            "emit_slices.wgsl",
+            "view_slices/emit_slices.wgsl",
             &["slice_params", "shell_vertices", "prisms", "plane_cursors", "slice_vertices"][..],
         ),
     ] {
@@ -508,6 +508,6 @@ fn kernels_validate_and_declare_the_bound_globals() {
         }
         let overrides: Vec<&str> =
             kernel.module.overrides.iter().filter_map(|(_, o)| o.name.as_deref()).collect();
-        assert_eq!(overrides.contains(&"trivial_reject"), file != "scan_plane_offsets.wgsl");
+        assert_eq!(overrides.contains(&"trivial_reject"), file != "view_slices/scan_plane_offsets.wgsl");
     }
 }

@@ -1,4 +1,4 @@
-//! CPU twin (f64) of `wgsl/splat_segments.wgsl` and `wgsl/resolve_splats.wgsl` (EWA-style
+//! CPU twin (f64) of `wgsl/ray_march/splat_segments.wgsl` and `wgsl/ray_march/resolve_splats.wgsl` (EWA-style
 //! splatting, Gilet & Dischler 2009, section 5.1), unshaded: per pixel, every interior splat (a
 //! sphere) the ray crosses adds the bounds march's samples inside it to the ray's depth slabs,
 //! weighted by a Gaussian of the ray's distance to its centre; each slab's weighted mean optical

@@ -1,4 +1,4 @@
-//! CPU twin (f64) of `wgsl/trace_reference.wgsl`: exact ray casting through the prisms of every
+//! CPU twin (f64) of `wgsl/reference/trace_reference.wgsl`: exact ray casting through the prisms of every
 //! `Reference` object. Per pixel: the intervals of the ray inside each prism (entry and exit
 //! through its triangles and bilinear sides), split where any interval starts or ends; each piece
 //! is integrated front to back with the fine step (rounded so the piece holds whole steps), each

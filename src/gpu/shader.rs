@@ -11,7 +11,7 @@ use crate::gpu::sources::{Source, Sources};
 /// info (used for reflection), and every file it was assembled from (on disk, or
 /// `<embedded>/wgsl/...`).
 pub struct Kernel {
-    /// Path relative to the WGSL root, e.g. `emit_slices.wgsl`.
+    /// Path relative to the WGSL root, e.g. `view_slices/emit_slices.wgsl`.
     pub name: String,
     pub module: naga::Module,
     pub info: naga::valid::ModuleInfo,

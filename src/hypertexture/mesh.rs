@@ -112,7 +112,7 @@ pub fn bake(ctx: &GpuContext, shape: &MeshShape, spec: &GridSpec) -> Result<Mesh
     b.insert("mesh_colors".into(), colors.clone().unwrap_or_else(stand_in));
     inputs.constants.push(("colored".into(), colored as u32 as f64));
     let mut encoder = ctx.device.create_command_encoder(&Default::default());
-    ComputeKernel::load(ctx, &Sources::project()?, "bake_mesh_grid.wgsl")?.dispatch(
+    ComputeKernel::load(ctx, &Sources::project()?, "bake/bake_mesh_grid.wgsl")?.dispatch(
         ctx,
         &mut encoder,
         &inputs,

@@ -63,7 +63,7 @@ pub fn bake(
     b.insert("splat_counts".into(), storage(ctx, "splat_counts", &[0u8; 16]));
     let mut encoder = ctx.device.create_command_encoder(&Default::default());
     let l = segments.lattice;
-    ComputeKernel::load(ctx, &Sources::project()?, "bake_splats.wgsl")?.dispatch(
+    ComputeKernel::load(ctx, &Sources::project()?, "ray_march/bake_splats.wgsl")?.dispatch(
         ctx,
         &mut encoder,
         &inputs,

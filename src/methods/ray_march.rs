@@ -416,13 +416,13 @@ pub fn probe(ctx: &GpuContext, plan: &RayMarchPlan, points: &[[f32; 4]]) -> Resu
     b.insert("probe_values".into(), storage(ctx, "probe_values", &zeros));
     let mut encoder = ctx.device.create_command_encoder(&Default::default());
     let functions = plan.packed.functions.len() as u32;
-    ComputeKernel::load(ctx, &root, "bake_transfer.wgsl")?.dispatch(
+    ComputeKernel::load(ctx, &root, "ray_march/bake_transfer.wgsl")?.dispatch(
         ctx,
         &mut encoder,
         &inputs,
         [TRANSFER_SIZE as u32, functions, 1],
     )?;
-    ComputeKernel::load(ctx, &root, "probe_hypertexture.wgsl")?.dispatch(
+    ComputeKernel::load(ctx, &root, "ray_march/probe_hypertexture.wgsl")?.dispatch(
         ctx,
         &mut encoder,
         &inputs,

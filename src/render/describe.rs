@@ -142,9 +142,9 @@ impl Blueprint {
         for b in &self.bakes {
             let r = b.request.resolution;
             let kind = match b.request.source {
-                BakeSource::Implicit(_) => "bake_implicit.wgsl",
-                BakeSource::Heightfield(_) => "bake_heightfield.wgsl",
-                BakeSource::HeightImage(..) => "bake_height_image.wgsl",
+                BakeSource::Implicit(_) => "bake/bake_implicit.wgsl",
+                BakeSource::Heightfield(_) => "bake/bake_heightfield.wgsl",
+                BakeSource::HeightImage(..) => "bake/bake_height_image.wgsl",
                 BakeSource::Stack(_) => "slice stack (uploaded)",
                 BakeSource::Mesh(_) => "bake_mesh_grid.wgsl + bake_mesh_texel.wgsl",
                 BakeSource::Hypertexture(ref h) if h.packed.mesh.is_some() => {
