@@ -306,15 +306,11 @@ fn scene_reference_names_every_field_and_variant() {
     );
 }
 
-/// The names the runtime provides to graphs, in one place: when methods declare their own
-/// contributions, point this at them.
+/// The names the runtime provides to graphs: the renderer's own and every registered method's
+/// contribution (`methods::REGISTRY`), through the vocabulary the planner checks against.
 fn runtime_names() -> BTreeMap<&'static str, Vec<&'static str>> {
-    BTreeMap::from([
-        ("frame resource", voltex::render::FRAME_RESOURCES.to_vec()),
-        ("instance resource", voltex::render::INSTANCE_RESOURCES.to_vec()),
-        ("count", voltex::graph::exec::COUNTS.to_vec()),
-        ("object filter", voltex::graph::plan::OBJECT_FILTERS.to_vec()),
-    ])
+    let v = voltex::render::vocabulary();
+    BTreeMap::from([("resource", v.resources), ("count", v.counts), ("object filter", v.filters)])
 }
 
 #[test]

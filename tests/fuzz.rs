@@ -186,7 +186,9 @@ fn scene_case(path: &Path, text: &str) -> Result<(), String> {
 fn graph_case(path: &Path, text: &str) -> Result<(), String> {
     match Graph::parse(path, text.to_string()) {
         Ok(graph) => {
-            let objects: Vec<plan::ObjectInfo> = plan::OBJECT_FILTERS
+            let vocabulary = voltex::render::vocabulary();
+            let objects: Vec<plan::ObjectInfo> = vocabulary
+                .filters
                 .iter()
                 .enumerate()
                 .map(|(i, f)| plan::ObjectInfo {
@@ -196,7 +198,12 @@ fn graph_case(path: &Path, text: &str) -> Result<(), String> {
                     order: 0,
                 })
                 .collect();
-            match plan::plan(&graph, &voltex::gpu::sources::Sources::project().unwrap(), &objects) {
+            match plan::plan(
+                &graph,
+                &voltex::gpu::sources::Sources::project().unwrap(),
+                &objects,
+                &vocabulary,
+            ) {
                 Ok(_) => accepted(),
                 Err(e) => check_error(&e, path, text, false),
             }

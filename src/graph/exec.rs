@@ -13,25 +13,6 @@ use crate::gpu::{GpuContext, Inputs};
 use crate::graph::plan::{self, Plan, PlannedPass};
 use crate::graph::{Blend, Clear, Dispatch, Draw, Graph, PassDecl, ResourceDecl, TextureSize};
 
-/// Count names the runtime provides (per object or per frame).
-pub const COUNTS: &[&str] = &[
-    "prisms",
-    "planes",
-    "plane_blocks",
-    "base_vertices",
-    "width",
-    "height",
-    "reference_dispatches",
-    "ray_march_dispatches",
-    "transfer_functions",
-    "axis_triangles",
-    "surface_splats",
-    "peel_blocks",
-    "peel_phases",
-    "interior_splats",
-    "splat_blocks",
-];
-
 struct Texture {
     texture: wgpu::Texture,
     view: wgpu::TextureView,
@@ -64,7 +45,7 @@ impl Executor {
             )));
         }
         for p in &plan.passes {
-            check_counts(&graph, &p.decl)?;
+            check_counts(&graph, &p.decl, &plan.vocabulary.counts)?;
         }
         let blended: Vec<&str> = plan
             .passes
@@ -633,9 +614,9 @@ fn count(name: &str, inst: &Inputs, frame: &Inputs) -> u32 {
         .unwrap_or(0)
 }
 
-/// Checks the dispatch and draw counts of a pass against [`COUNTS`] (called by the planner, so
-/// `voltex plan` reports them without a GPU).
-pub fn check_counts(graph: &Graph, decl: &PassDecl) -> Result<()> {
+/// Checks the dispatch and draw counts of a pass against the runtime's `counts` (called by the
+/// planner, so `voltex plan` reports them without a GPU).
+pub fn check_counts(graph: &Graph, decl: &PassDecl, counts: &[&str]) -> Result<()> {
     match decl {
         PassDecl::Compute {
             dispatch: Dispatch::Threads(x, y, z) | Dispatch::Groups(x, y, z),
@@ -643,10 +624,10 @@ pub fn check_counts(graph: &Graph, decl: &PassDecl) -> Result<()> {
             ..
         } => {
             for c in [x, y, z, repeat] {
-                plan::check_count(graph, c, COUNTS)?;
+                plan::check_count(graph, c, counts)?;
             }
         }
-        PassDecl::Raster { draw: Draw::Vertices(n), .. } => plan::check_count(graph, n, COUNTS)?,
+        PassDecl::Raster { draw: Draw::Vertices(n), .. } => plan::check_count(graph, n, counts)?,
         PassDecl::Raster { .. } => {}
     }
     Ok(())

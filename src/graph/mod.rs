@@ -37,6 +37,17 @@ pub enum ResourceDecl {
     },
 }
 
+/// The names the runtime offers a graph beyond its own resources: the object filters passes
+/// are instanced over, the counts dispatches and draws use, and the resources kernels bind, as
+/// the methods and the renderer declare them. The graph core checks names against it and names
+/// no method itself.
+#[derive(Debug, Clone, Default)]
+pub struct Vocabulary {
+    pub filters: Vec<&'static str>,
+    pub counts: Vec<&'static str>,
+    pub resources: Vec<&'static str>,
+}
+
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
 pub enum Format {
     Rgba8Unorm,
@@ -86,7 +97,7 @@ pub enum Instances {
     /// Once per frame.
     #[default]
     Frame,
-    /// Once per scene object matching the filter (see [`plan::OBJECT_FILTERS`]), back to front.
+    /// Once per scene object matching the filter (see [`Vocabulary::filters`]), back to front.
     Objects(String),
 }
 
@@ -274,17 +285,6 @@ impl Graph {
                 return Err(self.error_at(p.name(), format!("pass `{}` is declared twice", p.name())));
             }
             seen.push(p.name());
-            if let Instances::Objects(filter) = p.instances() {
-                if !plan::OBJECT_FILTERS.contains(&filter.as_str()) {
-                    return Err(self.error_at(
-                        filter,
-                        format!(
-                            "unknown object filter `{filter}`; expected one of {:?}",
-                            plan::OBJECT_FILTERS
-                        ),
-                    ));
-                }
-            }
             if let PassDecl::Raster { targets, depth, .. } = p {
                 for t in targets.iter().map(|t| &t.resource).chain(depth.iter().map(|d| &d.resource)) {
                     if !f.resources.contains_key(t) {

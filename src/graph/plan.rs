@@ -8,21 +8,7 @@ use crate::error::{Error, Result};
 use crate::gpu::reflect::{self, Binding};
 use crate::gpu::shader::{self, Kernel};
 use crate::gpu::sources::Sources;
-use crate::graph::{Draw, Graph, Instances, PassDecl, ResourceDecl};
-
-/// Object filters a pass can be instanced over.
-pub const OBJECT_FILTERS: &[&str] = &[
-    "ViewSlices",
-    "BaseSurface",
-    "Reference",
-    "AxisSlices",
-    "AxisSlicesBinary",
-    "AxisSlicesBlended",
-    "AxisSlicesBySlice",
-    "RayMarch",
-    "RayMarchPeeling",
-    "RayMarchSplatting",
-];
+use crate::graph::{Draw, Graph, Instances, PassDecl, ResourceDecl, Vocabulary};
 
 /// What the planner needs to know of a scene object.
 #[derive(Debug, Clone)]
@@ -52,19 +38,33 @@ pub struct Plan {
     pub textures: BTreeMap<String, ResourceDecl>,
     /// One line per pruned pass or resource, saying why.
     pub pruned: Vec<String>,
+    /// The runtime's names it was planned against.
+    pub vocabulary: Vocabulary,
 }
 
 /// Plans `graph` for `objects`, its shaders looked up in `sources` (the graph's folder first when
-/// the caller put it there: see [`Sources::beside`]).
-pub fn plan(graph: &Graph, sources: &Sources, objects: &[ObjectInfo]) -> Result<Plan> {
+/// the caller put it there: see [`Sources::beside`]), its filters and counts checked against
+/// `vocabulary`.
+pub fn plan(
+    graph: &Graph,
+    sources: &Sources,
+    objects: &[ObjectInfo],
+    vocabulary: &Vocabulary,
+) -> Result<Plan> {
     let mut kernels: BTreeMap<String, Arc<Kernel>> = BTreeMap::new();
     let mut candidates = Vec::new();
     let mut pruned = Vec::new();
     for decl in &graph.file.passes {
-        super::exec::check_counts(graph, decl)?;
+        super::exec::check_counts(graph, decl, &vocabulary.counts)?;
         let instances = match decl.instances() {
             Instances::Frame => None,
             Instances::Objects(filter) => {
+                if !vocabulary.filters.contains(&filter.as_str()) {
+                    return Err(graph.error_at(
+                        filter,
+                        format!("unknown object filter `{filter}`; expected one of {:?}", vocabulary.filters),
+                    ));
+                }
                 let mut ids: Vec<usize> =
                     (0..objects.len()).filter(|&i| objects[i].filters.contains(&filter.as_str())).collect();
                 if ids.is_empty() {
@@ -109,7 +109,7 @@ pub fn plan(graph: &Graph, sources: &Sources, objects: &[ObjectInfo]) -> Result<
             pruned.push(format!("resource {name}: no kept pass uses it"));
         }
     }
-    Ok(Plan { passes, textures, pruned })
+    Ok(Plan { passes, textures, pruned, vocabulary: vocabulary.clone() })
 }
 
 /// Resources a pass reads and writes: from reflection, render targets, indirect arguments and clears.

@@ -9,6 +9,28 @@ use crate::mesh::shell::Shell;
 use crate::scene::{AxisSlices, DrawOrder, SliceBlend, SliceDirections};
 use crate::types::{AxisParams, AxisVertex, Prism};
 
+/// What AxisSlices brings to the render graph.
+pub const CONTRIBUTION: super::Contribution = super::Contribution {
+    method: "AxisSlices",
+    filters: &["AxisSlices", "AxisSlicesBinary", "AxisSlicesBlended", "AxisSlicesBySlice"],
+    resources: &[
+        "shell_vertices",
+        "prisms",
+        "axis_params",
+        "axis_occupancy",
+        "axis_choices",
+        "axis_draw_args",
+        "axis_vertices",
+        "axis_layer_counts",
+        "axis_slices_s",
+        "axis_slices_t",
+        "axis_slices_w",
+        "axis_sampler",
+        "axis_sampler_side",
+    ],
+    counts: &["prisms", "axis_triangles"],
+};
+
 /// Slice-vertex budget of one object: the storage-binding size every WebGPU adapter offers.
 pub const MAX_VERTEX_BYTES: u64 = 128 << 20;
 

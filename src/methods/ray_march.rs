@@ -20,6 +20,37 @@ use crate::scene::hypertexture::diagonal;
 use crate::scene::{Hypertexture, RayMarch, Segments, Shading};
 use crate::types::{HyperParams, MarchState, SegmentParams};
 
+/// What RayMarch brings to the render graph.
+pub const CONTRIBUTION: super::Contribution = super::Contribution {
+    method: "RayMarch",
+    filters: &["RayMarch", "RayMarchPeeling", "RayMarchSplatting"],
+    resources: &[
+        "hyper",
+        "hyper_noises",
+        "transfer_points",
+        "transfer_functions",
+        "transfer_tables",
+        "ray_march_state",
+        "mesh_grid",
+        "mesh_depth",
+        "segments",
+        "segment_bounds",
+        "surface_splats",
+        "interior_splats",
+        "peel_tickets",
+        "splat_slabs",
+    ],
+    counts: &[
+        "ray_march_dispatches",
+        "transfer_functions",
+        "surface_splats",
+        "peel_blocks",
+        "peel_phases",
+        "interior_splats",
+        "splat_blocks",
+    ],
+};
+
 /// Loop iterations one invocation may run per dispatch. Lavapipe silently ends every loop of an
 /// invocation after 65535 iterations in all; a density evaluation costs one iteration per noise
 /// plus one of the sample or shadow loop around it.

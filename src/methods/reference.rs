@@ -20,6 +20,23 @@ use crate::types::{
     ShellVertex, VertexFrame,
 };
 
+/// What Reference brings to the render graph.
+pub const CONTRIBUTION: super::Contribution = super::Contribution {
+    method: "Reference",
+    filters: &["Reference"],
+    resources: &[
+        "reference_params",
+        "reference_nodes",
+        "reference_prisms",
+        "reference_objects",
+        "texel_atlas",
+        "normal_atlas",
+        "reference_state",
+        "vertex_frames",
+    ],
+    counts: &["reference_dispatches"],
+};
+
 /// Everything the reference kernel reads, for all Reference objects of a frame.
 pub struct ReferenceSet {
     /// Indices of the Reference objects in the blueprint.

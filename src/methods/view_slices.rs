@@ -5,6 +5,25 @@ use crate::error::{Error, Result};
 use crate::mesh::shell::Shell;
 use crate::types::{SliceParams, SliceVertex};
 
+/// What ViewSlices brings to the render graph.
+pub const CONTRIBUTION: super::Contribution = super::Contribution {
+    method: "ViewSlices",
+    filters: &["ViewSlices"],
+    resources: &[
+        "slice_params",
+        "shell_vertices",
+        "prisms",
+        "plane_cursors",
+        "draw_args",
+        "plane_draws",
+        "slice_vertices",
+        "volume",
+        "normals",
+        "vertex_frames",
+    ],
+    counts: &["prisms", "planes", "plane_blocks"],
+};
+
 /// The plane sweep: `planes` planes orthogonal to the view direction spanning the shell's depth
 /// range (clipped to the near plane), back to front, each in the middle of its slab.
 pub fn sweep(shell: &Shell, forward: [f32; 3], planes: u32, near: f64) -> SliceParams {

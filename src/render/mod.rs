@@ -15,7 +15,7 @@ use crate::bake::BakeRequest;
 use crate::error::{Error, Result};
 use crate::gpu::sources::Sources;
 use crate::graph::plan::{self, ObjectInfo, Plan};
-use crate::graph::Graph;
+use crate::graph::{Graph, Vocabulary};
 use crate::mesh::shell::{self, Shell};
 use crate::methods::axis_slices::AxisPlan;
 use crate::methods::ray_march::{self, RayMarchPlan};
@@ -252,7 +252,7 @@ impl Blueprint {
         let (graph, sources) = load_graph(opts.graph.as_deref())?;
         let reference = reference_set(&objects, &bakes, &view);
         let (instances, infos) = instances(&objects, reference.as_ref(), view.eye);
-        let plan = plan::plan(&graph, &sources, &infos)?;
+        let plan = plan::plan(&graph, &sources, &infos, &vocabulary())?;
         check_bindings(&graph, &plan)?;
         let samples_texels =
             plan.passes.iter().flat_map(|p| &p.bindings).any(|b| TEXEL_BINDINGS.contains(&b.name.as_str()));
@@ -574,64 +574,39 @@ fn instances(
 const TEXEL_BINDINGS: &[&str] =
     &["volume", "normals", "texel_atlas", "axis_slices_s", "axis_slices_t", "axis_slices_w"];
 
-/// Resources the runtime binds by name: per frame, and per instance (an object's base surface or
-/// one chunk of its slices).
+/// Resources the renderer itself binds by name: per frame, and per instance of any method.
 pub const FRAME_RESOURCES: &[&str] = &["frame", "volume_sampler"];
-pub const INSTANCE_RESOURCES: &[&str] = &[
-    "object",
-    "base_vertices",
-    "slice_params",
-    "shell_vertices",
-    "prisms",
-    "plane_cursors",
-    "draw_args",
-    "plane_draws",
-    "slice_vertices",
-    "volume",
-    "normals",
-    "vertex_frames",
-    "reference_params",
-    "reference_nodes",
-    "reference_prisms",
-    "reference_objects",
-    "texel_atlas",
-    "normal_atlas",
-    "reference_state",
-    "hyper",
-    "hyper_noises",
-    "transfer_points",
-    "transfer_functions",
-    "transfer_tables",
-    "ray_march_state",
-    "mesh_grid",
-    "mesh_depth",
-    "segments",
-    "segment_bounds",
-    "surface_splats",
-    "interior_splats",
-    "peel_tickets",
-    "splat_slabs",
-    "axis_params",
-    "axis_occupancy",
-    "axis_choices",
-    "axis_draw_args",
-    "axis_vertices",
-    "axis_layer_counts",
-    "axis_slices_s",
-    "axis_slices_t",
-    "axis_slices_w",
-    "axis_sampler",
-    "axis_sampler_side",
-];
+pub const OBJECT_RESOURCES: &[&str] = &["object"];
+/// Counts the renderer provides per frame.
+pub const FRAME_COUNTS: &[&str] = &["width", "height"];
+
+/// Every name the runtime offers graph files: the renderer's own and those the registered
+/// methods declare (`methods::REGISTRY`), each once.
+pub fn vocabulary() -> Vocabulary {
+    let mut v = Vocabulary {
+        filters: Vec::new(),
+        counts: FRAME_COUNTS.to_vec(),
+        resources: [FRAME_RESOURCES, OBJECT_RESOURCES].concat(),
+    };
+    for c in crate::methods::REGISTRY {
+        v.filters.extend(c.filters);
+        v.counts.extend(c.counts);
+        v.resources.extend(c.resources);
+    }
+    for list in [&mut v.filters, &mut v.counts, &mut v.resources] {
+        let mut seen = std::collections::HashSet::new();
+        list.retain(|n| seen.insert(*n));
+    }
+    v
+}
 
 /// Every WGSL global a kept pass uses must name a graph texture or a runtime resource, so that
 /// `voltex plan` reports what `render` would.
 fn check_bindings(graph: &Graph, plan: &Plan) -> Result<()> {
     for p in &plan.passes {
         for b in &p.bindings {
-            let known = plan.textures.contains_key(&b.name)
-                || FRAME_RESOURCES.contains(&b.name.as_str())
-                || INSTANCE_RESOURCES.contains(&b.name.as_str());
+            let known =
+                plan.textures.contains_key(&b.name) || plan.vocabulary.resources.contains(&b.name.as_str());
             if !known {
                 return Err(plan::unknown_resource(graph, p.decl.name(), &b.name));
             }
