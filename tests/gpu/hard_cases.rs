@@ -7,7 +7,7 @@
 //! the CPU twins (prism map inverse, ray intervals, slice polygons, axis choice) cover the
 //! degenerate prism geometries.
 
-mod common;
+use crate::common;
 
 use common::ctx;
 use std::path::PathBuf;

@@ -2,7 +2,7 @@
 //! time N / fps, each frame the same as a single render at that `--time`; motions animate the
 //! shell; bad motions and frame ranges are errors.
 
-mod common;
+use crate::common;
 
 use common::{ok, root, s, voltex};
 use std::path::Path;

@@ -1,7 +1,7 @@
 //! The reference renderer: the GPU kernel against its f64 CPU twin on every example scene, the
 //! exact answer on an analytic box of fog (sides included), and brightness independent of the step.
 
-mod common;
+use crate::common;
 
 use common::ctx;
 use std::path::{Path, PathBuf};

@@ -1,7 +1,7 @@
 //! Render-graph files through the library (no GPU): parse errors at `file:line:col`, pass order
 //! derived from reads and writes, pruning, and new passes added only in RON and WGSL.
 
-mod common;
+use crate::common;
 
 use std::path::{Path, PathBuf};
 

@@ -3,7 +3,7 @@
 //! twin and the torus's known ones, images against the whole-bounds march, and the limit of too
 //! few passes on a concave object.
 
-mod common;
+use crate::common;
 
 use common::{ctx, sized};
 use std::path::Path;

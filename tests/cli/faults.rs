@@ -2,7 +2,7 @@
 //! `VOLTEX_FAULT`, see `src/gpu/fault.rs`), an update of references killed at any point, and
 //! output folders nobody (root included) can write into.
 
-mod common;
+use crate::common;
 
 use common::{entries, root, s, scratch_dir, stderr};
 use std::path::{Path, PathBuf};

@@ -3,7 +3,7 @@
 //! torus hole empty), shells (`fill: false`), open meshes falling back to a shell with a warning,
 //! and bad bounds or files reported at their position.
 
-mod common;
+use crate::common;
 
 use common::ctx;
 use std::path::{Path, PathBuf};

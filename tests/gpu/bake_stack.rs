@@ -1,7 +1,7 @@
 //! `voltex bake` writes a texel as a slice stack, and a `Slices(dir: ..)` texel reads it back: the
 //! scene renders the same from the stack as from its recipe. Bad stacks are errors at `line:col`.
 
-mod common;
+use crate::common;
 
 use common::{ok, root, s, voltex};
 

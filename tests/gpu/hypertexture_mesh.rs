@@ -3,7 +3,7 @@
 //! ray marcher's mesh sampling against the twin's, whole images, the bake cache, and bad meshes
 //! reported at their position.
 
-mod common;
+use crate::common;
 
 use common::{ctx, sized};
 use std::path::{Path, PathBuf};

@@ -1,6 +1,6 @@
 //! EXR/PNG round trips, atomic writes, error metrics and the golden harness.
 
-mod common;
+use crate::common;
 
 use std::fs;
 use std::path::{Path, PathBuf};

@@ -3,7 +3,7 @@
 //! against its twin, brightness independent of the level, the error against the reference at a
 //! grazing view with three directions and with horizontal slices only, and bad knobs.
 
-mod common;
+use crate::common;
 
 use common::ctx;
 use std::path::{Path, PathBuf};

@@ -4,7 +4,7 @@
 //! a single slab, which does not order the splats, clearly worse; also transformed and seen from
 //! inside), and bad knobs.
 
-mod common;
+use crate::common;
 
 use common::{ctx, sized};
 use std::path::Path;

@@ -2,7 +2,7 @@
 //! constant volume over a plane must equal the box it encloses), brightness that does not depend
 //! on the plane count, and no seams along prism edges.
 
-mod common;
+use crate::common;
 
 use common::ctx;
 use std::path::Path;

@@ -2,7 +2,7 @@
 //! kernels and graphs, and a graph copied elsewhere brings its own WGSL beside it (see
 //! `voltex::gpu::sources`).
 
-mod common;
+use crate::common;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};

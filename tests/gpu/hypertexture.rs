@@ -2,7 +2,7 @@
 //! transfer tables, soft objects, vector fields, density, colour, whole images), the analytic
 //! checks of the paper's model, and bad input reported at its position.
 
-mod common;
+use crate::common;
 
 use common::{ctx, sized};
 use std::path::{Path, PathBuf};

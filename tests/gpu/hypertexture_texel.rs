@@ -3,7 +3,7 @@
 //! in several slabs), the opacity convention against RayMarch and the analytic slab, the bake
 //! cache key, `voltex bake`, and bad input reported at its position.
 
-mod common;
+use crate::common;
 
 use common::ctx;
 use std::path::Path;

@@ -2,7 +2,7 @@
 //! scene file changes on disk the next frame it shows differs. Needs `xvfb-run` (package `xvfb`;
 //! `.ci/run` installs it).
 
-mod common;
+use crate::common;
 
 use common::window::Preview;
 use std::process::{Command, Stdio};

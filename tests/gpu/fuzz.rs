@@ -13,7 +13,7 @@
 //! shrunk by proptest to a minimal input, printed; it then becomes a named test in
 //! `fuzz_regressions` below.
 
-mod fuzz_support;
+use crate::fuzz_support;
 
 use std::path::{Path, PathBuf};
 

@@ -2,7 +2,7 @@
 //! `--update`, broken scenes and references, an unwritable output folder, shards merging into one
 //! report, and the example scenes under `scenes/` against their committed references.
 
-mod common;
+use crate::common;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};

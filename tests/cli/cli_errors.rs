@@ -2,7 +2,7 @@
 //! there is one), exits with status 1 (no panic, no signal) and leaves no output or temporary
 //! file behind. Plus the success case and `voltex plan`.
 
-mod common;
+use crate::common;
 
 use common::{entries, stderr};
 

@@ -1,0 +1,12 @@
+//! Checks that need no GPU: the book, the module layers, the twin list, shared struct layouts, scene and graph errors, image I/O and metrics.
+
+#[path = "../common/mod.rs"]
+mod common;
+
+mod docs;
+mod layers;
+mod twins;
+mod types_layout;
+mod scene_errors;
+mod graph_errors;
+mod io_metrics;

@@ -1,0 +1,9 @@
+//! Tests through the `voltex` binary: command-line errors, fault injection, an installed (copied) binary, the preview window under Xvfb.
+
+#[path = "../common/mod.rs"]
+mod common;
+
+mod cli_errors;
+mod faults;
+mod install;
+mod preview_window;

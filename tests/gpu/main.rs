@@ -1,0 +1,23 @@
+//! GPU tests (software Vulkan is enough): the methods against their CPU twins, analytic answers and the Reference; bakes, scenes, hard cases, pareto, regress and the fuzz corpus through the library. One binary, so they share one device.
+
+#[path = "../common/mod.rs"]
+mod common;
+#[path = "../fuzz_support/mod.rs"]
+mod fuzz_support;
+
+mod animation;
+mod axis_slices;
+mod bake_stack;
+mod gpu_slicing;
+mod hard_cases;
+mod hypertexture;
+mod hypertexture_mesh;
+mod hypertexture_segments;
+mod hypertexture_splatting;
+mod hypertexture_texel;
+mod mesh_texel;
+mod reference;
+mod render_scenes;
+mod pareto;
+mod regress;
+mod fuzz;
