@@ -196,7 +196,7 @@ fn graph_case(path: &Path, text: &str) -> Result<(), String> {
                     order: 0,
                 })
                 .collect();
-            match plan::plan(&graph, &voltex::gpu::sources::Sources::project().unwrap(), &objects) {
+            match plan::plan(&graph, &voltex::gpu::sources::Sources::project().unwrap(), &objects, (8, 8)) {
                 Ok(_) => accepted(),
                 Err(e) => check_error(&e, path, text, false),
             }

@@ -29,7 +29,8 @@ fn gpu_slices(shell: &Shell, params: &SliceParams, trivial_reject: bool) -> Vec<
     let graph = Graph::load(&root.join("graphs/slices_only.ron")).unwrap();
     let info = ObjectInfo { name: "shell".into(), filters: vec!["ViewSlices"], distance: 0.0, order: 0 };
     let plan =
-        plan::plan(&graph, &voltex::gpu::sources::Sources::folder(&root.join("wgsl")), &[info]).unwrap();
+        plan::plan(&graph, &voltex::gpu::sources::Sources::folder(&root.join("wgsl")), &[info], (1, 1))
+            .unwrap();
     assert_eq!(plan.passes.len(), 3);
     let mut cache = voltex::gpu::cache::GpuCache::default();
     let mut exec = Executor::new(ctx, graph, &plan, (1, 1), &mut cache).unwrap();

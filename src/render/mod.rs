@@ -252,7 +252,18 @@ impl Blueprint {
         let (graph, sources) = load_graph(opts.graph.as_deref())?;
         let reference = reference_set(&objects, &bakes, &view);
         let (instances, infos) = instances(&objects, reference.as_ref(), view.eye);
-        let plan = plan::plan(&graph, &sources, &infos)?;
+        if let Some(n) = graph
+            .file
+            .resources
+            .keys()
+            .find(|n| FRAME_RESOURCES.contains(&n.as_str()) || INSTANCE_RESOURCES.contains(&n.as_str()))
+        {
+            return Err(graph.error_at_resource(
+                n,
+                format!("resource `{n}` is one the runtime provides: pick another name"),
+            ));
+        }
+        let plan = plan::plan(&graph, &sources, &infos, size)?;
         check_bindings(&graph, &plan)?;
         let samples_texels =
             plan.passes.iter().flat_map(|p| &p.bindings).any(|b| TEXEL_BINDINGS.contains(&b.name.as_str()));
@@ -597,7 +608,7 @@ pub const INSTANCE_RESOURCES: &[&str] = &[
 fn check_bindings(graph: &Graph, plan: &Plan) -> Result<()> {
     for p in &plan.passes {
         for b in &p.bindings {
-            let known = plan.textures.contains_key(&b.name)
+            let known = plan.declares(&b.name)
                 || FRAME_RESOURCES.contains(&b.name.as_str())
                 || INSTANCE_RESOURCES.contains(&b.name.as_str());
             if !known {
