@@ -400,3 +400,33 @@ fn an_oversized_buffer_names_the_adapter_limit() {
         assert!(err.contains(w), "expected {w:?} in: {err}");
     }
 }
+
+/// Plans the flat box through `text` (beside the two kernels).
+fn plan_of(name: &str, text: &str) -> Blueprint {
+    let dir = common::scratch_dir(&format!("voltex-graph-data-{name}"));
+    let path = write_graph(&dir);
+    std::fs::write(&path, text).unwrap();
+    let scene = voltex::scene::load(&scene_path()).unwrap();
+    Blueprint::new(&scene, &options(Some(&path))).unwrap()
+}
+
+#[test]
+fn buffers_order_and_prune_passes() {
+    // Declared reader first: the writer of the histogram still runs before it.
+    let (histogram, overlay) = PASSES.split_at(PASSES.find("        // After").unwrap());
+    let bp = plan_of("order", &graph_text(RESOURCES, &format!("{overlay}{histogram}")));
+    let order: Vec<&str> = bp.plan.passes.iter().map(|p| p.decl.name()).collect();
+    let at = |n: &str| order.iter().position(|p| *p == n).unwrap_or_else(|| panic!("{n} in {order:?}"));
+    assert!(at("draw_slices") < at("histogram"), "{order:?}");
+    assert!(at("histogram") < at("histogram_overlay"), "{order:?}");
+    assert!(at("composite") < at("histogram_overlay"), "{order:?}");
+    assert_eq!(bp.plan.buffers["luminance_histogram"].bytes, 256);
+    assert!(bp.plan.buffers["luminance_histogram"].clear);
+    // Without a reader, the histogram reaches no output: its pass, buffer and parameters go.
+    let bp = plan_of("prune", &graph_text(RESOURCES, histogram));
+    assert!(bp.plan.passes.iter().all(|p| p.decl.name() != "histogram"));
+    assert!(bp.plan.buffers.is_empty() && bp.plan.parameters.is_empty());
+    for line in ["pass histogram:", "resource luminance_histogram:", "resource bar_color:"] {
+        assert!(bp.plan.pruned.iter().any(|p| p.starts_with(line)), "{line} in {:?}", bp.plan.pruned);
+    }
+}
