@@ -340,21 +340,21 @@ fn size_and_type_errors_name_the_place() {
     );
     // A buffer where the WGSL binds a uniform, a parameter whose type the WGSL disagrees with.
     expect(
-        "not storage",
+        "not-storage",
         "\n        \"luminance_histogram\": Buffer(size: Words(\"64\")),\n        \"bar_color\": Buffer(size: Words(\"4\")),\n        \"bar_scale\": Parameter(F32(0.125)),",
         "\"bar_color\":",
         0,
         &["`bar_color` is a graph buffer", "histogram_overlay.wgsl", "`var<uniform>` `vec4<f32>`"],
     );
     expect(
-        "parameter type",
+        "parameter-type",
         "\n        \"luminance_histogram\": Buffer(size: Words(\"64\")),\n        \"bar_color\": Parameter(Vec4(0.1, 0.9, 0.2, 1.0)),\n        \"bar_scale\": Parameter(U32(2)),",
         "\"bar_scale\":",
         0,
         &["parameter `bar_scale` is declared U32 (`u32`)", "`var<uniform> bar_scale: f32`"],
     );
     expect(
-        "runtime name",
+        "runtime-name",
         &format!("{}\n        \"frame\": Parameter(F32(1.0)),", with(r#"Buffer(size: Words("64"))"#)),
         "\"frame\":",
         0,
