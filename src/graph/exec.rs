@@ -19,9 +19,16 @@ struct Texture {
     clear: Option<Clear>,
 }
 
+struct Buffer {
+    buffer: wgpu::Buffer,
+    clear: bool,
+}
+
 pub struct Executor {
     graph: Graph,
     textures: HashMap<String, Texture>,
+    /// Graph buffers and parameters (uniform buffers holding their value).
+    buffers: HashMap<String, Buffer>,
     modules: HashMap<String, wgpu::ShaderModule>,
     layouts: Vec<Layout>,
     pipelines: HashMap<(usize, String), Pipeline>,
@@ -47,6 +54,34 @@ impl Executor {
         for p in &plan.passes {
             check_counts(&graph, &p.decl, &plan.vocabulary.counts)?;
         }
+        plan::check_buffer_limits(&graph, plan, &ctx.limits)?;
+        let mut buffers = HashMap::new();
+        for (name, b) in &plan.buffers {
+            let usage = wgpu::BufferUsages::STORAGE
+                | wgpu::BufferUsages::COPY_DST
+                | wgpu::BufferUsages::COPY_SRC
+                | if b.indirect { wgpu::BufferUsages::INDIRECT } else { wgpu::BufferUsages::empty() };
+            let buffer = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(name),
+                size: b.bytes.next_multiple_of(4),
+                usage,
+                mapped_at_creation: false,
+            });
+            buffers.insert(name.clone(), Buffer { buffer, clear: b.clear });
+        }
+        for (name, v) in &plan.parameters {
+            let bytes = v.bytes();
+            let buffer = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(name),
+                size: bytes.len() as u64,
+                usage: wgpu::BufferUsages::UNIFORM
+                    | wgpu::BufferUsages::COPY_DST
+                    | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            });
+            ctx.queue.write_buffer(&buffer, 0, &bytes);
+            buffers.insert(name.clone(), Buffer { buffer, clear: false });
+        }
         let blended: Vec<&str> = plan
             .passes
             .iter()
@@ -68,7 +103,7 @@ impl Executor {
             .collect();
         let mut textures = HashMap::new();
         for (name, decl) in &plan.textures {
-            let ResourceDecl::Texture { format, size: tsize, clear } = decl;
+            let ResourceDecl::Texture { format, size: tsize, clear } = decl else { continue };
             let (w, h) = match tsize {
                 TextureSize::Output => size,
                 TextureSize::Fixed(w, h) => (*w, *h),
@@ -112,11 +147,40 @@ impl Executor {
             let groups: Vec<u32> = p.bindings.iter().map(|b| b.group).collect();
             layouts.push(cache.layout(cache::key(&(&entries, &groups)), || pass_layout(ctx, p)));
         }
-        Ok(Self { graph, textures, modules, layouts, pipelines: HashMap::new() })
+        Ok(Self { graph, textures, buffers, modules, layouts, pipelines: HashMap::new() })
     }
 
     pub fn texture(&self, name: &str) -> Option<&wgpu::Texture> {
         self.textures.get(name).map(|t| &t.texture)
+    }
+
+    /// A graph buffer (or a parameter's uniform buffer).
+    pub fn buffer(&self, name: &str) -> Option<&wgpu::Buffer> {
+        self.buffers.get(name).map(|b| &b.buffer)
+    }
+
+    /// A buffer bound by name: the instance's, then the frame's, then the graph's.
+    fn resolve<'a>(&'a self, inst: &'a Inputs, frame: &'a Inputs, name: &str) -> Option<&'a wgpu::Buffer> {
+        resolve_buffer(inst, frame, name).or_else(|| self.buffer(name))
+    }
+
+    /// Zeroes the graph buffers with `clear: Zero` that pass `pass` is the first this frame to use.
+    fn clear_buffers(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        pass: &PlannedPass,
+        written: &mut Vec<String>,
+    ) {
+        for name in pass.reads.iter().chain(&pass.writes) {
+            if let Some(b) = self.buffers.get(name) {
+                if !written.contains(name) {
+                    written.push(name.clone());
+                    if b.clear {
+                        encoder.clear_buffer(&b.buffer, 0, None);
+                    }
+                }
+            }
+        }
     }
 
     /// Creates every pipeline the frame will use now, so that errors come before any work.
@@ -291,6 +355,7 @@ impl Executor {
             .iter()
             .map(|inst| self.bind_groups(ctx, pass, index, frame, inst))
             .collect::<Result<_>>()?;
+        self.clear_buffers(encoder, pass, written);
         let pipeline_of = |inst: &Inputs| -> &Pipeline {
             // `prepare` made every pipeline, so the specialisation is known to succeed here.
             &self.pipelines[&(index, constants_key(&specialisation(pass, frame, inst).unwrap_or_default()))]
@@ -299,7 +364,8 @@ impl Executor {
             PassDecl::Compute { name, entry, clear, dispatch, repeat, .. } => {
                 for inst in &instances {
                     for b in clear {
-                        let buf = resolve_buffer(inst, frame, b)
+                        let buf = self
+                            .resolve(inst, frame, b)
                             .ok_or_else(|| plan::unknown_resource(&self.graph, name, b))?;
                         encoder.clear_buffer(buf, 0, None);
                     }
@@ -416,7 +482,7 @@ impl Executor {
                         bound = Some(i);
                     }
                     let buffer = |b: &str| {
-                        resolve_buffer(inst, frame, b)
+                        self.resolve(inst, frame, b)
                             .ok_or_else(|| plan::unknown_resource(&self.graph, name, b))
                     };
                     match (draw, plane) {
@@ -486,7 +552,7 @@ impl Executor {
             for b in pass.bindings.iter().filter(|b| b.group as usize == group) {
                 let resource = match &b.kind {
                     BindingKind::Uniform | BindingKind::Storage { .. } => {
-                        resolve_buffer(inst, frame, &b.name).map(|buf| buf.as_entire_binding())
+                        self.resolve(inst, frame, &b.name).map(|buf| buf.as_entire_binding())
                     }
                     BindingKind::Texture { .. } | BindingKind::StorageTexture { .. } => inst
                         .views

@@ -3,6 +3,7 @@
 //! not use is pruned ([`plan`]); [`exec`] records and runs a frame.
 
 pub mod exec;
+pub mod expr;
 pub mod plan;
 
 use std::collections::BTreeMap;
@@ -35,6 +36,80 @@ pub enum ResourceDecl {
         #[serde(default)]
         clear: Option<Clear>,
     },
+    /// A storage buffer of the frame (one for all instances), bound by name to WGSL
+    /// `var<storage, read>` or `var<storage, read_write>` globals.
+    Buffer {
+        size: BufferSize,
+        /// `Zero`: zeroed every frame before the first pass that uses it; otherwise contents
+        /// carry over from frame to frame (zero at first).
+        #[serde(default)]
+        clear: Option<BufferClear>,
+    },
+    /// A small uniform value set in the graph, bound by name to a WGSL `var<uniform>` of the same
+    /// type.
+    Parameter(Value),
+}
+
+/// The size of a graph buffer. Counts are size expressions: integer literals and the frame's
+/// counts (`width`, `height`) joined by `*` and `+`, e.g. `"width * height"` (see [`expr`]).
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+pub enum BufferSize {
+    /// A size in bytes.
+    Bytes(Count),
+    /// A size in 4-byte words (`u32`, `f32`, `atomic<u32>`).
+    Words(Count),
+    /// `count` elements of `stride` bytes each.
+    Elements { count: Count, stride: u32 },
+}
+
+impl BufferSize {
+    /// The expression and the bytes per unit it counts.
+    pub fn expr(&self) -> (&str, u64) {
+        match self {
+            BufferSize::Bytes(c) => (c, 1),
+            BufferSize::Words(c) => (c, 4),
+            BufferSize::Elements { count, stride } => (count, *stride as u64),
+        }
+    }
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+pub enum BufferClear {
+    Zero,
+}
+
+/// The value of a `Parameter`, with its WGSL type.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+pub enum Value {
+    /// `f32`
+    F32(f32),
+    /// `u32`
+    U32(u32),
+    /// `i32`
+    I32(i32),
+    /// `vec4<f32>`
+    Vec4(f32, f32, f32, f32),
+}
+
+impl Value {
+    /// The WGSL type a `var<uniform>` bound to this value must have.
+    pub fn wgsl_type(&self) -> &'static str {
+        match self {
+            Value::F32(_) => "f32",
+            Value::U32(_) => "u32",
+            Value::I32(_) => "i32",
+            Value::Vec4(..) => "vec4<f32>",
+        }
+    }
+    /// The value's bytes as WGSL lays them out.
+    pub fn bytes(&self) -> Vec<u8> {
+        match *self {
+            Value::F32(v) => v.to_le_bytes().to_vec(),
+            Value::U32(v) => v.to_le_bytes().to_vec(),
+            Value::I32(v) => v.to_le_bytes().to_vec(),
+            Value::Vec4(x, y, z, w) => [x, y, z, w].iter().flat_map(|v| v.to_le_bytes()).collect(),
+        }
+    }
 }
 
 /// The names the runtime offers a graph beyond its own resources: the object filters passes
@@ -277,6 +352,46 @@ impl Graph {
         Error::at(FileLoc::new(&self.path, line, col), message)
     }
 
+    /// Byte offset of the key of resource `name` in `resources` (`"name":`), or of its first
+    /// mention.
+    pub fn resource_offset(&self, name: &str) -> usize {
+        let needle = format!("\"{name}\"");
+        let mut from = 0;
+        while let Some(i) = self.source[from..].find(&needle) {
+            let at = from + i;
+            if self.source[at + needle.len()..].trim_start().starts_with(':') {
+                return at;
+            }
+            from = at + needle.len();
+        }
+        self.source.find(&needle).unwrap_or(0)
+    }
+
+    /// An error at the declaration of resource `name`.
+    pub fn error_at_resource(&self, name: &str, message: impl Into<String>) -> Error {
+        let (line, col) = crate::error::line_col(&self.source, self.resource_offset(name));
+        Error::at(FileLoc::new(&self.path, line, col), message)
+    }
+
+    /// An error at byte `offset` inside the string literal `text` that follows the declaration
+    /// of resource `name` (a size expression).
+    pub fn error_in_literal(
+        &self,
+        name: &str,
+        text: &str,
+        offset: usize,
+        message: impl Into<String>,
+    ) -> Error {
+        let from = self.resource_offset(name);
+        let needle = format!("\"{text}\"");
+        let at = match self.source[from..].find(&needle) {
+            Some(i) => from + i + 1 + offset,
+            None => from,
+        };
+        let (line, col) = crate::error::line_col(&self.source, at);
+        Error::at(FileLoc::new(&self.path, line, col), message)
+    }
+
     fn check_names(&self) -> Result<()> {
         let f = &self.file;
         let mut seen = Vec::new();
@@ -287,12 +402,23 @@ impl Graph {
             seen.push(p.name());
             if let PassDecl::Raster { targets, depth, .. } = p {
                 for t in targets.iter().map(|t| &t.resource).chain(depth.iter().map(|d| &d.resource)) {
-                    if !f.resources.contains_key(t) {
+                    if !matches!(f.resources.get(t), Some(ResourceDecl::Texture { .. })) {
                         return Err(self.error_at(
                             t,
                             format!("render target `{t}` is not a texture declared in `resources`"),
                         ));
                     }
+                }
+            }
+        }
+        for (name, decl) in &f.resources {
+            if let ResourceDecl::Buffer { size, .. } = decl {
+                let (text, unit) = size.expr();
+                expr::Expr::parse(text).map_err(|e| {
+                    self.error_in_literal(name, text, e.offset, format!("buffer `{name}`: {}", e.message))
+                })?;
+                if unit == 0 {
+                    return Err(self.error_at_resource(name, format!("buffer `{name}`: a stride of 0 bytes")));
                 }
             }
         }

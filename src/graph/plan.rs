@@ -8,7 +8,8 @@ use crate::error::{Error, Result};
 use crate::gpu::reflect::{self, Binding};
 use crate::gpu::shader::{self, Kernel};
 use crate::gpu::sources::Sources;
-use crate::graph::{Draw, Graph, Instances, PassDecl, ResourceDecl, Vocabulary};
+use crate::graph::expr::Expr;
+use crate::graph::{BufferClear, Draw, Graph, Instances, PassDecl, ResourceDecl, Value, Vocabulary};
 
 /// What the planner needs to know of a scene object.
 #[derive(Debug, Clone)]
@@ -32,25 +33,44 @@ pub struct PlannedPass {
     pub instances: Option<Vec<usize>>,
 }
 
+/// A graph buffer some kept pass uses, sized for the frame.
+#[derive(Debug, Clone)]
+pub struct PlannedBuffer {
+    pub bytes: u64,
+    /// Zeroed every frame before the first pass that uses it.
+    pub clear: bool,
+    /// Some pass draws with it as indirect arguments.
+    pub indirect: bool,
+}
+
 pub struct Plan {
     pub passes: Vec<PlannedPass>,
     /// Graph textures some kept pass uses.
     pub textures: BTreeMap<String, ResourceDecl>,
+    /// Graph buffers some kept pass uses.
+    pub buffers: BTreeMap<String, PlannedBuffer>,
+    /// Graph parameters some kept pass uses.
+    pub parameters: BTreeMap<String, Value>,
     /// One line per pruned pass or resource, saying why.
     pub pruned: Vec<String>,
     /// The runtime's names it was planned against.
     pub vocabulary: Vocabulary,
 }
 
-/// Plans `graph` for `objects`, its shaders looked up in `sources` (the graph's folder first when
-/// the caller put it there: see [`Sources::beside`]), its filters and counts checked against
-/// `vocabulary`.
+/// Counts known for the whole frame when the graph is planned: graph buffers are sized by them.
+pub const FRAME_COUNTS: &[&str] = &["width", "height"];
+
+/// Plans `graph` for `objects` and an output of `size` pixels, its shaders looked up in `sources`
+/// (the graph's folder first when the caller put it there: see [`Sources::beside`]), its filters
+/// and counts checked against `vocabulary`.
 pub fn plan(
     graph: &Graph,
     sources: &Sources,
     objects: &[ObjectInfo],
+    size: (u32, u32),
     vocabulary: &Vocabulary,
 ) -> Result<Plan> {
+    let sizes = buffer_sizes(graph, size, vocabulary)?;
     let mut kernels: BTreeMap<String, Arc<Kernel>> = BTreeMap::new();
     let mut candidates = Vec::new();
     let mut pruned = Vec::new();
@@ -102,14 +122,223 @@ pub fn plan(
     passes.shrink_to_fit();
     let used: BTreeSet<&String> = passes.iter().flat_map(|p| p.reads.iter().chain(p.writes.iter())).collect();
     let mut textures = BTreeMap::new();
+    let mut buffers = BTreeMap::new();
+    let mut parameters = BTreeMap::new();
     for (name, decl) in &graph.file.resources {
-        if used.contains(name) {
-            textures.insert(name.clone(), decl.clone());
-        } else {
+        if !used.contains(name) {
             pruned.push(format!("resource {name}: no kept pass uses it"));
+            continue;
+        }
+        match decl {
+            ResourceDecl::Texture { .. } => {
+                textures.insert(name.clone(), decl.clone());
+            }
+            ResourceDecl::Buffer { clear, .. } => {
+                let indirect = passes.iter().any(|p| match &p.decl {
+                    PassDecl::Raster { draw: Draw::Indirect(b), .. } => b == name,
+                    PassDecl::Raster { draw: Draw::DepthSorted { whole, per_plane }, .. } => {
+                        whole == name || per_plane == name
+                    }
+                    _ => false,
+                });
+                let bytes = sizes[name];
+                buffers.insert(
+                    name.clone(),
+                    PlannedBuffer { bytes, clear: *clear == Some(BufferClear::Zero), indirect },
+                );
+            }
+            ResourceDecl::Parameter(v) => {
+                parameters.insert(name.clone(), *v);
+            }
         }
     }
-    Ok(Plan { passes, textures, pruned, vocabulary: vocabulary.clone() })
+    for p in &passes {
+        for b in &p.bindings {
+            if let Some(decl) = graph.file.resources.get(&b.name) {
+                check_binding(graph, p, b, decl, sizes.get(&b.name).copied())?;
+            }
+        }
+    }
+    Ok(Plan { passes, textures, buffers, parameters, pruned, vocabulary: vocabulary.clone() })
+}
+
+/// The byte size of every graph buffer for an output of `size`: an error at the expression for an
+/// unknown or per-object count, at the declaration for a size of zero.
+fn buffer_sizes(graph: &Graph, (w, h): (u32, u32), vocabulary: &Vocabulary) -> Result<BTreeMap<String, u64>> {
+    let mut out = BTreeMap::new();
+    for (name, decl) in &graph.file.resources {
+        let ResourceDecl::Buffer { size, .. } = decl else { continue };
+        let (text, unit) = size.expr();
+        let at = |e: crate::graph::expr::ExprError| {
+            graph.error_in_literal(name, text, e.offset, format!("buffer `{name}`: {}", e.message))
+        };
+        let expr = Expr::parse(text).map_err(at)?;
+        for (n, offset) in expr.names() {
+            if !FRAME_COUNTS.contains(&n) {
+                let why = if vocabulary.counts.contains(&n) {
+                    format!("`{n}` is counted per object; a graph buffer is sized for the frame")
+                } else {
+                    format!("unknown count `{n}`")
+                };
+                return Err(at(crate::graph::expr::ExprError {
+                    offset,
+                    message: format!("{why}: a size is numbers and {FRAME_COUNTS:?} joined by `*` and `+`"),
+                }));
+            }
+        }
+        let units = expr
+            .eval(|n| match n {
+                "width" => Some(w as u64),
+                "height" => Some(h as u64),
+                _ => None,
+            })
+            .map_err(at)?;
+        let bytes = units.checked_mul(unit).ok_or_else(|| {
+            graph.error_at_resource(
+                name,
+                format!("buffer `{name}`: `{text}` x {unit} bytes overflows 64 bits"),
+            )
+        })?;
+        if bytes == 0 {
+            return Err(graph.error_at_resource(
+                name,
+                format!("buffer `{name}` is 0 bytes (`{text}` = 0 at {w}x{h}): a buffer needs at least 4"),
+            ));
+        }
+        out.insert(name.clone(), bytes);
+    }
+    Ok(out)
+}
+
+/// Checks a WGSL global bound to a graph resource: a texture to a texture, a buffer to a storage
+/// buffer at least as large as the WGSL type, a parameter to a `var<uniform>` of its type.
+fn check_binding(
+    graph: &Graph,
+    pass: &PlannedPass,
+    b: &Binding,
+    decl: &ResourceDecl,
+    bytes: Option<u64>,
+) -> Result<()> {
+    use reflect::BindingKind as K;
+    let module = &pass.kernel.module;
+    let var = module
+        .global_variables
+        .iter()
+        .map(|(_, v)| v)
+        .find(|v| v.binding.as_ref().is_some_and(|r| r.group == b.group && r.binding == b.binding));
+    let ty = var.map(|v| wgsl_type(module, v.ty)).unwrap_or_default();
+    let shader = pass.decl.shader();
+    let name = &b.name;
+    let wrong = |what: &str| {
+        graph.error_at_resource(
+            name,
+            format!(
+                "`{name}` is a graph {what}, but {shader} (pass `{}`) declares `{name}` as {} `{ty}`",
+                pass.decl.name(),
+                describe_kind(&b.kind)
+            ),
+        )
+    };
+    match decl {
+        ResourceDecl::Texture { .. } => {
+            if !matches!(b.kind, K::Texture { .. } | K::StorageTexture { .. }) {
+                return Err(wrong("texture"));
+            }
+        }
+        ResourceDecl::Buffer { .. } => {
+            if !matches!(b.kind, K::Storage { .. }) {
+                return Err(wrong("buffer: bind it as `var<storage, read>` or `var<storage, read_write>`"));
+            }
+            let need = var.map_or(0, |v| module.types[v.ty].inner.size(module.to_ctx()) as u64);
+            let have = bytes.unwrap_or(0);
+            if have < need {
+                return Err(graph.error_at_resource(
+                    name,
+                    format!(
+                        "buffer `{name}` is {have} bytes, but {shader} (pass `{}`) reads it as `{ty}`, at least {need} bytes",
+                        pass.decl.name()
+                    ),
+                ));
+            }
+        }
+        ResourceDecl::Parameter(v) => {
+            if !matches!(b.kind, K::Uniform) {
+                return Err(wrong("parameter: bind it as `var<uniform>`"));
+            }
+            if ty != v.wgsl_type() {
+                return Err(graph.error_at_resource(
+                    name,
+                    format!(
+                        "parameter `{name}` is declared {} (`{}`), but {shader} (pass `{}`) declares `var<uniform> {name}: {ty}`",
+                        match v {
+                            Value::F32(_) => "F32",
+                            Value::U32(_) => "U32",
+                            Value::I32(_) => "I32",
+                            Value::Vec4(..) => "Vec4",
+                        },
+                        v.wgsl_type(),
+                        pass.decl.name()
+                    ),
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+fn describe_kind(kind: &reflect::BindingKind) -> &'static str {
+    use reflect::BindingKind as K;
+    match kind {
+        K::Uniform => "`var<uniform>`",
+        K::Storage { read_only: true } => "`var<storage, read>`",
+        K::Storage { read_only: false } => "`var<storage, read_write>`",
+        K::Texture { .. } => "a texture",
+        K::StorageTexture { .. } => "a storage texture",
+        K::Sampler => "a sampler",
+    }
+}
+
+/// A WGSL spelling of a naga type, for messages and parameter checks.
+fn wgsl_type(module: &naga::Module, ty: naga::Handle<naga::Type>) -> String {
+    let scalar = |s: &naga::Scalar| match (s.kind, s.width) {
+        (naga::ScalarKind::Float, 4) => "f32".to_string(),
+        (naga::ScalarKind::Uint, 4) => "u32".to_string(),
+        (naga::ScalarKind::Sint, 4) => "i32".to_string(),
+        (naga::ScalarKind::Bool, _) => "bool".to_string(),
+        (k, w) => format!("{k:?}{}", w * 8),
+    };
+    let t = &module.types[ty];
+    match &t.inner {
+        naga::TypeInner::Scalar(s) => scalar(s),
+        naga::TypeInner::Atomic(s) => format!("atomic<{}>", scalar(s)),
+        naga::TypeInner::Vector { size, scalar: s } => format!("vec{}<{}>", *size as u8, scalar(s)),
+        naga::TypeInner::Matrix { columns, rows, scalar: s } => {
+            format!("mat{}x{}<{}>", *columns as u8, *rows as u8, scalar(s))
+        }
+        naga::TypeInner::Array { base, size, .. } => match size {
+            naga::ArraySize::Constant(n) => format!("array<{}, {n}>", wgsl_type(module, *base)),
+            _ => format!("array<{}>", wgsl_type(module, *base)),
+        },
+        _ => t.name.clone().unwrap_or_else(|| format!("{:?}", t.inner)),
+    }
+}
+
+/// Checks the graph buffers of a plan against an adapter's limits (`voltex plan` has no adapter:
+/// the executor calls this).
+pub fn check_buffer_limits(graph: &Graph, plan: &Plan, limits: &wgpu::Limits) -> Result<()> {
+    let max = limits.max_storage_buffer_binding_size.min(limits.max_buffer_size);
+    for (name, b) in &plan.buffers {
+        if b.bytes > max {
+            return Err(graph.error_at_resource(
+                name,
+                format!(
+                    "buffer `{name}` is {} bytes, beyond this adapter's max storage buffer binding size of {max} bytes",
+                    b.bytes
+                ),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// Resources a pass reads and writes: from reflection, render targets, indirect arguments and clears.
@@ -246,6 +475,13 @@ fn live(outputs: &[String], passes: Vec<PlannedPass>, pruned: &mut Vec<String>) 
 }
 
 impl Plan {
+    /// Whether `name` is a graph resource (texture, buffer or parameter) the plan allocates.
+    pub fn declares(&self, name: &str) -> bool {
+        self.textures.contains_key(name)
+            || self.buffers.contains_key(name)
+            || self.parameters.contains_key(name)
+    }
+
     /// Distinct kernels (WGSL files) the plan compiles.
     pub fn kernels(&self) -> BTreeSet<&str> {
         self.passes.iter().map(|p| p.decl.shader()).collect()

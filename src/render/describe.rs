@@ -12,7 +12,7 @@ impl Blueprint {
     pub fn memory(&self) -> Vec<(String, u64)> {
         let mut out = Vec::new();
         for (name, decl) in &self.plan.textures {
-            let ResourceDecl::Texture { format, size, .. } = decl;
+            let ResourceDecl::Texture { format, size, .. } = decl else { continue };
             let (w, h) = match size {
                 TextureSize::Output => self.size,
                 TextureSize::Fixed(w, h) => (*w, *h),
@@ -21,6 +21,12 @@ impl Blueprint {
                 format!("texture {name} {w}x{h} {format:?}"),
                 w as u64 * h as u64 * format.bytes_per_pixel(),
             ));
+        }
+        for (name, b) in &self.plan.buffers {
+            out.push((format!("buffer {name} {} bytes", b.bytes), b.bytes));
+        }
+        for (name, v) in &self.plan.parameters {
+            out.push((format!("parameter {name} {}", v.wgsl_type()), v.bytes().len() as u64));
         }
         for b in &self.bakes {
             let r = b.request.resolution;
@@ -217,6 +223,7 @@ impl Blueprint {
                 pipelines.join(", ")
             );
         }
+        s += &self.describe_resources();
         s += &format!(
             "\nkernels compiled: {}\n",
             self.plan.kernels().into_iter().collect::<Vec<_>>().join(", ")
@@ -233,6 +240,37 @@ impl Blueprint {
             s += &format!("  {:>10.2} MiB  {what}\n", *bytes as f64 / 1048576.0);
         }
         s += &format!("  {:>10.2} MiB  total\n", mem.iter().map(|m| m.1).sum::<u64>() as f64 / 1048576.0);
+        s
+    }
+
+    /// The graph's resources the plan allocates: textures with their size, buffers with their
+    /// size expression and bytes, parameters with their value.
+    fn describe_resources(&self) -> String {
+        let mut s = "\nresources:\n".to_string();
+        for (name, decl) in &self.plan.textures {
+            if let ResourceDecl::Texture { format, size, .. } = decl {
+                let (w, h) = match size {
+                    TextureSize::Output => self.size,
+                    TextureSize::Fixed(w, h) => (*w, *h),
+                };
+                s += &format!("  {name:<20} texture {w}x{h} {format:?}\n");
+            }
+        }
+        for (name, b) in &self.plan.buffers {
+            let Some(ResourceDecl::Buffer { size, .. }) = self.graph.file.resources.get(name) else {
+                continue;
+            };
+            let (expr, unit) = size.expr();
+            s += &format!(
+                "  {name:<20} buffer {} bytes (\"{expr}\" x {unit}){}{}\n",
+                b.bytes,
+                if b.clear { ", cleared each frame" } else { "" },
+                if b.indirect { ", indirect draws" } else { "" }
+            );
+        }
+        for (name, v) in &self.plan.parameters {
+            s += &format!("  {name:<20} parameter {} = {v:?}\n", v.wgsl_type());
+        }
         s
     }
 

@@ -252,7 +252,13 @@ impl Blueprint {
         let (graph, sources) = load_graph(opts.graph.as_deref())?;
         let reference = reference_set(&objects, &bakes, &view);
         let (instances, infos) = instances(&objects, reference.as_ref(), view.eye);
-        let plan = plan::plan(&graph, &sources, &infos, &vocabulary())?;
+        if let Some(n) = graph.file.resources.keys().find(|n| vocabulary().resources.contains(&n.as_str())) {
+            return Err(graph.error_at_resource(
+                n,
+                format!("resource `{n}` is one the runtime provides: pick another name"),
+            ));
+        }
+        let plan = plan::plan(&graph, &sources, &infos, size, &vocabulary())?;
         check_bindings(&graph, &plan)?;
         let samples_texels =
             plan.passes.iter().flat_map(|p| &p.bindings).any(|b| TEXEL_BINDINGS.contains(&b.name.as_str()));
@@ -577,15 +583,13 @@ const TEXEL_BINDINGS: &[&str] =
 /// Resources the renderer itself binds by name: per frame, and per instance of any method.
 pub const FRAME_RESOURCES: &[&str] = &["frame", "volume_sampler"];
 pub const OBJECT_RESOURCES: &[&str] = &["object"];
-/// Counts the renderer provides per frame.
-pub const FRAME_COUNTS: &[&str] = &["width", "height"];
 
 /// Every name the runtime offers graph files: the renderer's own and those the registered
 /// methods declare (`methods::REGISTRY`), each once.
 pub fn vocabulary() -> Vocabulary {
     let mut v = Vocabulary {
         filters: Vec::new(),
-        counts: FRAME_COUNTS.to_vec(),
+        counts: plan::FRAME_COUNTS.to_vec(),
         resources: [FRAME_RESOURCES, OBJECT_RESOURCES].concat(),
     };
     for c in crate::methods::REGISTRY {
@@ -605,8 +609,7 @@ pub fn vocabulary() -> Vocabulary {
 fn check_bindings(graph: &Graph, plan: &Plan) -> Result<()> {
     for p in &plan.passes {
         for b in &p.bindings {
-            let known =
-                plan.textures.contains_key(&b.name) || plan.vocabulary.resources.contains(&b.name.as_str());
+            let known = plan.declares(&b.name) || plan.vocabulary.resources.contains(&b.name.as_str());
             if !known {
                 return Err(plan::unknown_resource(graph, p.decl.name(), &b.name));
             }

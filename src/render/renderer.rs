@@ -171,6 +171,14 @@ impl Renderer {
         ctx.read_buffer(b, 0, b.size())
     }
 
+    /// Reads back a graph buffer (`Buffer` or `Parameter` in the graph file) as the last frame left it.
+    pub fn read_buffer(&self, ctx: &GpuContext, name: &str) -> Result<Vec<u8>> {
+        let b = self.exec.buffer(name).ok_or_else(|| {
+            Error::Invalid(format!("`{name}` is not a graph buffer of this plan (undeclared or pruned)"))
+        })?;
+        ctx.read_buffer(b, 0, b.size())
+    }
+
     /// The graph's first output (the linear image), as rendered by the last frame.
     pub fn output_texture(&self) -> Option<&wgpu::Texture> {
         self.exec.texture(&self.blueprint.graph.file.outputs[0])

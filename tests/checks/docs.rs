@@ -271,8 +271,8 @@ fn scene_registry() -> Registry {
 
 fn graph_registry() -> Registry {
     use voltex::graph::*;
-    trace!(GraphFile; ResourceDecl, Format, TextureSize, Clear, Instances, PassDecl, Dispatch, Blend,
-        Compare, Draw)
+    trace!(GraphFile; ResourceDecl, Format, TextureSize, Clear, BufferSize, BufferClear, Value, Instances,
+        PassDecl, Dispatch, Blend, Compare, Draw)
 }
 
 fn missing_in(page: &str, names: impl IntoIterator<Item = String>) -> Vec<String> {

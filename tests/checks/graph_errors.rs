@@ -19,7 +19,7 @@ fn wgsl_root() -> PathBuf {
 
 /// Plans `g` with its shaders read from the folder `wgsl` only.
 fn plan(g: &Graph, wgsl: &Path, objects: &[ObjectInfo]) -> voltex::Result<Plan> {
-    voltex::graph::plan::plan(g, &Sources::folder(wgsl), objects, &voltex::render::vocabulary())
+    voltex::graph::plan::plan(g, &Sources::folder(wgsl), objects, (64, 64), &voltex::render::vocabulary())
 }
 
 fn temp_dir(test: &str) -> PathBuf {

@@ -4,9 +4,9 @@
 mod common;
 
 mod docs;
-mod layers;
-mod twins;
-mod types_layout;
-mod scene_errors;
 mod graph_errors;
 mod io_metrics;
+mod layers;
+mod scene_errors;
+mod twins;
+mod types_layout;

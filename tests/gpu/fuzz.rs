@@ -202,6 +202,7 @@ fn graph_case(path: &Path, text: &str) -> Result<(), String> {
                 &graph,
                 &voltex::gpu::sources::Sources::project().unwrap(),
                 &objects,
+                (8, 8),
                 &vocabulary,
             ) {
                 Ok(_) => accepted(),

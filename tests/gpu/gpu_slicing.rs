@@ -32,6 +32,7 @@ fn gpu_slices(shell: &Shell, params: &SliceParams, trivial_reject: bool) -> Vec<
         &graph,
         &voltex::gpu::sources::Sources::folder(&root.join("wgsl")),
         &[info],
+        (1, 1),
         &voltex::render::vocabulary(),
     )
     .unwrap();
