@@ -1,4 +1,4 @@
-//! Structs shared with WGSL. Mirrored in `wgsl/shared/types.wgsl`; `tests/types_layout.rs` checks
+//! Structs shared with WGSL. Mirrored in `wgsl/shared/types.wgsl`; `tests/checks/types_layout.rs` checks
 //! that sizes and field offsets agree (naga reflection against these Rust layouts).
 
 use bytemuck::{Pod, Zeroable};

@@ -1,4 +1,4 @@
-//! Scene parsing and flattening (errors with positions are in tests/scene_errors.rs).
+//! Scene parsing and flattening (errors with positions are in tests/checks/scene_errors.rs).
 
 use super::*;
 use glam::DVec3;

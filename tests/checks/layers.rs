@@ -68,7 +68,7 @@ fn modules_import_only_lower_layers() {
     let modules: Vec<&str> =
         lib.lines().filter_map(|l| l.trim().strip_prefix("pub mod ")?.strip_suffix(';')).collect();
     for m in &modules {
-        assert!(layer_of(m).is_some(), "module `{m}` is in no layer of tests/layers.rs: place it");
+        assert!(layer_of(m).is_some(), "module `{m}` is in no layer of tests/checks/layers.rs: place it");
     }
     let mut files = Vec::new();
     rust_files(&src, &mut files);

@@ -14,18 +14,18 @@ const NO_TWIN: &[(&str, &str)] = &[
         "begin_segments",
         "depth peeling's first step (each pixel's start, no boundaries yet): the twin \
          `peel_segments` (src/cpu/peel_segments.rs) returns a pixel's boundaries after this step \
-         and every peel, compared with both kernels' output in tests/hypertexture_segments.rs",
+         and every peel, compared with both kernels' output in tests/gpu/hypertexture_segments.rs",
     ),
     (
         "resolve_splats",
         "splatting's second step (slabs composited front to back): the twin `splat_segments` \
          (src/cpu/splat_segments.rs) returns the resolved pixel of both steps, compared in \
-         tests/hypertexture_splatting.rs",
+         tests/gpu/hypertexture_splatting.rs",
     ),
     (
         "probe_hypertexture",
         "test probe, no math of its own: evaluates the functions of wgsl/shared/hypertexture.wgsl \
-         at given points so that tests/hypertexture.rs compares them with src/cpu/hypertexture.rs",
+         at given points so that tests/gpu/hypertexture.rs compares them with src/cpu/hypertexture.rs",
     ),
     (
         "bench_simplex",
@@ -35,23 +35,23 @@ const NO_TWIN: &[(&str, &str)] = &[
     (
         "scan_axis_slices",
         "bookkeeping: an exclusive prefix sum (wgsl/shared/scan.wgsl, as scan_plane_offsets, \
-         which has a twin) of per-prism vertex counts; tests/axis_slices.rs checks that every \
+         which has a twin) of per-prism vertex counts; tests/gpu/axis_slices.rs checks that every \
          vertex counted is drawn",
     ),
     (
         "scan_axis_layers",
         "bookkeeping: an exclusive prefix sum (wgsl/shared/scan.wgsl) of per-layer triangle \
-         counts; tests/axis_slices.rs checks that grouping draws the same image",
+         counts; tests/gpu/axis_slices.rs checks that grouping draws the same image",
     ),
     (
         "group_axis_slices",
         "bookkeeping: copies emitted triangles into their slice image's group, no arithmetic on \
-         them; tests/axis_slices.rs checks that grouping by slice image draws the same image",
+         them; tests/gpu/axis_slices.rs checks that grouping by slice image draws the same image",
     ),
     (
         "composite",
         "raster: blends the premultiplied accumulation over the background (one line); checked \
-         by the golden images (tests/render_scenes.rs, voltex regress)",
+         by the golden images (tests/gpu/render_scenes.rs, voltex regress)",
     ),
     (
         "composite_ray_march",
@@ -61,7 +61,7 @@ const NO_TWIN: &[(&str, &str)] = &[
     (
         "composite_reference",
         "raster: copies the trace_reference layer (premultiplied-over blending by the pipeline); \
-         checked by tests/reference.rs and the golden images",
+         checked by tests/gpu/reference.rs and the golden images",
     ),
     (
         "draw_base",
@@ -71,13 +71,13 @@ const NO_TWIN: &[(&str, &str)] = &[
     (
         "draw_slices",
         "raster: draws what emit_slices produced (checked against its twin in \
-         tests/gpu_slicing.rs) with trilinear sampling and the step-corrected opacity; checked \
+         tests/gpu/gpu_slicing.rs) with trilinear sampling and the step-corrected opacity; checked \
          by the golden images",
     ),
     (
         "draw_axis_slices",
         "raster: draws what emit_axis_slices produced (checked against its twin in \
-         tests/axis_slices.rs) from the slice images bake_axis_slices made; checked by the \
+         tests/gpu/axis_slices.rs) from the slice images bake_axis_slices made; checked by the \
          golden images",
     ),
     (

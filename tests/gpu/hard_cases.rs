@@ -286,7 +286,7 @@ fn every_hard_case_is_checked() {
         let p = e.unwrap().path();
         if p.extension().is_some_and(|x| x == "ron") {
             let stem = p.file_stem().unwrap().to_str().unwrap().to_string();
-            assert!(listed.contains(&stem.as_str()), "{stem}.ron is in no table of tests/hard_cases.rs");
+            assert!(listed.contains(&stem.as_str()), "{stem}.ron is in no table of tests/gpu/hard_cases.rs");
             let first = std::fs::read_to_string(&p).unwrap();
             assert!(first.starts_with("// Hard case"), "{stem}.ron begins with what the case is");
             assert!(first.contains("Correct:"), "{stem}.ron says what correct means");
