@@ -119,7 +119,7 @@ pub struct BaseVertex {
 pub struct BakeParams {
     /// xyz: volume resolution in voxels; w: number of shapes used (implicit bake only).
     pub resolution: [u32; 4],
-    /// xyz: texel-space direction towards the light (normalized by the kernel); w: ambient in [0,1].
+    /// xyz: texel-space direction towards the light (normalized by the kernel); w: ambient in `[0, 1]`.
     pub light: [f32; 4],
 }
 
@@ -167,7 +167,7 @@ pub struct HeightfieldParams {
 }
 
 /// A height field from a grey-level image (`heights`, row-major from the top row, values in
-/// [0,1]). Mirrored as `HeightImageParams` in `wgsl/shared/types.wgsl`. Height
+/// `[0, 1]`). Mirrored as `HeightImageParams` in `wgsl/shared/types.wgsl`. Height
 /// `h(s,t) = base + amplitude * image(s,t)`, bilinear with wrapping.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]

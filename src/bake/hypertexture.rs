@@ -1,5 +1,5 @@
 //! Texels baked from a hypertexture (Meyer & Neyret 1998, section 3.3): a box of the
-//! hypertexture's object space maps onto texel space [0,1]^3 and `bake_hypertexture.wgsl`
+//! hypertexture's object space maps onto texel space `[0, 1]^3` and `bake_hypertexture.wgsl`
 //! evaluates the density and colour transfer at each voxel centre, after `bake_transfer.wgsl`
 //! has sampled the transfer functions (and, for mesh objects, `bake_mesh_grid.wgsl` the mesh).
 //!

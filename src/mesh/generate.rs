@@ -1,5 +1,5 @@
 //! Built-in base surfaces: plane grid, UV sphere, (distorted) torus. All welded, counter-clockwise seen
-//! from outside, uv in [0,1] per tile, deterministic from their seed.
+//! from outside, uv in `[0, 1]` per tile, deterministic from their seed.
 
 use super::Mesh;
 use glam::{DVec2, DVec3};
@@ -77,7 +77,7 @@ fn with_corner_uvs(
 }
 
 /// A parametric closed surface sampled on a grid with wrapped indices (welded seams).
-/// `pos(u, v)` for u, v in [0,1]; u wraps; v wraps when `wrap_v`, else v = 0 and v = 1 are poles
+/// `pos(u, v)` for u, v in `[0, 1]`; u wraps; v wraps when `wrap_v`, else v = 0 and v = 1 are poles
 /// (one vertex each, triangle fans). Returns the mesh without normals.
 fn parametric(nu: usize, nv: usize, wrap_v: bool, pos: impl Fn(f64, f64) -> DVec3) -> Mesh {
     let mut positions = Vec::new();

@@ -70,7 +70,7 @@ pub struct Mesh {
     /// Unit outward normal per welded vertex (zero where undefined).
     pub normals: Vec<DVec3>,
     pub triangles: Vec<[u32; 3]>,
-    /// Per corner, one tile = [0,1]^2, no tiling.
+    /// Per corner, one tile = `[0, 1]^2`, no tiling.
     pub corner_uvs: Vec<[DVec2; 3]>,
     /// One uv per welded vertex (from its first corner) for sampling height textures.
     pub vertex_uvs: Vec<DVec2>,

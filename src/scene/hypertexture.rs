@@ -1,6 +1,6 @@
 //! Scene types of hypertextures (Gilet & Dischler 2009, section 4): a soft object, a vector field,
 //! noises filtered by shape transfer functions, and an RGBA transfer function on density. Value
-//! ranges are checked while parsing; list lengths and control-point order by [`check`] (positioned
+//! ranges are checked while parsing; list lengths and control-point order by `check` (positioned
 //! through [`Mark`]s).
 
 use std::sync::Arc;

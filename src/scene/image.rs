@@ -1,4 +1,4 @@
-//! Height textures: PNG images (grey, grey+alpha, RGB, RGBA; 8 or 16 bit) as values in [0,1].
+//! Height textures: PNG images (grey, grey+alpha, RGB, RGBA; 8 or 16 bit) as values in `[0, 1]`.
 
 use crate::error::{Error, Result};
 use glam::DVec2;
@@ -9,7 +9,7 @@ pub struct HeightImage {
     pub width: usize,
     pub height: usize,
     pub channels: usize,
-    /// Row-major from the top row, `channels` values per pixel, in [0,1].
+    /// Row-major from the top row, `channels` values per pixel, in `[0, 1]`.
     pub data: Vec<f32>,
 }
 

@@ -128,7 +128,7 @@ fn one_f32() -> f32 {
     1.0
 }
 
-/// A pattern volume over texture space [0,1]^3 (s, t tile; w is height).
+/// A pattern volume over texture space `[0, 1]^3` (s, t tile; w is height).
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Texel {
@@ -220,7 +220,7 @@ pub enum TexelSource {
         fps: f64,
     },
     /// A pattern mesh (Meyer & Neyret 1998, section 3.2): the OBJ at `path` inside the box
-    /// `bounds` (object space of the OBJ), which maps onto texel space [0,1]^3. Each voxel samples
+    /// `bounds` (object space of the OBJ), which maps onto texel space `[0, 1]^3`. Each voxel samples
     /// the mesh at its centre (`bake_mesh_grid.wgsl`, ray parity voted over three directions):
     /// `fill` covers the inside (a closed mesh is needed: an open one falls back to the shell
     /// with a warning); `fill: false` draws a one-voxel shell around the surface (sparse
@@ -238,7 +238,7 @@ pub enum TexelSource {
     },
     /// A hypertexture of `hypertextures` (Meyer & Neyret 1998, 3.3) sampled at the voxel centres
     /// of the box `bounds` of its object space (default: its enlarged bounds, every detail
-    /// inside), which maps onto texel space [0,1]^3: colour and opacity from its transfer
+    /// inside), which maps onto texel space `[0, 1]^3`: colour and opacity from its transfer
     /// function, shading from its density gradient (`bake_hypertexture.wgsl`). Animated noises
     /// are baked at the scene's time. The texel's `opacity_length` is the hypertexture's (both
     /// are world lengths, and a voxel stores the transfer function's opacity): drawn at any
@@ -272,7 +272,7 @@ fn one_u32() -> u32 {
     1
 }
 
-/// Implicit shapes in texel space [0,1]^3; colours linear RGB in [0,1]; opacity in [0,1].
+/// Implicit shapes in texel space `[0, 1]^3`; colours linear RGB in `[0, 1]`; opacity in `[0, 1]`.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub enum Shape {
@@ -493,7 +493,7 @@ impl Default for Height {
     }
 }
 
-/// Per-vertex factor in [0,1] on the height length.
+/// Per-vertex factor in `[0, 1]` on the height length.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub enum HeightScale {
