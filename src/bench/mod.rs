@@ -82,7 +82,7 @@ pub fn run(
         for o in &r.blueprint.objects {
             let Some(params) = o.sweep else { continue };
             let t = Instant::now();
-            let out = crate::cpu::slice_prisms::emit_slices(
+            let out = crate::methods::view_slices::slice_prisms::emit_slices(
                 &o.shell.vertices,
                 &o.shell.prisms,
                 &params,

@@ -326,7 +326,10 @@ impl Blueprint {
         &self,
         texel_atlas: &[u8],
         normal_atlas: &[u8],
-    ) -> (crate::cpu::trace_reference::TraceView, Vec<crate::cpu::trace_reference::TraceObject>) {
+    ) -> (
+        crate::methods::reference::trace_reference::TraceView,
+        Vec<crate::methods::reference::trace_reference::TraceObject>,
+    ) {
         let set = self.reference.as_ref().expect("a frame with Reference objects");
         let members = reference_members(&self.objects, &self.bakes);
         let frame = (&self.frame, self.size, self.eye);

@@ -13,13 +13,13 @@ const NO_TWIN: &[(&str, &str)] = &[
     (
         "begin_segments",
         "depth peeling's first step (each pixel's start, no boundaries yet): the twin \
-         `peel_segments` (src/cpu/peel_segments.rs) returns a pixel's boundaries after this step \
+         `peel_segments` (src/methods/ray_march/peel_segments.rs) returns a pixel's boundaries after this step \
          and every peel, compared with both kernels' output in tests/gpu/hypertexture_segments.rs",
     ),
     (
         "resolve_splats",
         "splatting's second step (slabs composited front to back): the twin `splat_segments` \
-         (src/cpu/splat_segments.rs) returns the resolved pixel of both steps, compared in \
+         (src/methods/ray_march/splat_segments.rs) returns the resolved pixel of both steps, compared in \
          tests/gpu/hypertexture_splatting.rs",
     ),
     (

@@ -3,8 +3,8 @@
 
 use glam::DVec3;
 use proptest::prelude::*;
-use voltex::cpu::slice_prisms;
 use voltex::mesh::prism;
+use voltex::methods::view_slices::slice_prisms;
 use voltex::types::{Prism, ShellVertex};
 
 /// A prism and a plane for the slicing twin: corners on a small integer grid (every dot product

@@ -1,11 +1,10 @@
 //! The view-slicing kernels (count, scan, emit) on software Vulkan against their CPU twin
-//! (`cpu::slice_prisms`), on random shells and planes and on the hard cases.
+//! (`methods::view_slices::slice_prisms`), on random shells and planes and on the hard cases.
 
 use std::collections::BTreeMap;
 use std::sync::OnceLock;
 
 use glam::{DVec2, DVec3};
-use voltex::cpu::slice_prisms;
 use voltex::gpu::timing::Timer;
 use voltex::gpu::GpuContext;
 use voltex::gpu::Inputs;
@@ -15,6 +14,7 @@ use voltex::graph::Graph;
 use voltex::mesh::shell::Shell;
 use voltex::mesh::BaseSurface;
 use voltex::methods::view_slices;
+use voltex::methods::view_slices::slice_prisms;
 use voltex::types::{SliceParams, SliceVertex};
 
 fn ctx() -> &'static GpuContext {

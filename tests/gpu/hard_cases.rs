@@ -14,8 +14,8 @@ use std::path::PathBuf;
 
 use voltex::cpu::bake_transfer::bake_transfer;
 use voltex::cpu::hypertexture::Model;
-use voltex::cpu::ray_march::{ray_march, MarchView};
 use voltex::io::Image;
+use voltex::methods::ray_march::ray_march::{ray_march, MarchView};
 use voltex::render::{Blueprint, MethodKind, Part, RenderOptions, Renderer, DEFAULT_AXIS_SLICES};
 use voltex::scene::{self, AxisSlices, Method, SliceBlend};
 use voltex::types::MarchState;
@@ -436,7 +436,7 @@ mod twins {
     use glam::{DVec3, Vec2, Vec3};
     use voltex::cpu::axis_slices::{choose_axis, level_count, AxisFrame};
     use voltex::cpu::prism_map::{inverse, ray_intervals, PrismCorners};
-    use voltex::cpu::slice_prisms::slice_prism;
+    use voltex::methods::view_slices::slice_prisms::slice_prism;
     use voltex::types::{AxisParams, Prism, ShellVertex};
 
     fn prism(bottom: [DVec3; 3], heights: [DVec3; 3]) -> PrismCorners {

@@ -11,9 +11,9 @@ use std::path::Path;
 
 use voltex::cpu::bake_transfer::bake_transfer;
 use voltex::cpu::hypertexture::Model;
-use voltex::cpu::splat_segments::splat_segments;
 use voltex::hypertexture::splats;
 use voltex::io::Image;
+use voltex::methods::ray_march::splat_segments::splat_segments;
 use voltex::render::{Blueprint, Part, RenderOptions, Renderer};
 use voltex::scene;
 use voltex::types::MarchState;

@@ -7,8 +7,9 @@ use common::ctx;
 use std::path::{Path, PathBuf};
 
 use glam::DVec3;
-use voltex::cpu::{prism_map, trace_reference};
+use voltex::cpu::prism_map;
 use voltex::io::Image;
+use voltex::methods::reference::trace_reference;
 use voltex::render::{Blueprint, MethodKind, RenderOptions, Renderer};
 use voltex::scene;
 

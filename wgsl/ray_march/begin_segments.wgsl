@@ -1,4 +1,4 @@
-// Depth peeling, first step: per pixel, the ray's start (near plane or bounds entry) and no boundaries yet; a ray that starts inside the splat surface enters there. CPU twin: src/cpu/peel_segments.rs.
+// Depth peeling, first step: per pixel, the ray's start (near plane or bounds entry) and no boundaries yet; a ray that starts inside the splat surface enters there. CPU twin: src/methods/ray_march/peel_segments.rs.
 #include "shared/types.wgsl"
 #include "shared/fields.wgsl"
 #include "shared/segments.wgsl"

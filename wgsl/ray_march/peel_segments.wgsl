@@ -1,4 +1,4 @@
-// Depth peeling (Gilet & Dischler 2009, section 5.2): one thread per surface splat and footprint block intersects the rays of its screen footprint with the splat's disk and keeps per pixel the nearest entry (front-facing) or exit (back-facing) beyond the previous boundary. CPU twin: src/cpu/peel_segments.rs.
+// Depth peeling (Gilet & Dischler 2009, section 5.2): one thread per surface splat and footprint block intersects the rays of its screen footprint with the splat's disk and keeps per pixel the nearest entry (front-facing) or exit (back-facing) beyond the previous boundary. CPU twin: src/methods/ray_march/peel_segments.rs.
 #include "shared/types.wgsl"
 #include "shared/fields.wgsl"
 #include "shared/segments.wgsl"

@@ -1,4 +1,4 @@
-// EWA-style splatting, second step: per pixel, its depth slabs (splat_segments.wgsl) composited front to back into the march state the RayMarch composite blends. CPU twin: src/cpu/splat_segments.rs.
+// EWA-style splatting, second step: per pixel, its depth slabs (splat_segments.wgsl) composited front to back into the march state the RayMarch composite blends. CPU twin: src/methods/ray_march/splat_segments.rs.
 #include "shared/types.wgsl"
 #include "shared/segments.wgsl"
 

@@ -1,4 +1,4 @@
-// EWA-style splatting (Gilet & Dischler 2009, section 5.1): one workgroup per interior splat (a sphere) and block of its screen footprint marches, for each pixel of the block, the ray's samples inside the sphere and adds them, weighted by a truncated Gaussian of the ray's distance to the centre, to the pixel's depth slabs. CPU twin: src/cpu/splat_segments.rs.
+// EWA-style splatting (Gilet & Dischler 2009, section 5.1): one workgroup per interior splat (a sphere) and block of its screen footprint marches, for each pixel of the block, the ray's samples inside the sphere and adds them, weighted by a truncated Gaussian of the ray's distance to the centre, to the pixel's depth slabs. CPU twin: src/methods/ray_march/splat_segments.rs.
 #include "shared/types.wgsl"
 #include "shared/hypertexture.wgsl"
 #include "shared/segments.wgsl"

@@ -1,4 +1,4 @@
-// Ground truth: exact ray casting through the prisms of every Reference object, one pixel per thread; CPU twin in src/cpu/trace_reference.rs.
+// Ground truth: exact ray casting through the prisms of every Reference object, one pixel per thread; CPU twin in src/methods/reference/trace_reference.rs.
 #include "shared/types.wgsl"
 #include "shared/prism_map.wgsl"
 #include "shared/shading.wgsl"

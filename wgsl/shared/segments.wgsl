@@ -1,6 +1,6 @@
 // Pixel rays of a RayMarch object and their segments: the span of the enlarged bounds, and the
 // per-pixel boundaries that depth peeling finds. Reads the kernel's `frame`, `hyper` and
-// `segments`. CPU twin: src/cpu/peel_segments.rs (same names).
+// `segments`. CPU twin: src/methods/ray_march/peel_segments.rs (same names).
 
 // f32 bits of +infinity: no boundary found.
 const NO_DEPTH: u32 = 0x7f800000u;

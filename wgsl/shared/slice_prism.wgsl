@@ -1,5 +1,5 @@
 // Plane/prism intersection of view-aligned slicing (2002 paper, Sec. 3-4, Fig. 4); CPU twin in
-// src/cpu/slice_prisms.rs, which mirrors these functions one to one.
+// src/methods/view_slices/slice_prisms.rs, which mirrors these functions one to one.
 // The including kernel declares `slice_params`, `shell_vertices`, `prisms`, `trivial_reject` and
 // `planes_per_thread`. Corners and polygons go by pointer: by-value copies of their arrays made
 // these kernels 4x slower on lavapipe.

@@ -3,11 +3,12 @@
 //! and level 0 of their baked volumes packed into one storage buffer (the kernel filters by hand,
 //! as the sampler would, so all objects fit in one dispatch without binding arrays).
 
+pub mod trace_reference;
+
 use glam::{DVec3, Vec3A};
 use obvhs::aabb::Aabb;
 
 use crate::cpu::prism_map::PrismCorners;
-use crate::cpu::trace_reference::{PerPixel, TraceObject, TraceView, Volume};
 use crate::error::{Error, Result};
 use crate::gpu::GpuContext;
 use crate::gpu::Inputs;
@@ -15,6 +16,7 @@ use crate::mesh::bvh::flat_bvh;
 use crate::mesh::shell;
 use crate::mesh::shell::Shell;
 use crate::mesh::BaseSurface;
+use crate::methods::reference::trace_reference::{PerPixel, TraceObject, TraceView, Volume};
 use crate::types::{
     FrameParams, ReferenceNode, ReferenceObject, ReferenceParams, ReferencePrism, ReferenceState,
     ShellVertex, VertexFrame,

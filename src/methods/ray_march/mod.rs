@@ -6,16 +6,20 @@
 //! or with EWA-style splatting the work blocks of `splat_segments.wgsl` and the per-pixel depth
 //! slabs `resolve_splats.wgsl` composites.
 
+pub mod peel_segments;
+pub mod ray_march;
+pub mod splat_segments;
+
 use glam::{DMat4, DVec3};
 
 use crate::cpu::bake_transfer::TRANSFER_SIZE;
-use crate::cpu::ray_march::Shade;
 use crate::error::{Error, Result};
 use crate::gpu::GpuContext;
 use crate::gpu::Inputs;
 use crate::hypertexture::mesh::{self, MeshGrid};
 use crate::hypertexture::splats::{self, Lattice, SplatSet, FOOTPRINT_BLOCK};
 use crate::hypertexture::{self, Packed};
+use crate::methods::ray_march::ray_march::Shade;
 use crate::scene::hypertexture::diagonal;
 use crate::scene::{Hypertexture, RayMarch, Segments, Shading};
 use crate::types::{HyperParams, MarchState, SegmentParams};

@@ -7,7 +7,7 @@
 
 use glam::{DMat4, DVec3, DVec4};
 
-use super::hypertexture::Model;
+use crate::cpu::hypertexture::Model;
 
 pub const MIN_TRANSMITTANCE: f64 = 1e-4;
 pub const MAX_ALPHA: f64 = 0.999999;

@@ -8,9 +8,9 @@
 
 use glam::DVec3;
 
-use super::hypertexture::Model;
 use super::peel_segments::{pixel_ray, PixelRay};
 use super::ray_march::{MAX_ALPHA, MIN_TRANSMITTANCE};
+use crate::cpu::hypertexture::Model;
 use crate::types::{FrameParams, SegmentParams, Splat};
 
 /// Standard deviation of the Gaussian in units of the sphere's radius (mirrors `SIGMA`).

@@ -1,6 +1,8 @@
 //! Host side of view-aligned prism slicing (2002 paper): the plane sweep of one object and the
 //! buffers its kernels (`count_slices`, `scan_plane_offsets`, `emit_slices`) and `draw_slices` use.
 
+pub mod slice_prisms;
+
 use crate::error::{Error, Result};
 use crate::mesh::shell::Shell;
 use crate::types::{SliceParams, SliceVertex};

@@ -11,7 +11,7 @@
 
 use glam::{DVec2, DVec3};
 
-use super::prism_map::{self, PrismCorners};
+use crate::cpu::prism_map::{self, PrismCorners};
 
 /// Rays stop once the transmittance falls below this (as the kernel does).
 pub const MIN_TRANSMITTANCE: f64 = 1e-4;

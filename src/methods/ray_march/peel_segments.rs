@@ -6,7 +6,7 @@
 
 use glam::{DMat4, DVec3};
 
-use super::hypertexture::Model;
+use crate::cpu::hypertexture::Model;
 use crate::types::{FrameParams, SegmentParams, Splat};
 
 /// Mirrors the kernel's: exits count only where the disk is on or outside the splat surface
