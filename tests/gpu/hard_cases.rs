@@ -15,7 +15,7 @@ use std::path::PathBuf;
 use voltex::cpu::bake_transfer::bake_transfer;
 use voltex::cpu::hypertexture::Model;
 use voltex::io::Image;
-use voltex::methods::ray_march::ray_march::{ray_march, MarchView};
+use voltex::methods::ray_march::march::{ray_march, MarchView};
 use voltex::render::{Blueprint, MethodKind, Part, RenderOptions, Renderer, DEFAULT_AXIS_SLICES};
 use voltex::scene::{self, AxisSlices, Method, SliceBlend};
 use voltex::types::MarchState;

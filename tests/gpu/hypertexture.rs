@@ -12,7 +12,7 @@ use voltex::cpu::bake::pcg_hash;
 use voltex::cpu::bake_transfer::bake_transfer;
 use voltex::cpu::hypertexture::Model;
 use voltex::cpu::noise_simplex::{simplex3, simplex3_tiled, simplex4};
-use voltex::methods::ray_march::ray_march::{ray_march, MarchView};
+use voltex::methods::ray_march::march::{ray_march, MarchView};
 use voltex::methods::ray_march::{probe, RayMarchPlan};
 use voltex::render::{Blueprint, Part, RenderOptions, Renderer};
 use voltex::scene;

@@ -15,7 +15,7 @@ use voltex::cpu::hypertexture::Model;
 use voltex::gpu::cache::GpuCache;
 use voltex::hypertexture::mesh;
 use voltex::mesh::shape::MeshShape;
-use voltex::methods::ray_march::ray_march::{ray_march, MarchView};
+use voltex::methods::ray_march::march::{ray_march, MarchView};
 use voltex::methods::ray_march::{probe, RayMarchPlan};
 use voltex::render::{Blueprint, Part, RenderOptions, Renderer};
 use voltex::scene;

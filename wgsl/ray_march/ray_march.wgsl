@@ -1,4 +1,4 @@
-// Hypertexture ray marching (Gilet & Dischler 2009): one thread per pixel marches the object's enlarged bounds, or the segments depth peeling found, front to back, resumable across dispatches; CPU twin src/methods/ray_march/ray_march.rs.
+// Hypertexture ray marching (Gilet & Dischler 2009): one thread per pixel marches the object's enlarged bounds, or the segments depth peeling found, front to back, resumable across dispatches; CPU twin src/methods/ray_march/march.rs.
 #include "shared/types.wgsl"
 #include "shared/hypertexture.wgsl"
 #include "shared/segments.wgsl"

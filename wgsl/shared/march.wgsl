@@ -1,6 +1,6 @@
 // Sampling and shading of hypertexture rays, shared by ray_march.wgsl and splat_segments.wgsl:
 // the ray's span and step, the step-corrected opacity, Phong and shadow rays. Reads the kernel's
-// `frame`, `hyper` and `depth`. CPU twin: src/methods/ray_march/ray_march.rs.
+// `frame`, `hyper` and `depth`. CPU twin: src/methods/ray_march/march.rs.
 
 // Shading, compiled out when off (set per object from `RayMarch(shading: ...)`): Phong with the
 // density gradient by central differences (six more density evaluations), and a secondary ray

@@ -6,8 +6,8 @@
 //! or with EWA-style splatting the work blocks of `splat_segments.wgsl` and the per-pixel depth
 //! slabs `resolve_splats.wgsl` composites.
 
+pub mod march;
 pub mod peel_segments;
-pub mod ray_march;
 pub mod splat_segments;
 
 use glam::{DMat4, DVec3};
@@ -19,7 +19,7 @@ use crate::gpu::Inputs;
 use crate::hypertexture::mesh::{self, MeshGrid};
 use crate::hypertexture::splats::{self, Lattice, SplatSet, FOOTPRINT_BLOCK};
 use crate::hypertexture::{self, Packed};
-use crate::methods::ray_march::ray_march::Shade;
+use crate::methods::ray_march::march::Shade;
 use crate::scene::hypertexture::diagonal;
 use crate::scene::{Hypertexture, RayMarch, Segments, Shading};
 use crate::types::{HyperParams, MarchState, SegmentParams};

@@ -8,8 +8,8 @@
 
 use glam::DVec3;
 
+use super::march::{MAX_ALPHA, MIN_TRANSMITTANCE};
 use super::peel_segments::{pixel_ray, PixelRay};
-use super::ray_march::{MAX_ALPHA, MIN_TRANSMITTANCE};
 use crate::cpu::hypertexture::Model;
 use crate::types::{FrameParams, SegmentParams, Splat};
 
