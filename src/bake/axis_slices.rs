@@ -2,7 +2,6 @@
 //! texture array holding every power-of-two level (finest first), each coarser slice combining
 //! `2^level` voxel slices, and one occupancy word per slice for empty-slice culling.
 
-use crate::cpu::axis_slices::{array_layers, level_count, level_layer, level_slices, occupancy_base};
 use crate::error::{Error, Result};
 use crate::gpu::kernel::ComputeKernel;
 use crate::gpu::GpuContext;
@@ -131,4 +130,35 @@ pub fn read_texture(ctx: &GpuContext, texture: &wgpu::Texture, bytes_per_texel: 
     ctx.queue.submit([enc.finish()]);
     let bytes = ctx.map_read(&staging)?;
     Ok((0..rows as usize).flat_map(|y| bytes[y * padded as usize..][..row as usize].to_vec()).collect())
+}
+
+// Layout of the slice-image arrays: power-of-two levels, finest first (mirrored in
+// wgsl/shared/axis_slices.wgsl; the kernels and the AxisSlices twin both index by it).
+
+pub fn level_count(r: u32) -> u32 {
+    32 - r.max(1).leading_zeros()
+}
+
+pub fn level_slices(r: u32, level: u32) -> u32 {
+    (r + (1 << level) - 1) >> level
+}
+
+/// First array layer of `level` in a direction's slice array (finest level first).
+pub fn level_layer(r: u32, level: u32) -> u32 {
+    (0..level).map(|l| level_slices(r, l)).sum()
+}
+
+/// Layers of a direction's slice array (all levels).
+pub fn array_layers(r: u32) -> u32 {
+    level_layer(r, level_count(r))
+}
+
+/// First occupancy word of (direction, level): directions s, t, w one after the other.
+pub fn occupancy_base(resolution: [u32; 3], direction: u32, level: u32) -> u32 {
+    (0..direction).map(|d| array_layers(resolution[d as usize])).sum::<u32>()
+        + level_layer(resolution[direction as usize], level)
+}
+
+pub fn slice_layer(g: i32, n: u32) -> u32 {
+    g.rem_euclid(n as i32) as u32
 }

@@ -1,6 +1,5 @@
 //! CPU twins of the kernels whose math matters; tests run both on the same inputs.
 
-pub mod axis_slices;
 pub mod bake;
 pub mod bake_hypertexture;
 pub mod bake_mesh_grid;

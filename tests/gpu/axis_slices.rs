@@ -9,10 +9,11 @@ use common::ctx;
 use std::path::{Path, PathBuf};
 
 use glam::{Vec2, Vec3};
+use voltex::bake::axis_slices as layout;
 use voltex::bake::{BakeRequest, BakeSource, Baker};
-use voltex::cpu::axis_slices::{self as twin, AxisFrame};
 use voltex::cpu::bake::{pack_shapes, Shape};
 use voltex::io::Image;
+use voltex::methods::axis_slices::twin::{self, AxisFrame};
 use voltex::render::{Blueprint, MethodKind, Part, RenderOptions, Renderer};
 use voltex::scene;
 use voltex::types::AxisParams;
@@ -73,7 +74,7 @@ fn slice_counts_at_known_angles() {
     };
     let slices = |angle: f32, p: &AxisParams| {
         let c = twin::choose_axis(&unit_prism(angle, 10.0), p);
-        twin::level_slices(p.resolution[c.direction as usize], c.level)
+        layout::level_slices(p.resolution[c.direction as usize], c.level)
     };
     // h tan(a) / d <= 1 with h = 64 / N voxels: N >= 64 tan(a) / d, rounded up to a power of two.
     let p = only_w(params([64, 64, 64], 1.0, 1e-6, 89.0, 1.0));
@@ -90,7 +91,7 @@ fn slice_counts_at_known_angles() {
     let c = twin::choose_axis(&unit_prism(30.0, 10.0), &far);
     let z = 10.0 * 30f32.to_radians().cos();
     let expected = (0.5 * 100.0 / z).ceil() as u32;
-    assert_eq!(twin::level_slices(64, c.level), expected.next_power_of_two());
+    assert_eq!(layout::level_slices(64, c.level), expected.next_power_of_two());
 }
 
 /// The f16 values of an `Rgba16Float` readback.
@@ -138,7 +139,7 @@ fn slice_image_bake_matches_its_twin() {
         .iter()
         .map(|t| f16s(&voltex::bake::axis_slices::read_texture(&ctx, t, 8).unwrap()))
         .collect();
-    let words: u64 = (0..3).map(|d| twin::array_layers(res[d]) as u64).sum();
+    let words: u64 = (0..3).map(|d| layout::array_layers(res[d]) as u64).sum();
     let occupancy: Vec<u32> =
         bytemuck::pod_collect_to_vec(&ctx.read_buffer(&axis.occupancy, 0, words * 4).unwrap());
     drop(ctx);
@@ -154,7 +155,7 @@ fn slice_image_bake_matches_its_twin() {
         assert!(worst < 4e-3, "direction {d}: worst relative difference {worst}");
     }
     // Coarser levels keep what finer ones hold: the coarsest w slice is the combination of all.
-    let top = twin::level_layer(res[2], twin::level_count(res[2]) - 1) as usize;
+    let top = layout::level_layer(res[2], layout::level_count(res[2]) - 1) as usize;
     let layer = (res[0] * res[1]) as usize;
     let coarsest_alpha: f32 = gpu[2][top * layer * 4..][..layer * 4].iter().skip(3).step_by(4).sum();
     assert!(coarsest_alpha > 0.0);

@@ -434,8 +434,9 @@ fn hypertextures_vanishing_fields_far_noise_and_transfer_limits() {
 
 mod twins {
     use glam::{DVec3, Vec2, Vec3};
-    use voltex::cpu::axis_slices::{choose_axis, level_count, AxisFrame};
+    use voltex::bake::axis_slices::level_count;
     use voltex::cpu::prism_map::{inverse, ray_intervals, PrismCorners};
+    use voltex::methods::axis_slices::twin::{choose_axis, AxisFrame};
     use voltex::methods::view_slices::slice_prisms::slice_prism;
     use voltex::types::{AxisParams, Prism, ShellVertex};
 

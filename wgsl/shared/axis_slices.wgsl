@@ -1,5 +1,5 @@
 // Meyer & Neyret axis-aligned slicing: per-prism frame, direction choice, slice count criteria,
-// slice ranges and layers (CPU twin: src/cpu/axis_slices.rs). Directions: 0 = s, 1 = t, 2 = w.
+// slice ranges and layers (CPU twin: src/methods/axis_slices/twin.rs). Directions: 0 = s, 1 = t, 2 = w.
 // Needs `axis_params: AxisParams`, `shell_vertices`, `prisms` and `axis_occupancy` bound.
 
 // Most slices of one direction crossing one prism (s, t sets of triangles spanning many tiles).

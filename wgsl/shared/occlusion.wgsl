@@ -1,5 +1,5 @@
 // Exact occlusion of a prism by the opaque base surfaces (CPU twin: `hidden_behind_base` in
-// src/cpu/axis_slices.rs). Needs `frame: FrameParams` and `base_depth` (R32Float) bound.
+// src/methods/axis_slices/twin.rs). Needs `frame: FrameParams` and `base_depth` (R32Float) bound.
 //
 // Every fragment of a prism's slices lies in the convex hull of its six corners, so its depth is
 // at least the nearest corner's, and its pixel centre lies in the prism's projection: inside the

@@ -2,12 +2,14 @@
 //! the prisms sorted back to front and the buffers of `choose_axis_slices`, `scan_axis_slices`,
 //! `emit_axis_slices` and `draw_axis_slices`. The slice images come from `bake::axis_slices`.
 
+pub mod twin;
+
 use crate::bake::axis_slices::AxisBaked;
-use crate::cpu::axis_slices::{self as twin, AxisFrame};
 use crate::error::{Error, Result};
 use crate::mesh::shell::Shell;
 use crate::scene::{AxisSlices, DrawOrder, SliceBlend, SliceDirections};
 use crate::types::{AxisParams, AxisVertex, Prism};
+use twin::AxisFrame;
 
 /// What AxisSlices brings to the render graph.
 pub const CONTRIBUTION: super::Contribution = super::Contribution {
@@ -169,7 +171,11 @@ pub fn add_inputs(
     b.insert("axis_vertices".into(), buffer("axis_vertices", copies * bytes, wgpu::BufferUsages::empty()));
     // One counter per slice image (the stride: the most layers of any direction); a stand-in
     // when not grouped.
-    let stride = plan.params.resolution[..3].iter().map(|&r| twin::array_layers(r)).max().unwrap_or(1);
+    let stride = plan.params.resolution[..3]
+        .iter()
+        .map(|&r| crate::bake::axis_slices::array_layers(r))
+        .max()
+        .unwrap_or(1);
     let counters = if plan.grouped { 3 * stride as u64 } else { 3 };
     b.insert(
         "axis_layer_counts".into(),

@@ -4,6 +4,8 @@
 
 use glam::{Vec2, Vec3, Vec4};
 
+use crate::bake::axis_slices::{level_count, level_layer, level_slices, occupancy_base, slice_layer};
+
 use crate::types::{AxisChoice, AxisParams, AxisVertex};
 
 /// Most slices of one direction crossing one prism.
@@ -63,34 +65,6 @@ impl AxisFrame {
             [Vec2::new(p.uv01[0], p.uv01[1]), Vec2::new(p.uv01[2], p.uv01[3]), Vec2::new(p.uv2[0], p.uv2[1])];
         Self::new([b(0), b(1), b(2)], [t(0), t(1), t(2)], uv)
     }
-}
-
-pub fn level_count(r: u32) -> u32 {
-    32 - r.max(1).leading_zeros()
-}
-
-pub fn level_slices(r: u32, level: u32) -> u32 {
-    (r + (1 << level) - 1) >> level
-}
-
-/// First array layer of `level` in a direction's slice array (finest level first).
-pub fn level_layer(r: u32, level: u32) -> u32 {
-    (0..level).map(|l| level_slices(r, l)).sum()
-}
-
-/// Layers of a direction's slice array (all levels).
-pub fn array_layers(r: u32) -> u32 {
-    level_layer(r, level_count(r))
-}
-
-/// First occupancy word of (direction, level): directions s, t, w one after the other.
-pub fn occupancy_base(resolution: [u32; 3], direction: u32, level: u32) -> u32 {
-    (0..direction).map(|d| array_layers(resolution[d as usize])).sum::<u32>()
-        + level_layer(resolution[direction as usize], level)
-}
-
-pub fn slice_layer(g: i32, n: u32) -> u32 {
-    g.rem_euclid(n as i32) as u32
 }
 
 /// The quality score `(1/c^2 - 1) h^2` of a direction (section 4.2); huge when unusable.
