@@ -1,9 +1,12 @@
 //! voltex: volumetric textures and hypertextures on wgpu.
 //!
 //! Data flow: scene file → [`scene`] → objects with base surfaces ([`mesh`]) → a [`graph`] of
-//! compute and raster passes built from `graphs/*.ron` and `wgsl/*.wgsl` → [`io`] (EXR, PNG).
+//! compute and raster passes built from `graphs/*.ron` and `wgsl/*.wgsl`, each [`methods`] module
+//! contributing its own → [`render`] → [`io`] (EXR, PNG). The modules form layers that import
+//! only downwards (`tests/checks/layers.rs` lists them).
 
 pub mod bake;
+pub mod bench;
 pub mod cpu;
 pub mod error;
 pub mod fault;
@@ -17,6 +20,7 @@ pub mod metrics;
 pub mod pareto;
 pub mod preview;
 pub mod regress;
+pub mod render;
 pub mod scene;
 pub mod types;
 
@@ -30,5 +34,3 @@ pub fn project_root() -> std::path::PathBuf {
         .map(Into::into)
         .unwrap_or_else(|| std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")))
 }
-pub mod bench;
-pub mod render;
