@@ -62,7 +62,7 @@ pub const FRAME_COUNTS: &[&str] = &["width", "height"];
 
 /// Plans `graph` for `objects` and an output of `size` pixels, its shaders looked up in `sources`
 /// (the graph's folder first when the caller put it there: see [`Sources::beside`]), its filters
-/// and counts checked against `vocabulary`.
+/// and counts checked against `vocabulary`, whose resource names its own resources may not take.
 pub fn plan(
     graph: &Graph,
     sources: &Sources,
@@ -70,6 +70,10 @@ pub fn plan(
     size: (u32, u32),
     vocabulary: &Vocabulary,
 ) -> Result<Plan> {
+    if let Some(n) = graph.file.resources.keys().find(|n| vocabulary.resources.contains(&n.as_str())) {
+        return Err(graph
+            .error_at_resource(n, format!("resource `{n}` is one the runtime provides: pick another name")));
+    }
     let sizes = buffer_sizes(graph, size, vocabulary)?;
     let mut kernels: BTreeMap<String, Arc<Kernel>> = BTreeMap::new();
     let mut candidates = Vec::new();

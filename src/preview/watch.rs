@@ -88,7 +88,7 @@ impl Watcher {
 /// metadata included: `touch` is a save), removals, and a writer closing the file. Opens and
 /// reads are not: the rebuild's own reads of the files it watches come back as such events, and
 /// counting them made a preview rebuild for ever after one save.
-pub fn changes_content(kind: &EventKind) -> bool {
+fn changes_content(kind: &EventKind) -> bool {
     match kind {
         EventKind::Create(_) | EventKind::Modify(_) | EventKind::Remove(_) => true,
         EventKind::Access(AccessKind::Close(AccessMode::Write)) => true,

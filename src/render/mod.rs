@@ -252,12 +252,6 @@ impl Blueprint {
         let (graph, sources) = load_graph(opts.graph.as_deref())?;
         let reference = reference_set(&objects, &bakes, &view);
         let (instances, infos) = instances(&objects, reference.as_ref(), view.eye);
-        if let Some(n) = graph.file.resources.keys().find(|n| vocabulary().resources.contains(&n.as_str())) {
-            return Err(graph.error_at_resource(
-                n,
-                format!("resource `{n}` is one the runtime provides: pick another name"),
-            ));
-        }
         let plan = plan::plan(&graph, &sources, &infos, size, &vocabulary())?;
         check_bindings(&graph, &plan)?;
         let samples_texels =

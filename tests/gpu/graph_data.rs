@@ -138,6 +138,15 @@ fn check_overlay(image: &Image, plain: &Image, histogram: &[u32]) {
     assert!(bar_pixels > 0, "the overlay draws something");
 }
 
+/// What `voltex plan` prints for the scene at 64x64, with `graph` or the default one.
+fn plan_with(graph: Option<&Path>) -> String {
+    let scene = scene_path();
+    let mut args = vec!["plan", common::s(&scene), "--size", "64x64"];
+    if let Some(g) = graph {
+        args.extend(["--graph", common::s(g)]);
+    }
+    common::ok(common::voltex(&args))
+}
 #[test]
 fn histogram_buffer_and_overlay_from_the_graph_alone() {
     let dir = common::scratch_dir("voltex-graph-data-render");
@@ -146,14 +155,7 @@ fn histogram_buffer_and_overlay_from_the_graph_alone() {
     let scene = voltex::scene::load(&scene_path()).unwrap();
 
     // `voltex plan` shows the new resources and counts them in the memory estimate.
-    let plan = common::ok(common::voltex(&[
-        "plan",
-        common::s(&scene_path()),
-        "--size",
-        "64x64",
-        "--graph",
-        common::s(&graph),
-    ]));
+    let plan = plan_with(Some(&graph));
     for s in [
         "histogram            histogram.wgsl",
         "histogram_overlay    histogram_overlay.wgsl",
@@ -168,7 +170,7 @@ fn histogram_buffer_and_overlay_from_the_graph_alone() {
         let line = text.lines().find(|l| l.trim_end().ends_with("MiB  total")).unwrap();
         line.split_whitespace().next().unwrap().parse().unwrap()
     };
-    let plain_plan = common::ok(common::voltex(&["plan", common::s(&scene_path()), "--size", "64x64"]));
+    let plain_plan = plan_with(None);
     assert!(!plain_plan.contains("luminance_histogram"));
     // 256 + 16 + 4 bytes more: below the printed precision, so only "not less".
     assert!(total(&plan) >= total(&plain_plan));
@@ -374,14 +376,7 @@ fn an_oversized_buffer_names_the_adapter_limit() {
     std::fs::write(&path, &text).unwrap();
     let bytes = 64u64 * 64 * 65536 * 16;
     // `voltex plan` has no adapter: it prints the size.
-    let plan = common::ok(common::voltex(&[
-        "plan",
-        common::s(&scene_path()),
-        "--size",
-        "64x64",
-        "--graph",
-        common::s(&path),
-    ]));
+    let plan = plan_with(Some(&path));
     assert!(plan.contains(&format!("buffer {bytes} bytes")), "{plan}");
     let out = common::voltex(&[
         "render",
