@@ -121,6 +121,47 @@ pub struct Baked {
     pub axis: Option<axis_slices::AxisBaked>,
 }
 
+impl BakeRequest {
+    /// GPU memory of the bake of `texel`, by item (`voltex plan`).
+    pub fn memory(&self, texel: &str) -> Vec<(String, u64)> {
+        let [x, y, z] = self.resolution;
+        let normals = if self.per_pixel { " + normals" } else { "" };
+        let mut out = vec![(
+            format!("texel {texel} {x}x{y}x{z} rgba8{normals}"),
+            bytes(self.resolution, self.per_pixel),
+        )];
+        if self.axis_slices {
+            out.push((
+                format!("texel {texel} slice images (s, t, w; all levels) rgba16f"),
+                axis_slices::bytes(self.resolution),
+            ));
+        }
+        out
+    }
+
+    /// The bake's lines in `voltex plan`: size, kernels and lighting.
+    pub fn describe(&self, texel: &str) -> String {
+        let [x, y, z] = self.resolution;
+        let kind = match self.source {
+            BakeSource::Implicit(_) => "bake/bake_implicit.wgsl",
+            BakeSource::Heightfield(_) => "bake/bake_heightfield.wgsl",
+            BakeSource::HeightImage(..) => "bake/bake_height_image.wgsl",
+            BakeSource::Stack(_) => "slice stack (uploaded)",
+            BakeSource::Mesh(_) => "bake_mesh_grid.wgsl + bake_mesh_texel.wgsl",
+            BakeSource::Hypertexture(ref h) if h.packed.mesh.is_some() => {
+                "bake_transfer.wgsl + bake_mesh_grid.wgsl + bake_hypertexture.wgsl"
+            }
+            BakeSource::Hypertexture(_) => "bake_transfer.wgsl + bake_hypertexture.wgsl",
+        };
+        let lighting = if self.per_pixel { "per-pixel (albedo + normals)" } else { "baked" };
+        let mut s = format!("  {texel:<16} {x}x{y}x{z}  {kind}  lighting {lighting}\n");
+        if self.axis_slices {
+            s += "  (and its slice images: bake_axis_slices.wgsl per direction and level)\n";
+        }
+        s
+    }
+}
+
 /// Bytes a bake allocates on the GPU (volume, plus normals at the same resolution).
 pub fn bytes(res: [u32; 3], per_pixel: bool) -> u64 {
     let volume = res.iter().map(|&x| x as u64).product::<u64>() * 4;

@@ -26,7 +26,8 @@ use crate::gpu::kernel::ComputeKernel;
 use crate::gpu::sources::Sources;
 use crate::gpu::GpuContext;
 use crate::gpu::Inputs;
-use crate::render::{Blueprint, Part, RenderOptions, Renderer};
+use crate::methods::ray_march::RayMarchPlan;
+use crate::render::{Blueprint, RenderOptions, Renderer};
 use crate::types::MarchState;
 
 /// The paper's objects: soft primitives, and the cube, teapot and bunny (a stand-in of our own)
@@ -113,7 +114,7 @@ struct Timed {
 impl Timed {
     fn counts(&self, ctx: &GpuContext) -> Result<(f64, f64, f64)> {
         let r = &self.renderer;
-        let instance = r.blueprint.instances.iter().position(|p| p.1 == Part::RayMarch).unwrap_or(0);
+        let instance = r.blueprint.find_instance("RayMarch").unwrap_or(0);
         let states: Vec<MarchState> =
             bytemuck::pod_collect_to_vec(&r.read_instance_buffer(ctx, instance, "ray_march_state")?);
         let evals: f64 = states.iter().map(|s| s.resume[1] as f64).sum();
@@ -164,7 +165,8 @@ pub fn segments_table(ctx: &GpuContext, size: (u32, u32), frames: usize, quick: 
             let mut unshaded = Renderer::new(ctx, Blueprint::new(&unshaded, &opts)?)?;
             unshaded.render_timed(ctx)?;
             let (samples, _, _) = Timed { renderer: unshaded, times: Vec::new() }.counts(ctx)?;
-            let plan = run.renderer.blueprint.objects.iter().find_map(|o| o.ray_march.clone());
+            let plan =
+                run.renderer.blueprint.objects.iter().find_map(|o| o.method::<RayMarchPlan>().cloned());
             // Splatting runs no marcher: its two passes are dispatched once each.
             let dispatches = plan.map_or("-".into(), |p| match p.splatting {
                 Some(_) => "1 + 1".to_string(),
@@ -204,7 +206,7 @@ pub fn run(size: (u32, u32), frames: usize, quick: bool, segments_only: bool) ->
             Path::new("bench-hyper.ron"),
         )?;
         let bp = Blueprint::new(&scene, &RenderOptions { size: Some(size), ..Default::default() })?;
-        let plan = bp.objects.iter().find_map(|o| o.ray_march.as_ref()).expect("a RayMarch object");
+        let plan = bp.objects.iter().find_map(|o| o.method::<RayMarchPlan>()).expect("a RayMarch object");
         let (shape, spec) = plan.packed.mesh.as_ref().expect("a mesh object");
         let mut times = Vec::new();
         // The first bake compiles the kernel.
@@ -241,7 +243,10 @@ pub fn run(size: (u32, u32), frames: usize, quick: bool, segments_only: bool) ->
                 let mut runs = Vec::new();
                 for noise in [true, false] {
                     let mut bp = Blueprint::new(&scene, &opts)?;
-                    bp.objects.iter_mut().filter_map(|o| o.ray_march.as_mut()).for_each(|m| m.noise = noise);
+                    bp.objects
+                        .iter_mut()
+                        .filter_map(|o| o.method_mut::<RayMarchPlan>())
+                        .for_each(|m| m.noise = noise);
                     let mut renderer = Renderer::new(&ctx, bp)?;
                     renderer.render_timed(&ctx)?;
                     runs.push(Timed { renderer, times: Vec::new() });
@@ -253,7 +258,12 @@ pub fn run(size: (u32, u32), frames: usize, quick: bool, segments_only: bool) ->
                         run.times.push(t.elapsed().as_secs_f64() * 1e3);
                     }
                 }
-                let plan = runs[0].renderer.blueprint.objects.iter().find_map(|o| o.ray_march.clone());
+                let plan = runs[0]
+                    .renderer
+                    .blueprint
+                    .objects
+                    .iter()
+                    .find_map(|o| o.method::<RayMarchPlan>().cloned());
                 let plan = plan.expect("a RayMarch object");
                 let ms = median(runs[0].times.clone());
                 let ms_off = median(runs[1].times.clone());

@@ -80,13 +80,13 @@ pub fn run(
         let mut cpu = Vec::new();
         let mut fragments = 0.0;
         for o in &r.blueprint.objects {
-            let Some(params) = o.sweep else { continue };
+            let Some(vs) = o.method::<crate::methods::view_slices::ViewSlicesPlan>() else { continue };
             let t = Instant::now();
             let out = crate::methods::view_slices::slice_prisms::emit_slices(
                 &o.shell.vertices,
                 &o.shell.prisms,
-                &params,
-                o.trivial_reject,
+                &vs.sweep,
+                vs.trivial_reject,
             );
             cpu.push(t.elapsed().as_secs_f64() * 1e3);
             fragments += covered_pixels(&r.blueprint, &out);

@@ -1,12 +1,23 @@
 //! Host side of each method: view-aligned prism slicing, axis-aligned slices, the reference ray
-//! caster, hypertexture ray marching, and the opaque base surface. Each declares what it brings
-//! to the render graph ([`Contribution`]) and is registered once, in [`REGISTRY`].
+//! caster, hypertexture ray marching, and the opaque base surface. Each lives in its own folder,
+//! declares what it brings to the render graph ([`Contribution`]), plans objects into a
+//! [`MethodPlan`], and is registered once, in [`REGISTRY`] and [`plan_method`].
 
 pub mod axis_slices;
 pub mod base_surface;
+pub mod options;
+pub mod plan;
 pub mod ray_march;
 pub mod reference;
+pub mod texels;
+pub mod view;
 pub mod view_slices;
+
+pub use plan::{BakePlan, InputCx, MethodPlan, ObjectPlan, PartDecl};
+
+use crate::error::Result;
+use crate::scene::{Method, Scene};
+use view::{Lighting, View};
 
 /// What a method brings to the render graph: the object filters its objects match (passes are
 /// instanced over them), and the per-object resources and counts its inputs provide (graph files
@@ -16,7 +27,15 @@ pub struct Contribution {
     pub filters: &'static [&'static str],
     pub resources: &'static [&'static str],
     pub counts: &'static [&'static str],
+    /// Resources that sample baked texels: a graph binding none of any method's bakes nothing.
+    pub texel_resources: &'static [&'static str],
+    /// For a method that draws all its objects in one graph instance: builds that instance's
+    /// plan from the frame's objects (`None` when no object uses the method).
+    pub gather: Option<Gather>,
 }
+
+/// Builds a frame-wide plan from the frame's objects, bakes and view (see [`Contribution::gather`]).
+pub type Gather = fn(&mut [ObjectPlan], &[BakePlan], &View) -> Option<Box<dyn MethodPlan>>;
 
 /// Every method, registered once.
 pub const REGISTRY: &[&Contribution] = &[
@@ -26,3 +45,63 @@ pub const REGISTRY: &[&Contribution] = &[
     &reference::CONTRIBUTION,
     &ray_march::CONTRIBUTION,
 ];
+
+/// What planning an object may read, and the frame's bakes it adds to.
+pub struct PlanCx<'a> {
+    pub scene: &'a Scene,
+    pub view: &'a View,
+    pub light: &'a Lighting,
+    /// The frame's time (animated texels are baked at it).
+    pub time: f64,
+    pub bakes: &'a mut Vec<BakePlan>,
+}
+
+/// Plans `object` for the scene method `method` (knobs resolved): adds its plan to
+/// `object.methods` and its bake, lighting and frames to the object.
+pub fn plan_method(cx: &mut PlanCx, object: &mut ObjectPlan, method: &Method) -> Result<()> {
+    match method {
+        Method::ViewSlices(m) => view_slices::plan(cx, object, m),
+        Method::AxisSlices(m) => axis_slices::plan(cx, object, m),
+        Method::Reference(m) => reference::plan(cx, object, m),
+        Method::RayMarch(m) => ray_march::plan_object(cx, object, m),
+    }
+}
+
+/// The frame-wide plans of methods that gather their objects (see [`Contribution::gather`]).
+pub fn gather(objects: &mut [ObjectPlan], bakes: &[BakePlan], view: &View) -> Vec<Box<dyn MethodPlan>> {
+    REGISTRY.iter().filter_map(|c| c.gather).filter_map(|g| g(objects, bakes, view)).collect()
+}
+
+/// Plans one object of the frame: its shell, its base surface if it has one, and its method
+/// (`opts` may switch it or change its knobs).
+pub fn plan_object(
+    cx: &mut PlanCx,
+    object: crate::scene::SceneObject,
+    opts: &options::RenderOptions,
+) -> Result<ObjectPlan> {
+    let eye = cx.view.eye;
+    let shell = crate::mesh::shell::Shell::new(&object.surface, eye);
+    // Kernels take camera-relative f32 corners and square their distances.
+    let limit = crate::mesh::prism::MAX_COORD as f32;
+    let in_range = |c: &[f32; 4]| c[..3].iter().all(|x| x.abs() <= limit);
+    if !shell.vertices.iter().all(|v| in_range(&v.bottom) && in_range(&v.top)) {
+        return Err(crate::error::Error::Invalid(format!(
+            "{}: object `{}` lies beyond ±{:e} of the camera: move the camera closer",
+            cx.scene.path.display(),
+            object.name,
+            crate::mesh::prism::MAX_COORD
+        )));
+    }
+    let mut methods: Vec<Box<dyn MethodPlan>> = Vec::new();
+    if object.base_color.is_some() {
+        let vertices = crate::mesh::shell::base_vertices(&object.surface, eye);
+        methods.push(Box::new(base_surface::BaseSurfacePlan { vertices }));
+    }
+    let chosen = opts.object_methods.iter().find(|(n, _)| *n == object.name).map(|(_, m)| m);
+    let method = chosen.or(object.method.as_ref()).map(|m| opts.apply(m));
+    let mut plan = ObjectPlan { object, shell, per_pixel: false, frames: None, bake: None, methods };
+    if let Some(method) = method {
+        plan_method(cx, &mut plan, &method)?;
+    }
+    Ok(plan)
+}

@@ -17,7 +17,7 @@ use crate::error::Result;
 use crate::gpu::GpuContext;
 use crate::graph::PassDecl;
 use crate::io::Image;
-use crate::render::{Blueprint, Part, Renderer};
+use crate::render::{Blueprint, Renderer};
 use crate::types::MarchState;
 
 /// Frames rendered and thrown away before the timed ones...
@@ -95,7 +95,7 @@ pub fn full_frames(ctx: &GpuContext, bp: Blueprint, frames: usize) -> Result<Fra
 /// `ray_march_state`): what an adaptive stride saves, independent of the machine's load.
 fn evaluations(ctx: &GpuContext, r: &Renderer) -> Result<f64> {
     let mut sum = 0.0;
-    for (i, _) in r.blueprint.instances.iter().enumerate().filter(|(_, p)| p.1 == Part::RayMarch) {
+    for (i, _) in r.blueprint.instances.iter().enumerate().filter(|(_, p)| p.filters.contains(&"RayMarch")) {
         let states: Vec<MarchState> =
             bytemuck::pod_collect_to_vec(&r.read_instance_buffer(ctx, i, "ray_march_state")?);
         sum += states.iter().map(|s| s.resume[1] as f64).sum::<f64>();

@@ -18,6 +18,7 @@ use std::str::FromStr;
 use crate::error::{Error, Result};
 use crate::gpu::GpuContext;
 use crate::io::{atomic, Image};
+use crate::methods::reference::ReferencePlan;
 use crate::render::{Blueprint, MethodKind, RenderOptions};
 use crate::scene::{Scene, Segments, MAX_PLANES};
 use report::Row;
@@ -308,7 +309,7 @@ pub fn sweep(scene: &Scene, args: &Args) -> Result<(Vec<Setting>, Vec<String>)> 
 pub fn reference_default_step(scene: &Scene, size: (u32, u32)) -> Result<Option<f64>> {
     let opts = RenderOptions { size: Some(size), method: Some(MethodKind::Reference), ..Default::default() };
     let bp = Blueprint::new(scene, &opts)?;
-    Ok(bp.objects.iter().filter_map(|o| o.reference_step).min_by(f64::total_cmp))
+    Ok(bp.objects.iter().filter_map(|o| Some(o.method::<ReferencePlan>()?.step)).min_by(f64::total_cmp))
 }
 
 pub fn run(args: &Args) -> Result<()> {

@@ -401,24 +401,7 @@ impl State {
     /// The drawn objects and their methods as the current renderer has them.
     fn methods(&self) -> Vec<(String, Method)> {
         let Some(r) = self.session.renderer() else { return Vec::new() };
-        r.blueprint
-            .objects
-            .iter()
-            .filter_map(|o| {
-                let lighting = o.object.method.as_ref()?.lighting();
-                let m = match (o.reference_step, &o.sweep, &o.axis) {
-                    (_, _, Some(a)) => Method::AxisSlices(a.method),
-                    (Some(step), _, _) => Method::Reference(Reference { step: Some(step), lighting }),
-                    (None, Some(p), _) => Method::ViewSlices(ViewSlices {
-                        planes: p.plane_count,
-                        trivial_reject: o.trivial_reject,
-                        lighting,
-                    }),
-                    _ => return None,
-                };
-                Some((o.object.name.clone(), m))
-            })
-            .collect()
+        r.blueprint.objects.iter().filter_map(|o| Some((o.object.name.clone(), o.scene_method()?))).collect()
     }
 
     fn set_method(&mut self, name: String, m: Method) {

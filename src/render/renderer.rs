@@ -8,12 +8,10 @@ use crate::gpu::timing::Timer;
 use crate::gpu::Inputs;
 use crate::gpu::{buffers, GpuContext};
 use crate::graph::exec::Executor;
-use crate::hypertexture::mesh::MeshGrid;
-use crate::hypertexture::splats::SplatSet;
 use crate::io::Image;
-use crate::methods::{axis_slices, view_slices};
-use crate::render::{Blueprint, ObjectPlan, Part};
-use crate::types::{ObjectParams, VertexFrame};
+use crate::methods::InputCx;
+use crate::render::Blueprint;
+use crate::types::ObjectParams;
 
 /// A rendered frame.
 pub struct Frame {
@@ -47,13 +45,12 @@ impl Renderer {
     /// nothing that defines them changed (the preview's hot reload).
     pub fn with_cache(ctx: &GpuContext, blueprint: Blueprint, cache: &mut GpuCache) -> Result<Self> {
         for o in &blueprint.objects {
-            for c in &o.chunks {
-                let max = ctx.limits.max_storage_buffer_binding_size;
-                view_slices::check_capacity(c.capacity, max, &o.object.name, c.params.plane_count)?;
+            for m in &o.methods {
+                m.check_limits(o, &ctx.limits)?;
             }
         }
-        if let Some(set) = &blueprint.reference {
-            set.check_limits(ctx.limits.max_storage_buffer_binding_size)?;
+        for g in &blueprint.groups {
+            g.check_limits(&blueprint.objects[g.members()[0]], &ctx.limits)?;
         }
         let mut baker = Baker::new(&Sources::project()?);
         let baked: Vec<bake::Baked> = blueprint
@@ -70,27 +67,12 @@ impl Renderer {
             min_filter: wgpu::FilterMode::Linear,
             ..Default::default()
         });
-        // Mesh objects' grids, baked once per mesh and grid while the cache holds them.
-        let grids: Vec<Option<MeshGrid>> = blueprint
-            .objects
-            .iter()
-            .map(|o| {
-                let Some(m) = &o.ray_march else { return Ok(None) };
-                let Some(key) = m.mesh_grid_key() else { return Ok(None) };
-                cache.bake(key, || Ok(m.bake_mesh_grid(ctx)?.expect("a mesh object"))).map(Some)
-            })
-            .collect::<Result<_>>()?;
-        // Depth-peeled objects' splat sets, baked once per object and lattice.
-        let splat_sets: Vec<Option<SplatSet>> = blueprint
-            .objects
-            .iter()
-            .zip(&grids)
-            .map(|(o, grid)| {
-                let Some(m) = &o.ray_march else { return Ok(None) };
-                let Some(key) = m.splat_key() else { return Ok(None) };
-                cache.bake(key, || m.bake_splats(ctx, grid.as_ref())).map(Some)
-            })
-            .collect::<Result<_>>()?;
+        // What plans bake for themselves (mesh grids, splat sets), per instance's plan.
+        let prepare = |plan: &dyn crate::methods::MethodPlan, cache: &mut GpuCache| plan.prepare(ctx, cache);
+        let mut prepared = Vec::with_capacity(blueprint.instances.len());
+        for i in &blueprint.instances {
+            prepared.push(prepare(blueprint.plan_of(i), cache)?);
+        }
         let mut frame = Inputs::default();
         frame
             .buffers
@@ -101,9 +83,16 @@ impl Renderer {
         let objects = blueprint
             .instances
             .iter()
-            .map(|&(i, part)| {
-                let gpu = (grids[i].as_ref(), splat_sets[i].as_ref());
-                instance_inputs(ctx, &blueprint, &blueprint.objects[i], part, &baked, gpu)
+            .zip(&prepared)
+            .map(|(i, prepared)| {
+                let cx = InputCx {
+                    ctx,
+                    size: blueprint.size,
+                    bakes: &blueprint.bakes,
+                    baked: &baked,
+                    prepared: prepared.as_deref(),
+                };
+                instance_inputs(&cx, &blueprint, i)
             })
             .collect();
         let exec = Executor::new(ctx, blueprint.graph.clone(), &blueprint.plan, blueprint.size, cache)?;
@@ -143,22 +132,9 @@ impl Renderer {
         self.read_texture(ctx, &self.blueprint.graph.file.outputs[0])
     }
 
-    /// The texel and normal atlases of the Reference objects as the kernel reads them (for the
-    /// CPU twin); `None` without Reference objects.
     /// The inputs of graph instance `i` (tests and benchmarks read kernel outputs from them).
     pub fn instance_inputs(&self, i: usize) -> &Inputs {
         &self.objects[i]
-    }
-
-    pub fn reference_atlases(&self, ctx: &GpuContext) -> Result<Option<(Vec<u8>, Vec<u8>)>> {
-        let Some(i) = self.blueprint.instances.iter().position(|p| p.1 == Part::Reference) else {
-            return Ok(None);
-        };
-        let read = |name: &str| {
-            let b = &self.objects[i].buffers[name];
-            ctx.read_buffer(b, 0, b.size())
-        };
-        Ok(Some((read("texel_atlas")?, read("normal_atlas")?)))
     }
 
     /// Reads back a buffer of graph instance `instance` (tests and tools: a layer, a table).
@@ -231,62 +207,17 @@ fn padded_row(w: u32) -> u32 {
     (w * 16).div_ceil(256) * 256
 }
 
-/// Buffers, views, counts and constants of one graph instance.
-fn instance_inputs(
-    ctx: &GpuContext,
-    bp: &Blueprint,
-    o: &ObjectPlan,
-    part: Part,
-    baked: &[bake::Baked],
-    (grid, splats): (Option<&MeshGrid>, Option<&SplatSet>),
-) -> Inputs {
+/// Buffers, views, counts and constants of one graph instance: the object's uniform, then
+/// what its plan binds.
+fn instance_inputs(cx: &InputCx, bp: &Blueprint, i: &crate::render::Instance) -> Inputs {
+    let o = &bp.objects[i.object];
     let mut inputs = Inputs::default();
     inputs.constants.push(("per_pixel_lighting".into(), o.per_pixel as u32 as f64));
     let opacity_length = o.bake.map(|b| bp.bakes[b].opacity_length).unwrap_or(1.0);
     let c = o.object.base_color.unwrap_or([0.0; 3]);
     let params = ObjectParams { base_color: [c[0], c[1], c[2], 1.0], opacity_length, _pad: [0.0; 3] };
-    inputs.buffers.insert("object".into(), buffers::uniform(ctx, "object", bytemuck::bytes_of(&params)));
-    match part {
-        Part::Base => {
-            let base = o.base.as_deref().unwrap_or_default();
-            inputs.buffers.insert(
-                "base_vertices".into(),
-                buffers::storage(ctx, "base_vertices", bytemuck::cast_slice(base)),
-            );
-            inputs.counts.insert("base_vertices".into(), base.len() as u32);
-        }
-        Part::RayMarch => {
-            if let Some(m) = &o.ray_march {
-                m.add_inputs(ctx, &mut inputs, bp.size, grid, splats);
-            }
-        }
-        Part::Reference => {
-            if let Some(set) = &bp.reference {
-                set.add_inputs(ctx, &mut inputs, bp.size);
-                set.copy_volumes(ctx, &inputs, baked);
-            }
-        }
-        Part::Slices(chunk) => {
-            let c = &o.chunks[chunk];
-            view_slices::add_inputs(ctx, &mut inputs, &o.shell, &c.params, c.capacity, o.trivial_reject);
-            // Bound even when unlit per pixel (the binding exists in the kernel): one entry then.
-            let frames = o.frames.as_deref().unwrap_or(&[VertexFrame { ds: [0.0; 4], dt: [0.0; 4] }]);
-            inputs.buffers.insert(
-                "vertex_frames".into(),
-                buffers::storage(ctx, "vertex_frames", bytemuck::cast_slice(frames)),
-            );
-            if let Some(b) = o.bake {
-                inputs.views.insert("volume".into(), baked[b].volume.create_view(&Default::default()));
-                inputs.views.insert("normals".into(), baked[b].normals.create_view(&Default::default()));
-            }
-        }
-        Part::AxisSlices => {
-            let (Some(plan), Some(b)) = (&o.axis, o.bake) else { return inputs };
-            if let Some(axis) = &baked[b].axis {
-                axis_slices::add_inputs(ctx, &mut inputs, &o.shell, plan, axis);
-            }
-        }
-    }
+    inputs.buffers.insert("object".into(), buffers::uniform(cx.ctx, "object", bytemuck::bytes_of(&params)));
+    bp.plan_of(i).add_inputs(cx, o, i.part, &mut inputs);
     inputs
 }
 
@@ -301,21 +232,7 @@ impl Renderer {
             m.push(("voltex_gpu_ms".into(), format!("{t:.3}")));
         }
         for o in &self.blueprint.objects {
-            let method = match (&o.sweep, o.reference_step, &o.axis) {
-                _ if o.ray_march.is_some() => o.ray_march.as_ref().map(|m| m.describe()).unwrap_or_default(),
-                (_, _, Some(a)) => format!("{:?}", a.method),
-                (_, Some(step), _) => format!(
-                    "Reference(step: {step:.6}, lighting: {})",
-                    if o.per_pixel { "PerPixel" } else { "Baked" }
-                ),
-                (Some(p), _, _) => format!(
-                    "ViewSlices(planes: {}, trivial_reject: {}, lighting: {})",
-                    p.plane_count,
-                    o.trivial_reject,
-                    if o.per_pixel { "PerPixel" } else { "Baked" }
-                ),
-                (None, _, _) => "BaseSurface".into(),
-            };
+            let method = o.methods.last().map_or("BaseSurface".into(), |m| m.metadata(o));
             m.push((format!("voltex_object_{}", o.object.name), method));
         }
         m

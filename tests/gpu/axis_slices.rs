@@ -14,7 +14,8 @@ use voltex::bake::{BakeRequest, BakeSource, Baker};
 use voltex::cpu::bake::{pack_shapes, Shape};
 use voltex::io::Image;
 use voltex::methods::axis_slices::twin::{self, AxisFrame};
-use voltex::render::{Blueprint, MethodKind, Part, RenderOptions, Renderer};
+use voltex::methods::axis_slices::AxisPlan;
+use voltex::render::{Blueprint, MethodKind, RenderOptions, Renderer};
 use voltex::scene;
 use voltex::types::AxisParams;
 
@@ -224,12 +225,12 @@ fn gpu_and_twin(scene: &Path, opts: &RenderOptions) -> usize {
         size: r.blueprint.size,
         depth: &base_depth,
     };
-    for (i, &(o, part)) in r.blueprint.instances.iter().enumerate() {
-        if part != Part::AxisSlices {
+    for (i, (o, part)) in r.blueprint.instances.iter().map(|x| (x.object, x.filters[0])).enumerate() {
+        if part != "AxisSlices" {
             continue;
         }
         let object = &r.blueprint.objects[o];
-        let plan = object.axis.as_ref().unwrap();
+        let plan = object.method::<AxisPlan>().unwrap();
         let inputs = r.instance_inputs(i);
         let (choices, vertices) =
             voltex::methods::axis_slices::read_back(&ctx, inputs, plan.prisms.len()).unwrap();
@@ -310,9 +311,9 @@ fn render_culled(path: &Path, culling: bool) -> (Image, usize, usize) {
     let mut r = Renderer::new(&ctx, Blueprint::new(&scene, &opts).unwrap()).unwrap();
     let image = r.render(&ctx).unwrap().image;
     let (mut prisms, mut culled) = (0, 0);
-    for (i, &(o, part)) in r.blueprint.instances.iter().enumerate() {
-        if part == Part::AxisSlices {
-            let n = r.blueprint.objects[o].axis.as_ref().unwrap().prisms.len();
+    for (i, (o, part)) in r.blueprint.instances.iter().map(|x| (x.object, x.filters[0])).enumerate() {
+        if part == "AxisSlices" {
+            let n = r.blueprint.objects[o].method::<AxisPlan>().unwrap().prisms.len();
             let (choices, _) =
                 voltex::methods::axis_slices::read_back(&ctx, r.instance_inputs(i), n).unwrap();
             prisms += n;
@@ -454,9 +455,9 @@ fn grouping_by_slice_image_draws_the_same_image() {
         let mut r = Renderer::new(&ctx, Blueprint::new(&parse(&grouped(&text)), &opts).unwrap()).unwrap();
         let b = r.render(&ctx).unwrap().image;
         // The grouped half of the vertex buffer: every triangle once, slice images contiguous.
-        let i = r.blueprint.instances.iter().position(|&(_, p)| p == Part::AxisSlices).unwrap();
+        let i = r.blueprint.find_instance("AxisSlices").unwrap();
         let inputs = r.instance_inputs(i);
-        let plan = r.blueprint.objects[r.blueprint.instances[i].0].axis.as_ref().unwrap();
+        let plan = r.blueprint.objects[r.blueprint.instances[i].object].method::<AxisPlan>().unwrap();
         let (_, emitted) = voltex::methods::axis_slices::read_back(&ctx, inputs, plan.prisms.len()).unwrap();
         let size = std::mem::size_of::<voltex::types::AxisVertex>() as u64;
         let bytes = ctx.read_buffer(
@@ -525,8 +526,8 @@ fn draw_order_times() {
                 v.sort_by(f64::total_cmp);
                 v[v.len() / 2]
             };
-            let i = r.blueprint.instances.iter().position(|&(_, p)| p == Part::AxisSlices).unwrap();
-            let plan = r.blueprint.objects[r.blueprint.instances[i].0].axis.as_ref().unwrap();
+            let i = r.blueprint.find_instance("AxisSlices").unwrap();
+            let plan = r.blueprint.objects[r.blueprint.instances[i].object].method::<AxisPlan>().unwrap();
             let (_, v) =
                 voltex::methods::axis_slices::read_back(&ctx, r.instance_inputs(i), plan.prisms.len())
                     .unwrap();
@@ -620,9 +621,9 @@ fn triangle_counts_and_times() {
                 .map(|t| t.1)
                 .sum();
             let mut drawn = 0;
-            for (i, &(o, part)) in r.blueprint.instances.iter().enumerate() {
-                if part == Part::AxisSlices {
-                    let plan = r.blueprint.objects[o].axis.as_ref().unwrap();
+            for (i, (o, part)) in r.blueprint.instances.iter().map(|x| (x.object, x.filters[0])).enumerate() {
+                if part == "AxisSlices" {
+                    let plan = r.blueprint.objects[o].method::<AxisPlan>().unwrap();
                     let (_, v) = voltex::methods::axis_slices::read_back(
                         &ctx,
                         r.instance_inputs(i),
@@ -673,7 +674,7 @@ fn eye_inside_the_shell_sees_the_analytic_transmittance() {
     assert!(gpu_and_twin(&camera_inside, &opts) > 0);
     let scene = scene::load(&camera_inside).unwrap();
     let bp = Blueprint::new(&scene, &opts).unwrap();
-    let plan = bp.objects[0].axis.as_ref().unwrap();
+    let plan = bp.objects[0].method::<AxisPlan>().unwrap();
     assert_eq!(plan.params.forward[3], 1.0, "the eye is inside the shell");
     for z in [0.3f32, 0.4375, 0.81] {
         let source = inside_fog(z);
@@ -699,12 +700,12 @@ fn eye_inside_the_shell_sees_the_analytic_transmittance() {
             &RenderOptions::default(),
         )
         .unwrap();
-        assert_eq!(bp.objects[0].axis.as_ref().unwrap().params.forward[3], 1.0);
+        assert_eq!(bp.objects[0].method::<AxisPlan>().unwrap().params.forward[3], 1.0);
     }
     // The eye above the shell: the flag is off, the kernels keep the paper's criteria.
     let above = inside_fog(1.5).replace("METHOD", axis);
     let bp =
         Blueprint::new(&scene::parse(&above, Path::new("inline.ron")).unwrap(), &RenderOptions::default())
             .unwrap();
-    assert_eq!(bp.objects[0].axis.as_ref().unwrap().params.forward[3], 0.0);
+    assert_eq!(bp.objects[0].method::<AxisPlan>().unwrap().params.forward[3], 0.0);
 }

@@ -16,7 +16,8 @@ use voltex::cpu::bake_transfer::bake_transfer;
 use voltex::cpu::hypertexture::Model;
 use voltex::io::Image;
 use voltex::methods::ray_march::march::{ray_march, MarchView};
-use voltex::render::{Blueprint, MethodKind, Part, RenderOptions, Renderer, DEFAULT_AXIS_SLICES};
+use voltex::methods::ray_march::RayMarchPlan;
+use voltex::render::{Blueprint, MethodKind, RenderOptions, Renderer, DEFAULT_AXIS_SLICES};
 use voltex::scene::{self, AxisSlices, Method, SliceBlend};
 use voltex::types::MarchState;
 
@@ -379,8 +380,8 @@ fn layers_and_twins(name: &str) -> Vec<(String, Layer, Layer)> {
     let view = MarchView::of_frame(&f, r.blueprint.size);
     let mut out = Vec::new();
     for instance in 0..r.blueprint.instances.len() {
-        let (o, part) = r.blueprint.instances[instance];
-        if part != Part::RayMarch {
+        let (o, part) = (r.blueprint.instances[instance].object, r.blueprint.instances[instance].filters[0]);
+        if part != "RayMarch" {
             continue;
         }
         let bytes = r.read_instance_buffer(&ctx, instance, "ray_march_state").unwrap();
@@ -389,7 +390,7 @@ fn layers_and_twins(name: &str) -> Vec<(String, Layer, Layer)> {
             .map(|s| std::array::from_fn(|c| s.color[c] as f64 * if c < 3 { light[c] } else { 1.0 }))
             .collect();
         let object = &r.blueprint.objects[o];
-        let plan = object.ray_march.as_ref().unwrap();
+        let plan = object.method::<RayMarchPlan>().unwrap();
         let tables = bake_transfer(&plan.packed.functions, &plan.packed.points);
         let model = Model { params: &plan.params, noises: &plan.packed.noises, tables: &tables, grid: None };
         let cpu = ray_march(&view, model, plan.shade);

@@ -14,7 +14,7 @@ use voltex::cpu::hypertexture::Model;
 use voltex::cpu::noise_simplex::{simplex3, simplex3_tiled, simplex4};
 use voltex::methods::ray_march::march::{ray_march, MarchView};
 use voltex::methods::ray_march::{probe, RayMarchPlan};
-use voltex::render::{Blueprint, Part, RenderOptions, Renderer};
+use voltex::render::{Blueprint, RenderOptions, Renderer};
 use voltex::scene;
 use voltex::types::MarchState;
 
@@ -75,7 +75,7 @@ fn blueprint(scene: &scene::Scene, opts: &RenderOptions) -> Blueprint {
 }
 
 fn plans(bp: &Blueprint) -> Vec<&RayMarchPlan> {
-    bp.objects.iter().filter_map(|o| o.ray_march.as_ref()).collect()
+    bp.objects.iter().filter_map(|o| o.method::<RayMarchPlan>()).collect()
 }
 
 /// A scene with one hypertexture `h` (given as RON) on a node drawn with `method`.
@@ -274,13 +274,13 @@ fn layer_and_twin(scene: &scene::Scene, opts: &RenderOptions) -> (Vec<[f64; 4]>,
     let mut r = Renderer::new(&ctx, bp).unwrap();
     let frame = r.render(&ctx).unwrap();
     assert_eq!(voltex::metrics::count_nonfinite(&frame.image), 0);
-    let instance = r.blueprint.instances.iter().position(|p| p.1 == Part::RayMarch).unwrap();
+    let instance = r.blueprint.find_instance("RayMarch").unwrap();
     let bytes = r.read_instance_buffer(&ctx, instance, "ray_march_state").unwrap();
     drop(ctx);
     let f = &r.blueprint.frame;
     let gpu = common::lit_march_state(f, &bytes);
-    let o = r.blueprint.objects.iter().find(|o| o.ray_march.is_some()).unwrap();
-    let plan = o.ray_march.as_ref().unwrap();
+    let o = r.blueprint.objects.iter().find(|o| o.method::<RayMarchPlan>().is_some()).unwrap();
+    let plan = o.method::<RayMarchPlan>().unwrap();
     let tables = twin_tables(plan);
     let view = MarchView::of_frame(f, r.blueprint.size);
     let cpu = ray_march(&view, model(plan, &tables), plan.shade);
@@ -358,7 +358,7 @@ fn adaptive_stride_matches_twin() {
     // The kernel's layer, its per-pixel states, and the twin's layer, with a small budget.
     let run = |scene: &scene::Scene| {
         let mut bp = blueprint(scene, &sized(32, 32));
-        let plan = bp.objects.iter_mut().find_map(|o| o.ray_march.as_mut()).unwrap();
+        let plan = bp.objects.iter_mut().find_map(|o| o.method_mut::<RayMarchPlan>()).unwrap();
         let budget = plan.params.budget[0];
         plan.params.budget[0] = 97;
         plan.dispatches *= budget / 97 + 1;
@@ -366,7 +366,7 @@ fn adaptive_stride_matches_twin() {
         let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
         let mut r = Renderer::new(&ctx, bp).unwrap();
         r.render(&ctx).unwrap();
-        let instance = r.blueprint.instances.iter().position(|p| p.1 == Part::RayMarch).unwrap();
+        let instance = r.blueprint.find_instance("RayMarch").unwrap();
         let bytes = r.read_instance_buffer(&ctx, instance, "ray_march_state").unwrap();
         drop(ctx);
         let states = bytemuck::pod_collect_to_vec::<u8, MarchState>(&bytes);

@@ -17,7 +17,7 @@ use voltex::hypertexture::mesh;
 use voltex::mesh::shape::MeshShape;
 use voltex::methods::ray_march::march::{ray_march, MarchView};
 use voltex::methods::ray_march::{probe, RayMarchPlan};
-use voltex::render::{Blueprint, Part, RenderOptions, Renderer};
+use voltex::render::{Blueprint, RenderOptions, Renderer};
 use voltex::scene;
 
 /// A closed UV sphere: `around` segments, `rings` bands from pole to pole, shared vertices.
@@ -87,7 +87,7 @@ fn mesh_scene(dir: &Path, object: &str, noises: &str, method: &str) -> scene::Sc
 }
 
 fn plan_of(bp: &Blueprint) -> &RayMarchPlan {
-    bp.objects.iter().find_map(|o| o.ray_march.as_ref()).unwrap()
+    bp.objects.iter().find_map(|o| o.method::<RayMarchPlan>()).unwrap()
 }
 
 /// The grid of a 24 x 12 sphere, of a box made of 12 triangles and of the union of two
@@ -277,7 +277,7 @@ fn layer_and_twin(scene: &scene::Scene, opts: &RenderOptions) -> (Vec<[f64; 4]>,
     let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
     let mut r = Renderer::new(&ctx, bp).unwrap();
     r.render(&ctx).unwrap();
-    let instance = r.blueprint.instances.iter().position(|p| p.1 == Part::RayMarch).unwrap();
+    let instance = r.blueprint.find_instance("RayMarch").unwrap();
     let bytes = r.read_instance_buffer(&ctx, instance, "ray_march_state").unwrap();
     let plan = plan_of(&r.blueprint);
     let (cells, depth) = mesh::read(&ctx, &plan.bake_mesh_grid(&ctx).unwrap().unwrap()).unwrap();

@@ -15,12 +15,12 @@ use voltex::hypertexture::{mesh, splats};
 use voltex::io::Image;
 use voltex::methods::ray_march::peel_segments::peel_segments;
 use voltex::methods::ray_march::RayMarchPlan;
-use voltex::render::{Blueprint, Part, RenderOptions, Renderer};
+use voltex::render::{Blueprint, RenderOptions, Renderer};
 use voltex::scene;
 use voltex::types::{MarchState, Splat};
 
 fn plan_of(bp: &Blueprint) -> &RayMarchPlan {
-    bp.objects.iter().find_map(|o| o.ray_march.as_ref()).unwrap()
+    bp.objects.iter().find_map(|o| o.method::<RayMarchPlan>()).unwrap()
 }
 
 const BUMPS: &str = "[(shape: Curve([(0.0, 0.0, 0.0), (1.0, 1.0, 0.0)]), amplitude: 0.12, frequency: 3.0, \
@@ -220,12 +220,12 @@ fn render_blocks(
 ) -> (Image, Vec<MarchState>, Vec<u32>, Blueprint) {
     let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
     let mut bp = Blueprint::new(scene, opts).unwrap();
-    for m in bp.objects.iter_mut().filter_map(|o| o.ray_march.as_mut()) {
+    for m in bp.objects.iter_mut().filter_map(|o| o.method_mut::<RayMarchPlan>()) {
         m.segments.counts[3] = block.unwrap_or(m.segments.counts[3]);
     }
     let mut r = Renderer::new(&ctx, bp).unwrap();
     let image = r.render(&ctx).unwrap().image;
-    let instance = r.blueprint.instances.iter().position(|p| p.1 == Part::RayMarch).unwrap();
+    let instance = r.blueprint.find_instance("RayMarch").unwrap();
     let states =
         bytemuck::pod_collect_to_vec(&r.read_instance_buffer(&ctx, instance, "ray_march_state").unwrap());
     let bounds =

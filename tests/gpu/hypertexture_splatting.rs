@@ -14,7 +14,8 @@ use voltex::cpu::hypertexture::Model;
 use voltex::hypertexture::splats;
 use voltex::io::Image;
 use voltex::methods::ray_march::splat_segments::splat_segments;
-use voltex::render::{Blueprint, Part, RenderOptions, Renderer};
+use voltex::methods::ray_march::RayMarchPlan;
+use voltex::render::{Blueprint, RenderOptions, Renderer};
 use voltex::scene;
 use voltex::types::MarchState;
 
@@ -53,12 +54,12 @@ fn render(
 ) -> (Image, Vec<MarchState>, Blueprint) {
     let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
     let mut bp = Blueprint::new(scene, opts).unwrap();
-    for m in bp.objects.iter_mut().filter_map(|o| o.ray_march.as_mut()) {
+    for m in bp.objects.iter_mut().filter_map(|o| o.method_mut::<RayMarchPlan>()) {
         m.segments.splatting = splatting.unwrap_or(m.segments.splatting);
     }
     let mut r = Renderer::new(&ctx, bp).unwrap();
     let image = r.render(&ctx).unwrap().image;
-    let instance = r.blueprint.instances.iter().position(|p| p.1 == Part::RayMarch).unwrap();
+    let instance = r.blueprint.find_instance("RayMarch").unwrap();
     let states =
         bytemuck::pod_collect_to_vec(&r.read_instance_buffer(&ctx, instance, "ray_march_state").unwrap());
     drop(ctx);
@@ -74,7 +75,7 @@ fn splatting_kernels_match_twin() {
     let opts = sized(32, 32);
     let (_, states, bp) = render(&scene, &opts, None);
     let (_, pieces, _) = render(&scene, &opts, Some([8, 2, 24, 6]));
-    let plan = bp.objects.iter().find_map(|o| o.ray_march.as_ref()).unwrap();
+    let plan = bp.objects.iter().find_map(|o| o.method::<RayMarchPlan>()).unwrap();
     assert_eq!(plan.dispatches, 0, "the marcher dispatches nothing for a splatted object");
     let [_, pixels, parts, samples] = plan.segments.splatting;
     let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());

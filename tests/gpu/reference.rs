@@ -8,8 +8,10 @@ use std::path::{Path, PathBuf};
 
 use glam::DVec3;
 use voltex::cpu::prism_map;
+use voltex::gpu::GpuContext;
 use voltex::io::Image;
-use voltex::methods::reference::trace_reference;
+use voltex::methods::reference::trace_reference::{self, TraceObject, TraceView};
+use voltex::methods::reference::ReferenceSet;
 use voltex::render::{Blueprint, MethodKind, RenderOptions, Renderer};
 use voltex::scene;
 
@@ -39,9 +41,9 @@ fn gpu_and_twin(scene: &Path, opts: &RenderOptions) -> Traced {
     let frame = r.render(&ctx).unwrap();
     assert_eq!(voltex::metrics::count_nonfinite(&frame.image), 0, "no NaN or infinity in any pixel");
     let gpu = r.read_texture(&ctx, "reference_rgba").unwrap();
-    let (texels, normals) = r.reference_atlases(&ctx).unwrap().unwrap();
+    let (texels, normals) = atlases(&ctx, &r);
     drop(ctx);
-    let (view, objects) = r.blueprint.reference_twin_inputs(&texels, &normals);
+    let (view, objects) = twin_inputs(&r.blueprint, &texels, &normals);
     let cpu = trace_reference::trace_reference(&view, &objects);
     let cpu = Image::from_pixels(view.width, view.height, cpu.iter().map(|p| p.map(|c| c as f32)).collect())
         .unwrap();
@@ -103,7 +105,7 @@ fn box_of_fog_is_exact() {
     let scene = scene::load(&example("flat_box.ron")).unwrap();
     let eye = scene.camera.eye;
     let bp = Blueprint::new(&scene, &reference(size)).unwrap();
-    let (view, _) = bp.reference_twin_inputs(&[0; 4 * 8 * 8 * 64], &[0; 4]);
+    let (view, _) = twin_inputs(&bp, &[0; 4 * 8 * 8 * 64], &[0; 4]);
     // The bake stores 0.5 as rgba8: 127 or 128, as the adapter rounds (llvmpipe 128, NVIDIA 127).
     let a = t.texels[3] as f64 / 255.0;
     assert!((a - 0.5).abs() < 1.0 / 255.0, "stored opacity {a}");
@@ -168,4 +170,18 @@ fn supersampled_reference_is_the_pixel_average() {
     let expected = fine.box_downsample(2);
     let (max, _) = differences(&averaged, &expected);
     assert!(max < 1e-5, "supersampled against averaged: {max}");
+}
+
+/// The texel and normal atlases of the frame's Reference objects as the kernel read them.
+fn atlases(ctx: &GpuContext, r: &Renderer) -> (Vec<u8>, Vec<u8>) {
+    let i = r.blueprint.find_instance("Reference").expect("a Reference instance");
+    let read = |name| r.read_instance_buffer(ctx, i, name).unwrap();
+    (read("texel_atlas"), read("normal_atlas"))
+}
+
+/// Inputs of the f64 twin for the blueprint's frame.
+fn twin_inputs(bp: &Blueprint, texels: &[u8], normals: &[u8]) -> (TraceView, Vec<TraceObject>) {
+    let set = bp.group::<ReferenceSet>().expect("a frame with Reference objects");
+    let frame = (&bp.frame, bp.size, bp.eye);
+    voltex::methods::reference::frame_twin_inputs(&bp.objects, &bp.bakes, set, frame, texels, normals)
 }

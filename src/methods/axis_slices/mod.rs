@@ -2,7 +2,10 @@
 //! the prisms sorted back to front and the buffers of `choose_axis_slices`, `scan_axis_slices`,
 //! `emit_axis_slices` and `draw_axis_slices`. The slice images come from `bake::axis_slices`.
 
+mod object;
 pub mod twin;
+
+pub use object::plan;
 
 use crate::bake::axis_slices::AxisBaked;
 use crate::error::{Error, Result};
@@ -31,6 +34,8 @@ pub const CONTRIBUTION: super::Contribution = super::Contribution {
         "axis_sampler_side",
     ],
     counts: &["prisms", "axis_triangles"],
+    texel_resources: &["axis_slices_s", "axis_slices_t", "axis_slices_w"],
+    gather: None,
 };
 
 /// Slice-vertex budget of one object: the storage-binding size every WebGPU adapter offers.

@@ -7,6 +7,7 @@
 //! slabs `resolve_splats.wgsl` composites.
 
 pub mod march;
+mod object;
 pub mod peel_segments;
 pub mod splat_segments;
 
@@ -53,7 +54,11 @@ pub const CONTRIBUTION: super::Contribution = super::Contribution {
         "interior_splats",
         "splat_blocks",
     ],
+    texel_resources: &[],
+    gather: None,
 };
+
+pub use object::plan_object;
 
 /// Loop iterations one invocation may run per dispatch. Lavapipe silently ends every loop of an
 /// invocation after 65535 iterations in all; a density evaluation costs one iteration per noise
@@ -64,16 +69,7 @@ pub const MAX_SHADOW_SAMPLES: u32 = 256;
 /// More dispatches than this means a step far finer than the scene needs.
 pub const MAX_DISPATCHES: u32 = 20_000;
 
-/// The camera as the kernels see it (see `ReferenceParams`).
-#[derive(Debug, Clone, Copy)]
-pub struct Camera {
-    pub eye: DVec3,
-    /// Right and up scaled by the half extents of the image at unit distance.
-    pub right: DVec3,
-    pub up: DVec3,
-    pub near: f64,
-    pub far: f64,
-}
+pub use crate::methods::view::RayCamera as Camera;
 
 /// One RayMarch object of a frame.
 #[derive(Debug, Clone)]

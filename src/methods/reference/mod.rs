@@ -3,7 +3,10 @@
 //! and level 0 of their baked volumes packed into one storage buffer (the kernel filters by hand,
 //! as the sampler would, so all objects fit in one dispatch without binding arrays).
 
+mod object;
 pub mod trace_reference;
+
+pub use object::{frame_twin_inputs, plan, ReferencePlan};
 
 use glam::{DVec3, Vec3A};
 use obvhs::aabb::Aabb;
@@ -37,6 +40,8 @@ pub const CONTRIBUTION: super::Contribution = super::Contribution {
         "vertex_frames",
     ],
     counts: &["reference_dispatches"],
+    texel_resources: &["texel_atlas"],
+    gather: Some(object::gather),
 };
 
 /// Everything the reference kernel reads, for all Reference objects of a frame.

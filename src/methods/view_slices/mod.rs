@@ -1,7 +1,10 @@
 //! Host side of view-aligned prism slicing (2002 paper): the plane sweep of one object and the
 //! buffers its kernels (`count_slices`, `scan_plane_offsets`, `emit_slices`) and `draw_slices` use.
 
+mod object;
 pub mod slice_prisms;
+
+pub use object::{plan, ViewSlicesPlan};
 
 use crate::error::{Error, Result};
 use crate::mesh::shell::Shell;
@@ -24,6 +27,8 @@ pub const CONTRIBUTION: super::Contribution = super::Contribution {
         "vertex_frames",
     ],
     counts: &["prisms", "planes", "plane_blocks"],
+    texel_resources: &["volume", "normals"],
+    gather: None,
 };
 
 /// The plane sweep: `planes` planes orthogonal to the view direction spanning the shell's depth

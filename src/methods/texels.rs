@@ -4,13 +4,14 @@ use crate::bake::hypertexture::HyperTexel;
 use crate::bake::{BakeRequest, BakeSource, Heights, MeshTexel, StackTexels};
 use crate::cpu::bake::{pack_shapes, Shape as BakeShape};
 use crate::error::{Error, Result};
-use crate::render::{BakePlan, Lighting};
+use crate::methods::plan::BakePlan;
+use crate::methods::view::Lighting;
 use crate::scene::{Scene, Shape, TexelSource};
 use crate::types::{HeightImageParams, HeightfieldParams};
 
 /// Index of the bake for `texel` with the given lighting, added if new; `time`: the frame's
 /// (animated hypertextures are baked at it).
-pub(super) fn bake_index(
+pub fn bake_index(
     scene: &Scene,
     texel: &str,
     per_pixel: bool,
@@ -146,7 +147,7 @@ pub(super) fn bake_index(
 }
 
 /// Like [`bake_index`], with the slice images of axis-aligned slicing baked too.
-pub(super) fn bake_index_axis(
+pub fn bake_index_axis(
     scene: &Scene,
     texel: &str,
     light: &Lighting,

@@ -1,0 +1,114 @@
+//! Overrides of what a scene file says (the command line, the preview, sweeps), and how they
+//! resolve an object's method.
+
+use std::path::PathBuf;
+
+use crate::scene::{AxisSlices, Camera, Method, RayMarch, Reference, ViewSlices};
+
+/// Overrides of what the scene file says, from the command line or tests.
+#[derive(Debug, Clone, Default)]
+pub struct RenderOptions {
+    pub size: Option<(u32, u32)>,
+    pub graph: Option<PathBuf>,
+    pub planes: Option<u32>,
+    pub trivial_reject: Option<bool>,
+    /// Render every textured object with this method (keeping its lighting mode).
+    pub method: Option<MethodKind>,
+    /// Ray step for `Reference` and `RayMarch` objects (world units).
+    pub step: Option<f64>,
+    /// Segment strategy of every `RayMarch` object (the Pareto sweep).
+    pub segments: Option<crate::scene::Segments>,
+    /// RayMarch objects: an adaptive stride up to this step (world units; the Pareto sweep);
+    /// `Some(None)` turns it off.
+    pub max_step: Option<Option<f64>>,
+    /// Methods replacing those of named objects (the preview's per-object switch), before
+    /// `method` and the knob overrides apply.
+    pub object_methods: Vec<(String, Method)>,
+    /// A camera replacing the scene's (the preview's orbit).
+    pub camera: Option<Camera>,
+    /// Render at `n` times the width and height and average each `n x n` block: every pixel is
+    /// then the mean over its area rather than a point sample (anti-aliasing; a reference for
+    /// methods that filter by the pixel footprint).
+    pub supersample: Option<u32>,
+    /// AxisSlices criteria `(d, p)` for every AxisSlices object: slice depth in voxels and
+    /// apparent slice distance in pixels (`--criteria`, the Pareto sweep).
+    pub axis_criteria: Option<(f64, f64)>,
+    /// Time of the frame in seconds (animated hypertextures; default: the scene's).
+    pub time: Option<f64>,
+    /// AxisSlices occlusion culling for every AxisSlices object (`--occlusion-culling`).
+    pub occlusion_culling: Option<bool>,
+}
+
+/// A method without its knobs, to switch every object to it (`--method`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum MethodKind {
+    ViewSlices,
+    Reference,
+    AxisSlices,
+}
+
+/// Axis slicing's knobs when an object is switched to it from another method.
+pub const DEFAULT_AXIS_SLICES: AxisSlices = AxisSlices {
+    depth: 1.0,
+    pixels: 1.0,
+    max_angle: 80.0,
+    directions: crate::scene::SliceDirections::Three,
+    blend: crate::scene::SliceBlend::Binary,
+    occlusion_culling: false,
+    empty_culling: true,
+    draw_order: crate::scene::DrawOrder::Texels,
+};
+
+/// Plane count when an object is switched to view slicing from a method without planes.
+pub const DEFAULT_PLANES: u32 = 400;
+
+impl RenderOptions {
+    /// An object's method after the overrides: switched to `method` if given, knobs replaced.
+    pub fn apply(&self, method: &Method) -> Method {
+        if let Method::RayMarch(rm) = method {
+            // Hypertextures have no texel for other methods: only the step changes.
+            let adaptive = match self.max_step {
+                Some(m) => m.map(|max_step| crate::scene::Adaptive { max_step }),
+                None => rm.adaptive,
+            };
+            return Method::RayMarch(RayMarch {
+                step: self.step.or(rm.step),
+                segments: self.segments.unwrap_or(rm.segments),
+                adaptive,
+                ..*rm
+            });
+        }
+        let lighting = method.lighting();
+        // A method the switch does not know keeps its knobs unless switched.
+        let Some(kind) = self.method.or(match method {
+            Method::ViewSlices(_) => Some(MethodKind::ViewSlices),
+            Method::Reference(_) => Some(MethodKind::Reference),
+            Method::AxisSlices(_) => Some(MethodKind::AxisSlices),
+            _ => None,
+        }) else {
+            return method.clone();
+        };
+        match (kind, method) {
+            (MethodKind::ViewSlices, Method::ViewSlices(vs)) => Method::ViewSlices(ViewSlices {
+                planes: self.planes.unwrap_or(vs.planes),
+                trivial_reject: self.trivial_reject.unwrap_or(vs.trivial_reject),
+                lighting,
+            }),
+            (MethodKind::ViewSlices, _) => Method::ViewSlices(ViewSlices {
+                planes: self.planes.unwrap_or(DEFAULT_PLANES),
+                trivial_reject: self.trivial_reject.unwrap_or(true),
+                lighting,
+            }),
+            (MethodKind::Reference, Method::Reference(r)) => {
+                Method::Reference(Reference { step: self.step.or(r.step), lighting })
+            }
+            (MethodKind::Reference, _) => Method::Reference(Reference { step: self.step, lighting }),
+            (MethodKind::AxisSlices, m) => {
+                let a = if let Method::AxisSlices(a) = m { *a } else { DEFAULT_AXIS_SLICES };
+                let (depth, pixels) = self.axis_criteria.unwrap_or((a.depth, a.pixels));
+                let occlusion_culling = self.occlusion_culling.unwrap_or(a.occlusion_culling);
+                Method::AxisSlices(AxisSlices { depth, pixels, occlusion_culling, ..a })
+            }
+        }
+    }
+}

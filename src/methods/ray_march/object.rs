@@ -1,0 +1,118 @@
+//! One RayMarch object of a frame as the renderer sees it.
+
+use std::any::Any;
+
+use super::{plan, RayMarchPlan};
+use crate::error::{Error, Result};
+use crate::gpu::cache::GpuCache;
+use crate::gpu::{GpuContext, Inputs};
+use crate::hypertexture::mesh::MeshGrid;
+use crate::hypertexture::splats::SplatSet;
+use crate::methods::{InputCx, MethodPlan, ObjectPlan, PartDecl, PlanCx};
+use crate::scene::RayMarch;
+
+/// Plans the march through `object`'s hypertexture.
+pub fn plan_object(cx: &mut PlanCx, object: &mut ObjectPlan, m: &RayMarch) -> Result<()> {
+    let name = &object.object.name;
+    let node = object
+        .object
+        .hypertexture
+        .as_ref()
+        .ok_or_else(|| Error::Invalid(format!("object \"{name}\": RayMarch needs a hypertexture")))?;
+    let h = cx.scene.hypertextures.get(&node.name).ok_or_else(|| {
+        Error::Invalid(format!("{}: unknown hypertexture `{}`", cx.scene.path.display(), node.name))
+    })?;
+    let plan = plan(name, node, h, m, &cx.view.camera(), cx.time, cx.view.size)?;
+    object.methods.push(Box::new(plan));
+    Ok(())
+}
+
+/// What `prepare` bakes: the mesh grid of a mesh object, the splat set of a segmented one.
+type Prepared = (Option<MeshGrid>, Option<SplatSet>);
+
+impl MethodPlan for RayMarchPlan {
+    fn parts(&self) -> Vec<PartDecl> {
+        let filters = match (&self.peel, &self.splatting) {
+            (Some(_), _) => vec!["RayMarch", "RayMarchPeeling"],
+            (_, Some(_)) => vec!["RayMarch", "RayMarchSplatting"],
+            _ => vec!["RayMarch"],
+        };
+        vec![PartDecl { filters, order: 0 }]
+    }
+
+    fn distance(&self, eye: glam::DVec3) -> Option<f64> {
+        Some((self.corners.iter().sum::<glam::DVec3>() / 8.0 - eye).length())
+    }
+
+    fn constants(&self) -> Vec<(String, f64)> {
+        RayMarchPlan::constants(self)
+    }
+
+    /// Mesh grids and splat sets, baked once per mesh, grid and lattice while the cache holds them.
+    fn prepare(&self, ctx: &GpuContext, cache: &mut GpuCache) -> Result<Option<Box<dyn Any + Send>>> {
+        let grid = match self.mesh_grid_key() {
+            Some(key) => Some(cache.bake(key, || Ok(self.bake_mesh_grid(ctx)?.expect("a mesh object")))?),
+            None => None,
+        };
+        let splats = match self.splat_key() {
+            Some(key) => Some(cache.bake(key, || self.bake_splats(ctx, grid.as_ref()))?),
+            None => None,
+        };
+        let prepared: Prepared = (grid, splats);
+        Ok(Some(Box::new(prepared)))
+    }
+
+    fn add_inputs(&self, cx: &InputCx, _object: &ObjectPlan, _part: usize, inputs: &mut Inputs) {
+        let prepared = cx.prepared.and_then(|p| p.downcast_ref::<Prepared>());
+        let (grid, splats) = prepared.map_or((None, None), |(g, s)| (g.as_ref(), s.as_ref()));
+        RayMarchPlan::add_inputs(self, cx.ctx, inputs, cx.size, grid, splats);
+    }
+
+    fn bake_lines(&self, object: &ObjectPlan) -> Vec<String> {
+        let name = &object.object.name;
+        let mut lines = Vec::new();
+        if let Some((shape, spec)) = &self.packed.mesh {
+            let [x, y, z] = spec.n;
+            lines.push(format!(
+                "{name:<16} {x}x{y}x{z}  bake_mesh_grid.wgsl  mesh grid of {} triangles in {} part(s)",
+                shape.triangles.len(),
+                shape.parts.len(),
+            ));
+        }
+        if let Some(l) = self.lattice() {
+            let [x, y, z] = l.counts;
+            lines.push(format!(
+                "{name:<16} {x}x{y}x{z}  bake_splats.wgsl  surface and interior splats, cell {:.4}, surface at \
+                 support distance {:.4}",
+                l.cell, l.level
+            ));
+        }
+        lines
+    }
+
+    fn summary(&self, _object: &ObjectPlan) -> String {
+        format!(
+            "{} of hypertexture \"{}\", {} noise(s), {} dispatch(es) per frame",
+            self.describe(),
+            self.hypertexture,
+            self.packed.noises.len(),
+            self.dispatches
+        )
+    }
+
+    fn metadata(&self, _object: &ObjectPlan) -> String {
+        self.describe()
+    }
+
+    fn memory(&self, object: &ObjectPlan, size: (u32, u32)) -> Vec<(String, u64)> {
+        let what = format!(
+            "object {}: hypertexture parameters, transfer tables, per-pixel march state{}",
+            object.object.name,
+            if self.packed.mesh.is_some() { ", mesh grid" } else { "" }
+        ) + if self.peel.is_some() { ", splat sets, per-pixel segment bounds" } else { "" }
+            + if self.splatting.is_some() { ", splat sets, per-pixel depth slabs" } else { "" };
+        vec![(what, self.bytes(size))]
+    }
+
+    crate::any_plan!();
+}
