@@ -469,6 +469,9 @@ impl State {
                             };
                             Method::RayMarch(h)
                         }
+                        // A method without keys here keeps its knobs.
+                        #[allow(unreachable_patterns)]
+                        other => other,
                     };
                     self.set_method(name, next);
                 }
@@ -505,6 +508,9 @@ impl State {
                             }
                             Method::RayMarch(h)
                         }
+                        // A method without keys here keeps its knobs.
+                        #[allow(unreachable_patterns)]
+                        other => other,
                     };
                     self.set_method(name, next);
                 }
@@ -568,6 +574,8 @@ fn describe(m: &Method) -> String {
                 r.lighting
             )
         }
+        #[allow(unreachable_patterns)]
+        other => format!("{other:?}"),
     }
 }
 
