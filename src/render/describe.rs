@@ -68,7 +68,7 @@ impl Blueprint {
         }
         s += "\nobjects:\n";
         for o in &self.objects {
-            let method = o.methods.last().map_or("base surface only".into(), |m| m.summary(o));
+            let method = o.methods.last().map_or("nothing drawn".into(), |m| m.summary(o));
             let what = match &o.object.hypertexture {
                 Some(_) => "hypertexture".to_string(),
                 None => format!("{} triangles", o.shell.prisms.len()),

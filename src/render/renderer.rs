@@ -232,7 +232,7 @@ impl Renderer {
             m.push(("voltex_gpu_ms".into(), format!("{t:.3}")));
         }
         for o in &self.blueprint.objects {
-            let method = o.methods.last().map_or("BaseSurface".into(), |m| m.metadata(o));
+            let method = o.methods.last().map_or("None".into(), |m| m.metadata(o));
             m.push((format!("voltex_object_{}", o.object.name), method));
         }
         m

@@ -103,3 +103,35 @@ fn the_scan_sees_grouped_and_nested_imports() {
         "use crate::gpu::{GpuContext, Inputs};\nuse crate::{Error, io::png};\nlet x = crate::render::f();";
     assert_eq!(imports(text), ["gpu", "Error", "io", "render"]);
 }
+
+/// The graph core and the renderer reach methods only through `methods::REGISTRY` and the
+/// `MethodPlan` trait: no file of theirs names a method's module, plan type or object filter.
+#[test]
+fn graph_and_render_name_no_method() {
+    let mut names: Vec<String> = Vec::new();
+    for c in voltex::methods::REGISTRY {
+        names.extend(c.filters.iter().map(|f| format!("\"{f}\"")));
+    }
+    for module in ["view_slices", "axis_slices", "reference", "ray_march", "base_surface"] {
+        names.push(format!("methods::{module}"));
+    }
+    names.extend(
+        ["ViewSlicesPlan", "AxisPlan", "ReferencePlan", "ReferenceSet", "RayMarchPlan", "BaseSurfacePlan"]
+            .map(String::from),
+    );
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let mut files = Vec::new();
+    rust_files(&root.join("graph"), &mut files);
+    rust_files(&root.join("render"), &mut files);
+    let mut found = Vec::new();
+    for f in &files {
+        let text = std::fs::read_to_string(f).unwrap();
+        for (n, line) in text.lines().enumerate() {
+            let code = line.split("//").next().unwrap_or("");
+            for name in names.iter().filter(|name| code.contains(name.as_str())) {
+                found.push(format!("{}:{}: {name}", f.display(), n + 1));
+            }
+        }
+    }
+    assert!(found.is_empty(), "graph/ or render/ names a method:\n{}", found.join("\n"));
+}
