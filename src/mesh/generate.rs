@@ -71,6 +71,7 @@ fn with_corner_uvs(
         attribute: None,
         colors: None,
         face_lines: vec![],
+        uvs_missing: false,
     };
     m.vertex_uvs = m.vertex_uvs_from_corners();
     m

@@ -1,8 +1,9 @@
 //! Base surfaces: triangle meshes whose welded vertices carry height vectors, the generators and OBJ
-//! loader that make them, and the prism checks that say whether their extrusions are usable.
+//! and glTF loaders that make them, and the prism checks that say whether their extrusions are usable.
 
 pub mod bvh;
 pub mod generate;
+pub mod gltf;
 pub mod motion;
 pub mod obj;
 pub mod prism;
@@ -10,6 +11,16 @@ pub mod shape;
 pub mod shell;
 
 use glam::{DMat4, DVec2, DVec3};
+
+use crate::error::Result;
+
+/// Reads a mesh file by its extension: `.gltf` and `.glb` as glTF 2.0, anything else as OBJ.
+pub fn load(path: &std::path::Path) -> Result<Mesh> {
+    match path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() {
+        Some("gltf" | "glb") => gltf::load(path),
+        _ => obj::load(path),
+    }
+}
 
 /// A base surface ready for a method: world-space (or model-space) f64 data.
 ///
@@ -80,6 +91,8 @@ pub struct Mesh {
     pub colors: Option<Vec<[f64; 3]>>,
     /// OBJ: the line of the `f` statement of each triangle, for errors (empty when generated).
     pub face_lines: Vec<u32>,
+    /// glTF: some primitive had no `TEXCOORD_0` (its corners' uvs are planar).
+    pub uvs_missing: bool,
 }
 
 impl Mesh {

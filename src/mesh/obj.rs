@@ -158,6 +158,7 @@ pub fn parse(text: &str, path: &Path) -> Result<Mesh> {
         attribute,
         colors,
         face_lines,
+        uvs_missing: false,
     };
     m.vertex_uvs = m.vertex_uvs_from_corners();
     Ok(m)

@@ -9,7 +9,7 @@ use super::values::Mark;
 use crate::error::Error;
 use crate::io::stack::{self, SliceStack};
 use crate::mesh::shape::MeshShape;
-use crate::mesh::{obj, Mesh};
+use crate::mesh::Mesh;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -57,11 +57,12 @@ impl Checker<'_> {
             return Some(m.clone());
         }
         if !full.is_file() {
-            let msg = format!("expected an OBJ file, but {} does not exist", full.display());
+            let msg =
+                format!("expected a mesh file (.obj, .gltf or .glb), but {} does not exist", full.display());
             self.fail(path, msg);
             return None;
         }
-        match obj::load(&full) {
+        match crate::mesh::load(&full) {
             Ok(m) => {
                 let m = Arc::new(m);
                 self.f.assets.meshes.insert(full, m.clone());
@@ -345,7 +346,17 @@ impl Checker<'_> {
                 Surface::Torus { major, minor, .. } if minor >= major => {
                     self.fail(s, format!("expected a torus minor radius below the major radius ({major})"));
                 }
-                Surface::Obj { path } => mesh = self.mesh(path),
+                Surface::Obj { path } => {
+                    mesh = self.mesh(path);
+                    // Texels tile by uv: a surface without them would be textured by accident.
+                    if mesh.as_ref().is_some_and(|m| m.uvs_missing) {
+                        let msg = format!(
+                            "{} has a primitive without TEXCOORD_0: a base surface needs uvs",
+                            path.value
+                        );
+                        self.fail(path, msg);
+                    }
+                }
                 _ => {}
             }
         }
@@ -355,7 +366,7 @@ impl Checker<'_> {
                 (HeightScale::VertexAttribute, Some(Surface::Obj { path })) => {
                     if mesh.as_ref().is_some_and(|m| m.attribute.is_none()) {
                         let msg = format!(
-                            "{} has no vertex colours: expected `v x y z r g b` lines for VertexAttribute",
+                            "{} has no vertex colours: expected `v x y z r g b` lines (OBJ) or COLOR_0 (glTF) for VertexAttribute",
                             path.value
                         );
                         self.fail(scale, msg);

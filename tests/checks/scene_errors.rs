@@ -133,7 +133,7 @@ fn output_sizes() {
 #[test]
 fn missing_obj_file() {
     let l = r#"            surface: Obj(path: "missing.obj"),"#;
-    assert_err("noobj", &[(11, l)], "scene.ron", 11, 32, "expected an OBJ file");
+    assert_err("noobj", &[(11, l)], "scene.ron", 11, 32, "expected a mesh file (.obj, .gltf or .glb)");
 }
 
 #[test]

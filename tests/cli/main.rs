@@ -5,5 +5,6 @@ mod common;
 
 mod cli_errors;
 mod faults;
+mod gltf;
 mod install;
 mod preview_window;

@@ -1,0 +1,90 @@
+//! glTF 2.0 meshes through the `voltex` binary: `meshes/dome.glb` (per-corner vertices under a
+//! scaled, translated parent node, v flipped) and `meshes/dome.obj` (the same surface as OBJ,
+//! written by `tools/gen_dome.py`) load to the same mesh and render the same image; broken glTF
+//! files fail with the file named, status 1 and no output.
+
+use crate::common;
+
+use common::{ok, root, s, scratch_dir, stderr, voltex};
+
+fn dome(file: &str) -> String {
+    let text = std::fs::read_to_string(root().join("scenes/view_slices/gltf_dome.ron")).unwrap();
+    let dir = root().join("scenes/view_slices/meshes");
+    text.replace("\"meshes/dome.glb\"", &format!("{:?}", dir.join(file)))
+}
+
+#[test]
+fn glb_and_obj_load_the_same_mesh() {
+    let dir = root().join("scenes/view_slices/meshes");
+    let glb = voltex::mesh::load(&dir.join("dome.glb")).unwrap();
+    let obj = voltex::mesh::load(&dir.join("dome.obj")).unwrap();
+    assert_eq!(glb.triangles.len(), 288);
+    assert_eq!(glb.positions, obj.positions);
+    assert_eq!(glb.triangles, obj.triangles);
+    assert_eq!(glb.corner_uvs, obj.corner_uvs);
+    assert_eq!(glb.colors, obj.colors);
+    assert_eq!(glb.normals, obj.normals);
+}
+
+#[test]
+fn glb_and_obj_render_the_same_image() {
+    let dir = scratch_dir("voltex-gltf-render");
+    let mut images = Vec::new();
+    for file in ["dome.glb", "dome.obj"] {
+        let scene = dir.join(format!("{file}.ron"));
+        std::fs::write(&scene, dome(file)).unwrap();
+        let out = dir.join(format!("{file}.exr"));
+        ok(voltex(&["render", s(&scene), "--size", "32x32", "-o", s(&out)]));
+        images.push(voltex::io::exr::read(&out).unwrap().0);
+    }
+    assert!(images[0].pixels.iter().any(|p| p[0] > 0.1), "the dome is drawn");
+    assert_eq!(images[0].pixels, images[1].pixels);
+}
+
+#[test]
+fn broken_gltf_names_the_file_and_writes_nothing() {
+    let dir = scratch_dir("voltex-gltf-broken");
+    let glb = std::fs::read(root().join("scenes/view_slices/meshes/dome.glb")).unwrap();
+    let cases: [(&str, Vec<u8>, &str); 3] = [
+        ("truncated.glb", glb[..glb.len() / 2].to_vec(), "not a valid glTF 2.0 file"),
+        ("empty.gltf", b"{\"asset\": {\"version\": \"2.0\"}}".to_vec(), "expected at least one triangle"),
+        ("junk.glb", b"glTF\x02\0\0\0junk".to_vec(), "not a valid glTF 2.0 file"),
+    ];
+    for (name, bytes, expected) in cases {
+        let mesh = dir.join(name);
+        std::fs::write(&mesh, bytes).unwrap();
+        let scene = dir.join(format!("{name}.ron"));
+        std::fs::write(
+            &scene,
+            dome("dome.glb").replace(s(&root().join("scenes/view_slices/meshes/dome.glb")), s(&mesh)),
+        )
+        .unwrap();
+        let out = dir.join(format!("{name}.exr"));
+        let run = voltex(&["render", s(&scene), "--size", "16x16", "-o", s(&out)]);
+        let err = stderr(&run);
+        assert_eq!(run.status.code(), Some(1), "{err}");
+        assert!(err.contains(s(&mesh)) && err.contains(expected), "{name}: {err}");
+        assert!(!out.exists());
+    }
+}
+
+#[test]
+fn a_base_surface_without_uvs_is_an_error_at_its_path() {
+    let dir = scratch_dir("voltex-gltf-no-uvs");
+    // The dome's glb with TEXCOORD_0 dropped from its primitive.
+    let glb = std::fs::read(root().join("scenes/view_slices/meshes/dome.glb")).unwrap();
+    let text = String::from_utf8_lossy(&glb).into_owned();
+    let at = text.find("\"TEXCOORD_0\":1,").unwrap();
+    let mut edited = glb.clone();
+    edited.splice(at..at + 15, b"               ".iter().copied());
+    let mesh = dir.join("no_uvs.glb");
+    std::fs::write(&mesh, edited).unwrap();
+    let scene = dir.join("no_uvs.ron");
+    let text = dome("dome.glb").replace(s(&root().join("scenes/view_slices/meshes/dome.glb")), s(&mesh));
+    let line = text.lines().position(|l| l.contains("no_uvs.glb")).unwrap() + 1;
+    std::fs::write(&scene, text).unwrap();
+    let run = voltex(&["plan", s(&scene)]);
+    let err = stderr(&run);
+    assert_eq!(run.status.code(), Some(1), "{err}");
+    assert!(err.contains(&format!("no_uvs.ron:{line}:")) && err.contains("without TEXCOORD_0"), "{err}");
+}
