@@ -331,8 +331,7 @@ pub struct Graph {
 
 impl Graph {
     pub fn load(path: &Path) -> Result<Self> {
-        let source = std::fs::read_to_string(path)
-            .map_err(|e| Error::file(path, format!("cannot read graph: {e}")))?;
+        let source = crate::input::read_text(path, "a graph file")?;
         Self::parse(path, source)
     }
 

@@ -79,7 +79,7 @@ impl Scene {
 
 /// Reads, parses and checks a scene file, and loads the files it refers to.
 pub fn load(path: &Path) -> Result<Scene> {
-    let source = std::fs::read_to_string(path).map_err(|e| Error::file(path, e))?;
+    let source = crate::input::read_text(path, "a scene file")?;
     parse(&source, path)
 }
 

@@ -56,9 +56,14 @@ impl Checker<'_> {
         if let Some(m) = self.f.assets.meshes.get(&full) {
             return Some(m.clone());
         }
-        if !full.is_file() {
+        // Special files and files over the cap fail at the path's position, before any read.
+        if std::fs::metadata(&full).is_err() {
             let msg = format!("expected an OBJ file, but {} does not exist", full.display());
             self.fail(path, msg);
+            return None;
+        }
+        if let Err(e) = crate::input::check(&full, crate::input::Kind::Asset, "an OBJ file") {
+            self.fail(path, e.to_string());
             return None;
         }
         match obj::load(&full) {
@@ -229,9 +234,13 @@ impl Checker<'_> {
         if let Some(m) = self.f.assets.images.get(&full) {
             return Some(m.clone());
         }
-        if !full.is_file() {
+        if std::fs::metadata(&full).is_err() {
             let msg = format!("expected a PNG file, but {} does not exist", full.display());
             self.fail(path, msg);
+            return None;
+        }
+        if let Err(e) = crate::input::check(&full, crate::input::Kind::Asset, "a PNG file") {
+            self.fail(path, e.to_string());
             return None;
         }
         match HeightImage::load(&full) {

@@ -5,5 +5,6 @@ mod common;
 
 mod cli_errors;
 mod faults;
+mod hostile_files;
 mod install;
 mod preview_window;
