@@ -21,7 +21,7 @@ pub struct GraphFile {
     /// runtime provides (e.g. `slice_vertices` in a debug graph). Passes that contribute to none
     /// of them are pruned.
     pub outputs: Vec<String>,
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::input::unique_keys")]
     pub resources: BTreeMap<String, ResourceDecl>,
     pub passes: Vec<PassDecl>,
 }
@@ -53,6 +53,7 @@ pub enum ResourceDecl {
 /// The size of a graph buffer. Counts are size expressions: integer literals and the frame's
 /// counts (`width`, `height`) joined by `*` and `+`, e.g. `"width * height"` (see [`expr`]).
 #[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum BufferSize {
     /// A size in bytes.
     Bytes(Count),
@@ -74,12 +75,14 @@ impl BufferSize {
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum BufferClear {
     Zero,
 }
 
 /// The value of a `Parameter`, with its WGSL type.
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum Value {
     /// `f32`
     F32(f32),
@@ -124,6 +127,7 @@ pub struct Vocabulary {
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum Format {
     Rgba8Unorm,
     Rgba16Float,
@@ -152,6 +156,7 @@ impl Format {
 }
 
 #[derive(Debug, Clone, Copy, Default, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum TextureSize {
     /// The scene's output size.
     #[default]
@@ -160,6 +165,7 @@ pub enum TextureSize {
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum Clear {
     /// Linear RGBA.
     Color(f32, f32, f32, f32),
@@ -168,6 +174,7 @@ pub enum Clear {
 
 /// Which instances a pass runs for.
 #[derive(Debug, Clone, Default, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum Instances {
     /// Once per frame.
     #[default]
@@ -254,6 +261,7 @@ impl PassDecl {
 pub type Count = String;
 
 #[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum Dispatch {
     /// Invocation counts per axis; workgroup counts follow from the kernel's workgroup size.
     Threads(Count, Count, Count),
@@ -270,6 +278,7 @@ pub struct Target {
 }
 
 #[derive(Debug, Clone, Copy, Default, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum Blend {
     #[default]
     Replace,
@@ -289,6 +298,7 @@ pub struct DepthTarget {
 }
 
 #[derive(Debug, Clone, Copy, Default, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum Compare {
     #[default]
     Less,
@@ -307,6 +317,7 @@ impl Compare {
 }
 
 #[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum Draw {
     Vertices(Count),
     /// Indirect draw from a buffer holding `DrawIndirect` arguments.

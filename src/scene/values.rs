@@ -143,6 +143,15 @@ adapter!(cells, [u32; 2], [Cells; 2], |v| v.map(|x| x.0));
 adapter!(sphere_segments, [u32; 2], (Around, PoleToPole), |v| [v.0 .0, v.1 .0]);
 adapter!(torus_segments, [u32; 2], [Around; 2], |v| v.map(|x| x.0));
 
+/// A sequence's frames: at least one (checked here so the error has the list's position).
+pub(super) fn frames<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<Mark<String>>, D::Error> {
+    let v = Vec::<Mark<String>>::deserialize(d)?;
+    if v.is_empty() {
+        return Err(D::Error::custom("expected at least one texel name in a sequence, found `[]`"));
+    }
+    Ok(v)
+}
+
 /// A direction: finite and not zero.
 pub(super) fn direction<'de, D: Deserializer<'de>>(d: D) -> Result<DVec3, D::Error> {
     let v = vec3(d)?;
