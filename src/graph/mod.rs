@@ -161,15 +161,48 @@ pub enum TextureSize {
     /// The scene's output size.
     #[default]
     Output,
-    Fixed(u32, u32),
+    Fixed(#[serde(deserialize_with = "side")] u32, #[serde(deserialize_with = "side")] u32),
+}
+
+/// Most colour targets of one raster pass (WebGPU's `maxColorAttachments`).
+pub const MAX_TARGETS: usize = 8;
+
+// Value checks run while deserializing, so ron positions the error at the value.
+fn side<'de, D: serde::Deserializer<'de>>(d: D) -> Result<u32, D::Error> {
+    let v = u32::deserialize(d)?;
+    match v {
+        1..=16384 => Ok(v),
+        _ => Err(serde::de::Error::custom(format!("expected a texture side in 1..=16384, found {v}"))),
+    }
+}
+
+fn finite<'de, D: serde::Deserializer<'de>>(d: D) -> Result<f32, D::Error> {
+    let v = f32::deserialize(d)?;
+    match v.is_finite() {
+        true => Ok(v),
+        false => Err(serde::de::Error::custom(format!("expected a finite clear value, found {v}"))),
+    }
+}
+
+fn depth<'de, D: serde::Deserializer<'de>>(d: D) -> Result<f32, D::Error> {
+    let v = f32::deserialize(d)?;
+    match (0.0..=1.0).contains(&v) {
+        true => Ok(v),
+        false => Err(serde::de::Error::custom(format!("expected a depth clear value in [0, 1], found {v}"))),
+    }
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub enum Clear {
     /// Linear RGBA.
-    Color(f32, f32, f32, f32),
-    Depth(f32),
+    Color(
+        #[serde(deserialize_with = "finite")] f32,
+        #[serde(deserialize_with = "finite")] f32,
+        #[serde(deserialize_with = "finite")] f32,
+        #[serde(deserialize_with = "finite")] f32,
+    ),
+    Depth(#[serde(deserialize_with = "depth")] f32),
 }
 
 /// Which instances a pass runs for.
@@ -362,6 +395,14 @@ impl Graph {
         Error::at(FileLoc::new(&self.path, line, col), message)
     }
 
+    /// An error at the string literal `text` inside pass `pass`, after its field `field`.
+    pub fn error_in_pass(&self, pass: &str, field: &str, text: &str, message: impl Into<String>) -> Error {
+        let mut from = self.source.find(&format!("\"{pass}\"")).unwrap_or(0);
+        from += self.source[from..].find(&format!("{field}:")).unwrap_or(0);
+        let (line, col) = locate_literal(&self.source, text, from).unwrap_or((1, 1));
+        Error::at(FileLoc::new(&self.path, line, col), message)
+    }
+
     /// Byte offset of the key of resource `name` in `resources` (`"name":`), or of its first
     /// mention.
     pub fn resource_offset(&self, name: &str) -> usize {
@@ -411,17 +452,45 @@ impl Graph {
             }
             seen.push(p.name());
             if let PassDecl::Raster { targets, depth, .. } = p {
-                for t in targets.iter().map(|t| &t.resource).chain(depth.iter().map(|d| &d.resource)) {
-                    if !matches!(f.resources.get(t), Some(ResourceDecl::Texture { .. })) {
+                if targets.len() > MAX_TARGETS {
+                    let msg = format!(
+                        "pass `{}` has {} colour targets: at most {MAX_TARGETS} are allowed",
+                        p.name(),
+                        targets.len()
+                    );
+                    return Err(self.error_at(p.name(), msg));
+                }
+                let colour = targets.iter().map(|t| (&t.resource, false));
+                for (t, is_depth) in colour.chain(depth.iter().map(|d| (&d.resource, true))) {
+                    let Some(ResourceDecl::Texture { format, .. }) = f.resources.get(t) else {
                         return Err(self.error_at(
                             t,
                             format!("render target `{t}` is not a texture declared in `resources`"),
+                        ));
+                    };
+                    // wgpu rejects these only when the pipeline is made; here they have a position.
+                    if is_depth != (*format == Format::Depth32Float) {
+                        let want = if is_depth { "a depth format (Depth32Float)" } else { "a colour format" };
+                        let role = if is_depth { "depth target" } else { "colour target" };
+                        return Err(self.error_in_pass(
+                            p.name(),
+                            if is_depth { "depth" } else { "targets" },
+                            t,
+                            format!("pass `{}`: {role} `{t}` needs {want}, found {format:?}", p.name()),
                         ));
                     }
                 }
             }
         }
         for (name, decl) in &f.resources {
+            if let ResourceDecl::Texture { format, clear: Some(clear), .. } = decl {
+                let is_depth = *format == Format::Depth32Float;
+                if is_depth != matches!(clear, Clear::Depth(_)) {
+                    let want = if is_depth { "`Depth(..)`" } else { "`Color(..)`" };
+                    let msg = format!("texture `{name}` is {format:?}: its clear must be {want}");
+                    return Err(self.error_at_resource(name, msg));
+                }
+            }
             if let ResourceDecl::Buffer { size, .. } = decl {
                 let (text, unit) = size.expr();
                 expr::Expr::parse(text).map_err(|e| {

@@ -334,6 +334,7 @@ pub struct Ball {
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Node {
+    #[serde(deserialize_with = "v::object_name")]
     pub name: String,
     #[serde(default)]
     pub transform: Transform,

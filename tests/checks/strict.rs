@@ -127,3 +127,83 @@ fn an_empty_sequence_is_an_error_at_its_list() {
     assert!(e.starts_with("s.ron:5:"), "{e}");
     assert!(e.contains("expected at least one texel name in a sequence"), "{e}");
 }
+
+// ---- checks that only the GPU (or the EXR writer) made, now made when the files are read ----
+
+#[test]
+fn node_names_must_fit_exr_metadata() {
+    let base = std::fs::read_to_string(root().join("scenes/view_slices/flat_box.ron")).unwrap();
+    let name = base.split("name: \"").nth(1).and_then(|r| r.split('"').next()).expect("a node name");
+    let text = replaced(&base, &format!("\"{name}\""), "\"漢\"");
+    // ron positions a string's error just inside its opening quote.
+    scene_err(&text, &at(&text, "漢\"", 0), &["Latin-1", "EXR metadata"]);
+    let long = "n".repeat(250);
+    let text = replaced(&base, &format!("\"{name}\""), &format!("\"{long}\""));
+    scene_err(&text, &at(&text, &long, 0), &["at most 241 bytes", "found 250"]);
+}
+
+/// A graph with one extra texture resource and one raster pass, from `graphs/frame.ron`.
+fn frame_with(resource: &str) -> String {
+    let text = frame_graph();
+    let first = text.find("resources: {").unwrap() + "resources: {".len();
+    format!("{}\n        {resource},{}", &text[..first], &text[first..])
+}
+
+#[test]
+fn graph_values_are_checked_when_read() {
+    let text = frame_with("\"x\": Texture(format: Depth32Float, clear: Depth(NaN))");
+    graph_err(&text, &at(&text, "NaN", 0), &["expected a depth clear value in [0, 1]"]);
+    let text = frame_with("\"x\": Texture(format: Rgba16Float, clear: Color(0.0, inf, 0.0, 1.0))");
+    graph_err(&text, &at(&text, "inf", 0), &["expected a finite clear value"]);
+    let text = frame_with("\"x\": Texture(format: Rgba16Float, clear: Depth(1.0))");
+    graph_err(&text, &at(&text, "\"x\"", 0), &["Rgba16Float", "`Color(..)`"]);
+    let text = frame_with("\"x\": Texture(format: R32Float, size: Fixed(0, 100000))");
+    graph_err(&text, &at(&text, "0, 100000", 0), &["expected a texture side in 1..=16384"]);
+}
+
+#[test]
+fn raster_targets_are_checked_against_their_formats_and_count() {
+    let text = frame_graph();
+    // The frame's depth target on a colour texture.
+    let depth = text.find("depth: (resource: \"depth\"").expect("a pass with a depth target");
+    let text = format!(
+        "{}depth: (resource: \"hdr\"{}",
+        &text[..depth],
+        &text[depth + "depth: (resource: \"depth\"".len()..]
+    );
+    let e = Graph::parse(Path::new("g.ron"), text.clone()).unwrap_err().to_string();
+    let (line, _) = voltex::error::line_col(&text, depth);
+    assert!(e.starts_with(&format!("g.ron:{line}:")), "{e}");
+    assert!(e.contains("depth target `hdr` needs a depth format (Depth32Float), found Rgba32Float"), "{e}");
+    // Nine colour targets.
+    let text = frame_graph();
+    let t = text.find("targets: [(resource: \"hdr\"").expect("a pass drawing into hdr");
+    let nine = ["(resource: \"hdr\")"; 9].join(", ");
+    let end = t + text[t..].find(']').unwrap();
+    let text = format!("{}targets: [{nine}{}", &text[..t], &text[end..]);
+    let e = Graph::parse(Path::new("g.ron"), text).unwrap_err().to_string();
+    assert!(e.contains("9 colour targets: at most 8"), "{e}");
+}
+
+#[test]
+fn kernels_beyond_the_default_limits_are_errors_at_their_wgsl_line() {
+    use voltex::gpu::shader::load_str;
+    let k = |body: &str| load_str(Path::new("k.wgsl"), body).map(|_| ()).map_err(|e| e.to_string());
+    let ok = "@compute @workgroup_size(64)\nfn main() {}\n";
+    k(ok).unwrap();
+    let e = k("// big\n@compute @workgroup_size(1024, 1024, 64)\nfn main() {}\n").unwrap_err();
+    assert!(e.starts_with("k.wgsl:2:10: ") && e.contains("(1024, 1024, 64) is beyond the limits"), "{e}");
+    let e = k("@compute @workgroup_size(16, 32)\nfn main() {}\n").unwrap_err();
+    assert!(e.contains("256 invocations in all"), "{e}");
+    let big = "var<private> big: array<vec4<f32>, 100000000>;\n@compute @workgroup_size(1)\nfn main() { big[0] = vec4(1.0); }\n";
+    let e = k(big).unwrap_err();
+    assert!(e.starts_with("k.wgsl:1:") && e.contains("var<private> `big` takes 1600000000 bytes"), "{e}");
+    let shared =
+        "var<workgroup> w: array<f32, 8192>;\n@compute @workgroup_size(1)\nfn main() { w[0] = 1.0; }\n";
+    let e = k(shared).unwrap_err();
+    assert!(e.starts_with("k.wgsl:1:") && e.contains("workgroup memory to 32768 bytes"), "{e}");
+    let local =
+        "@compute @workgroup_size(1)\nfn main() {\n    var a: array<u32, 1000000>;\n    a[0] = 1u;\n}\n";
+    let e = k(local).unwrap_err();
+    assert!(e.starts_with("k.wgsl:3:") && e.contains("var `a` takes 4000000 bytes"), "{e}");
+}
