@@ -8,6 +8,7 @@
 /// Most planes one ViewSlices object may use (the scan kernel and the dispatch height allow it).
 pub const MAX_PLANES: u32 = 16384;
 
+mod budget;
 mod flatten;
 pub mod hypertexture;
 mod image;
@@ -15,6 +16,7 @@ mod types;
 mod validate;
 mod values;
 
+pub use budget::{MAX_NODES, MAX_SHAPE_VOXELS, MAX_TRIANGLES};
 pub use flatten::{HyperNode, SceneObject};
 pub use hypertexture::Hypertexture;
 pub use image::HeightImage;
@@ -89,7 +91,7 @@ pub fn parse(source: &str, path: &Path) -> Result<Scene> {
         values::with_marking(BTreeMap::new(), || options().from_str(source)).map_err(|e| located(path, e))?;
     scene.path = path.to_path_buf();
     let dir = path.parent().unwrap_or(Path::new(""));
-    let found = validate::check(&scene, dir);
+    let found = validate::check(&scene, dir, source, path);
     if let Some(first) = found.fail.values().next().cloned() {
         let again: ron::error::SpannedResult<Scene> =
             values::with_marking(found.fail, || options().from_str(source));

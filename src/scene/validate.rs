@@ -450,7 +450,7 @@ pub const MAX_HYPERTEXTURE_VOXELS: u64 = 1 << 24;
 /// More samples than this along one ray means a step far finer than any scene needs.
 pub const MAX_SAMPLES_PER_RAY: f64 = 1e5;
 
-pub(super) fn check(scene: &Scene, dir: &Path) -> Findings {
+pub(super) fn check(scene: &Scene, dir: &Path, source: &str, path: &Path) -> Findings {
     let mut c = Checker {
         scene,
         f: Findings {
@@ -496,6 +496,13 @@ pub(super) fn check(scene: &Scene, dir: &Path) -> Findings {
     }
     for n in &scene.nodes {
         c.node(n, glam::DMat4::IDENTITY);
+    }
+    let (marks, other) = super::budget::check(scene, &c.f.assets, source, path);
+    for (seq, msg) in marks {
+        c.f.fail.entry(seq).or_insert(msg);
+    }
+    if let Some(e) = other {
+        c.other(e);
     }
     c.f
 }

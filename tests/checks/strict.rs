@@ -207,3 +207,27 @@ fn kernels_beyond_the_default_limits_are_errors_at_their_wgsl_line() {
     let e = k(local).unwrap_err();
     assert!(e.starts_with("k.wgsl:3:") && e.contains("var `a` takes 4000000 bytes"), "{e}");
 }
+
+// ---- budgets from the counts, before any work ----
+
+#[test]
+fn work_over_a_budget_is_refused_from_the_counts() {
+    let base = std::fs::read_to_string(root().join("scenes/view_slices/flat_box.ron")).unwrap();
+    // Inside the documented cell maximum, but 33,554,432 triangles.
+    let text = replaced(&base, "cells: (4, 4)", "cells: (4096, 4096)");
+    scene_err(&text, &at(&text, "Plane(", 0), &["33554432 base triangles", "at most 2097152"]);
+    // More nodes than the budget: the first one past it is named.
+    let node = "(name: \"n\", surface: Plane(size: (1.0, 1.0), cells: (1, 1))),\n";
+    let nodes = node.repeat(voltex::scene::MAX_NODES + 1);
+    let text = format!("Scene(\n    output: (width: 8, height: 8),\n    camera: (eye: (0.0, -3.0, 2.0), target: (0.0, 0.0, 0.0), fov_y: 40.0),\n    nodes: [\n{nodes}    ],\n)\n");
+    let loc = format!("{}:", voltex::scene::MAX_NODES + 5);
+    let e = voltex::scene::parse(&text, Path::new("s.ron")).unwrap_err().to_string();
+    assert!(e.starts_with(&format!("s.ron:{loc}")) && e.contains("1025 nodes: at most 1024"), "{e}");
+    // An Implicit texel: shapes x voxels.
+    let sphere = "Sphere(center: (0.5, 0.5, 0.5), radius: 0.3, color: (1.0, 1.0, 1.0)), ";
+    let text = format!(
+        "Scene(\n    output: (width: 8, height: 8),\n    camera: (eye: (0.0, -3.0, 2.0), target: (0.0, 0.0, 0.0), fov_y: 40.0),\n    texels: {{\n        \"many\": (resolution: (1024, 1024, 1024), source: Implicit(shapes: [{}])),\n    }},\n)\n",
+        sphere.repeat(5)
+    );
+    scene_err(&text, "5:9", &["texel \"many\": 5 shapes x 1073741824 voxels", "at most 4294967296"]);
+}
