@@ -13,6 +13,7 @@ pub mod fault;
 pub mod gpu;
 pub mod graph;
 pub mod hypertexture;
+pub mod input;
 pub mod io;
 pub mod mesh;
 pub mod methods;

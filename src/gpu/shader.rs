@@ -124,8 +124,90 @@ fn load_expanded(name: &str, ex: Expanded) -> Result<Kernel> {
             }
             Error::at(ex.locate(line, col), format!("WGSL validation error: {msg}"))
         })?;
+    check_limits(&module, &ex)?;
     let source_hash = crate::gpu::cache::key(&ex.text);
     Ok(Kernel { name: name.to_string(), module, info, files: ex.files, source_hash })
+}
+
+/// Most bytes of `var<private>` or `var<function>` memory one variable may take: naga accepts
+/// any size, and drivers fail late (or crash) on huge per-invocation arrays.
+pub const MAX_PRIVATE_BYTES: u64 = 64 << 10;
+
+/// Checks naga accepts but a device may not: workgroup sizes and workgroup memory against
+/// WebGPU's default limits (what every adapter offers), and per-invocation arrays against
+/// [`MAX_PRIVATE_BYTES`], each at its WGSL position.
+fn check_limits(module: &naga::Module, ex: &Expanded) -> Result<()> {
+    let limits = wgpu::Limits::default();
+    let at = |span: naga::Span| {
+        let l = span.location(&ex.text);
+        ex.locate(l.line_number.max(1), l.line_position.max(1))
+    };
+    let size = |ty: naga::Handle<naga::Type>| module.types[ty].inner.try_size(module.to_ctx()).map(u64::from);
+    for ep in module.entry_points.iter().filter(|ep| ep.stage == naga::ShaderStage::Compute) {
+        let [x, y, z] = ep.workgroup_size;
+        let max = [
+            limits.max_compute_workgroup_size_x,
+            limits.max_compute_workgroup_size_y,
+            limits.max_compute_workgroup_size_z,
+        ];
+        let total = x as u64 * y as u64 * z as u64;
+        let per_axis = [x, y, z].iter().zip(max).any(|(&v, m)| v > m);
+        if per_axis || total > limits.max_compute_invocations_per_workgroup as u64 {
+            // naga keeps no span for the attribute: the last `@workgroup_size` before the entry point.
+            let fn_at = ex.text.find(&format!("fn {}(", ep.name)).unwrap_or(ex.text.len());
+            let attr = ex.text[..fn_at].rfind("@workgroup_size").unwrap_or(fn_at);
+            let (line, col) = crate::error::line_col(&ex.text, attr);
+            return Err(Error::at(
+                ex.locate(line as u32, col as u32),
+                format!(
+                    "entry point `{}`: workgroup size ({x}, {y}, {z}) is beyond the limits of \
+                     ({}, {}, {}) and {} invocations in all",
+                    ep.name, max[0], max[1], max[2], limits.max_compute_invocations_per_workgroup
+                ),
+            ));
+        }
+    }
+    let mut workgroup = 0u64;
+    for (h, g) in module.global_variables.iter() {
+        let Some(bytes) = size(g.ty) else { continue };
+        let name = g.name.as_deref().unwrap_or("?");
+        match g.space {
+            naga::AddressSpace::WorkGroup => {
+                workgroup += bytes;
+                if workgroup > limits.max_compute_workgroup_storage_size as u64 {
+                    return Err(Error::at(
+                        at(module.global_variables.get_span(h)),
+                        format!(
+                            "var<workgroup> `{name}` brings workgroup memory to {workgroup} bytes: at most {} are allowed",
+                            limits.max_compute_workgroup_storage_size
+                        ),
+                    ));
+                }
+            }
+            naga::AddressSpace::Private if bytes > MAX_PRIVATE_BYTES => {
+                return Err(Error::at(
+                    at(module.global_variables.get_span(h)),
+                    format!("var<private> `{name}` takes {bytes} bytes per invocation: at most {MAX_PRIVATE_BYTES} are allowed"),
+                ));
+            }
+            _ => {}
+        }
+    }
+    let functions =
+        module.functions.iter().map(|(_, f)| f).chain(module.entry_points.iter().map(|e| &e.function));
+    for f in functions {
+        for (h, v) in f.local_variables.iter() {
+            let Some(bytes) = size(v.ty) else { continue };
+            if bytes > MAX_PRIVATE_BYTES {
+                let name = v.name.as_deref().unwrap_or("?");
+                return Err(Error::at(
+                    at(f.local_variables.get_span(h)),
+                    format!("var `{name}` takes {bytes} bytes per invocation: at most {MAX_PRIVATE_BYTES} are allowed"),
+                ));
+            }
+        }
+    }
+    Ok(())
 }
 
 fn first_line(diagnostic: &str) -> String {

@@ -96,8 +96,10 @@ impl Sources {
     pub fn shader(&self, rel: &str) -> Result<Option<Source>> {
         for dir in &self.dirs {
             let path = dir.join(rel);
-            if path.is_file() {
-                let text = std::fs::read_to_string(&path).map_err(|e| Error::file(&path, e))?;
+            // Anything at the path counts as found, so a FIFO or a folder there is an error
+            // rather than a silent fall-through to the embedded copy.
+            if std::fs::symlink_metadata(&path).is_ok() {
+                let text = crate::input::read_text(&path, "a WGSL file")?;
                 return Ok(Some(Source { path, text, on_disk: true }));
             }
         }
@@ -107,9 +109,8 @@ impl Sources {
     /// The graph `name` of the project (e.g. `frame.ron`): the file in the project tree's
     /// `graphs/` when present, else the embedded copy.
     pub fn graph(&self, name: &str) -> Result<Option<Source>> {
-        if let Some(path) = self.graphs.as_ref().map(|g| g.join(name)).filter(|p| p.is_file()) {
-            let text = std::fs::read_to_string(&path)
-                .map_err(|e| Error::file(&path, format!("cannot read graph: {e}")))?;
+        if let Some(path) = self.graphs.as_ref().map(|g| g.join(name)).filter(|p| p.exists()) {
+            let text = crate::input::read_text(&path, "a graph file")?;
             return Ok(Some(Source { path, text, on_disk: true }));
         }
         Ok(self.embedded_file("graphs", name))

@@ -21,7 +21,7 @@ pub struct GraphFile {
     /// runtime provides (e.g. `slice_vertices` in a debug graph). Passes that contribute to none
     /// of them are pruned.
     pub outputs: Vec<String>,
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::input::unique_keys")]
     pub resources: BTreeMap<String, ResourceDecl>,
     pub passes: Vec<PassDecl>,
 }
@@ -53,6 +53,7 @@ pub enum ResourceDecl {
 /// The size of a graph buffer. Counts are size expressions: integer literals and the frame's
 /// counts (`width`, `height`) joined by `*` and `+`, e.g. `"width * height"` (see [`expr`]).
 #[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum BufferSize {
     /// A size in bytes.
     Bytes(Count),
@@ -74,12 +75,14 @@ impl BufferSize {
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum BufferClear {
     Zero,
 }
 
 /// The value of a `Parameter`, with its WGSL type.
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum Value {
     /// `f32`
     F32(f32),
@@ -124,6 +127,7 @@ pub struct Vocabulary {
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum Format {
     Rgba8Unorm,
     Rgba16Float,
@@ -152,22 +156,58 @@ impl Format {
 }
 
 #[derive(Debug, Clone, Copy, Default, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum TextureSize {
     /// The scene's output size.
     #[default]
     Output,
-    Fixed(u32, u32),
+    Fixed(#[serde(deserialize_with = "side")] u32, #[serde(deserialize_with = "side")] u32),
+}
+
+/// Most colour targets of one raster pass (WebGPU's `maxColorAttachments`).
+pub const MAX_TARGETS: usize = 8;
+
+// Value checks run while deserializing, so ron positions the error at the value.
+fn side<'de, D: serde::Deserializer<'de>>(d: D) -> Result<u32, D::Error> {
+    let v = u32::deserialize(d)?;
+    match v {
+        1..=16384 => Ok(v),
+        _ => Err(serde::de::Error::custom(format!("expected a texture side in 1..=16384, found {v}"))),
+    }
+}
+
+fn finite<'de, D: serde::Deserializer<'de>>(d: D) -> Result<f32, D::Error> {
+    let v = f32::deserialize(d)?;
+    match v.is_finite() {
+        true => Ok(v),
+        false => Err(serde::de::Error::custom(format!("expected a finite clear value, found {v}"))),
+    }
+}
+
+fn depth<'de, D: serde::Deserializer<'de>>(d: D) -> Result<f32, D::Error> {
+    let v = f32::deserialize(d)?;
+    match (0.0..=1.0).contains(&v) {
+        true => Ok(v),
+        false => Err(serde::de::Error::custom(format!("expected a depth clear value in [0, 1], found {v}"))),
+    }
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum Clear {
     /// Linear RGBA.
-    Color(f32, f32, f32, f32),
-    Depth(f32),
+    Color(
+        #[serde(deserialize_with = "finite")] f32,
+        #[serde(deserialize_with = "finite")] f32,
+        #[serde(deserialize_with = "finite")] f32,
+        #[serde(deserialize_with = "finite")] f32,
+    ),
+    Depth(#[serde(deserialize_with = "depth")] f32),
 }
 
 /// Which instances a pass runs for.
 #[derive(Debug, Clone, Default, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum Instances {
     /// Once per frame.
     #[default]
@@ -254,6 +294,7 @@ impl PassDecl {
 pub type Count = String;
 
 #[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum Dispatch {
     /// Invocation counts per axis; workgroup counts follow from the kernel's workgroup size.
     Threads(Count, Count, Count),
@@ -270,6 +311,7 @@ pub struct Target {
 }
 
 #[derive(Debug, Clone, Copy, Default, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum Blend {
     #[default]
     Replace,
@@ -289,6 +331,7 @@ pub struct DepthTarget {
 }
 
 #[derive(Debug, Clone, Copy, Default, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum Compare {
     #[default]
     Less,
@@ -307,6 +350,7 @@ impl Compare {
 }
 
 #[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum Draw {
     Vertices(Count),
     /// Indirect draw from a buffer holding `DrawIndirect` arguments.
@@ -331,8 +375,7 @@ pub struct Graph {
 
 impl Graph {
     pub fn load(path: &Path) -> Result<Self> {
-        let source = std::fs::read_to_string(path)
-            .map_err(|e| Error::file(path, format!("cannot read graph: {e}")))?;
+        let source = crate::input::read_text(path, "a graph file")?;
         Self::parse(path, source)
     }
 
@@ -349,6 +392,14 @@ impl Graph {
     /// An error at the first occurrence of the string literal `text` (or the file start).
     pub fn error_at(&self, text: &str, message: impl Into<String>) -> Error {
         let (line, col) = locate_literal(&self.source, text, 0).unwrap_or((1, 1));
+        Error::at(FileLoc::new(&self.path, line, col), message)
+    }
+
+    /// An error at the string literal `text` inside pass `pass`, after its field `field`.
+    pub fn error_in_pass(&self, pass: &str, field: &str, text: &str, message: impl Into<String>) -> Error {
+        let mut from = self.source.find(&format!("\"{pass}\"")).unwrap_or(0);
+        from += self.source[from..].find(&format!("{field}:")).unwrap_or(0);
+        let (line, col) = locate_literal(&self.source, text, from).unwrap_or((1, 1));
         Error::at(FileLoc::new(&self.path, line, col), message)
     }
 
@@ -401,17 +452,45 @@ impl Graph {
             }
             seen.push(p.name());
             if let PassDecl::Raster { targets, depth, .. } = p {
-                for t in targets.iter().map(|t| &t.resource).chain(depth.iter().map(|d| &d.resource)) {
-                    if !matches!(f.resources.get(t), Some(ResourceDecl::Texture { .. })) {
+                if targets.len() > MAX_TARGETS {
+                    let msg = format!(
+                        "pass `{}` has {} colour targets: at most {MAX_TARGETS} are allowed",
+                        p.name(),
+                        targets.len()
+                    );
+                    return Err(self.error_at(p.name(), msg));
+                }
+                let colour = targets.iter().map(|t| (&t.resource, false));
+                for (t, is_depth) in colour.chain(depth.iter().map(|d| (&d.resource, true))) {
+                    let Some(ResourceDecl::Texture { format, .. }) = f.resources.get(t) else {
                         return Err(self.error_at(
                             t,
                             format!("render target `{t}` is not a texture declared in `resources`"),
+                        ));
+                    };
+                    // wgpu rejects these only when the pipeline is made; here they have a position.
+                    if is_depth != (*format == Format::Depth32Float) {
+                        let want = if is_depth { "a depth format (Depth32Float)" } else { "a colour format" };
+                        let role = if is_depth { "depth target" } else { "colour target" };
+                        return Err(self.error_in_pass(
+                            p.name(),
+                            if is_depth { "depth" } else { "targets" },
+                            t,
+                            format!("pass `{}`: {role} `{t}` needs {want}, found {format:?}", p.name()),
                         ));
                     }
                 }
             }
         }
         for (name, decl) in &f.resources {
+            if let ResourceDecl::Texture { format, clear: Some(clear), .. } = decl {
+                let is_depth = *format == Format::Depth32Float;
+                if is_depth != matches!(clear, Clear::Depth(_)) {
+                    let want = if is_depth { "`Depth(..)`" } else { "`Color(..)`" };
+                    let msg = format!("texture `{name}` is {format:?}: its clear must be {want}");
+                    return Err(self.error_at_resource(name, msg));
+                }
+            }
             if let ResourceDecl::Buffer { size, .. } = decl {
                 let (text, unit) = size.expr();
                 expr::Expr::parse(text).map_err(|e| {

@@ -79,9 +79,7 @@ pub fn write(path: &Path, image: &Image, metadata: &[(&str, String)]) -> Result<
 /// converting samples to f32, and its string attributes sorted by key. Attributes of other types
 /// are skipped. Errors (missing file, not an EXR, no RGB layer) are [`Error::File`].
 pub fn read(path: &Path) -> Result<(Image, Vec<(String, String)>)> {
-    if !path.is_file() {
-        return Err(Error::file(path, "EXR file does not exist"));
-    }
+    let bytes = crate::input::read(path, crate::input::Kind::Asset, "an EXR image")?;
     let exr_image = x::read()
         .no_deep_data()
         .largest_resolution_level()
@@ -94,7 +92,7 @@ pub fn read(path: &Path) -> Result<(Image, Vec<(String, String)>)> {
         )
         .first_valid_layer()
         .all_attributes()
-        .from_file(path)
+        .from_buffered(std::io::Cursor::new(bytes))
         .map_err(|e| Error::file(path, format!("cannot read as an EXR image with R, G, B channels: {e}")))?;
     let mut metadata: Vec<(String, String)> = exr_image
         .attributes

@@ -1,7 +1,7 @@
 //! PNG: 8-bit sRGB previews of HDR images (tonemapped) and plain RGBA8 images (heat maps).
 
 use std::fs::File;
-use std::io::{BufReader, BufWriter, Write};
+use std::io::{BufWriter, Write};
 use std::path::Path;
 
 use super::atomic::write_atomic;
@@ -58,8 +58,8 @@ fn write_png(path: &Path, width: u32, height: u32, pixels: &[[u8; 4]], alpha: bo
 /// Returns `(width, height, pixels)`, row-major, top row first.
 pub fn read_rgba8(path: &Path) -> Result<(u32, u32, Vec<[u8; 4]>)> {
     let err = |e: &dyn std::fmt::Display| Error::file(path, format!("cannot read PNG: {e}"));
-    let file = File::open(path).map_err(|e| err(&e))?;
-    let mut decoder = ::png::Decoder::new(BufReader::new(file));
+    let bytes = crate::input::read(path, crate::input::Kind::Asset, "a PNG image")?;
+    let mut decoder = ::png::Decoder::new(std::io::Cursor::new(bytes));
     decoder.set_transformations(::png::Transformations::normalize_to_color8());
     let mut reader = decoder.read_info().map_err(|e| err(&e))?;
     let size = reader.output_buffer_size().ok_or_else(|| err(&"image too large"))?;

@@ -70,6 +70,9 @@ pub fn write(dir: &Path, resolution: [u32; 3], volume: &[u8]) -> Result<()> {
     Ok(())
 }
 
+/// Most slices, and pixels per side, in a stack: a texel's largest resolution.
+const MAX_SLICES: u32 = 1024;
+
 /// Reads the stack `dir`: slices `slice_000.png` onwards, consecutive, all of one size.
 pub fn read(dir: &Path) -> Result<SliceStack> {
     if !dir.is_dir() {
@@ -81,9 +84,24 @@ pub fn read(dir: &Path) -> Result<SliceStack> {
     let mut texels = Vec::new();
     let mut size = None;
     let mut d = 0;
-    while dir.join(slice_name(d)).is_file() {
+    // Any entry named like a slice is read, so a FIFO or folder there is an error, not the end.
+    while std::fs::symlink_metadata(dir.join(slice_name(d))).is_ok() {
         let path = dir.join(slice_name(d));
+        if d >= MAX_SLICES {
+            return Err(Error::file(
+                &path,
+                format!("expected at most {MAX_SLICES} slices (a texel's resolution)"),
+            ));
+        }
         let (w, h, pixels) = crate::io::png::read_rgba8(&path)?;
+        if w > MAX_SLICES || h > MAX_SLICES {
+            return Err(Error::file(
+                &path,
+                format!(
+                    "expected at most {MAX_SLICES}x{MAX_SLICES} pixels (a texel's resolution), got {w}x{h}"
+                ),
+            ));
+        }
         match size {
             None => size = Some((w, h)),
             Some(s) if s != (w, h) => {

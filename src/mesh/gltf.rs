@@ -16,7 +16,7 @@ use crate::error::{Error, Result};
 
 /// Reads and parses a `.gltf` or `.glb` file; external buffers are read beside it.
 pub fn load(path: &Path) -> Result<Mesh> {
-    let bytes = std::fs::read(path).map_err(|e| Error::file(path, e))?;
+    let bytes = crate::input::read(path, crate::input::Kind::Asset, "a glTF file")?;
     parse(&bytes, path)
 }
 
@@ -61,7 +61,8 @@ fn buffer_data(b: &gltf::Buffer, blob: Option<&[u8]>, path: &Path) -> Result<Vec
                 return Err(Error::file(path, format!("{what}: `{uri}` is not a file beside the glTF")));
             }
             let file = path.parent().unwrap_or(Path::new(".")).join(uri.replace("%20", " "));
-            std::fs::read(&file).map_err(|e| Error::file(path, format!("{what}: {}: {e}", file.display())))?
+            crate::input::read(&file, crate::input::Kind::Asset, "a glTF buffer")
+                .map_err(|e| Error::file(path, format!("{what}: {e}")))?
         }
     };
     if (data.len() as u64) < b.length() as u64 {

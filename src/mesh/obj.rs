@@ -10,7 +10,7 @@ use std::path::Path;
 
 /// Reads and parses an OBJ file; every problem is reported at its `file:line:col`.
 pub fn load(path: &Path) -> Result<Mesh> {
-    let text = std::fs::read_to_string(path).map_err(|e| Error::file(path, e))?;
+    let text = crate::input::read_asset_text(path, "an OBJ file")?;
     parse(&text, path)
 }
 

@@ -74,7 +74,7 @@ fn matching(text: &str, open: usize) -> Option<usize> {
 }
 
 pub fn write_camera(path: &Path, cam: &Camera) -> Result<()> {
-    let text = std::fs::read_to_string(path).map_err(|e| Error::file(path, e))?;
+    let text = crate::input::read_text(path, "a scene file")?;
     let (start, end) = camera_span(&text)
         .ok_or_else(|| Error::file(path, "no `camera: (...)` field to write the camera into"))?;
     let new = format!("{}{}{}", &text[..start], format_camera(cam), &text[end..]);

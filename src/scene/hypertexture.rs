@@ -201,6 +201,7 @@ impl Noise {
 }
 
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum Operator {
     #[default]
     Sum,
@@ -209,6 +210,7 @@ pub enum Operator {
 
 /// A 1D shape transfer function on [0, 1] with values in [0, 1].
 #[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum ShapeTransfer {
     /// Control points `(x, y, slope)` joined by cubic Hermite segments (clamped to [0, 1]);
     /// constant beyond the first and last points.
@@ -246,6 +248,7 @@ impl ShapeTransfer {
 pub struct GridRows(#[serde(deserialize_with = "v::unit_rows")] pub Vec<Vec<f64>>);
 
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct CurvePoint(
     #[serde(deserialize_with = "v::unit")] pub f64,
     #[serde(deserialize_with = "v::unit")] pub f64,
@@ -258,6 +261,7 @@ pub struct TableValues(#[serde(deserialize_with = "v::unit_list")] pub Vec<f64>)
 
 /// Colour (linear rgb) and opacity per opacity length, by density.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum ColorTransfer {
     /// Control points `(density, (r, g, b, a))` joined linearly.
     Ramp(Mark<Vec<Mark<RampPoint>>>),
@@ -273,6 +277,7 @@ pub enum ColorTransfer {
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct RampPoint(
     #[serde(deserialize_with = "v::unit")] pub f64,
     #[serde(deserialize_with = "v::rgba")] pub [f64; 4],

@@ -15,8 +15,8 @@ pub struct HeightImage {
 
 impl HeightImage {
     pub fn load(path: &Path) -> Result<HeightImage> {
-        let file = std::fs::File::open(path).map_err(|e| Error::file(path, e))?;
-        let mut decoder = png::Decoder::new(std::io::BufReader::new(file));
+        let bytes = crate::input::read(path, crate::input::Kind::Asset, "a PNG image")?;
+        let mut decoder = png::Decoder::new(std::io::Cursor::new(bytes));
         // Palettes and low bit depths expand to 8 bit; 16 bit stays 16 (precision for heights).
         decoder.set_transformations(png::Transformations::EXPAND);
         let bad = |e: png::DecodingError| Error::file(path, format!("expected a PNG image: {e}"));

@@ -8,6 +8,7 @@
 /// Most planes one ViewSlices object may use (the scan kernel and the dispatch height allow it).
 pub const MAX_PLANES: u32 = 16384;
 
+mod budget;
 mod flatten;
 pub mod hypertexture;
 mod image;
@@ -15,6 +16,7 @@ mod types;
 mod validate;
 mod values;
 
+pub use budget::{MAX_NODES, MAX_SHAPE_VOXELS, MAX_TRIANGLES};
 pub use flatten::{HyperNode, SceneObject};
 pub use hypertexture::Hypertexture;
 pub use image::HeightImage;
@@ -79,7 +81,7 @@ impl Scene {
 
 /// Reads, parses and checks a scene file, and loads the files it refers to.
 pub fn load(path: &Path) -> Result<Scene> {
-    let source = std::fs::read_to_string(path).map_err(|e| Error::file(path, e))?;
+    let source = crate::input::read_text(path, "a scene file")?;
     parse(&source, path)
 }
 
@@ -89,7 +91,7 @@ pub fn parse(source: &str, path: &Path) -> Result<Scene> {
         values::with_marking(BTreeMap::new(), || options().from_str(source)).map_err(|e| located(path, e))?;
     scene.path = path.to_path_buf();
     let dir = path.parent().unwrap_or(Path::new(""));
-    let found = validate::check(&scene, dir);
+    let found = validate::check(&scene, dir, source, path);
     if let Some(first) = found.fail.values().next().cloned() {
         let again: ron::error::SpannedResult<Scene> =
             values::with_marking(found.fail, || options().from_str(source));

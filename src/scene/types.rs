@@ -21,10 +21,10 @@ pub struct Scene {
     pub ambient: f32,
     #[serde(default)]
     pub lights: Vec<Light>,
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::input::unique_keys")]
     pub texels: BTreeMap<String, Texel>,
     /// Hypertextures (Gilet & Dischler 2009) that nodes draw with `RayMarch`.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::input::unique_keys")]
     pub hypertextures: BTreeMap<String, super::hypertexture::Hypertexture>,
     #[serde(default)]
     pub nodes: Vec<Node>,
@@ -215,6 +215,7 @@ pub enum TexelSource {
     /// Cycling volume sequence (Meyer & Neyret 1998, section 5): at time `t` the texel is
     /// `texels[floor(t * fps) mod n]`, each frame a texel of this map with this resolution.
     Sequence {
+        #[serde(deserialize_with = "v::frames")]
         texels: Vec<Mark<String>>,
         #[serde(deserialize_with = "v::positive")]
         fps: f64,
@@ -333,6 +334,7 @@ pub struct Ball {
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Node {
+    #[serde(deserialize_with = "v::object_name")]
     pub name: String,
     #[serde(default)]
     pub transform: Transform,
@@ -636,6 +638,7 @@ impl RayMarch {
 
 /// The quality settings of the paper's Figure 11.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum Quality {
     /// High quality: step 0.002.
     #[serde(rename = "HQ")]
@@ -658,6 +661,7 @@ impl Quality {
 /// Shading of a hypertexture: the transfer function's colour as is, Phong with the density
 /// gradient by central differences, or Phong with shadow rays towards the light.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum Shading {
     #[default]
     None,
@@ -726,6 +730,7 @@ pub struct AxisSlices {
 
 /// The order in which `AxisSlices` draws its slices.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum DrawOrder {
     /// Prisms back to front, each prism's slices back to front (needed by blending).
     #[default]
@@ -742,6 +747,7 @@ fn default_max_angle() -> f64 {
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum SliceDirections {
     /// Horizontal (w) and the two vertical sets (s, t), chosen per triangle.
     #[default]
@@ -751,6 +757,7 @@ pub enum SliceDirections {
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum SliceBlend {
     /// The paper's binary alpha: the step-corrected opacity thresholded at 1/2, depth-tested and
     /// written, so intersecting texels are right.

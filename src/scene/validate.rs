@@ -56,10 +56,15 @@ impl Checker<'_> {
         if let Some(m) = self.f.assets.meshes.get(&full) {
             return Some(m.clone());
         }
-        if !full.is_file() {
+        // Special files and files over the cap fail at the path's position, before any read.
+        if std::fs::metadata(&full).is_err() {
             let msg =
                 format!("expected a mesh file (.obj, .gltf or .glb), but {} does not exist", full.display());
             self.fail(path, msg);
+            return None;
+        }
+        if let Err(e) = crate::input::check(&full, crate::input::Kind::Asset, "a mesh file") {
+            self.fail(path, e.to_string());
             return None;
         }
         match crate::mesh::load(&full) {
@@ -230,9 +235,13 @@ impl Checker<'_> {
         if let Some(m) = self.f.assets.images.get(&full) {
             return Some(m.clone());
         }
-        if !full.is_file() {
+        if std::fs::metadata(&full).is_err() {
             let msg = format!("expected a PNG file, but {} does not exist", full.display());
             self.fail(path, msg);
+            return None;
+        }
+        if let Err(e) = crate::input::check(&full, crate::input::Kind::Asset, "a PNG file") {
+            self.fail(path, e.to_string());
             return None;
         }
         match HeightImage::load(&full) {
@@ -452,7 +461,7 @@ pub const MAX_HYPERTEXTURE_VOXELS: u64 = 1 << 24;
 /// More samples than this along one ray means a step far finer than any scene needs.
 pub const MAX_SAMPLES_PER_RAY: f64 = 1e5;
 
-pub(super) fn check(scene: &Scene, dir: &Path) -> Findings {
+pub(super) fn check(scene: &Scene, dir: &Path, source: &str, path: &Path) -> Findings {
     let mut c = Checker {
         scene,
         f: Findings {
@@ -498,6 +507,13 @@ pub(super) fn check(scene: &Scene, dir: &Path) -> Findings {
     }
     for n in &scene.nodes {
         c.node(n, glam::DMat4::IDENTITY);
+    }
+    let (marks, other) = super::budget::check(scene, &c.f.assets, source, path);
+    for (seq, msg) in marks {
+        c.f.fail.entry(seq).or_insert(msg);
+    }
+    if let Some(e) = other {
+        c.other(e);
     }
     c.f
 }

@@ -143,6 +143,36 @@ adapter!(cells, [u32; 2], [Cells; 2], |v| v.map(|x| x.0));
 adapter!(sphere_segments, [u32; 2], (Around, PoleToPole), |v| [v.0 .0, v.1 .0]);
 adapter!(torus_segments, [u32; 2], [Around; 2], |v| v.map(|x| x.0));
 
+/// Longest node name: each object's name becomes the EXR attribute `voltex_object_NAME`, and
+/// EXR attribute names are at most 255 bytes.
+pub const MAX_NAME_BYTES: usize = 255 - "voltex_object_".len();
+
+/// A node name that can be written as EXR metadata (checked here, not after the render).
+pub(super) fn object_name<'de, D: Deserializer<'de>>(d: D) -> Result<String, D::Error> {
+    let v = String::deserialize(d)?;
+    if let Some(c) = v.chars().find(|&c| c as u32 > 0xff || c == '\0') {
+        return Err(D::Error::custom(format!(
+            "expected a name of Latin-1 characters without NUL (it is written as EXR metadata), found {c:?}"
+        )));
+    }
+    if v.len() > MAX_NAME_BYTES {
+        return Err(D::Error::custom(format!(
+            "expected a name of at most {MAX_NAME_BYTES} bytes (it is written as EXR metadata), found {}",
+            v.len()
+        )));
+    }
+    Ok(v)
+}
+
+/// A sequence's frames: at least one (checked here so the error has the list's position).
+pub(super) fn frames<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<Mark<String>>, D::Error> {
+    let v = Vec::<Mark<String>>::deserialize(d)?;
+    if v.is_empty() {
+        return Err(D::Error::custom("expected at least one texel name in a sequence, found `[]`"));
+    }
+    Ok(v)
+}
+
 /// A direction: finite and not zero.
 pub(super) fn direction<'de, D: Deserializer<'de>>(d: D) -> Result<DVec3, D::Error> {
     let v = vec3(d)?;

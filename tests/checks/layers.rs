@@ -10,6 +10,8 @@ use std::path::{Path, PathBuf};
 const LAYERS: &[&[&str]] = &[
     // Errors, fault injection, the Pod structs shared with WGSL.
     &["error", "fault", "types"],
+    // Bounded reads of user files (every reader above uses them).
+    &["input"],
     // Device, shader sources, reflection, caches; file formats; meshes, shells, BVHs.
     &["gpu", "io", "mesh"],
     // Render graphs; image metrics; scene files (no GPU).

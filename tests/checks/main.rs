@@ -8,5 +8,6 @@ mod graph_errors;
 mod io_metrics;
 mod layers;
 mod scene_errors;
+mod strict;
 mod twins;
 mod types_layout;

@@ -6,5 +6,6 @@ mod common;
 mod cli_errors;
 mod faults;
 mod gltf;
+mod hostile_files;
 mod install;
 mod preview_window;
