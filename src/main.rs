@@ -1,4 +1,4 @@
-//! The `voltex` command line: render, bake, compare, plan, preview, regress, info, bench,
+//! The `voltex` command line: render, bake, compare, plan, import, preview, regress, info, bench,
 //! bench-hyper, pareto. Each subcommand lives in `src/cli/<name>.rs`; this file parses and
 //! dispatches.
 
@@ -18,6 +18,7 @@ fn main() -> ExitCode {
         Command::Bake(args) => cli::bake::run(args),
         Command::Compare(args) => cli::compare::run(args),
         Command::Plan(args) => cli::plan::run(args),
+        Command::Import(args) => cli::import::run(args),
         Command::Preview(args) => cli::preview::run(args),
         Command::Regress(args) => voltex::regress::command(&args),
         Command::Info => cli::info::run(),

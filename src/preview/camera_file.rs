@@ -74,6 +74,12 @@ fn matching(text: &str, open: usize) -> Option<usize> {
 }
 
 pub fn write_camera(path: &Path, cam: &Camera) -> Result<()> {
+    if crate::scene::import::is_asset(path) {
+        return Err(Error::file(
+            path,
+            "a mesh opened directly has no scene file: `voltex import` writes one",
+        ));
+    }
     let text = crate::input::read_text(path, "a scene file")?;
     let (start, end) = camera_span(&text)
         .ok_or_else(|| Error::file(path, "no `camera: (...)` field to write the camera into"))?;

@@ -12,6 +12,7 @@ mod budget;
 mod flatten;
 pub mod hypertexture;
 mod image;
+pub mod import;
 mod types;
 mod validate;
 mod values;
@@ -80,7 +81,12 @@ impl Scene {
 }
 
 /// Reads, parses and checks a scene file, and loads the files it refers to.
+/// A mesh asset (`.glb`, `.gltf`, `.obj`) is opened as the scene `voltex import` would write.
 pub fn load(path: &Path) -> Result<Scene> {
+    if import::is_asset(path) {
+        let name = path.file_name().and_then(|n| n.to_str()).unwrap_or_default();
+        return parse(&import::scene_text(path, name)?, path);
+    }
     let source = crate::input::read_text(path, "a scene file")?;
     parse(&source, path)
 }

@@ -88,3 +88,37 @@ fn a_base_surface_without_uvs_is_an_error_at_its_path() {
     assert_eq!(run.status.code(), Some(1), "{err}");
     assert!(err.contains(&format!("no_uvs.ron:{line}:")) && err.contains("without TEXCOORD_0"), "{err}");
 }
+
+/// `voltex render FILE.glb` opens the asset as the scene `voltex import` writes, so both render
+/// the same image; the written scene names the mesh relative to itself and says where it came from.
+#[test]
+fn an_asset_opens_directly_and_imports_as_the_same_scene() {
+    let dir = scratch_dir("voltex-gltf-import");
+    let glb = dir.join("dome.glb");
+    std::fs::copy(root().join("scenes/view_slices/meshes/dome.glb"), &glb).unwrap();
+    let scene = dir.join("scenes/dome.ron");
+    std::fs::create_dir_all(scene.parent().unwrap()).unwrap();
+    ok(voltex(&["import", s(&glb), "-o", s(&scene)]));
+    let text = std::fs::read_to_string(&scene).unwrap();
+    assert!(text.contains("Written by `voltex import` around dome.glb"), "{text}");
+    assert!(
+        text.contains(&format!("surface: Obj(path: {:?})", s(&glb))),
+        "outside its folder: absolute\n{text}"
+    );
+    let mut images = Vec::new();
+    for (input, out) in [(&glb, "direct.exr"), (&scene, "imported.exr")] {
+        let out = dir.join(out);
+        ok(voltex(&["render", s(input), "--size", "24x24", "-o", s(&out)]));
+        images.push(voltex::io::exr::read(&out).unwrap().0);
+    }
+    assert_eq!(images[0].pixels, images[1].pixels);
+    // Beside the asset, the path is relative; `plan` reads the asset too.
+    ok(voltex(&["import", s(&glb)]));
+    assert!(std::fs::read_to_string(dir.join("dome.ron")).unwrap().contains("Obj(path: \"dome.glb\")"));
+    assert!(ok(voltex(&["plan", s(&glb)])).contains("ViewSlices planes 256"));
+    // Not an asset: a clear error, nothing written.
+    let run = voltex(&["import", s(&scene), "-o", s(&dir.join("x.ron"))]);
+    assert_eq!(run.status.code(), Some(1));
+    assert!(stderr(&run).contains("expected a mesh asset (.glb, .gltf or .obj)"));
+    assert!(!dir.join("x.ron").exists());
+}

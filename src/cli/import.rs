@@ -1,0 +1,35 @@
+//! `voltex import`: writes the scene that `voltex render|preview FILE` opens for a mesh asset, as
+//! an editable, commented scene file.
+
+use std::path::PathBuf;
+
+use clap::Args;
+
+use voltex::scene::import;
+use voltex::{Error, Result};
+
+#[derive(Args)]
+pub struct ImportArgs {
+    /// A mesh asset: `.glb`, `.gltf` or `.obj`.
+    pub file: PathBuf,
+    /// The scene file to write (default: FILE with the extension `.ron`).
+    #[arg(short, long)]
+    pub out: Option<PathBuf>,
+}
+
+pub fn run(args: ImportArgs) -> Result<()> {
+    if !import::is_asset(&args.file) {
+        return Err(Error::Invalid(format!(
+            "{}: expected a mesh asset (.glb, .gltf or .obj)",
+            args.file.display()
+        )));
+    }
+    let out = args.out.unwrap_or_else(|| args.file.with_extension("ron"));
+    let mesh = import::mesh_path(&args.file, &out);
+    let text = import::scene_text(&args.file, &mesh.to_string_lossy())?;
+    // What `render` would read back must parse: check before writing.
+    voltex::scene::parse(&text, &out)?;
+    voltex::io::atomic::write_bytes(&out, text.as_bytes())?;
+    println!("{}", out.display());
+    Ok(())
+}
