@@ -108,6 +108,32 @@ pub fn read(path: &Path) -> Result<(Image, Vec<(String, String)>)> {
     Ok((exr_image.layer_data.channel_data.pixels, metadata))
 }
 
+/// The first layer's channels of any EXR (any names, f16/f32/u32 samples) as f32 planes in the
+/// order R, G, B, A where present, then the others in the file's (alphabetical) order:
+/// `(width, height, [(name, row-major samples from the top row)])`.
+pub fn read_channels(path: &Path) -> Result<(usize, usize, Vec<(String, Vec<f32>)>)> {
+    let bytes = crate::input::read(path, crate::input::Kind::Asset, "an EXR image")?;
+    let image = x::read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .all_channels()
+        .first_valid_layer()
+        .all_attributes()
+        .from_buffered(std::io::Cursor::new(bytes))
+        .map_err(|e| Error::file(path, format!("cannot read as an EXR image: {e}")))?;
+    let size = image.layer_data.size;
+    let mut channels: Vec<(String, Vec<f32>)> = image
+        .layer_data
+        .channel_data
+        .list
+        .iter()
+        .map(|c| (latin1(&c.name), c.sample_data.values_as_f32().collect()))
+        .collect();
+    let rank = |n: &str| ["R", "G", "B", "A"].iter().position(|c| *c == n).unwrap_or(4);
+    channels.sort_by_key(|(n, _)| rank(n));
+    Ok((size.width(), size.height(), channels))
+}
+
 /// EXR text bytes are Latin-1; decode them so that `é` survives a round trip.
 fn latin1(t: &Text) -> String {
     t.as_slice().iter().map(|&b| b as char).collect()

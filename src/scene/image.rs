@@ -1,4 +1,5 @@
-//! Height textures: PNG images (grey, grey+alpha, RGB, RGBA; 8 or 16 bit) as values in `[0, 1]`.
+//! Height textures: PNG images (grey, grey+alpha, RGB, RGBA; 8 or 16 bit) as values in `[0, 1]`,
+//! and EXR images (any channels, half or float) as their values, at full precision.
 
 use crate::error::{Error, Result};
 use glam::DVec2;
@@ -9,12 +10,17 @@ pub struct HeightImage {
     pub width: usize,
     pub height: usize,
     pub channels: usize,
-    /// Row-major from the top row, `channels` values per pixel, in `[0, 1]`.
+    /// Row-major from the top row, `channels` values per pixel: in `[0, 1]` from a PNG, as
+    /// stored (finite) from an EXR.
     pub data: Vec<f32>,
 }
 
 impl HeightImage {
+    /// Reads a PNG, or an EXR by its extension.
     pub fn load(path: &Path) -> Result<HeightImage> {
+        if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr")) {
+            return Self::load_exr(path);
+        }
         let bytes = crate::input::read(path, crate::input::Kind::Asset, "a PNG image")?;
         let mut decoder = png::Decoder::new(std::io::Cursor::new(bytes));
         // Palettes and low bit depths expand to 8 bit; 16 bit stays 16 (precision for heights).
@@ -36,6 +42,23 @@ impl HeightImage {
             _ => buf[..n].iter().map(|&b| b as f32 / 255.0).collect(),
         };
         Ok(HeightImage { width: w, height: h, channels, data })
+    }
+
+    /// An EXR's channels interleaved (R, G, B, A first; see `io::exr::read_channels`).
+    fn load_exr(path: &Path) -> Result<HeightImage> {
+        let (width, height, planes) = crate::io::exr::read_channels(path)?;
+        if planes.is_empty() || width == 0 || height == 0 {
+            return Err(Error::file(path, "expected an EXR image with at least one channel and pixel"));
+        }
+        for (name, values) in &planes {
+            if let Some(i) = values.iter().position(|v| !v.is_finite()) {
+                let (x, y) = (i % width, i / width);
+                return Err(Error::file(path, format!("channel {name}: pixel ({x}, {y}) is not finite")));
+            }
+        }
+        let channels = planes.len();
+        let data = (0..width * height).flat_map(|i| planes.iter().map(move |(_, p)| p[i])).collect();
+        Ok(HeightImage { width, height, channels, data })
     }
 
     fn texel(&self, x: i64, y: i64, channel: usize) -> f64 {

@@ -236,11 +236,11 @@ impl Checker<'_> {
             return Some(m.clone());
         }
         if std::fs::metadata(&full).is_err() {
-            let msg = format!("expected a PNG file, but {} does not exist", full.display());
+            let msg = format!("expected a PNG or EXR image, but {} does not exist", full.display());
             self.fail(path, msg);
             return None;
         }
-        if let Err(e) = crate::input::check(&full, crate::input::Kind::Asset, "a PNG file") {
+        if let Err(e) = crate::input::check(&full, crate::input::Kind::Asset, "a PNG or EXR image") {
             self.fail(path, e.to_string());
             return None;
         }

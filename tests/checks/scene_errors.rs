@@ -156,7 +156,7 @@ fn node_consistency() {
     assert_err("vattr", &[(12, l)], "scene.ron", 12, 42, "built-in surfaces have no vertex attribute");
     assert_err("notexel", &[(13, "")], "scene.ron", 14, 21, "expected a `texel`");
     let l = r#"            height: (length: 0.1, scale: Texture(path: "h.png")),"#;
-    assert_err("nopng", &[(12, l)], "scene.ron", 12, 56, "expected a PNG file");
+    assert_err("nopng", &[(12, l)], "scene.ron", 12, 56, "expected a PNG or EXR image");
 }
 
 #[test]
@@ -204,7 +204,7 @@ fn image_height_errors() {
         )
     };
     let text = with_lines(&[(6, &source(0))]);
-    assert_err_files("hmissing", &text, &[], "scene.ron", 6, 65, "expected a PNG file");
+    assert_err_files("hmissing", &text, &[], "scene.ron", 6, 65, "expected a PNG or EXR image");
     let (_, r) = load("hgarbage", &text, &[("h.png", "not an image")]);
     let e = r.expect_err("a text file is no PNG").to_string();
     assert!(e.contains("h.png") && e.contains("expected a PNG image"), "{e}");

@@ -3,9 +3,9 @@
 #[path = "../common/mod.rs"]
 mod common;
 
+mod assets;
 mod cli_errors;
 mod faults;
-mod gltf;
 mod hostile_files;
 mod install;
 mod preview_window;

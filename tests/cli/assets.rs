@@ -1,7 +1,8 @@
-//! glTF 2.0 meshes through the `voltex` binary: `meshes/dome.glb` (per-corner vertices under a
+//! Assets in through the `voltex` binary. glTF 2.0 meshes: `meshes/dome.glb` (per-corner vertices under a
 //! scaled, translated parent node, v flipped) and `meshes/dome.obj` (the same surface as OBJ,
 //! written by `tools/gen_dome.py`) load to the same mesh and render the same image; broken glTF
-//! files fail with the file named, status 1 and no output.
+//! files fail with the file named, status 1 and no output. EXR height images: the same heights
+//! as a PNG's render the same image.
 
 use crate::common;
 
@@ -121,4 +122,46 @@ fn an_asset_opens_directly_and_imports_as_the_same_scene() {
     assert_eq!(run.status.code(), Some(1));
     assert!(stderr(&run).contains("expected a mesh asset (.glb, .gltf or .obj)"));
     assert!(!dir.join("x.ron").exists());
+}
+
+/// Writes `values` (row-major from the top) as a one-channel (`Y`) f32 EXR.
+fn write_grey_exr(path: &std::path::Path, width: usize, height: usize, values: Vec<f32>) {
+    use exr::prelude::*;
+    let channel = AnyChannel::new("Y", FlatSamples::F32(values));
+    let layer = Layer::new(
+        (width, height),
+        LayerAttributes::default(),
+        Encoding::FAST_LOSSLESS,
+        AnyChannels::sort(vec![channel].into()),
+    );
+    Image::from_layer(layer).write().to_file(path).unwrap();
+}
+
+#[test]
+fn an_exr_height_image_renders_as_the_png_with_its_values() {
+    let dir = scratch_dir("voltex-exr-heights");
+    let scenes = root().join("scenes/meyer_neyret");
+    let png = voltex::scene::HeightImage::load(&scenes.join("cobbles.png")).unwrap();
+    let grey: Vec<f32> = png.data.iter().step_by(png.channels).copied().collect();
+    let exr = dir.join("cobbles.exr");
+    write_grey_exr(&exr, png.width, png.height, grey.clone());
+    let loaded = voltex::scene::HeightImage::load(&exr).unwrap();
+    assert_eq!((loaded.width, loaded.height, loaded.channels), (png.width, png.height, 1));
+    assert_eq!(loaded.data, grey);
+    let text = std::fs::read_to_string(scenes.join("heightfield_image.ron")).unwrap();
+    let mut images = Vec::new();
+    for image in [scenes.join("cobbles.png"), exr.clone()] {
+        let scene = dir.join("scene.ron");
+        std::fs::write(&scene, text.replace("\"cobbles.png\"", &format!("{:?}", s(&image)))).unwrap();
+        let out = dir.join("out.exr");
+        ok(voltex(&["render", s(&scene), "--size", "24x24", "-o", s(&out)]));
+        images.push(voltex::io::exr::read(&out).unwrap().0);
+    }
+    assert_eq!(images[0].pixels, images[1].pixels);
+    // A non-finite height is an error naming the channel and pixel.
+    let mut bad = grey;
+    bad[png.width + 2] = f32::NAN;
+    write_grey_exr(&exr, png.width, png.height, bad);
+    let e = voltex::scene::HeightImage::load(&exr).unwrap_err().to_string();
+    assert!(e.contains("cobbles.exr") && e.contains("channel Y: pixel (2, 1) is not finite"), "{e}");
 }
