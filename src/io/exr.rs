@@ -108,10 +108,13 @@ pub fn read(path: &Path) -> Result<(Image, Vec<(String, String)>)> {
     Ok((exr_image.layer_data.channel_data.pixels, metadata))
 }
 
+/// Named planes of f32 samples, row-major from the top row.
+pub type Channels = Vec<(String, Vec<f32>)>;
+
 /// The first layer's channels of any EXR (any names, f16/f32/u32 samples) as f32 planes in the
 /// order R, G, B, A where present, then the others in the file's (alphabetical) order:
-/// `(width, height, [(name, row-major samples from the top row)])`.
-pub fn read_channels(path: &Path) -> Result<(usize, usize, Vec<(String, Vec<f32>)>)> {
+/// `(width, height, channels)`.
+pub fn read_channels(path: &Path) -> Result<(usize, usize, Channels)> {
     let bytes = crate::input::read(path, crate::input::Kind::Asset, "an EXR image")?;
     let image = x::read()
         .no_deep_data()
@@ -122,7 +125,7 @@ pub fn read_channels(path: &Path) -> Result<(usize, usize, Vec<(String, Vec<f32>
         .from_buffered(std::io::Cursor::new(bytes))
         .map_err(|e| Error::file(path, format!("cannot read as an EXR image: {e}")))?;
     let size = image.layer_data.size;
-    let mut channels: Vec<(String, Vec<f32>)> = image
+    let mut channels: Channels = image
         .layer_data
         .channel_data
         .list
