@@ -21,11 +21,15 @@
 
 mod check;
 mod discover;
+pub mod junit;
+pub mod merge;
 mod progress;
 pub mod record;
 pub mod report;
+pub mod shards;
 
 pub use discover::{find, SceneEntry, Shard};
+pub use merge::Problem;
 pub use record::{Record, Status};
 
 use std::collections::BTreeSet;
@@ -58,13 +62,35 @@ pub struct Args {
     /// Scenes rendered concurrently (threads sharing one GPU device).
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=256))]
     pub jobs: u32,
-    /// Check only shard i of n (1-based): the scenes whose 0-based index k in the sorted list has
-    /// k % n == i - 1.
+    /// Check only shard i of n (1-based), as planned from the scenes' costs (OUT/.voltex/plan-N.json,
+    /// shared by the shards of one output folder). `auto/n` takes i from SLURM_ARRAY_TASK_ID or
+    /// JOB_COMPLETION_INDEX.
     #[arg(long, default_value = "1/1")]
     pub shard: Shard,
+    /// Render scenes whose record is current too (same scene, assets, reference, size, graphs,
+    /// WGSL and binary); without it they are kept and not rendered again.
+    #[arg(long)]
+    pub force: bool,
+    /// Write the JUnit XML report to FILE (default: OUT/junit.xml, beside index.html).
+    #[arg(long, value_name = "FILE")]
+    pub junit: Option<PathBuf>,
+    /// Render nothing: print how N shards would split DIR (costs from the records under --out,
+    /// else estimates) and the predicted makespan.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=100_000),
+          conflicts_with_all = ["update", "jobs", "shard", "force", "junit"])]
+    pub plan_shards: Option<u32>,
     /// Render nothing: rebuild OUT/index.html from the records under OUT (after merging shards).
-    #[arg(long, value_name = "OUT", conflicts_with_all = ["dir", "out", "update", "size", "jobs", "shard"])]
+    #[arg(long, value_name = "OUT", conflicts_with_all = ["dir", "out", "update", "size", "jobs", "shard", "force"])]
     pub report_only: Option<PathBuf>,
+}
+
+/// What every scene check of one run shares.
+pub(crate) struct RunInfo<'a> {
+    pub args: &'a Args,
+    pub shard: Shard,
+    pub suite: String,
+    pub toolchain: String,
+    pub host: String,
 }
 
 fn parse_size(s: &str) -> std::result::Result<(u32, u32), String> {
@@ -83,37 +109,83 @@ pub struct Outcome {
     pub records: Vec<Record>,
     /// Records under the output folder that could not be read.
     pub unreadable: Vec<Error>,
+    /// What the merged output folder must not hide (different suites, duplicates, lost shards).
+    /// They fail `--report-only` (the merge); a run only reports them, since while shards run the
+    /// others' results are not there yet.
+    pub problems: Vec<Problem>,
+    pub merged: bool,
+    /// Scenes of this run whose record was current, so they were not rendered again.
+    pub skipped: usize,
     pub report: PathBuf,
+    pub junit: PathBuf,
 }
 
 impl Outcome {
-    /// Scenes that did not pass (and were not updated), plus unreadable records.
+    /// Scenes that did not pass (and were not updated), plus unreadable records, and for a merge
+    /// its problems.
     pub fn failures(&self) -> usize {
-        self.records.iter().filter(|r| r.failed()).count() + self.unreadable.len()
+        self.records.iter().filter(|r| r.failed()).count()
+            + self.unreadable.len()
+            + if self.merged { self.problems.len() } else { 0 }
     }
 }
 
 /// Runs `voltex regress` as the command line asked: prints the summary and the report's path, and
 /// fails when a scene did not pass.
 pub fn command(args: &Args) -> Result<()> {
+    if let Some(n) = args.plan_shards {
+        print!("{}", plan_shards(args, n as usize)?);
+        return Ok(());
+    }
     let outcome = match &args.report_only {
-        Some(out) => report_only(out)?,
+        Some(out) => report_only(out, args.junit.as_deref())?,
         None => run(args)?,
     };
     print!("{}", report::summary_table(&outcome.records));
     for e in &outcome.unreadable {
         println!("unreadable record: {e}");
     }
+    for p in &outcome.problems {
+        println!("{}: {p}", if outcome.merged { "merge" } else { "note" });
+    }
+    if outcome.skipped > 0 {
+        println!("{} scene(s) current, not rendered again (--force renders them)", outcome.skipped);
+    }
     println!("report: {}", outcome.report.display());
     match outcome.failures() {
         0 => Ok(()),
-        n => Err(Error::Invalid(format!(
-            "{n} of {} scene{} did not pass (see {})",
-            outcome.records.len() + outcome.unreadable.len(),
-            if outcome.records.len() == 1 { "" } else { "s" },
-            outcome.report.display()
-        ))),
+        n => {
+            let problems = if outcome.merged { outcome.problems.len() } else { 0 };
+            let scenes = outcome.records.len() + outcome.unreadable.len();
+            let mut text = format!(
+                "{} of {scenes} scene{} did not pass",
+                n - problems,
+                if scenes == 1 { "" } else { "s" }
+            );
+            if problems > 0 {
+                text += &format!(" and the merge found {problems} problem(s)");
+            }
+            Err(Error::Invalid(format!("{text} (see {})", outcome.report.display())))
+        }
     }
+}
+
+/// `--plan-shards N`: the plan of DIR's scenes on N shards from the costs under `--out`, as text.
+pub fn plan_shards(args: &Args, n: usize) -> Result<String> {
+    let dir = args.dir.as_deref().ok_or_else(|| Error::Invalid("regress: no scene folder given".into()))?;
+    let all = find(dir)?;
+    if all.is_empty() {
+        return Err(Error::file(dir, "no scene files (*.ron) in this folder"));
+    }
+    let plan = shards::fresh_plan(&args.out, &all, n, args.size);
+    let mut s = String::from("shard  cost ms  source    scene\n");
+    let mut rows: Vec<&shards::Planned> = plan.scenes.iter().collect();
+    rows.sort_by(|a, b| a.shard.cmp(&b.shard).then(b.cost.ms.total_cmp(&a.cost.ms)));
+    for p in rows {
+        let source = if p.cost.measured { "measured" } else { "estimate" };
+        s += &format!("{:>5}  {:>7.0}  {source:<8}  {}\n", p.shard, p.cost.ms, p.scene);
+    }
+    Ok(s + &plan.table())
 }
 
 /// Checks the scenes of `args.dir` (this shard's share) and rewrites the report.
@@ -123,46 +195,80 @@ pub fn run(args: &Args) -> Result<Outcome> {
     if all.is_empty() {
         return Err(Error::file(dir, "no scene files (*.ron) in this folder"));
     }
-    let scenes = args.shard.take(all);
     // Everything that will be written must be writable before any rendering.
     std::fs::create_dir_all(&args.out)
         .map_err(|e| Error::file(&args.out, format!("cannot create the output folder: {e}")))?;
     check_writable_dir(&args.out)?;
+    let shard = args.shard;
+    let suite = shards::suite_id(&all);
+    let scenes = match shard.count {
+        1 => all,
+        n => shards::plan_for(&args.out, &all, n, args.size)?.take(shard, all),
+    };
     if args.update {
         let folders: BTreeSet<PathBuf> = scenes.iter().map(|s| parent(&s.reference)).collect();
         folders.iter().try_for_each(|d| check_writable_dir(d))?;
     }
-    let records = if scenes.is_empty() {
-        eprintln!("shard {}: no scenes", args.shard);
-        Vec::new()
+    let info = RunInfo { args, shard, suite, toolchain: shards::toolchain_hash()?, host: shards::host() };
+    let mut manifest = shards::Manifest {
+        suite: info.suite.clone(),
+        shard: shard.to_string(),
+        scenes: scenes.iter().map(|s| s.rel.clone()).collect(),
+        host: info.host.clone(),
+        pid: std::process::id(),
+        started_unix: shards::unix_now(),
+        finished_unix: None,
+    };
+    manifest.write(&args.out, shard)?;
+    let junit = args.junit.clone().unwrap_or_else(|| args.out.join(junit::JUNIT_FILE));
+    let (records, skipped) = if scenes.is_empty() {
+        eprintln!("shard {shard}: no scenes");
+        (Vec::new(), 0)
     } else {
-        match run_scenes(GpuContext::new()?, args, &scenes) {
-            Ok(records) => records,
+        match run_scenes(GpuContext::new()?, &info, &scenes) {
+            Ok(done) => done,
             Err(e) => {
                 // The report of what was checked before the run stopped, if it can be written.
-                if let Ok((found, unreadable)) = record::collect(&args.out) {
-                    let _ = report::write_index(&args.out, &found, &unreadable);
-                }
+                let _ = write_reports(&args.out, &junit);
                 return Err(e);
             }
         }
     };
-    let (found, unreadable) = record::collect(&args.out)?;
-    let report = report::write_index(&args.out, &found, &unreadable)?;
-    Ok(Outcome { records, unreadable, report })
+    manifest.finished_unix = Some(shards::unix_now());
+    manifest.write(&args.out, shard)?;
+    let Merged { unreadable, problems, report, .. } = write_reports(&args.out, &junit)?;
+    Ok(Outcome { records, unreadable, problems, merged: false, skipped, report, junit })
 }
 
-/// Rebuilds `out/index.html` from the records under `out`.
-pub fn report_only(out: &Path) -> Result<Outcome> {
+/// What [`write_reports`] found under an output folder.
+struct Merged {
+    found: Vec<record::Found>,
+    unreadable: Vec<Error>,
+    problems: Vec<Problem>,
+    report: PathBuf,
+}
+
+/// The records under `out`, checked as a merge, and `index.html` and the JUnit file from them.
+fn write_reports(out: &Path, junit: &Path) -> Result<Merged> {
+    let (found, unreadable) = record::collect(out)?;
+    let problems = merge::check(out, &found)?;
+    let report = report::write_index(out, &found, &unreadable, &problems)?;
+    junit::write(junit, &found, &unreadable, &problems)?;
+    Ok(Merged { found, unreadable, problems, report })
+}
+
+/// Rebuilds `out/index.html` (and the JUnit file) from the records under `out`.
+pub fn report_only(out: &Path, junit: Option<&Path>) -> Result<Outcome> {
     check_writable_dir(out)?;
+    let junit = junit.map(Path::to_path_buf).unwrap_or_else(|| out.join(junit::JUNIT_FILE));
     let (found, unreadable) = record::collect(out)?;
     if found.is_empty() && unreadable.is_empty() {
         return Err(Error::file(out, "no regress records (result.json) in this folder"));
     }
-    let report = report::write_index(out, &found, &unreadable)?;
+    let Merged { found, unreadable, problems, report } = write_reports(out, &junit)?;
     let mut records: Vec<Record> = found.into_iter().map(|f| f.record).collect();
     records.sort_by(|a, b| a.scene.cmp(&b.scene));
-    Ok(Outcome { records, unreadable, report })
+    Ok(Outcome { records, unreadable, problems, merged: true, skipped: 0, report, junit })
 }
 
 fn parent(path: &Path) -> PathBuf {
@@ -174,7 +280,7 @@ fn parent(path: &Path) -> PathBuf {
 
 enum Event {
     Started(usize),
-    Done(usize, Box<Result<Record>>),
+    Done(usize, Box<Result<check::Checked>>),
 }
 
 /// The device the workers share; replaced by a new one when it is lost.
@@ -203,11 +309,13 @@ impl SharedContext {
 /// Checks `scenes` on `args.jobs` threads sharing `ctx`. A failure to write into the output folder
 /// (or a reference), or to open a new device after one was lost, stops handing out scenes and is
 /// returned once the running ones finish.
-fn run_scenes(ctx: GpuContext, args: &Args, scenes: &[SceneEntry]) -> Result<Vec<Record>> {
+fn run_scenes(ctx: GpuContext, info: &RunInfo, scenes: &[SceneEntry]) -> Result<(Vec<Record>, usize)> {
+    let args = info.args;
     let shared = SharedContext(RwLock::new(Arc::new(ctx)));
     let mut progress = Progress::new(scenes.len());
     let (next, stop) = (AtomicUsize::new(0), AtomicBool::new(false));
     let mut records: Vec<Option<Record>> = vec![None; scenes.len()];
+    let mut skipped = 0;
     let mut first_error = None;
     std::thread::scope(|s| {
         let (tx, rx) = mpsc::channel();
@@ -219,7 +327,7 @@ fn run_scenes(ctx: GpuContext, args: &Args, scenes: &[SceneEntry]) -> Result<Vec
                     let Some(entry) = scenes.get(i) else { break };
                     let _ = tx.send(Event::Started(i));
                     let ctx = shared.current();
-                    let mut result = catch_unwind(AssertUnwindSafe(|| check::check(&ctx, args, entry)))
+                    let mut result = catch_unwind(AssertUnwindSafe(|| check::check(&ctx, info, entry)))
                         .unwrap_or_else(|p| {
                             Err(Error::Invalid(format!("{}: {}", entry.rel, panic_text(&p))))
                         });
@@ -239,9 +347,10 @@ fn run_scenes(ctx: GpuContext, args: &Args, scenes: &[SceneEntry]) -> Result<Vec
             match event {
                 Event::Started(i) => progress.started(&scenes[i].rel),
                 Event::Done(i, result) => match *result {
-                    Ok(rec) => {
-                        progress.finished(&rec);
-                        records[i] = Some(rec);
+                    Ok(checked) => {
+                        progress.finished(&checked.record, checked.skipped);
+                        skipped += usize::from(checked.skipped);
+                        records[i] = Some(checked.record);
                     }
                     Err(e) => {
                         stop.store(true, Ordering::Relaxed);
@@ -255,7 +364,7 @@ fn run_scenes(ctx: GpuContext, args: &Args, scenes: &[SceneEntry]) -> Result<Vec
     progress.end();
     match first_error {
         Some(e) => Err(e),
-        None => Ok(records.into_iter().flatten().collect()),
+        None => Ok((records.into_iter().flatten().collect(), skipped)),
     }
 }
 

@@ -26,10 +26,12 @@ impl Progress {
         self.draw();
     }
 
-    pub fn finished(&mut self, rec: &Record) {
+    /// `skipped`: the record is an earlier run's, still current.
+    pub fn finished(&mut self, rec: &Record, skipped: bool) {
         self.done += 1;
         self.running.retain(|s| s != &rec.scene);
-        let line = format!("[{}/{}] {}", self.done, self.total, result_line(rec));
+        let current = if skipped { " (current, not rendered again)" } else { "" };
+        let line = format!("[{}/{}] {}{current}", self.done, self.total, result_line(rec));
         if self.tty {
             // Passing scenes only move the bar; the others stay on screen.
             if rec.status != Status::Pass {
