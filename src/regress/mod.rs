@@ -84,6 +84,32 @@ pub struct Args {
     pub report_only: Option<PathBuf>,
 }
 
+/// Exit statuses of `voltex regress` and `voltex farm`, by cause (other commands exit 1 on any
+/// error). The worst cause wins: broken input over regressions.
+pub mod exit {
+    use crate::Error;
+
+    pub const PASS: u8 = 0;
+    /// A scene regressed, or is new without `--update`.
+    pub const REGRESSIONS: u8 = 1;
+    /// A bad command line (clap's status).
+    pub const USAGE: u8 = 2;
+    /// Broken input: a broken scene or reference, an unreadable record, a merge that found
+    /// problems, a missing or unwritable folder.
+    pub const BROKEN_INPUT: u8 = 3;
+    /// The engine failed: no GPU device could be opened (or reopened after a loss), or the farm's
+    /// engine is missing, refused the jobs or lost them.
+    pub const ENGINE: u8 = 4;
+
+    /// The status of a run that stopped with `e`.
+    pub fn of_error(e: &Error) -> u8 {
+        match e {
+            Error::Gpu(_) | Error::DeviceLost(_) => ENGINE,
+            _ => BROKEN_INPUT,
+        }
+    }
+}
+
 /// What every scene check of one run shares.
 pub(crate) struct RunInfo<'a> {
     pub args: &'a Args,
@@ -121,6 +147,23 @@ pub struct Outcome {
 }
 
 impl Outcome {
+    /// The exit status: [`exit::BROKEN_INPUT`] if a scene or reference is broken, a record
+    /// unreadable or (for a merge) the merge found problems, else [`exit::REGRESSIONS`] if a scene
+    /// failed, else [`exit::PASS`].
+    pub fn exit_code(&self) -> u8 {
+        let broken = self
+            .records
+            .iter()
+            .any(|r| r.failed() && matches!(r.status, Status::BrokenScene | Status::BrokenReference));
+        if broken || !self.unreadable.is_empty() || (self.merged && !self.problems.is_empty()) {
+            exit::BROKEN_INPUT
+        } else if self.failures() > 0 {
+            exit::REGRESSIONS
+        } else {
+            exit::PASS
+        }
+    }
+
     /// Scenes that did not pass (and were not updated), plus unreadable records, and for a merge
     /// its problems.
     pub fn failures(&self) -> usize {
@@ -131,11 +174,11 @@ impl Outcome {
 }
 
 /// Runs `voltex regress` as the command line asked: prints the summary and the report's path, and
-/// fails when a scene did not pass.
-pub fn command(args: &Args) -> Result<()> {
+/// returns the exit status ([`exit`]); says on stderr why it is not 0.
+pub fn command(args: &Args) -> Result<u8> {
     if let Some(n) = args.plan_shards {
         print!("{}", plan_shards(args, n as usize)?);
-        return Ok(());
+        return Ok(exit::PASS);
     }
     let outcome = match &args.report_only {
         Some(out) => report_only(out, args.junit.as_deref())?,
@@ -153,7 +196,7 @@ pub fn command(args: &Args) -> Result<()> {
     }
     println!("report: {}", outcome.report.display());
     match outcome.failures() {
-        0 => Ok(()),
+        0 => Ok(exit::PASS),
         n => {
             let problems = if outcome.merged { outcome.problems.len() } else { 0 };
             let scenes = outcome.records.len() + outcome.unreadable.len();
@@ -165,7 +208,8 @@ pub fn command(args: &Args) -> Result<()> {
             if problems > 0 {
                 text += &format!(" and the merge found {problems} problem(s)");
             }
-            Err(Error::Invalid(format!("{text} (see {})", outcome.report.display())))
+            eprintln!("error: {text} (see {})", outcome.report.display());
+            Ok(outcome.exit_code())
         }
     }
 }

@@ -284,6 +284,44 @@ pub fn fresh_plan(out: &Path, scenes: &[SceneEntry], count: usize, size: Option<
     Plan::new(scenes, &costs, count)
 }
 
+/// Before a farm submission: DIR's scenes planned on `count` shards from the costs under `out`
+/// (created), the plan stored for the shards to follow, and the shard manifests of earlier runs
+/// removed, so that the merge judges this submission's shards only.
+pub fn prepare(dir: &Path, out: &Path, count: usize, size: Option<(u32, u32)>) -> Result<Plan> {
+    let all = super::find(dir)?;
+    if all.is_empty() {
+        return Err(Error::file(dir, "no scene files (*.ron) in this folder"));
+    }
+    std::fs::create_dir_all(out)
+        .map_err(|e| Error::file(out, format!("cannot create the output folder: {e}")))?;
+    atomic::check_writable_dir(out)?;
+    let plan = fresh_plan(out, &all, count, size);
+    plan.write(out)?;
+    let state = out.join(STATE_DIR);
+    for e in std::fs::read_dir(&state).map_err(|e| Error::file(&state, e))?.flatten() {
+        let name = e.file_name().to_string_lossy().into_owned();
+        if name.starts_with("shard-") && name.ends_with(".json") {
+            std::fs::remove_file(e.path()).map_err(|err| Error::file(e.path(), err))?;
+        }
+    }
+    Ok(plan)
+}
+
+/// The shard manifests under `out/.voltex` that say their shard finished, and all of them.
+pub fn finished_shards(out: &Path) -> (usize, usize) {
+    let (mut done, mut all) = (0, 0);
+    for e in std::fs::read_dir(out.join(STATE_DIR)).into_iter().flatten().flatten() {
+        let name = e.file_name().to_string_lossy().into_owned();
+        if name.starts_with("shard-") && name.ends_with(".json") {
+            all += 1;
+            if read_json::<Manifest>(&e.path()).is_ok_and(|m| m.finished_unix.is_some()) {
+                done += 1;
+            }
+        }
+    }
+    (done, all)
+}
+
 /// What one shard run planned and whether it finished: `OUT/.voltex/shard-K-of-N.json`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Manifest {

@@ -4,6 +4,7 @@
 mod common;
 
 mod cli_errors;
+mod farm;
 mod faults;
 mod install;
 mod preview_window;

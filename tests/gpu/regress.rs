@@ -233,7 +233,7 @@ fn broken_scene_is_reported_and_the_others_render() {
     std::fs::copy(root().join("graphs/frame.ron"), scenes.join("graph.ron")).unwrap();
     let out = dir.join("out");
     let run = regress(&[&scenes, p("--out"), &out]);
-    assert_eq!(run.status.code(), Some(1));
+    assert_eq!(run.status.code(), Some(3), "broken input");
     let text_of_scene = std::fs::read_to_string(&broken).unwrap();
     let line = text_of_scene.lines().position(|l| l.contains("ambient: 7.0")).unwrap() + 1;
     let loc = format!("{}:{line}:14", broken.display());
@@ -266,7 +266,7 @@ fn wrong_size_garbage_and_channel_less_references_are_broken() {
     write_luminance_exr(&reference(&grey));
     let out = dir.join("out");
     let run = regress(&[&scenes, p("--out"), &out]);
-    assert_eq!(run.status.code(), Some(1));
+    assert_eq!(run.status.code(), Some(3), "broken references");
     let r = record(&out, "small");
     assert_eq!(r.status, Status::BrokenReference);
     let m = r.message.unwrap();
@@ -282,7 +282,7 @@ fn wrong_size_garbage_and_channel_less_references_are_broken() {
     // --update rewrites a reference of another size, never one it cannot read.
     let garbage_bytes = std::fs::read(reference(&garbage)).unwrap();
     let run = regress(&[&scenes, p("--out"), &out, p("--update")]);
-    assert_eq!(run.status.code(), Some(1));
+    assert_eq!(run.status.code(), Some(3), "the unreadable reference stays broken");
     assert!(record(&out, "small").updated);
     assert_eq!(voltex::io::exr::read(&reference(&small)).unwrap().0.width, 128);
     assert!(!record(&out, "garbage").updated && !record(&out, "grey").updated);
@@ -316,7 +316,7 @@ fn unwritable_output_folder_fails_before_rendering() {
     std::fs::write(dir.join("file"), "in the way").unwrap();
     let out = dir.join("file/out");
     let run = regress(&[&scenes, p("--out"), &out]);
-    assert_eq!(run.status.code(), Some(1));
+    assert_eq!(run.status.code(), Some(3));
     let err = String::from_utf8_lossy(&run.stderr);
     assert!(err.starts_with("error: ") && err.contains("cannot create the output folder"), "{err}");
     assert!(err.contains(&out.display().to_string()), "{err}");
@@ -424,7 +424,7 @@ fn merge_reports_missing_shards_duplicates_and_other_suites() {
     let one = dir.join("one");
     assert_eq!(regress(&[&scenes, p("--out"), &one, p("--shard"), p("2/2")]).status.code(), Some(0));
     let merge = regress(&[p("--report-only"), &one]);
-    assert_eq!(merge.status.code(), Some(1));
+    assert_eq!(merge.status.code(), Some(3), "a merge with problems is broken input");
     assert!(text(&merge).contains("shard 1/2: missing"), "{}", text(&merge));
     assert!(std::fs::read_to_string(one.join("junit.xml")).unwrap().contains("name=\"shard 1/2\""));
     // A shard that died: its manifest never says finished.
@@ -442,7 +442,7 @@ fn merge_reports_missing_shards_duplicates_and_other_suites() {
         "{}",
         text(&merge)
     );
-    assert_eq!(merge.status.code(), Some(1));
+    assert_eq!(merge.status.code(), Some(3));
 
     // Both shards: the merge passes; shard folders copied side by side are duplicates.
     let both = dir.join("both");
@@ -451,7 +451,7 @@ fn merge_reports_missing_shards_duplicates_and_other_suites() {
     assert_eq!(regress(&[p("--report-only"), &both]).status.code(), Some(0));
     common::copy_dir(&one, &both.join("copied"));
     let merge = regress(&[p("--report-only"), &both]);
-    assert_eq!(merge.status.code(), Some(1));
+    assert_eq!(merge.status.code(), Some(3));
     assert!(text(&merge).contains("c.ron: duplicate records in c, copied/c"), "{}", text(&merge));
     std::fs::remove_dir_all(both.join("copied")).unwrap();
     // A record of another suite.
@@ -459,7 +459,7 @@ fn merge_reports_missing_shards_duplicates_and_other_suites() {
     r.suite = "0123456789abcdef".into();
     r.write(&both.join("c")).unwrap();
     let merge = regress(&[p("--report-only"), &both]);
-    assert_eq!(merge.status.code(), Some(1));
+    assert_eq!(merge.status.code(), Some(3));
     assert!(text(&merge).contains("results from different suites"), "{}", text(&merge));
 }
 
@@ -467,10 +467,10 @@ fn merge_reports_missing_shards_duplicates_and_other_suites() {
 fn bad_arguments() {
     let dir = Temp::new("args");
     let run = regress(&[&dir.join("missing")]);
-    assert_eq!(run.status.code(), Some(1));
+    assert_eq!(run.status.code(), Some(3));
     assert!(String::from_utf8_lossy(&run.stderr).contains("missing"));
     let run = regress(&[&dir]);
-    assert_eq!(run.status.code(), Some(1), "a folder without scenes");
+    assert_eq!(run.status.code(), Some(3), "a folder without scenes");
     assert!(String::from_utf8_lossy(&run.stderr).contains("no scene files"));
     for shard in ["0/2", "3/2", "x"] {
         let run = regress(&[&dir, p("--shard"), p(shard)]);
@@ -483,7 +483,7 @@ fn bad_arguments() {
         String::from_utf8_lossy(&run.stderr).contains("neither SLURM_ARRAY_TASK_ID nor JOB_COMPLETION_INDEX")
     );
     assert_ne!(regress(&[&dir, p("--jobs"), p("0")]).status.code(), Some(0));
-    assert_eq!(regress(&[p("--report-only"), &dir]).status.code(), Some(1), "no records");
+    assert_eq!(regress(&[p("--report-only"), &dir]).status.code(), Some(3), "no records");
 }
 
 #[test]
