@@ -41,7 +41,7 @@ use std::sync::{mpsc, Arc, RwLock};
 use crate::gpu::GpuContext;
 use crate::io::atomic::check_writable_dir;
 use crate::{Error, Result};
-use progress::Progress;
+use progress::{Progress, Verbosity};
 
 /// The `regress` command line.
 #[derive(clap::Args, Debug, Clone)]
@@ -77,8 +77,18 @@ pub struct Args {
     /// Render nothing: print how N shards would split DIR (costs from the records under --out,
     /// else estimates) and the predicted makespan.
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=100_000),
-          conflicts_with_all = ["update", "jobs", "shard", "force", "junit"])]
+          conflicts_with_all = ["update", "jobs", "shard", "force", "junit", "json"])]
     pub plan_shards: Option<u32>,
+    /// Print a JSON summary on stdout (verdict, exit status, counts, failures, merge problems,
+    /// report paths) instead of the table.
+    #[arg(long)]
+    pub json: bool,
+    /// No progress on stderr (errors still).
+    #[arg(short, long, conflicts_with = "verbose")]
+    pub quiet: bool,
+    /// Each scene's warnings in the progress too.
+    #[arg(short, long)]
+    pub verbose: bool,
     /// Render nothing: rebuild OUT/index.html from the records under OUT (after merging shards).
     #[arg(long, value_name = "OUT", conflicts_with_all = ["dir", "out", "update", "size", "jobs", "shard", "force"])]
     pub report_only: Option<PathBuf>,
@@ -184,17 +194,21 @@ pub fn command(args: &Args) -> Result<u8> {
         Some(out) => report_only(out, args.junit.as_deref())?,
         None => run(args)?,
     };
-    print!("{}", report::summary_table(&outcome.records));
-    for e in &outcome.unreadable {
-        println!("unreadable record: {e}");
+    if args.json {
+        println!("{}", summary_json(&outcome));
+    } else {
+        print!("{}", report::summary_table(&outcome.records));
+        for e in &outcome.unreadable {
+            println!("unreadable record: {e}");
+        }
+        for p in &outcome.problems {
+            println!("{}: {p}", if outcome.merged { "merge" } else { "note" });
+        }
+        if outcome.skipped > 0 {
+            println!("{} scene(s) current, not rendered again (--force renders them)", outcome.skipped);
+        }
+        println!("report: {}", outcome.report.display());
     }
-    for p in &outcome.problems {
-        println!("{}: {p}", if outcome.merged { "merge" } else { "note" });
-    }
-    if outcome.skipped > 0 {
-        println!("{} scene(s) current, not rendered again (--force renders them)", outcome.skipped);
-    }
-    println!("report: {}", outcome.report.display());
     match outcome.failures() {
         0 => Ok(exit::PASS),
         n => {
@@ -212,6 +226,39 @@ pub fn command(args: &Args) -> Result<u8> {
             Ok(outcome.exit_code())
         }
     }
+}
+
+/// The `--json` summary of a run or merge.
+pub fn summary_json(o: &Outcome) -> String {
+    let code = o.exit_code();
+    let count = |st: Status| o.records.iter().filter(|r| r.status == st).count();
+    let failed: Vec<serde_json::Value> = o
+        .records
+        .iter()
+        .filter(|r| r.failed())
+        .map(|r| serde_json::json!({"scene": r.scene, "status": r.status, "message": r.message}))
+        .collect();
+    serde_json::json!({
+        "verdict": match code { exit::PASS => "pass", exit::REGRESSIONS => "regressions", _ => "broken input" },
+        "exit_code": code,
+        "scenes": o.records.len(),
+        "counts": {
+            "pass": count(Status::Pass),
+            "regressed": count(Status::Regressed),
+            "new": count(Status::New),
+            "broken_scene": count(Status::BrokenScene),
+            "broken_reference": count(Status::BrokenReference),
+            "updated": o.records.iter().filter(|r| r.updated).count(),
+            "current_not_rendered": o.skipped,
+        },
+        "failed": failed,
+        "unreadable": o.unreadable.iter().map(|e| e.to_string()).collect::<Vec<_>>(),
+        "merge_problems": o.problems,
+        "merge_problems_fail": o.merged,
+        "report": o.report,
+        "junit": o.junit,
+    })
+    .to_string()
 }
 
 /// `--plan-shards N`: the plan of DIR's scenes on N shards from the costs under `--out`, as text.
@@ -356,7 +403,12 @@ impl SharedContext {
 fn run_scenes(ctx: GpuContext, info: &RunInfo, scenes: &[SceneEntry]) -> Result<(Vec<Record>, usize)> {
     let args = info.args;
     let shared = SharedContext(RwLock::new(Arc::new(ctx)));
-    let mut progress = Progress::new(scenes.len());
+    let verbosity = match (args.quiet, args.verbose) {
+        (true, _) => Verbosity::Quiet,
+        (_, true) => Verbosity::Verbose,
+        _ => Verbosity::Normal,
+    };
+    let mut progress = Progress::new(scenes.len(), verbosity);
     let (next, stop) = (AtomicUsize::new(0), AtomicBool::new(false));
     let mut records: Vec<Option<Record>> = vec![None; scenes.len()];
     let mut skipped = 0;

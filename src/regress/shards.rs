@@ -122,10 +122,12 @@ pub struct Cost {
     pub measured: bool,
 }
 
-/// Estimated milliseconds per 1000 pixels of each method on software Vulkan (fitted to the
-/// example scenes' wall times at 128x128 on two busy cores), plus a fixed cost per scene.
+/// Estimated milliseconds per 1000 pixels of each method on software Vulkan: medians of the
+/// example scenes' wall times (`regress scenes/ --jobs 2` on two busy cores, less the fixed
+/// cost), by the costliest method a scene names. A scene takes the highest rate of the methods
+/// its file names.
 const PER_KPIXEL_MS: [(&str, f64); 4] =
-    [("RayMarch", 40.0), ("Reference", 30.0), ("ViewSlices", 6.0), ("AxisSlices", 6.0)];
+    [("AxisSlices", 90.0), ("RayMarch", 75.0), ("ViewSlices", 45.0), ("Reference", 15.0)];
 const FIXED_MS: f64 = 150.0;
 
 /// A scene's cost: its record's wall time under `out`, else an estimate from its render size
@@ -144,7 +146,7 @@ fn estimate(entry: &SceneEntry, size: Option<(u32, u32)>) -> f64 {
     let Ok(scene) = crate::scene::parse(&text, &entry.path) else { return FIXED_MS };
     let (w, h) =
         size.or(scene.regress.size.map(|[w, h]| (w, h))).unwrap_or((scene.output.width, scene.output.height));
-    let rate = PER_KPIXEL_MS.iter().filter(|(m, _)| text.contains(m)).map(|(_, r)| *r).fold(6.0, f64::max);
+    let rate = PER_KPIXEL_MS.iter().filter(|(m, _)| text.contains(m)).map(|(_, r)| *r).fold(15.0, f64::max);
     FIXED_MS + rate * f64::from(w) * f64::from(h) / 1000.0
 }
 
