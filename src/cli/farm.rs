@@ -40,6 +40,12 @@ struct Pass {
     /// Write references of new, regressed and other-size scenes (regress --update).
     #[arg(long)]
     update: bool,
+    /// Mean FLIP a scene may reach, for every scene (regress --max-flip).
+    #[arg(long, value_parser = voltex::regress::parse_max_flip)]
+    max_flip: Option<f64>,
+    /// Relative RMSE a scene may reach, for every scene (regress --max-rel-rmse).
+    #[arg(long, value_parser = voltex::regress::parse_max_rel_rmse)]
+    max_rel_rmse: Option<f64>,
     /// Render scenes whose record is current too (regress --force).
     #[arg(long)]
     force: bool,
@@ -59,6 +65,12 @@ impl Pass {
         }
         if self.force {
             a.push("--force".into());
+        }
+        if let Some(v) = self.max_flip {
+            a.extend(["--max-flip".into(), v.to_string()]);
+        }
+        if let Some(v) = self.max_rel_rmse {
+            a.extend(["--max-rel-rmse".into(), v.to_string()]);
         }
         if self.jobs != 1 {
             a.extend(["--jobs".into(), self.jobs.to_string()]);

@@ -85,6 +85,8 @@ pub(super) fn check(ctx: &GpuContext, run: &RunInfo, entry: &SceneEntry) -> Resu
                 }
             }
         }
+        rec.max_flip = opts.max_flip.unwrap_or(scene.regress.max_flip);
+        rec.max_rel_rmse = opts.max_rel_rmse.unwrap_or(scene.regress.max_rel_rmse);
         std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| render(ctx, &scene, size, &mut rec)))
             .unwrap_or_else(|p| Err(Error::file(&entry.path, super::panic_text(&p))))
             .map(Some)
@@ -143,8 +145,6 @@ fn file_name(path: &Path) -> String {
 
 /// Plans and renders the loaded scene; any error here makes it a broken scene.
 fn render(ctx: &GpuContext, scene: &scene::Scene, size: (u32, u32), rec: &mut Record) -> Result<Rendered> {
-    rec.max_flip = scene.regress.max_flip;
-    rec.max_rel_rmse = scene.regress.max_rel_rmse;
     let bp = Blueprint::new(scene, &RenderOptions { size: Some(size), ..Default::default() })?;
     rec.warnings.extend(scene.warnings.iter().cloned());
     for o in &bp.objects {

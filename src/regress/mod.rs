@@ -67,6 +67,12 @@ pub struct Args {
     /// JOB_COMPLETION_INDEX.
     #[arg(long, default_value = "1/1")]
     pub shard: Shard,
+    /// Mean FLIP a scene may reach, for every scene (default: each scene's regress.max_flip).
+    #[arg(long, value_parser = parse_max_flip)]
+    pub max_flip: Option<f64>,
+    /// Relative RMSE a scene may reach, for every scene (default: each scene's regress.max_rel_rmse).
+    #[arg(long, value_parser = parse_max_rel_rmse)]
+    pub max_rel_rmse: Option<f64>,
     /// Render scenes whose record is current too (same scene, assets, reference, size, graphs,
     /// WGSL and binary); without it they are kept and not rendered again.
     #[arg(long)]
@@ -90,7 +96,7 @@ pub struct Args {
     #[arg(short, long)]
     pub verbose: bool,
     /// Render nothing: rebuild OUT/index.html from the records under OUT (after merging shards).
-    #[arg(long, value_name = "OUT", conflicts_with_all = ["dir", "out", "update", "size", "jobs", "shard", "force"])]
+    #[arg(long, value_name = "OUT", conflicts_with_all = ["dir", "out", "update", "size", "jobs", "shard", "force", "max_flip", "max_rel_rmse"])]
     pub report_only: Option<PathBuf>,
 }
 
@@ -127,6 +133,20 @@ pub(crate) struct RunInfo<'a> {
     pub suite: String,
     pub toolchain: String,
     pub host: String,
+}
+
+pub fn parse_max_flip(s: &str) -> std::result::Result<f64, String> {
+    s.parse::<f64>()
+        .ok()
+        .filter(|v| (0.0..=1.0).contains(v))
+        .ok_or_else(|| format!("`{s}`: expected a mean FLIP in [0, 1]"))
+}
+
+pub fn parse_max_rel_rmse(s: &str) -> std::result::Result<f64, String> {
+    s.parse::<f64>()
+        .ok()
+        .filter(|v| v.is_finite() && *v >= 0.0)
+        .ok_or_else(|| format!("`{s}`: expected a relative RMSE >= 0"))
 }
 
 fn parse_size(s: &str) -> std::result::Result<(u32, u32), String> {
@@ -300,7 +320,18 @@ pub fn run(args: &Args) -> Result<Outcome> {
         let folders: BTreeSet<PathBuf> = scenes.iter().map(|s| parent(&s.reference)).collect();
         folders.iter().try_for_each(|d| check_writable_dir(d))?;
     }
-    let info = RunInfo { args, shard, suite, toolchain: shards::toolchain_hash()?, host: shards::host() };
+    // Thresholds given on the command line change verdicts as much as the binary does.
+    let toolchain = format!("{}/{:?}/{:?}", shards::toolchain_hash()?, args.max_flip, args.max_rel_rmse);
+    let info = RunInfo { args, shard, suite, toolchain, host: shards::host() };
+    if let Some(other) = shards::running_elsewhere(&args.out, shard) {
+        return Err(Error::file(
+            &args.out,
+            format!(
+                "shard {shard} is already running into this folder ({other}); two runs of one shard would \
+                 overwrite each other's results: wait for it, or stop it"
+            ),
+        ));
+    }
     let mut manifest = shards::Manifest {
         suite: info.suite.clone(),
         shard: shard.to_string(),

@@ -350,6 +350,19 @@ impl Manifest {
     }
 }
 
+/// Another voltex process on this machine running `shard` into `out` now (its unfinished
+/// manifest names a live process of the same program), as `pid P on HOST`. Runs on other
+/// machines cannot be seen from here.
+pub fn running_elsewhere(out: &Path, shard: Shard) -> Option<String> {
+    let m: Manifest = read_json(&Manifest::path(out, shard)).ok()?;
+    let comm = |pid: u32| std::fs::read_to_string(format!("/proc/{pid}/comm")).ok();
+    let alive = m.finished_unix.is_none()
+        && m.host == host()
+        && m.pid != std::process::id()
+        && comm(m.pid).is_some_and(|c| Some(c) == comm(std::process::id()));
+    alive.then(|| format!("pid {} on {}", m.pid, m.host))
+}
+
 /// Seconds since 1970 now.
 pub fn unix_now() -> u64 {
     std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map(|d| d.as_secs()).unwrap_or(0)
