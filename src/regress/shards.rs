@@ -270,14 +270,34 @@ impl Plan {
 
 /// The plan shard runs into `out` follow: the stored one for these scenes, else a new one from
 /// the costs under `out`, stored so that shards starting later (after records changed the
-/// costs) and reruns of a lost shard take the same scenes.
+/// costs) and reruns of a lost shard take the same scenes. Of shards planning at once, the first
+/// to store its plan wins and the others follow it.
 pub fn plan_for(out: &Path, scenes: &[SceneEntry], count: usize, size: Option<(u32, u32)>) -> Result<Plan> {
     if let Some(plan) = Plan::stored(out, scenes, count) {
         return Ok(plan);
     }
     let plan = fresh_plan(out, scenes, count, size);
-    plan.write(out)?;
-    Ok(plan)
+    let path = Plan::path(out, count);
+    if path.exists() {
+        // A plan for another scene list: replaced.
+        plan.write(out)?;
+        return Ok(plan);
+    }
+    // Written aside, then linked into place, which fails if another shard's plan got there first.
+    let state = out.join(STATE_DIR);
+    std::fs::create_dir_all(&state).map_err(|e| Error::file(&state, format!("cannot create folder: {e}")))?;
+    let aside = state.join(format!(".plan-{count}.json.{}-{}", host(), std::process::id()));
+    write_json(&aside, &plan)?;
+    let linked = std::fs::hard_link(&aside, &path);
+    let _ = std::fs::remove_file(&aside);
+    match linked {
+        Ok(()) => Ok(plan),
+        Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {
+            Ok(Plan::stored(out, scenes, count).unwrap_or(plan))
+        }
+        // No hard links on this file system: the last writer wins.
+        Err(_) => plan.write(out).map(|()| plan),
+    }
 }
 
 /// A plan from the costs under `out` now, not stored.

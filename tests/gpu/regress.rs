@@ -402,8 +402,15 @@ fn results_travel_and_current_scenes_are_not_rendered_again() {
     assert_eq!(record(&out, "a").status, Status::Regressed);
     let junit = std::fs::read_to_string(dir.join("j.xml")).unwrap();
     assert!(junit.contains("<failure type=\"regressed\""), "{junit}");
-    let forced = regress(&[&scenes, p("--out"), &out, p("--force")]);
-    assert!(!text(&forced).contains("current"), "{}", text(&forced));
+    // --json: the summary for scripts on stdout, -q: no progress.
+    let forced = regress(&[&scenes, p("--out"), &out, p("--force"), p("--json"), p("-q")]);
+    assert_eq!(forced.status.code(), Some(1));
+    let json: serde_json::Value = serde_json::from_slice(&forced.stdout).unwrap();
+    assert_eq!((json["verdict"].as_str(), json["exit_code"].as_u64()), (Some("regressions"), Some(1)));
+    assert_eq!((json["counts"]["regressed"].as_u64(), json["counts"]["pass"].as_u64()), (Some(1), Some(2)));
+    assert_eq!(json["counts"]["current_not_rendered"].as_u64(), Some(0), "--force renders all");
+    assert_eq!(json["failed"][0]["scene"].as_str(), Some("a.ron"));
+    assert!(!String::from_utf8_lossy(&forced.stderr).contains("[1/3"), "-q: no progress");
 }
 
 #[test]
