@@ -288,7 +288,7 @@ fn submit_slurm(a: SubmitArgs) -> Result<u8, FarmError> {
     if !a.wait {
         return Ok(exit::PASS);
     }
-    wait_slurm(&merge_id, &out, &status_file, &jobs.join("merge.log"))
+    wait_slurm(&merge_id, n, plan.makespan() / 1e3, &out, &status_file, &jobs.join("merge.log"))
 }
 
 fn words(cmd: &[String]) -> String {
@@ -331,13 +331,29 @@ fn sbatch(args: &[String], what: &str) -> Result<String, FarmError> {
 }
 
 /// Waits for the merge job: its state from `scontrol`, else (once Slurm forgot the job) the
-/// status its script wrote. Prints shard progress as manifests finish.
-fn wait_slurm(merge_id: &str, out: &Path, status_file: &Path, log: &Path) -> Result<u8, FarmError> {
+/// status its script wrote. Prints shard progress as manifests finish, against the plan's
+/// predicted makespan (queueing not included).
+fn wait_slurm(
+    merge_id: &str,
+    count: usize,
+    makespan_s: f64,
+    out: &Path,
+    status_file: &Path,
+    log: &Path,
+) -> Result<u8, FarmError> {
+    let start = std::time::Instant::now();
     let mut shown = None;
     loop {
         let progress = shards::finished_shards(out);
         if shown != Some(progress) {
-            eprintln!("shards finished: {}/{} started", progress.0, progress.1);
+            let mmss = |s: f64| format!("{}:{:02}", s as u64 / 60, s as u64 % 60);
+            eprintln!(
+                "shards: {} of {count} finished, {} started; {} elapsed (the plan predicts {} once running)",
+                progress.0,
+                progress.1,
+                mmss(start.elapsed().as_secs_f64()),
+                mmss(makespan_s.ceil())
+            );
             shown = Some(progress);
         }
         let info = Command::new("scontrol").args(["show", "job", "-o", merge_id]).output();
