@@ -281,6 +281,61 @@ fn slurm_array_and_merge_equal_a_one_machine_run() {
     );
     assert_eq!(refused.status.code(), Some(4), "{}", text(&refused));
     assert!(text(&refused).contains("sbatch refused the array job"), "{}", text(&refused));
+    // A shard that dies: jobs held at submission, shard 2 cancelled, the others released. The
+    // merge names the lost shard; rerun alone, it completes the merge.
+    let lost = dir.join("lost");
+    let args = [
+        &[
+            "farm",
+            "submit",
+            "--engine",
+            "slurm",
+            "--shards",
+            "3",
+            s(&suite),
+            "--out",
+            s(&lost),
+            "--sbatch-arg=--hold",
+        ][..],
+        &size,
+    ];
+    let held = voltex(&args.concat(), &env);
+    assert_eq!(held.status.code(), Some(0), "{}", text(&held));
+    let stdout = String::from_utf8_lossy(&held.stdout).into_owned();
+    let id = |what: &str| {
+        let line = stdout.lines().find(|l| l.starts_with(what)).unwrap_or_else(|| panic!("{what}: {stdout}"));
+        line[what.len()..].split(':').next().unwrap().to_string()
+    };
+    let (array, merge) = (id("array job "), id("merge job "));
+    let slurm = |cmd: &str, args: &[&str]| {
+        let ok = Command::new(program(cmd).unwrap()).args(args).env("SLURM_CONF", &conf).status().unwrap();
+        assert!(ok.success(), "{cmd} {args:?}");
+    };
+    slurm("scancel", &[&format!("{array}_2")]);
+    for job in [format!("{array}_1"), format!("{array}_3"), merge.clone()] {
+        slurm("scontrol", &["release", &job]);
+    }
+    let status = lost.join(".voltex/slurm/merge-status");
+    let waited = Instant::now();
+    while !status.exists() {
+        assert!(waited.elapsed() < Duration::from_secs(60), "merge job {merge} did not end");
+        std::thread::sleep(Duration::from_millis(200));
+    }
+    std::thread::sleep(Duration::from_millis(200));
+    assert_eq!(
+        std::fs::read_to_string(&status).unwrap().trim(),
+        "3",
+        "a merge with a lost shard is broken input"
+    );
+    let log = std::fs::read_to_string(lost.join(".voltex/slurm/merge.log")).unwrap();
+    assert!(log.contains("merge: shard 2/3: missing"), "{log}");
+    let rerun =
+        voltex(&[&["regress", s(&suite), "--out", s(&lost), "--shard", "2/3"][..], &size].concat(), &[]);
+    assert_eq!(rerun.status.code(), Some(0));
+    let merged = voltex(&["regress", "--report-only", s(&lost)], &[]);
+    assert_eq!(merged.status.code(), Some(0), "{}", text(&merged));
+    assert_eq!(verdicts(&lost), verdicts(&local));
+
     drop(cluster);
     eprintln!("slurm test: {:.1} s", start.elapsed().as_secs_f64());
     let _ = std::fs::remove_dir_all(&dir);
