@@ -1,5 +1,5 @@
-//! The `voltex` command line: render, bake, compare, plan, import, preview, regress, info, bench,
-//! bench-hyper, pareto. Each subcommand lives in `src/cli/<name>.rs`; this file parses and
+//! The `voltex` command line: render, bake, compare, plan, import, preview, regress, farm, info,
+//! bench, bench-hyper, pareto. Each subcommand lives in `src/cli/<name>.rs`; this file parses and
 //! dispatches.
 
 mod cli;
@@ -20,7 +20,25 @@ fn main() -> ExitCode {
         Command::Plan(args) => cli::plan::run(args),
         Command::Import(args) => cli::import::run(args),
         Command::Preview(args) => cli::preview::run(args),
-        Command::Regress(args) => voltex::regress::command(&args),
+        // regress and farm exit with a status by cause (voltex::regress::exit).
+        Command::Regress(args) => {
+            return match voltex::regress::command(&args) {
+                Ok(code) => ExitCode::from(code),
+                Err(e) => {
+                    eprintln!("error: {e}");
+                    ExitCode::from(voltex::regress::exit::of_error(&e))
+                }
+            }
+        }
+        Command::Farm(args) => {
+            return match cli::farm::run(args) {
+                Ok(code) => ExitCode::from(code),
+                Err(e) => {
+                    eprintln!("error: {e}");
+                    ExitCode::from(e.code())
+                }
+            }
+        }
         Command::Info => cli::info::run(),
         Command::Bench(args) => cli::bench::run(args),
         Command::BenchHyper(args) => cli::bench::run_hyper(args),

@@ -4,6 +4,7 @@
 pub mod bake;
 pub mod bench;
 pub mod compare;
+pub mod farm;
 pub mod import;
 pub mod info;
 pub mod pareto;
@@ -52,6 +53,9 @@ pub enum Command {
     Preview(preview::PreviewArgs),
     /// Render every scene under a folder and compare it with its reference image (<stem>.ref.exr).
     Regress(voltex::regress::Args),
+    /// Regression runs on a cluster: submit to Slurm as an array job and a merge job, or write a
+    /// Kubernetes Indexed Job and its merge Job.
+    Farm(farm::FarmArgs),
     /// Print the adapter, backend, driver, the features voltex uses and limits.
     Info,
     /// Benchmark view-aligned slicing (the 2002 paper's Table 1 set-up) with GPU timestamps.

@@ -5,8 +5,8 @@ use std::path::Path;
 use std::time::Instant;
 
 use super::discover::SceneEntry;
-use super::record::{Record, Status, ARTEFACTS, IMAGES};
-use super::Args;
+use super::record::{Record, Status, ARTEFACTS, IMAGES, RECORD_FILE};
+use super::{shards, Args, RunInfo};
 use crate::gpu::GpuContext;
 use crate::io::{self, Image};
 use crate::metrics;
@@ -21,18 +21,32 @@ struct Rendered {
     metadata: Vec<(String, String)>,
 }
 
-/// Checks one scene. Problems of the scene or its reference become the record's status; only
+/// One scene's outcome: its record, and whether that is an earlier run's, still current.
+pub(super) struct Checked {
+    pub record: Record,
+    pub skipped: bool,
+}
+
+/// Checks one scene, or keeps its record when that is current (see [`current`]; a broken scene
+/// is always rechecked, since it may have been a passing GPU fault) unless `--force`. Problems of the scene or its reference become the record's status; only
 /// failures to write into the output folder or the reference are errors.
-pub(super) fn check(ctx: &GpuContext, opts: &Args, entry: &SceneEntry) -> Result<Record> {
+pub(super) fn check(ctx: &GpuContext, run: &RunInfo, entry: &SceneEntry) -> Result<Checked> {
+    let opts = run.args;
     let start = Instant::now();
     let folder = opts.out.join(&entry.folder);
     std::fs::create_dir_all(&folder)
         .map_err(|e| Error::file(&folder, format!("cannot create folder: {e}")))?;
     let defaults = Regress::default();
+    let reference_rel = match entry.rel.rsplit_once('/') {
+        Some((dir, _)) => format!("{dir}/{}", file_name(&entry.reference)),
+        None => file_name(&entry.reference),
+    };
     let mut rec = Record {
         scene: entry.rel.clone(),
-        scene_path: entry.path.display().to_string(),
-        reference_path: entry.reference.display().to_string(),
+        scene_path: entry.rel.clone(),
+        reference_path: reference_rel,
+        suite: run.suite.clone(),
+        inputs: String::new(),
         status: Status::BrokenScene,
         updated: false,
         message: None,
@@ -48,16 +62,51 @@ pub(super) fn check(ctx: &GpuContext, opts: &Args, entry: &SceneEntry) -> Result
         adapter: ctx.adapter_line(),
         reference_adapter: None,
         images: Vec::new(),
-        shard: opts.shard.to_string(),
+        shard: run.shard.to_string(),
+        host: run.host.clone(),
         finished_unix: 0,
         voltex_version: env!("CARGO_PKG_VERSION").to_string(),
     };
     // A panic on some input is a bug, but still only this scene's problem.
-    let rendered =
-        std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| render(ctx, opts, entry, &mut rec)))
-            .unwrap_or_else(|p| Err(Error::file(&entry.path, super::panic_text(&p))));
+    let mut scene_hash = String::new();
+    let loaded = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| scene::load(&entry.path)))
+        .unwrap_or_else(|p| Err(Error::file(&entry.path, super::panic_text(&p))));
+    let rendered = loaded.and_then(|scene| {
+        let size = opts
+            .size
+            .or(scene.regress.size.map(|[w, h]| (w, h)))
+            .unwrap_or((scene.output.width, scene.output.height));
+        scene_hash = shards::scene_hash(&scene, entry, size, &run.toolchain);
+        rec.inputs = shards::inputs_hash(&scene_hash, entry);
+        if !opts.force {
+            if let Ok(old) = Record::read(&folder.join(RECORD_FILE)) {
+                if current(&old, &rec, opts.update) {
+                    return Ok(None);
+                }
+            }
+        }
+        rec.max_flip = opts.max_flip.unwrap_or(scene.regress.max_flip);
+        rec.max_rel_rmse = opts.max_rel_rmse.unwrap_or(scene.regress.max_rel_rmse);
+        std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| render(ctx, &scene, size, &mut rec)))
+            .unwrap_or_else(|p| Err(Error::file(&entry.path, super::panic_text(&p))))
+            .map(Some)
+    });
+    let rendered = match rendered {
+        Ok(None) => {
+            let record = Record::read(&folder.join(RECORD_FILE))?;
+            return Ok(Checked { record, skipped: true });
+        }
+        Ok(Some(frame)) => Ok(frame),
+        Err(e) => Err(e),
+    };
     match rendered {
-        Ok(frame) => compare(opts, entry, &folder, &frame, &mut rec)?,
+        Ok(frame) => {
+            compare(opts, entry, &folder, &frame, &mut rec)?;
+            if rec.updated {
+                // The reference is part of the inputs, and this run rewrote it.
+                rec.inputs = shards::inputs_hash(&scene_hash, entry);
+            }
+        }
         Err(e) => rec.message = Some(e.to_string()),
     }
     rec.wall_ms = start.elapsed().as_secs_f64() * 1e3;
@@ -75,19 +124,28 @@ pub(super) fn check(ctx: &GpuContext, opts: &Args, entry: &SceneEntry) -> Result
             let _ = std::fs::remove_file(folder.join(name));
         }
     }
-    Ok(rec)
+    Ok(Checked { record: rec, skipped: false })
 }
 
-/// Loads, plans and renders the scene; any error here makes it a broken scene.
-fn render(ctx: &GpuContext, opts: &Args, entry: &SceneEntry, rec: &mut Record) -> Result<Rendered> {
-    let scene = scene::load(&entry.path)?;
-    rec.max_flip = scene.regress.max_flip;
-    rec.max_rel_rmse = scene.regress.max_rel_rmse;
-    let size = opts
-        .size
-        .or(scene.regress.size.map(|[w, h]| (w, h)))
-        .unwrap_or((scene.output.width, scene.output.height));
-    let bp = Blueprint::new(&scene, &RenderOptions { size: Some(size), ..Default::default() })?;
+/// Whether an earlier record of this scene still holds: same inputs and suite, not a broken
+/// scene, not one whose reference that run rewrote (a rerun says whether it passes now), and
+/// nothing `--update` would rewrite.
+fn current(old: &Record, new: &Record, update: bool) -> bool {
+    let rewrite = matches!(old.status, Status::New | Status::Regressed | Status::BrokenReference);
+    old.inputs == new.inputs
+        && old.suite == new.suite
+        && old.status != Status::BrokenScene
+        && !old.updated
+        && !(update && rewrite)
+}
+
+fn file_name(path: &Path) -> String {
+    path.file_name().unwrap_or_default().to_string_lossy().into_owned()
+}
+
+/// Plans and renders the loaded scene; any error here makes it a broken scene.
+fn render(ctx: &GpuContext, scene: &scene::Scene, size: (u32, u32), rec: &mut Record) -> Result<Rendered> {
+    let bp = Blueprint::new(scene, &RenderOptions { size: Some(size), ..Default::default() })?;
     rec.warnings.extend(scene.warnings.iter().cloned());
     for o in &bp.objects {
         for w in &o.object.report.warnings {

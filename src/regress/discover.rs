@@ -1,5 +1,5 @@
 //! Which scenes a run checks: every `.ron` file under a folder whose top level is not a
-//! `Graph(...)`, sorted by relative path, then the shard's share of them.
+//! `Graph(...)`, sorted by relative path; and the `--shard` argument.
 
 use std::path::{Path, PathBuf};
 use std::str::FromStr;
@@ -19,7 +19,7 @@ pub struct SceneEntry {
 }
 
 impl SceneEntry {
-    fn new(base: &Path, rel_parts: &[String]) -> Self {
+    pub(super) fn new(base: &Path, rel_parts: &[String]) -> Self {
         let rel = rel_parts.join("/");
         let path = rel_parts.iter().fold(base.to_path_buf(), |p, s| p.join(s));
         let stem = path.file_stem().unwrap_or_default().to_string_lossy().into_owned();
@@ -30,9 +30,13 @@ impl SceneEntry {
     }
 }
 
-/// `--shard i/n`: the scenes whose 0-based index `k` in the sorted list has `k % n == i - 1`
-/// (`i` is 1-based: `1/2` and `2/2` split a suite in two).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+/// `--shard i/n` (1-based: `1/2` and `2/2` split a suite in two); which scenes shard `i` checks
+/// is the plan's business (`shards.rs`).
+///
+/// `auto/n` takes `i` from the engine running the task: Slurm's `SLURM_ARRAY_TASK_ID` (counted
+/// from `SLURM_ARRAY_TASK_MIN`, so arrays numbered from 0 or 1 both work) or Kubernetes'
+/// `JOB_COMPLETION_INDEX` (0-based); plain `auto` also takes `n` from `SLURM_ARRAY_TASK_COUNT`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
 pub struct Shard {
     pub index: usize,
     pub count: usize,
@@ -47,12 +51,56 @@ impl Default for Shard {
 impl FromStr for Shard {
     type Err = String;
     fn from_str(s: &str) -> std::result::Result<Self, String> {
-        let bad = || format!("`{s}`: expected a shard i/n with 1 <= i <= n, e.g. 1/4");
-        let (i, n) = s.split_once('/').ok_or_else(bad)?;
-        let (index, count): (usize, usize) =
-            (i.trim().parse().map_err(|_| bad())?, n.trim().parse().map_err(|_| bad())?);
+        Self::parse(s, &|k| std::env::var(k).ok())
+    }
+}
+
+impl Shard {
+    /// Parses `i/n`, `auto/n` or `auto`, reading engine variables through `env`.
+    pub fn parse(s: &str, env: &dyn Fn(&str) -> Option<String>) -> std::result::Result<Self, String> {
+        let bad = || format!("`{s}`: expected a shard i/n with 1 <= i <= n, e.g. 1/4, or auto/n");
+        let (i, n) = match s.split_once('/') {
+            Some((i, n)) => (i.trim(), Some(n.trim())),
+            None if s.trim() == "auto" => ("auto", None),
+            None => return Err(bad()),
+        };
+        let number = |name: &str, v: &str| {
+            v.trim().parse::<usize>().map_err(|_| format!("`{s}`: {name}={v:?} is not a whole number"))
+        };
+        let count = match n {
+            Some(n) => n.parse().map_err(|_| bad())?,
+            None => match env("SLURM_ARRAY_TASK_COUNT") {
+                Some(v) => number("SLURM_ARRAY_TASK_COUNT", &v)?,
+                None => {
+                    return Err(format!(
+                        "`{s}`: SLURM_ARRAY_TASK_COUNT is not set; give the count, e.g. auto/4"
+                    ))
+                }
+            },
+        };
+        let index = if i == "auto" {
+            if let Some(id) = env("SLURM_ARRAY_TASK_ID") {
+                let min =
+                    env("SLURM_ARRAY_TASK_MIN").map(|m| number("SLURM_ARRAY_TASK_MIN", &m)).transpose()?;
+                let id = number("SLURM_ARRAY_TASK_ID", &id)?;
+                id.checked_sub(min.unwrap_or(0)).ok_or_else(bad)? + 1
+            } else if let Some(k) = env("JOB_COMPLETION_INDEX") {
+                number("JOB_COMPLETION_INDEX", &k)? + 1
+            } else {
+                return Err(format!(
+                    "`{s}`: no engine shard index: neither SLURM_ARRAY_TASK_ID nor JOB_COMPLETION_INDEX is set \
+                     (run it as a Slurm array task or a Kubernetes Indexed Job, or give i/n)"
+                ));
+            }
+        } else {
+            i.parse().map_err(|_| bad())?
+        };
         if index == 0 || index > count {
-            return Err(bad());
+            return Err(if i == "auto" {
+                format!("`{s}`: the engine's task is shard {index}, outside 1..={count}")
+            } else {
+                bad()
+            });
         }
         Ok(Shard { index, count })
     }
@@ -61,17 +109,6 @@ impl FromStr for Shard {
 impl std::fmt::Display for Shard {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(f, "{}/{}", self.index, self.count)
-    }
-}
-
-impl Shard {
-    pub fn take(&self, scenes: Vec<SceneEntry>) -> Vec<SceneEntry> {
-        scenes
-            .into_iter()
-            .enumerate()
-            .filter(|(k, _)| k % self.count == self.index - 1)
-            .map(|(_, s)| s)
-            .collect()
     }
 }
 
@@ -142,17 +179,24 @@ mod tests {
     use super::*;
 
     #[test]
-    fn shards_partition_the_list() {
-        let scenes: Vec<SceneEntry> =
-            (0..7).map(|i| SceneEntry::new(Path::new("d"), &[format!("s{i}.ron")])).collect();
-        let a = "1/3".parse::<Shard>().unwrap().take(scenes.clone());
-        let b = "2/3".parse::<Shard>().unwrap().take(scenes.clone());
-        let c = "3/3".parse::<Shard>().unwrap().take(scenes.clone());
-        assert_eq!(a.iter().map(|s| s.rel.as_str()).collect::<Vec<_>>(), ["s0.ron", "s3.ron", "s6.ron"]);
-        assert_eq!(a.len() + b.len() + c.len(), 7);
-        for bad in ["0/2", "3/2", "1", "a/b", "1/0", ""] {
-            assert!(bad.parse::<Shard>().is_err(), "{bad}");
+    fn shard_arguments() {
+        let none = |_: &str| None;
+        assert_eq!(Shard::parse("2/3", &none), Ok(Shard { index: 2, count: 3 }));
+        for bad in ["0/2", "3/2", "1", "a/b", "1/0", "", "auto/3", "auto"] {
+            assert!(Shard::parse(bad, &none).is_err(), "{bad}");
         }
+        let slurm = |k: &str| match k {
+            "SLURM_ARRAY_TASK_ID" => Some("4".to_string()),
+            "SLURM_ARRAY_TASK_MIN" => Some("3".to_string()),
+            "SLURM_ARRAY_TASK_COUNT" => Some("5".to_string()),
+            _ => None,
+        };
+        assert_eq!(Shard::parse("auto", &slurm), Ok(Shard { index: 2, count: 5 }));
+        assert_eq!(Shard::parse("auto/2", &slurm), Ok(Shard { index: 2, count: 2 }));
+        assert!(Shard::parse("auto/1", &slurm).unwrap_err().contains("outside 1..=1"));
+        let k8s = |k: &str| (k == "JOB_COMPLETION_INDEX").then(|| "0".to_string());
+        assert_eq!(Shard::parse("auto/3", &k8s), Ok(Shard { index: 1, count: 3 }));
+        assert!(Shard::parse("auto", &k8s).unwrap_err().contains("SLURM_ARRAY_TASK_COUNT"));
     }
 
     #[test]

@@ -45,9 +45,17 @@ impl Status {
 pub struct Record {
     /// Scene file relative to the scanned folder, `/`-separated (`view_slices/torus_egg.ron`).
     pub scene: String,
-    /// The scene file as the run found it, and its reference image.
+    /// The scene file and its reference image relative to the suite root (the scanned folder),
+    /// `/`-separated, so that records written on other machines merge.
     pub scene_path: String,
     pub reference_path: String,
+    /// Fingerprint of the suite's sorted scene list: records of different suites do not merge.
+    #[serde(default)]
+    pub suite: String,
+    /// Hash of what the result depends on (scene and asset bytes, reference bytes, render size,
+    /// graphs, WGSL, the binary): a rerun skips a scene whose record has the same hash.
+    #[serde(default)]
+    pub inputs: String,
     pub status: Status,
     /// `--update` wrote the reference in this run (the scene was new, regressed or of another size).
     pub updated: bool,
@@ -75,6 +83,9 @@ pub struct Record {
     pub images: Vec<String>,
     /// `i/n` of the run that wrote this record.
     pub shard: String,
+    /// Host that wrote the record (for the report of a farm run).
+    #[serde(default)]
+    pub host: String,
     /// Seconds since 1970-01-01 UTC when the record was written.
     pub finished_unix: u64,
     pub voltex_version: String,

@@ -4,6 +4,7 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
+use super::merge::Problem;
 use super::record::{Found, Record, Status, IMAGES};
 use crate::io::atomic;
 use crate::{Error, Result};
@@ -55,22 +56,26 @@ pub fn counts(records: &[&Record]) -> String {
     s
 }
 
-/// Writes `out/index.html` from the records found under `out` (and the unreadable ones).
-pub fn write_index(out: &Path, found: &[Found], bad: &[Error]) -> Result<PathBuf> {
+/// Writes `out/index.html` from the records found under `out` (and the unreadable ones, and what
+/// the merge found wrong).
+pub fn write_index(out: &Path, found: &[Found], bad: &[Error], problems: &[Problem]) -> Result<PathBuf> {
     let path = out.join(INDEX_FILE);
-    atomic::write_bytes(&path, html(found, bad).as_bytes())?;
+    atomic::write_bytes(&path, html(found, bad, problems).as_bytes())?;
     Ok(path)
 }
 
-fn html(found: &[Found], bad: &[Error]) -> String {
+fn html(found: &[Found], bad: &[Error], problems: &[Problem]) -> String {
     let records: Vec<&Record> = found.iter().map(|f| &f.record).collect();
     let failed = records.iter().filter(|r| r.failed()).count();
     let mut h = String::from(HEAD);
-    let verdict = if failed == 0 && bad.is_empty() { "ok" } else { "failed" };
+    let verdict = if failed == 0 && bad.is_empty() && problems.is_empty() { "ok" } else { "failed" };
     let _ = writeln!(h, "<h1>voltex regress: <span class=\"{verdict}\">{verdict}</span></h1>");
     let _ = writeln!(h, "<p>{}</p>", esc(&counts(&records)));
     for e in bad {
         let _ = writeln!(h, "<p class=\"failed\">unreadable record: {}</p>", esc(&e.to_string()));
+    }
+    for p in problems {
+        let _ = writeln!(h, "<p class=\"failed\">merge: {}</p>", esc(&p.to_string()));
     }
     h += "<table>\n<tr><th>scene</th><th>status</th><th>FLIP / max</th><th>rel RMSE / max</th><th>size</th>\
           <th>GPU ms</th><th>wall ms</th><th>shard</th><th>finished (UTC)</th></tr>\n";

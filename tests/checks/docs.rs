@@ -452,9 +452,10 @@ fn link_checks_can_fail() {
 // ---------------------------------------------------------------------------------------------
 // 5. Commands
 
-/// `(line, subcommand, flags)` of every `voltex SUB ...` or `cargo run --release -- SUB ...` in
-/// code (fenced blocks and inline spans). In fenced blocks a `#` after a space starts a comment.
-fn commands(text: &str) -> Vec<(usize, String, Vec<String>)> {
+/// `(line, subcommand, next word, flags)` of every `voltex SUB ...` or `cargo run --release -- SUB
+/// ...` in code (fenced blocks and inline spans); the next word (a bare lowercase word, if any) may
+/// name a nested subcommand (`farm submit`). In fenced blocks a `#` after a space starts a comment.
+fn commands(text: &str) -> Vec<(usize, String, Option<String>, Vec<String>)> {
     let mut code: Vec<(usize, String)> = prose(text).spans;
     for b in fenced_blocks(text) {
         for (k, line) in b.text.lines().enumerate() {
@@ -481,6 +482,10 @@ fn commands(text: &str) -> Vec<(usize, String, Vec<String>)> {
                 continue;
             }
             let name: String = name.chars().take_while(|c| c.is_ascii_lowercase() || *c == '-').collect();
+            let nested = words
+                .get(sub + 1)
+                .filter(|w| w.chars().all(|c| c.is_ascii_lowercase() || c == '-') && !w.starts_with('-'))
+                .map(|w| w.to_string());
             let flags = words[sub + 1..]
                 .iter()
                 .take_while(|w| **w != "voltex" && **w != "cargo" && **w != "|" && **w != "&&")
@@ -493,7 +498,7 @@ fn commands(text: &str) -> Vec<(usize, String, Vec<String>)> {
                         .to_string()
                 })
                 .collect();
-            out.push((n, name, flags));
+            out.push((n, name, nested, flags));
         }
     }
     out
@@ -506,16 +511,26 @@ fn commands_exist() {
     let mut failures = Vec::new();
     let mut count = 0;
     for (path, text) in doc_files() {
-        for (line, sub, flags) in commands(&text) {
+        for (line, sub, nested, flags) in commands(&text) {
             count += 1;
-            let h = help.entry(sub.clone()).or_insert_with(|| {
-                let out = Command::new(exe).args([sub.as_str(), "--help"]).output().expect("runs voltex");
-                out.status.success().then(|| String::from_utf8_lossy(&out.stdout).into_owned())
-            });
+            let mut get_help = |words: Vec<&str>| {
+                help.entry(words.join(" "))
+                    .or_insert_with(|| {
+                        let out = Command::new(exe).args(&words).arg("--help").output().expect("runs voltex");
+                        out.status.success().then(|| String::from_utf8_lossy(&out.stdout).into_owned())
+                    })
+                    .clone()
+            };
+            // A nested subcommand's own help holds its flags.
+            let h = match nested.as_deref().and_then(|n| get_help(vec![sub.as_str(), n])) {
+                Some(h) => Some(h),
+                None => get_help(vec![sub.as_str()]),
+            };
             let Some(h) = h else {
                 failures.push(format!("{}:{line}: `voltex {sub}` is not a subcommand", rel(&path)));
                 continue;
             };
+            let h = &h;
             for f in flags {
                 if !has_flag(h, &f) {
                     failures.push(format!("{}:{line}: `voltex {sub}` has no flag `{f}`", rel(&path)));
@@ -538,10 +553,12 @@ fn has_flag(help: &str, flag: &str) -> bool {
 
 #[test]
 fn command_checks_can_fail() {
-    let found = commands("`voltex render x --size 8x8`, and\n```sh\ncargo run --release -- bake S --out o  # --not\n```\nprose voltex renders");
-    assert_eq!(found.len(), 2, "{:?}", found.iter().map(|c| &c.1).collect::<Vec<_>>());
-    assert_eq!((found[0].1.as_str(), found[0].2.clone()), ("render", vec!["--size".to_string()]));
-    assert_eq!((found[1].0, found[1].1.as_str(), found[1].2.clone()), (3, "bake", vec!["--out".to_string()]));
+    let found = commands("`voltex render x --size 8x8`, and\n```sh\ncargo run --release -- bake S --out o  # --not\n```\nprose voltex renders `voltex farm submit --wait`");
+    assert_eq!(found.len(), 3, "{:?}", found.iter().map(|c| &c.1).collect::<Vec<_>>());
+    assert_eq!((found[0].1.as_str(), found[0].3.clone()), ("render", vec!["--size".to_string()]));
+    // Inline spans first, then fenced blocks.
+    assert_eq!((found[1].1.as_str(), found[1].2.as_deref()), ("farm", Some("submit")));
+    assert_eq!((found[2].0, found[2].1.as_str(), found[2].3.clone()), (3, "bake", vec!["--out".to_string()]));
     assert!(has_flag("  --size <SIZE>", "--size") && !has_flag("  --sizes", "--size"));
     let exe = env!("CARGO_BIN_EXE_voltex");
     assert!(!Command::new(exe).args(["no-such-command", "--help"]).output().unwrap().status.success());

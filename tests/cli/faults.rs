@@ -92,7 +92,7 @@ fn regress_records_the_scene_a_fault_hit_and_goes_on() {
     for (fault, words) in [("device-lost@pass:1", "GPU device lost"), ("oom@pass:1", "Out of Memory")] {
         let run = voltex(&[&["regress", s(&scene_dir), "--out", s(&out)][..], &size].concat(), Some(fault));
         let err = stderr(&run);
-        assert_eq!(run.status.code(), Some(1), "{fault}: {err}");
+        assert_eq!(run.status.code(), Some(3), "{fault}: a broken scene: {err}");
         assert!(!err.contains("panicked"), "{err}");
         // The first scene met the fault; a new device (after a loss) or the same one checked the rest.
         let a = record(&out, "a");
@@ -120,7 +120,7 @@ fn regress_stops_cleanly_when_no_new_device_opens() {
         Some("device-lost@pass:1,no-device@open:2"),
     );
     let err = stderr(&run);
-    assert_eq!(run.status.code(), Some(1), "{err}");
+    assert_eq!(run.status.code(), Some(4), "no device is an engine failure: {err}");
     assert!(err.contains("error: GPU device lost") && err.contains("opening a new device failed"), "{err}");
     assert!(!err.contains("panicked"), "{err}");
     // The scene that lost the device is recorded and reported; the others were not started.
@@ -273,7 +273,7 @@ fn read_only_output_folder_fails_before_rendering() {
 
     let run = voltex(&["regress", s(&dir.join("scenes")), "--out", READ_ONLY, "--size", "32x32"], None);
     let err = stderr(&run);
-    assert_eq!(run.status.code(), Some(1), "{err}");
+    assert_eq!(run.status.code(), Some(3), "{err}");
     assert!(err.starts_with("error: /proc/self: output folder is not writable"), "{err}");
     assert!(!err.contains("[1/1]") && run.stdout.is_empty(), "nothing rendered: {err}");
     let _ = std::fs::remove_dir_all(&dir);

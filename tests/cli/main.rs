@@ -5,6 +5,7 @@ mod common;
 
 mod assets;
 mod cli_errors;
+mod farm;
 mod faults;
 mod hostile_files;
 mod install;

@@ -233,7 +233,7 @@ fn broken_scene_is_reported_and_the_others_render() {
     std::fs::copy(root().join("graphs/frame.ron"), scenes.join("graph.ron")).unwrap();
     let out = dir.join("out");
     let run = regress(&[&scenes, p("--out"), &out]);
-    assert_eq!(run.status.code(), Some(1));
+    assert_eq!(run.status.code(), Some(3), "broken input");
     let text_of_scene = std::fs::read_to_string(&broken).unwrap();
     let line = text_of_scene.lines().position(|l| l.contains("ambient: 7.0")).unwrap() + 1;
     let loc = format!("{}:{line}:14", broken.display());
@@ -266,7 +266,7 @@ fn wrong_size_garbage_and_channel_less_references_are_broken() {
     write_luminance_exr(&reference(&grey));
     let out = dir.join("out");
     let run = regress(&[&scenes, p("--out"), &out]);
-    assert_eq!(run.status.code(), Some(1));
+    assert_eq!(run.status.code(), Some(3), "broken references");
     let r = record(&out, "small");
     assert_eq!(r.status, Status::BrokenReference);
     let m = r.message.unwrap();
@@ -282,7 +282,7 @@ fn wrong_size_garbage_and_channel_less_references_are_broken() {
     // --update rewrites a reference of another size, never one it cannot read.
     let garbage_bytes = std::fs::read(reference(&garbage)).unwrap();
     let run = regress(&[&scenes, p("--out"), &out, p("--update")]);
-    assert_eq!(run.status.code(), Some(1));
+    assert_eq!(run.status.code(), Some(3), "the unreadable reference stays broken");
     assert!(record(&out, "small").updated);
     assert_eq!(voltex::io::exr::read(&reference(&small)).unwrap().0.width, 128);
     assert!(!record(&out, "garbage").updated && !record(&out, "grey").updated);
@@ -316,7 +316,7 @@ fn unwritable_output_folder_fails_before_rendering() {
     std::fs::write(dir.join("file"), "in the way").unwrap();
     let out = dir.join("file/out");
     let run = regress(&[&scenes, p("--out"), &out]);
-    assert_eq!(run.status.code(), Some(1));
+    assert_eq!(run.status.code(), Some(3));
     let err = String::from_utf8_lossy(&run.stderr);
     assert!(err.starts_with("error: ") && err.contains("cannot create the output folder"), "{err}");
     assert!(err.contains(&out.display().to_string()), "{err}");
@@ -332,13 +332,15 @@ fn shards_merge_into_one_report() {
         flat_box(&scenes, name, true, same);
     }
     let out = dir.join("out");
-    // Sorted: a.ron, c.ron, sub/b.ron; shard 1/2 takes indices 0 and 2, shard 2/2 index 1.
+    // Sorted: a.ron, c.ron, sub/b.ron; their estimates are equal, so the plan deals them out in
+    // order: shard 1/2 takes a.ron and sub/b.ron, shard 2/2 c.ron.
     let first = regress(&[&scenes, p("--out"), &out, p("--shard"), p("1/2")]);
     let stdout = String::from_utf8_lossy(&first.stdout);
     assert!(
-        stdout.contains("a.ron") && stdout.contains("sub/b.ron") && !stdout.contains("c.ron"),
+        stdout.contains("a.ron") && stdout.contains("sub/b.ron") && !stdout.contains("\nc.ron "),
         "{stdout}"
     );
+    assert!(stdout.contains("note: shard 2/2: missing"), "{stdout}");
     let second = regress(&[&scenes, p("--out"), &out, p("--shard"), p("2/2"), p("--jobs"), p("2")]);
     assert_eq!((first.status.code(), second.status.code()), (Some(0), Some(0)));
     let html = index(&out);
@@ -368,21 +370,127 @@ fn shards_merge_into_one_report() {
 }
 
 #[test]
+fn results_travel_and_current_scenes_are_not_rendered_again() {
+    let dir = Temp::new("resume");
+    let scenes = dir.join("scenes");
+    for name in ["a.ron", "c.ron", "sub/b.ron"] {
+        flat_box(&scenes, name, true, same);
+    }
+    let out = dir.join("out");
+    let first = regress(&[&scenes, p("--out"), &out]);
+    assert_eq!(first.status.code(), Some(0));
+    // Paths relative to the suite root, so that records from other machines merge.
+    let b = record(&out, "sub/b");
+    assert_eq!((b.scene_path.as_str(), b.reference_path.as_str()), ("sub/b.ron", "sub/b.ref.exr"));
+    assert!(!b.suite.is_empty() && !b.inputs.is_empty());
+    let junit = std::fs::read_to_string(out.join("junit.xml")).unwrap();
+    assert!(junit.contains("tests=\"3\" failures=\"0\" errors=\"0\""), "{junit}");
+    assert!(junit.contains("<testcase classname=\"sub\" name=\"b.ron\""), "{junit}");
+
+    // Nothing changed: nothing is rendered; a changed scene is, and --force renders all.
+    let before = std::fs::read(out.join("a/result.json")).unwrap();
+    let again = regress(&[&scenes, p("--out"), &out]);
+    assert_eq!(again.status.code(), Some(0));
+    assert!(text(&again).contains("3 scene(s) current"), "{}", text(&again));
+    assert_eq!(std::fs::read(out.join("a/result.json")).unwrap(), before);
+    let c = scenes.join("c.ron");
+    std::fs::write(&c, std::fs::read_to_string(&c).unwrap() + "// changed\n").unwrap();
+    perturb(&reference(&scenes.join("a.ron")));
+    let changed = regress(&[&scenes, p("--out"), &out, p("--junit"), &dir.join("j.xml")]);
+    assert_eq!(changed.status.code(), Some(1), "a's reference was perturbed");
+    assert!(text(&changed).contains("1 scene(s) current"), "{}", text(&changed));
+    assert_eq!(record(&out, "a").status, Status::Regressed);
+    let junit = std::fs::read_to_string(dir.join("j.xml")).unwrap();
+    assert!(junit.contains("<failure type=\"regressed\""), "{junit}");
+    // --json: the summary for scripts on stdout, -q: no progress.
+    let forced = regress(&[&scenes, p("--out"), &out, p("--force"), p("--json"), p("-q")]);
+    assert_eq!(forced.status.code(), Some(1));
+    let json: serde_json::Value = serde_json::from_slice(&forced.stdout).unwrap();
+    assert_eq!((json["verdict"].as_str(), json["exit_code"].as_u64()), (Some("regressions"), Some(1)));
+    assert_eq!((json["counts"]["regressed"].as_u64(), json["counts"]["pass"].as_u64()), (Some(1), Some(2)));
+    assert_eq!(json["counts"]["current_not_rendered"].as_u64(), Some(0), "--force renders all");
+    assert_eq!(json["failed"][0]["scene"].as_str(), Some("a.ron"));
+    assert!(!String::from_utf8_lossy(&forced.stderr).contains("[1/3"), "-q: no progress");
+}
+
+#[test]
+fn merge_reports_missing_shards_duplicates_and_other_suites() {
+    let dir = Temp::new("merge");
+    let scenes = dir.join("scenes");
+    for name in ["a.ron", "c.ron", "sub/b.ron"] {
+        flat_box(&scenes, name, true, same);
+    }
+    // The plan, without rendering: equal estimates deal the scenes out in order.
+    let plan = regress(&[&scenes, p("--out"), &dir.join("out"), p("--plan-shards"), p("2")]);
+    assert_eq!(plan.status.code(), Some(0));
+    let plan = String::from_utf8_lossy(&plan.stdout).into_owned();
+    assert!(plan.contains("predicted makespan") && plan.contains("estimate"), "{plan}");
+    assert!(!dir.join("out").exists(), "--plan-shards renders and writes nothing");
+
+    // One of two shards: its own run passes, the merge names the missing shard.
+    let one = dir.join("one");
+    assert_eq!(regress(&[&scenes, p("--out"), &one, p("--shard"), p("2/2")]).status.code(), Some(0));
+    let merge = regress(&[p("--report-only"), &one]);
+    assert_eq!(merge.status.code(), Some(3), "a merge with problems is broken input");
+    assert!(text(&merge).contains("shard 1/2: missing"), "{}", text(&merge));
+    assert!(std::fs::read_to_string(one.join("junit.xml")).unwrap().contains("name=\"shard 1/2\""));
+    // A shard that died: its manifest never says finished.
+    let died = dir.join("died");
+    assert_eq!(regress(&[&scenes, p("--out"), &died, p("--shard"), p("1/2")]).status.code(), Some(0));
+    common::copy_dir(&one, &died);
+    let manifest = died.join(".voltex/shard-1-of-2.json");
+    let mut m: serde_json::Value = serde_json::from_slice(&std::fs::read(&manifest).unwrap()).unwrap();
+    m["finished_unix"] = serde_json::Value::Null;
+    std::fs::write(&manifest, m.to_string()).unwrap();
+    std::fs::remove_dir_all(died.join("a")).unwrap();
+    let merge = regress(&[p("--report-only"), &died]);
+    assert!(
+        text(&merge).contains("shard 1/2: started on") && text(&merge).contains("did not finish"),
+        "{}",
+        text(&merge)
+    );
+    assert_eq!(merge.status.code(), Some(3));
+
+    // Both shards: the merge passes; shard folders copied side by side are duplicates.
+    let both = dir.join("both");
+    common::copy_dir(&one, &both);
+    assert_eq!(regress(&[&scenes, p("--out"), &both, p("--shard"), p("1/2")]).status.code(), Some(0));
+    assert_eq!(regress(&[p("--report-only"), &both]).status.code(), Some(0));
+    common::copy_dir(&one, &both.join("copied"));
+    let merge = regress(&[p("--report-only"), &both]);
+    assert_eq!(merge.status.code(), Some(3));
+    assert!(text(&merge).contains("c.ron: duplicate records in c, copied/c"), "{}", text(&merge));
+    std::fs::remove_dir_all(both.join("copied")).unwrap();
+    // A record of another suite.
+    let mut r = record(&both, "c");
+    r.suite = "0123456789abcdef".into();
+    r.write(&both.join("c")).unwrap();
+    let merge = regress(&[p("--report-only"), &both]);
+    assert_eq!(merge.status.code(), Some(3));
+    assert!(text(&merge).contains("results from different suites"), "{}", text(&merge));
+}
+
+#[test]
 fn bad_arguments() {
     let dir = Temp::new("args");
     let run = regress(&[&dir.join("missing")]);
-    assert_eq!(run.status.code(), Some(1));
+    assert_eq!(run.status.code(), Some(3));
     assert!(String::from_utf8_lossy(&run.stderr).contains("missing"));
     let run = regress(&[&dir]);
-    assert_eq!(run.status.code(), Some(1), "a folder without scenes");
+    assert_eq!(run.status.code(), Some(3), "a folder without scenes");
     assert!(String::from_utf8_lossy(&run.stderr).contains("no scene files"));
     for shard in ["0/2", "3/2", "x"] {
         let run = regress(&[&dir, p("--shard"), p(shard)]);
         assert_ne!(run.status.code(), Some(0));
         assert!(String::from_utf8_lossy(&run.stderr).contains("expected a shard i/n"));
     }
+    let run = regress(&[&dir, p("--shard"), p("auto/2")]);
+    assert_ne!(run.status.code(), Some(0));
+    assert!(
+        String::from_utf8_lossy(&run.stderr).contains("neither SLURM_ARRAY_TASK_ID nor JOB_COMPLETION_INDEX")
+    );
     assert_ne!(regress(&[&dir, p("--jobs"), p("0")]).status.code(), Some(0));
-    assert_eq!(regress(&[p("--report-only"), &dir]).status.code(), Some(1), "no records");
+    assert_eq!(regress(&[p("--report-only"), &dir]).status.code(), Some(3), "no records");
 }
 
 #[test]
