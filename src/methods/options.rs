@@ -37,6 +37,8 @@ pub struct RenderOptions {
     pub time: Option<f64>,
     /// AxisSlices occlusion culling for every AxisSlices object (`--occlusion-culling`).
     pub occlusion_culling: Option<bool>,
+    /// RayMarch objects' step times this (after `step`; a converged truth).
+    pub step_scale: Option<f64>,
 }
 
 /// A method without its knobs, to switch every object to it (`--method`).
@@ -71,8 +73,10 @@ impl RenderOptions {
                 Some(m) => m.map(|max_step| crate::scene::Adaptive { max_step }),
                 None => rm.adaptive,
             };
+            let step = self.step.or(rm.step);
+            let step = self.step_scale.map_or(step, |k| Some(k * step.unwrap_or(rm.step())));
             return Method::RayMarch(RayMarch {
-                step: self.step.or(rm.step),
+                step,
                 segments: self.segments.unwrap_or(rm.segments),
                 adaptive,
                 ..*rm

@@ -10,7 +10,7 @@ use super::{shards, Args, RunInfo};
 use crate::gpu::GpuContext;
 use crate::io::{self, Image};
 use crate::metrics;
-use crate::render::{Blueprint, RenderOptions, Renderer};
+use crate::render::{Blueprint, MethodKind, RenderOptions, Renderer};
 use crate::scene::{self, Regress};
 use crate::{Error, Result};
 
@@ -56,6 +56,8 @@ pub(super) fn check(ctx: &GpuContext, run: &RunInfo, entry: &SceneEntry) -> Resu
         rel_rmse: None,
         max_flip: defaults.max_flip,
         max_rel_rmse: defaults.max_rel_rmse,
+        truth_flip: None,
+        max_truth_flip: None,
         nonfinite_pixels: None,
         gpu_ms: None,
         wall_ms: 0.0,
@@ -87,9 +89,14 @@ pub(super) fn check(ctx: &GpuContext, run: &RunInfo, entry: &SceneEntry) -> Resu
         }
         rec.max_flip = opts.max_flip.unwrap_or(scene.regress.max_flip);
         rec.max_rel_rmse = opts.max_rel_rmse.unwrap_or(scene.regress.max_rel_rmse);
-        std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| render(ctx, &scene, size, &mut rec)))
-            .unwrap_or_else(|p| Err(Error::file(&entry.path, super::panic_text(&p))))
-            .map(Some)
+        rec.max_truth_flip = scene.regress.truth.filter(|_| !opts.no_truth).map(|t| t.max_flip);
+        std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+            let frame = render(ctx, &scene, size, &mut rec)?;
+            let truth = if opts.no_truth { None } else { truth(ctx, &scene, size)? };
+            Ok((frame, truth))
+        }))
+        .unwrap_or_else(|p| Err(Error::file(&entry.path, super::panic_text(&p))))
+        .map(Some)
     });
     let rendered = match rendered {
         Ok(None) => {
@@ -100,8 +107,12 @@ pub(super) fn check(ctx: &GpuContext, run: &RunInfo, entry: &SceneEntry) -> Resu
         Err(e) => Err(e),
     };
     match rendered {
-        Ok(frame) => {
-            compare(opts, entry, &folder, &frame, &mut rec)?;
+        Ok((frame, truth)) => {
+            let true_enough = match truth {
+                Some(t) => measure_truth(&frame.image, &t, &folder, &mut rec)?,
+                None => true,
+            };
+            compare(opts, entry, &folder, &frame, true_enough, &mut rec)?;
             if rec.updated {
                 // The reference is part of the inputs, and this run rewrote it.
                 rec.inputs = shards::inputs_hash(&scene_hash, entry);
@@ -158,8 +169,42 @@ fn render(ctx: &GpuContext, scene: &scene::Scene, size: (u32, u32), rec: &mut Re
     Ok(Rendered { gpu_ms: frame.gpu_ms(), image: frame.image, metadata })
 }
 
-/// Writes the render, compares it with the reference, and updates the reference if asked.
-fn compare(opts: &Args, entry: &SceneEntry, folder: &Path, frame: &Rendered, rec: &mut Record) -> Result<()> {
+/// The scene's independent truth at `size` (see `scene::Truth`), if it states a bound.
+fn truth(ctx: &GpuContext, scene: &scene::Scene, size: (u32, u32)) -> Result<Option<Image>> {
+    let Some(t) = scene.regress.truth else { return Ok(None) };
+    let opts = RenderOptions {
+        size: Some(size),
+        method: Some(MethodKind::Reference),
+        step_scale: Some(t.step_scale),
+        segments: Some(scene::Segments::Bounds),
+        max_step: Some(None),
+        ..Default::default()
+    };
+    let mut renderer = Renderer::new(ctx, Blueprint::new(scene, &opts)?)?;
+    Ok(Some(renderer.render(ctx)?.image))
+}
+
+/// FLIP of the render against its truth (written as `truth.png`); a render beyond the bound
+/// regresses. Whether it is within.
+fn measure_truth(image: &Image, truth: &Image, folder: &Path, rec: &mut Record) -> Result<bool> {
+    io::png::write_tonemapped(&folder.join("truth.png"), truth)?;
+    rec.images.push("truth.png".into());
+    let flip = metrics::flip(image, truth)?.mean;
+    rec.truth_flip = flip.is_finite().then_some(flip);
+    let bound = rec.max_truth_flip.unwrap_or(1.0);
+    Ok(flip <= bound)
+}
+
+/// Writes the render, compares it with the reference, and updates the reference if asked and
+/// the render is within its truth bound.
+fn compare(
+    opts: &Args,
+    entry: &SceneEntry,
+    folder: &Path,
+    frame: &Rendered,
+    true_enough: bool,
+    rec: &mut Record,
+) -> Result<()> {
     let image = &frame.image;
     rec.size = Some([image.width, image.height]);
     rec.gpu_ms = frame.gpu_ms;
@@ -212,8 +257,26 @@ fn compare(opts: &Args, entry: &SceneEntry, folder: &Path, frame: &Rendered, rec
             None => note,
         });
     }
+    if !true_enough {
+        // Unchanged or not, a render this far from the truth is wrong.
+        let note = format!(
+            "mean FLIP {:.5} against the truth > {} (regress.truth)",
+            rec.truth_flip.unwrap_or(f64::NAN),
+            rec.max_truth_flip.unwrap_or(1.0)
+        );
+        if rec.status == Status::Pass {
+            rec.status = Status::Regressed;
+        }
+        rec.message = Some(match rec.message.take() {
+            Some(m) => format!("{m}; {note}"),
+            None => note,
+        });
+    }
     let rewrite = matches!(rec.status, Status::New | Status::Regressed) || size_mismatch;
-    if opts.update && rewrite {
+    if opts.update && rewrite && !true_enough {
+        let what = format!("--update refused: {} would break its truth bound", entry.reference.display());
+        rec.message = rec.message.take().map(|m| format!("{m}; {what}"));
+    } else if opts.update && rewrite {
         let mut meta = meta;
         meta.push(("voltex_regress_scene", entry.rel.clone()));
         io::exr::write(&entry.reference, image, &meta)?;

@@ -73,6 +73,11 @@ pub struct Args {
     /// Relative RMSE a scene may reach, for every scene (default: each scene's regress.max_rel_rmse).
     #[arg(long, value_parser = parse_max_rel_rmse)]
     pub max_rel_rmse: Option<f64>,
+    /// Skip the truth renders (`regress.truth`): check only "unchanged against the reference".
+    /// Faster (a truth render costs a Reference or fine-step render); refused with `--update`,
+    /// which must never accept a reference beyond its truth bound.
+    #[arg(long, conflicts_with = "update")]
+    pub no_truth: bool,
     /// Render scenes whose record is current too (same scene, assets, reference, size, graphs,
     /// WGSL and binary); without it they are kept and not rendered again.
     #[arg(long)]
@@ -96,7 +101,7 @@ pub struct Args {
     #[arg(short, long)]
     pub verbose: bool,
     /// Render nothing: rebuild OUT/index.html from the records under OUT (after merging shards).
-    #[arg(long, value_name = "OUT", conflicts_with_all = ["dir", "out", "update", "size", "jobs", "shard", "force", "max_flip", "max_rel_rmse"])]
+    #[arg(long, value_name = "OUT", conflicts_with_all = ["dir", "out", "update", "size", "jobs", "shard", "force", "max_flip", "max_rel_rmse", "no_truth"])]
     pub report_only: Option<PathBuf>,
 }
 
@@ -321,7 +326,13 @@ pub fn run(args: &Args) -> Result<Outcome> {
         folders.iter().try_for_each(|d| check_writable_dir(d))?;
     }
     // Thresholds given on the command line change verdicts as much as the binary does.
-    let toolchain = format!("{}/{:?}/{:?}", shards::toolchain_hash()?, args.max_flip, args.max_rel_rmse);
+    let toolchain = format!(
+        "{}/{:?}/{:?}/{}",
+        shards::toolchain_hash()?,
+        args.max_flip,
+        args.max_rel_rmse,
+        args.no_truth
+    );
     let info = RunInfo { args, shard, suite, toolchain, host: shards::host() };
     if let Some(other) = shards::running_elsewhere(&args.out, shard) {
         return Err(Error::file(

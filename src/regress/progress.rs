@@ -132,6 +132,9 @@ pub(super) fn result_line(rec: &Record) -> String {
         if let Some(g) = rec.gpu_ms {
             s += &format!(", {g:.1} ms GPU");
         }
+        if let Some(t) = rec.truth_flip {
+            s += &format!(", FLIP {t:.5} against the truth");
+        }
         s += ")";
     }
     if let Some(m) = rec.message.as_ref().filter(|_| rec.status != Status::Pass || rec.updated) {

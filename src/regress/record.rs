@@ -12,10 +12,10 @@ use crate::{Error, Result};
 pub const RECORD_FILE: &str = "result.json";
 
 /// Images a scene's output folder may hold, in the order the report shows them.
-pub const IMAGES: [&str; 3] = ["reference.png", "actual.png", "diff.png"];
+pub const IMAGES: [&str; 4] = ["reference.png", "actual.png", "diff.png", "truth.png"];
 
 /// Artefacts a run writes into a scene's folder besides the record; others are never touched.
-pub const ARTEFACTS: [&str; 4] = ["reference.png", "actual.png", "diff.png", "actual.exr"];
+pub const ARTEFACTS: [&str; 5] = ["reference.png", "actual.png", "diff.png", "truth.png", "actual.exr"];
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -70,6 +70,12 @@ pub struct Record {
     pub rel_rmse: Option<f64>,
     pub max_flip: f64,
     pub max_rel_rmse: f64,
+    /// Mean FLIP of the render against the scene's independent truth, and its bound (`None`:
+    /// the scene states no `regress.truth`).
+    #[serde(default)]
+    pub truth_flip: Option<f64>,
+    #[serde(default)]
+    pub max_truth_flip: Option<f64>,
     /// Pixels of the render with a NaN or infinite channel.
     pub nonfinite_pixels: Option<usize>,
     /// GPU time of the frame from timestamp queries (none without TIMESTAMP_QUERY).

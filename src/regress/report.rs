@@ -20,18 +20,21 @@ fn metric(v: Option<f64>) -> String {
 pub fn summary_table<'a>(records: impl IntoIterator<Item = &'a Record>) -> String {
     let records: Vec<&Record> = records.into_iter().collect();
     let w = records.iter().map(|r| r.scene.len()).max().unwrap_or(0).max(5);
-    let mut s =
-        format!("{:<w$}  {:<22} {:>9} {:>9} {:>9}\n", "scene", "status", "FLIP", "rel RMSE", "GPU ms");
+    let mut s = format!(
+        "{:<w$}  {:<22} {:>9} {:>9} {:>9} {:>9}\n",
+        "scene", "status", "FLIP", "rel RMSE", "GPU ms", "truth"
+    );
     for r in &records {
         let status =
             if r.updated { format!("{} (updated)", r.status.label()) } else { r.status.label().into() };
         let gpu = r.gpu_ms.map(|g| format!("{g:.1}")).unwrap_or_else(|| "-".into());
         let _ = writeln!(
             s,
-            "{:<w$}  {status:<22} {:>9} {:>9} {gpu:>9}",
+            "{:<w$}  {status:<22} {:>9} {:>9} {gpu:>9} {:>9}",
             r.scene,
             metric(r.flip),
-            metric(r.rel_rmse)
+            metric(r.rel_rmse),
+            metric(r.truth_flip)
         );
     }
     s + &counts(&records) + "\n"
@@ -77,7 +80,7 @@ fn html(found: &[Found], bad: &[Error], problems: &[Problem]) -> String {
     for p in problems {
         let _ = writeln!(h, "<p class=\"failed\">merge: {}</p>", esc(&p.to_string()));
     }
-    h += "<table>\n<tr><th>scene</th><th>status</th><th>FLIP / max</th><th>rel RMSE / max</th><th>size</th>\
+    h += "<table>\n<tr><th>scene</th><th>status</th><th>FLIP / max</th><th>rel RMSE / max</th><th>truth FLIP / max</th><th>size</th>\
           <th>GPU ms</th><th>wall ms</th><th>shard</th><th>finished (UTC)</th></tr>\n";
     for (i, f) in found.iter().enumerate() {
         let r = &f.record;
@@ -85,7 +88,7 @@ fn html(found: &[Found], bad: &[Error], problems: &[Problem]) -> String {
         let gpu = r.gpu_ms.map(|g| format!("{g:.1}")).unwrap_or_else(|| "-".into());
         let _ = writeln!(
             h,
-            "<tr><td><a href=\"#s{i}\">{}</a></td><td>{}</td><td>{} / {}</td><td>{} / {}</td><td>{size}</td>\
+            "<tr><td><a href=\"#s{i}\">{}</a></td><td>{}</td><td>{} / {}</td><td>{} / {}</td><td>{} / {}</td><td>{size}</td>\
              <td>{gpu}</td><td>{:.0}</td><td>{}</td><td>{}</td></tr>",
             esc(&r.scene),
             badge(r),
@@ -93,6 +96,8 @@ fn html(found: &[Found], bad: &[Error], problems: &[Problem]) -> String {
             r.max_flip,
             metric(r.rel_rmse),
             r.max_rel_rmse,
+            metric(r.truth_flip),
+            r.max_truth_flip.map_or("-".into(), |m| m.to_string()),
             r.wall_ms,
             esc(&r.shard),
             utc(r.finished_unix)

@@ -71,6 +71,27 @@ pub struct Regress {
     /// Largest relative RMSE (linear HDR) against the reference that passes.
     #[serde(default = "default_max_rel_rmse", deserialize_with = "v::non_negative")]
     pub max_rel_rmse: f64,
+    /// The error bound against an independent truth (see [`Truth`]).
+    #[serde(default)]
+    pub truth: Option<Truth>,
+}
+
+/// `truth: (max_flip: 0.05)`: the scene rendered as its truth (textured objects by the exact
+/// Reference method; hypertextures ray-marched at `step_scale` times their step, without
+/// adaptive stride or segments) at the regress size; the render must be within `max_flip`
+/// mean FLIP of it, or `voltex regress` fails the scene and `--update` writes no reference.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Truth {
+    #[serde(deserialize_with = "v::unit")]
+    pub max_flip: f64,
+    /// RayMarch objects' step in the truth, as a fraction of theirs.
+    #[serde(default = "default_step_scale", deserialize_with = "v::positive")]
+    pub step_scale: f64,
+}
+
+fn default_step_scale() -> f64 {
+    0.25
 }
 
 fn default_max_flip() -> f64 {
@@ -82,7 +103,12 @@ fn default_max_rel_rmse() -> f64 {
 
 impl Default for Regress {
     fn default() -> Self {
-        Regress { size: None, max_flip: default_max_flip(), max_rel_rmse: default_max_rel_rmse() }
+        Regress {
+            size: None,
+            max_flip: default_max_flip(),
+            max_rel_rmse: default_max_rel_rmse(),
+            truth: None,
+        }
     }
 }
 

@@ -9,5 +9,6 @@ mod io_metrics;
 mod layers;
 mod scene_errors;
 mod strict;
+mod truth;
 mod twins;
 mod types_layout;

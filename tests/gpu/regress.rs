@@ -52,12 +52,19 @@ impl Drop for Temp {
 fn flat_box(dir: &Path, name: &str, with_reference: bool, edit: impl Fn(String) -> String) -> PathBuf {
     let path = dir.join(name);
     std::fs::create_dir_all(path.parent().unwrap()).unwrap();
-    let text = std::fs::read_to_string(example("flat_box.ron")).unwrap();
+    let text = without_truth(std::fs::read_to_string(example("flat_box.ron")).unwrap());
     std::fs::write(&path, edit(text)).unwrap();
     if with_reference {
         std::fs::copy(example("flat_box.ref.exr"), reference(&path)).unwrap();
     }
     path
+}
+
+/// The scene without its `regress.truth` bound: the tests of "unchanged" render no truth.
+fn without_truth(text: String) -> String {
+    let Some(at) = text.find(", truth: (") else { return text };
+    let end = at + text[at..].find(')').unwrap() + 1;
+    format!("{}{}", &text[..at], &text[end..])
 }
 
 fn same(text: String) -> String {
@@ -495,7 +502,7 @@ fn bad_arguments() {
 
 #[test]
 fn regress_field_is_checked_at_its_position() {
-    let base = std::fs::read_to_string(example("flat_box.ron")).unwrap();
+    let base = without_truth(std::fs::read_to_string(example("flat_box.ron")).unwrap());
     let parse = |regress: &str| {
         let text = base.replace("regress: (size: (128, 128)),", regress);
         voltex::scene::parse(&text, Path::new("s.ron")).map(|s| s.regress).map_err(|e| e.to_string())
@@ -516,13 +523,64 @@ fn regress_field_is_checked_at_its_position() {
 }
 
 /// The example scenes against their committed references: `cargo test --release` runs the
-/// regression suite this way.
+/// regression suite this way, without the truth renders (a few minutes more on software Vulkan;
+/// `truth_bounds_of_the_hard_cases_hold` checks the truth of one folder).
 #[test]
 fn example_scenes_match_their_references() {
     let dir = Temp::new("examples");
     let out = dir.join("out");
     let start = std::time::Instant::now();
-    let run = regress(&[&root().join("scenes"), p("--out"), &out, p("--jobs"), p("2")]);
+    let run = regress(&[&root().join("scenes"), p("--out"), &out, p("--jobs"), p("2"), p("--no-truth")]);
     eprintln!("voltex regress scenes/: {:.1} s", start.elapsed().as_secs_f64());
     assert_eq!(run.status.code(), Some(0), "see {}", out.join("index.html").display());
+}
+
+/// `regress.truth`: the render is measured against the scene's independent truth (the Reference
+/// method here); beyond the bound the scene fails and `--update` writes no reference; within
+/// it, `--update` writes one and the record holds the measured FLIP.
+#[test]
+fn truth_bound_fails_a_wrong_render_and_refuses_update() {
+    let dir = Temp::new("truth");
+    let bound = |max: &str| {
+        let max = max.to_string();
+        move |t: String| {
+            t.replace(
+                "regress: (size: (128, 128))",
+                &format!("regress: (size: (32, 32), truth: (max_flip: {max}))"),
+            )
+        }
+    };
+    let tight = flat_box(&dir.join("tight"), "flat_box.ron", false, bound("0.0"));
+    let out = dir.join("out");
+    let run = regress(&[p("--update"), &dir.join("tight"), p("--out"), &out]);
+    assert_eq!(run.status.code(), Some(1), "{}", text(&run));
+    let r = record(&out, "flat_box");
+    assert!(r.truth_flip.is_some_and(|f| f > 0.0), "{r:?}");
+    assert_eq!(r.max_truth_flip, Some(0.0));
+    let m = r.message.clone().unwrap_or_default();
+    assert!(m.contains("against the truth > 0") && m.contains("--update refused"), "{m}");
+    assert!(!r.updated && !reference(&tight).exists(), "no reference from a render beyond its truth bound");
+    assert!(files(&out.join("flat_box")).contains(&"truth.png".to_string()));
+
+    let loose = flat_box(&dir.join("loose"), "flat_box.ron", false, bound("0.5"));
+    let out = dir.join("out2");
+    let run = regress(&[p("--update"), &dir.join("loose"), p("--out"), &out]);
+    assert!(run.status.success(), "{}", text(&run));
+    let r = record(&out, "flat_box");
+    assert!(r.updated && reference(&loose).exists(), "{r:?}");
+    let flip = r.truth_flip.unwrap();
+    assert!(flip > 0.0 && flip < 0.5, "{flip}");
+    assert!(text(&run).contains(&format!("{flip:.5}")), "the table shows the truth FLIP: {}", text(&run));
+}
+
+/// The hard cases against their truth bounds (`regress.truth`, set from measurement): the
+/// example suite above runs with `--no-truth`, this folder with its truth renders.
+#[test]
+fn truth_bounds_of_the_hard_cases_hold() {
+    let dir = Temp::new("hard-truth");
+    let out = dir.join("out");
+    let run = regress(&[&root().join("scenes/hard_cases"), p("--out"), &out, p("--jobs"), p("2")]);
+    assert_eq!(run.status.code(), Some(0), "see {}", out.join("index.html").display());
+    let r = record(&out, "thin_shell");
+    assert!(r.truth_flip.is_some() && r.max_truth_flip.is_some(), "{r:?}");
 }
