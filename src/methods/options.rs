@@ -37,6 +37,8 @@ pub struct RenderOptions {
     pub time: Option<f64>,
     /// AxisSlices occlusion culling for every AxisSlices object (`--occlusion-culling`).
     pub occlusion_culling: Option<bool>,
+    /// GPU memory the frame may allocate (`--budget`; default `gpu::budget::DEFAULT_BUDGET`).
+    pub budget: Option<u64>,
 }
 
 /// A method without its knobs, to switch every object to it (`--method`).

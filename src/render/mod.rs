@@ -1,8 +1,11 @@
 //! From a scene to an image: a [`Blueprint`] (CPU only: objects, shells, plane sweeps, bakes and
 //! the pruned graph plan, enough for `voltex plan`), then a [`Renderer`] holding the GPU resources.
 
+mod budget;
 mod describe;
 mod renderer;
+
+pub use budget::Positions;
 
 pub use crate::methods::options::{MethodKind, RenderOptions, DEFAULT_AXIS_SLICES, DEFAULT_PLANES};
 pub use crate::methods::{BakePlan, ObjectPlan};
@@ -55,6 +58,10 @@ pub struct Blueprint {
     pub bakes: Vec<BakePlan>,
     pub graph: Graph,
     pub plan: Plan,
+    /// GPU memory the frame may allocate (`RenderOptions::budget` or the default).
+    pub budget: u64,
+    /// Where the values that size the allocations are written, for the limit checks' errors.
+    pub positions: Positions,
 }
 
 /// The bake of `texel` with the scene's first light baked in (what `voltex bake` writes out).
@@ -145,6 +152,8 @@ impl Blueprint {
             bakes,
             graph,
             plan,
+            budget: opts.budget.unwrap_or(crate::gpu::budget::DEFAULT_BUDGET),
+            positions: Positions::of(scene, opts.size.is_some()),
         })
     }
 }

@@ -90,9 +90,10 @@ fn sparse_giant_and_fifo_as_obj_paths() {
     let big = std::fs::File::create(dir.join("big.obj")).unwrap();
     big.set_len(6 << 30).unwrap();
     mkfifo(&dir.join("pipe.obj"));
-    for (name, words) in
-        [("big.obj", ["at most 256.0 MiB", "VOLTEX_MAX_FILE_BYTES"]), ("pipe.obj", ["found a FIFO", "mesh file"])]
-    {
+    for (name, words) in [
+        ("big.obj", ["at most 256.0 MiB", "VOLTEX_MAX_FILE_BYTES"]),
+        ("pipe.obj", ["found a FIFO", "mesh file"]),
+    ] {
         let text = flat_box_with(&format!("Obj(path: \"{name}\")"));
         let scene = dir.join("scene.ron");
         std::fs::write(&scene, &text).unwrap();
