@@ -48,6 +48,17 @@ impl Positions {
     }
 }
 
+impl Positions {
+    /// `e`, a planning error of object `name` without a position, at the node's name (the
+    /// method's knobs and surface that sized the work are in that node).
+    pub fn at_object(&self, name: &str, e: Error) -> Error {
+        match (e, self.objects.iter().find(|o| o.0 == name)) {
+            (Error::Invalid(msg), Some((_, loc))) => Error::at(loc.clone(), msg),
+            (e, _) => e,
+        }
+    }
+}
+
 fn collect_names<'a>(nodes: &'a [crate::scene::Node], out: &mut Vec<&'a str>) {
     for n in nodes {
         out.push(&n.name);

@@ -122,9 +122,13 @@ impl Blueprint {
         let mut bakes: Vec<BakePlan> = Vec::new();
         let time = opts.time.unwrap_or(scene.time);
         let mut cx = PlanCx { scene, view: &view, light: &light, time, bakes: &mut bakes };
+        let positions = Positions::of(scene, opts.size.is_some());
         let mut objects = objects
             .into_iter()
-            .map(|o| crate::methods::plan_object(&mut cx, o, opts))
+            .map(|o| {
+                let name = o.name.clone();
+                crate::methods::plan_object(&mut cx, o, opts).map_err(|e| positions.at_object(&name, e))
+            })
             .collect::<Result<Vec<_>>>()?;
         let (graph, sources) = load_graph(opts.graph.as_deref())?;
         let groups = crate::methods::gather(&mut objects, &bakes, &view);
@@ -153,7 +157,7 @@ impl Blueprint {
             graph,
             plan,
             budget: opts.budget.unwrap_or(crate::gpu::budget::DEFAULT_BUDGET),
-            positions: Positions::of(scene, opts.size.is_some()),
+            positions,
         })
     }
 }

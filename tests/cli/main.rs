@@ -8,4 +8,5 @@ mod faults;
 mod gltf;
 mod hostile_files;
 mod install;
+mod maxima;
 mod preview_window;
