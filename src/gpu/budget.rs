@@ -75,7 +75,8 @@ pub fn over_limit(a: &Allocation, limits: &wgpu::Limits) -> Option<String> {
     };
     let bytes = |max: u64, name: &str| {
         (a.bytes > max).then(|| {
-            format!("{} needs {} in one allocation: beyond the {name} of {}", a.what, mib(a.bytes), mib(max))
+            let need = crate::input::bytes(a.bytes);
+            format!("{} needs {need} in one allocation: beyond the {name} of {}", a.what, mib(max))
         })
     };
     match a.shape {
