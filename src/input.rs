@@ -45,7 +45,8 @@ pub fn cap(kind: Kind) -> Result<u64> {
     }
 }
 
-fn parse_bytes(v: &str) -> Option<u64> {
+/// A byte count, or one with a `K`, `M` or `G` suffix (binary units).
+pub fn parse_bytes(v: &str) -> Option<u64> {
     let (digits, shift) = match v.as_bytes().last()?.to_ascii_uppercase() {
         b'K' => (&v[..v.len() - 1], 10),
         b'M' => (&v[..v.len() - 1], 20),

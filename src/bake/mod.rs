@@ -9,6 +9,7 @@ use crate::gpu::sources::Sources;
 
 use crate::cpu::bake::PackedShapes;
 use crate::error::{Error, Result};
+use crate::gpu::budget::{Allocation, Driver, Shape};
 use crate::gpu::buffers::{storage, uniform};
 use crate::gpu::kernel::ComputeKernel;
 use crate::gpu::GpuContext;
@@ -135,6 +136,44 @@ impl BakeRequest {
                 format!("texel {texel} slice images (s, t, w; all levels) rgba16f"),
                 axis_slices::bytes(self.resolution),
             ));
+        }
+        out
+    }
+
+    /// Each texture and large buffer of the bake of `texel`, for the checks against the limits.
+    pub fn allocations(&self, texel: &str) -> Vec<Allocation> {
+        let res = self.resolution;
+        let voxels = res.iter().map(|&r| r as u64).product::<u64>();
+        let driver = Driver::Texel(texel.to_string());
+        let volume = |what: String, size| Allocation {
+            what,
+            bytes: voxels * 4,
+            shape: Shape::Texture3d { size },
+            driver: driver.clone(),
+        };
+        let mut out = vec![volume(format!("texel \"{texel}\"'s volume"), res)];
+        if self.per_pixel {
+            out.push(volume(format!("texel \"{texel}\"'s normal volume"), res));
+        }
+        if let BakeSource::Mesh(_) = self.source {
+            out.push(Allocation {
+                what: format!("texel \"{texel}\"'s mesh grid"),
+                bytes: voxels * 16,
+                shape: Shape::Buffer { storage: true },
+                driver: driver.clone(),
+            });
+        }
+        if self.axis_slices {
+            for d in 0..3 {
+                let size = axis_slices::image_size(res, d);
+                let layers = axis_slices::array_layers(res[d]);
+                out.push(Allocation {
+                    what: format!("texel \"{texel}\"'s {} slice images", ["s", "t", "w"][d]),
+                    bytes: size[0] as u64 * size[1] as u64 * 8 * layers as u64,
+                    shape: Shape::Texture2d { size, layers },
+                    driver: driver.clone(),
+                });
+            }
         }
         out
     }

@@ -99,6 +99,10 @@ pub struct Overrides {
     /// slice distance in pixels) or one value for both (default: the scene's).
     #[arg(long, value_parser = parse_criteria)]
     criteria: Option<(f64, f64)>,
+    /// GPU memory the frame may allocate, e.g. 512M or 8G (default 4G); a scene over it is
+    /// refused before any work.
+    #[arg(long, value_parser = voltex::gpu::budget::parse_budget)]
+    budget: Option<u64>,
 }
 
 #[derive(clap::ValueEnum, Clone, Copy)]
@@ -151,6 +155,7 @@ impl Overrides {
             supersample: self.supersample,
             time: self.time,
             axis_criteria: self.criteria,
+            budget: self.budget,
             ..Default::default()
         })
     }

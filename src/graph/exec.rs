@@ -194,10 +194,22 @@ impl Executor {
     ) -> Result<()> {
         for i in 0..plan.passes.len() {
             for inst in instance_inputs(&plan.passes[i], frame, objects) {
-                self.pipeline(ctx, plan, i, frame, inst, cache)?;
+                self.pipeline(ctx, plan, i, frame, inst, cache)
+                    .map_err(|e| self.at_pass(&plan.passes[i].decl, e))?;
             }
         }
         Ok(())
+    }
+
+    /// A wgpu error met while making or recording pass `decl`, at the pass in the graph file
+    /// (a lost device stays what it is: nothing in the graph caused it).
+    fn at_pass(&self, decl: &PassDecl, e: Error) -> Error {
+        match e {
+            Error::Gpu(msg) => {
+                self.graph.error_at(decl.name(), format!("pass `{}` ({}): {msg}", decl.name(), decl.shader()))
+            }
+            e => e,
+        }
     }
 
     fn pipeline(
@@ -329,10 +341,21 @@ impl Executor {
         let mut written: Vec<String> = Vec::new();
         for index in 0..plan.passes.len() {
             ctx.fault_at_pass();
-            self.record(ctx, plan, index, frame, objects, &mut encoder, timer, &mut written)?;
+            self.record(ctx, plan, index, frame, objects, &mut encoder, timer, &mut written)
+                .map_err(|e| self.at_pass(&plan.passes[index].decl, e))?;
         }
         timer.resolve(&mut encoder);
-        let commands = ctx.scoped("recording the frame", || encoder.finish())?;
+        // The encoder reports a pass's error at `finish`; wgpu's message quotes the pass's label.
+        let commands = ctx.scoped("recording the frame", || encoder.finish()).map_err(|e| {
+            let culprit = match &e {
+                Error::Gpu(msg) => plan.passes.iter().find(|p| msg.contains(&format!("'{}'", p.decl.name()))),
+                _ => None,
+            };
+            match culprit {
+                Some(p) => self.at_pass(&p.decl, e),
+                None => e,
+            }
+        })?;
         ctx.queue.submit([commands]);
         ctx.take_errors()
     }

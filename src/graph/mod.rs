@@ -395,6 +395,13 @@ impl Graph {
         Error::at(FileLoc::new(&self.path, line, col), message)
     }
 
+    /// An error at output `name` in the graph's `outputs` list.
+    pub fn error_at_output(&self, name: &str, message: impl Into<String>) -> Error {
+        let from = self.source.find("outputs").unwrap_or(0);
+        let (line, col) = locate_literal(&self.source, name, from).unwrap_or((1, 1));
+        Error::at(FileLoc::new(&self.path, line, col), message)
+    }
+
     /// An error at the string literal `text` inside pass `pass`, after its field `field`.
     pub fn error_in_pass(&self, pass: &str, field: &str, text: &str, message: impl Into<String>) -> Error {
         let mut from = self.source.find(&format!("\"{pass}\"")).unwrap_or(0);

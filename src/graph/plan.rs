@@ -123,6 +123,24 @@ pub fn plan(
     }
     let ordered = order(graph, candidates)?;
     let mut passes = live(&graph.file.outputs, ordered, &mut pruned);
+    // An output no kept pass writes was never allocated: say so here rather than let the
+    // readback fail after the GPU work.
+    for out in &graph.file.outputs {
+        if !passes.iter().any(|p| p.writes.contains(out)) {
+            let why: Vec<&str> =
+                pruned.iter().filter(|p| p.starts_with("pass ")).take(4).map(String::as_str).collect();
+            let why = if why.is_empty() {
+                "no pass writes it".to_string()
+            } else {
+                format!("pruned: {}", why.join("; "))
+            };
+            return Err(graph.error_at_output(
+                out,
+                format!("output `{out}` is written by no pass kept for this scene ({why}): draw an object the passes \
+                         that write it match, or render with another graph"),
+            ));
+        }
+    }
     passes.shrink_to_fit();
     let used: BTreeSet<&String> = passes.iter().flat_map(|p| p.reads.iter().chain(p.writes.iter())).collect();
     let mut textures = BTreeMap::new();

@@ -6,6 +6,7 @@ use std::any::Any;
 
 use crate::bake::{BakeRequest, Baked};
 use crate::error::Result;
+use crate::gpu::budget::Allocation;
 use crate::gpu::cache::GpuCache;
 use crate::gpu::{GpuContext, Inputs};
 use crate::mesh::shell::Shell;
@@ -130,6 +131,12 @@ pub trait MethodPlan: Any + Send {
 
     /// GPU memory the plan allocates, by item.
     fn memory(&self, object: &ObjectPlan, size: (u32, u32)) -> Vec<(String, u64)>;
+
+    /// Its buffers that grow with the scene's values (per-pixel state, atlases), one by one, for
+    /// the checks against the adapter's limits (`memory` is what counts against the budget).
+    fn allocations(&self, _object: &ObjectPlan, _size: (u32, u32)) -> Vec<Allocation> {
+        Vec::new()
+    }
 
     /// The scene method this plan draws, knobs resolved (the preview's method switch).
     fn scene_method(&self, _object: &ObjectPlan) -> Option<Method> {

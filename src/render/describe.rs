@@ -26,6 +26,7 @@ impl Blueprint {
         for (name, v) in &self.plan.parameters {
             out.push((format!("parameter {name} {}", v.wgsl_type()), v.bytes().len() as u64));
         }
+        out.push(("image readback buffer".to_string(), self.readback_bytes()));
         for b in &self.bakes {
             out.extend(b.request.memory(&b.texel));
         }

@@ -1,8 +1,11 @@
 //! From a scene to an image: a [`Blueprint`] (CPU only: objects, shells, plane sweeps, bakes and
 //! the pruned graph plan, enough for `voltex plan`), then a [`Renderer`] holding the GPU resources.
 
+mod budget;
 mod describe;
 mod renderer;
+
+pub use budget::Positions;
 
 pub use crate::methods::options::{MethodKind, RenderOptions, DEFAULT_AXIS_SLICES, DEFAULT_PLANES};
 pub use crate::methods::{BakePlan, ObjectPlan};
@@ -55,6 +58,10 @@ pub struct Blueprint {
     pub bakes: Vec<BakePlan>,
     pub graph: Graph,
     pub plan: Plan,
+    /// GPU memory the frame may allocate (`RenderOptions::budget` or the default).
+    pub budget: u64,
+    /// Where the values that size the allocations are written, for the limit checks' errors.
+    pub positions: Positions,
 }
 
 /// The bake of `texel` with the scene's first light baked in (what `voltex bake` writes out).
@@ -115,9 +122,13 @@ impl Blueprint {
         let mut bakes: Vec<BakePlan> = Vec::new();
         let time = opts.time.unwrap_or(scene.time);
         let mut cx = PlanCx { scene, view: &view, light: &light, time, bakes: &mut bakes };
+        let positions = Positions::of(scene, opts.size.is_some());
         let mut objects = objects
             .into_iter()
-            .map(|o| crate::methods::plan_object(&mut cx, o, opts))
+            .map(|o| {
+                let name = o.name.clone();
+                crate::methods::plan_object(&mut cx, o, opts).map_err(|e| positions.at_object(&name, e))
+            })
             .collect::<Result<Vec<_>>>()?;
         let (graph, sources) = load_graph(opts.graph.as_deref())?;
         let groups = crate::methods::gather(&mut objects, &bakes, &view);
@@ -145,6 +156,8 @@ impl Blueprint {
             bakes,
             graph,
             plan,
+            budget: opts.budget.unwrap_or(crate::gpu::budget::DEFAULT_BUDGET),
+            positions,
         })
     }
 }

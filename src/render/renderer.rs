@@ -44,14 +44,7 @@ impl Renderer {
     /// Like [`Renderer::new`], taking shader modules, pipelines and bakes from `cache` where
     /// nothing that defines them changed (the preview's hot reload).
     pub fn with_cache(ctx: &GpuContext, blueprint: Blueprint, cache: &mut GpuCache) -> Result<Self> {
-        for o in &blueprint.objects {
-            for m in &o.methods {
-                m.check_limits(o, &ctx.limits)?;
-            }
-        }
-        for g in &blueprint.groups {
-            g.check_limits(&blueprint.objects[g.members()[0]], &ctx.limits)?;
-        }
+        blueprint.check_limits(&ctx.limits, "this adapter's limit")?;
         let mut baker = Baker::new(&Sources::project()?);
         let baked: Vec<bake::Baked> = blueprint
             .bakes
@@ -97,10 +90,9 @@ impl Renderer {
             .collect();
         let exec = Executor::new(ctx, blueprint.graph.clone(), &blueprint.plan, blueprint.size, cache)?;
         let timer = Timer::new(ctx, blueprint.plan.passes.len() as u32);
-        let (w, h) = blueprint.size;
         let readback = ctx.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("image readback"),
-            size: padded_row(w) as u64 * h as u64,
+            size: blueprint.readback_bytes(),
             usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });

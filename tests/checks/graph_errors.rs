@@ -460,3 +460,20 @@ fn broken_wgsl_is_reported_at_its_line_col() {
     let at = format!("{}:15:13", wgsl.join("invert.wgsl").display());
     assert_err(e, &at, &["WGSL"]);
 }
+
+#[test]
+fn output_pruned_for_the_scene_is_an_error_at_the_output() {
+    // `linear` is written only by a pass for ViewSlices objects: a scene without one prunes it.
+    let pass = r#"Raster(
+            name: "slices_to_linear",
+            shader: "composite.wgsl",
+            instances: Objects("ViewSlices"),
+            targets: [(resource: "linear")],
+            draw: Vertices("3"),
+        )"#;
+    let text = graph_text(&["linear"], "", &[pass]);
+    let g = parse(&text).unwrap();
+    assert!(plan(&g, &wgsl_root(), &objects(&[&["ViewSlices"]])).is_ok());
+    let Err(e) = plan(&g, &wgsl_root(), &objects(&[&["Reference"]])) else { panic!("the output was pruned") };
+    assert_err(e, "test.ron:2:15", &["output `linear`", "no pass kept", "no object matches ViewSlices"]);
+}

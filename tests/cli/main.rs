@@ -9,4 +9,5 @@ mod farm;
 mod faults;
 mod hostile_files;
 mod install;
+mod maxima;
 mod preview_window;

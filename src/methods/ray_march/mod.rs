@@ -309,6 +309,21 @@ impl RayMarchPlan {
         self.peel.or(self.splatting).map(|(_, l)| l)
     }
 
+    /// The buffers sized per pixel, with their bytes (as `add_inputs` creates them).
+    pub fn per_pixel_buffers(&self, size: (u32, u32)) -> Vec<(&'static str, u64)> {
+        let mut out = vec![(
+            "ray_march_state",
+            size.0 as u64 * size.1 as u64 * std::mem::size_of::<MarchState>() as u64,
+        )];
+        if let Some((passes, _)) = &self.peel {
+            out.push(("segment_bounds", Self::segment_bytes(size, *passes)));
+        }
+        if let Some((slabs, _)) = &self.splatting {
+            out.push(("splat_slabs", slab_bytes(size, *slabs)));
+        }
+        out
+    }
+
     /// Bytes of the per-pixel segment boundaries (`segment_bounds`).
     fn segment_bytes(size: (u32, u32), passes: u32) -> u64 {
         size.0 as u64 * size.1 as u64 * (2 * passes as u64 + 2) * 4

@@ -4,6 +4,7 @@ use std::any::Any;
 
 use super::{plan, RayMarchPlan};
 use crate::error::{Error, Result};
+use crate::gpu::budget::{Allocation, Driver, Shape};
 use crate::gpu::cache::GpuCache;
 use crate::gpu::{GpuContext, Inputs};
 use crate::hypertexture::mesh::MeshGrid;
@@ -102,6 +103,18 @@ impl MethodPlan for RayMarchPlan {
 
     fn metadata(&self, _object: &ObjectPlan) -> String {
         self.describe()
+    }
+
+    fn allocations(&self, _object: &ObjectPlan, size: (u32, u32)) -> Vec<Allocation> {
+        self.per_pixel_buffers(size)
+            .into_iter()
+            .map(|(name, bytes)| Allocation {
+                what: format!("RayMarch buffer `{name}` at {}x{}", size.0, size.1),
+                bytes,
+                shape: Shape::Buffer { storage: true },
+                driver: Driver::Output,
+            })
+            .collect()
     }
 
     fn memory(&self, object: &ObjectPlan, size: (u32, u32)) -> Vec<(String, u64)> {

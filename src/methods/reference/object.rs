@@ -3,6 +3,7 @@
 
 use super::{build, default_step, twin_inputs, Member, ReferenceSet};
 use crate::error::Result;
+use crate::gpu::budget::{Allocation, Driver, Shape};
 use crate::gpu::Inputs;
 use crate::methods::reference::trace_reference::{TraceObject, TraceView};
 use crate::methods::view::View;
@@ -159,6 +160,15 @@ impl MethodPlan for ReferenceSet {
 
     fn metadata(&self, object: &ObjectPlan) -> String {
         self.summary(object)
+    }
+
+    fn allocations(&self, _object: &ObjectPlan, size: (u32, u32)) -> Vec<Allocation> {
+        vec![Allocation {
+            what: format!("the Reference per-pixel state at {}x{}", size.0, size.1),
+            bytes: size.0 as u64 * size.1 as u64 * std::mem::size_of::<crate::types::ReferenceState>() as u64,
+            shape: Shape::Buffer { storage: true },
+            driver: Driver::Output,
+        }]
     }
 
     fn memory(&self, _object: &ObjectPlan, size: (u32, u32)) -> Vec<(String, u64)> {
