@@ -89,10 +89,14 @@ pub(super) fn check(ctx: &GpuContext, run: &RunInfo, entry: &SceneEntry) -> Resu
         }
         rec.max_flip = opts.max_flip.unwrap_or(scene.regress.max_flip);
         rec.max_rel_rmse = opts.max_rel_rmse.unwrap_or(scene.regress.max_rel_rmse);
-        rec.max_truth_flip = scene.regress.truth.filter(|_| !opts.no_truth).map(|t| t.max_flip);
+        // A bound holds at the size it was measured at: `--size` renders check no truth.
+        let own_size =
+            scene.regress.size.map(|[w, h]| (w, h)).unwrap_or((scene.output.width, scene.output.height));
+        let checked = !opts.no_truth && size == own_size;
+        rec.max_truth_flip = scene.regress.truth.filter(|_| checked).map(|t| t.max_flip);
         std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
             let frame = render(ctx, &scene, size, &mut rec)?;
-            let truth = if opts.no_truth { None } else { truth(ctx, &scene, size)? };
+            let truth = if checked { truth(ctx, &scene, size)? } else { None };
             Ok((frame, truth))
         }))
         .unwrap_or_else(|p| Err(Error::file(&entry.path, super::panic_text(&p))))
