@@ -23,7 +23,12 @@ pub fn load(path: &Path) -> Result<Mesh> {
 /// Parses glTF or GLB bytes; `path` names the file in errors and locates external buffers.
 pub fn parse(bytes: &[u8], path: &Path) -> Result<Mesh> {
     let fail = |msg: String| Error::file(path, msg);
-    let file = gltf::Gltf::from_slice(bytes).map_err(|e| fail(format!("not a valid glTF 2.0 file: {e}")))?;
+    check_position_accessors(bytes).map_err(fail)?;
+    // The loader's validation has panicked on input it should reject (see above): a panic is
+    // still this file's error, not voltex's.
+    let file = std::panic::catch_unwind(|| gltf::Gltf::from_slice(bytes))
+        .map_err(|_| fail("not a valid glTF 2.0 file: the glTF loader failed on it".into()))?
+        .map_err(|e| fail(format!("not a valid glTF 2.0 file: {e}")))?;
     let buffers = file
         .buffers()
         .map(|b| buffer_data(&b, file.blob.as_deref(), path))
@@ -40,6 +45,31 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<Mesh> {
         return Err(fail("expected at least one triangle primitive in the scene's nodes".into()));
     }
     Ok(out.finish())
+}
+
+/// gltf-json 1.4 validates a primitive's `POSITION` accessor by indexing the accessor list
+/// unchecked, and panics when the index is out of range: check that first (found by fuzzing).
+fn check_position_accessors(bytes: &[u8]) -> std::result::Result<(), String> {
+    let json = match bytes.get(..4) {
+        Some(b"glTF") => {
+            let len = bytes.get(12..16).map_or(0, |b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as usize);
+            bytes.get(20..20usize.saturating_add(len)).unwrap_or_default()
+        }
+        _ => bytes,
+    };
+    // Not JSON, or not as expected: the loader says what is wrong.
+    let Ok(doc) = serde_json::from_slice::<serde_json::Value>(json) else { return Ok(()) };
+    let accessors = doc["accessors"].as_array().map_or(0, Vec::len) as u64;
+    for (m, mesh) in doc["meshes"].as_array().into_iter().flatten().enumerate() {
+        for (p, prim) in mesh["primitives"].as_array().into_iter().flatten().enumerate() {
+            if let Some(i) = prim["attributes"]["POSITION"].as_u64().filter(|&i| i >= accessors) {
+                return Err(format!(
+                    "mesh {m} primitive {p}: POSITION accessor {i} out of range: {accessors} accessors"
+                ));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// The bytes of a buffer: the GLB's binary chunk, a base64 `data:` URI, or a file beside `path`.
@@ -164,6 +194,32 @@ fn check_range(a: &gltf::Accessor, buffers: &[Vec<u8>]) -> std::result::Result<(
     Ok(())
 }
 
+/// The component types and dimensions glTF allows for the attributes read here (the loader's
+/// readers assume them and panic otherwise).
+fn check_type(semantic: &gltf::Semantic, a: &gltf::Accessor) -> std::result::Result<(), String> {
+    use gltf::accessor::{DataType::*, Dimensions::*};
+    use gltf::Semantic::*;
+    let ok = match (semantic, a.data_type(), a.dimensions()) {
+        (Positions, F32, Vec3) => true,
+        (Positions, ..) => false,
+        (TexCoords(_), F32 | U8 | U16, Vec2) => true,
+        (TexCoords(_), ..) => false,
+        (Colors(_), F32 | U8 | U16, Vec3 | Vec4) => true,
+        (Colors(_), ..) => false,
+        _ => true,
+    };
+    if ok {
+        Ok(())
+    } else {
+        Err(format!(
+            "{semantic:?} accessor {}: {:?} {:?} is not a type glTF allows for it",
+            a.index(),
+            a.data_type(),
+            a.dimensions()
+        ))
+    }
+}
+
 fn primitive(
     p: &gltf::Primitive,
     world: &DMat4,
@@ -174,11 +230,16 @@ fn primitive(
     if p.mode() != Mode::Triangles {
         return Err(format!("mode {:?}: expected triangles", p.mode()));
     }
-    for (_, a) in p.attributes() {
+    for (semantic, a) in p.attributes() {
         check_range(&a, buffers)?;
+        check_type(&semantic, &a)?;
     }
     if let Some(a) = p.indices() {
         check_range(&a, buffers)?;
+        use gltf::accessor::{DataType::*, Dimensions::Scalar};
+        if !matches!((a.data_type(), a.dimensions()), (U8 | U16 | U32, Scalar)) {
+            return Err(format!("indices accessor {}: expected unsigned integer scalars", a.index()));
+        }
     }
     let reader = p.reader(|b| buffers.get(b.index()).map(|d| d.as_slice()));
     let positions: Vec<DVec3> = reader

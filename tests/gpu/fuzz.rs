@@ -576,3 +576,65 @@ mod fuzz_regressions {
         assert!(e.starts_with(&format!("long.obj:4:{col}: expected a vertex index, found `1é`")), "{e}");
     }
 }
+
+/// What a scene does with a glTF mesh: parse (no panic; an error names the file), then heights
+/// along the normals and the prism checks.
+fn gltf_case(bytes: &[u8]) -> Result<(), String> {
+    let path = Path::new("fuzz.glb");
+    match voltex::mesh::gltf::parse(bytes, path) {
+        Ok(mesh) => {
+            if let Some(p) = mesh.positions.iter().find(|p| !p.is_finite()) {
+                return Err(format!("a vertex is not finite: {p:?}"));
+            }
+            let _ = prism::check(&mesh.to_base(0.1, None, DVec2::ONE));
+            accepted()
+        }
+        Err(e) if e.to_string().starts_with("fuzz.glb: ") => Ok(()),
+        Err(e) => Err(format!("the error does not name the file: {e}")),
+    }
+}
+
+fn dome_glb() -> Vec<u8> {
+    std::fs::read(root().join("scenes/view_slices/meshes/dome.glb")).unwrap()
+}
+
+/// The GLB with its JSON chunk replaced (padded as the format wants), its binary chunk kept.
+fn with_json(glb: &[u8], json: &str) -> Vec<u8> {
+    let json_len = u32::from_le_bytes(glb[12..16].try_into().unwrap()) as usize;
+    let bin = &glb[20 + json_len..];
+    let mut text = json.as_bytes().to_vec();
+    text.resize(text.len().div_ceil(4) * 4, b' ');
+    let mut out = b"glTF".to_vec();
+    out.extend(2u32.to_le_bytes());
+    out.extend(((12 + 8 + text.len() + bin.len()) as u32).to_le_bytes());
+    out.extend((text.len() as u32).to_le_bytes());
+    out.extend(b"JSON");
+    out.extend(text);
+    out.extend(bin);
+    out
+}
+
+#[test]
+fn gltf_bytes_mutated() {
+    let glb = dome_glb();
+    let n = glb.len();
+    let edits = prop::collection::vec((0..n, any::<u8>()), 0..8);
+    let strategy = (edits, prop::option::of(0..n));
+    fuzz("gltf_bytes_mutated", 3000, strategy, |(edits, cut)| {
+        let mut bytes = glb.clone();
+        for (at, b) in edits {
+            bytes[at] = b;
+        }
+        bytes.truncate(cut.unwrap_or(n));
+        gltf_case(&bytes)
+    });
+}
+
+#[test]
+fn gltf_json_mutated() {
+    let glb = dome_glb();
+    let json_len = u32::from_le_bytes(glb[12..16].try_into().unwrap()) as usize;
+    let json = String::from_utf8(glb[20..20 + json_len].to_vec()).unwrap();
+    let strategy = prop::collection::vec(any::<Mutation>(), 1..6);
+    fuzz("gltf_json_mutated", 3000, strategy, |muts| gltf_case(&with_json(&glb, &mutate(&json, &muts))));
+}
