@@ -90,7 +90,9 @@ pub struct ObjectParams {
     pub base_color: [f32; 4],
     /// World length over which a voxel's stored opacity is reached.
     pub opacity_length: f32,
-    pub _pad: [f32; 3],
+    /// The object's index in the scene (its slot in per-object AOVs such as coverage).
+    pub index: u32,
+    pub _pad: [f32; 2],
 }
 
 /// Texel-to-world derivatives at a welded vertex, `dP/ds` and `dP/dt` (w unused), averaged over
@@ -344,6 +346,8 @@ pub struct HyperParams {
     pub grid_min: [f32; 4],
     /// Mesh objects: xyz the upper corner of the baked grid.
     pub grid_max: [f32; 4],
+    /// Density modulation (Perlin's functions): x bias, y gain (0.5: none).
+    pub modulation: [f32; 4],
 }
 
 /// What `bake_mesh_grid.wgsl` bakes: samples at the vertices of an `n^3` grid from `lo` to `hi`

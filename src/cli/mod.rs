@@ -103,6 +103,10 @@ pub struct Overrides {
     /// refused before any work.
     #[arg(long, value_parser = voltex::gpu::budget::parse_budget)]
     budget: Option<u64>,
+    /// Extra images written as EXR channels beside the colour, by the names the graph declares,
+    /// e.g. `depth,coverage,transmittance` (replaces the scene's `aovs`).
+    #[arg(long, value_delimiter = ',')]
+    aov: Option<Vec<String>>,
 }
 
 #[derive(clap::ValueEnum, Clone, Copy)]
@@ -156,6 +160,7 @@ impl Overrides {
             time: self.time,
             axis_criteria: self.criteria,
             budget: self.budget,
+            aovs: self.aov.clone(),
             ..Default::default()
         })
     }

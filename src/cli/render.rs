@@ -49,7 +49,7 @@ fn render(scene_path: &Path, output: Option<PathBuf>, overrides: &Overrides) -> 
     let scene = scene::load(scene_path)?;
     let exr_path = output_path(scene_path, output)?;
     let ctx = GpuContext::new()?;
-    render_one(&ctx, &scene, &opts, &exr_path, &mut GpuCache::default(), true)
+    render_one(&ctx, &scene, &opts, &exr_path, &mut GpuCache::default(), None)
 }
 
 /// `render --frames A..B`: one scene, one device, bakes shared between frames; frame N at time
@@ -83,7 +83,7 @@ fn render_frames(
         let frame_opts = RenderOptions { time: Some(n as f64 / fps), ..opts.clone() };
         let exr = path.with_file_name(format!("{stem}_{n:04}.exr"));
         cache.begin();
-        render_one(&ctx, &scene, &frame_opts, &exr, &mut cache, n == first)?;
+        render_one(&ctx, &scene, &frame_opts, &exr, &mut cache, Some((n, fps, n == first)))?;
         if animated {
             cache.retain_used();
         }
@@ -109,14 +109,17 @@ fn output_path(scene_path: &Path, output: Option<PathBuf>) -> Result<PathBuf> {
     Ok(exr_path)
 }
 
+/// Renders one frame to `exr_path` (and its PNG); `frame`: a sequence's frame number, rate and
+/// whether it is the first (whose warnings are printed).
 fn render_one(
     ctx: &GpuContext,
     scene: &scene::Scene,
     opts: &RenderOptions,
     exr_path: &Path,
     cache: &mut GpuCache,
-    warn: bool,
+    frame: Option<(u32, f64, bool)>,
 ) -> Result<()> {
+    let warn = frame.is_none_or(|f| f.2);
     let png_path = exr_path.with_extension("png");
     let bp = Blueprint::new(scene, opts)?;
     for w in scene.warnings.iter().filter(|_| warn) {
@@ -129,10 +132,20 @@ fn render_one(
     }
     // Nothing is evicted: a sequence's frames come back, and a scene's bakes are bounded.
     let mut renderer = Renderer::with_cache(ctx, bp, cache)?;
+    let sequence = frame;
     let frame = renderer.render(ctx)?;
-    let metadata = renderer.metadata(ctx, &frame);
+    let mut metadata = renderer.metadata(ctx, &frame);
+    if let Some((n, fps, _)) = sequence {
+        metadata.push(("voltex_frame".into(), n.to_string()));
+        metadata.push(("voltex_fps".into(), fps.to_string()));
+    }
     let meta: Vec<(&str, String)> = metadata.iter().map(|(k, v)| (k.as_str(), v.clone())).collect();
-    io::exr::write(exr_path, &frame.image, &meta)?;
+    let extras = io::exr::Extras {
+        channels: &frame.aovs,
+        camera: Some(renderer.camera_attributes()),
+        fps: sequence.map(|s| s.1),
+    };
+    io::exr::write_with(exr_path, &frame.image, &meta, &extras)?;
     io::png::write_tonemapped(&png_path, &frame.image)?;
     let gpu = frame.gpu_ms().map(|t| format!("{t:.2} ms GPU")).unwrap_or_else(|| "no GPU timestamps".into());
     println!(

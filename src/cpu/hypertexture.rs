@@ -221,7 +221,16 @@ impl Model<'_> {
             return 0.0;
         }
         let v = self.vector_field(x);
-        self.object_density(x - unit_or_zero(v) * self.distortion(x, v))
+        self.modulate(self.object_density(x - unit_or_zero(v) * self.distortion(x, v)))
+    }
+
+    /// The density modulation functions (`bias`, `gain`: 0.5 is the identity).
+    pub fn modulate(&self, density: f64) -> f64 {
+        let [b, g, ..] = self.params.modulation.map(|m| m as f64);
+        if b == 0.5 && g == 0.5 {
+            return density;
+        }
+        perlin_gain(g, perlin_bias(b, density.clamp(0.0, 1.0)))
     }
 
     /// A noise's shape transfer function at noise value u (2D: bilinear with the density o).
@@ -246,6 +255,23 @@ impl Model<'_> {
     pub fn hyper_color(&self, density: f64) -> [f64; 4] {
         let first = self.color_tables();
         std::array::from_fn(|c| transfer_lookup(self.tables, first + c as u32, density))
+    }
+}
+
+/// Perlin's bias: `t^(ln b / ln 0.5)`, so that `perlin_bias(b, 0.5) = b`; 0 and 1 stay.
+pub fn perlin_bias(b: f64, t: f64) -> f64 {
+    if t <= 0.0 {
+        return 0.0;
+    }
+    t.powf(b.ln() / 0.5f64.ln())
+}
+
+/// Perlin's gain: two biases of `1 - g` mirrored about 0.5, so that `perlin_gain(g, 0.5) = 0.5`.
+pub fn perlin_gain(g: f64, t: f64) -> f64 {
+    if t < 0.5 {
+        0.5 * perlin_bias(1.0 - g, 2.0 * t)
+    } else {
+        1.0 - 0.5 * perlin_bias(1.0 - g, 2.0 - 2.0 * t)
     }
 }
 

@@ -24,6 +24,85 @@ pub struct GraphFile {
     #[serde(default, deserialize_with = "crate::input::unique_keys")]
     pub resources: BTreeMap<String, ResourceDecl>,
     pub passes: Vec<PassDecl>,
+    /// Extra images a render may ask for by name (`--aov NAME`, a scene's `output.aovs`): their
+    /// textures become outputs, so the passes that write them are kept only then, and are
+    /// written beside the colour as EXR channels.
+    #[serde(default, deserialize_with = "crate::input::unique_keys")]
+    pub aovs: BTreeMap<String, AovDecl>,
+}
+
+/// An AOV: graph textures (R32Float or Rgba32Float) read back after the frame, and how their
+/// channels are named in the EXR.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AovDecl {
+    pub textures: Vec<String>,
+    pub channels: AovChannels,
+    /// How `supersample` reduces a block of samples to a pixel.
+    #[serde(default)]
+    pub downsample: Downsample,
+}
+
+/// EXR channel names of an AOV's texture channels.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum AovChannels {
+    /// One name per channel, in order: R of an R32Float texture, R, G, B, A of an Rgba32Float
+    /// one, texture after texture; channels left unnamed are not written.
+    Named(Vec<String>),
+    /// The R, G and B channels of the textures in turn hold the scene's objects in order
+    /// (`object.index` in WGSL): channel `PREFIX.OBJECT.Y` for each object (dots in the object's
+    /// name become `_`). A scene with more objects than three per texture cannot ask for it.
+    Objects(String),
+}
+
+/// How an AOV is reduced over a supersampled pixel's samples.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum Downsample {
+    /// The mean (coverage, transmittance).
+    #[default]
+    Mean,
+    /// The smallest sample (a depth: the nearest hit).
+    Min,
+}
+
+/// Longest EXR channel name (OpenEXR 2's long names).
+pub const MAX_CHANNEL_BYTES: usize = 255;
+
+impl AovDecl {
+    /// Channels per texture of `format` this AOV reads: 1 for R32Float, 3 (objects) or 4 for
+    /// Rgba32Float.
+    pub fn channels_of(&self, format: Format) -> usize {
+        match (format, &self.channels) {
+            (Format::R32Float, _) => 1,
+            (_, AovChannels::Objects(_)) => 3,
+            _ => 4,
+        }
+    }
+
+    /// The EXR channel name of each texture channel read, `None` where none is written, for a
+    /// scene whose objects are `objects` (in order), given the graph's texture formats.
+    pub fn channel_names(&self, formats: &[Format], objects: &[&str]) -> Vec<Option<String>> {
+        let per: Vec<usize> = formats.iter().map(|f| self.channels_of(*f)).collect();
+        let total: usize = per.iter().sum();
+        match &self.channels {
+            AovChannels::Named(names) => (0..total).map(|i| names.get(i).cloned()).collect(),
+            AovChannels::Objects(prefix) => {
+                let mut seen = std::collections::BTreeSet::new();
+                (0..total)
+                    .map(|i| {
+                        let name = objects.get(i)?;
+                        let mut n = format!("{prefix}.{}.Y", name.replace('.', "_"));
+                        if !seen.insert(n.clone()) {
+                            n = format!("{prefix}.{}_{i}.Y", name.replace('.', "_"));
+                        }
+                        Some(n)
+                    })
+                    .collect()
+            }
+        }
+    }
 }
 
 #[derive(Debug, Clone, Deserialize)]
@@ -508,9 +587,88 @@ impl Graph {
                 }
             }
         }
+        self.check_aovs()?;
         if f.outputs.is_empty() {
             return Err(Error::at(FileLoc::new(&self.path, 1, 1), "expected at least one name in `outputs`"));
         }
         Ok(())
+    }
+
+    /// AOV textures must be R32Float or Rgba32Float graph textures; named channels valid EXR
+    /// channel names (1 to 255 Latin-1 bytes, no NUL), not the colour's R, G, B, A, and each
+    /// written once.
+    fn check_aovs(&self) -> Result<()> {
+        let mut seen: Vec<&str> = vec!["R", "G", "B", "A"];
+        for (aov, decl) in &self.file.aovs {
+            if decl.textures.is_empty() {
+                return Err(self.error_in_aov(aov, aov, format!("AOV `{aov}` names no texture")));
+            }
+            let mut capacity = 0;
+            for t in &decl.textures {
+                match self.file.resources.get(t) {
+                    Some(ResourceDecl::Texture { format: format @ (Format::R32Float | Format::Rgba32Float), .. }) => {
+                        capacity += decl.channels_of(*format);
+                    }
+                    _ => {
+                        return Err(self.error_in_aov(
+                            aov,
+                            t,
+                            format!("AOV `{aov}`: `{t}` must be an R32Float or Rgba32Float texture declared in `resources`"),
+                        ))
+                    }
+                }
+            }
+            let names = match &decl.channels {
+                AovChannels::Named(names) => names.iter().map(String::as_str).collect(),
+                AovChannels::Objects(prefix) => vec![prefix.as_str()],
+            };
+            if let AovChannels::Named(names) = &decl.channels {
+                if names.len() > capacity {
+                    return Err(self.error_in_aov(
+                        aov,
+                        aov,
+                        format!("AOV `{aov}` names {} channels; its textures hold {capacity}", names.len()),
+                    ));
+                }
+            }
+            for n in names {
+                let bad = n.is_empty()
+                    || n.len() > MAX_CHANNEL_BYTES
+                    || n.chars().any(|c| c as u32 > 0xff || c == '\0');
+                if bad {
+                    return Err(self.error_in_aov(
+                        aov,
+                        n,
+                        format!("AOV `{aov}`: `{n}` is no EXR channel name (1 to {MAX_CHANNEL_BYTES} Latin-1 bytes without NUL)"),
+                    ));
+                }
+                if matches!(decl.channels, AovChannels::Named(_)) {
+                    if seen.contains(&n) {
+                        return Err(self.error_in_aov(
+                            aov,
+                            n,
+                            format!("AOV `{aov}`: channel `{n}` is written by the colour or another AOV"),
+                        ));
+                    }
+                    seen.push(n);
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// An error at the string literal `text` inside AOV `aov`'s declaration.
+    fn error_in_aov(&self, aov: &str, text: &str, message: impl Into<String>) -> Error {
+        // The `aovs:` field: the first line that begins with it.
+        let mut from = 0;
+        for line in self.source.split_inclusive('\n') {
+            if line.trim_start().starts_with("aovs:") {
+                break;
+            }
+            from += line.len();
+        }
+        let from = from + self.source.get(from..).and_then(|s| s.find(&format!("\"{aov}\""))).unwrap_or(0);
+        let (line, col) = locate_literal(&self.source, text, from).unwrap_or((1, 1));
+        Error::at(FileLoc::new(&self.path, line, col), message)
     }
 }

@@ -36,6 +36,8 @@ pub struct Packed {
     /// Object-space bounds enlarged by the largest shift.
     pub bounds: (DVec3, DVec3),
     pub opacity_length: f64,
+    /// Bias and gain of the density (0.5: none).
+    pub modulation: [f32; 4],
     /// The largest shift the noises reach (object space).
     pub max_shift: f64,
     /// Mesh objects: the mesh and where its grid samples lie.
@@ -71,6 +73,7 @@ pub fn pack(h: &Hypertexture) -> Packed {
         points: Vec::new(),
         bounds: h.bounds(),
         opacity_length: h.opacity_length,
+        modulation: [h.bias as f32, h.gain as f32, 0.0, 0.0],
         max_shift: h.max_shift(),
         mesh,
     };
@@ -171,6 +174,7 @@ impl Packed {
             perturb: self.perturb,
             kinds: self.kinds,
             march: [0.0, 0.0, self.tested_shift() as f32, time as f32],
+            modulation: self.modulation,
             ..Default::default()
         };
         if let Some((_, g)) = &self.mesh {

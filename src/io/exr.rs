@@ -1,5 +1,6 @@
 //! OpenEXR: one RGBA f32 layer plus free-text metadata (method, quality knobs, adapter, GPU time)
-//! as custom string attributes.
+//! as custom string attributes; optionally more channels (AOVs: `Z`, `coverage.OBJECT.Y`, ...)
+//! and the standard camera attributes.
 
 use std::path::Path;
 
@@ -42,6 +43,34 @@ fn check_key(key: &str) -> Result<Text> {
 /// Keys are free text but must be 1–255 Latin-1 characters and not a standard EXR attribute
 /// name; values may be anything (characters outside Latin-1 are stored as `?`).
 pub fn write(path: &Path, image: &Image, metadata: &[(&str, String)]) -> Result<()> {
+    write_with(path, image, metadata, &Extras::default())
+}
+
+/// What an EXR may carry beside the colour and the string metadata.
+#[derive(Debug, Default)]
+pub struct Extras<'a> {
+    /// More f32 channels, one sample per pixel, row-major from the top row (AOVs).
+    pub channels: &'a [(String, Vec<f32>)],
+    /// The standard `worldToCamera`, `worldToNDC`, `nearClipPlane` and `farClipPlane`.
+    pub camera: Option<CameraAttributes>,
+    /// The standard `framesPerSecond` (a sequence's frames).
+    pub fps: Option<f64>,
+}
+
+/// OpenEXR's camera attributes, matrices as Imath stores them (row vectors: `p * M`, the
+/// translation in the last row). Camera space is left-handed: x right, y up, z the viewing
+/// direction; NDC has (0, 0) at the top-left corner of the image and (1, 1) at the bottom-right.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CameraAttributes {
+    pub world_to_camera: [f32; 16],
+    pub world_to_ndc: [f32; 16],
+    pub near: f32,
+    pub far: f32,
+}
+
+/// Like [`write`], with AOV channels and camera attributes. A channel name must be 1–255 Latin-1
+/// bytes, not R, G, B or A, and appear once; each channel has one sample per pixel.
+pub fn write_with(path: &Path, image: &Image, metadata: &[(&str, String)], extras: &Extras) -> Result<()> {
     if image.pixels.len() != image.width as usize * image.height as usize {
         return Err(Error::Invalid(format!(
             "image {}x{} has {} pixels",
@@ -58,21 +87,72 @@ pub fn write(path: &Path, image: &Image, metadata: &[(&str, String)]) -> Result<
     for (key, value) in metadata {
         attributes.other.insert(check_key(key)?, AttributeValue::Text(to_text(value)));
     }
-    let width = image.width as usize;
-    let channels = x::SpecificChannels::rgba(|pos: x::Vec2<usize>| {
-        let p = image.pixels[pos.y() * width + pos.x()];
-        (p[0], p[1], p[2], p[3])
-    });
-    let layer = x::Layer::new(
-        (image.width as usize, image.height as usize),
-        attributes,
-        x::Encoding::SMALL_LOSSLESS,
-        channels,
-    );
-    let exr_image = x::Image::from_layer(layer);
-    write_atomic(path, |tmp| {
-        exr_image.write().to_file(tmp).map_err(|e| Error::file(path, format!("cannot write EXR: {e}")))
-    })
+    if let Some(c) = extras.camera {
+        attributes.world_to_camera = Some(c.world_to_camera);
+        attributes.world_to_normalized_device = Some(c.world_to_ndc);
+        attributes.near_clip_plane = Some(c.near);
+        attributes.far_clip_plane = Some(c.far);
+    }
+    attributes.frames_per_second = extras.fps.filter(|f| f.is_finite() && *f > 0.0).map(rational);
+    let size = (image.width as usize, image.height as usize);
+    let encoding = x::Encoding::SMALL_LOSSLESS;
+    if extras.channels.is_empty() {
+        let width = image.width as usize;
+        let channels = x::SpecificChannels::rgba(|pos: x::Vec2<usize>| {
+            let p = image.pixels[pos.y() * width + pos.x()];
+            (p[0], p[1], p[2], p[3])
+        });
+        let image = x::Image::from_layer(x::Layer::new(size, attributes, encoding, channels));
+        write_atomic(path, |tmp| image.write().to_file(tmp).map_err(|e| cannot(path, e)))
+    } else {
+        let mut list = x::SmallVec::new();
+        for (c, name) in ["R", "G", "B", "A"].iter().enumerate() {
+            let plane = image.pixels.iter().map(|p| p[c]).collect();
+            list.push(x::AnyChannel::new(*name, x::FlatSamples::F32(plane)));
+        }
+        let mut names: Vec<&str> = vec!["R", "G", "B", "A"];
+        for (name, plane) in extras.channels {
+            check_channel(name, &names)?;
+            if plane.len() != image.pixels.len() {
+                return Err(Error::Invalid(format!(
+                    "EXR channel `{name}` has {} samples for {} pixels",
+                    plane.len(),
+                    image.pixels.len()
+                )));
+            }
+            names.push(name);
+            list.push(x::AnyChannel::new(to_text(name), x::FlatSamples::F32(plane.clone())));
+        }
+        let channels = x::AnyChannels::sort(list);
+        let image = x::Image::from_layer(x::Layer::new(size, attributes, encoding, channels));
+        write_atomic(path, |tmp| image.write().to_file(tmp).map_err(|e| cannot(path, e)))
+    }
+}
+
+fn cannot(path: &Path, e: ::exr::error::Error) -> Error {
+    Error::file(path, format!("cannot write EXR: {e}"))
+}
+
+/// A frame rate as the rational EXR stores (exact for whole rates, else to a thousandth).
+fn rational(fps: f64) -> (i32, u32) {
+    if fps.fract() == 0.0 && fps <= i32::MAX as f64 {
+        (fps as i32, 1)
+    } else {
+        ((fps * 1000.0).round().min(i32::MAX as f64) as i32, 1000)
+    }
+}
+
+/// An EXR channel name: 1–255 Latin-1 bytes without NUL, not one already written.
+fn check_channel(name: &str, written: &[&str]) -> Result<()> {
+    if name.is_empty() || name.len() > 255 || name.chars().any(|c| c as u32 > 0xff || c == '\0') {
+        return Err(Error::Invalid(format!(
+            "EXR channel name {name:?} must be 1 to 255 Latin-1 bytes without NUL"
+        )));
+    }
+    if written.contains(&name) {
+        return Err(Error::Invalid(format!("EXR channel `{name}` is written twice")));
+    }
+    Ok(())
 }
 
 /// Reads the first layer with R, G, B channels of an EXR file (A is optional and defaults to 1),

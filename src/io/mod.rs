@@ -99,6 +99,26 @@ impl Image {
         })
     }
 
+    /// Like [`Image::box_downsample`], keeping each block's smallest value per channel (a depth:
+    /// the nearest hit, not a mean of near and far).
+    pub fn min_downsample(self, n: u32) -> Image {
+        if n <= 1 {
+            return self;
+        }
+        Image::from_fn(self.width / n, self.height / n, |x, y| {
+            let mut out = [f32::INFINITY; 4];
+            for dy in 0..n {
+                for dx in 0..n {
+                    let p = self.get(x * n + dx, y * n + dy);
+                    for c in 0..4 {
+                        out[c] = out[c].min(p[c]);
+                    }
+                }
+            }
+            out
+        })
+    }
+
     pub fn same_size(&self, other: &Image) -> bool {
         self.width == other.width && self.height == other.height
     }

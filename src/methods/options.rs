@@ -39,6 +39,8 @@ pub struct RenderOptions {
     pub occlusion_culling: Option<bool>,
     /// RayMarch objects' step times this (after `step`; a converged truth).
     pub step_scale: Option<f64>,
+    /// AOVs to write beside the colour (`--aov`), replacing the scene's `aovs`.
+    pub aovs: Option<Vec<String>>,
     /// GPU memory the frame may allocate (`--budget`; default `gpu::budget::DEFAULT_BUDGET`).
     pub budget: Option<u64>,
 }

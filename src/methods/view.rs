@@ -18,6 +18,7 @@ pub struct RayCamera {
 }
 
 /// The camera, with the depth range of everything drawn for the projection's near and far planes.
+#[derive(Debug, Clone)]
 pub struct View {
     pub eye: DVec3,
     pub forward: DVec3,

@@ -465,7 +465,8 @@ impl State {
                             h.shading = match h.shading {
                                 Shading::None => Shading::Phong,
                                 Shading::Phong => Shading::PhongShadows,
-                                Shading::PhongShadows => Shading::None,
+                                Shading::PhongShadows => Shading::HenyeyGreenstein { g: 0.5, shadows: true },
+                                Shading::HenyeyGreenstein { .. } => Shading::None,
                             };
                             Method::RayMarch(h)
                         }

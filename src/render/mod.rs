@@ -1,6 +1,7 @@
 //! From a scene to an image: a [`Blueprint`] (CPU only: objects, shells, plane sweeps, bakes and
 //! the pruned graph plan, enough for `voltex plan`), then a [`Renderer`] holding the GPU resources.
 
+pub mod aov;
 mod budget;
 mod describe;
 mod renderer;
@@ -62,6 +63,11 @@ pub struct Blueprint {
     pub budget: u64,
     /// Where the values that size the allocations are written, for the limit checks' errors.
     pub positions: Positions,
+    /// The AOVs this render writes beside the colour (`--aov`, the scene's `aovs`).
+    pub aovs: Vec<aov::PlannedAov>,
+    /// The camera rendered through, and the frame's time (seconds): the EXR says so.
+    pub view: View,
+    pub time: f64,
 }
 
 /// The bake of `texel` with the scene's first light baked in (what `voltex bake` writes out).
@@ -130,8 +136,15 @@ impl Blueprint {
                 crate::methods::plan_object(&mut cx, o, opts).map_err(|e| positions.at_object(&name, e))
             })
             .collect::<Result<Vec<_>>>()?;
-        let (graph, sources) = load_graph(opts.graph.as_deref())?;
+        let (mut graph, sources) = load_graph(opts.graph.as_deref())?;
+        let names: Vec<&str> = objects.iter().map(|o| o.object.name.as_str()).collect();
+        let requested = match &opts.aovs {
+            Some(names) => aov::Requested { names, at: None },
+            None => aov::Requested { names: &scene.aovs, at: scene.locate_key("aovs") },
+        };
+        let aovs = aov::plan(&mut graph, requested, &names)?;
         let groups = crate::methods::gather(&mut objects, &bakes, &view);
+        aov::check_groups(&aovs, &graph, &groups, &objects)?;
         let (instances, infos) = instances(&objects, &groups, view.eye);
         let plan = plan::plan(&graph, &sources, &infos, size, &vocabulary())?;
         check_bindings(&graph, &plan)?;
@@ -158,6 +171,9 @@ impl Blueprint {
             plan,
             budget: opts.budget.unwrap_or(crate::gpu::budget::DEFAULT_BUDGET),
             positions,
+            aovs,
+            view,
+            time,
         })
     }
 }

@@ -18,6 +18,8 @@ pub struct Frame {
     pub image: Image,
     /// Per-pass GPU time (ms) from timestamp queries; empty without TIMESTAMP_QUERY.
     pub pass_times: Vec<(String, f64)>,
+    /// The AOVs asked for, as EXR channels: (name, samples row-major from the top row).
+    pub aovs: Vec<(String, Vec<f32>)>,
 }
 
 impl Frame {
@@ -109,7 +111,13 @@ impl Renderer {
         self.exec.run(ctx, &self.blueprint.plan, &self.frame, &self.objects, &mut self.timer)?;
         let pass_times = self.timer.read(ctx)?;
         let image = self.read_output(ctx)?.box_downsample(self.blueprint.supersample);
-        Ok(Frame { image, pass_times })
+        let mut aovs = Vec::new();
+        for aov in &self.blueprint.aovs {
+            let images =
+                aov.textures.iter().map(|(t, _)| self.read_texture(ctx, t)).collect::<Result<Vec<_>>>()?;
+            aovs.extend(crate::render::aov::channels(aov, images, self.blueprint.supersample));
+        }
+        Ok(Frame { image, pass_times, aovs })
     }
 
     /// Renders without reading the image back (benchmarks); returns per-pass GPU times.
@@ -207,26 +215,91 @@ fn instance_inputs(cx: &InputCx, bp: &Blueprint, i: &crate::render::Instance) ->
     inputs.constants.push(("per_pixel_lighting".into(), o.per_pixel as u32 as f64));
     let opacity_length = o.bake.map(|b| bp.bakes[b].opacity_length).unwrap_or(1.0);
     let c = o.object.base_color.unwrap_or([0.0; 3]);
-    let params = ObjectParams { base_color: [c[0], c[1], c[2], 1.0], opacity_length, _pad: [0.0; 3] };
+    let params = ObjectParams {
+        base_color: [c[0], c[1], c[2], 1.0],
+        opacity_length,
+        index: i.object as u32,
+        _pad: [0.0; 2],
+    };
     inputs.buffers.insert("object".into(), buffers::uniform(cx.ctx, "object", bytemuck::bytes_of(&params)));
     bp.plan_of(i).add_inputs(cx, o, i.part, &mut inputs);
     inputs
 }
 
 impl Renderer {
-    /// EXR metadata: scene, methods and their quality knobs, adapter, GPU time.
+    /// EXR metadata: how the image was made (voltex version, scene, graph, camera, time, size,
+    /// AOVs, each object's method and quality knobs, adapter, GPU time).
     pub fn metadata(&self, ctx: &GpuContext, frame: &Frame) -> Vec<(String, String)> {
+        let bp = &self.blueprint;
+        let v = &bp.view;
+        let (w, h) = bp.size;
+        let n = bp.supersample;
         let mut m = vec![
-            ("voltex_scene".to_string(), self.blueprint.scene_path.display().to_string()),
+            ("voltex_version".to_string(), env!("CARGO_PKG_VERSION").to_string()),
+            ("voltex_scene".to_string(), bp.scene_path.display().to_string()),
+            ("voltex_graph".to_string(), bp.graph.path.display().to_string()),
+            (
+                "voltex_camera".to_string(),
+                format!(
+                    "eye ({}, {}, {}), forward ({:.6}, {:.6}, {:.6}), up ({}, {}, {}), fov_y {} degrees",
+                    v.eye.x,
+                    v.eye.y,
+                    v.eye.z,
+                    v.forward.x,
+                    v.forward.y,
+                    v.forward.z,
+                    v.up.x,
+                    v.up.y,
+                    v.up.z,
+                    v.fov_y
+                ),
+            ),
+            ("voltex_time".to_string(), format!("{}", bp.time)),
+            ("voltex_size".to_string(), format!("{}x{} (supersample {n})", w / n, h / n)),
             ("voltex_adapter".to_string(), ctx.adapter_line()),
         ];
+        if !bp.aovs.is_empty() {
+            let names: Vec<&str> = bp.aovs.iter().map(|a| a.name.as_str()).collect();
+            m.push(("voltex_aovs".into(), names.join(",")));
+        }
         if let Some(t) = frame.gpu_ms() {
             m.push(("voltex_gpu_ms".into(), format!("{t:.3}")));
         }
-        for o in &self.blueprint.objects {
+        for o in &bp.objects {
             let method = o.methods.last().map_or("None".into(), |m| m.metadata(o));
             m.push((format!("voltex_object_{}", o.object.name), method));
         }
         m
+    }
+
+    /// OpenEXR's standard camera attributes of the frame (world space, not camera-relative).
+    pub fn camera_attributes(&self) -> crate::io::exr::CameraAttributes {
+        let v = &self.blueprint.view;
+        let c = v.camera();
+        let right = c.right.normalize();
+        let up = right.cross(v.forward);
+        // Left-handed camera space: x right, y up, z forward.
+        let rotation = glam::DMat4::from_cols(
+            glam::DVec4::new(right.x, up.x, v.forward.x, 0.0),
+            glam::DVec4::new(right.y, up.y, v.forward.y, 0.0),
+            glam::DVec4::new(right.z, up.z, v.forward.z, 0.0),
+            glam::DVec4::W,
+        );
+        let world_to_camera = rotation * glam::DMat4::from_translation(-v.eye);
+        // NDC x = 0.5 + 0.5 x / (z tan_x), y = 0.5 - 0.5 y / (z tan_y), after the divide by w = z.
+        let (kx, ky) = (0.5 / c.right.length(), 0.5 / c.up.length());
+        let project = glam::DMat4::from_cols(
+            glam::DVec4::new(kx, 0.0, 0.0, 0.0),
+            glam::DVec4::new(0.0, -ky, 0.0, 0.0),
+            glam::DVec4::new(0.5, 0.5, 1.0, 1.0),
+            glam::DVec4::ZERO,
+        );
+        // Imath multiplies row vectors: its row-major array is glam's column-major one.
+        crate::io::exr::CameraAttributes {
+            world_to_camera: world_to_camera.as_mat4().to_cols_array(),
+            world_to_ndc: (project * world_to_camera).as_mat4().to_cols_array(),
+            near: v.near as f32,
+            far: v.far as f32,
+        }
     }
 }

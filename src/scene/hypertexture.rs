@@ -35,6 +35,18 @@ pub struct Hypertexture {
     /// World length over which the transfer function's opacity is reached.
     #[serde(default = "default_opacity_length", deserialize_with = "v::positive")]
     pub opacity_length: f64,
+    /// Perlin's bias applied to the density, `d^(ln b / ln 0.5)`: below 0.5 it thins the soft
+    /// region, above it thickens it; 0.5 changes nothing. In (0, 1).
+    #[serde(default = "identity_modulation", deserialize_with = "v::open_unit")]
+    pub bias: f64,
+    /// Perlin's gain applied after the bias: above 0.5 it sharpens the soft region towards a
+    /// step at density 0.5, below it flattens it; 0.5 changes nothing. In (0, 1).
+    #[serde(default = "identity_modulation", deserialize_with = "v::open_unit")]
+    pub gain: f64,
+}
+
+fn identity_modulation() -> f64 {
+    0.5
 }
 
 fn default_opacity_length() -> f64 {

@@ -78,6 +78,21 @@ impl Scene {
     pub fn source(&self) -> &str {
         &self.source
     }
+
+    /// Where the top-level field `key` is written (`key:` at the start of a line), if it is.
+    pub fn locate_key(&self, key: &str) -> Option<crate::error::FileLoc> {
+        let mut offset = 0;
+        for line in self.source.split_inclusive('\n') {
+            let t = line.trim_start();
+            if t.strip_prefix(key).is_some_and(|rest| rest.trim_start().starts_with(':')) {
+                let at = offset + line.len() - t.len();
+                let (l, c) = crate::error::line_col(&self.source, at);
+                return Some(crate::error::FileLoc::new(&self.path, l, c));
+            }
+            offset += line.len();
+        }
+        None
+    }
 }
 
 /// Reads, parses and checks a scene file, and loads the files it refers to.

@@ -31,6 +31,10 @@ pub struct Scene {
     /// Time of the frame in seconds (animated hypertextures; `--time` overrides it).
     #[serde(default, deserialize_with = "v::finite")]
     pub time: f64,
+    /// Extra images (AOVs) written as EXR channels beside the colour, by the names the graph
+    /// declares (the default graph: `depth`, `coverage`, `transmittance`); `--aov` replaces it.
+    #[serde(default)]
+    pub aovs: Vec<String>,
     /// Settings of `voltex regress` runs: render size and pass thresholds.
     #[serde(default)]
     pub regress: Regress,
@@ -685,14 +689,25 @@ impl Quality {
 }
 
 /// Shading of a hypertexture: the transfer function's colour as is, Phong with the density
-/// gradient by central differences, or Phong with shadow rays towards the light.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
+/// gradient by central differences, Phong with shadow rays towards the light, or volumetric
+/// lighting by a Henyey-Greenstein phase function (no normal: the paper's section 3 alternative).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub enum Shading {
     #[default]
     None,
     Phong,
     PhongShadows,
+    /// Single scattering of the light with the phase function `p_HG(g, cos)`: the colour is the
+    /// transfer's times `ambient + (1 - ambient) 4 pi p_HG` (so `g: 0`, isotropic, is the
+    /// unshaded colour), times the transmittance towards the light with `shadows`. `g` in
+    /// (-1, 1): above 0 forward scattering (bright towards the light), below 0 backward.
+    HenyeyGreenstein {
+        #[serde(deserialize_with = "v::anisotropy")]
+        g: f64,
+        #[serde(default)]
+        shadows: bool,
+    },
 }
 
 /// Exact ray casting through the prisms with a fine fixed step: the ground truth.

@@ -37,6 +37,8 @@ checked_f64!(Finite, |_| true, "a finite number");
 checked_f64!(Positive, |v| v > 0.0, "a positive finite number");
 checked_f64!(NonNegative, |v| v >= 0.0, "a finite number >= 0");
 checked_f64!(Unit, |v| (0.0..=1.0).contains(&v), "a number in [0, 1]");
+checked_f64!(OpenUnit, |v| v > 0.0 && v < 1.0, "a number in (0, 1)");
+checked_f64!(Anisotropy, |v| v > -1.0 && v < 1.0, "an anisotropy g in (-1, 1)");
 checked_f64!(NonZero, |v| v != 0.0, "a finite non-zero number");
 checked_f64!(Jitter, |v| (0.0..0.5).contains(&v), "a jitter in [0, 0.5) (fraction of a cell)");
 checked_f64!(Distortion, |v| (0.0..0.9).contains(&v), "a distortion in [0, 0.9)");
@@ -110,6 +112,8 @@ adapter!(unit_rows, Vec<Vec<f64>>, Vec<Vec<Unit>>, |v| v
 adapter!(opt_positive, Option<f64>, Option<Positive>, |v| v.map(|x| x.0));
 adapter!(non_negative, f64, NonNegative, |v| v.0);
 adapter!(unit, f64, Unit, |v| v.0);
+adapter!(open_unit, f64, OpenUnit, |v| v.0);
+adapter!(anisotropy, f64, Anisotropy, |v| v.0);
 adapter!(jitter, f64, Jitter, |v| v.0);
 adapter!(distortion, f64, Distortion, |v| v.0);
 adapter!(fov, f64, FieldOfView, |v| v.0);

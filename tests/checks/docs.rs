@@ -272,7 +272,7 @@ fn scene_registry() -> Registry {
 fn graph_registry() -> Registry {
     use voltex::graph::*;
     trace!(GraphFile; ResourceDecl, Format, TextureSize, Clear, BufferSize, BufferClear, Value, Instances,
-        PassDecl, Dispatch, Blend, Compare, Draw)
+        PassDecl, Dispatch, Blend, Compare, Draw, AovChannels, Downsample)
 }
 
 fn missing_in(page: &str, names: impl IntoIterator<Item = String>) -> Vec<String> {

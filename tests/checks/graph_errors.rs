@@ -159,6 +159,29 @@ fn frame_graph_parses_and_plans() {
             "composite"
         ]
     );
+    // Only the AOV passes, which no render asked for, are pruned.
+    let aov = ["aov_", "cover_", "depth_", "resolve_"];
+    assert!(p.pruned.iter().all(|r| aov.iter().any(|a| r.contains(a))), "{:?}", p.pruned);
+    // Asked for, the AOV passes come after the passes they repeat or whose results they read.
+    let mut with_aovs = g.clone();
+    for a in g.file.aovs.values() {
+        with_aovs.file.outputs.extend(a.textures.iter().cloned());
+    }
+    let p = plan(&with_aovs, &wgsl_root(), &objects(all)).unwrap();
+    let order = names(&p);
+    for (before, after) in [
+        ("draw_axis_slices", "cover_base"),
+        ("blend_axis_slices", "cover_blended_axis_slices"),
+        ("cover_base", "cover_axis_slices"),
+        ("cover_slices", "cover_blended_axis_slices"),
+        ("cover_reference", "cover_ray_march"),
+        ("ray_march", "resolve_depth"),
+        ("trace_reference", "resolve_depth"),
+        ("depth_slices", "resolve_depth"),
+        ("composite_ray_march", "resolve_transmittance"),
+    ] {
+        assert!(pos(&order, before) < pos(&order, after), "{before} after {after}: {order:?}");
+    }
     assert!(p.pruned.is_empty(), "{:?}", p.pruned);
     // Without Reference objects its passes and layer go.
     let p = plan(&g, &wgsl_root(), &objects(&[&["ViewSlices", "BaseSurface"]])).unwrap();

@@ -3,6 +3,7 @@
 #[path = "../common/mod.rs"]
 mod common;
 
+mod aov;
 mod docs;
 mod graph_errors;
 mod io_metrics;

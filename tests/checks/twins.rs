@@ -54,6 +54,16 @@ const NO_TWIN: &[(&str, &str)] = &[
          by the golden images (tests/gpu/render_scenes.rs, voltex regress)",
     ),
     (
+        "resolve_depth",
+        "raster: turns the nearest opaque hit (1 / z bits) into z, one line; checked against \
+         analytic depths (a floor, a slab's top, a sphere) in tests/gpu/aov.rs",
+    ),
+    (
+        "resolve_transmittance",
+        "raster: 1 - alpha of the frame, one line; checked against a constant slab's \
+         transmittance in tests/gpu/aov.rs",
+    ),
+    (
         "composite_ray_march",
         "raster: blends the march state the ray_march twin computes over the frame (one line); \
          checked by the golden images",

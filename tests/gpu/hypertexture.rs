@@ -317,6 +317,17 @@ fn images_match_twin() {
             "cloud, Phong + shadows",
             one(CLOUD, "RayMarch(step: 0.01, shading: PhongShadows, shadow_step: 0.04)"),
         ),
+        (
+            "cloud, Henyey-Greenstein g 0.6",
+            one(CLOUD, "RayMarch(step: 0.02, shading: HenyeyGreenstein(g: 0.6))"),
+        ),
+        (
+            "cloud, Henyey-Greenstein g -0.4 + shadows",
+            one(
+                CLOUD,
+                "RayMarch(step: 0.02, shading: HenyeyGreenstein(g: -0.4, shadows: true), shadow_step: 0.04)",
+            ),
+        ),
     ];
     let mut resumed = false;
     for (what, scene) in &cases {
@@ -462,6 +473,101 @@ fn zero_amplitude_gives_the_undistorted_object() {
     }
     eprintln!("a = 0: density equals the soft object's at 2048 points; {inside} pixels covered, {outside} empty as the sphere says");
     assert!(inside > 200 && outside > 200);
+}
+
+/// The Henyey-Greenstein phase function: isotropic at g = 0, a density over the sphere of
+/// directions for every g (it integrates to 1), and its peak value; with g = 0 the phase shading
+/// keeps the albedo: the image equals the unshaded one.
+#[test]
+fn henyey_greenstein_phase_function() {
+    use std::f64::consts::PI;
+    use voltex::methods::ray_march::march::henyey_greenstein as hg;
+    for cos in [-1.0, -0.3, 0.0, 0.7, 1.0] {
+        assert!((hg(0.0, cos) - 1.0 / (4.0 * PI)).abs() < 1e-15, "isotropic at cos {cos}");
+    }
+    for g in [-0.9, -0.5, 0.0, 0.3, 0.8, 0.9] {
+        // 2 pi times the integral over cos in [-1, 1], by Simpson's rule on 20000 intervals.
+        let n = 20000;
+        let h = 2.0 / n as f64;
+        let f = |i: usize| hg(g, -1.0 + i as f64 * h);
+        let s: f64 = (0..=n)
+            .map(|i| {
+                f(i) * if i == 0 || i == n {
+                    1.0
+                } else if i % 2 == 1 {
+                    4.0
+                } else {
+                    2.0
+                }
+            })
+            .sum();
+        let total = 2.0 * PI * s * h / 3.0;
+        assert!((total - 1.0).abs() < 1e-6, "g {g}: integrates to {total}");
+        // Mean cosine is g (the anisotropy's definition).
+        let m: f64 = (0..=n)
+            .map(|i| {
+                f(i) * (-1.0 + i as f64 * h)
+                    * if i == 0 || i == n {
+                        1.0
+                    } else if i % 2 == 1 {
+                        4.0
+                    } else {
+                        2.0
+                    }
+            })
+            .sum();
+        assert!((2.0 * PI * m * h / 3.0 - g).abs() < 1e-5, "g {g}: mean cosine");
+    }
+    // Forward peak: (1 - g^2) / (4 pi (1 - g)^3) = (1 + g) / (4 pi (1 - g)^2); g = 1/2: 1.5 / pi.
+    assert!((hg(0.5, 1.0) - 1.5 / PI).abs() < 1e-15);
+    assert!((hg(0.5, -1.0) - 0.75 / (4.0 * PI * 1.5f64.powi(3))).abs() < 1e-15);
+    // Images: g = 0 equals the unshaded render.
+    let (unshaded, _, _) = layer_and_twin(&one(CLOUD, "RayMarch(step: 0.02)"), &sized(32, 32));
+    let (isotropic, _, _) = layer_and_twin(
+        &one(CLOUD, "RayMarch(step: 0.02, shading: HenyeyGreenstein(g: 0.0))"),
+        &sized(32, 32),
+    );
+    let (max, _, _) = compare(&unshaded, &isotropic);
+    assert!(max < 1e-6, "g = 0 differs from unshaded by {max}");
+}
+
+/// Perlin's bias and gain (the density modulation functions of section 3): known values of the
+/// twin, and the kernel against the twin on a soft sphere whose density they reshape.
+#[test]
+fn bias_and_gain_modulate_the_density() {
+    use voltex::cpu::hypertexture::{perlin_bias, perlin_gain};
+    for b in [0.1, 0.3, 0.5, 0.8, 0.95] {
+        assert!((perlin_bias(b, 0.5) - b).abs() < 1e-15, "bias({b}, 0.5) = {b}");
+        assert_eq!((perlin_bias(b, 0.0), perlin_bias(b, 1.0)), (0.0, 1.0));
+        assert!((perlin_gain(b, 0.5) - 0.5).abs() < 1e-15, "gain({b}, 0.5) = 0.5");
+        // gain(g, 1/4) = bias(1 - g, 1/2) / 2 = (1 - g) / 2, and it is odd about (1/2, 1/2).
+        assert!((perlin_gain(b, 0.25) - (1.0 - b) / 2.0).abs() < 1e-15);
+        assert!((perlin_gain(b, 0.75) - (1.0 - (1.0 - b) / 2.0)).abs() < 1e-15);
+    }
+    // bias(b, t) = t^(ln b / ln 1/2): bias(1/4, t) = t^2, bias(1/8, t) = t^3.
+    assert!((perlin_bias(0.25, 0.3) - 0.09).abs() < 1e-15);
+    assert!((perlin_bias(0.125, 0.6) - 0.216).abs() < 1e-14);
+    assert!((perlin_gain(0.75, 0.1) - 0.5 * 0.2f64.powi(2)).abs() < 1e-15, "gain(3/4, t) = 2 t^2 below 1/2");
+    let h = "(object: Sphere(radius: 1.0), noises: [(shape: Table([0.0, 1.0]), amplitude: 0.0, frequency: 3.0)], \
+        color: Step(threshold: 0.4, color: (1.0, 1.0, 1.0)), opacity_length: 0.01, bias: 0.3, gain: 0.8)";
+    let scene = one(h, "RayMarch(step: 0.01)");
+    let bp = blueprint(&scene, &sized(16, 16));
+    let plan = plans(&bp)[0];
+    let mut rng = Rng(17);
+    let points: Vec<[f32; 4]> =
+        (0..1024).map(|_| point(rng.in_box(DVec3::splat(-1.1), DVec3::splat(1.1)), 0)).collect();
+    let gpu = probe(&ctx().lock().unwrap_or_else(|e| e.into_inner()), plan, &points).unwrap();
+    let tables = twin_tables(plan);
+    let m = model(plan, &tables);
+    let mut worst: f64 = 0.0;
+    for (i, p) in points.iter().enumerate() {
+        let x = DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64);
+        let expected = perlin_gain(0.8, perlin_bias(0.3, (1.0 - x.length()).max(0.0)));
+        assert!((m.hyper_density(x) - expected).abs() < 1e-6, "twin at {x}");
+        worst = worst.max((gpu.values[4 * i + 2][0] as f64 - expected).abs());
+    }
+    eprintln!("bias 0.3, gain 0.8 on a soft sphere: kernel within {worst:.1e} of gain(bias(1 - |x|))");
+    assert!(worst < 1e-5, "kernel off by {worst}");
 }
 
 /// r = 1 with the closest-surface field on a sphere (section 4.1): every point of a radius is

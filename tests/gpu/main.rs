@@ -6,6 +6,7 @@ mod common;
 mod fuzz_support;
 
 mod animation;
+mod aov;
 mod axis_slices;
 mod bake_stack;
 mod fuzz;

@@ -13,6 +13,11 @@ override blended_slices: bool = false;
 // Repeats along both image axes (w slices: s, t); the side sampler clamps the image's v (= w).
 @group(0) @binding(6) var axis_sampler: sampler;
 @group(0) @binding(7) var axis_sampler_side: sampler;
+// AOVs (fs_coverage, fs_depth): the nearest opaque hit per pixel.
+@group(0) @binding(8) var<storage, read_write> aov_opaque_depth: array<atomic<u32>>;
+
+#include "shared/aov_coverage.wgsl"
+#include "shared/aov_depth.wgsl"
 
 struct VsOut {
     @builtin(position) clip: vec4<f32>,
@@ -36,8 +41,14 @@ fn vs_main(@builtin(vertex_index) index: u32) -> VsOut {
     return out;
 }
 
-@fragment
-fn fs_main(in: VsOut) -> @location(0) vec4<f32> {
+// The slice image's sample: albedo, opacity over `opacity_length`, and step-corrected opacity.
+struct SliceSample {
+    albedo: vec3<f32>,
+    alpha: f32,
+    corrected: f32,
+}
+
+fn sample_slice(in: VsOut) -> SliceSample {
     var texel: vec4<f32>;
     if (in.direction == 2u) {
         texel = textureSampleLevel(axis_slices_w, axis_sampler, in.uv, in.layer, 0.0);
@@ -51,13 +62,40 @@ fn fs_main(in: VsOut) -> @location(0) vec4<f32> {
     let step = in.normal.w / max(abs(dot(ray, in.normal.xyz)), 1e-4);
     let a = clamp(texel.a, 0.0, 1.0);
     let corrected = 1.0 - pow(1.0 - min(a, 0.999999), step / object.opacity_length);
-    let albedo = texel.rgb / max(a, 1e-6);
+    return SliceSample(texel.rgb / max(a, 1e-6), a, corrected);
+}
+
+@fragment
+fn fs_main(in: VsOut) -> @location(0) vec4<f32> {
+    let s = sample_slice(in);
     if (!blended_slices) {
         // Binary alpha as in the paper: the step-corrected opacity is thresholded.
-        if (corrected < 0.5) {
+        if (s.corrected < 0.5) {
             discard;
         }
-        return vec4<f32>(albedo * frame.light_color.rgb, 1.0);
+        return vec4<f32>(s.albedo * frame.light_color.rgb, 1.0);
     }
-    return vec4<f32>(albedo * corrected * frame.light_color.rgb, corrected);
+    return vec4<f32>(s.albedo * s.corrected * frame.light_color.rgb, s.corrected);
+}
+
+// Coverage AOV: the opacity fs_main draws with, into the object's slot.
+@fragment
+fn fs_coverage(in: VsOut) -> Coverage {
+    let s = sample_slice(in);
+    if (!blended_slices) {
+        if (s.corrected < 0.5) {
+            discard;
+        }
+        return coverage_slot(object.index, 1.0);
+    }
+    return coverage_slot(object.index, s.corrected);
+}
+
+// Depth AOV: binary slices are opaque where they are drawn; blended ones where the texel is.
+@fragment
+fn fs_depth(in: VsOut) {
+    let s = sample_slice(in);
+    if (select(s.alpha >= OPAQUE_ALPHA, s.corrected >= 0.5, !blended_slices)) {
+        record_opaque_depth(fragment_pixel(in.clip), dot(in.rel, frame.forward.xyz));
+    }
 }

@@ -4,6 +4,11 @@
 @group(0) @binding(0) var<uniform> frame: FrameParams;
 @group(0) @binding(1) var<uniform> object: ObjectParams;
 @group(0) @binding(2) var<storage, read> base_vertices: array<BaseVertex>;
+// AOVs (fs_coverage, fs_depth): the nearest opaque hit per pixel.
+@group(0) @binding(3) var<storage, read_write> aov_opaque_depth: array<atomic<u32>>;
+
+#include "shared/aov_coverage.wgsl"
+#include "shared/aov_depth.wgsl"
 
 struct VsOut {
     @builtin(position) clip: vec4<f32>,
@@ -38,4 +43,16 @@ fn fs_main(in: VsOut) -> FsOut {
     let diffuse = max(dot(n, frame.light_dir.xyz), 0.0);
     let rgb = object.base_color.rgb * (ambient + (1.0 - ambient) * diffuse) * frame.light_color.rgb;
     return FsOut(vec4<f32>(rgb, 1.0), in.clip.z);
+}
+
+// Coverage AOV: a base surface covers its pixels wholly.
+@fragment
+fn fs_coverage(in: VsOut) -> Coverage {
+    return coverage_slot(object.index, 1.0);
+}
+
+// Depth AOV: a base surface is opaque.
+@fragment
+fn fs_depth(in: VsOut) {
+    record_opaque_depth(fragment_pixel(in.clip), dot(in.rel, frame.forward.xyz));
 }

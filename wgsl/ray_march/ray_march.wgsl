@@ -25,6 +25,10 @@ override peeling: bool = false;
 // Depth peeling's segments (stand-ins without it); the marcher keeps its segment in word 0.
 @group(0) @binding(8) var<uniform> segments: SegmentParams;
 @group(0) @binding(9) var<storage, read_write> segment_bounds: array<u32>;
+// The depth AOV: the nearest opaque sample of each pixel (shared/aov_depth.wgsl).
+@group(0) @binding(10) var<storage, read_write> aov_opaque_depth: array<atomic<u32>>;
+
+#include "shared/aov_depth.wgsl"
 
 @compute @workgroup_size(8, 8, 1)
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {
@@ -60,6 +64,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     // The bounds are one segment. With depth peeling, segment i is [entry i, exit i] of this
     // pixel (an exit not found: the bounds' exit), and only the samples above inside it are
     // taken: the same samples as the bounds march, less those in empty space.
+    var opaque_found = false;
     var segment = 0u;
     var segment_count = 1u;
     let base = pixel * segment_stride();
@@ -99,9 +104,13 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
                 continue;
             }
             if (rgba.a > 1e-6) {
+                if (rgba.a >= OPAQUE_ALPHA && !opaque_found) {
+                    opaque_found = true;
+                    record_opaque_depth(pixel, (t0 + (f32(k) + 0.5) * h) * dot(d, frame.forward.xyz));
+                }
                 let alpha = step_alpha(rgba.a, h);
                 var colour = rgba.rgb;
-                if (phong) {
+                if (phong || phase) {
                     let shaded = shade(x, d, colour);
                     colour = shaded.xyz;
                     budget -= i32(shaded.w);

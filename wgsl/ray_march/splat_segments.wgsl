@@ -123,7 +123,7 @@ fn main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index
                 // The step's optical depth: -ln of its step-corrected transmittance.
                 let depth_k = -log(1.0 - min(rgba.a, MAX_ALPHA)) * h / hyper.bounds_max.w;
                 var c = rgba.rgb;
-                if (phong) {
+                if (phong || phase) {
                     let shaded = shade(x, d, c);
                     c = shaded.xyz;
                     evaluations += u32(shaded.w);

@@ -32,6 +32,10 @@ const DEPTH_SLACK: f32 = 2e-3;
 @group(0) @binding(9) var depth: texture_depth_2d;
 @group(0) @binding(10) var reference_rgba: texture_storage_2d<rgba32float, write>;
 @group(0) @binding(11) var<storage, read_write> reference_state: array<ReferenceState>;
+// The depth AOV: the nearest opaque sample of each pixel (shared/aov_depth.wgsl).
+@group(0) @binding(12) var<storage, read_write> aov_opaque_depth: array<atomic<u32>>;
+
+#include "shared/aov_depth.wgsl"
 
 // The intervals of the current window: the MAX_SEGMENTS earliest starts at or after the window's
 // start; `cut` is the earliest start that did not fit, so everything before it is complete.
@@ -41,6 +45,8 @@ var<private> seg_prism: array<u32, MAX_SEGMENTS>;
 var<private> seg_count: u32;
 var<private> cut: f32;
 var<private> t_opaque: f32;
+// Some prism's texel at the last sample was opaque (the depth AOV).
+var<private> sample_opaque: bool;
 
 fn load_shape(index: u32) -> PrismShape {
     let ids = reference_prisms[index].vertices.xyz;
@@ -220,6 +226,7 @@ fn segment_sample(index: u32, x: vec3<f32>, d: vec3<f32>) -> vec4<f32> {
     let texel = sample_volume(object, uvw, false);
     let alpha = clamp(texel.a, 0.0, MAX_ALPHA);
     var out = vec4<f32>(0.0);
+    sample_opaque = sample_opaque || (inv.w >= 0.0 && texel.a >= OPAQUE_ALPHA);
     if (inv.w >= 0.0 && alpha > 1e-6) {
         var colour = texel.rgb / alpha;
         if ((object.resolution.w & 1u) != 0u) {
@@ -278,6 +285,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     var budget = samples_per_dispatch;
     var finished = false;
+    var opaque_found = false;
     // Each window holds the next MAX_SEGMENTS intervals and is marched from t_start to its cut.
     while (!finished && budget >= WINDOW_COST) {
         budget -= WINDOW_COST;
@@ -303,7 +311,12 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
                 let h = (b - a) / f32(n);
                 var k = 0u;
                 while (k < n && transmittance >= MIN_TRANSMITTANCE && budget > 0u) {
+                    sample_opaque = false;
                     let s = sample_point(d, a + (f32(k) + 0.5) * h, a, b);
+                    if (sample_opaque && !opaque_found) {
+                        opaque_found = true;
+                        record_opaque_depth(pixel, (a + (f32(k) + 0.5) * h) * cos_d);
+                    }
                     if (s.w > 0.0) {
                         let alpha = 1.0 - exp(-s.w * h);
                         rgb += s.xyz / s.w * alpha * transmittance;

@@ -44,7 +44,32 @@ fn hyper_density(x: vec3<f32>) -> f32 {
             k += n.amplitude * t;
         }
     }
-    return object_density(x - k * dir);
+    return modulate(object_density(x - k * dir));
+}
+
+// Perlin's bias: t^(ln b / ln 0.5), so that bias(b, 0.5) = b; 0 and 1 stay.
+fn perlin_bias(b: f32, t: f32) -> f32 {
+    if (t <= 0.0) {
+        return 0.0;
+    }
+    return pow(t, log(b) / log(0.5));
+}
+
+// Perlin's gain: two biases of 1 - g mirrored about t = 0.5, so that gain(g, 0.5) = 0.5.
+fn perlin_gain(g: f32, t: f32) -> f32 {
+    if (t < 0.5) {
+        return 0.5 * perlin_bias(1.0 - g, 2.0 * t);
+    }
+    return 1.0 - 0.5 * perlin_bias(1.0 - g, 2.0 - 2.0 * t);
+}
+
+// The density modulation functions of the hypertexture (`bias`, `gain`: 0.5 is the identity).
+fn modulate(density: f32) -> f32 {
+    let m = hyper.modulation;
+    if (m.x == 0.5 && m.y == 0.5) {
+        return density;
+    }
+    return perlin_gain(m.y, perlin_bias(m.x, clamp(density, 0.0, 1.0)));
 }
 
 // A noise's shape transfer function at noise value u: its table, or with rows (a 2D function,

@@ -7,6 +7,11 @@
 // towards the light for shadows.
 override phong: bool = false;
 override shadows: bool = false;
+// Volumetric lighting instead of Phong (`shading: HenyeyGreenstein(g, shadows)`): the
+// Henyey-Greenstein phase function of anisotropy `phase_g`, no gradient.
+override phase: bool = false;
+override phase_g: f32 = 0.0;
+const PI: f32 = 3.14159265358979;
 const MIN_TRANSMITTANCE: f32 = 1e-4;
 const MAX_ALPHA: f32 = 0.999999;
 // Raster depth is coarse far from the camera: opaque surfaces are moved back by this margin.
@@ -62,7 +67,8 @@ fn shade(x: vec3<f32>, ray: vec3<f32>, albedo: vec3<f32>) -> vec4<f32> {
     }
     var g = vec3<f32>(0.0);
     var lit = 1.0;
-    var j = 0u;
+    // The phase function needs no gradient: straight to the shadow samples.
+    var j = select(0u, 6u, phase);
     while (j < 6u + n && lit >= MIN_TRANSMITTANCE) {
         let axis = min(j / 2u, 2u);
         let side = select(-1.0, 1.0, (j & 1u) == 0u);
@@ -78,10 +84,16 @@ fn shade(x: vec3<f32>, ray: vec3<f32>, albedo: vec3<f32>) -> vec4<f32> {
         }
         j++;
     }
-    let len = length(g);
-    let normal = select(-ray, -g / len, len > 1e-12);
     let light = frame.light_dir.xyz;
     let ambient = frame.light_dir.w;
+    if (phase) {
+        // The light travels along -light and leaves towards the eye along -ray: the scattering
+        // angle's cosine is light . ray; 4 pi p keeps the albedo for isotropic scattering.
+        let p = 4.0 * PI * henyey_greenstein(phase_g, dot(light, ray));
+        return vec4<f32>(albedo * (ambient + (1.0 - ambient) * p * lit), f32(j - 6u));
+    }
+    let len = length(g);
+    let normal = select(-ray, -g / len, len > 1e-12);
     let half_way = normalize(light - ray);
     let diffuse = max(dot(normal, light), 0.0);
     let specular = select(0.0, 0.25 * pow(max(dot(normal, half_way), 0.0), 32.0), diffuse > 0.0);
@@ -89,3 +101,10 @@ fn shade(x: vec3<f32>, ray: vec3<f32>, albedo: vec3<f32>) -> vec4<f32> {
     return vec4<f32>(colour, f32(j));
 }
 
+
+// The Henyey-Greenstein phase function at the cosine of the scattering angle: a density over the
+// sphere of directions, (1 - g^2) / (4 pi (1 + g^2 - 2 g cos)^(3/2)).
+fn henyey_greenstein(g: f32, cos_theta: f32) -> f32 {
+    let d = max(1.0 + g * g - 2.0 * g * cos_theta, 1e-12);
+    return (1.0 - g * g) / (4.0 * PI * d * sqrt(d));
+}

@@ -48,7 +48,8 @@ struct FrameParams {
 struct ObjectParams {
     base_color: vec4<f32>,
     opacity_length: f32,
-    _pad0: f32,
+    // The object's index in the scene: its slot in per-object AOVs (coverage).
+    index: u32,
     _pad1: f32,
     _pad2: f32,
 }
@@ -183,6 +184,7 @@ struct HyperParams {
     budget: vec4<u32>,
     grid_min: vec4<f32>,
     grid_max: vec4<f32>,
+    modulation: vec4<f32>,
 }
 
 // A mesh object's grid bake (twin: MeshGridParams in src/types.rs).

@@ -16,6 +16,11 @@ override per_pixel_lighting: bool = false;
 @group(0) @binding(7) var normals: texture_3d<f32>;
 @group(0) @binding(8) var volume_sampler: sampler;
 @group(0) @binding(9) var<storage, read> vertex_frames: array<VertexFrame>;
+// AOVs (fs_coverage, fs_depth): the nearest opaque hit per pixel.
+@group(0) @binding(10) var<storage, read_write> aov_opaque_depth: array<atomic<u32>>;
+
+#include "shared/aov_coverage.wgsl"
+#include "shared/aov_depth.wgsl"
 
 struct VsOut {
     @builtin(position) clip: vec4<f32>,
@@ -59,6 +64,14 @@ fn vs_main(@builtin(vertex_index) index: u32) -> VsOut {
     return out;
 }
 
+// The texel's opacity over `opacity_length` (x) and over this pixel's ray between two planes (y).
+fn slice_alpha(in: VsOut) -> vec2<f32> {
+    let texel = textureSampleLevel(volume, volume_sampler, in.uvw, 0.0);
+    let step = slice_params.spacing / max(dot(normalize(in.rel), frame.forward.xyz), 1e-4);
+    let a = clamp(texel.a, 0.0, 1.0);
+    return vec2<f32>(a, 1.0 - pow(1.0 - min(a, 0.999999), step / object.opacity_length));
+}
+
 @fragment
 fn fs_main(in: VsOut) -> @location(0) vec4<f32> {
     // Level 0, as the Reference samples it. Mipmaps chosen by the sampler's implicit level cost
@@ -80,4 +93,18 @@ fn fs_main(in: VsOut) -> @location(0) vec4<f32> {
         rgb = corrected * shade_phong(albedo, n, frame.light_dir, -ray, PIXEL_SPECULAR, PIXEL_SHININESS);
     }
     return vec4<f32>(rgb * frame.light_color.rgb, corrected);
+}
+
+// Coverage AOV: the opacity fs_main draws with, into the object's slot.
+@fragment
+fn fs_coverage(in: VsOut) -> Coverage {
+    return coverage_slot(object.index, slice_alpha(in).y);
+}
+
+// Depth AOV: where the texel is opaque.
+@fragment
+fn fs_depth(in: VsOut) {
+    if (slice_alpha(in).x >= OPAQUE_ALPHA) {
+        record_opaque_depth(fragment_pixel(in.clip), dot(in.rel, frame.forward.xyz));
+    }
 }

@@ -40,10 +40,38 @@ impl MarchView {
 }
 
 /// Shading switches (the kernel's overrides).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Shade {
     pub phong: bool,
     pub shadows: bool,
+    /// Volumetric lighting by the Henyey-Greenstein phase function of this anisotropy g
+    /// (instead of Phong).
+    pub phase: Option<f64>,
+}
+
+impl Shade {
+    pub fn of(shading: crate::scene::Shading) -> Self {
+        use crate::scene::Shading as S;
+        match shading {
+            S::None => Shade::default(),
+            S::Phong => Shade { phong: true, ..Default::default() },
+            S::PhongShadows => Shade { phong: true, shadows: true, phase: None },
+            S::HenyeyGreenstein { g, shadows } => Shade { phong: false, shadows, phase: Some(g) },
+        }
+    }
+
+    /// Density evaluations of shading one sample besides its own: 6 for Phong's gradient, one
+    /// per shadow sample.
+    pub fn evaluations(&self, shadow_samples: u32) -> u32 {
+        6 * self.phong as u32 + shadow_samples * self.shadows as u32
+    }
+}
+
+/// The Henyey-Greenstein phase function at the cosine of the scattering angle (between the
+/// light's and the scattered direction): `(1 - g^2) / (4 pi (1 + g^2 - 2 g cos)^(3/2))`, a
+/// density over the sphere of directions (it integrates to 1).
+pub fn henyey_greenstein(g: f64, cos: f64) -> f64 {
+    (1.0 - g * g) / (4.0 * std::f64::consts::PI * (1.0 + g * g - 2.0 * g * cos).powf(1.5))
 }
 
 fn v3(a: [f32; 4]) -> DVec3 {
@@ -112,6 +140,14 @@ impl Ray<'_> {
             + DVec3::splat(specular * lit)
     }
 
+    /// Single scattering with the Henyey-Greenstein phase function: the light travels along
+    /// `-light_dir` and leaves towards the eye along `-ray`, so the scattering angle's cosine is
+    /// `light_dir . ray`; scaled by 4 pi so that isotropic scattering keeps the albedo.
+    fn phase_shade(&self, albedo: DVec3, g: f64, ray: DVec3, lit: f64) -> DVec3 {
+        let p = 4.0 * std::f64::consts::PI * henyey_greenstein(g, self.view.light_dir.dot(ray));
+        albedo * (self.view.ambient + (1.0 - self.view.ambient) * p * lit)
+    }
+
     /// Premultiplied rgb and coverage of the ray `d` (unit, camera-relative world).
     fn march(&self, d: DVec3) -> [f64; 4] {
         let p = self.model.params;
@@ -152,6 +188,9 @@ impl Ray<'_> {
                     let normal = self.surface_normal(x, d);
                     let lit = if self.shade.shadows { self.shadow(x) } else { 1.0 };
                     colour = self.phong_shade(colour, normal, d, lit);
+                } else if let Some(g) = self.shade.phase {
+                    let lit = if self.shade.shadows { self.shadow(x) } else { 1.0 };
+                    colour = self.phase_shade(colour, g, d, lit);
                 }
                 rgb += colour * alpha * transmittance;
                 transmittance *= 1.0 - alpha;

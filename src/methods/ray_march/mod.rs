@@ -22,7 +22,7 @@ use crate::hypertexture::splats::{self, Lattice, SplatSet, FOOTPRINT_BLOCK};
 use crate::hypertexture::{self, Packed};
 use crate::methods::ray_march::march::Shade;
 use crate::scene::hypertexture::diagonal;
-use crate::scene::{Hypertexture, RayMarch, Segments, Shading};
+use crate::scene::{Hypertexture, RayMarch, Segments};
 use crate::types::{HyperParams, MarchState, SegmentParams};
 
 /// What RayMarch brings to the render graph.
@@ -110,11 +110,10 @@ pub fn plan(
     let diagonal = diagonal(&corners);
     let step = method.step();
     let shadow_step = method.shadow_step.unwrap_or(2.0 * step);
-    let shade =
-        Shade { phong: method.shading != Shading::None, shadows: method.shading == Shading::PhongShadows };
+    let shade = Shade::of(method.shading);
     let evals = LOOP_BUDGET / (packed.noises.len() as u32 + 1);
     let shadow_samples = ((diagonal / shadow_step).ceil() as u32).clamp(1, MAX_SHADOW_SAMPLES);
-    let worst = 1 + 6 * shade.phong as u32 + shadow_samples * shade.shadows as u32;
+    let worst = 1 + shade.evaluations(shadow_samples);
     let lattice = |grid| Lattice::new(h.bounds(), packed.tested_shift(), grid);
     let (peel, splatting) = match method.segments {
         Segments::Bounds => (None, None),
@@ -244,6 +243,10 @@ impl RayMarchPlan {
             ("phong".into(), self.shade.phong as u32 as f64),
             ("shadows".into(), self.shade.shadows as u32 as f64),
         ];
+        if let Some(g) = self.shade.phase {
+            c.push(("phase".into(), 1.0));
+            c.push(("phase_g".into(), g));
+        }
         if !self.noise {
             c.push(("noise_off".into(), 1.0));
         }
@@ -258,10 +261,11 @@ impl RayMarchPlan {
 
     /// The method as written in metadata and `voltex plan`.
     pub fn describe(&self) -> String {
-        let shading = match (self.shade.phong, self.shade.shadows) {
-            (false, _) => "None",
-            (true, false) => "Phong",
-            (true, true) => "PhongShadows",
+        let shading = match (self.shade.phong, self.shade.shadows, self.shade.phase) {
+            (_, shadows, Some(g)) => format!("HenyeyGreenstein(g: {g}, shadows: {shadows})"),
+            (false, ..) => "None".into(),
+            (true, false, _) => "Phong".into(),
+            (true, true, _) => "PhongShadows".into(),
         };
         let segments = match (&self.peel, &self.splatting) {
             (Some((passes, l)), _) => format!(
