@@ -20,6 +20,7 @@ pub mod methods;
 pub mod metrics;
 pub mod pareto;
 pub mod preview;
+pub mod progress;
 pub mod regress;
 pub mod render;
 pub mod scene;

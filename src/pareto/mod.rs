@@ -19,6 +19,7 @@ use crate::error::{Error, Result};
 use crate::gpu::GpuContext;
 use crate::io::{atomic, Image};
 use crate::methods::reference::ReferencePlan;
+use crate::progress::{Progress, Verbosity};
 use crate::render::{Blueprint, MethodKind, RenderOptions};
 use crate::scene::{Scene, Segments, MAX_PLANES};
 use report::Row;
@@ -328,13 +329,24 @@ pub fn run(args: &Args) -> Result<()> {
     eprintln!("truth: {}", args.truth);
     let truth = measure::image(&ctx, Blueprint::new(&scene, &args.truth.options(args.size))?)?;
     let mut rows = Vec::new();
-    for (i, (s, bp)) in settings.into_iter().zip(blueprints).enumerate() {
-        eprintln!("[{}/{n}] {} {}", i + 1, s.method, s.knobs);
+    let mut progress = Progress::new(n, Verbosity::Normal);
+    for (s, bp) in settings.into_iter().zip(blueprints) {
+        let label = format!("{} {}", s.method, s.knobs);
+        progress.started(&label);
         match measure_setting(&scene, args, &s, bp, &truth) {
-            Ok(row) => rows.push(row),
-            Err(e) => note(&mut notes, &s, &e),
+            Ok(row) => {
+                progress.finished(&label, &format!("{label}: {}", row.summary()), true, false);
+                rows.push(row);
+            }
+            Err(e) => {
+                progress.finished(&label, &format!("{label}: not measured"), true, true);
+                if let Some(line) = note(&mut notes, &s, &e) {
+                    progress.note(&line);
+                }
+            }
         }
     }
+    progress.end();
     if rows.is_empty() {
         return Err(Error::Invalid(format!("nothing was measured: {}", notes.join("; "))));
     }
@@ -382,7 +394,11 @@ fn plan(scene: &Scene, args: &Args) -> Result<Planned> {
                 settings.push(s);
                 blueprints.push(bp);
             }
-            Err(e) => note(&mut notes, &s, &e),
+            Err(e) => {
+                if let Some(line) = note(&mut notes, &s, &e) {
+                    eprintln!("{line}");
+                }
+            }
         }
     }
     if settings.is_empty() {
@@ -401,13 +417,15 @@ struct Planned {
     notes: Vec<String>,
 }
 
-/// Records why a setting was skipped, once per method and message.
-fn note(notes: &mut Vec<String>, s: &Setting, e: &Error) {
+/// Records why a setting was skipped, once per method and message; returns the line to show
+/// when it is new.
+fn note(notes: &mut Vec<String>, s: &Setting, e: &Error) -> Option<String> {
     let line = format!("{}: not measured: {e}", s.method);
-    if !notes.contains(&line) {
-        eprintln!("{line} ({})", s.knobs);
-        notes.push(line);
+    if notes.contains(&line) {
+        return None;
     }
+    notes.push(line.clone());
+    Some(format!("{line} ({})", s.knobs))
 }
 
 fn unique<T: PartialEq>(items: impl Iterator<Item = T>) -> Vec<T> {
