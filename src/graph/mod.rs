@@ -289,8 +289,8 @@ impl PassDecl {
     }
 }
 
-/// A count: a number, or a name the runtime knows (`prisms`, `planes`, `base_vertices`,
-/// `width`, `height`).
+/// A count: a number, or a name the runtime (`width`, `height`) or a method's contribution
+/// provides (`prisms`, `planes`, ...: `render::vocabulary().counts`, listed in the graph reference).
 pub type Count = String;
 
 #[derive(Debug, Clone, Deserialize)]

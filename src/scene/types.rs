@@ -188,10 +188,12 @@ impl Texel {
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub enum TexelSource {
-    /// Union of implicit shapes (later shapes win where they overlap).
+    /// Union of implicit shapes: each voxel takes colour, opacity and normal from the shape
+    /// nearest to it (the deepest where they overlap; the first listed on a tie).
     Implicit { shapes: Vec<Shape> },
     /// Periodic Perlin height field: voxel filled where `w < base + amplitude * noise(s, t)`,
-    /// colour from `color_low` (w = 0) to `color_high` (w = 1).
+    /// colour from `color_low` (w = 0) to `color_high` (w = base + amplitude, the highest
+    /// possible height).
     PerlinHeight {
         #[serde(deserialize_with = "v::frequency")]
         frequency: u32,
