@@ -14,6 +14,7 @@ use std::path::Path;
 use glam::{DMat4, DVec3};
 
 use crate::error::{Error, Result};
+use crate::io::atomic::Staged;
 
 /// `OPENVDB_MAGIC` (" BDV" as a little-endian int64).
 const MAGIC: i64 = 0x5644_4220;
@@ -33,9 +34,8 @@ const NO_MASK_AND_ALL_VALS: u8 = 6;
 const LEAF_LOG2: u32 = 3;
 const NODE4_LOG2: u32 = 4;
 const NODE5_LOG2: u32 = 5;
-/// Voxels per side of a leaf, an internal node of leaves, a root child.
+/// Voxels per side of a leaf and of a root child.
 const LEAF_DIM: i32 = 1 << LEAF_LOG2;
-const NODE4_DIM: i32 = 1 << (LEAF_LOG2 + NODE4_LOG2);
 const NODE5_DIM: i32 = 1 << (LEAF_LOG2 + NODE4_LOG2 + NODE5_LOG2);
 /// Voxels of a leaf.
 pub const LEAF_VOXELS: usize = 1 << (3 * LEAF_LOG2);
@@ -215,8 +215,14 @@ impl Compression {
 /// Checks `grids` (names non-empty and unique, values finite, transforms invertible and
 /// finite), then writes them to `path` atomically.
 pub fn write(path: &Path, grids: &[Grid], compression: Compression) -> Result<()> {
+    stage(path, grids, compression)?.commit()
+}
+
+/// Like [`write`], but leaves the file at its temporary name until [`Staged::commit`], so that
+/// several files can be written all or none.
+pub fn stage(path: &Path, grids: &[Grid], compression: Compression) -> Result<Staged> {
     check(grids).map_err(|e| Error::file(path, e))?;
-    crate::io::atomic::write_atomic(path, |tmp| {
+    crate::io::atomic::stage(path, |tmp| {
         let file = std::fs::File::create(tmp).map_err(|e| Error::file(path, format!("cannot write: {e}")))?;
         let mut out = std::io::BufWriter::new(file);
         encode(&mut out, grids, compression)
