@@ -114,3 +114,25 @@ pub fn write_bytes(path: &Path, bytes: &[u8]) -> Result<()> {
         fs::write(tmp, bytes).map_err(|e| Error::file(path, format!("cannot write: {e}")))
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn staged_files_appear_only_when_committed() {
+        let dir = std::env::temp_dir().join(format!("voltex-staged-{}", std::process::id()));
+        let _ = fs::remove_dir_all(&dir);
+        fs::create_dir_all(&dir).unwrap();
+        let write = |text: &'static str| move |tmp: &Path| fs::write(tmp, text).map_err(|e| Error::file(tmp, e));
+        let a = stage(&dir.join("a.txt"), write("a")).unwrap();
+        let b = stage(&dir.join("b.txt"), write("b")).unwrap();
+        assert_eq!(fs::read_dir(&dir).unwrap().count(), 2, "two temporary files");
+        assert!(!dir.join("a.txt").exists());
+        a.commit().unwrap();
+        drop(b); // a later failure: b is never committed
+        let names: Vec<_> = fs::read_dir(&dir).unwrap().map(|e| e.unwrap().file_name()).collect();
+        assert_eq!(names, ["a.txt"]);
+        fs::remove_dir_all(&dir).unwrap();
+    }
+}

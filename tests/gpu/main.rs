@@ -8,6 +8,7 @@ mod fuzz_support;
 mod animation;
 mod axis_slices;
 mod bake_stack;
+mod export;
 mod fuzz;
 mod gpu_slicing;
 mod graph_data;
