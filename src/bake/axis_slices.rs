@@ -111,7 +111,8 @@ pub fn read_texture(ctx: &GpuContext, texture: &wgpu::Texture, bytes_per_texel: 
     let padded = row.div_ceil(256) * 256;
     let layer = padded as u64 * size.height as u64;
     let per_slab = ((64u64 << 20) / layer).clamp(1, size.depth_or_array_layers as u64) as u32;
-    let mut out = Vec::with_capacity(row as usize * size.height as usize * size.depth_or_array_layers as usize);
+    let mut out =
+        Vec::with_capacity(row as usize * size.height as usize * size.depth_or_array_layers as usize);
     for first in (0..size.depth_or_array_layers).step_by(per_slab as usize) {
         let layers = per_slab.min(size.depth_or_array_layers - first);
         let staging = ctx.device.create_buffer(&wgpu::BufferDescriptor {

@@ -258,9 +258,10 @@ impl Baker {
     ) -> Result<&'a mut ComputeKernel> {
         if slot.is_none() {
             let mut kernel = crate::gpu::shader::load_from(sources, name)?;
-            let writes_volume = crate::gpu::reflect::bindings(&kernel, &["main"])?
-                .iter()
-                .any(|b| b.name == "volume" && matches!(b.kind, crate::gpu::reflect::BindingKind::StorageTexture { .. }));
+            let writes_volume = crate::gpu::reflect::bindings(&kernel, &["main"])?.iter().any(|b| {
+                b.name == "volume"
+                    && matches!(b.kind, crate::gpu::reflect::BindingKind::StorageTexture { .. })
+            });
             if format == wgpu::TextureFormat::Rgba32Float && writes_volume {
                 kernel = kernel.with_storage_format("volume", naga::StorageFormat::Rgba32Float)?;
             }
@@ -307,12 +308,8 @@ impl Baker {
                 inputs
                     .buffers
                     .insert("balls".into(), storage(ctx, "balls", bytemuck::cast_slice(&packed.balls)));
-                Self::kernel(&mut self.implicit, ctx, &root, "bake/bake_implicit.wgsl", self.format)?.dispatch(
-                    ctx,
-                    &mut encoder,
-                    &inputs,
-                    req.resolution,
-                )?;
+                Self::kernel(&mut self.implicit, ctx, &root, "bake/bake_implicit.wgsl", self.format)?
+                    .dispatch(ctx, &mut encoder, &inputs, req.resolution)?;
             }
             BakeSource::Heightfield(hf) => {
                 inputs
@@ -321,12 +318,8 @@ impl Baker {
                 inputs
                     .buffers
                     .insert("heightfield".into(), uniform(ctx, "heightfield", bytemuck::bytes_of(hf)));
-                Self::kernel(&mut self.heightfield, ctx, &root, "bake/bake_heightfield.wgsl", self.format)?.dispatch(
-                    ctx,
-                    &mut encoder,
-                    &inputs,
-                    req.resolution,
-                )?;
+                Self::kernel(&mut self.heightfield, ctx, &root, "bake/bake_heightfield.wgsl", self.format)?
+                    .dispatch(ctx, &mut encoder, &inputs, req.resolution)?;
             }
             BakeSource::HeightImage(hi, heights) => {
                 inputs
@@ -339,12 +332,8 @@ impl Baker {
                     "heights".into(),
                     storage(ctx, "heights", bytemuck::cast_slice(heights.0.as_slice())),
                 );
-                Self::kernel(&mut self.height_image, ctx, &root, "bake/bake_height_image.wgsl", self.format)?.dispatch(
-                    ctx,
-                    &mut encoder,
-                    &inputs,
-                    req.resolution,
-                )?;
+                Self::kernel(&mut self.height_image, ctx, &root, "bake/bake_height_image.wgsl", self.format)?
+                    .dispatch(ctx, &mut encoder, &inputs, req.resolution)?;
             }
             BakeSource::Stack(texels) => {
                 let [w, h, d] = req.resolution;
@@ -393,12 +382,8 @@ impl Baker {
                 let colors = grid.colors.unwrap_or_else(|| storage(ctx, "mesh_colors", &[0u8; 16]));
                 inputs.buffers.insert("mesh_colors".into(), colors);
                 inputs.constants.push(("colored".into(), m.shape.colors.is_some() as u32 as f64));
-                Self::kernel(&mut self.mesh, ctx, &root, "bake/bake_mesh_texel.wgsl", self.format)?.dispatch(
-                    ctx,
-                    &mut encoder,
-                    &inputs,
-                    req.resolution,
-                )?;
+                Self::kernel(&mut self.mesh, ctx, &root, "bake/bake_mesh_texel.wgsl", self.format)?
+                    .dispatch(ctx, &mut encoder, &inputs, req.resolution)?;
             }
             BakeSource::Hypertexture(ht) => {
                 let format = self.format;
@@ -410,8 +395,13 @@ impl Baker {
         }
         let axis = match req.axis_slices {
             true => {
-                let kernel =
-                    Self::kernel(&mut self.axis, ctx, &root, "axis_slices/bake_axis_slices.wgsl", self.format)?;
+                let kernel = Self::kernel(
+                    &mut self.axis,
+                    ctx,
+                    &root,
+                    "axis_slices/bake_axis_slices.wgsl",
+                    self.format,
+                )?;
                 Some(axis_slices::bake(ctx, kernel, &mut encoder, &volume, req.resolution)?)
             }
             false => None,

@@ -124,7 +124,8 @@ mod tests {
         let dir = std::env::temp_dir().join(format!("voltex-staged-{}", std::process::id()));
         let _ = fs::remove_dir_all(&dir);
         fs::create_dir_all(&dir).unwrap();
-        let write = |text: &'static str| move |tmp: &Path| fs::write(tmp, text).map_err(|e| Error::file(tmp, e));
+        let write =
+            |text: &'static str| move |tmp: &Path| fs::write(tmp, text).map_err(|e| Error::file(tmp, e));
         let a = stage(&dir.join("a.txt"), write("a")).unwrap();
         let b = stage(&dir.join("b.txt"), write("b")).unwrap();
         assert_eq!(fs::read_dir(&dir).unwrap().count(), 2, "two temporary files");

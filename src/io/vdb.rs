@@ -122,7 +122,8 @@ impl<T: Value> Voxels<T> {
         for ox in leaf_range(0) {
             for oy in leaf_range(1) {
                 for oz in leaf_range(2) {
-                    let mut leaf = Leaf { mask: [0; LEAF_VOXELS / 64], values: vec![T::default(); LEAF_VOXELS] };
+                    let mut leaf =
+                        Leaf { mask: [0; LEAF_VOXELS / 64], values: vec![T::default(); LEAF_VOXELS] };
                     let mut any = false;
                     for x in ox.max(first[0])..=(ox + LEAF_DIM - 1).min(last[0]) {
                         for y in oy.max(first[1])..=(oy + LEAF_DIM - 1).min(last[1]) {
@@ -285,7 +286,9 @@ fn uuid() -> String {
     for i in 0..2u64 {
         let mut h = std::collections::hash_map::RandomState::new().build_hasher();
         h.write_u64(i);
-        h.write_u128(std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).unwrap_or_default().as_nanos());
+        h.write_u128(
+            std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).unwrap_or_default().as_nanos(),
+        );
         hex += &format!("{:016X}", h.finish());
     }
     format!("{}-{}-{}-{}-{}", &hex[0..8], &hex[8..12], &hex[12..16], &hex[16..20], &hex[20..32])
@@ -325,7 +328,8 @@ fn write_metadata<W: Write>(out: &mut W, items: &[(&str, Meta)]) -> std::io::Res
 /// reader, vdb-rs included, knows), else a general `AffineMap`.
 fn write_transform<W: Write>(out: &mut W, m: &DMat4) -> std::io::Result<()> {
     let linear = glam::DMat3::from_mat4(*m);
-    let diagonal = [(0, 1), (0, 2), (1, 0), (1, 2), (2, 0), (2, 1)].iter().all(|&(c, r)| linear.col(c)[r] == 0.0);
+    let diagonal =
+        [(0, 1), (0, 2), (1, 0), (1, 2), (2, 0), (2, 1)].iter().all(|&(c, r)| linear.col(c)[r] == 0.0);
     let vec3 = |out: &mut W, v: DVec3| out.write_all(bytemuck::cast_slice(&v.to_array()));
     if diagonal {
         let scale = DVec3::new(linear.x_axis.x, linear.y_axis.y, linear.z_axis.z);
@@ -389,19 +393,29 @@ fn write_typed<W: Write + Seek, T: Value>(
     let (lo, hi) = voxels.bbox().unwrap_or(([0; 3], [0; 3]));
     let leaf_bytes = voxels.leaves.len() as i64 * (LEAF_VOXELS * std::mem::size_of::<T>() + 64) as i64;
     let mut meta = vec![
-        ("class", Meta::Str(match g.class {
-            GridClass::FogVolume => "fog volume",
-            GridClass::Unknown => "unknown",
-        }
-        .into())),
+        (
+            "class",
+            Meta::Str(
+                match g.class {
+                    GridClass::FogVolume => "fog volume",
+                    GridClass::Unknown => "unknown",
+                }
+                .into(),
+            ),
+        ),
         ("creator", Meta::Str("voltex".into())),
         ("file_bbox_max", Meta::Vec3i(hi)),
         ("file_bbox_min", Meta::Vec3i(lo)),
-        ("file_compression", Meta::Str(match compression {
-            Compression::None => "none",
-            Compression::Zip => "zip + active values",
-        }
-        .into())),
+        (
+            "file_compression",
+            Meta::Str(
+                match compression {
+                    Compression::None => "none",
+                    Compression::Zip => "zip + active values",
+                }
+                .into(),
+            ),
+        ),
         ("file_mem_bytes", Meta::I64(leaf_bytes)),
         ("file_voxel_count", Meta::I64(voxels.active_count() as i64)),
         ("is_local_space", Meta::Bool(false)),
@@ -466,10 +480,20 @@ fn write_internal<'a, W: Write, T: Value>(
 /// `io::writeCompressedValues`: the metadata byte, then every value, or with active-mask
 /// compression only the active ones (inactive values are all the background here), raw or
 /// zipped (`zipToStream`: the byte count, negative when stored raw because zlib did not help).
-fn write_values<W: Write, T: Value>(out: &mut W, values: &[T], mask: &[u64], flags: u32) -> std::io::Result<()> {
+fn write_values<W: Write, T: Value>(
+    out: &mut W,
+    values: &[T],
+    mask: &[u64],
+    flags: u32,
+) -> std::io::Result<()> {
     let kept: Vec<T> = if flags & COMPRESS_ACTIVE_MASK != 0 {
         out.write_all(&[NO_MASK_OR_INACTIVE_VALS])?;
-        values.iter().enumerate().filter(|(i, _)| mask[i / 64] >> (i % 64) & 1 == 1).map(|(_, v)| *v).collect()
+        values
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| mask[i / 64] >> (i % 64) & 1 == 1)
+            .map(|(_, v)| *v)
+            .collect()
     } else {
         out.write_all(&[NO_MASK_AND_ALL_VALS])?;
         values.to_vec()

@@ -20,8 +20,8 @@ use crate::bake::{BakeRequest, BakeSource, Baker};
 use crate::error::{Error, Result};
 use crate::gpu::GpuContext;
 use crate::io::vdb::{self, Grid, GridClass, GridData, Voxels};
-use crate::methods::view::Lighting;
 use crate::mesh::BaseSurface;
+use crate::methods::view::Lighting;
 use crate::scene::{Scene, TexelSource};
 
 /// The transmittance of one voxel (its smallest world side) of opacity 1.
@@ -96,7 +96,11 @@ pub fn plan(scene: &Scene, opts: &ExportOptions) -> Result<Vec<Export>> {
             index_to_world: texel_to_world * index_to_box(DVec3::ZERO, DVec3::ONE, request.resolution),
             request,
             opacity_length: texel.opacity_length(&scene.hypertextures) as f64,
-            note: if per_pixel { note } else { Some(join(note, "a slice stack: Cd holds its baked shading")) },
+            note: if per_pixel {
+                note
+            } else {
+                Some(join(note, "a slice stack: Cd holds its baked shading"))
+            },
         });
     }
     for o in &objects {
@@ -106,8 +110,9 @@ pub fn plan(scene: &Scene, opts: &ExportOptions) -> Result<Vec<Export>> {
         })?;
         let (lo, hi) = crate::hypertexture::pack(h).bounds;
         let extent = hi - lo;
-        let resolution =
-            extent.to_array().map(|e| ((opts.resolution as f64 * e / extent.max_element()).round() as u32).max(1));
+        let resolution = extent
+            .to_array()
+            .map(|e| ((opts.resolution as f64 * e / extent.max_element()).round() as u32).max(1));
         let texel = HyperTexel::new(h, Some((lo, hi)), resolution, time);
         out.push(Export {
             name: o.name.clone(),
@@ -212,7 +217,12 @@ pub fn grids(e: &Export, rgba: &[[f32; 4]]) -> Vec<Grid> {
             index_to_world: e.index_to_world,
             data: GridData::Float(density),
         },
-        Grid { name: "Cd".into(), class: GridClass::Unknown, index_to_world: e.index_to_world, data: GridData::Vec3(colour) },
+        Grid {
+            name: "Cd".into(),
+            class: GridClass::Unknown,
+            index_to_world: e.index_to_world,
+            data: GridData::Vec3(colour),
+        },
     ]
 }
 

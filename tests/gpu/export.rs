@@ -58,7 +58,9 @@ fn a_constant_texel_on_a_plane_exports_its_extinction_colour_and_tile() {
         assert!(c.iter().zip([0.2, 0.4, 0.6]).all(|(a, b)| (a - b).abs() < 1e-5), "{c:?}");
     }
     // Voxel (i, j, k) sits at the centre of its cell of the plane's tile, lifted by the node.
-    let centre = |i: f64, j: f64, k: f64| DVec3::new(-1.0 + (i + 0.5) * 0.25, -1.5 + (j + 0.5) * 0.5, 1.0 + (k + 0.5) * 0.125);
+    let centre = |i: f64, j: f64, k: f64| {
+        DVec3::new(-1.0 + (i + 0.5) * 0.25, -1.5 + (j + 0.5) * 0.5, 1.0 + (k + 0.5) * 0.125)
+    };
     for (i, j, k) in [(0.0, 0.0, 0.0), (7.0, 5.0, 3.0), (3.0, 1.0, 2.0)] {
         let p = e.index_to_world.transform_point3(DVec3::new(i, j, k));
         assert!((p - centre(i, j, k)).length() < 1e-9, "{p} at {i} {j} {k}");
@@ -74,7 +76,9 @@ fn a_constant_texel_on_a_plane_exports_its_extinction_colour_and_tile() {
     match grid.transform {
         vdb_rs::Map::ScaleTranslateMap { translation, scale_values, .. } => {
             assert!((DVec3::from_array(translation.to_array()) - centre(0.0, 0.0, 0.0)).length() < 1e-9);
-            assert!((DVec3::from_array(scale_values.to_array()) - DVec3::new(0.25, 0.5, 0.125)).length() < 1e-12);
+            assert!(
+                (DVec3::from_array(scale_values.to_array()) - DVec3::new(0.25, 0.5, 0.125)).length() < 1e-12
+            );
         }
         other => panic!("expected a scale-translate map, got {other:?}"),
     }
@@ -118,7 +122,9 @@ fn a_hypertexture_node_exports_the_kernels_values_at_full_precision() {
         matter += (gpu[3] > 0.0) as usize;
         off_grid += ((gpu[3] * 255.0 - (gpu[3] * 255.0).round()).abs() > 0.01) as usize;
     }
-    eprintln!("export bake vs twin: worst {worst}, {matter} voxels with matter, {off_grid} between 8-bit steps");
+    eprintln!(
+        "export bake vs twin: worst {worst}, {matter} voxels with matter, {off_grid} between 8-bit steps"
+    );
     assert!(matter > 500, "{matter}");
     assert!(worst < 2e-3, "worst difference {worst}");
     assert!(off_grid * 2 > matter, "only {off_grid} of {matter} alphas are off the 8-bit grid");
@@ -144,7 +150,10 @@ fn a_hypertexture_node_exports_the_kernels_values_at_full_precision() {
 #[test]
 fn plan_selects_and_refuses_before_baking() {
     let scene = parse(PUFF);
-    let only = |names: &[&str]| ExportOptions { only: names.iter().map(|s| s.to_string()).collect(), ..Default::default() };
+    let only = |names: &[&str]| ExportOptions {
+        only: names.iter().map(|s| s.to_string()).collect(),
+        ..Default::default()
+    };
     assert_eq!(export::plan(&scene, &only(&["cloud"])).unwrap().len(), 1);
     let e = export::plan(&scene, &only(&["fog"])).unwrap_err().to_string();
     assert!(e.contains("--only \"fog\"") && e.contains("cloud"), "{e}");

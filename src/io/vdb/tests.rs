@@ -76,7 +76,10 @@ fn all<T: Value>(v: &Voxels<T>) -> BTreeMap<[i32; 3], T> {
     let mut out = BTreeMap::new();
     for (o, leaf) in &v.leaves {
         for n in (0..LEAF_VOXELS).filter(|n| leaf.mask[n / 64] >> (n % 64) & 1 == 1) {
-            out.insert([o[0] + (n >> 6) as i32, o[1] + ((n >> 3) & 7) as i32, o[2] + (n & 7) as i32], leaf.values[n]);
+            out.insert(
+                [o[0] + (n >> 6) as i32, o[1] + ((n >> 3) & 7) as i32, o[2] + (n & 7) as i32],
+                leaf.values[n],
+            );
         }
     }
     out
@@ -170,8 +173,12 @@ fn vec3_grids_read_back_voxel_for_voxel_uncompressed_and_zip() {
 fn vdb_rs_0_6_misreads_vec3_backgrounds() {
     let mut v = Voxels::new();
     v.set([1, 2, 3], [0.5f32, 0.25, 1.0]);
-    let grid =
-        Grid { name: "Cd".into(), class: GridClass::Unknown, index_to_world: DMat4::IDENTITY, data: GridData::Vec3(v) };
+    let grid = Grid {
+        name: "Cd".into(),
+        class: GridClass::Unknown,
+        index_to_world: DMat4::IDENTITY,
+        data: GridData::Vec3(v),
+    };
     let bytes = encoded(&[grid], Compression::None);
     let mut r = vdb_rs::VdbReader::new(Cursor::new(bytes.clone())).unwrap();
     let g = r.read_grid::<[f32; 3]>("Cd").unwrap();
@@ -215,7 +222,13 @@ fn sparse_grids_store_only_active_leaves_across_negative_and_far_coordinates() {
         class: GridClass::Unknown,
         index_to_world: DMat4::IDENTITY,
         data: GridData::Vec3(Voxels {
-            leaves: v.leaves.iter().map(|(o, l)| (*o, Leaf { mask: l.mask, values: l.values.iter().map(|&x| [x, -x, 2.0 * x]).collect() })).collect(),
+            leaves: v
+                .leaves
+                .iter()
+                .map(|(o, l)| {
+                    (*o, Leaf { mask: l.mask, values: l.values.iter().map(|&x| [x, -x, 2.0 * x]).collect() })
+                })
+                .collect(),
         }),
     };
     let vec3_truth: BTreeMap<_, _> = truth.iter().map(|(k, &x)| (*k, [x, -x, 2.0 * x])).collect();
@@ -227,7 +240,8 @@ fn sparse_grids_store_only_active_leaves_across_negative_and_far_coordinates() {
 
 #[test]
 fn dense_boxes_keep_only_leaves_with_an_active_voxel() {
-    let v = Voxels::from_dense([-8, 0, 0], [64, 64, 64], |[i, j, k]| (i < 2 && j < 2 && k < 2).then_some(1.0f32));
+    let v =
+        Voxels::from_dense([-8, 0, 0], [64, 64, 64], |[i, j, k]| (i < 2 && j < 2 && k < 2).then_some(1.0f32));
     assert_eq!((v.leaves.len(), v.active_count()), (1, 8));
     assert_eq!(v.get([-8, 1, 0]), Some(1.0));
     assert_eq!(v.get([-6, 0, 0]), None);
@@ -240,7 +254,8 @@ fn rotated_transforms_are_written_as_affine_maps() {
     let mut out = Vec::new();
     write_transform(&mut out, &m).unwrap();
     assert_eq!(&out[4..13], b"AffineMap");
-    let values: Vec<f64> = out[13..].chunks_exact(8).map(|c| f64::from_le_bytes(c.try_into().unwrap())).collect();
+    let values: Vec<f64> =
+        out[13..].chunks_exact(8).map(|c| f64::from_le_bytes(c.try_into().unwrap())).collect();
     assert_eq!(values.len(), 16);
     // OpenVDB maps row vectors: the translation is the last row.
     let t = m.transform_point3(DVec3::ZERO);
@@ -252,7 +267,12 @@ fn rotated_transforms_are_written_as_affine_maps() {
 fn unwritable_grids_are_refused_with_their_name() {
     let mut v = Voxels::new();
     v.set([0, 0, 0], f32::NAN);
-    let grid = |name: &str, m: DMat4, data: GridData| Grid { name: name.into(), class: GridClass::FogVolume, index_to_world: m, data };
+    let grid = |name: &str, m: DMat4, data: GridData| Grid {
+        name: name.into(),
+        class: GridClass::FogVolume,
+        index_to_world: m,
+        data,
+    };
     let ok = || GridData::Float(ball([0, 0, 0], 4));
     let cases = [
         (vec![grid("density", DMat4::IDENTITY, GridData::Float(v))], "non-finite"),
