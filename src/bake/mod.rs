@@ -24,7 +24,7 @@ pub enum BakeSource {
     Implicit(PackedShapes),
     Heightfield(HeightfieldParams),
     HeightImage(HeightImageParams, Heights),
-    /// A slice stack's texels (rgba8, premultiplied, baked shading), uploaded as they are.
+    /// A slice stack's texels (16-bit premultiplied RGBA), uploaded at the volume's precision.
     Stack(StackTexels),
     /// A pattern mesh sampled at the voxel centres (`bake_mesh_grid.wgsl`), then coloured.
     Mesh(MeshTexel),
@@ -87,9 +87,9 @@ impl std::fmt::Debug for Heights {
     }
 }
 
-/// Bytes shown in `Debug` by a digest, like [`Heights`].
+/// A slice stack's 16-bit premultiplied RGBA, shown in `Debug` by a digest, like [`Heights`].
 #[derive(Clone)]
-pub struct StackTexels(pub std::sync::Arc<Vec<u8>>);
+pub struct StackTexels(pub std::sync::Arc<Vec<u16>>);
 
 impl std::fmt::Debug for StackTexels {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
@@ -339,19 +339,22 @@ impl Baker {
                 let [w, h, d] = req.resolution;
                 if texels.0.len() != (w * h * d * 4) as usize || req.per_pixel {
                     return Err(Error::Invalid(format!(
-                        "a {w}x{h}x{d} slice stack with baked shading was expected (got {} bytes{})",
+                        "a {w}x{h}x{d} slice stack with baked shading was expected (got {} values{})",
                         texels.0.len(),
                         if req.per_pixel { ", per-pixel lighting" } else { "" }
                     )));
                 }
-                // A full-precision volume takes the stored values as floats.
-                let floats: Vec<f32>;
+                // Stacks are read at 16 bits: rounded to the volume's 8 bits, or as floats.
+                let (floats, bytes): (Vec<f32>, Vec<u8>);
                 let (data, texel_bytes) = match self.format {
                     wgpu::TextureFormat::Rgba32Float => {
-                        floats = texels.0.iter().map(|&b| b as f32 / 255.0).collect();
+                        floats = texels.0.iter().map(|&v| v as f32 / 65535.0).collect();
                         (bytemuck::cast_slice(&floats), 16)
                     }
-                    _ => (texels.0.as_slice(), 4),
+                    _ => {
+                        bytes = texels.0.iter().map(|&v| ((v as u32 * 255 + 32767) / 65535) as u8).collect();
+                        (bytes.as_slice(), 4)
+                    }
                 };
                 ctx.queue.write_texture(
                     volume.as_image_copy(),

@@ -80,8 +80,14 @@ pub fn plan(scene: &Scene, opts: &ExportOptions) -> Result<Vec<Export>> {
         if matches!(texel.source, TexelSource::Sequence { .. }) {
             continue; // its frames are texels of their own
         }
-        // Slice stacks hold their shading; every other source bakes the unlit albedo.
-        let per_pixel = !matches!(texel.source, TexelSource::Slices { .. });
+        // Slice stacks hold what they were baked with; every other source bakes the unlit albedo.
+        let stack = match &texel.source {
+            TexelSource::Slices { dir } => Some(scene.stack(&dir.value).and_then(|s| s.manifest.as_ref())),
+            _ => None,
+        };
+        let per_pixel = stack.is_none();
+        let lit =
+            stack.is_some_and(|m| m.is_none_or(|m| m.lighting == crate::io::stack::StackLighting::Baked));
         let mut bakes = Vec::new();
         crate::methods::texels::bake_index(scene, name, per_pixel, &light, time, &mut bakes)?;
         let request = bakes.remove(0).request;
@@ -96,11 +102,7 @@ pub fn plan(scene: &Scene, opts: &ExportOptions) -> Result<Vec<Export>> {
             index_to_world: texel_to_world * index_to_box(DVec3::ZERO, DVec3::ONE, request.resolution),
             request,
             opacity_length: texel.opacity_length(&scene.hypertextures) as f64,
-            note: if per_pixel {
-                note
-            } else {
-                Some(join(note, "a slice stack: Cd holds its baked shading"))
-            },
+            note: if lit { Some(join(note, "a slice stack: Cd holds its baked shading")) } else { note },
         });
     }
     for o in &objects {
