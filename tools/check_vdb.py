@@ -11,7 +11,7 @@ For every scene (default: a texel scene, a curved-shell scene and a hypertexture
   1. loads it with `openvdb.readAll` and checks the grids (`density` a FloatGrid of class fog
      volume, `Cd` a Vec3SGrid with the same active voxels, finite, density >= 0);
   2. compares every voxel of the zip and the uncompressed file (two code paths of the writer,
-     read by OpenVDB) and, where `voltex bake --unlit` can write the same texel as float slices,
+     read by OpenVDB) and, where `voltex bake --unlit --depth 32` can write the same texel as float slices,
      every voxel against those slices converted here (density = -ln(1 - alpha) / opacity length,
      Cd = colour / alpha);
   3. for the analytic `flat_box` (a constant fog box, opacity 0.5 over 0.5 world units, 0.5 high)
@@ -107,7 +107,7 @@ def check_file(vdb, path, plain):
 
 
 def compare_with_slices(oiio, data, slices_dir, manifest, name):
-    """Every active voxel against `voltex bake --unlit` float slices (OpenImageIO reads them)."""
+    """Every active voxel against `voltex bake --unlit --depth 32` float slices (OpenImageIO reads them)."""
     res = manifest["resolution"]
     L = manifest["opacity_length"]
     vol = np.zeros((res[0], res[1], res[2], 4), dtype=np.float64)
@@ -261,7 +261,7 @@ def main():
             texel = os.path.splitext(os.path.basename(f))[0]
             slices = os.path.join(args.out, stem, "slices")
             bake = subprocess.run(
-                [args.voltex, "bake", s, "--texel", texel, "--out", slices, "--unlit"], capture_output=True, text=True
+                [args.voltex, "bake", s, "--texel", texel, "--out", slices, "--unlit", "--depth", "32"], capture_output=True, text=True
             )
             if bake.returncode == 0:
                 with open(os.path.join(slices, texel, "manifest.json")) as m:

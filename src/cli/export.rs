@@ -94,7 +94,7 @@ fn write_all(out: &std::path::Path, exports: &[export::Export], compression: Com
             "{}  {} {x}x{y}x{z}, {active} active voxels, opacity length {}, {:.0} ms{}",
             path.display(),
             e.what,
-            e.opacity_length,
+            e.opacity_length as f32,
             start.elapsed().as_secs_f64() * 1e3,
             e.note.as_ref().map(|n| format!("\n    note: {n}")).unwrap_or_default()
         ));

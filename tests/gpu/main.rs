@@ -13,6 +13,7 @@ mod fuzz;
 mod gpu_slicing;
 mod graph_data;
 mod hard_cases;
+mod height_precision;
 mod hypertexture;
 mod hypertexture_mesh;
 mod hypertexture_segments;
