@@ -24,7 +24,7 @@ pub enum BakeSource {
     Implicit(PackedShapes),
     Heightfield(HeightfieldParams),
     HeightImage(HeightImageParams, Heights),
-    /// A slice stack's texels (rgba8, premultiplied, baked shading), uploaded as they are.
+    /// A slice stack's texels (16-bit premultiplied RGBA), uploaded at the volume's precision.
     Stack(StackTexels),
     /// A pattern mesh sampled at the voxel centres (`bake_mesh_grid.wgsl`), then coloured.
     Mesh(MeshTexel),
@@ -87,9 +87,9 @@ impl std::fmt::Debug for Heights {
     }
 }
 
-/// Bytes shown in `Debug` by a digest, like [`Heights`].
+/// A slice stack's 16-bit premultiplied RGBA, shown in `Debug` by a digest, like [`Heights`].
 #[derive(Clone)]
-pub struct StackTexels(pub std::sync::Arc<Vec<u8>>);
+pub struct StackTexels(pub std::sync::Arc<Vec<u16>>);
 
 impl std::fmt::Debug for StackTexels {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
@@ -217,6 +217,8 @@ pub struct Baker {
     transfer: Option<ComputeKernel>,
     axis: Option<ComputeKernel>,
     sources: Sources,
+    /// `Rgba32Float` for [`Baker::full_precision`], else `Rgba8Unorm`.
+    format: wgpu::TextureFormat,
 }
 
 impl Baker {
@@ -231,7 +233,20 @@ impl Baker {
             transfer: None,
             axis: None,
             sources: sources.clone(),
+            format: wgpu::TextureFormat::Rgba8Unorm,
         }
+    }
+
+    /// A baker whose volumes hold f32 RGBA: the same kernels, their `volume` declared
+    /// `rgba32float` instead of `rgba8unorm`, so nothing is quantised (`voltex export`). The
+    /// normal volume stays `rgba8snorm`.
+    pub fn full_precision(sources: &Sources) -> Self {
+        Self { format: wgpu::TextureFormat::Rgba32Float, ..Self::new(sources) }
+    }
+
+    /// The format of the texel volumes this baker makes.
+    pub fn format(&self) -> wgpu::TextureFormat {
+        self.format
     }
 
     fn kernel<'a>(
@@ -239,9 +254,18 @@ impl Baker {
         ctx: &GpuContext,
         sources: &Sources,
         name: &str,
+        format: wgpu::TextureFormat,
     ) -> Result<&'a mut ComputeKernel> {
         if slot.is_none() {
-            *slot = Some(ComputeKernel::load(ctx, sources, name)?);
+            let mut kernel = crate::gpu::shader::load_from(sources, name)?;
+            let writes_volume = crate::gpu::reflect::bindings(&kernel, &["main"])?.iter().any(|b| {
+                b.name == "volume"
+                    && matches!(b.kind, crate::gpu::reflect::BindingKind::StorageTexture { .. })
+            });
+            if format == wgpu::TextureFormat::Rgba32Float && writes_volume {
+                kernel = kernel.with_storage_format("volume", naga::StorageFormat::Rgba32Float)?;
+            }
+            *slot = Some(ComputeKernel::new(ctx, kernel)?);
         }
         Ok(slot.as_mut().unwrap())
     }
@@ -254,7 +278,7 @@ impl Baker {
                 req.resolution
             )));
         }
-        let volume = volume_texture(ctx, "texel volume", req.resolution, wgpu::TextureFormat::Rgba8Unorm);
+        let volume = volume_texture(ctx, "texel volume", req.resolution, self.format);
         let normals_res = if req.per_pixel { req.resolution } else { [1, 1, 1] };
         let normals = volume_texture(ctx, "texel normals", normals_res, wgpu::TextureFormat::Rgba8Snorm);
         let params = crate::cpu::bake::bake_params(req.resolution, 0, req.light, req.ambient);
@@ -284,12 +308,8 @@ impl Baker {
                 inputs
                     .buffers
                     .insert("balls".into(), storage(ctx, "balls", bytemuck::cast_slice(&packed.balls)));
-                Self::kernel(&mut self.implicit, ctx, &root, "bake/bake_implicit.wgsl")?.dispatch(
-                    ctx,
-                    &mut encoder,
-                    &inputs,
-                    req.resolution,
-                )?;
+                Self::kernel(&mut self.implicit, ctx, &root, "bake/bake_implicit.wgsl", self.format)?
+                    .dispatch(ctx, &mut encoder, &inputs, req.resolution)?;
             }
             BakeSource::Heightfield(hf) => {
                 inputs
@@ -298,12 +318,8 @@ impl Baker {
                 inputs
                     .buffers
                     .insert("heightfield".into(), uniform(ctx, "heightfield", bytemuck::bytes_of(hf)));
-                Self::kernel(&mut self.heightfield, ctx, &root, "bake/bake_heightfield.wgsl")?.dispatch(
-                    ctx,
-                    &mut encoder,
-                    &inputs,
-                    req.resolution,
-                )?;
+                Self::kernel(&mut self.heightfield, ctx, &root, "bake/bake_heightfield.wgsl", self.format)?
+                    .dispatch(ctx, &mut encoder, &inputs, req.resolution)?;
             }
             BakeSource::HeightImage(hi, heights) => {
                 inputs
@@ -316,28 +332,36 @@ impl Baker {
                     "heights".into(),
                     storage(ctx, "heights", bytemuck::cast_slice(heights.0.as_slice())),
                 );
-                Self::kernel(&mut self.height_image, ctx, &root, "bake/bake_height_image.wgsl")?.dispatch(
-                    ctx,
-                    &mut encoder,
-                    &inputs,
-                    req.resolution,
-                )?;
+                Self::kernel(&mut self.height_image, ctx, &root, "bake/bake_height_image.wgsl", self.format)?
+                    .dispatch(ctx, &mut encoder, &inputs, req.resolution)?;
             }
             BakeSource::Stack(texels) => {
                 let [w, h, d] = req.resolution;
                 if texels.0.len() != (w * h * d * 4) as usize || req.per_pixel {
                     return Err(Error::Invalid(format!(
-                        "a {w}x{h}x{d} slice stack with baked shading was expected (got {} bytes{})",
+                        "a {w}x{h}x{d} slice stack with baked shading was expected (got {} values{})",
                         texels.0.len(),
                         if req.per_pixel { ", per-pixel lighting" } else { "" }
                     )));
                 }
+                // Stacks are read at 16 bits: rounded to the volume's 8 bits, or as floats.
+                let (floats, bytes): (Vec<f32>, Vec<u8>);
+                let (data, texel_bytes) = match self.format {
+                    wgpu::TextureFormat::Rgba32Float => {
+                        floats = texels.0.iter().map(|&v| v as f32 / 65535.0).collect();
+                        (bytemuck::cast_slice(&floats), 16)
+                    }
+                    _ => {
+                        bytes = texels.0.iter().map(|&v| ((v as u32 * 255 + 32767) / 65535) as u8).collect();
+                        (bytes.as_slice(), 4)
+                    }
+                };
                 ctx.queue.write_texture(
                     volume.as_image_copy(),
-                    &texels.0,
+                    data,
                     wgpu::TexelCopyBufferLayout {
                         offset: 0,
-                        bytes_per_row: Some(w * 4),
+                        bytes_per_row: Some(w * texel_bytes),
                         rows_per_image: Some(h),
                     },
                     wgpu::Extent3d { width: w, height: h, depth_or_array_layers: d },
@@ -361,22 +385,26 @@ impl Baker {
                 let colors = grid.colors.unwrap_or_else(|| storage(ctx, "mesh_colors", &[0u8; 16]));
                 inputs.buffers.insert("mesh_colors".into(), colors);
                 inputs.constants.push(("colored".into(), m.shape.colors.is_some() as u32 as f64));
-                Self::kernel(&mut self.mesh, ctx, &root, "bake/bake_mesh_texel.wgsl")?.dispatch(
-                    ctx,
-                    &mut encoder,
-                    &inputs,
-                    req.resolution,
-                )?;
+                Self::kernel(&mut self.mesh, ctx, &root, "bake/bake_mesh_texel.wgsl", self.format)?
+                    .dispatch(ctx, &mut encoder, &inputs, req.resolution)?;
             }
             BakeSource::Hypertexture(ht) => {
-                let transfer = Self::kernel(&mut self.transfer, ctx, &root, "ray_march/bake_transfer.wgsl")?;
-                let hyper = Self::kernel(&mut self.hyper, ctx, &root, "bake/bake_hypertexture.wgsl")?;
+                let format = self.format;
+                let transfer =
+                    Self::kernel(&mut self.transfer, ctx, &root, "ray_march/bake_transfer.wgsl", format)?;
+                let hyper = Self::kernel(&mut self.hyper, ctx, &root, "bake/bake_hypertexture.wgsl", format)?;
                 ht.bake(ctx, (transfer, hyper), &mut encoder, &mut inputs, params)?;
             }
         }
         let axis = match req.axis_slices {
             true => {
-                let kernel = Self::kernel(&mut self.axis, ctx, &root, "axis_slices/bake_axis_slices.wgsl")?;
+                let kernel = Self::kernel(
+                    &mut self.axis,
+                    ctx,
+                    &root,
+                    "axis_slices/bake_axis_slices.wgsl",
+                    self.format,
+                )?;
                 Some(axis_slices::bake(ctx, kernel, &mut encoder, &volume, req.resolution)?)
             }
             false => None,

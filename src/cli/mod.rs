@@ -4,6 +4,7 @@
 pub mod bake;
 pub mod bench;
 pub mod compare;
+pub mod export;
 pub mod farm;
 pub mod import;
 pub mod info;
@@ -38,8 +39,13 @@ pub enum Command {
     /// Render a scene headless to EXR (linear, with metadata) and a tonemapped PNG.
     Render(render::RenderArgs),
     /// Bake texels on the GPU and write each as a slice stack: OUT/<texel>/slice_000.png onwards
-    /// (RGBA, premultiplied, the scene's first light baked in), readable as `Slices(dir: ..)`.
+    /// (16-bit RGBA, premultiplied, the scene's first light baked in; or 8-bit, float EXR,
+    /// unlit) and manifest.json, readable as `Slices(dir: ..)`.
     Bake(bake::BakeArgs),
+    /// Write every texel and every node's hypertexture as an OpenVDB file, OUT/<name>.vdb: a
+    /// `density` grid (extinction per world unit) and a `Cd` colour grid, placed in the world,
+    /// baked on the GPU at full precision (for Blender, Houdini, Mitsuba).
+    Export(export::ExportArgs),
     /// Compare two EXR images: FLIP, relative RMSE, largest difference and non-finite pixels;
     /// optionally write a FLIP heat map (no GPU needed).
     Compare(compare::CompareArgs),

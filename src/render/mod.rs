@@ -3,6 +3,7 @@
 
 mod budget;
 mod describe;
+pub mod export;
 mod renderer;
 
 pub use budget::Positions;

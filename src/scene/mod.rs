@@ -123,6 +123,13 @@ pub fn parse(source: &str, path: &Path) -> Result<Scene> {
         }
     }
     scene.assets = found.assets;
+    // A slice stack's manifest gives its texel's opacity length unless the file does.
+    for t in scene.texels.values_mut() {
+        if let (TexelSource::Slices { dir: stack }, None) = (&t.source, t.opacity_length_given) {
+            let manifest = scene.assets.stacks.get(&dir.join(&stack.value)).and_then(|s| s.manifest.as_ref());
+            t.opacity_length_given = manifest.map(|m| m.opacity_length);
+        }
+    }
     // A warning at a mark is positioned like an error: by a parse that stops there.
     scene.warnings = (found.warnings.into_iter())
         .map(|(seq, msg)| match seq {

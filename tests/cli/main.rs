@@ -5,6 +5,7 @@ mod common;
 
 mod assets;
 mod cli_errors;
+mod export;
 mod farm;
 mod faults;
 mod hostile_files;
