@@ -3,6 +3,7 @@
 
 pub mod camera_file;
 pub mod present;
+pub mod scene_text;
 pub mod session;
 pub mod watch;
 pub mod window;
