@@ -109,10 +109,16 @@ fn interact(
 ) -> Option<Gesture> {
     let at = resp.interact_pointer_pos().or(resp.hover_pos())?;
     if resp.drag_started() {
-        ui.data_mut(|d| d.insert_temp(id, pick(r, curves, at)));
+        // The point under the press, not under the pointer once it has moved enough to drag.
+        let origin = ui.input(|i| i.pointer.press_origin()).unwrap_or(at);
+        ui.data_mut(|d| d.insert_temp(id, pick(r, curves, origin)));
     }
     let dragging: Option<Option<(usize, usize)>> = ui.data(|d| d.get_temp(id));
-    if resp.dragged() {
+    if resp.drag_stopped() {
+        ui.data_mut(|d| d.remove::<Option<(usize, usize)>>(id));
+    }
+    // The frame a drag stops in may hold its last move.
+    if resp.dragged() || resp.drag_stopped() {
         if let Some(Some((c, i))) = dragging {
             let (mut x, y) = from_screen(r, at);
             let pts = &curves[c].points;
@@ -122,9 +128,6 @@ fn interact(
             x = x.clamp(lo, hi.max(lo));
             return Some(Gesture::Move { c, i, x, y });
         }
-    }
-    if resp.drag_stopped() {
-        ui.data_mut(|d| d.remove::<Option<(usize, usize)>>(id));
     }
     if resp.double_clicked() && pick(r, curves, at).is_none() {
         let (x, y) = from_screen(r, at);
@@ -217,6 +220,9 @@ pub fn shape_curve(ui: &mut egui::Ui, cx: &mut Cx, v: &Value, path: &[Step]) {
             &resp,
         );
     }
+    if resp.drag_stopped() {
+        cx.actions.push(Action::EndGesture);
+    }
     ui.small("drag a point; double click: add; right click: delete");
 }
 
@@ -289,6 +295,9 @@ pub fn color_ramp(ui: &mut egui::Ui, cx: &mut Cx, v: &Value, path: &[Step]) {
             },
             &resp,
         );
+    }
+    if resp.drag_stopped() {
+        cx.actions.push(Action::EndGesture);
     }
     ui.small("r g b a by density: drag a point; double click: add; right click: delete");
 }

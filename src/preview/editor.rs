@@ -172,6 +172,9 @@ impl Editor {
         match super::scene_text::write(&self.path, &self.text) {
             Ok(()) => {
                 self.disk = self.text.clone();
+                if self.read_only {
+                    self.note = Some(format!("written to {} (writable again)", self.path.display()));
+                }
                 self.read_only = false;
             }
             Err(e) => {

@@ -66,7 +66,7 @@ pub struct Cx<'a> {
     pub scene: Option<&'a Scene>,
     refused: Option<&'a (Vec<Step>, String)>,
     pub actions: Vec<Action>,
-    /// Screen rectangles of the curve editors by path (the window tests drive them).
+    /// Screen rectangles of the curve editors and number fields by path (window tests drive them).
     pub rects: Vec<(String, egui::Rect)>,
 }
 
@@ -281,9 +281,7 @@ fn field(ui: &mut egui::Ui, cx: &mut Cx, name: &str, v: &Value, path: &[Step]) {
         && !v.items().is_empty()
         && v.items().len() <= 4
         && v.items().iter().all(|i| i.number(src).is_some());
-    let unit_choice =
-        matches!(v.kind, Kind::Atom) || matches!(&v.kind, Kind::Paren { fields, .. } if fields.is_empty());
-    if small_tuple || unit_choice {
+    if small_tuple || matches!(v.kind, Kind::Atom) {
         ui.horizontal(|ui| {
             ui.label(name);
             value(ui, cx, name, v, path);
@@ -308,7 +306,7 @@ fn value(ui: &mut egui::Ui, cx: &mut Cx, name: &str, v: &Value, path: &[Step]) {
     match &v.kind {
         Kind::Atom if group(v.text(src)).is_some() => choice(ui, cx, v, path),
         Kind::Atom => {
-            let (new, stopped) = atom(ui, v.text(src), refused, path);
+            let (new, stopped) = atom(ui, &mut cx.rects, v.text(src), refused, path);
             if let Some((text, live)) = new {
                 push_edit(cx, st::set(src, path, &text), live);
             }
@@ -427,7 +425,8 @@ fn structure(ui: &mut egui::Ui, cx: &mut Cx, v: &Value, path: &[Step]) {
         let p = [path, &[Step::Field(name.to_string())]].concat();
         ui.horizontal(|ui| {
             ui.label(RichText::new(*name).weak());
-            if let Some(new) = default_widget(ui, default, refused_here(cx, &p).is_some(), &p) {
+            let refused = refused_here(cx, &p).is_some();
+            if let Some(new) = default_widget(ui, &mut cx.rects, default, refused, &p) {
                 push_edit(cx, st::add_field(src, path, name, &new), false);
             }
         });
@@ -439,12 +438,18 @@ fn structure(ui: &mut egui::Ui, cx: &mut Cx, v: &Value, path: &[Step]) {
 
 /// A field left out: its default as a widget; the text to add when it is edited (the first step
 /// of a drag adds the field, which then moves among the file's fields).
-fn default_widget(ui: &mut egui::Ui, default: &str, refused: bool, path: &[Step]) -> Option<String> {
+fn default_widget(
+    ui: &mut egui::Ui,
+    rects: &mut Vec<(String, egui::Rect)>,
+    default: &str,
+    refused: bool,
+    path: &[Step],
+) -> Option<String> {
     if let Some(g) = group(default) {
         return combo(ui, g, default, path).map(str::to_string);
     }
     match st::parse(default).ok()?.kind {
-        Kind::Atom => atom(ui, default, refused, path).0.map(|(text, _)| text),
+        Kind::Atom => atom(ui, rects, default, refused, path).0.map(|(text, _)| text),
         _ => ui.button(RichText::new(format!("add {default}")).weak()).clicked().then(|| default.to_string()),
     }
 }
@@ -511,7 +516,7 @@ fn numbers_row(ui: &mut egui::Ui, cx: &mut Cx, name: &str, v: &Value, path: &[St
         }
         for (k, i) in items.iter().enumerate() {
             let p = [path, &[Step::Index(k)]].concat();
-            let (new, stopped) = atom(ui, i.text(src), refused, &p);
+            let (new, stopped) = atom(ui, &mut cx.rects, i.text(src), refused, &p);
             if let Some((text, live)) = new {
                 out[k] = text;
                 changed = Some((live, false));
@@ -530,7 +535,13 @@ fn numbers_row(ui: &mut egui::Ui, cx: &mut Cx, name: &str, v: &Value, path: &[St
 
 /// A number (drag value) or a bool (check box): the new text and whether it is a step of a drag;
 /// and whether a drag just ended.
-fn atom(ui: &mut egui::Ui, text: &str, refused: bool, path: &[Step]) -> (Option<(String, bool)>, bool) {
+fn atom(
+    ui: &mut egui::Ui,
+    rects: &mut Vec<(String, egui::Rect)>,
+    text: &str,
+    refused: bool,
+    path: &[Step],
+) -> (Option<(String, bool)>, bool) {
     if let Some(x) = st::parse_number(text) {
         let mut y = x;
         let integer = !text.contains(['.', 'e', 'E']);
@@ -538,6 +549,7 @@ fn atom(ui: &mut egui::Ui, text: &str, refused: bool, path: &[Step]) -> (Option<
         let mut drag = egui::DragValue::new(&mut y).speed(speed);
         drag = if integer { drag.fixed_decimals(0) } else { drag.max_decimals(6) };
         let r = ui.add(drag);
+        rects.push((st::show(path), r.rect));
         if refused {
             ui.painter().rect_stroke(
                 r.rect.expand(2.0),

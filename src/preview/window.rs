@@ -134,6 +134,18 @@ impl ApplicationHandler for App {
                 }
             }
             WindowEvent::ModifiersChanged(m) => s.modifiers = m.state(),
+            // The modifier keys' own events: synthetic input (xdotool under Xvfb) can leave the
+            // modifiers' state event late or stale.
+            WindowEvent::KeyboardInput {
+                event: winit::event::KeyEvent { logical_key: Key::Named(k), state, .. },
+                ..
+            } if matches!(k, NamedKey::Control | NamedKey::Shift) => {
+                let held = state == ElementState::Pressed;
+                s.modifiers.set(
+                    if k == NamedKey::Control { ModifiersState::CONTROL } else { ModifiersState::SHIFT },
+                    held,
+                );
+            }
             WindowEvent::KeyboardInput { event, .. } if event.state == ElementState::Pressed && !typing => {
                 if matches!(event.logical_key, Key::Named(NamedKey::Escape)) {
                     event_loop.exit();
@@ -144,7 +156,7 @@ impl ApplicationHandler for App {
             }
             WindowEvent::MouseInput { state, button, .. } => {
                 let on_image = !s.panel || s.cursor.0 < s.image_width() as f64;
-                if state == ElementState::Pressed && on_image && !s.gui.ctx.egui_wants_pointer_input() {
+                if state == ElementState::Pressed && on_image {
                     s.drag = Some((button, s.cursor));
                 } else if state == ElementState::Released {
                     s.drag = None;
@@ -704,8 +716,9 @@ impl State {
             return;
         };
         if self.modifiers.control_key() {
+            // Shift may reach us as the key's case before the modifiers' own event.
             if c.eq_ignore_ascii_case("z") {
-                self.history(!self.modifiers.shift_key());
+                self.history(!(self.modifiers.shift_key() || c == "Z"));
             }
             return;
         }
