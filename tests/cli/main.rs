@@ -11,4 +11,5 @@ mod faults;
 mod hostile_files;
 mod install;
 mod maxima;
+mod preview_input;
 mod preview_window;

@@ -75,6 +75,8 @@ pub use crate::methods::view::RayCamera as Camera;
 #[derive(Debug, Clone)]
 pub struct RayMarchPlan {
     pub hypertexture: String,
+    /// The method as the scene (and the overrides) gave it: what the preview shows and steps.
+    pub method: RayMarch,
     pub packed: Packed,
     pub params: HyperParams,
     pub shade: Shade,
@@ -164,6 +166,7 @@ pub fn plan(
     }
     Ok(RayMarchPlan {
         hypertexture: node.name.clone(),
+        method: *method,
         packed,
         params,
         shade,

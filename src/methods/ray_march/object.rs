@@ -105,6 +105,10 @@ impl MethodPlan for RayMarchPlan {
         self.describe()
     }
 
+    fn scene_method(&self, _object: &ObjectPlan) -> Option<crate::scene::Method> {
+        Some(crate::scene::Method::RayMarch(self.method))
+    }
+
     fn allocations(&self, _object: &ObjectPlan, size: (u32, u32)) -> Vec<Allocation> {
         self.per_pixel_buffers(size)
             .into_iter()
