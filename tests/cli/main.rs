@@ -11,3 +11,4 @@ mod hostile_files;
 mod install;
 mod maxima;
 mod preview_window;
+mod volumes;

@@ -22,3 +22,4 @@ mod pareto;
 mod reference;
 mod regress;
 mod render_scenes;
+mod volume;
