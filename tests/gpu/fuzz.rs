@@ -708,3 +708,44 @@ fn vdb_bytes_mutated() {
         vdb_case(bytes, density, *color)
     });
 }
+
+/// By hand: what vdb-rs does with the same mutations when nothing guards it (no walk, no
+/// splices): the panics the walk keeps it from (`-- --ignored --nocapture`).
+#[test]
+#[ignore]
+fn vdb_rs_unguarded() {
+    use std::collections::BTreeMap;
+    let files = vdb_examples();
+    let mut panics: BTreeMap<String, u32> = BTreeMap::new();
+    let mut errors = 0;
+    let mut ok = 0;
+    let mut runner = proptest::test_runner::TestRunner::deterministic();
+    let strategy = (0..files.len(), prop::collection::vec((any::<prop::sample::Index>(), any::<u8>()), 0..6), prop::option::of(any::<prop::sample::Index>()));
+    for _ in 0..4000 {
+        let (f, edits, cut) = proptest::strategy::ValueTree::current(&strategy.new_tree(&mut runner).unwrap());
+        let (bytes, density, _) = &files[f];
+        let mut bytes = bytes.clone();
+        for (at, b) in edits {
+            let at = at.index(bytes.len());
+            bytes[at] = b;
+        }
+        if let Some(cut) = cut {
+            bytes.truncate(cut.index(bytes.len()));
+        }
+        let name = density.to_string();
+        let result = voltex::error::quietly(std::panic::AssertUnwindSafe(|| {
+            let mut r = vdb_rs::VdbReader::new(std::io::Cursor::new(bytes)).map_err(|e| e.to_string())?;
+            r.read_grid::<f32>(&name).map(|_| ()).map_err(|e| e.to_string())
+        }));
+        match result {
+            Ok(Ok(())) => ok += 1,
+            Ok(Err(_)) => errors += 1,
+            Err(p) => {
+                let msg = p.downcast_ref::<String>().cloned().or_else(|| p.downcast_ref::<&str>().map(|s| s.to_string())).unwrap_or_default();
+                let key: String = msg.chars().take(60).collect();
+                *panics.entry(key).or_default() += 1;
+            }
+        }
+    }
+    println!("vdb-rs alone on 4000 mutated files: {ok} read, {errors} errors, panics: {panics:#?}");
+}

@@ -256,3 +256,50 @@ fn volume_texel_bake_matches_twin() {
         assert!(worst_normal < 0.05, "{worst_normal}");
     }
 }
+
+/// By hand (`cargo test --release --test gpu volume::measure -- --ignored --nocapture`): the
+/// RMSE against the analytic transmittance at 256x256 (the bound for the Reference is
+/// 1e-3) for both methods and several RayMarch steps, with the march's GPU time.
+#[test]
+#[ignore]
+fn measure_transmittance_rmse_256() {
+    let size = 256;
+    for (grid, v) in [("density", [ONE, ONE, ONE]), ("ramp", [RAMP, ONE, ONE])] {
+        let truth = analytic(&box_scene(grid, "Reference()"), size, &v);
+        for method in ["Reference()", "RayMarch(quality: HQ)", "RayMarch()", "RayMarch(step: 0.125)"] {
+            let scene = box_scene(grid, method);
+            let bp = Blueprint::new(&scene, &common::sized(size, size)).unwrap();
+            let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
+            let mut r = Renderer::new(&ctx, bp).unwrap();
+            r.render(&ctx).unwrap();
+            let times = r.render_timed(&ctx).unwrap();
+            let frame = r.render(&ctx).unwrap();
+            drop(ctx);
+            let image: Vec<f64> = frame.image.pixels.iter().map(|p| p[0] as f64).collect();
+            let ms: f64 = times.iter().filter(|(n, _)| n.starts_with("march_volume")).map(|(_, t)| t).sum();
+            println!(
+                "{grid:8} {method:24} RMSE {:.2e}  max {:.2e}  march_volume {ms:.1} ms",
+                rmse(&image, &truth),
+                max_error(&image, &truth)
+            );
+        }
+    }
+}
+
+/// The sparse case through the plan: two blobs 1000 voxels apart cost the frame well under a
+/// MiB of table and bricks (a dense grid over their bounds: 1016^3 floats, 4 GB), and `voltex
+/// plan`'s memory says so before anything is allocated.
+#[test]
+fn far_apart_blobs_plan_sparse_memory() {
+    let scene = scene::load(&scene_path("far_apart.ron")).unwrap();
+    let bp = Blueprint::new(&scene, &common::sized(64, 64)).unwrap();
+    let o = &bp.objects[0];
+    let plan = o.method::<VolumePlan>().unwrap();
+    let bytes: u64 = voltex::methods::MethodPlan::memory(plan, o, (64, 64)).iter().map(|m| m.1).sum();
+    let grid = &o.object.volume.as_ref().unwrap().grid;
+    let span = (grid.hi - grid.lo + 1).as_dvec3();
+    let dense = span.x * span.y * span.z * 4.0;
+    println!("far_apart: {} bricks, {} table words, {bytes} bytes planned; dense {dense:.3e} bytes", grid.bricks(), grid.table.len());
+    assert!(span.min_element() > 1000.0);
+    assert!(bytes < 1 << 20 && (bytes as f64) < dense * 1e-3, "{bytes} bytes");
+}
