@@ -51,8 +51,9 @@ pub enum Command {
     Compare(compare::CompareArgs),
     /// Print the bakes, passes, pipelines and GPU memory a scene will use (no GPU needed).
     Plan(plan::PlanArgs),
-    /// Write the scene that `render` and `preview` open for a mesh asset (.glb, .gltf, .obj):
-    /// the mesh as a base surface under a default texel, framed by a camera, editable.
+    /// Write the scene that `render` and `preview` open for an asset: a mesh (.glb, .gltf, .obj)
+    /// as a base surface under a default texel, or an OpenVDB file (.vdb) as a volume object;
+    /// framed by a camera, editable.
     Import(import::ImportArgs),
     /// Open a window showing the scene, redrawn whenever the scene, its files, a graph or a kernel
     /// changes (keys and mouse: see the overlay and the README).

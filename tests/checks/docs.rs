@@ -142,6 +142,7 @@ const SNIPPET_FOLDERS: &[&str] = &[
     "scenes/meyer_neyret",
     "scenes/hypertextures",
     "scenes/hard_cases",
+    "scenes/volumes",
     "scenes/reference",
 ];
 

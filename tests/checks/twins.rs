@@ -59,6 +59,11 @@ const NO_TWIN: &[(&str, &str)] = &[
          checked by the golden images",
     ),
     (
+        "composite_volume",
+        "raster: blends the march state the march_volume twin computes over the frame (one line); \
+         checked by tests/gpu/volume.rs's analytic transmittance and the golden images",
+    ),
+    (
         "composite_reference",
         "raster: copies the trace_reference layer (premultiplied-over blending by the pipeline); \
          checked by tests/gpu/reference.rs and the golden images",

@@ -13,3 +13,4 @@ mod install;
 mod maxima;
 mod preview_input;
 mod preview_window;
+mod volumes;

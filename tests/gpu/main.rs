@@ -24,3 +24,4 @@ mod pareto;
 mod reference;
 mod regress;
 mod render_scenes;
+mod volume;

@@ -246,3 +246,17 @@ struct Splat {
     center: vec4<f32>,
     normal: vec4<f32>,
 }
+
+// Volume objects (twin: VolumeParams in src/types.rs).
+struct VolumeParams {
+    to_index: mat4x4<f32>,
+    right: vec4<f32>,
+    up: vec4<f32>,
+    box_lo: vec4<f32>,
+    box_hi: vec4<f32>,
+    medium: vec4<f32>,
+    origin: vec4<i32>,
+    table: vec4<u32>,
+    atlas: vec4<u32>,
+    budget: vec4<u32>,
+}
