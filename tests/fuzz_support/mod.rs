@@ -1,7 +1,10 @@
 //! Helpers of the fuzz targets: token-level mutations of example files, the error-position
 //! property, and an allocator that records the peak of live bytes per thread.
 
+pub mod ron_items;
+pub mod runner;
 pub mod slice;
+pub mod special;
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;

@@ -13,10 +13,14 @@
 //! shrunk by proptest to a minimal input, printed; it then becomes a named test in
 //! `fuzz_regressions` below.
 
+mod gpu_paths;
+mod hostile;
+
 use crate::fuzz_support;
 
 use std::path::{Path, PathBuf};
 
+use fuzz_support::runner::{accepted, fuzz, SMALL};
 use fuzz_support::slice::{slice_case, slice_input};
 use fuzz_support::{check_error, mutate, Mutation, Tracked};
 use glam::{DVec2, DVec3};
@@ -29,9 +33,6 @@ use voltex::render::{Blueprint, RenderOptions};
 
 #[global_allocator]
 static ALLOC: Tracked = Tracked;
-
-/// Most bytes one case may have live at once (inputs are a few KiB).
-const ALLOC_LIMIT: usize = 256 << 20;
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -50,63 +51,6 @@ fn files(dir: &Path, ext: &str) -> Vec<PathBuf> {
     }
     out.sort();
     out
-}
-
-thread_local! {
-    /// Inputs of the running target that got through every stage without an error.
-    static ACCEPTED: std::cell::Cell<u64> = const { std::cell::Cell::new(0) };
-}
-
-fn accepted() -> Result<(), String> {
-    ACCEPTED.with(|a| a.set(a.get() + 1));
-    Ok(())
-}
-
-/// Runs `test` on `cases` inputs of `strategy` (proptest shrinks a failure), with the allocation
-/// bound checked around every case. Prints the number of inputs tried.
-fn fuzz<S: Strategy>(
-    name: &str,
-    default_cases: u32,
-    strategy: S,
-    test: impl Fn(S::Value) -> Result<(), String>,
-) where
-    S::Value: std::fmt::Debug,
-{
-    let cases = std::env::var("VOLTEX_FUZZ_CASES").ok().and_then(|v| v.parse().ok()).unwrap_or(default_cases);
-    let seed: u64 = std::env::var("VOLTEX_FUZZ_SEED").ok().and_then(|v| v.parse().ok()).unwrap_or(0);
-    let config = ProptestConfig {
-        cases,
-        failure_persistence: None,
-        max_shrink_iters: 4096,
-        ..ProptestConfig::default()
-    };
-    let mut seed_bytes = [0u8; 32];
-    seed_bytes[..8].copy_from_slice(&seed.to_le_bytes());
-    let rng =
-        proptest::test_runner::TestRng::from_seed(proptest::test_runner::RngAlgorithm::ChaCha, &seed_bytes);
-    let mut runner = proptest::test_runner::TestRunner::new_with_rng(config, rng);
-    let tried = std::cell::Cell::new(0u64);
-    let start = std::time::Instant::now();
-    let result = runner.run(&strategy, |value| {
-        tried.set(tried.get() + 1);
-        let start = Tracked::begin_case();
-        let outcome = test(value);
-        let peak = Tracked::peak_since(start);
-        outcome.map_err(TestCaseError::fail)?;
-        if peak > ALLOC_LIMIT {
-            return Err(TestCaseError::fail(format!("allocated {} MiB at once", peak >> 20)));
-        }
-        Ok(())
-    });
-    eprintln!(
-        "fuzz {name}: {} inputs tried, {} accepted (seed {seed}, {cases} cases asked, {:.1} s)",
-        tried.get(),
-        ACCEPTED.with(|a| a.get()),
-        start.elapsed().as_secs_f64()
-    );
-    if let Err(e) = result {
-        panic!("fuzz {name}: {e}");
-    }
 }
 
 /// Example files with a list of mutations, applied to the file's tokens.
@@ -216,7 +160,7 @@ fn graph_case(path: &Path, text: &str) -> Result<(), String> {
 #[test]
 fn scene_files_mutated() {
     let paths = files(&root().join("scenes"), "ron");
-    fuzz("scene_files_mutated", 15000, mutated(paths), |(path, muts)| {
+    fuzz("scene_files_mutated", 15000, SMALL, mutated(paths), |(path, muts)| {
         let text = mutate(&std::fs::read_to_string(&path).unwrap(), &muts);
         scene_case(&path, &text)
     });
@@ -225,13 +169,15 @@ fn scene_files_mutated() {
 #[test]
 fn scene_strings() {
     let path = root().join("scenes/fuzz.ron");
-    fuzz("scene_strings", 50000, prop_oneof![ron_like(), any::<String>()], |text| scene_case(&path, &text));
+    fuzz("scene_strings", 50000, SMALL, prop_oneof![ron_like(), any::<String>()], |text| {
+        scene_case(&path, &text)
+    });
 }
 
 #[test]
 fn graph_files_mutated() {
     let paths = files(&root().join("graphs"), "ron");
-    fuzz("graph_files_mutated", 6000, mutated(paths), |(path, muts)| {
+    fuzz("graph_files_mutated", 6000, SMALL, mutated(paths), |(path, muts)| {
         let text = mutate(&std::fs::read_to_string(&path).unwrap(), &muts);
         graph_case(&path, &text)
     });
@@ -240,7 +186,9 @@ fn graph_files_mutated() {
 #[test]
 fn graph_strings() {
     let path = root().join("graphs/fuzz.ron");
-    fuzz("graph_strings", 50000, prop_oneof![ron_like(), any::<String>()], |text| graph_case(&path, &text));
+    fuzz("graph_strings", 50000, SMALL, prop_oneof![ron_like(), any::<String>()], |text| {
+        graph_case(&path, &text)
+    });
 }
 
 /// One OBJ statement: mostly well formed, with bad numbers, indices and shapes mixed in.
@@ -341,7 +289,7 @@ fn obj_text() -> impl Strategy<Value = String> {
 #[test]
 fn obj_statements() {
     let text = prop_oneof![obj_text(), prop::collection::vec(obj_line(), 0..40).prop_map(|l| l.join("\n"))];
-    fuzz("obj_statements", 50000, text, |text| obj_case(&text));
+    fuzz("obj_statements", 50000, SMALL, text, |text| obj_case(&text));
 }
 
 #[test]
@@ -351,7 +299,7 @@ fn obj_mutated() {
                 f 1/1/1 2/2/1 3/3/1 4/4/1\nf -4 -2 -1\nf 1//1 2//1 3//1\nf 1/1 2/2 3/3\n";
     let strategy =
         (prop::collection::vec(any::<Mutation>(), 1..6), prop_oneof![Just(String::new()), any::<String>()]);
-    fuzz("obj_mutated", 50000, strategy, |(muts, tail)| obj_case(&(mutate(quad, &muts) + &tail)));
+    fuzz("obj_mutated", 50000, SMALL, strategy, |(muts, tail)| obj_case(&(mutate(quad, &muts) + &tail)));
 }
 
 /// A coordinate on a small grid (exact coincidences are likely), a float, or a special value.
@@ -462,7 +410,7 @@ fn surface() -> impl Strategy<Value = BaseSurface> {
 #[test]
 fn prism_builder() {
     let forward = (vec3(false), 1u32..600, -1.0f64..1.0);
-    fuzz("prism_builder", 50000, (surface(), forward), |(s, (f, planes, near))| {
+    fuzz("prism_builder", 50000, SMALL, (surface(), forward), |(s, (f, planes, near))| {
         let report = prism::check(&s);
         if !report.is_ok() {
             return Ok(());
@@ -479,7 +427,7 @@ fn prism_builder() {
         if planes_in_chunks != planes {
             return Err(format!("chunks hold {planes_in_chunks} planes, the sweep {planes}"));
         }
-        ACCEPTED.with(|a| a.set(a.get() + 1));
+        let _ = accepted();
         for v in &shell.vertices {
             if !v.bottom.iter().chain(&v.top).all(|x| x.is_finite()) {
                 return Err(format!("a checked surface made a non-finite shell vertex {v:?}"));
@@ -491,7 +439,7 @@ fn prism_builder() {
 
 #[test]
 fn slice_classification() {
-    fuzz("slice_classification", 100000, slice_input(), |input| match slice_case(&input)? {
+    fuzz("slice_classification", 100000, SMALL, slice_input(), |input| match slice_case(&input)? {
         true => accepted(),
         false => Ok(()),
     });
@@ -620,7 +568,7 @@ fn gltf_bytes_mutated() {
     let n = glb.len();
     let edits = prop::collection::vec((0..n, any::<u8>()), 0..8);
     let strategy = (edits, prop::option::of(0..n));
-    fuzz("gltf_bytes_mutated", 3000, strategy, |(edits, cut)| {
+    fuzz("gltf_bytes_mutated", 3000, SMALL, strategy, |(edits, cut)| {
         let mut bytes = glb.clone();
         for (at, b) in edits {
             bytes[at] = b;
@@ -636,5 +584,7 @@ fn gltf_json_mutated() {
     let json_len = u32::from_le_bytes(glb[12..16].try_into().unwrap()) as usize;
     let json = String::from_utf8(glb[20..20 + json_len].to_vec()).unwrap();
     let strategy = prop::collection::vec(any::<Mutation>(), 1..6);
-    fuzz("gltf_json_mutated", 3000, strategy, |muts| gltf_case(&with_json(&glb, &mutate(&json, &muts))));
+    fuzz("gltf_json_mutated", 3000, SMALL, strategy, |muts| {
+        gltf_case(&with_json(&glb, &mutate(&json, &muts)))
+    });
 }
