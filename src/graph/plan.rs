@@ -9,7 +9,9 @@ use crate::gpu::reflect::{self, Binding};
 use crate::gpu::shader::{self, Kernel};
 use crate::gpu::sources::Sources;
 use crate::graph::expr::Expr;
-use crate::graph::{BufferClear, Draw, Graph, Instances, PassDecl, ResourceDecl, Value, Vocabulary};
+use crate::graph::{
+    BufferClear, Draw, Graph, Instances, PassDecl, ResourceDecl, TextureSize, Value, Vocabulary,
+};
 
 /// What the planner needs to know of a scene object.
 #[derive(Debug, Clone)]
@@ -63,6 +65,37 @@ pub const FRAME_COUNTS: &[&str] = &["width", "height"];
 /// Plans `graph` for `objects` and an output of `size` pixels, its shaders looked up in `sources`
 /// (the graph's folder first when the caller put it there: see [`Sources::beside`]), its filters
 /// and counts checked against `vocabulary`, whose resource names its own resources may not take.
+/// The targets of a raster pass must have one size (at the frame's `size`): wgpu refuses
+/// differing attachments only when the frame is recorded.
+fn check_target_sizes(graph: &Graph, decl: &PassDecl, size: (u32, u32)) -> Result<()> {
+    let PassDecl::Raster { targets, depth, .. } = decl else { return Ok(()) };
+    let extent = |name: &str| match graph.file.resources.get(name) {
+        Some(ResourceDecl::Texture { size: TextureSize::Fixed(w, h), .. }) => Some((*w, *h)),
+        Some(ResourceDecl::Texture { .. }) => Some(size),
+        _ => None,
+    };
+    let colour = targets.iter().map(|t| (&t.resource, "targets"));
+    let mut first: Option<(&String, (u32, u32))> = None;
+    for (name, field) in colour.chain(depth.iter().map(|d| (&d.resource, "depth"))) {
+        let Some(e) = extent(name) else { continue };
+        match first {
+            None => first = Some((name, e)),
+            Some((f, (w, h))) if (w, h) != e => {
+                let msg = format!(
+                    "pass `{}`: target `{name}` is {}x{} but target `{f}` is {w}x{h}: the targets of a raster pass \
+                     must have one size",
+                    decl.name(),
+                    e.0,
+                    e.1
+                );
+                return Err(graph.error_in_pass(decl.name(), field, name, msg));
+            }
+            Some(_) => {}
+        }
+    }
+    Ok(())
+}
+
 pub fn plan(
     graph: &Graph,
     sources: &Sources,
@@ -102,6 +135,7 @@ pub fn plan(
                 Some(ids)
             }
         };
+        check_target_sizes(graph, decl, size)?;
         let kernel = match kernels.get(decl.shader()) {
             Some(k) => k.clone(),
             None => {

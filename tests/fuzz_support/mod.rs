@@ -28,7 +28,8 @@ pub enum Mutation {
     Truncate(Index),
 }
 
-const NUMBERS: &[&str] = &[
+/// Awkward numbers a mutation puts in place of a number.
+pub const NUMBERS: &[&str] = &[
     "NaN",
     "inf",
     "-inf",

@@ -1,11 +1,11 @@
 //! The fuzz driver: a target's inputs under proptest, each with bounds on time and memory, and
 //! the counts a campaign reports (inputs tried and accepted, the slowest and largest input).
 //!
-//! Time: an input over [`case_secs`] (10 s by default, `VOLTEX_FUZZ_CASE_SECS`; CPU time of the
-//! case's thread, or wall time for the GPU targets, whose work runs in the driver's threads)
-//! fails the target when it returns; one still running after three times the bound of wall time
-//! is a hang: a watchdog thread prints the input and aborts the test binary (a blocked read
-//! cannot be interrupted).
+//! Time: an input over [`case_secs`] (10 s by default, `VOLTEX_FUZZ_CASE_SECS`) of its thread's
+//! CPU time fails the target when it returns; the GPU targets, whose work runs in the driver's
+//! threads, have three times the bound in wall time. One still running after three times its
+//! bound in wall time is a hang: a watchdog thread prints the input and aborts the test binary
+//! (a blocked read cannot be interrupted).
 //! Memory: the Rust heap a case has live at once (the counting allocator, per thread), and for
 //! the GPU targets the growth of the process's resident memory, sampled by the watchdog (the
 //! driver allocates outside Rust).
@@ -89,8 +89,13 @@ impl Drop for CaseGuard<'_> {
     }
 }
 
-fn watchdog(name: String, watch: Arc<Mutex<Watch>>, sample_rss: bool) -> std::thread::JoinHandle<()> {
-    let hang = Duration::from_secs_f64(3.0 * case_secs());
+fn watchdog(
+    name: String,
+    watch: Arc<Mutex<Watch>>,
+    sample_rss: bool,
+    limit: f64,
+) -> std::thread::JoinHandle<()> {
+    let hang = Duration::from_secs_f64(3.0 * limit);
     std::thread::spawn(move || loop {
         std::thread::sleep(Duration::from_millis(if sample_rss { 20 } else { 200 }));
         let mut w = watch.lock().unwrap();
@@ -103,9 +108,8 @@ fn watchdog(name: String, watch: Arc<Mutex<Watch>>, sample_rss: bool) -> std::th
         if let Some((start, input)) = &w.case {
             if start.elapsed() > hang {
                 eprintln!(
-                    "fuzz {name}: an input still runs after {:.0} s (a hang; the bound is {} s), aborting: {input}",
+                    "fuzz {name}: an input still runs after {:.0} s (a hang; the bound is {limit} s), aborting: {input}",
                     start.elapsed().as_secs_f64(),
-                    case_secs()
                 );
                 std::process::abort();
             }
@@ -153,15 +157,28 @@ pub fn fuzz<S: Strategy>(
     let rng = TestRng::from_seed(RngAlgorithm::ChaCha, &seed_bytes);
     let mut runner = TestRunner::new_with_rng(config, rng);
     let watch = Arc::new(Mutex::new(Watch::default()));
-    let dog = watchdog(name.to_string(), watch.clone(), bounds.rss.is_some());
-    let limit = case_secs();
+    // GPU targets: wall time, and three times the bound (llvmpipe shares the machine's cores).
+    let limit = if bounds.rss.is_some() { 3.0 * case_secs() } else { case_secs() };
+    let dog = watchdog(name.to_string(), watch.clone(), bounds.rss.is_some(), limit);
     let (tried, slowest, heap_peak, rss_peak) =
         (Cell::new(0u64), Cell::new(0f64), Cell::new(0usize), Cell::new(0u64));
     let start = Instant::now();
+    let last_report = Cell::new(start);
+    let accepted_before = ACCEPTED.with(Cell::get);
     let result = runner.run(&strategy, |value| {
         tried.set(tried.get() + 1);
-        if tried.get() % 10_000 == 0 {
-            eprintln!("fuzz {name}: {} inputs, {:.0} s", tried.get(), start.elapsed().as_secs_f64());
+        // A long campaign's progress, once a minute (its figures if it is stopped).
+        if last_report.get().elapsed() > Duration::from_secs(60) {
+            last_report.set(Instant::now());
+            eprintln!(
+                "fuzz {name}: {} inputs so far, {} accepted, {:.0} s; slowest input {:.2} s, largest heap {} MiB, resident +{} MiB",
+                tried.get() - 1,
+                ACCEPTED.with(Cell::get) - accepted_before,
+                start.elapsed().as_secs_f64(),
+                slowest.get(),
+                heap_peak.get() >> 20,
+                rss_peak.get() >> 20,
+            );
         }
         let input = shorten(format!("{value:?}"), 2000);
         {
@@ -215,7 +232,7 @@ pub fn fuzz<S: Strategy>(
         "fuzz {name}: {} inputs tried, {} accepted (seed {seed}, {cases} cases asked, {:.1} s; slowest input \
          {:.2} s, largest heap {} MiB{rss_text})",
         tried.get(),
-        ACCEPTED.with(|a| a.get()),
+        ACCEPTED.with(Cell::get) - accepted_before,
         start.elapsed().as_secs_f64(),
         slowest.get(),
         heap_peak.get() >> 20,

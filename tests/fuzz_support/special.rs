@@ -67,12 +67,37 @@ pub fn make(kind: Special, path: &Path) {
     }
 }
 
-/// A scratch folder `<temp>/voltex-fuzz-<name>-<pid>`, emptied.
-pub fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("voltex-fuzz-{name}-{}", std::process::id()));
+/// A scratch folder, removed when dropped.
+pub struct Scratch(pub PathBuf);
+
+impl std::ops::Deref for Scratch {
+    type Target = Path;
+    fn deref(&self) -> &Path {
+        &self.0
+    }
+}
+
+impl Drop for Scratch {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+/// An empty scratch folder `voltex-fuzz-<name>-<pid>` in memory (`/dev/shm`) where there is one:
+/// targets rewrite files for every input, and on a disk each truncation may wait for a discard.
+pub fn scratch(name: &str) -> Scratch {
+    let shm = Path::new("/dev/shm");
+    let base = if shm.is_dir() { shm.to_path_buf() } else { std::env::temp_dir() };
+    let dir = base.join(format!("voltex-fuzz-{name}-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+    match std::fs::create_dir_all(&dir) {
+        Ok(()) => Scratch(dir),
+        Err(_) => {
+            let dir = std::env::temp_dir().join(format!("voltex-fuzz-{name}-{}", std::process::id()));
+            std::fs::create_dir_all(&dir).unwrap();
+            Scratch(dir)
+        }
+    }
 }
 
 /// Under `dir`: `KIND.EXT` for every kind and extension, and `stack_KIND/slice_000.png` (a

@@ -449,6 +449,32 @@ fn slice_classification() {
 mod fuzz_regressions {
     use super::*;
 
+    /// render_tiny, seed 19: the graph texture `hdr` made `Fixed(1, 1)` beside the output-sized
+    /// `depth`: plan accepted, and recording the frame failed in wgpu ("Attachments have
+    /// differing sizes") with no position. Now a plan error at the pass's target.
+    #[test]
+    fn raster_targets_of_differing_sizes_are_a_plan_error() {
+        let dir = std::env::temp_dir().join(format!("voltex-fuzz-sizes-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let graph = dir.join("frame.ron");
+        let text = std::fs::read_to_string(root().join("graphs/frame.ron")).unwrap();
+        let from = "\"hdr\": Texture(format: Rgba32Float, size: Output";
+        assert!(text.contains(from));
+        std::fs::write(
+            &graph,
+            text.replacen(from, "\"hdr\": Texture(format: Rgba32Float, size: Fixed(1, 1)", 1),
+        )
+        .unwrap();
+        let scene = voltex::scene::load(&root().join("scenes/view_slices/flat_box.ron")).unwrap();
+        let opts = RenderOptions { size: Some((8, 8)), graph: Some(graph.clone()), ..Default::default() };
+        let e = Blueprint::new(&scene, &opts).err().expect("an error").to_string();
+        assert!(e.starts_with(&format!("{}:", graph.display())), "{e}");
+        assert!(e.contains("target `depth` is 8x8 but target `hdr` is 1x1"), "{e}");
+        // At the output size, a fixed size is no mismatch.
+        let opts = RenderOptions { size: Some((1, 1)), ..opts };
+        assert!(Blueprint::new(&scene, &opts).is_ok());
+    }
+
     fn surface(positions: Vec<DVec3>, triangles: Vec<[u32; 3]>) -> BaseSurface {
         BaseSurface {
             heights: vec![DVec3::ZERO; positions.len()],

@@ -12,7 +12,7 @@ use super::hostile::{apply, graph_edit, GraphEdit, Tree};
 use super::root;
 use crate::common;
 use crate::fuzz_support::runner::{accepted, fuzz, GPU};
-use crate::fuzz_support::{check_error, mutate, Mutation};
+use crate::fuzz_support::{check_error, mutate, Mutation, NUMBERS};
 
 use std::cell::RefCell;
 use std::path::{Path, PathBuf};
@@ -110,13 +110,23 @@ fn render_tiny() {
     let original = tree.text("frame.ron");
     let cache = RefCell::new(GpuCache::default());
     let exr = tree.dir.join("out.exr");
+    // The examples as they are first: each renders, and the pipelines are made before the clock
+    // runs (making them all takes seconds on llvmpipe).
+    for rel in SCENES {
+        let (path, text) = read(rel);
+        render_case(&device(), &mut cache.borrow_mut(), (&path, &text), 16, None, &exr).unwrap();
+    }
     let graph_edits = prop::option::weighted(0.25, prop::collection::vec(graph_edit(), 1..3));
-    let strategy = (
-        prop::sample::select(SCENES),
-        prop::collection::vec(any::<Mutation>(), 0..4),
-        graph_edits,
-        prop::sample::select(vec![8u32, 16]),
-    );
+    // Mostly numbers changed (the text still parses, so the GPU sees it), else any edits.
+    let mild = ["0.5", "2", "3", "7", "0.01", "100", "33", "1.5", "0.9", "12"];
+    let numbers: Vec<&'static str> = NUMBERS.iter().chain(&mild).copied().collect();
+    let number = (any::<Index>(), prop::sample::select(numbers)).prop_map(|(i, n)| Mutation::Number(i, n));
+    let mutations = prop_oneof![
+        3 => prop::collection::vec(number, 1..3),
+        2 => prop::collection::vec(any::<Mutation>(), 0..4),
+    ];
+    let strategy =
+        (prop::sample::select(SCENES), mutations, graph_edits, prop::sample::select(vec![8u32, 16]));
     fuzz("render_tiny", 40, GPU, strategy, |(rel, muts, edits, size)| {
         let (path, text) = read(rel);
         let text = mutate(&text, &muts);
@@ -198,11 +208,19 @@ fn preview_reload() {
     let originals: Vec<(String, String)> = kernels.iter().map(|k| (k.clone(), tree.text(k))).collect();
     let bases: Vec<String> = RELOAD_SCENES.iter().map(|rel| read(rel).1).collect();
     let opts = RenderOptions { size: Some((16, 16)), graph: Some(tree.graph()), ..Default::default() };
+    // What each file holds now, so that only changed files are written.
+    let disk: RefCell<std::collections::HashMap<PathBuf, String>> = RefCell::default();
+    let write = |path: &Path, text: &str| {
+        if disk.borrow().get(path).map(String::as_str) != Some(text) {
+            std::fs::write(path, text).unwrap();
+            disk.borrow_mut().insert(path.to_path_buf(), text.to_string());
+        }
+    };
     let put_back = |base: &str| {
-        std::fs::write(&scene_path, base).unwrap();
-        std::fs::write(tree.graph(), &graph).unwrap();
+        write(&scene_path, base);
+        write(&tree.graph(), &graph);
         for (rel, text) in &originals {
-            std::fs::write(tree.dir.join(rel), text).unwrap();
+            write(&tree.dir.join(rel), text);
         }
     };
     put_back(&bases[0]);
@@ -245,22 +263,22 @@ fn preview_reload() {
             match v {
                 Version::Scene(muts) => {
                     let text = mutate(&bases[b], muts);
-                    std::fs::write(&scene_path, &text).unwrap();
+                    write(&scene_path, &text);
                     files[0].1 = text;
                 }
                 Version::Graph(edits) => {
                     let mut g = graph.clone();
                     if let Some((rel, k)) = edits.iter().fold(None, |k, e| apply(e, &mut g, &tree).or(k)) {
-                        std::fs::write(tree.dir.join(&rel), &k).unwrap();
+                        write(&tree.dir.join(&rel), &k);
                         files.push((tree.dir.join(rel), k));
                     }
-                    std::fs::write(tree.graph(), &g).unwrap();
+                    write(&tree.graph(), &g);
                     files.push((tree.graph(), g));
                 }
                 Version::Kernel(k, muts) => {
                     let (rel, text) = &originals[k.index(originals.len())];
                     let text = mutate(text, muts);
-                    std::fs::write(tree.dir.join(rel), &text).unwrap();
+                    write(&tree.dir.join(rel), &text);
                     files.push((tree.dir.join(rel), text));
                 }
                 Version::Good => {}

@@ -55,7 +55,7 @@ fn planned(path: &Path, text: &str, opts: &RenderOptions) -> Result<Option<Bluep
 /// A fixture: the project's WGSL tree and default graph copied into a scratch folder, so that a
 /// case can edit a kernel (found beside the graph, or as the only source) and restore it.
 pub(super) struct Tree {
-    pub(super) dir: PathBuf,
+    pub(super) dir: special::Scratch,
 }
 
 impl Tree {
@@ -414,7 +414,7 @@ fn counts() {
         MethodKind::AxisSlices,
         MethodKind::Reference,
     ]));
-    fuzz("counts", 60, LARGE, (count(), methods), |(c, method)| {
+    fuzz("counts", 40, LARGE, (count(), methods), |(c, method)| {
         let (path, text) = count_scene(&c, &objs);
         let opts = RenderOptions { method, ..Default::default() };
         match planned(&path, &text, &opts)? {
