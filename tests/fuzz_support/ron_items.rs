@@ -41,6 +41,20 @@ pub fn openings(text: &str) -> Vec<usize> {
     punctuation(text).into_iter().filter(|&(_, c)| c == b'(').map(|(i, _)| i + 1).collect()
 }
 
+/// Offset of the bracket closing the one opened just before `after_open`.
+pub fn closing(text: &str, after_open: usize) -> usize {
+    let mut depth = 0;
+    for (i, c) in punctuation(text).into_iter().filter(|&(i, _)| i >= after_open) {
+        match c {
+            b'(' | b'[' | b'{' => depth += 1,
+            b')' | b']' | b'}' if depth == 0 => return i,
+            b')' | b']' | b'}' => depth -= 1,
+            _ => {}
+        }
+    }
+    text.len()
+}
+
 /// One item of a struct or map: its text spans `start..end` (without the separating comma).
 #[derive(Debug, Clone, Copy)]
 pub struct Item {

@@ -156,6 +156,10 @@ pub fn fuzz<S: Strategy>(
     seed_bytes[..8].copy_from_slice(&seed.to_le_bytes());
     let rng = TestRng::from_seed(RngAlgorithm::ChaCha, &seed_bytes);
     let mut runner = TestRunner::new_with_rng(config, rng);
+    let rss_text = |grew: u64| match bounds.rss {
+        Some(_) => format!(", resident +{} MiB", grew >> 20),
+        None => String::new(),
+    };
     let watch = Arc::new(Mutex::new(Watch::default()));
     // GPU targets: wall time, and three times the bound (llvmpipe shares the machine's cores).
     let limit = if bounds.rss.is_some() { 3.0 * case_secs() } else { case_secs() };
@@ -171,13 +175,13 @@ pub fn fuzz<S: Strategy>(
         if last_report.get().elapsed() > Duration::from_secs(60) {
             last_report.set(Instant::now());
             eprintln!(
-                "fuzz {name}: {} inputs so far, {} accepted, {:.0} s; slowest input {:.2} s, largest heap {} MiB, resident +{} MiB",
+                "fuzz {name}: {} inputs so far, {} accepted, {:.0} s; slowest input {:.2} s, largest heap {} MiB{}",
                 tried.get() - 1,
                 ACCEPTED.with(Cell::get) - accepted_before,
                 start.elapsed().as_secs_f64(),
                 slowest.get(),
                 heap_peak.get() >> 20,
-                rss_peak.get() >> 20,
+                rss_text(rss_peak.get()),
             );
         }
         let input = shorten(format!("{value:?}"), 2000);
@@ -198,9 +202,12 @@ pub fn fuzz<S: Strategy>(
             Some(_) => wall.elapsed().as_secs_f64(),
             None => thread_cpu() - cpu,
         };
-        let grew = {
-            let w = watch.lock().unwrap();
-            w.rss_peak.max(rss()).saturating_sub(w.rss_start)
+        let grew = match bounds.rss {
+            Some(_) => {
+                let w = watch.lock().unwrap();
+                w.rss_peak.max(rss()).saturating_sub(w.rss_start)
+            }
+            None => 0,
         };
         drop(guard);
         slowest.set(slowest.get().max(secs));
@@ -224,18 +231,15 @@ pub fn fuzz<S: Strategy>(
     });
     watch.lock().unwrap().stop = true;
     dog.join().unwrap();
-    let rss_text = match bounds.rss {
-        Some(_) => format!(", resident +{} MiB", rss_peak.get() >> 20),
-        None => String::new(),
-    };
     eprintln!(
         "fuzz {name}: {} inputs tried, {} accepted (seed {seed}, {cases} cases asked, {:.1} s; slowest input \
-         {:.2} s, largest heap {} MiB{rss_text})",
+         {:.2} s, largest heap {} MiB{})",
         tried.get(),
         ACCEPTED.with(Cell::get) - accepted_before,
         start.elapsed().as_secs_f64(),
         slowest.get(),
         heap_peak.get() >> 20,
+        rss_text(rss_peak.get()),
     );
     if let Err(e) = result {
         panic!("fuzz {name}: {e}");

@@ -1,14 +1,16 @@
 //! Bounded fuzzing of what reads user input or builds on it: the scene parser and validator, the
-//! graph parser and planner, the OBJ loader, the prism builder (prism checks, shells, plane sweep)
-//! and the slicing twin's classification. Structured generators: token-level mutations of the
-//! real example files, OBJ text built from statements, random meshes and prisms with exact
-//! coincidences, plus arbitrary strings.
+//! graph parser and planner, the OBJ and glTF loaders, the prism builder (prism checks, shells,
+//! plane sweep) and the slicing twin's classification. Structured generators: token-level
+//! mutations of the real example files, OBJ text built from statements, random meshes and prisms
+//! with exact coincidences, plus arbitrary strings. `hostile` adds the hostile inputs of issue 19
+//! (special files, counts near the budgets, graph values and WGSL beyond the limits, lenient
+//! parsing, names EXR cannot hold); `gpu_paths` renders what plan accepts and drives the
+//! preview's reload path.
 //!
-//! Properties: no panic, errors from a file carry that file and a `line:col` inside it, no input
-//! of a few KiB makes a case allocate more than [`ALLOC_LIMIT`], and time per input is bounded by
-//! construction (inputs are a few KiB, meshes a few hundred triangles).
+//! Properties: no panic, errors from a file carry that file and a `line:col` inside it, and each
+//! input within the runner's bounds on time and memory (`fuzz_support::runner`).
 //!
-//! `VOLTEX_FUZZ_CASES=N` sets the inputs per target (default: a CI budget of about a minute in
+//! `VOLTEX_FUZZ_CASES=N` sets the inputs per target (default: a CI budget of about two minutes in
 //! all), `VOLTEX_FUZZ_SEED=N` the random seed (default fixed, so CI is reproducible). A failure is
 //! shrunk by proptest to a minimal input, printed; it then becomes a named test in
 //! `fuzz_regressions` below.
@@ -448,6 +450,22 @@ fn slice_classification() {
 /// Minimised failures found by the fuzz targets above, kept as named tests.
 mod fuzz_regressions {
     use super::*;
+
+    /// render_tiny, seed 19: a raster pass's target listed twice (`targets: [(resource: "hdr"),
+    /// (resource: "hdr")]`): plan accepted, recording the frame failed in wgpu ("already attached
+    /// to this render pass"). Now an error at the target in the graph file.
+    #[test]
+    fn a_target_attached_twice_is_an_error_at_the_pass() {
+        let path = root().join("graphs/frame.ron");
+        let text = std::fs::read_to_string(&path).unwrap();
+        let from = "targets: [(resource: \"hdr\", blend: PremultipliedOver)]";
+        let twice = "targets: [(resource: \"hdr\", blend: PremultipliedOver), (resource: \"hdr\")]";
+        let text = text.replacen(from, twice, 1);
+        let e = Graph::parse(&path, text.clone()).err().expect("an error").to_string();
+        let line = text[..text.find(twice).unwrap()].matches('\n').count() + 1;
+        assert!(e.starts_with(&format!("{}:{line}:", path.display())), "{e}");
+        assert!(e.contains("target `hdr` is attached twice"), "{e}");
+    }
 
     /// render_tiny, seed 19: the graph texture `hdr` made `Fixed(1, 1)` beside the output-sized
     /// `depth`: plan accepted, and recording the frame failed in wgpu ("Attachments have

@@ -207,7 +207,12 @@ fn preview_reload() {
     let kernels = super::hostile::graph_kernels(&graph);
     let originals: Vec<(String, String)> = kernels.iter().map(|k| (k.clone(), tree.text(k))).collect();
     let bases: Vec<String> = RELOAD_SCENES.iter().map(|rel| read(rel).1).collect();
-    let opts = RenderOptions { size: Some((16, 16)), graph: Some(tree.graph()), ..Default::default() };
+    let opts = RenderOptions {
+        size: Some((16, 16)),
+        graph: Some(tree.graph()),
+        budget: Some(BUDGET),
+        ..Default::default()
+    };
     // What each file holds now, so that only changed files are written.
     let disk: RefCell<std::collections::HashMap<PathBuf, String>> = RefCell::default();
     let write = |path: &Path, text: &str| {

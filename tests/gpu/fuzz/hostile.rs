@@ -700,9 +700,10 @@ fn unknown_fields() {
         let text = match before_close {
             false => format!("{}fuzz_unknown: 0, {}", &text[..k], &text[k..]),
             true => {
-                let end = value_end(text, k);
-                let end = if text[end..].starts_with(',') { value_end(text, end + 1) } else { end };
-                format!("{}, fuzz_unknown: 0{}", &text[..end], &text[end..])
+                let end = ron_items::closing(text, k);
+                let inside = text[k..end].trim_end();
+                let sep = if inside.is_empty() || inside.ends_with(',') { "" } else { ", " };
+                format!("{}{sep}fuzz_unknown: 0{}", &text[..end], &text[end..])
             }
         };
         match parses(path, &text)? {
