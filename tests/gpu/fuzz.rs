@@ -461,7 +461,7 @@ mod fuzz_regressions {
         let from = "targets: [(resource: \"hdr\", blend: PremultipliedOver)]";
         let twice = "targets: [(resource: \"hdr\", blend: PremultipliedOver), (resource: \"hdr\")]";
         let text = text.replacen(from, twice, 1);
-        let e = Graph::parse(&path, text.clone()).err().expect("an error").to_string();
+        let e = Graph::parse(&path, text.clone()).expect_err("an error").to_string();
         let line = text[..text.find(twice).unwrap()].matches('\n').count() + 1;
         assert!(e.starts_with(&format!("{}:{line}:", path.display())), "{e}");
         assert!(e.contains("target `hdr` is attached twice"), "{e}");
