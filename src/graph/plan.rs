@@ -10,7 +10,7 @@ use crate::gpu::shader::{self, Kernel};
 use crate::gpu::sources::Sources;
 use crate::graph::expr::Expr;
 use crate::graph::{
-    BufferClear, Draw, Graph, Instances, PassDecl, ResourceDecl, TextureSize, Value, Vocabulary,
+    BufferClear, Draw, Format, Graph, Instances, PassDecl, ResourceDecl, TextureSize, Value, Vocabulary,
 };
 
 /// What the planner needs to know of a scene object.
@@ -65,6 +65,32 @@ pub const FRAME_COUNTS: &[&str] = &["width", "height"];
 /// Plans `graph` for `objects` and an output of `size` pixels, its shaders looked up in `sources`
 /// (the graph's folder first when the caller put it there: see [`Sources::beside`]), its filters
 /// and counts checked against `vocabulary`, whose resource names its own resources may not take.
+/// A first output that is a texture is read back as the frame's image: it must be Rgba32Float or
+/// R32Float and of the frame's size (the readback found this only after the GPU work). A buffer
+/// output (a debug or benchmark graph) is left to what reads it.
+fn check_image_output(graph: &Graph, size: (u32, u32)) -> Result<()> {
+    let Some(first) = graph.file.outputs.first() else { return Ok(()) };
+    let Some(ResourceDecl::Texture { format, size: texture_size, .. }) = graph.file.resources.get(first)
+    else {
+        return Ok(());
+    };
+    let extent = match texture_size {
+        TextureSize::Output => size,
+        TextureSize::Fixed(w, h) => (*w, *h),
+    };
+    let msg = if !matches!(format, Format::Rgba32Float | Format::R32Float) {
+        format!("output `{first}` is {format:?}: the first output is read back as the image, from an Rgba32Float or R32Float texture")
+    } else if extent != size {
+        format!(
+            "output `{first}` is {}x{}: the first output is read back as the image, at the frame's size {}x{}",
+            extent.0, extent.1, size.0, size.1
+        )
+    } else {
+        return Ok(());
+    };
+    Err(graph.error_at_output(first, msg))
+}
+
 /// The targets of a raster pass must have one size (at the frame's `size`): wgpu refuses
 /// differing attachments only when the frame is recorded.
 fn check_target_sizes(graph: &Graph, decl: &PassDecl, size: (u32, u32)) -> Result<()> {
@@ -175,6 +201,7 @@ pub fn plan(
             ));
         }
     }
+    check_image_output(graph, size)?;
     passes.shrink_to_fit();
     let used: BTreeSet<&String> = passes.iter().flat_map(|p| p.reads.iter().chain(p.writes.iter())).collect();
     let mut textures = BTreeMap::new();

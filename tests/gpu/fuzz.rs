@@ -467,6 +467,44 @@ mod fuzz_regressions {
         assert!(e.contains("target `hdr` is attached twice"), "{e}");
     }
 
+    /// preview_reload, seed 19: a texture of another format than Rgba32Float or R32Float put
+    /// first in the graph's `outputs` (there `depth`): the rebuild succeeded, then every frame
+    /// failed to be read back (and `render` failed after the GPU work). Now a plan error at the
+    /// output; a fixed size other than the frame's too.
+    #[test]
+    fn an_output_that_cannot_be_read_back_is_a_plan_error() {
+        let dir = std::env::temp_dir().join(format!("voltex-fuzz-output-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let graph = dir.join("frame.ron");
+        let text = std::fs::read_to_string(root().join("graphs/frame.ron")).unwrap();
+        let scene = voltex::scene::load(&root().join("scenes/view_slices/flat_box.ron")).unwrap();
+        let opts = RenderOptions { size: Some((8, 8)), graph: Some(graph.clone()), ..Default::default() };
+        let text = text.replacen("outputs: [\"linear\"]", "outputs: [\"linear\", \"hdr\"]", 1);
+        for (from, to, words) in [
+            (
+                "outputs: [\"linear\", \"hdr\"]",
+                "outputs: [\"hdr\", \"linear\"]",
+                "output `hdr` is Rgba16Float",
+            ),
+            (
+                "\"linear\": Texture(format: Rgba32Float, size: Output",
+                "\"linear\": Texture(format: Rgba32Float, size: Fixed(4, 4)",
+                "output `linear` is 4x4",
+            ),
+        ] {
+            assert!(text.contains(from));
+            let text = text.replacen(from, to, 1).replacen(
+                "\"hdr\": Texture(format: Rgba32Float",
+                "\"hdr\": Texture(format: Rgba16Float",
+                1,
+            );
+            std::fs::write(&graph, text).unwrap();
+            let e = Blueprint::new(&scene, &opts).err().expect("an error").to_string();
+            assert!(e.starts_with(&format!("{}:6:", graph.display())), "{e}");
+            assert!(e.contains(words), "{e}");
+        }
+    }
+
     /// render_tiny, seed 19: the graph texture `hdr` made `Fixed(1, 1)` beside the output-sized
     /// `depth`: plan accepted, and recording the frame failed in wgpu ("Attachments have
     /// differing sizes") with no position. Now a plan error at the pass's target.
