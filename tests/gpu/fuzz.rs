@@ -2,10 +2,10 @@
 //! graph parser and planner, the OBJ and glTF loaders, the prism builder (prism checks, shells,
 //! plane sweep) and the slicing twin's classification. Structured generators: token-level
 //! mutations of the real example files, OBJ text built from statements, random meshes and prisms
-//! with exact coincidences, plus arbitrary strings. `hostile` adds the hostile inputs of issue 19
-//! (special files, counts near the budgets, graph values and WGSL beyond the limits, lenient
-//! parsing, names EXR cannot hold); `gpu_paths` renders what plan accepts and drives the
-//! preview's reload path.
+//! with exact coincidences, plus arbitrary strings. The hostile inputs of issue 19 are in `hostile`
+//! (special files, counts near the budgets), `graphs` (graph values and WGSL beyond the limits)
+//! and `parsing` (unknown fields, duplicate keys, invalid UTF-8, names EXR cannot hold);
+//! `gpu_paths` renders what plan accepts and drives the preview's reload path.
 //!
 //! Properties: no panic, errors from a file carry that file and a `line:col` inside it, and each
 //! input within the runner's bounds on time and memory (`fuzz_support::runner`).
@@ -16,7 +16,9 @@
 //! `fuzz_regressions` below.
 
 mod gpu_paths;
+mod graphs;
 mod hostile;
+mod parsing;
 
 use crate::fuzz_support;
 

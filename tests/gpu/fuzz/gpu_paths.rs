@@ -8,7 +8,8 @@
 //! positioned error and keeps the last good frame, a good one renders, and putting the good files
 //! back gives the first frame again, pixel for pixel.
 
-use super::hostile::{apply, graph_edit, GraphEdit, Tree};
+use super::graphs::{apply, graph_edit, GraphEdit};
+use super::hostile::Tree;
 use super::root;
 use crate::common;
 use crate::fuzz_support::runner::{accepted, fuzz, GPU};
@@ -204,7 +205,7 @@ fn preview_reload() {
     let tree = Tree::new("reload");
     let scene_path = tree.dir.join("scene.ron");
     let graph = tree.text("frame.ron");
-    let kernels = super::hostile::graph_kernels(&graph);
+    let kernels = super::graphs::graph_kernels(&graph);
     let originals: Vec<(String, String)> = kernels.iter().map(|k| (k.clone(), tree.text(k))).collect();
     let bases: Vec<String> = RELOAD_SCENES.iter().map(|rel| read(rel).1).collect();
     let opts = RenderOptions {

@@ -1,15 +1,13 @@
-//! The hostile inputs of issue 19 as fuzz targets, through what `voltex plan` does: special
-//! files wherever a path is read, counts near and beyond the budgets, graph values and WGSL
-//! beyond the device's limits, lenient parsing (unknown fields, duplicate keys, invalid UTF-8)
-//! and node names that EXR metadata cannot hold.
+//! Hostile inputs of issue 19 through what `voltex plan` does: special files wherever a path is
+//! read, and counts that drive work near and beyond the budgets; with the helpers the other
+//! hostile targets share (`graphs`, `parsing`, `gpu_paths`).
 //!
 //! Property: each input is accepted or fails with an error naming its file (and `line:col`
 //! where it is about the file's content); no panic; within the runner's bounds on time and
 //! memory per input.
 
-use super::{files, root};
+use super::root;
 use crate::fuzz_support::check_error;
-use crate::fuzz_support::ron_items;
 use crate::fuzz_support::runner::{accepted, fuzz, LARGE, SMALL};
 use crate::fuzz_support::special::{self, grid_obj, Special};
 
@@ -18,19 +16,18 @@ use std::path::{Path, PathBuf};
 use proptest::prelude::*;
 use proptest::sample::Index;
 use voltex::render::{Blueprint, MethodKind, RenderOptions};
-use voltex::Error;
 
-const FLAT: &str = "scenes/view_slices/flat_box.ron";
+pub(super) const FLAT: &str = "scenes/view_slices/flat_box.ron";
 const PLANE: &str = "Plane(size: (2.0, 2.0), cells: (4, 4))";
 
-fn example(rel: &str) -> (PathBuf, String) {
+pub(super) fn example(rel: &str) -> (PathBuf, String) {
     let path = root().join(rel);
     let text = std::fs::read_to_string(&path).unwrap();
     (path, text)
 }
 
 /// `text` with `from` (which must be there) replaced once by `to`.
-fn edit(text: &str, from: &str, to: &str) -> String {
+pub(super) fn edit(text: &str, from: &str, to: &str) -> String {
     assert!(text.contains(from), "{from:?} is not in the example");
     text.replacen(from, to, 1)
 }
@@ -38,7 +35,7 @@ fn edit(text: &str, from: &str, to: &str) -> String {
 /// What `voltex plan` does with scene text claiming to be `path`: parse and check, plan, check
 /// the allocations against the limits every adapter offers. `Ok(None)`: rejected as it should
 /// be (the error property holds); `Err`: a broken property.
-fn planned(path: &Path, text: &str, opts: &RenderOptions) -> Result<Option<Blueprint>, String> {
+pub(super) fn planned(path: &Path, text: &str, opts: &RenderOptions) -> Result<Option<Blueprint>, String> {
     let scene = match voltex::scene::parse(text, path) {
         Ok(s) => s,
         Err(e) => return check_error(&e, path, text, true).map(|()| None),
@@ -90,7 +87,7 @@ impl Tree {
 }
 
 /// `line` (modulo the line count) of `text` with `insert` put before it.
-fn insert_line(text: &str, line: &Index, insert: &str) -> String {
+pub(super) fn insert_line(text: &str, line: &Index, insert: &str) -> String {
     let lines: Vec<&str> = text.split_inclusive('\n').collect();
     let k = line.index(lines.len() + 1);
     let mut before = lines[..k].concat();
@@ -420,406 +417,6 @@ fn counts() {
         match planned(&path, &text, &opts)? {
             Some(_) => accepted(),
             None => Ok(()),
-        }
-    });
-}
-
-// ---------------------------------------------------------------------------------------------
-// Graph values and kernels beyond the device's limits.
-
-/// One edit of the default graph or of one of its kernels (written beside it).
-#[derive(Debug, Clone)]
-pub(super) enum GraphEdit {
-    /// The `n`-th `clear:` value replaced.
-    Clear(Index, &'static str),
-    Format(Index, &'static str),
-    /// The `n`-th `size: Output` replaced.
-    Size(Index, &'static str),
-    /// The `n`-th `depth: (resource: "..."` naming another resource.
-    Depth(Index, Index),
-    /// The `n`-th `targets: [` list's first target repeated.
-    Targets(Index, usize),
-    /// Another resource added to the outputs.
-    Output(Index),
-    /// A kernel's first `@workgroup_size(...)` replaced.
-    Workgroup(Index, [&'static str; 3]),
-    /// A declaration put before line `at` of a kernel.
-    Declare(Index, Index, String),
-    /// A function variable put at the start of the kernel's entry point.
-    Local(Index, String),
-}
-
-const CLEARS: &[&str] = &[
-    "Depth(NaN)",
-    "Depth(inf)",
-    "Depth(-1.0)",
-    "Depth(2.0)",
-    "Depth(0.5)",
-    "Color(NaN, 0.0, 0.0, 1.0)",
-    "Color(inf, 0.0, 0.0, 1.0)",
-    "Color(1e39, 0.0, 0.0, 0.0)",
-    "Color(0.0, 0.0, 0.0, 0.0)",
-];
-const FORMATS: &[&str] = &[
-    "Depth32Float",
-    "Depth24Plus",
-    "Rgba16Float",
-    "Rgba8Unorm",
-    "R32Float",
-    "Rgba32Float",
-    "Bgra8Unorm",
-    "R32Uint",
-];
-const SIZES: &[&str] =
-    &["Fixed(1, 1)", "Fixed(16384, 16384)", "Fixed(16385, 1)", "Fixed(0, 4)", "Fixed(8192, 8192)"];
-const WORKGROUP: &[&str] =
-    &["0", "1", "64", "256", "257", "1024", "65535", "65536", "4294967295", "4294967296", "-1"];
-const LENGTHS: &[&str] = &["1", "4096", "4097", "16384", "100000000", "268435456", "4294967295"];
-
-fn declaration() -> impl Strategy<Value = String> {
-    let n = || prop::sample::select(LENGTHS);
-    prop_oneof![
-        n().prop_map(|n| format!("var<private> fuzz_p: array<vec4<f32>, {n}>;")),
-        n().prop_map(|n| format!("var<workgroup> fuzz_w: array<f32, {n}>;")),
-        (n(), n()).prop_map(|(n, m)| format!("var<private> fuzz_n: array<array<vec4<f32>, {n}>, {m}>;")),
-        n().prop_map(|n| format!("struct FuzzS {{ a: array<f32, {n}>, }}\nvar<private> fuzz_s: FuzzS;")),
-        (n(), n()).prop_map(|(n, m)| format!(
-            "var<workgroup> fuzz_a: array<f32, {n}>;\nvar<workgroup> fuzz_b: array<f32, {m}>;"
-        )),
-    ]
-}
-
-pub(super) fn graph_edit() -> impl Strategy<Value = GraphEdit> {
-    let i = any::<Index>;
-    prop_oneof![
-        (i(), prop::sample::select(CLEARS)).prop_map(|(n, v)| GraphEdit::Clear(n, v)),
-        (i(), prop::sample::select(FORMATS)).prop_map(|(n, v)| GraphEdit::Format(n, v)),
-        (i(), prop::sample::select(SIZES)).prop_map(|(n, v)| GraphEdit::Size(n, v)),
-        (i(), i()).prop_map(|(n, r)| GraphEdit::Depth(n, r)),
-        (i(), prop::sample::select(vec![2usize, 8, 9, 100, 100_000]))
-            .prop_map(|(n, k)| GraphEdit::Targets(n, k)),
-        i().prop_map(GraphEdit::Output),
-        (
-            i(),
-            [
-                prop::sample::select(WORKGROUP),
-                prop::sample::select(WORKGROUP),
-                prop::sample::select(WORKGROUP)
-            ]
-        )
-            .prop_map(|(k, w)| GraphEdit::Workgroup(k, w)),
-        (i(), i(), declaration()).prop_map(|(k, at, d)| GraphEdit::Declare(k, at, d)),
-        (i(), prop::sample::select(LENGTHS))
-            .prop_map(|(k, n)| GraphEdit::Local(k, format!("var fuzz_l: array<vec4<f32>, {n}>;"))),
-    ]
-}
-
-/// Offsets of `needle` in `text`.
-fn find_all(text: &str, needle: &str) -> Vec<usize> {
-    text.match_indices(needle).map(|(i, _)| i).collect()
-}
-
-/// The value starting at `start`: up to the first `,` or closing bracket outside brackets.
-fn value_end(text: &str, start: usize) -> usize {
-    let mut depth = 0i32;
-    for (i, c) in text[start..].char_indices() {
-        match c {
-            '(' | '[' => depth += 1,
-            ')' | ']' if depth == 0 => return start + i,
-            ')' | ']' => depth -= 1,
-            ',' if depth == 0 => return start + i,
-            _ => {}
-        }
-    }
-    text.len()
-}
-
-/// `graph` with the value after the `n`-th `key` replaced by `value`.
-fn replace_value(graph: &str, key: &str, n: &Index, value: &str) -> String {
-    let at = find_all(graph, key);
-    if at.is_empty() {
-        return graph.to_string();
-    }
-    let start = at[n.index(at.len())] + key.len();
-    let end = value_end(graph, start);
-    format!("{}{value}{}", &graph[..start], &graph[end..])
-}
-
-/// The kernels the default graph names, in its order.
-pub(super) fn graph_kernels(graph: &str) -> Vec<String> {
-    let mut k: Vec<String> =
-        graph.split("shader: \"").skip(1).map(|s| s[..s.find('"').unwrap()].to_string()).collect();
-    k.dedup();
-    k
-}
-
-/// Applies `e` to the graph text, or returns the kernel (relative path) and its new text.
-pub(super) fn apply(e: &GraphEdit, graph: &mut String, tree: &Tree) -> Option<(String, String)> {
-    let resources: Vec<String> = graph
-        .split("        \"")
-        .skip(1)
-        .filter_map(|s| s.find("\": Texture").map(|i| s[..i].to_string()))
-        .collect();
-    let kernels = graph_kernels(graph);
-    let kernel = |k: &Index| kernels[k.index(kernels.len())].clone();
-    match e {
-        GraphEdit::Clear(n, v) => *graph = replace_value(graph, "clear: ", n, v),
-        GraphEdit::Format(n, v) => *graph = replace_value(graph, "format: ", n, v),
-        GraphEdit::Size(n, v) => *graph = replace_value(graph, "size: ", n, v),
-        GraphEdit::Depth(n, r) => {
-            let name = format!("\"{}\"", resources[r.index(resources.len())]);
-            *graph = replace_value(graph, "depth: (resource: ", n, &name);
-        }
-        GraphEdit::Targets(n, k) => {
-            let at = find_all(graph, "targets: [");
-            if let Some(&a) = at.get(n.index(at.len().max(1))) {
-                let start = a + "targets: [".len();
-                let end = value_end(graph, start);
-                let first = graph[start..end].to_string();
-                let list = vec![first; *k].join(", ");
-                *graph = format!("{}{list}{}", &graph[..start], &graph[end..]);
-            }
-        }
-        GraphEdit::Output(r) => {
-            let name = &resources[r.index(resources.len())];
-            *graph = graph.replacen("outputs: [", &format!("outputs: [\"{name}\", "), 1);
-        }
-        GraphEdit::Workgroup(k, [x, y, z]) => {
-            let rel = kernel(k);
-            let text = tree.text(&rel);
-            let start = text.find("@workgroup_size(")?;
-            let end = start + text[start..].find(')')? + 1;
-            return Some((rel, format!("{}@workgroup_size({x}, {y}, {z}){}", &text[..start], &text[end..])));
-        }
-        GraphEdit::Declare(k, at, d) => {
-            let rel = kernel(k);
-            return Some((rel.clone(), insert_line(&tree.text(&rel), at, d)));
-        }
-        GraphEdit::Local(k, d) => {
-            let rel = kernel(k);
-            let text = tree.text(&rel);
-            let entry = text.find("\nfn main(").or_else(|| text.find("\nfn vs_main("))?;
-            let body = entry + text[entry..].find("{\n")? + 2;
-            return Some((rel, format!("{}    {d}\n{}", &text[..body], &text[body..])));
-        }
-    }
-    None
-}
-
-/// Scenes that keep different parts of the default graph (and so compile different kernels).
-const GRAPH_SCENES: &[&str] = &[
-    FLAT,
-    "scenes/meyer_neyret/pear_grazing.ron",
-    "scenes/reference/torus_egg.ron",
-    "scenes/hypertextures/fig4_identity.ron",
-];
-
-#[test]
-fn graph_values() {
-    let tree = Tree::new("graph-values");
-    let original = tree.text("frame.ron");
-    let strategy = (prop::sample::select(GRAPH_SCENES), prop::collection::vec(graph_edit(), 1..4));
-    fuzz("graph_values", 300, SMALL, strategy, |(scene, edits)| {
-        let mut graph = original.clone();
-        let mut kernel = None;
-        for e in &edits {
-            if let Some(k) = apply(e, &mut graph, &tree) {
-                kernel = Some(k);
-            }
-        }
-        let (path, text) = example(scene);
-        let graph_path = tree.graph();
-        let run = || {
-            tree.with_file("frame.ron", &graph, || {
-                let scene = voltex::scene::parse(&text, &path).unwrap();
-                let opts = RenderOptions {
-                    graph: Some(graph_path.clone()),
-                    size: Some((16, 16)),
-                    ..Default::default()
-                };
-                Blueprint::new(&scene, &opts)
-                    .and_then(|bp| bp.check_limits(&voltex::gpu::budget::plan_limits(), "the plan's limit"))
-            })
-        };
-        let result = match &kernel {
-            Some((rel, k)) => tree.with_file(rel, k, run),
-            None => run(),
-        };
-        match result {
-            Ok(()) => accepted(),
-            // Everything about the graph or a kernel is positioned in that file.
-            Err(e) => {
-                let (file, text) = match (&e, &kernel) {
-                    (Error::At { loc, .. }, Some((rel, k))) if loc.path == tree.dir.join(rel) => {
-                        (tree.dir.join(rel), k)
-                    }
-                    _ => (graph_path.clone(), &graph),
-                };
-                check_error(&e, &file, text, true)
-            }
-        }
-    });
-}
-
-// ---------------------------------------------------------------------------------------------
-// Lenient parsing.
-
-/// Every example scene and graph with its text.
-fn examples() -> Vec<(PathBuf, String)> {
-    let mut paths = files(&root().join("scenes"), "ron");
-    paths.extend(files(&root().join("graphs"), "ron"));
-    paths.into_iter().map(|p| (p.clone(), std::fs::read_to_string(&p).unwrap())).collect()
-}
-
-fn is_graph(path: &Path) -> bool {
-    path.parent().is_some_and(|d| d.ends_with("graphs"))
-}
-
-/// Parses `text` as the scene or graph `path` is; `Ok(true)`: accepted; `Ok(false)`: a parse
-/// error with its position (checked strictly).
-fn parses(path: &Path, text: &str) -> Result<bool, String> {
-    let result = match is_graph(path) {
-        true => voltex::graph::Graph::parse(path, text.to_string()).map(drop),
-        false => voltex::scene::parse(text, path).map(drop),
-    };
-    match result {
-        Ok(()) => Ok(true),
-        Err(e) => check_error(&e, path, text, true).map(|()| false),
-    }
-}
-
-#[test]
-fn unknown_fields() {
-    let all = examples();
-    let strategy = (any::<Index>(), any::<Index>(), any::<bool>());
-    fuzz("unknown_fields", 400, SMALL, strategy, |(file, at, before_close)| {
-        let (path, text) = &all[file.index(all.len())];
-        let open = ron_items::openings(text);
-        let k = open[at.index(open.len())];
-        // Right after `(`, or as the last field before its `)`: both must be refused.
-        let text = match before_close {
-            false => format!("{}fuzz_unknown: 0, {}", &text[..k], &text[k..]),
-            true => {
-                let end = ron_items::closing(text, k);
-                let inside = text[k..end].trim_end();
-                let sep = if inside.is_empty() || inside.ends_with(',') { "" } else { ", " };
-                format!("{}{sep}fuzz_unknown: 0{}", &text[..end], &text[end..])
-            }
-        };
-        match parses(path, &text)? {
-            true => Err(format!("an unknown field was accepted:\n{text}")),
-            false => Ok(()),
-        }
-    });
-}
-
-#[test]
-fn duplicate_keys() {
-    let all = examples();
-    fuzz("duplicate_keys", 400, SMALL, (any::<Index>(), any::<Index>()), |(file, at)| {
-        let (path, text) = &all[file.index(all.len())];
-        let items = ron_items::items(text);
-        let item = items[at.index(items.len())];
-        let text = ron_items::duplicate(text, item);
-        match parses(path, &text)? {
-            true => Err(format!("a duplicate key was accepted:\n{text}")),
-            false => Ok(()),
-        }
-    });
-}
-
-/// Bytes that are not UTF-8 (alone, or cut short), and where they go.
-const BAD_UTF8: &[&[u8]] =
-    &[b"\xff", b"\x80", b"\xc3\x28", b"\xe2\x82", b"\xed\xa0\x80", b"\xf8\x88\x80\x80\x80", b"\xc0\xaf"];
-
-/// Invalid UTF-8 at a random offset of a scene, graph, kernel, include or OBJ file, read from
-/// disk: the error names the file and the line of the first bad byte.
-#[test]
-fn invalid_utf8() {
-    let tree = Tree::new("utf8");
-    let scenes = files(&root().join("scenes"), "ron");
-    let objs = files(&root().join("scenes"), "obj");
-    let kernels = files(&root().join("wgsl"), "wgsl");
-    let strategy = (0..4u8, any::<Index>(), any::<Index>(), prop::sample::select(BAD_UTF8), any::<bool>());
-    fuzz("invalid_utf8", 300, SMALL, strategy, |(kind, file, at, bad, overwrite)| {
-        let (source, rel) = match kind {
-            0 => (scenes[file.index(scenes.len())].clone(), "scene.ron".to_string()),
-            1 => (root().join("graphs/frame.ron"), "frame.ron".to_string()),
-            2 => {
-                let k = &kernels[file.index(kernels.len())];
-                (k.clone(), k.strip_prefix(root().join("wgsl")).unwrap().display().to_string())
-            }
-            _ => (objs[file.index(objs.len())].clone(), "mesh.obj".to_string()),
-        };
-        let mut bytes = std::fs::read(&source).unwrap();
-        let k = at.index(bytes.len() + 1);
-        let end = if overwrite { (k + bad.len()).min(bytes.len()) } else { k };
-        bytes.splice(k..end, bad.iter().copied());
-        let valid = match std::str::from_utf8(&bytes) {
-            Ok(_) => return Ok(()),
-            Err(e) => e.valid_up_to(),
-        };
-        let line = bytes[..valid].iter().filter(|&&b| b == b'\n').count() + 1;
-        let path = tree.dir.join(&rel);
-        let result = tree.with_file(&rel, &bytes, || match kind {
-            0 => voltex::scene::load(&path).map(drop),
-            1 => voltex::graph::Graph::load(&path).map(drop),
-            2 => {
-                let sources = voltex::gpu::sources::Sources::folder(&tree.dir);
-                voltex::gpu::shader::load_from(&sources, &rel).map(drop)
-            }
-            _ => voltex::mesh::load(&path).map(drop),
-        });
-        match result {
-            Err(Error::At { loc, message }) if loc.path == path && loc.line == line => {
-                match message.contains("UTF-8") {
-                    true => Ok(()),
-                    false => Err(format!("{}: {message}", loc)),
-                }
-            }
-            Err(e) => Err(format!("expected an error at {}:{line}: {e}", path.display())),
-            Ok(()) => Err("invalid UTF-8 was accepted".into()),
-        }
-    });
-}
-
-// ---------------------------------------------------------------------------------------------
-// Late failures: node names that EXR metadata cannot hold.
-
-fn node_name() -> impl Strategy<Value = String> {
-    let char = prop_oneof![
-        4 => prop::char::range('a', 'z'),
-        2 => prop::char::range('\u{a0}', '\u{ff}'),
-        1 => prop::char::range('\u{80}', '\u{9f}'),
-        1 => prop::sample::select(vec!['漢', '🎉', '\u{301}', '\u{0}', '"', '\\', ' ', '\u{ffff}', '\u{100}']),
-    ];
-    prop_oneof![
-        prop::collection::vec(char, 0..300).prop_map(|c| c.into_iter().collect()),
-        (
-            prop::sample::select(vec!['n', 'é', 'ÿ', '漢']),
-            prop::sample::select(vec![1usize, 120, 121, 240, 241, 242, 255, 256])
-        )
-            .prop_map(|(c, n)| std::iter::repeat_n(c, n).collect()),
-    ]
-}
-
-#[test]
-fn node_names() {
-    let dir = special::scratch("names");
-    let (path, flat) = example(FLAT);
-    fuzz("node_names", 300, SMALL, node_name(), |name| {
-        let escaped = name.replace('\\', "\\\\").replace('"', "\\\"");
-        let text = edit(&flat, "name: \"box\"", &format!("name: \"{escaped}\""));
-        let opts = RenderOptions { size: Some((16, 16)), ..Default::default() };
-        if planned(&path, &text, &opts)?.is_none() {
-            return Ok(());
-        }
-        // What `render` writes last: the EXR with the object's name in its metadata.
-        let image = voltex::io::Image::new(1, 1);
-        let key = format!("voltex_object_{name}");
-        match voltex::io::exr::write(&dir.join("x.exr"), &image, &[(&key, "ViewSlices".into())]) {
-            Ok(()) => accepted(),
-            Err(e) => Err(format!("plan accepted the name {name:?}, the EXR cannot hold it: {e}")),
         }
     });
 }
