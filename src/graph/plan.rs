@@ -65,10 +65,10 @@ pub const FRAME_COUNTS: &[&str] = &["width", "height"];
 /// Plans `graph` for `objects` and an output of `size` pixels, its shaders looked up in `sources`
 /// (the graph's folder first when the caller put it there: see [`Sources::beside`]), its filters
 /// and counts checked against `vocabulary`, whose resource names its own resources may not take.
-/// A first output that is a texture is read back as the frame's image: it must be Rgba32Float or
-/// R32Float and of the frame's size (the readback found this only after the GPU work). A buffer
-/// output (a debug or benchmark graph) is left to what reads it.
-fn check_image_output(graph: &Graph, size: (u32, u32)) -> Result<()> {
+/// A first output that is a texture is read back as the frame's image (what a render writes):
+/// it must be Rgba32Float or R32Float and of the frame's size, which the readback found only
+/// after the GPU work. A buffer output (a debug or benchmark graph) is left to what reads it.
+pub fn check_image_output(graph: &Graph, size: (u32, u32)) -> Result<()> {
     let Some(first) = graph.file.outputs.first() else { return Ok(()) };
     let Some(ResourceDecl::Texture { format, size: texture_size, .. }) = graph.file.resources.get(first)
     else {
@@ -201,7 +201,6 @@ pub fn plan(
             ));
         }
     }
-    check_image_output(graph, size)?;
     passes.shrink_to_fit();
     let used: BTreeSet<&String> = passes.iter().flat_map(|p| p.reads.iter().chain(p.writes.iter())).collect();
     let mut textures = BTreeMap::new();

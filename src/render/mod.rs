@@ -134,6 +134,7 @@ impl Blueprint {
         let groups = crate::methods::gather(&mut objects, &bakes, &view);
         let (instances, infos) = instances(&objects, &groups, view.eye);
         let plan = plan::plan(&graph, &sources, &infos, size, &vocabulary())?;
+        plan::check_image_output(&graph, size)?;
         check_bindings(&graph, &plan)?;
         let texel_resources: Vec<&str> = REGISTRY.iter().flat_map(|c| c.texel_resources).copied().collect();
         let samples_texels =
