@@ -471,8 +471,9 @@ mod fuzz_regressions {
 
     /// preview_reload, seed 19: a texture of another format than Rgba32Float or R32Float put
     /// first in the graph's `outputs` (there `depth`): the rebuild succeeded, then every frame
-    /// failed to be read back (and `render` failed after the GPU work). Now a plan error at the
-    /// output; a fixed size other than the frame's too.
+    /// failed to be read back (and `render` failed after the GPU work). render_tiny, seed 19:
+    /// the output made `Fixed(1, 1)`, and the readback's copy overran it (a wgpu error without a
+    /// position). Now both are plan errors at the output.
     #[test]
     fn an_output_that_cannot_be_read_back_is_a_plan_error() {
         let dir = std::env::temp_dir().join(format!("voltex-fuzz-output-{}", std::process::id()));
@@ -505,6 +506,49 @@ mod fuzz_regressions {
             assert!(e.starts_with(&format!("{}:6:", graph.display())), "{e}");
             assert!(e.contains(words), "{e}");
         }
+    }
+
+    /// counts, seed 19: a texel of 577x64x1024 voxels drawn with `--method reference`: the
+    /// Reference atlas needs 160 MiB in one storage buffer, over the 128 MiB binding limit, and
+    /// plan said so as a GPU error without a position. Now at the node.
+    #[test]
+    fn reference_atlas_over_the_binding_limit_is_at_the_node() {
+        let path = root().join("scenes/view_slices/flat_box.ron");
+        let text = std::fs::read_to_string(&path).unwrap();
+        let text = text.replacen("resolution: (8, 8, 8)", "resolution: (577, 64, 1024)", 1);
+        let scene = voltex::scene::parse(&text, &path).unwrap();
+        let opts =
+            RenderOptions { method: Some(voltex::render::MethodKind::Reference), ..Default::default() };
+        let limits = voltex::gpu::budget::plan_limits();
+        let e = Blueprint::new(&scene, &opts)
+            .and_then(|bp| bp.check_limits(&limits, "x"))
+            .err()
+            .expect("an error");
+        let line = text[..text.find("name: \"box\"").unwrap()].matches('\n').count() + 1;
+        let e = e.to_string();
+        assert!(e.starts_with(&format!("{}:{line}:", path.display())), "{e}");
+        assert!(e.contains("texel volumes need"), "{e}");
+    }
+
+    /// preview_reload, seed 19: a kernel with `#include`s cut short. naga's error at the end of
+    /// the input was placed at the expanded text's line number, past the kernel's last line. Now
+    /// at the end of the kernel's last line.
+    #[test]
+    fn an_error_at_the_end_of_a_kernel_is_on_its_last_line() {
+        let dir = std::env::temp_dir().join(format!("voltex-fuzz-eof-{}", std::process::id()));
+        std::fs::create_dir_all(dir.join("shared")).unwrap();
+        std::fs::write(dir.join("shared/a.wgsl"), "fn a() -> u32 {\n    return 1u;\n}\n\n").unwrap();
+        std::fs::write(
+            dir.join("k.wgsl"),
+            "// k\n#include \"shared/a.wgsl\"\nfn c() -> u32 {\n    return a()",
+        )
+        .unwrap();
+        let sources = voltex::gpu::sources::Sources::folder(&dir);
+        let Err(e) = voltex::gpu::shader::load_from(&sources, "k.wgsl") else {
+            panic!("a cut kernel compiled")
+        };
+        let e = e.to_string();
+        assert!(e.starts_with(&format!("{}:4:15: WGSL parse error", dir.join("k.wgsl").display())), "{e}");
     }
 
     /// render_tiny, seed 19: the graph texture `hdr` made `Fixed(1, 1)` beside the output-sized
