@@ -116,6 +116,31 @@ pub struct BakeRequest {
     pub axis_slices: bool,
 }
 
+impl BakeRequest {
+    /// The kernels the bake runs (under `wgsl/`), so that `plan` can check them before any GPU
+    /// work: the same files [`Baker::bake`] loads.
+    pub fn kernels(&self) -> Vec<&'static str> {
+        let mut k = match &self.source {
+            BakeSource::Implicit(_) => vec!["bake/bake_implicit.wgsl"],
+            BakeSource::Heightfield(_) => vec!["bake/bake_heightfield.wgsl"],
+            BakeSource::HeightImage(..) => vec!["bake/bake_height_image.wgsl"],
+            BakeSource::Stack(_) => vec![],
+            BakeSource::Mesh(_) => vec!["bake/bake_mesh_grid.wgsl", "bake/bake_mesh_texel.wgsl"],
+            BakeSource::Hypertexture(h) => {
+                let mut k = vec!["ray_march/bake_transfer.wgsl", "bake/bake_hypertexture.wgsl"];
+                if h.packed.mesh.is_some() {
+                    k.push("bake/bake_mesh_grid.wgsl");
+                }
+                k
+            }
+        };
+        if self.axis_slices {
+            k.push("axis_slices/bake_axis_slices.wgsl");
+        }
+        k
+    }
+}
+
 #[derive(Clone)]
 pub struct Baked {
     pub volume: wgpu::Texture,

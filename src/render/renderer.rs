@@ -155,8 +155,12 @@ impl Renderer {
     /// Reads a graph texture back as a linear image: Rgba32Float as it is, R32Float as grey with
     /// alpha 1.
     pub fn read_texture(&self, ctx: &GpuContext, name: &str) -> Result<Image> {
-        let texture =
-            self.exec.texture(name).ok_or_else(|| Error::Invalid(format!("output `{name}` was pruned")))?;
+        let texture = self.exec.texture(name).ok_or_else(|| {
+            let msg = format!(
+                "output `{name}` is not a graph texture of this frame: it cannot be read back as an image"
+            );
+            self.blueprint.graph.error_at_output(name, msg)
+        })?;
         let grey = texture.format() == wgpu::TextureFormat::R32Float;
         if texture.format() != wgpu::TextureFormat::Rgba32Float && !grey {
             return Err(self

@@ -63,6 +63,12 @@ impl MethodPlan for RayMarchPlan {
         Ok(Some(Box::new(prepared)))
     }
 
+    fn kernels(&self) -> Vec<&'static str> {
+        let grid = self.mesh_grid_key().map(|_| "bake/bake_mesh_grid.wgsl");
+        let splats = self.splat_key().map(|_| "ray_march/bake_splats.wgsl");
+        grid.into_iter().chain(splats).collect()
+    }
+
     fn add_inputs(&self, cx: &InputCx, _object: &ObjectPlan, _part: usize, inputs: &mut Inputs) {
         let prepared = cx.prepared.and_then(|p| p.downcast_ref::<Prepared>());
         let (grid, splats) = prepared.map_or((None, None), |(g, s)| (g.as_ref(), s.as_ref()));
