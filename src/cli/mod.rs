@@ -103,6 +103,18 @@ pub struct Overrides {
     /// refused before any work.
     #[arg(long, value_parser = voltex::gpu::budget::parse_budget)]
     budget: Option<u64>,
+    /// Shadows of every RayMarch object: `none` (Phong), `rays` (a shadow ray per shaded sample)
+    /// or `volume:N` (a light volume of resolution N) (default: the scene's).
+    #[arg(long, value_parser = parse_shadows)]
+    shadows: Option<ShadowsArg>,
+}
+
+/// A `--shadows` value (`None`: Phong without shadows).
+#[derive(Clone, Copy, Debug)]
+pub struct ShadowsArg(pub Option<voltex::scene::Shadows>);
+
+pub fn parse_shadows(s: &str) -> std::result::Result<ShadowsArg, String> {
+    voltex::methods::options::parse_shadows(s).map(ShadowsArg)
 }
 
 #[derive(clap::ValueEnum, Clone, Copy)]
@@ -156,6 +168,7 @@ impl Overrides {
             time: self.time,
             axis_criteria: self.criteria,
             budget: self.budget,
+            shadows: self.shadows.map(|s| s.0),
             ..Default::default()
         })
     }
