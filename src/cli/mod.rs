@@ -3,6 +3,7 @@
 
 pub mod bake;
 pub mod bench;
+pub mod bench_report;
 pub mod compare;
 pub mod farm;
 pub mod import;
@@ -63,6 +64,9 @@ pub enum Command {
     /// Benchmark hypertexture ray marching (the 2009 paper's Figure 11 set-up): frame times and
     /// the share of noise evaluation.
     BenchHyper(bench::BenchHyperArgs),
+    /// The performance page's tables from `bench --json` and `bench-hyper --json` files: print
+    /// them as Markdown, or write them into a page between its bench-report markers.
+    BenchReport(bench_report::BenchReportArgs),
     /// Speed against error: sweep each method's quality knobs, time every setting with GPU
     /// timestamps, measure its error against a truth image, write pareto.csv and pareto.svg.
     Pareto(pareto::ParetoCmd),

@@ -4,6 +4,7 @@
 mod budget;
 mod describe;
 mod renderer;
+pub mod trace;
 
 pub use budget::Positions;
 
