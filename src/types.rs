@@ -455,6 +455,28 @@ pub struct SegmentParams {
     pub splatting: [u32; 4],
 }
 
+/// The light volume of a RayMarch object (`bake_light_volume.wgsl`; read by `shade` in
+/// wgsl/shared/march.wgsl): transmittance towards a directional light at the vertices of a grid
+/// laid in the light's frame over the object's bounds, vertex `(i, j, k)` at `origin + i u + j v
+/// + k w`, `k = 0` on the light's side and `w` pointing away from the light. Twin:
+/// `LightVolumeParams` in wgsl/shared/types.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct LightVolumeParams {
+    /// xyz: vertex (0, 0, 0) (object space); w: world length of one sub-step along the light.
+    pub origin: [f32; 4],
+    /// xyz: object-space step between vertices along i; w: the opacity length (world).
+    pub u: [f32; 4],
+    /// xyz: step along j; w: world length of one step along k (a layer).
+    pub v: [f32; 4],
+    /// xyz: step along k (away from the light); w: unused.
+    pub w: [f32; 4],
+    /// Object space to grid coordinates in vertex units (affine, column-major).
+    pub to_grid: [[f32; 4]; 4],
+    /// xyz: vertices along i, j, k; w: sub-steps per layer.
+    pub counts: [u32; 4],
+}
+
 /// A splat of a hypertexture object's splat set (object space): a surface splat is a disk with
 /// an outward normal, an interior splat a sphere (normal zero).
 #[repr(C)]

@@ -37,10 +37,14 @@ pub struct PreviewArgs {
     pub quit_after: Option<f64>,
     /// The view to start in.
     pub mode: Mode,
+    /// Keep the per-pass GPU times of the last frames rendered in this Chrome/Perfetto trace.
+    pub trace: Option<PathBuf>,
 }
 
 /// Said when a key or the panel would edit a scene that has no file of its own.
 const NO_FILE: &str = "a mesh opened directly has no scene file to edit: `voltex import` writes one";
+/// Frames a preview trace keeps (the latest).
+const TRACE_FRAMES: usize = 100;
 
 pub fn run(args: PreviewArgs) -> Result<()> {
     let event_loop = EventLoop::new().map_err(|e| Error::Invalid(format!("cannot open a window: {e}")))?;
@@ -93,6 +97,8 @@ struct State {
     modifiers: ModifiersState,
     recorded: usize,
     started: Instant,
+    /// `--trace`: the passes of the frames rendered so far (the last `TRACE_FRAMES`).
+    trace: crate::render::trace::Track,
 }
 
 impl ApplicationHandler for App {
@@ -303,6 +309,7 @@ impl State {
             modifiers: ModifiersState::empty(),
             recorded: 0,
             started: Instant::now(),
+            trace: crate::render::trace::Track { name: "preview".into(), frames: Vec::new() },
         })
     }
 
@@ -346,7 +353,19 @@ impl State {
         if self.dirty {
             self.dirty = false;
             if let Some(frame) = self.session.render(&self.ctx) {
-                self.gpu_ms = frame?.gpu_ms();
+                let frame = frame?;
+                self.gpu_ms = frame.gpu_ms();
+                if let Some(path) = &args.trace {
+                    // Written after every frame, so the file holds the latest whatever ends the preview.
+                    self.trace.frames.push(frame.spans);
+                    let excess = self.trace.frames.len().saturating_sub(TRACE_FRAMES);
+                    self.trace.frames.drain(..excess);
+                    crate::render::trace::write(
+                        path,
+                        std::slice::from_ref(&self.trace),
+                        &self.ctx.adapter_line(),
+                    )?;
+                }
             }
             if self.mode != Mode::Image && self.reference.is_none() {
                 let mut options = self.session.options.clone();

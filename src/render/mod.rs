@@ -5,6 +5,7 @@ mod budget;
 mod describe;
 pub mod export;
 mod renderer;
+pub mod trace;
 
 pub use budget::Positions;
 

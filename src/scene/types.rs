@@ -628,6 +628,34 @@ pub struct RayMarch {
     /// the fine `step` where there is matter (default: off, every step sampled).
     #[serde(default)]
     pub adaptive: Option<Adaptive>,
+    /// How `PhongShadows` finds the light reaching a sample: exact shadow rays (the default) or
+    /// a transmittance grid marched once per light.
+    #[serde(default)]
+    pub shadows: Shadows,
+}
+
+/// Shadows of `RayMarch(shading: PhongShadows)`.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum Shadows {
+    /// A shadow ray from every shaded sample to the bounds' exit, step `shadow_step`: exact.
+    #[default]
+    Rays,
+    /// A light volume: transmittance towards the light on a grid over the object's bounds
+    /// (`resolution` samples along its longest axis, in the light's frame), marched once per
+    /// light and density by `bake_light_volume.wgsl` and read trilinearly by the shading.
+    LightVolume {
+        #[serde(default = "default_light_resolution", deserialize_with = "v::light_resolution")]
+        resolution: u32,
+    },
+}
+
+/// `LightVolume`'s default and largest resolution (samples along the longest axis).
+pub const DEFAULT_LIGHT_RESOLUTION: u32 = 64;
+pub const MAX_LIGHT_RESOLUTION: u32 = 256;
+
+fn default_light_resolution() -> u32 {
+    DEFAULT_LIGHT_RESOLUTION
 }
 
 /// `RayMarch(adaptive: (max_step: ..))`: on the lattice of `step`, strides of 1, 2, 4, ... steps

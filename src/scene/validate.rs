@@ -3,7 +3,8 @@
 
 use super::image::HeightImage;
 use super::types::{
-    DrawOrder, HeightScale, MeshBounds, Method, Node, Scene, SliceBlend, Surface, Texel, TexelSource,
+    DrawOrder, HeightScale, MeshBounds, Method, Node, Scene, Shading, Shadows, SliceBlend, Surface, Texel,
+    TexelSource,
 };
 use super::values::Mark;
 use crate::error::Error;
@@ -538,6 +539,14 @@ impl Checker<'_> {
                     "RayMarch(adaptive: (max_step: {})) is below the step {}: expected a max_step of at least the step",
                     a.max_step,
                     rm.step()
+                );
+                self.fail(ray_march.unwrap(), msg);
+            }
+            if rm.shadows != Shadows::Rays && rm.shading != Shading::PhongShadows {
+                let msg = format!(
+                    "RayMarch(shadows: LightVolume(..)) with shading: {:?}: expected shading: PhongShadows (the \
+                     light volume replaces its shadow rays)",
+                    rm.shading
                 );
                 self.fail(ray_march.unwrap(), msg);
             }

@@ -266,7 +266,7 @@ fn scene_registry() -> Registry {
     use voltex::scene::hypertexture as h;
     use voltex::scene::*;
     trace!(Scene; Light, TexelSource, Shape, Surface, HeightScale, Method, Lighting, Quality, Shading,
-        Segments, SliceDirections, SliceBlend, DrawOrder, h::SoftObject, h::Field, h::Operator,
+        Segments, Shadows, SliceDirections, SliceBlend, DrawOrder, h::SoftObject, h::Field, h::Operator,
         h::ShapeTransfer, h::ColorTransfer)
 }
 

@@ -90,6 +90,16 @@ const NO_TWIN: &[(&str, &str)] = &[
         "debug view: counts the slice polygons covering each pixel (additive white), no math",
     ),
     (
+        "bench_blend",
+        "benchmark only (`voltex bench --limits` times it): full-screen layers blended with one \
+         3D texture fetch each, a fill rate; its output is never read",
+    ),
+    (
+        "bench_texture",
+        "benchmark only (`voltex bench --limits` times it): sums trilinear 3D texture samples, a \
+         sample rate; its output is never read",
+    ),
+    (
         "present",
         "preview window only: shows an image already computed (filmic tonemap, sRGB, difference \
          heat map, overlay text); no headless output goes through it",

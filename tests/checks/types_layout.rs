@@ -49,6 +49,7 @@ fn wgsl_structs_match_rust() {
         layout!(VolumeParams; to_index, right, up, box_lo, box_hi, medium, origin, table, atlas, budget),
         layout!(SegmentParams; from_local, lattice_min, lattice, surface, counts, splatting),
         layout!(Splat; center, normal),
+        layout!(LightVolumeParams; origin, u, v, w, to_grid, counts),
     ];
     let mut seen = 0;
     for (_, ty) in kernel.module.types.iter() {

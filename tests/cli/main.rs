@@ -4,6 +4,7 @@
 mod common;
 
 mod assets;
+mod bench_json;
 mod cli_errors;
 mod export;
 mod farm;

@@ -19,6 +19,7 @@ mod hypertexture_mesh;
 mod hypertexture_segments;
 mod hypertexture_splatting;
 mod hypertexture_texel;
+mod light_volume;
 mod mesh_texel;
 mod pareto;
 mod reference;

@@ -242,6 +242,16 @@ struct SegmentParams {
     splatting: vec4<u32>,
 }
 
+// The light volume of a RayMarch object (twin: LightVolumeParams in src/types.rs).
+struct LightVolumeParams {
+    origin: vec4<f32>,
+    u: vec4<f32>,
+    v: vec4<f32>,
+    w: vec4<f32>,
+    to_grid: mat4x4<f32>,
+    counts: vec4<u32>,
+}
+
 struct Splat {
     center: vec4<f32>,
     normal: vec4<f32>,
