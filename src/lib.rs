@@ -20,10 +20,12 @@ pub mod methods;
 pub mod metrics;
 pub mod pareto;
 pub mod preview;
+pub mod progress;
 pub mod regress;
 pub mod render;
 pub mod scene;
 pub mod types;
+pub mod vdb;
 
 pub use error::{Error, FileLoc, Result};
 

@@ -1,5 +1,5 @@
-//! The `voltex` command line: render, bake, compare, plan, import, preview, regress, farm, info,
-//! bench, bench-hyper, pareto. Each subcommand lives in `src/cli/<name>.rs`; this file parses and
+//! The `voltex` command line: render, bake, export, compare, plan, import, preview, regress, farm, info,
+//! bench, bench-hyper, bench-report, pareto. Each subcommand lives in `src/cli/<name>.rs`; this file parses and
 //! dispatches.
 
 mod cli;
@@ -16,6 +16,7 @@ fn main() -> ExitCode {
     let result = match Cli::parse().command {
         Command::Render(args) => cli::render::run(args),
         Command::Bake(args) => cli::bake::run(args),
+        Command::Export(args) => cli::export::run(args),
         Command::Compare(args) => cli::compare::run(args),
         Command::Plan(args) => cli::plan::run(args),
         Command::Import(args) => cli::import::run(args),
@@ -42,6 +43,7 @@ fn main() -> ExitCode {
         Command::Info => cli::info::run(),
         Command::Bench(args) => cli::bench::run(args),
         Command::BenchHyper(args) => cli::bench::run_hyper(args),
+        Command::BenchReport(args) => cli::bench_report::run(args),
         Command::Pareto(args) => cli::pareto::run(args),
     };
     match result {

@@ -4,6 +4,7 @@
 
 pub mod axis_slices;
 pub mod hypertexture;
+pub mod volume;
 
 use crate::gpu::sources::Sources;
 
@@ -24,12 +25,14 @@ pub enum BakeSource {
     Implicit(PackedShapes),
     Heightfield(HeightfieldParams),
     HeightImage(HeightImageParams, Heights),
-    /// A slice stack's texels (rgba8, premultiplied, baked shading), uploaded as they are.
+    /// A slice stack's texels (16-bit premultiplied RGBA), uploaded at the volume's precision.
     Stack(StackTexels),
     /// A pattern mesh sampled at the voxel centres (`bake_mesh_grid.wgsl`), then coloured.
     Mesh(MeshTexel),
     /// A hypertexture sampled at the voxel centres of a box of its object space.
     Hypertexture(Box<hypertexture::HyperTexel>),
+    /// A volume (an OpenVDB grid) sampled at the voxel centres of a box of its world space.
+    Volume(Box<volume::VolumeTexel>),
 }
 
 /// A mesh texel's pattern, where its voxel centres lie, and its colouring; shown in `Debug` (the
@@ -87,9 +90,9 @@ impl std::fmt::Debug for Heights {
     }
 }
 
-/// Bytes shown in `Debug` by a digest, like [`Heights`].
+/// A slice stack's 16-bit premultiplied RGBA, shown in `Debug` by a digest, like [`Heights`].
 #[derive(Clone)]
-pub struct StackTexels(pub std::sync::Arc<Vec<u8>>);
+pub struct StackTexels(pub std::sync::Arc<Vec<u16>>);
 
 impl std::fmt::Debug for StackTexels {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
@@ -111,6 +114,31 @@ pub struct BakeRequest {
     pub ambient: f32,
     /// Also bake the slice images of axis-aligned slicing.
     pub axis_slices: bool,
+}
+
+impl BakeRequest {
+    /// The kernels the bake runs (under `wgsl/`), so that `plan` can check them before any GPU
+    /// work: the same files [`Baker::bake`] loads.
+    pub fn kernels(&self) -> Vec<&'static str> {
+        let mut k = match &self.source {
+            BakeSource::Implicit(_) => vec!["bake/bake_implicit.wgsl"],
+            BakeSource::Heightfield(_) => vec!["bake/bake_heightfield.wgsl"],
+            BakeSource::HeightImage(..) => vec!["bake/bake_height_image.wgsl"],
+            BakeSource::Stack(_) => vec![],
+            BakeSource::Mesh(_) => vec!["bake/bake_mesh_grid.wgsl", "bake/bake_mesh_texel.wgsl"],
+            BakeSource::Hypertexture(h) => {
+                let mut k = vec!["ray_march/bake_transfer.wgsl", "bake/bake_hypertexture.wgsl"];
+                if h.packed.mesh.is_some() {
+                    k.push("bake/bake_mesh_grid.wgsl");
+                }
+                k
+            }
+        };
+        if self.axis_slices {
+            k.push("axis_slices/bake_axis_slices.wgsl");
+        }
+        k
+    }
 }
 
 #[derive(Clone)]
@@ -155,6 +183,16 @@ impl BakeRequest {
         if self.per_pixel {
             out.push(volume(format!("texel \"{texel}\"'s normal volume"), res));
         }
+        if let BakeSource::Volume(v) = &self.source {
+            let size = volume::atlas_size(volume::slots(&v.grid));
+            let texels = size.iter().map(|&s| s as u64).product::<u64>();
+            out.push(Allocation {
+                what: format!("texel \"{texel}\"'s volume atlas ({} bricks)", v.grid.bricks()),
+                bytes: texels * if v.grid.color.is_some() { 12 } else { 4 },
+                shape: Shape::Texture3d { size },
+                driver: driver.clone(),
+            });
+        }
         if let BakeSource::Mesh(_) = self.source {
             out.push(Allocation {
                 what: format!("texel \"{texel}\"'s mesh grid"),
@@ -191,6 +229,7 @@ impl BakeRequest {
                 "bake_transfer.wgsl + bake_mesh_grid.wgsl + bake_hypertexture.wgsl"
             }
             BakeSource::Hypertexture(_) => "bake_transfer.wgsl + bake_hypertexture.wgsl",
+            BakeSource::Volume(_) => "bake/bake_volume.wgsl",
         };
         let lighting = if self.per_pixel { "per-pixel (albedo + normals)" } else { "baked" };
         let mut s = format!("  {texel:<16} {x}x{y}x{z}  {kind}  lighting {lighting}\n");
@@ -216,7 +255,10 @@ pub struct Baker {
     hyper: Option<ComputeKernel>,
     transfer: Option<ComputeKernel>,
     axis: Option<ComputeKernel>,
+    volume: Option<ComputeKernel>,
     sources: Sources,
+    /// `Rgba32Float` for [`Baker::full_precision`], else `Rgba8Unorm`.
+    format: wgpu::TextureFormat,
 }
 
 impl Baker {
@@ -230,8 +272,22 @@ impl Baker {
             hyper: None,
             transfer: None,
             axis: None,
+            volume: None,
             sources: sources.clone(),
+            format: wgpu::TextureFormat::Rgba8Unorm,
         }
+    }
+
+    /// A baker whose volumes hold f32 RGBA: the same kernels, their `volume` declared
+    /// `rgba32float` instead of `rgba8unorm`, so nothing is quantised (`voltex export`). The
+    /// normal volume stays `rgba8snorm`.
+    pub fn full_precision(sources: &Sources) -> Self {
+        Self { format: wgpu::TextureFormat::Rgba32Float, ..Self::new(sources) }
+    }
+
+    /// The format of the texel volumes this baker makes.
+    pub fn format(&self) -> wgpu::TextureFormat {
+        self.format
     }
 
     fn kernel<'a>(
@@ -239,9 +295,18 @@ impl Baker {
         ctx: &GpuContext,
         sources: &Sources,
         name: &str,
+        format: wgpu::TextureFormat,
     ) -> Result<&'a mut ComputeKernel> {
         if slot.is_none() {
-            *slot = Some(ComputeKernel::load(ctx, sources, name)?);
+            let mut kernel = crate::gpu::shader::load_from(sources, name)?;
+            let writes_volume = crate::gpu::reflect::bindings(&kernel, &["main"])?.iter().any(|b| {
+                b.name == "volume"
+                    && matches!(b.kind, crate::gpu::reflect::BindingKind::StorageTexture { .. })
+            });
+            if format == wgpu::TextureFormat::Rgba32Float && writes_volume {
+                kernel = kernel.with_storage_format("volume", naga::StorageFormat::Rgba32Float)?;
+            }
+            *slot = Some(ComputeKernel::new(ctx, kernel)?);
         }
         Ok(slot.as_mut().unwrap())
     }
@@ -254,7 +319,7 @@ impl Baker {
                 req.resolution
             )));
         }
-        let volume = volume_texture(ctx, "texel volume", req.resolution, wgpu::TextureFormat::Rgba8Unorm);
+        let volume = volume_texture(ctx, "texel volume", req.resolution, self.format);
         let normals_res = if req.per_pixel { req.resolution } else { [1, 1, 1] };
         let normals = volume_texture(ctx, "texel normals", normals_res, wgpu::TextureFormat::Rgba8Snorm);
         let params = crate::cpu::bake::bake_params(req.resolution, 0, req.light, req.ambient);
@@ -284,12 +349,8 @@ impl Baker {
                 inputs
                     .buffers
                     .insert("balls".into(), storage(ctx, "balls", bytemuck::cast_slice(&packed.balls)));
-                Self::kernel(&mut self.implicit, ctx, &root, "bake/bake_implicit.wgsl")?.dispatch(
-                    ctx,
-                    &mut encoder,
-                    &inputs,
-                    req.resolution,
-                )?;
+                Self::kernel(&mut self.implicit, ctx, &root, "bake/bake_implicit.wgsl", self.format)?
+                    .dispatch(ctx, &mut encoder, &inputs, req.resolution)?;
             }
             BakeSource::Heightfield(hf) => {
                 inputs
@@ -298,12 +359,8 @@ impl Baker {
                 inputs
                     .buffers
                     .insert("heightfield".into(), uniform(ctx, "heightfield", bytemuck::bytes_of(hf)));
-                Self::kernel(&mut self.heightfield, ctx, &root, "bake/bake_heightfield.wgsl")?.dispatch(
-                    ctx,
-                    &mut encoder,
-                    &inputs,
-                    req.resolution,
-                )?;
+                Self::kernel(&mut self.heightfield, ctx, &root, "bake/bake_heightfield.wgsl", self.format)?
+                    .dispatch(ctx, &mut encoder, &inputs, req.resolution)?;
             }
             BakeSource::HeightImage(hi, heights) => {
                 inputs
@@ -316,28 +373,36 @@ impl Baker {
                     "heights".into(),
                     storage(ctx, "heights", bytemuck::cast_slice(heights.0.as_slice())),
                 );
-                Self::kernel(&mut self.height_image, ctx, &root, "bake/bake_height_image.wgsl")?.dispatch(
-                    ctx,
-                    &mut encoder,
-                    &inputs,
-                    req.resolution,
-                )?;
+                Self::kernel(&mut self.height_image, ctx, &root, "bake/bake_height_image.wgsl", self.format)?
+                    .dispatch(ctx, &mut encoder, &inputs, req.resolution)?;
             }
             BakeSource::Stack(texels) => {
                 let [w, h, d] = req.resolution;
                 if texels.0.len() != (w * h * d * 4) as usize || req.per_pixel {
                     return Err(Error::Invalid(format!(
-                        "a {w}x{h}x{d} slice stack with baked shading was expected (got {} bytes{})",
+                        "a {w}x{h}x{d} slice stack with baked shading was expected (got {} values{})",
                         texels.0.len(),
                         if req.per_pixel { ", per-pixel lighting" } else { "" }
                     )));
                 }
+                // Stacks are read at 16 bits: rounded to the volume's 8 bits, or as floats.
+                let (floats, bytes): (Vec<f32>, Vec<u8>);
+                let (data, texel_bytes) = match self.format {
+                    wgpu::TextureFormat::Rgba32Float => {
+                        floats = texels.0.iter().map(|&v| v as f32 / 65535.0).collect();
+                        (bytemuck::cast_slice(&floats), 16)
+                    }
+                    _ => {
+                        bytes = texels.0.iter().map(|&v| ((v as u32 * 255 + 32767) / 65535) as u8).collect();
+                        (bytes.as_slice(), 4)
+                    }
+                };
                 ctx.queue.write_texture(
                     volume.as_image_copy(),
-                    &texels.0,
+                    data,
                     wgpu::TexelCopyBufferLayout {
                         offset: 0,
-                        bytes_per_row: Some(w * 4),
+                        bytes_per_row: Some(w * texel_bytes),
                         rows_per_image: Some(h),
                     },
                     wgpu::Extent3d { width: w, height: h, depth_or_array_layers: d },
@@ -361,22 +426,30 @@ impl Baker {
                 let colors = grid.colors.unwrap_or_else(|| storage(ctx, "mesh_colors", &[0u8; 16]));
                 inputs.buffers.insert("mesh_colors".into(), colors);
                 inputs.constants.push(("colored".into(), m.shape.colors.is_some() as u32 as f64));
-                Self::kernel(&mut self.mesh, ctx, &root, "bake/bake_mesh_texel.wgsl")?.dispatch(
-                    ctx,
-                    &mut encoder,
-                    &inputs,
-                    req.resolution,
-                )?;
+                Self::kernel(&mut self.mesh, ctx, &root, "bake/bake_mesh_texel.wgsl", self.format)?
+                    .dispatch(ctx, &mut encoder, &inputs, req.resolution)?;
             }
             BakeSource::Hypertexture(ht) => {
-                let transfer = Self::kernel(&mut self.transfer, ctx, &root, "ray_march/bake_transfer.wgsl")?;
-                let hyper = Self::kernel(&mut self.hyper, ctx, &root, "bake/bake_hypertexture.wgsl")?;
+                let format = self.format;
+                let transfer =
+                    Self::kernel(&mut self.transfer, ctx, &root, "ray_march/bake_transfer.wgsl", format)?;
+                let hyper = Self::kernel(&mut self.hyper, ctx, &root, "bake/bake_hypertexture.wgsl", format)?;
                 ht.bake(ctx, (transfer, hyper), &mut encoder, &mut inputs, params)?;
+            }
+            BakeSource::Volume(v) => {
+                let kernel = Self::kernel(&mut self.volume, ctx, &root, "bake/bake_volume.wgsl")?;
+                v.bake(ctx, kernel, &mut encoder, &mut inputs, params)?;
             }
         }
         let axis = match req.axis_slices {
             true => {
-                let kernel = Self::kernel(&mut self.axis, ctx, &root, "axis_slices/bake_axis_slices.wgsl")?;
+                let kernel = Self::kernel(
+                    &mut self.axis,
+                    ctx,
+                    &root,
+                    "axis_slices/bake_axis_slices.wgsl",
+                    self.format,
+                )?;
                 Some(axis_slices::bake(ctx, kernel, &mut encoder, &volume, req.resolution)?)
             }
             false => None,

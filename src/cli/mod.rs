@@ -3,7 +3,9 @@
 
 pub mod bake;
 pub mod bench;
+pub mod bench_report;
 pub mod compare;
+pub mod export;
 pub mod farm;
 pub mod import;
 pub mod info;
@@ -38,15 +40,21 @@ pub enum Command {
     /// Render a scene headless to EXR (linear, with metadata) and a tonemapped PNG.
     Render(render::RenderArgs),
     /// Bake texels on the GPU and write each as a slice stack: OUT/<texel>/slice_000.png onwards
-    /// (RGBA, premultiplied, the scene's first light baked in), readable as `Slices(dir: ..)`.
+    /// (16-bit RGBA, premultiplied, the scene's first light baked in; or 8-bit, float EXR,
+    /// unlit) and manifest.json, readable as `Slices(dir: ..)`.
     Bake(bake::BakeArgs),
+    /// Write every texel and every node's hypertexture as an OpenVDB file, OUT/<name>.vdb: a
+    /// `density` grid (extinction per world unit) and a `Cd` colour grid, placed in the world,
+    /// baked on the GPU at full precision (for Blender, Houdini, Mitsuba).
+    Export(export::ExportArgs),
     /// Compare two EXR images: FLIP, relative RMSE, largest difference and non-finite pixels;
     /// optionally write a FLIP heat map (no GPU needed).
     Compare(compare::CompareArgs),
     /// Print the bakes, passes, pipelines and GPU memory a scene will use (no GPU needed).
     Plan(plan::PlanArgs),
-    /// Write the scene that `render` and `preview` open for a mesh asset (.glb, .gltf, .obj):
-    /// the mesh as a base surface under a default texel, framed by a camera, editable.
+    /// Write the scene that `render` and `preview` open for an asset: a mesh (.glb, .gltf, .obj)
+    /// as a base surface under a default texel, or an OpenVDB file (.vdb) as a volume object;
+    /// framed by a camera, editable.
     Import(import::ImportArgs),
     /// Open a window showing the scene, redrawn whenever the scene, its files, a graph or a kernel
     /// changes (keys and mouse: see the overlay and the README).
@@ -63,6 +71,9 @@ pub enum Command {
     /// Benchmark hypertexture ray marching (the 2009 paper's Figure 11 set-up): frame times and
     /// the share of noise evaluation.
     BenchHyper(bench::BenchHyperArgs),
+    /// The performance page's tables from `bench --json` and `bench-hyper --json` files: print
+    /// them as Markdown, or write them into a page between its bench-report markers.
+    BenchReport(bench_report::BenchReportArgs),
     /// Speed against error: sweep each method's quality knobs, time every setting with GPU
     /// timestamps, measure its error against a truth image, write pareto.csv and pareto.svg.
     Pareto(pareto::ParetoCmd),
@@ -107,6 +118,18 @@ pub struct Overrides {
     /// e.g. `depth,coverage,transmittance` (replaces the scene's `aovs`).
     #[arg(long, value_delimiter = ',')]
     aov: Option<Vec<String>>,
+    /// Shadows of every RayMarch object: `none` (Phong), `rays` (a shadow ray per shaded sample)
+    /// or `volume:N` (a light volume of resolution N) (default: the scene's).
+    #[arg(long, value_parser = parse_shadows)]
+    shadows: Option<ShadowsArg>,
+}
+
+/// A `--shadows` value (`None`: Phong without shadows).
+#[derive(Clone, Copy, Debug)]
+pub struct ShadowsArg(pub Option<voltex::scene::Shadows>);
+
+pub fn parse_shadows(s: &str) -> std::result::Result<ShadowsArg, String> {
+    voltex::methods::options::parse_shadows(s).map(ShadowsArg)
 }
 
 #[derive(clap::ValueEnum, Clone, Copy)]
@@ -161,6 +184,7 @@ impl Overrides {
             axis_criteria: self.criteria,
             budget: self.budget,
             aovs: self.aov.clone(),
+            shadows: self.shadows.map(|s| s.0),
             ..Default::default()
         })
     }

@@ -24,7 +24,13 @@ pub struct ComputeKernel {
 
 impl ComputeKernel {
     pub fn load(ctx: &GpuContext, sources: &Sources, name: &str) -> Result<Self> {
-        let kernel = shader::load_from(sources, name)?;
+        Self::new(ctx, shader::load_from(sources, name)?)
+    }
+
+    /// A kernel from validated WGSL (e.g. [`shader::Kernel::with_storage_format`]).
+    pub fn new(ctx: &GpuContext, kernel: shader::Kernel) -> Result<Self> {
+        let name = kernel.name.clone();
+        let name = name.as_str();
         let bindings = reflect::bindings(&kernel, &["main"])?;
         if bindings.iter().any(|b| b.group != 0) {
             return Err(Error::Invalid(format!("{name}: bake kernels bind everything in @group(0)")));

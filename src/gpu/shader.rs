@@ -68,9 +68,18 @@ fn expand(sources: &Sources, rel: &str, out: &mut Expanded, from: Option<FileLoc
 
 impl Expanded {
     fn locate(&self, line: u32, col: u32) -> FileLoc {
-        let (file, orig) =
-            self.origin.get((line as usize).saturating_sub(1)).copied().unwrap_or((0, line as usize));
-        FileLoc::new(&self.files[file], orig, col as usize)
+        match self.origin.get((line as usize).saturating_sub(1)) {
+            Some(&(file, orig)) => FileLoc::new(&self.files[file], orig, col as usize),
+            // Past the last line (an error at the end of the input, after the newline each
+            // expanded line ends with): the end of the last line, in the file it came from.
+            None => match self.origin.last() {
+                Some(&(file, orig)) => {
+                    let width = self.text.lines().last().map_or(0, |l| l.chars().count());
+                    FileLoc::new(&self.files[file], orig, width + 1)
+                }
+                None => FileLoc::new(&self.files[0], 1, 1),
+            },
+        }
     }
 }
 
@@ -127,6 +136,31 @@ fn load_expanded(name: &str, ex: Expanded) -> Result<Kernel> {
     check_limits(&module, &ex)?;
     let source_hash = crate::gpu::cache::key(&ex.text);
     Ok(Kernel { name: name.to_string(), module, info, files: ex.files, source_hash })
+}
+
+impl Kernel {
+    /// The same kernel with the storage texture `global` declared in `format` (same access and
+    /// dimension), re-validated: e.g. a bake writing `rgba8unorm` made to write `rgba32float`,
+    /// so its results can be read back at full precision (`voltex export`).
+    pub fn with_storage_format(mut self, global: &str, format: naga::StorageFormat) -> Result<Kernel> {
+        let wrong = |what: &str| Error::Invalid(format!("{}: `{global}` {what}", self.name));
+        let (_, var) = (self.module.global_variables.iter_mut())
+            .find(|(_, g)| g.name.as_deref() == Some(global))
+            .ok_or_else(|| wrong("is not a global of this kernel"))?;
+        let naga::TypeInner::Image { dim, arrayed, class: naga::ImageClass::Storage { access, .. } } =
+            self.module.types[var.ty].inner
+        else {
+            return Err(wrong("is not a storage texture"));
+        };
+        let class = naga::ImageClass::Storage { format, access };
+        let inner = naga::TypeInner::Image { dim, arrayed, class };
+        var.ty = self.module.types.insert(naga::Type { name: None, inner }, naga::Span::UNDEFINED);
+        self.info = naga::valid::Validator::new(naga::valid::ValidationFlags::all(), capabilities())
+            .validate(&self.module)
+            .map_err(|e| wrong(&format!("cannot be {format:?}: {}", e.as_inner())))?;
+        self.source_hash ^= crate::gpu::cache::key(&format!("{global}:{format:?}"));
+        Ok(self)
+    }
 }
 
 /// Most bytes of `var<private>` or `var<function>` memory one variable may take: naga accepts

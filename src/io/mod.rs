@@ -6,6 +6,7 @@ pub mod atomic;
 pub mod exr;
 pub mod png;
 pub mod stack;
+pub mod vdb;
 
 use crate::{Error, Result};
 

@@ -47,6 +47,11 @@ impl Row {
         })
     }
 
+    /// `12.3 ms wall, FLIP 0.01234`: a progress line's result.
+    pub(super) fn summary(&self) -> String {
+        format!("{:.1} ms wall, FLIP {:.5}", self.wall_ms, self.flip)
+    }
+
     /// GPU ms of a frame: the sum of its passes' medians (NaN without timestamps).
     fn gpu_ms(&self) -> f64 {
         if self.passes.is_empty() {

@@ -40,8 +40,8 @@ use std::sync::{mpsc, Arc, RwLock};
 
 use crate::gpu::GpuContext;
 use crate::io::atomic::check_writable_dir;
+use crate::progress::{Progress, Verbosity};
 use crate::{Error, Result};
-use progress::{Progress, Verbosity};
 
 /// The `regress` command line.
 #[derive(clap::Args, Debug, Clone)]
@@ -445,11 +445,7 @@ impl SharedContext {
 fn run_scenes(ctx: GpuContext, info: &RunInfo, scenes: &[SceneEntry]) -> Result<(Vec<Record>, usize)> {
     let args = info.args;
     let shared = SharedContext(RwLock::new(Arc::new(ctx)));
-    let verbosity = match (args.quiet, args.verbose) {
-        (true, _) => Verbosity::Quiet,
-        (_, true) => Verbosity::Verbose,
-        _ => Verbosity::Normal,
-    };
+    let verbosity = Verbosity::from_flags(args.quiet, args.verbose);
     let mut progress = Progress::new(scenes.len(), verbosity);
     let (next, stop) = (AtomicUsize::new(0), AtomicBool::new(false));
     let mut records: Vec<Option<Record>> = vec![None; scenes.len()];
@@ -486,7 +482,7 @@ fn run_scenes(ctx: GpuContext, info: &RunInfo, scenes: &[SceneEntry]) -> Result<
                 Event::Started(i) => progress.started(&scenes[i].rel),
                 Event::Done(i, result) => match *result {
                     Ok(checked) => {
-                        progress.finished(&checked.record, checked.skipped);
+                        progress::finished(&mut progress, &checked.record, checked.skipped);
                         skipped += usize::from(checked.skipped);
                         records[i] = Some(checked.record);
                     }

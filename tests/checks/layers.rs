@@ -8,12 +8,12 @@ use std::path::{Path, PathBuf};
 
 /// Lowest first. Modules of one layer may not import each other.
 const LAYERS: &[&[&str]] = &[
-    // Errors, fault injection, the Pod structs shared with WGSL.
-    &["error", "fault", "types"],
+    // Errors, fault injection, the Pod structs shared with WGSL, progress on stderr.
+    &["error", "fault", "progress", "types"],
     // Bounded reads of user files (every reader above uses them).
     &["input"],
-    // Device, shader sources, reflection, caches; file formats; meshes, shells, BVHs.
-    &["gpu", "io", "mesh"],
+    // Device, shader sources, reflection, caches; file formats; meshes, shells, BVHs; OpenVDB grids.
+    &["gpu", "io", "mesh", "vdb"],
     // Render graphs; image metrics; scene files (no GPU).
     &["graph", "metrics", "scene"],
     // CPU twins shared by several methods.

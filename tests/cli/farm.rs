@@ -1,7 +1,8 @@
 //! `voltex farm` for real: a single-node Slurm cluster (munged, slurmctld and slurmd from Debian's
 //! `munge` and `slurm-wlm`, configured in a temporary folder, stopped by their process ids) runs
 //! a small suite as an array of 3 shards and a merge, whose verdicts and metrics must equal a
-//! one-machine run; sbatch missing or refusing; and the Kubernetes manifest parsed as YAML.
+//! one-machine run; sbatch missing or refusing; and the Kubernetes manifest parsed as YAML and
+//! validated against Kubernetes' schemas.
 //!
 //! Without slurmctld (or as a user other than root, which slurmd needs to start jobs) the Slurm
 //! test prints why and passes, unless `VOLTEX_REQUIRE_SLURM=1` (as `.ci/run` sets) makes it fail.
@@ -428,5 +429,24 @@ fn kubernetes_manifest_is_an_indexed_job_and_a_merge_job() {
         .map(|v| v.as_str().unwrap())
         .collect();
     assert_eq!(merge_cmd, ["voltex", "regress", "--report-only", "/data/results"]);
+    validate_with_kubernetes_schemas(&out.join("voltex-regress.yaml"));
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Both Jobs against Kubernetes' own OpenAPI schemas, strictly (unknown fields rejected), with
+/// `kubernetes-validate` from PyPI (`.ci/run` installs it and sets `VOLTEX_REQUIRE_K8S_VALIDATE=1`;
+/// elsewhere the check is skipped with a message when the tool is missing).
+fn validate_with_kubernetes_schemas(manifest: &Path) {
+    let Some(tool) = program("kubernetes-validate") else {
+        let why = "kubernetes-validate is not on PATH (pip install kubernetes-validate)";
+        if std::env::var("VOLTEX_REQUIRE_K8S_VALIDATE").as_deref() == Ok("1") {
+            panic!("VOLTEX_REQUIRE_K8S_VALIDATE=1 but {why}");
+        }
+        eprintln!("skipped the schema check of the Kubernetes manifest: {why}");
+        return;
+    };
+    let run = Command::new(tool).arg("--strict").arg(manifest).output().unwrap();
+    let said = text(&run);
+    assert!(run.status.success(), "kubernetes-validate --strict rejects the manifest:\n{said}");
+    assert_eq!(said.matches(" passed for resource job/").count(), 2, "{said}");
 }

@@ -4,10 +4,14 @@
 mod common;
 
 mod assets;
+mod bench_json;
 mod cli_errors;
+mod export;
 mod farm;
 mod faults;
 mod hostile_files;
 mod install;
 mod maxima;
+mod preview_input;
 mod preview_window;
+mod volumes;

@@ -19,14 +19,46 @@ fn a_baked_stack_renders_like_its_recipe() {
     let text = std::fs::read_to_string(&recipe).unwrap();
     let start = text.find("source: ImageHeight(").unwrap();
     let end = start + text[start..].find("\n            ),").unwrap() + "\n            ),".len();
-    let from_stack = format!("{}source: Slices(dir: \"cobbles\"),{}", &text[..start], &text[end..]);
+    // The opacity length comes from the stack's manifest, not the scene.
+    let from_stack = format!("{}source: Slices(dir: \"cobbles\"),{}", &text[..start], &text[end..])
+        .replace("opacity_length: 0.002,", "");
     let scene = dir.join("from_stack.ron");
     std::fs::write(&scene, &from_stack).unwrap();
+    let manifest = std::fs::read_to_string(dir.join("cobbles/manifest.json")).unwrap();
+    for field in [
+        "\"bit_depth\": 16",
+        "\"opacity_length\": 0.002",
+        "\"premultiplied\": true",
+        "\"lighting\": \"baked\"",
+    ] {
+        assert!(manifest.contains(field), "{field} in {manifest}");
+    }
     let (a, b) = (dir.join("recipe.exr"), dir.join("stack.exr"));
     ok(voltex(&["render", s(&recipe), "--size", "64x64", "-o", s(&a)]));
-    ok(voltex(&["render", s(&scene), "--size", "64x64", "-o", s(&b)]));
-    let compared = ok(voltex(&["compare", s(&b), s(&a)]));
-    assert!(compared.contains("largest difference  0.000e0"), "{compared}");
+    let same_as_recipe = |what: &str| {
+        ok(voltex(&["render", s(&scene), "--size", "64x64", "-o", s(&b)]));
+        let compared = ok(voltex(&["compare", s(&b), s(&a)]));
+        assert!(compared.contains("largest difference  0.000e0"), "{what}: {compared}");
+    };
+    same_as_recipe("16-bit stack");
+    // 8 bits, and 8 bits without a manifest (a stack from before manifests), render the same.
+    ok(voltex(&["bake", s(&recipe), "--out", s(&dir), "--depth", "8"]));
+    same_as_recipe("8-bit stack");
+    std::fs::remove_file(dir.join("cobbles/manifest.json")).unwrap();
+    let stated = from_stack.replacen("\"cobbles\": (", "\"cobbles\": (opacity_length: 0.002,", 1);
+    std::fs::write(&scene, stated).unwrap();
+    same_as_recipe("8-bit stack without a manifest");
+    std::fs::write(&scene, &from_stack).unwrap();
+    // The unlit float stack: straight albedo and alpha in EXR slices.
+    let unlit = dir.join("unlit");
+    ok(voltex(&["bake", s(&recipe), "--out", s(&unlit), "--depth", "32", "--unlit"]));
+    let manifest = std::fs::read_to_string(unlit.join("cobbles/manifest.json")).unwrap();
+    assert!(
+        manifest.contains("\"lighting\": \"unlit\"") && manifest.contains("\"premultiplied\": false"),
+        "{manifest}"
+    );
+    assert!(unlit.join("cobbles/slice_015.exr").is_file());
+    ok(voltex(&["bake", s(&recipe), "--out", s(&dir)]));
 
     // A stack of another resolution, and a missing one, are errors at the `dir` string.
     let line = from_stack.lines().position(|l| l.contains("Slices(dir")).unwrap() + 1;

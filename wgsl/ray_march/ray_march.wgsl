@@ -25,8 +25,11 @@ override peeling: bool = false;
 // Depth peeling's segments (stand-ins without it); the marcher keeps its segment in word 0.
 @group(0) @binding(8) var<uniform> segments: SegmentParams;
 @group(0) @binding(9) var<storage, read_write> segment_bounds: array<u32>;
+// `shadows: LightVolume(..)`: the object's light volume (stand-ins otherwise).
+@group(0) @binding(10) var<uniform> light_grid: LightVolumeParams;
+@group(0) @binding(11) var<storage, read> light_volume: array<u32>;
 // The depth AOV: the nearest opaque sample of each pixel (shared/aov_depth.wgsl).
-@group(0) @binding(10) var<storage, read_write> aov_opaque_depth: array<atomic<u32>>;
+@group(0) @binding(12) var<storage, read_write> aov_opaque_depth: array<atomic<u32>>;
 
 #include "shared/aov_depth.wgsl"
 

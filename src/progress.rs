@@ -1,0 +1,126 @@
+//! Progress of a long command on stderr (regress, pareto): a `\r`-updated bar with an ETA when
+//! stderr is a terminal (notable lines printed above it as they come), one line per finished item
+//! otherwise (logs, CI, tests); nothing with `--quiet` but errors.
+
+use std::io::{IsTerminal, Write};
+use std::time::Instant;
+
+/// How much a command says on stderr.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Verbosity {
+    Quiet,
+    Normal,
+    Verbose,
+}
+
+impl Verbosity {
+    pub fn from_flags(quiet: bool, verbose: bool) -> Self {
+        match (quiet, verbose) {
+            (true, _) => Verbosity::Quiet,
+            (_, true) => Verbosity::Verbose,
+            _ => Verbosity::Normal,
+        }
+    }
+}
+
+pub struct Progress {
+    total: usize,
+    done: usize,
+    /// Items that did their work (not skipped as current): the ETA is their mean time.
+    worked: usize,
+    running: Vec<String>,
+    tty: bool,
+    pub verbosity: Verbosity,
+    start: Instant,
+}
+
+const WIDTH: usize = 100;
+
+impl Progress {
+    pub fn new(total: usize, verbosity: Verbosity) -> Self {
+        let tty = std::io::stderr().is_terminal() && verbosity != Verbosity::Quiet;
+        let p =
+            Self { total, done: 0, worked: 0, running: Vec::new(), tty, verbosity, start: Instant::now() };
+        p.draw();
+        p
+    }
+
+    /// `, ETA 1:05` from the mean time of the items worked so far (none before the first).
+    fn eta(&self) -> String {
+        let left = self.total - self.done;
+        if left == 0 || self.worked == 0 {
+            return String::new();
+        }
+        let secs = self.start.elapsed().as_secs_f64() / self.worked as f64 * left as f64;
+        let secs = secs.round() as u64;
+        format!(", ETA {}:{:02}", secs / 60, secs % 60)
+    }
+
+    pub fn started(&mut self, item: &str) {
+        self.running.push(item.to_string());
+        self.draw();
+    }
+
+    /// `item` is done and `line` says how. `worked`: it did its work (counts for the ETA);
+    /// `notable`: on a terminal the line stays above the bar (else only the bar moves).
+    pub fn finished(&mut self, item: &str, line: &str, worked: bool, notable: bool) {
+        self.done += 1;
+        self.worked += usize::from(worked);
+        if let Some(i) = self.running.iter().position(|s| s == item) {
+            self.running.remove(i);
+        }
+        if self.verbosity == Verbosity::Quiet {
+            return;
+        }
+        let line = format!("[{}/{}{}] {line}", self.done, self.total, self.eta());
+        if self.tty {
+            if notable {
+                eprint!("\r{:WIDTH$}\r{line}\n", "");
+            }
+            self.draw();
+        } else {
+            eprintln!("{line}");
+        }
+    }
+
+    /// A line that is not about one item (a fatal error, say); errors show even with `--quiet`.
+    pub fn note(&self, text: &str) {
+        if self.verbosity == Verbosity::Quiet && !text.starts_with("error") {
+            return;
+        }
+        if self.tty {
+            eprint!("\r{:WIDTH$}\r", "");
+        }
+        eprintln!("{text}");
+        self.draw();
+    }
+
+    pub fn end(&self) {
+        if self.tty {
+            eprint!("\r{:WIDTH$}\r", "");
+            let _ = std::io::stderr().flush();
+        }
+    }
+
+    fn draw(&self) {
+        if !self.tty {
+            return;
+        }
+        const BAR: usize = 24;
+        let filled = (self.done * BAR).checked_div(self.total).unwrap_or(BAR);
+        let mut line = format!(
+            "[{}{}] {}/{}{} {}",
+            "#".repeat(filled),
+            "-".repeat(BAR - filled),
+            self.done,
+            self.total,
+            self.eta(),
+            self.running.join(", ")
+        );
+        if line.chars().count() > WIDTH {
+            line = line.chars().take(WIDTH - 3).collect::<String>() + "...";
+        }
+        eprint!("\r{line:WIDTH$}");
+        let _ = std::io::stderr().flush();
+    }
+}

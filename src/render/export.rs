@@ -1,0 +1,350 @@
+//! `voltex export`: every texel, and the hypertexture of every node that draws one, baked on the
+//! GPU by the render's own kernels at full precision (f32, [`Baker::full_precision`]) and turned
+//! into OpenVDB grids that Blender, Houdini and Mitsuba render: a float `density` (fog volume)
+//! and a vec3 `Cd` colour, with the index-to-world transform.
+//!
+//! Density is the extinction coefficient per world unit: a voxel of opacity `a` over the opacity
+//! length `L` (a world length; every method composites `1 - (1 - a)^(step / L)`) has
+//! `sigma_t = -ln(1 - a) / L`, so `exp(-sigma_t * step)` is voltex's own transmittance.
+//! Voxels of opacity 0 are inactive. Opacity 1 (an opaque voxel: infinitely dense for voltex)
+//! becomes [`OPAQUE_TRANSMITTANCE`] through one voxel. `Cd` is the colour without the opacity
+//! (the premultiplied colour over alpha): unlit albedo, except for slice stacks, which hold
+//! their baked shading.
+
+use std::path::Path;
+
+use glam::{DMat4, DVec3, DVec4};
+
+use crate::bake::hypertexture::HyperTexel;
+use crate::bake::{BakeRequest, BakeSource, Baker};
+use crate::error::{Error, Result};
+use crate::gpu::GpuContext;
+use crate::io::vdb::{self, Grid, GridClass, GridData, Voxels};
+use crate::mesh::BaseSurface;
+use crate::methods::view::Lighting;
+use crate::scene::{Scene, TexelSource};
+
+/// The transmittance of one voxel (its smallest world side) of opacity 1.
+pub const OPAQUE_TRANSMITTANCE: f64 = 1e-4;
+/// Most voxels one exported volume may have: its f32 RGBA read-back takes 16 bytes a voxel
+/// (1 GiB at this limit), and the grids as much again.
+pub const MAX_EXPORT_VOXELS: u64 = 1 << 26;
+/// Default voxels along the longest side of an exported hypertexture node.
+pub const DEFAULT_HYPER_RESOLUTION: u32 = 128;
+
+#[derive(Debug, Clone)]
+pub struct ExportOptions {
+    /// Texels and nodes to export (default: all).
+    pub only: Vec<String>,
+    /// Time of the bake (animated hypertextures, sequences' frames, moving surfaces).
+    pub time: Option<f64>,
+    /// Voxels along the longest side of a hypertexture node's box.
+    pub resolution: u32,
+    pub compression: vdb::Compression,
+}
+
+impl Default for ExportOptions {
+    fn default() -> Self {
+        ExportOptions {
+            only: Vec::new(),
+            time: None,
+            resolution: DEFAULT_HYPER_RESOLUTION,
+            compression: vdb::Compression::Zip,
+        }
+    }
+}
+
+/// One volume to write: its file stem, what it is, its bake and where it lies.
+#[derive(Debug)]
+pub struct Export {
+    pub name: String,
+    pub what: String,
+    pub request: BakeRequest,
+    /// World length over which a voxel's alpha is reached.
+    pub opacity_length: f64,
+    /// Voxel `(i, j, k)` (the bake's voxel centre) to world.
+    pub index_to_world: DMat4,
+    /// How the transform was found, when that is not exact.
+    pub note: Option<String>,
+}
+
+/// Every volume the scene exports (or those `only` names), in a fixed order: texels by name,
+/// then hypertexture nodes in document order. CPU only: unknown names, file-name clashes and
+/// volumes over [`MAX_EXPORT_VOXELS`] fail here, before any GPU work.
+pub fn plan(scene: &Scene, opts: &ExportOptions) -> Result<Vec<Export>> {
+    let time = opts.time.unwrap_or(scene.time);
+    let objects = scene.objects_at(time)?;
+    let light = Lighting::of(scene);
+    let mut out = Vec::new();
+    for (name, texel) in &scene.texels {
+        if matches!(texel.source, TexelSource::Sequence { .. }) {
+            continue; // its frames are texels of their own
+        }
+        // Slice stacks hold what they were baked with; every other source bakes the unlit albedo.
+        let stack = match &texel.source {
+            TexelSource::Slices { dir } => Some(scene.stack(&dir.value).and_then(|s| s.manifest.as_ref())),
+            _ => None,
+        };
+        let per_pixel = stack.is_none();
+        let lit =
+            stack.is_some_and(|m| m.is_none_or(|m| m.lighting == crate::io::stack::StackLighting::Baked));
+        let mut bakes = Vec::new();
+        crate::methods::texels::bake_index(scene, name, per_pixel, &light, time, &mut bakes)?;
+        let request = bakes.remove(0).request;
+        let drawn_by = objects.iter().find(|o| o.texel.as_deref() == Some(name.as_str()));
+        let (texel_to_world, note) = match drawn_by {
+            Some(o) => texel_frame(&o.surface, &o.name),
+            None => (DMat4::IDENTITY, Some("drawn by no object: one tile is one world unit".into())),
+        };
+        out.push(Export {
+            name: name.clone(),
+            what: format!("texel \"{name}\""),
+            index_to_world: texel_to_world * index_to_box(DVec3::ZERO, DVec3::ONE, request.resolution),
+            request,
+            opacity_length: texel.opacity_length(&scene.hypertextures) as f64,
+            note: if lit { Some(join(note, "a slice stack: Cd holds its baked shading")) } else { note },
+        });
+    }
+    for o in &objects {
+        let Some(node) = &o.hypertexture else { continue };
+        let h = scene.hypertextures.get(&node.name).ok_or_else(|| {
+            Error::Invalid(format!("{}: unknown hypertexture `{}`", scene.path.display(), node.name))
+        })?;
+        let (lo, hi) = crate::hypertexture::pack(h).bounds;
+        let extent = hi - lo;
+        let resolution = extent
+            .to_array()
+            .map(|e| ((opts.resolution as f64 * e / extent.max_element()).round() as u32).max(1));
+        let texel = HyperTexel::new(h, Some((lo, hi)), resolution, time);
+        out.push(Export {
+            name: o.name.clone(),
+            what: format!("hypertexture \"{}\" of node \"{}\"", node.name, o.name),
+            request: BakeRequest {
+                resolution,
+                source: BakeSource::Hypertexture(Box::new(texel)),
+                per_pixel: true,
+                light: light.direction,
+                ambient: light.ambient,
+                axis_slices: false,
+            },
+            opacity_length: h.opacity_length,
+            index_to_world: node.to_world * index_to_box(lo, hi, resolution),
+            note: None,
+        });
+    }
+    select(scene, out, &opts.only)
+}
+
+/// Keeps the volumes `only` names (all when empty), and checks names and sizes.
+fn select(scene: &Scene, all: Vec<Export>, only: &[String]) -> Result<Vec<Export>> {
+    let at = |msg: String| Error::Invalid(format!("{}: {msg}", scene.path.display()));
+    if let Some(unknown) = only.iter().find(|n| !all.iter().any(|e| &e.name == *n)) {
+        let names: Vec<&str> = all.iter().map(|e| e.name.as_str()).collect();
+        return Err(at(format!(
+            "--only {unknown:?}: expected a texel or a hypertexture node of the scene: {}",
+            if names.is_empty() { "it has none".to_string() } else { names.join(", ") }
+        )));
+    }
+    let chosen: Vec<Export> = all.into_iter().filter(|e| only.is_empty() || only.contains(&e.name)).collect();
+    if chosen.is_empty() {
+        return Err(at("the scene has no texel and no hypertexture node to export".into()));
+    }
+    for (i, e) in chosen.iter().enumerate() {
+        if let Some(other) = chosen[..i].iter().find(|o| o.name == e.name) {
+            return Err(at(format!(
+                "{} and {} would both be written to {}.vdb: export one at a time with --only",
+                other.what, e.what, e.name
+            )));
+        }
+        file_name(&e.name).map_err(|m| at(format!("{}: {m}", e.what)))?;
+        let [x, y, z] = e.request.resolution;
+        let voxels = x as u64 * y as u64 * z as u64;
+        if voxels > MAX_EXPORT_VOXELS {
+            return Err(at(format!(
+                "{}: {x}x{y}x{z} = {voxels} voxels, more than the {MAX_EXPORT_VOXELS} one export may have \
+                 (16 bytes a voxel are read back): lower its resolution{}",
+                e.what,
+                if matches!(e.request.source, BakeSource::Hypertexture(_)) { " (--resolution)" } else { "" }
+            )));
+        }
+    }
+    Ok(chosen)
+}
+
+/// `NAME.vdb`, or why NAME cannot be a file name on every system a scene travels to.
+pub fn file_name(name: &str) -> std::result::Result<String, String> {
+    let bad = |c: char| c.is_control() || "/\\:*?\"<>|".contains(c);
+    if name.is_empty() || name == "." || name == ".." || name.starts_with('.') {
+        return Err(format!("{name:?} is not a file name (empty, or starting with a dot)"));
+    }
+    if let Some(c) = name.chars().find(|&c| bad(c)) {
+        return Err(format!("{name:?} is not a file name: it holds {c:?}"));
+    }
+    if name.len() > 200 {
+        return Err(format!("{name:?} is too long for a file name ({} bytes, at most 200)", name.len()));
+    }
+    Ok(format!("{name}.vdb"))
+}
+
+/// Bakes `e` with `baker` (a [`Baker::full_precision`]) and reads the volume back: premultiplied
+/// RGBA, x fastest, then y, then z.
+pub fn bake(ctx: &GpuContext, baker: &mut Baker, e: &Export) -> Result<Vec<[f32; 4]>> {
+    if baker.format() != wgpu::TextureFormat::Rgba32Float {
+        return Err(Error::Invalid("export needs a full-precision baker".into()));
+    }
+    let baked = baker.bake(ctx, &e.request)?;
+    let bytes = crate::bake::axis_slices::read_texture(ctx, &baked.volume, 16)?;
+    Ok(bytemuck::pod_collect_to_vec(&bytes))
+}
+
+/// The `density` and `Cd` grids of `e` from its baked volume.
+pub fn grids(e: &Export, rgba: &[[f32; 4]]) -> Vec<Grid> {
+    let [nx, ny, _] = e.request.resolution;
+    let at = |[i, j, k]: [u32; 3]| rgba[(k as usize * ny as usize + j as usize) * nx as usize + i as usize];
+    let voxel = (0..3).map(|a| e.index_to_world.col(a).truncate().length()).fold(f64::INFINITY, f64::min);
+    let opaque = density(1.0 - 2f64.powi(-20), e.opacity_length).max(-OPAQUE_TRANSMITTANCE.ln() / voxel);
+    let first = [0; 3];
+    let density = Voxels::from_dense(first, e.request.resolution, |ijk| {
+        let a = at(ijk)[3] as f64;
+        (a > 0.0).then(|| if a >= 1.0 { opaque } else { density(a, e.opacity_length).min(opaque) } as f32)
+    });
+    let colour = Voxels::from_dense(first, e.request.resolution, |ijk| {
+        let [r, g, b, a] = at(ijk);
+        (a > 0.0).then(|| [r / a, g / a, b / a])
+    });
+    vec![
+        Grid {
+            name: "density".into(),
+            class: GridClass::FogVolume,
+            index_to_world: e.index_to_world,
+            data: GridData::Float(density),
+        },
+        Grid {
+            name: "Cd".into(),
+            class: GridClass::Unknown,
+            index_to_world: e.index_to_world,
+            data: GridData::Vec3(colour),
+        },
+    ]
+}
+
+/// Extinction per world unit of opacity `a` reached over `length`.
+pub fn density(a: f64, length: f64) -> f64 {
+    -(1.0 - a).ln() / length
+}
+
+/// Voxel `(i, j, k)` of `n` voxels filling the box `lo..hi` (cell-centred) to the box's space.
+pub fn index_to_box(lo: DVec3, hi: DVec3, n: [u32; 3]) -> DMat4 {
+    let voxel = (hi - lo) / DVec3::from_array(n.map(f64::from));
+    DMat4::from_translation(lo + voxel / 2.0) * DMat4::from_scale(voxel)
+}
+
+/// Texel space `(s, t, w)` onto the object: the affine map that best fits every prism corner
+/// (`(uv, 0)` to the base vertex, `(uv, 1)` to its tip), exact for a flat base surface with
+/// constant height vectors and affine uvs (a plane). A curved shell has no such map: then one
+/// tile at the world origin, scaled like the shell on average, and a note says so.
+pub fn texel_frame(surface: &BaseSurface, object: &str) -> (DMat4, Option<String>) {
+    let mut samples = Vec::new();
+    for (tri, uvs) in surface.triangles.iter().zip(&surface.corner_uvs) {
+        for k in 0..3 {
+            let i = tri[k] as usize;
+            let (p, h, uv) = (surface.positions[i], surface.heights[i], uvs[k]);
+            samples.push((DVec4::new(uv.x, uv.y, 0.0, 1.0), p));
+            samples.push((DVec4::new(uv.x, uv.y, 1.0, 1.0), p + h));
+        }
+    }
+    let normal = samples.iter().fold(DMat4::ZERO, |m, (x, _)| m + outer(*x, *x));
+    let rhs = samples.iter().fold(DMat4::ZERO, |m, (x, p)| m + outer(p.extend(0.0), *x));
+    let size = samples.iter().map(|(_, p)| p.length()).fold(0.0, f64::max).max(1e-12);
+    if normal.determinant().abs() > 1e-12 {
+        // Round-off of the solve is cleared, so an axis-aligned tile stays a scale-translate map.
+        let mut cols = (rhs * normal.inverse()).to_cols_array();
+        cols.iter_mut().filter(|v| v.abs() < 1e-12 * size).for_each(|v| *v = 0.0);
+        cols[15] = 1.0;
+        let fit = DMat4::from_cols_array(&cols);
+        let error = samples.iter().map(|(x, p)| ((fit * *x).truncate() - *p).length()).fold(0.0, f64::max);
+        if error <= 1e-6 * size && fit.determinant().abs() > 1e-300 {
+            return (fit, None);
+        }
+    }
+    // Mean scales: world area over uv area for s and t, the mean height for w.
+    let (mut world, mut uv, mut height) = (0.0, 0.0, 0.0);
+    for (t, uvs) in surface.corner_uvs.iter().enumerate() {
+        world += surface.face_normal(t).length() / 2.0;
+        uv += (uvs[1] - uvs[0]).perp_dot(uvs[2] - uvs[0]).abs() / 2.0;
+    }
+    for h in &surface.heights {
+        height += h.length() / surface.heights.len().max(1) as f64;
+    }
+    let st = if uv > 0.0 { (world / uv).sqrt() } else { 1.0 };
+    let scale = DVec3::new(st, st, if height > 0.0 { height } else { st });
+    let note = format!(
+        "object \"{object}\"'s shell is curved: one tile at the world origin, {st:.4} x {st:.4} x {:.4} world units \
+         (its mean scale)",
+        scale.z
+    );
+    (DMat4::from_scale(scale), Some(note))
+}
+
+fn outer(a: DVec4, b: DVec4) -> DMat4 {
+    DMat4::from_cols(a * b.x, a * b.y, a * b.z, a * b.w)
+}
+
+fn join(a: Option<String>, b: &str) -> String {
+    match a {
+        Some(a) => format!("{a}; {b}"),
+        None => b.to_string(),
+    }
+}
+
+/// The output file of `e` in `dir`.
+pub fn path_in(dir: &Path, e: &Export) -> std::path::PathBuf {
+    dir.join(format!("{}.vdb", e.name))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn density_is_the_extinction_that_gives_back_the_opacity() {
+        for (a, l) in [(0.5, 0.05), (0.01, 2.0), (0.999, 0.1)] {
+            let sigma = density(a, l);
+            // Transmittance over the opacity length is 1 - a; over half of it, sqrt(1 - a).
+            assert!(((-sigma * l).exp() - (1.0 - a)).abs() < 1e-12);
+            assert!(((-sigma * l / 2.0).exp() - (1.0 - a).sqrt()).abs() < 1e-12);
+        }
+    }
+
+    #[test]
+    fn a_plane_gives_its_exact_tile() {
+        let mesh = crate::mesh::generate::plane([4.0, 2.0], [3, 2], 0.0, 0);
+        let surface = mesh.to_base(0.5, None, glam::DVec2::new(2.0, 1.0));
+        let (m, note) = texel_frame(&surface, "floor");
+        assert!(note.is_none());
+        // Tile (0, 0) starts at the plane's corner; s spans 4 / 2 world units, t 2, w 0.5.
+        let p = |s: f64, t: f64, w: f64| m.transform_point3(DVec3::new(s, t, w));
+        assert!((p(0.0, 0.0, 0.0) - DVec3::new(-2.0, -1.0, 0.0)).length() < 1e-9);
+        assert!((p(1.0, 1.0, 1.0) - DVec3::new(0.0, 1.0, 0.5)).length() < 1e-9);
+    }
+
+    #[test]
+    fn a_sphere_gets_its_mean_scale_and_a_note() {
+        let mesh = crate::mesh::generate::sphere(1.0, [24, 12]);
+        let surface = mesh.to_base(0.1, None, glam::DVec2::ONE);
+        let (m, note) = texel_frame(&surface, "ball");
+        assert!(note.unwrap().contains("curved"));
+        // uv [0,1]^2 covers the sphere's area 4 pi (less at the poles' triangles): s and t
+        // scale by about sqrt(4 pi).
+        assert!((m.x_axis.x / (4.0 * std::f64::consts::PI).sqrt() - 1.0).abs() < 0.05, "{m}");
+        assert!((m.z_axis.z - 0.1).abs() < 1e-9);
+    }
+
+    #[test]
+    fn file_names_refuse_separators_and_dots() {
+        assert_eq!(file_name("moss").unwrap(), "moss.vdb");
+        for bad in ["", "..", ".hidden", "a/b", "a\\b", "c:d", "new\nline"] {
+            assert!(file_name(bad).is_err(), "{bad:?}");
+        }
+    }
+}
