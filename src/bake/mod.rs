@@ -133,6 +133,7 @@ impl BakeRequest {
                 }
                 k
             }
+            BakeSource::Volume(_) => vec!["bake/bake_volume.wgsl"],
         };
         if self.axis_slices {
             k.push("axis_slices/bake_axis_slices.wgsl");
@@ -437,7 +438,7 @@ impl Baker {
                 ht.bake(ctx, (transfer, hyper), &mut encoder, &mut inputs, params)?;
             }
             BakeSource::Volume(v) => {
-                let kernel = Self::kernel(&mut self.volume, ctx, &root, "bake/bake_volume.wgsl")?;
+                let kernel = Self::kernel(&mut self.volume, ctx, &root, "bake/bake_volume.wgsl", self.format)?;
                 v.bake(ctx, kernel, &mut encoder, &mut inputs, params)?;
             }
         }

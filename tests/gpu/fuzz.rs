@@ -772,7 +772,7 @@ fn vdb_bytes_mutated() {
     ];
     let strategy =
         (0..files.len(), prop::collection::vec(edit, 0..6), prop::option::of(any::<prop::sample::Index>()));
-    fuzz("vdb_bytes_mutated", 1500, strategy, |(f, edits, cut)| {
+    fuzz("vdb_bytes_mutated", 1500, SMALL, strategy, |(f, edits, cut)| {
         let (bytes, density, color) = &files[f];
         let mut bytes = bytes.clone();
         for (at, b) in edits {
