@@ -438,7 +438,8 @@ impl Baker {
                 ht.bake(ctx, (transfer, hyper), &mut encoder, &mut inputs, params)?;
             }
             BakeSource::Volume(v) => {
-                let kernel = Self::kernel(&mut self.volume, ctx, &root, "bake/bake_volume.wgsl", self.format)?;
+                let kernel =
+                    Self::kernel(&mut self.volume, ctx, &root, "bake/bake_volume.wgsl", self.format)?;
                 v.bake(ctx, kernel, &mut encoder, &mut inputs, params)?;
             }
         }

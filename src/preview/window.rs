@@ -118,10 +118,10 @@ impl ApplicationHandler for App {
         let Some(s) = self.state.as_mut() else { return };
         // Keys go to the panel only while one of its fields has the focus (typing a value).
         let typing = s.gui.ctx.egui_wants_keyboard_input();
-        if !matches!(event, WindowEvent::KeyboardInput { .. }) || typing {
-            if s.gui.on_event(&s.window, &event).repaint {
-                s.window.request_redraw();
-            }
+        if (!matches!(event, WindowEvent::KeyboardInput { .. }) || typing)
+            && s.gui.on_event(&s.window, &event).repaint
+        {
+            s.window.request_redraw();
         }
         match event {
             WindowEvent::CloseRequested => event_loop.exit(),

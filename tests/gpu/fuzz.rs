@@ -522,8 +522,7 @@ mod fuzz_regressions {
         let limits = voltex::gpu::budget::plan_limits();
         let e = Blueprint::new(&scene, &opts)
             .and_then(|bp| bp.check_limits(&limits, "x"))
-            .err()
-            .expect("an error");
+            .expect_err("an error");
         let line = text[..text.find("name: \"box\"").unwrap()].matches('\n').count() + 1;
         let e = e.to_string();
         assert!(e.starts_with(&format!("{}:{line}:", path.display())), "{e}");
@@ -798,9 +797,14 @@ fn vdb_rs_unguarded() {
     let mut errors = 0;
     let mut ok = 0;
     let mut runner = proptest::test_runner::TestRunner::deterministic();
-    let strategy = (0..files.len(), prop::collection::vec((any::<prop::sample::Index>(), any::<u8>()), 0..6), prop::option::of(any::<prop::sample::Index>()));
+    let strategy = (
+        0..files.len(),
+        prop::collection::vec((any::<prop::sample::Index>(), any::<u8>()), 0..6),
+        prop::option::of(any::<prop::sample::Index>()),
+    );
     for _ in 0..4000 {
-        let (f, edits, cut) = proptest::strategy::ValueTree::current(&strategy.new_tree(&mut runner).unwrap());
+        let (f, edits, cut) =
+            proptest::strategy::ValueTree::current(&strategy.new_tree(&mut runner).unwrap());
         let (bytes, density, _) = &files[f];
         let mut bytes = bytes.clone();
         for (at, b) in edits {
@@ -819,7 +823,11 @@ fn vdb_rs_unguarded() {
             Ok(Ok(())) => ok += 1,
             Ok(Err(_)) => errors += 1,
             Err(p) => {
-                let msg = p.downcast_ref::<String>().cloned().or_else(|| p.downcast_ref::<&str>().map(|s| s.to_string())).unwrap_or_default();
+                let msg = p
+                    .downcast_ref::<String>()
+                    .cloned()
+                    .or_else(|| p.downcast_ref::<&str>().map(|s| s.to_string()))
+                    .unwrap_or_default();
                 let key: String = msg.chars().take(60).collect();
                 *panics.entry(key).or_default() += 1;
             }

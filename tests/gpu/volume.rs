@@ -299,7 +299,11 @@ fn far_apart_blobs_plan_sparse_memory() {
     let grid = &o.object.volume.as_ref().unwrap().grid;
     let span = (grid.hi - grid.lo + 1).as_dvec3();
     let dense = span.x * span.y * span.z * 4.0;
-    println!("far_apart: {} bricks, {} table words, {bytes} bytes planned; dense {dense:.3e} bytes", grid.bricks(), grid.table.len());
+    println!(
+        "far_apart: {} bricks, {} table words, {bytes} bytes planned; dense {dense:.3e} bytes",
+        grid.bricks(),
+        grid.table.len()
+    );
     assert!(span.min_element() > 1000.0);
     assert!(bytes < 1 << 20 && (bytes as f64) < dense * 1e-3, "{bytes} bytes");
 }
