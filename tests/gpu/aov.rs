@@ -98,12 +98,14 @@ fn transmittance_coverage_and_depth_of_a_slab_beside_a_floor() {
 }
 
 /// An opaque slab: its depth is that of its top face (z = 1, camera depth 2), found within one
-/// plane spacing by view slicing, one step by the Reference, one slice by axis slicing.
+/// plane spacing by view slicing and one step by the Reference. Axis slicing draws each slab's
+/// slice at its far side, and each prism picks its level: the depth is within one slab of the
+/// level chosen (here up to 2 of the texel's 8 layers, 1/8), one more where two prisms meet.
 #[test]
 fn depth_of_an_opaque_slab_by_slicing_and_by_the_reference() {
     let scene = scene(0.9);
     for (method, within) in
-        [(None, 1.2 / 96.0), (Some(MethodKind::Reference), 0.01), (Some(MethodKind::AxisSlices), 0.5 / 8.0)]
+        [(None, 1.2 / 96.0), (Some(MethodKind::Reference), 0.01), (Some(MethodKind::AxisSlices), 3.0 / 16.0)]
     {
         let opts = RenderOptions {
             method,
@@ -206,4 +208,26 @@ fn exr_channels_metadata_and_camera_round_trip() {
     let ndc = m(a.world_to_normalized_device.unwrap(), [-edge, edge, 0.0]);
     assert!(ndc[0].abs() < 1e-5 && ndc[1].abs() < 1e-5, "top-left corner at NDC {ndc:?}");
     assert_eq!(a.frames_per_second, Some((24, 1)));
+}
+
+/// A volume object's coverage is its layer's opacity: over a white background a purely absorbing
+/// box shows its transmittance, so `coverage.box` = 1 - R and `transmittance` = R per pixel.
+#[test]
+fn coverage_and_transmittance_of_an_absorbing_volume() {
+    let path = common::root().join("scenes/volumes/absorbing_box.ron");
+    let text = std::fs::read_to_string(&path).unwrap().replace(
+        "background: (1.0, 1.0, 1.0),",
+        "background: (1.0, 1.0, 1.0),\n    aovs: [\"coverage\", \"transmittance\"],",
+    );
+    let scene = scene::parse(&text, &path).unwrap();
+    let (frame, _) = render(&scene, common::sized(32, 32));
+    let (cover, trans) = (channel(&frame, "coverage.box.Y"), channel(&frame, "transmittance.Y"));
+    let mut worst = 0.0f32;
+    let mut seen = 0;
+    for (i, p) in frame.image.pixels.iter().enumerate() {
+        worst = worst.max((cover[i] - (1.0 - p[0])).abs()).max((trans[i] - p[0]).abs());
+        seen += usize::from(cover[i] > 0.5);
+    }
+    assert!(seen > 50, "the box covers {seen} pixels");
+    assert!(worst < 2e-3, "coverage or transmittance off by {worst}");
 }

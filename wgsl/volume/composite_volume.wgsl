@@ -4,6 +4,9 @@
 
 @group(0) @binding(0) var<uniform> frame: FrameParams;
 @group(0) @binding(1) var<storage, read> volume_state: array<MarchState>;
+@group(0) @binding(2) var<uniform> object: ObjectParams;
+
+#include "shared/aov_coverage.wgsl"
 
 @vertex
 fn vs_main(@builtin(vertex_index) index: u32) -> @builtin(position) vec4<f32> {
@@ -15,4 +18,11 @@ fn fs_main(@builtin(position) pixel: vec4<f32>) -> @location(0) vec4<f32> {
     let p = vec2<u32>(pixel.xy);
     let s = volume_state[p.y * u32(frame.viewport.x) + p.x];
     return vec4<f32>(s.color.rgb * frame.light_color.rgb, s.color.a);
+}
+
+// Coverage AOV: the layer's alpha, into the object's slot.
+@fragment
+fn fs_coverage(@builtin(position) pixel: vec4<f32>) -> Coverage {
+    let p = vec2<u32>(pixel.xy);
+    return coverage_slot(object.index, volume_state[p.y * u32(frame.viewport.x) + p.x].color.a);
 }
