@@ -91,7 +91,8 @@ fn graph_text(resources: &str, passes: &str) -> String {
     let anchor = "\"reference_rgba\": Texture(format: Rgba32Float, size: Output),";
     assert!(text.contains(anchor));
     let text = text.replacen(anchor, &format!("{anchor}{resources}"), 1);
-    let end = text.rfind("    ],\n)").expect("the end of `passes`");
+    let start = text.find("passes: [").expect("`passes`");
+    let end = start + text[start..].find("\n    ],\n").expect("the end of `passes`") + 1;
     format!("{}{passes}\n{}", &text[..end], &text[end..])
 }
 
