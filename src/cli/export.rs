@@ -31,6 +31,10 @@ pub struct ExportArgs {
     /// How voxel values are stored.
     #[arg(long, value_enum, default_value_t = CompressionArg::Zip)]
     compression: CompressionArg,
+    /// Also write view.json: output size, camera, background and lights, for other renderers
+    /// (tools/peers/).
+    #[arg(long)]
+    view: bool,
     /// No progress on stderr (errors still show).
     #[arg(long, short)]
     quiet: bool,
@@ -72,7 +76,8 @@ pub fn run(args: ExportArgs) -> Result<()> {
             .map_err(|e| Error::file(&args.out, format!("cannot make the output folder: {e}")))?;
     }
     let verbosity = Verbosity::from_flags(args.quiet, false);
-    let result = write_all(&args.out, &exports, opts.compression, verbosity);
+    let view = args.view.then(|| export::view_json(&scene, &exports));
+    let result = write_all(&args.out, &exports, view, opts.compression, verbosity);
     if result.is_err() && made {
         let _ = std::fs::remove_dir(&args.out); // only if still empty
     }
@@ -82,6 +87,7 @@ pub fn run(args: ExportArgs) -> Result<()> {
 fn write_all(
     out: &std::path::Path,
     exports: &[export::Export],
+    view: Option<String>,
     compression: Compression,
     verbosity: Verbosity,
 ) -> Result<()> {
@@ -126,6 +132,13 @@ fn write_all(
         ));
     }
     progress.end();
+    if let Some(json) = view {
+        let path = out.join("view.json");
+        staged.push(voltex::io::atomic::stage(&path, |tmp| {
+            std::fs::write(tmp, json).map_err(|e| Error::file(&path, format!("cannot write: {e}")))
+        })?);
+        lines.push(format!("{}  the view: size, camera, background, lights", path.display()));
+    }
     for s in staged {
         s.commit()?;
     }

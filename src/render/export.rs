@@ -397,6 +397,39 @@ fn join(a: Option<String>, b: &str) -> String {
     }
 }
 
+/// The scene's view for other renderers (`voltex export --view`, read by `tools/peers/`): the
+/// output size, the camera (a pinhole through pixel centres, `fov_y` the vertical field of view
+/// in degrees), background, ambient term and lights (each travelling along `direction`), and the
+/// files written.
+pub fn view_json(scene: &Scene, exports: &[Export]) -> String {
+    let cam = &scene.camera.value;
+    let v = |d: DVec3| [d.x, d.y, d.z];
+    let lights: Vec<_> = scene
+        .lights
+        .iter()
+        .map(|l| match l {
+            crate::scene::Light::Directional { direction, color, intensity } => serde_json::json!({
+                "type": "directional", "direction": v(*direction), "color": color, "intensity": intensity,
+            }),
+        })
+        .collect();
+    let files: Vec<_> = exports
+        .iter()
+        .map(|e| serde_json::json!({ "file": format!("{}.vdb", e.name), "what": e.what }))
+        .collect();
+    let json = serde_json::json!({
+        "scene": scene.path.display().to_string(),
+        "width": scene.output.width,
+        "height": scene.output.height,
+        "camera": { "eye": v(cam.eye), "target": v(cam.target), "up": v(cam.up), "fov_y": cam.fov_y },
+        "background": scene.background,
+        "ambient": scene.ambient,
+        "lights": lights,
+        "files": files,
+    });
+    serde_json::to_string_pretty(&json).unwrap_or_default() + "\n"
+}
+
 /// The output file of `e` in `dir`.
 pub fn path_in(dir: &Path, e: &Export) -> std::path::PathBuf {
     dir.join(format!("{}.vdb", e.name))
