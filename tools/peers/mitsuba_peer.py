@@ -72,7 +72,7 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--view", required=True)
     ap.add_argument("--vol", required=True, help="the stem vdb_to_vol.py wrote")
-    ap.add_argument("--truth", required=True)
+    ap.add_argument("--truth", help="the truth image (without it: renders only, no CSV)")
     ap.add_argument("--spp", default="1,4,16,64")
     ap.add_argument("--albedo", type=float, default=0.0)
     ap.add_argument("--max-depth", type=int, default=-1)
@@ -101,11 +101,15 @@ def main():
         seconds = time.perf_counter() - start
         exr = os.path.join(args.out, f"mitsuba_{spp}.exr")
         mi.Bitmap(image).write(exr)
+        if not args.truth:
+            print(f"{spp:5d} spp  {seconds:8.3f} s  -> {exr}")
+            continue
         m = common.metrics(exr, args.truth)
         setting = f"albedo={args.albedo} max_depth={args.max_depth}"
         rows.append(common.row(args.label, setting, spp, seconds, args.threads, version, m))
         print(f"{spp:5d} spp  {seconds:8.3f} s  FLIP {m['flip']:.5f}  RMSE {m['rmse']:.3e}  load {common.load_average():.2f}")
-    common.write_csv(os.path.join(args.out, "mitsuba.csv"), rows)
+    if rows:
+        common.write_csv(os.path.join(args.out, "mitsuba.csv"), rows)
 
 
 if __name__ == "__main__":
