@@ -36,6 +36,11 @@ echo "== Mitsuba: $VDB to .vol"
 if [ "$ALBEDO" = "0.0" ] || [ "$ALBEDO" = "0" ]; then
     echo "== truth: the exact Reference (optical depth of every voxel cell), ${SUPERSAMPLE:-8}^2 samples a pixel"
     "$VOLTEX" render "$SCENE" --method reference --supersample "${SUPERSAMPLE:-8}" -o "$OUT/truth.exr" | tail -n 1
+    echo "== the truth checked: voltex's Reference at the pixel centres against analytic.py's exact f64 transmittance"
+    "$VOLTEX" render "$SCENE" --method reference -o "$OUT/reference.exr" > /dev/null
+    "$BPY_VENV/bin/python" "$ROOT/tools/peers/analytic.py" --view "$OUT/export/view.json" --vdb "$VDB" \
+        --out "$OUT/analytic.exr" 2>/dev/null
+    echo "Reference against analytic: $("$VOLTEX" compare "$OUT/reference.exr" "$OUT/analytic.exr" --json)"
 else
     echo "== truth: Mitsuba at ${TRUTH_SPP:-1024} samples a pixel"
     "$PEERS_VENV/bin/python" "$ROOT/tools/peers/mitsuba_peer.py" --view "$OUT/export/view.json" --vol "$OUT/grid" \
