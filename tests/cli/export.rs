@@ -131,9 +131,23 @@ fn export_writes_volume_nodes_with_scaled_density_colour_and_world_transform() {
         volume_scene("smoke.vdb", "color: \"Cd\",", "(translate: (1.0, 2.0, 3.0), scale: (2.0, 2.0, 2.0))");
     std::fs::write(&scene, text).unwrap();
     let out = dir.join("vdb");
-    let text = common::ok(voltex(&["export", scene.to_str().unwrap(), "--out", out.to_str().unwrap(), "-q"]));
+    let text = common::ok(voltex(&[
+        "export",
+        scene.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "-q",
+        "--view",
+    ]));
     assert!(text.contains("volume \"fog\" of node \"cloud\"") && text.contains("density_scale 3"), "{text}");
-    assert_eq!(entries(&out), ["cloud.vdb"]);
+    assert_eq!(entries(&out), ["cloud.vdb", "view.json"]);
+    // The view other renderers are given: the scene's size and camera, the files written.
+    let view: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("view.json")).unwrap()).unwrap();
+    assert_eq!((view["width"].as_u64(), view["height"].as_u64()), (Some(16), Some(16)));
+    assert_eq!(view["camera"]["eye"], serde_json::json!([3.0, -6.0, 4.0]));
+    assert_eq!(view["camera"]["target"], serde_json::json!([1.0, 2.0, 3.0]));
+    assert_eq!(view["files"][0]["file"], "cloud.vdb");
     let source = common::root().join("scenes/volumes/smoke.vdb");
     let (src, src_map) = read_grid::<f32>(&source, "density");
     let (got, got_map) = read_grid::<f32>(&out.join("cloud.vdb"), "density");
