@@ -11,13 +11,27 @@ pub struct CompareArgs {
     /// Write the FLIP error heat map here (PNG).
     #[arg(long)]
     diff: Option<PathBuf>,
+    /// Print the metrics as one JSON object at full precision (flip, rel_rmse, rmse,
+    /// max_difference; for scripts such as tools/peers/).
+    #[arg(long)]
+    json: bool,
 }
 
 pub fn run(args: CompareArgs) -> Result<()> {
-    let CompareArgs { actual, reference, diff } = args;
+    let CompareArgs { actual, reference, diff, json } = args;
     let (a, _) = voltex::io::exr::read(&actual)?;
     let (r, _) = voltex::io::exr::read(&reference)?;
     let flip = metrics::flip(&a, &r)?;
+    if json {
+        let v = serde_json::json!({
+            "flip": flip.mean,
+            "rel_rmse": metrics::relative_rmse(&a, &r)?,
+            "rmse": rmse(&a, &r),
+            "max_difference": metrics::max_abs_diff(&a, &r)?,
+        });
+        println!("{v}");
+        return Ok(());
+    }
     println!("FLIP (mean)         {:.5}", flip.mean);
     println!("relative RMSE       {:.5}", metrics::relative_rmse(&a, &r)?);
     println!("largest difference  {:.3e}", metrics::max_abs_diff(&a, &r)?);
@@ -32,4 +46,15 @@ pub fn run(args: CompareArgs) -> Result<()> {
         println!("heat map            {}", path.display());
     }
     Ok(())
+}
+
+/// RMSE over pixels and R, G, B (sizes already checked by the metrics above).
+fn rmse(a: &voltex::io::Image, r: &voltex::io::Image) -> f64 {
+    let sum: f64 = a
+        .pixels
+        .iter()
+        .zip(&r.pixels)
+        .map(|(x, y)| (0..3).map(|c| (x[c] as f64 - y[c] as f64).powi(2)).sum::<f64>())
+        .sum();
+    (sum / (3 * a.pixels.len().max(1)) as f64).sqrt()
 }

@@ -1,4 +1,5 @@
-//! `voltex export`: texels and hypertexture nodes as OpenVDB files (`density` + `Cd`).
+//! `voltex export`: texels, hypertexture nodes and volume nodes as OpenVDB files (`density` +
+//! `Cd`).
 
 use std::path::PathBuf;
 
@@ -13,10 +14,11 @@ use voltex::{scene, Error, Result};
 pub struct ExportArgs {
     scene: PathBuf,
     /// Output folder (made if missing): one NAME.vdb per texel and per node drawing a
-    /// hypertexture.
+    /// hypertexture or a volume.
     #[arg(long)]
     out: PathBuf,
-    /// Export only this texel or hypertexture node (repeatable; default: all of them).
+    /// Export only this texel, hypertexture node or volume node (repeatable; default: all of
+    /// them).
     #[arg(long = "only", value_name = "NAME")]
     only: Vec<String>,
     /// Time of the bake in seconds (animated hypertextures, sequences, moving surfaces;
@@ -29,6 +31,10 @@ pub struct ExportArgs {
     /// How voxel values are stored.
     #[arg(long, value_enum, default_value_t = CompressionArg::Zip)]
     compression: CompressionArg,
+    /// Also write view.json: output size, camera, background and lights, for other renderers
+    /// (tools/peers/).
+    #[arg(long)]
+    view: bool,
     /// No progress on stderr (errors still show).
     #[arg(long, short)]
     quiet: bool,
@@ -70,7 +76,8 @@ pub fn run(args: ExportArgs) -> Result<()> {
             .map_err(|e| Error::file(&args.out, format!("cannot make the output folder: {e}")))?;
     }
     let verbosity = Verbosity::from_flags(args.quiet, false);
-    let result = write_all(&args.out, &exports, opts.compression, verbosity);
+    let view = args.view.then(|| export::view_json(&scene, &exports));
+    let result = write_all(&args.out, &exports, view, opts.compression, verbosity);
     if result.is_err() && made {
         let _ = std::fs::remove_dir(&args.out); // only if still empty
     }
@@ -80,12 +87,16 @@ pub fn run(args: ExportArgs) -> Result<()> {
 fn write_all(
     out: &std::path::Path,
     exports: &[export::Export],
+    view: Option<String>,
     compression: Compression,
     verbosity: Verbosity,
 ) -> Result<()> {
     voltex::io::atomic::check_writable_dir(out)?;
-    let ctx = GpuContext::new()?;
-    let mut baker = voltex::bake::Baker::full_precision(&Sources::project()?);
+    // Volume nodes are written from their grids: the GPU starts only for bakes.
+    let mut gpu = None;
+    if exports.iter().any(|e| e.needs_gpu()) {
+        gpu = Some((GpuContext::new()?, voltex::bake::Baker::full_precision(&Sources::project()?)));
+    }
     // Every file is staged first and renamed into place only when all are written.
     let mut staged = Vec::new();
     let mut lines = Vec::new();
@@ -93,7 +104,10 @@ fn write_all(
     for e in exports {
         let start = std::time::Instant::now();
         progress.started(&e.name);
-        let rgba = export::bake(&ctx, &mut baker, e)?;
+        let rgba = match &mut gpu {
+            Some((ctx, baker)) if e.needs_gpu() => export::bake(ctx, baker, e)?,
+            _ => Vec::new(),
+        };
         let grids = export::grids(e, &rgba);
         let path = export::path_in(out, e);
         staged.push(voltex::io::vdb::stage(&path, &grids, compression)?);
@@ -101,18 +115,30 @@ fn write_all(
             voltex::io::vdb::GridData::Float(v) => v.active_count(),
             _ => 0,
         };
-        let [x, y, z] = e.request.resolution;
+        let [x, y, z] = e.resolution();
         let ms = start.elapsed().as_secs_f64() * 1e3;
         progress.finished(&e.name, &format!("{} {x}x{y}x{z}: {ms:.0} ms", e.what), true, false);
+        let convention = match &e.source {
+            export::Source::Bake { opacity_length, .. } => {
+                format!("opacity length {}", *opacity_length as f32)
+            }
+            export::Source::Volume { density_scale, .. } => format!("density_scale {density_scale} applied"),
+        };
         lines.push(format!(
-            "{}  {} {x}x{y}x{z}, {active} active voxels, opacity length {}, {ms:.0} ms{}",
+            "{}  {} {x}x{y}x{z}, {active} active voxels, {convention}, {ms:.0} ms{}",
             path.display(),
             e.what,
-            e.opacity_length as f32,
             e.note.as_ref().map(|n| format!("\n    note: {n}")).unwrap_or_default()
         ));
     }
     progress.end();
+    if let Some(json) = view {
+        let path = out.join("view.json");
+        staged.push(voltex::io::atomic::stage(&path, |tmp| {
+            std::fs::write(tmp, json).map_err(|e| Error::file(&path, format!("cannot write: {e}")))
+        })?);
+        lines.push(format!("{}  the view: size, camera, background, lights", path.display()));
+    }
     for s in staged {
         s.commit()?;
     }

@@ -93,7 +93,8 @@ pub struct Overrides {
     /// Render graph file (default: graphs/frame.ron).
     #[arg(long)]
     graph: Option<PathBuf>,
-    /// Render every textured object with this method (its lighting mode is kept).
+    /// Render every textured object with this method (its lighting mode is kept); `reference`
+    /// also switches RayMarch volume objects to the exact Reference.
     #[arg(long, value_enum)]
     method: Option<MethodArg>,
     /// Render N x N samples per pixel and average them (anti-aliasing; e.g. 2 or 4).

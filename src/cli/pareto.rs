@@ -51,6 +51,11 @@ pub struct ParetoCmd {
     /// object's own shading).
     #[arg(long, value_delimiter = ',', value_parser = super::parse_shadows)]
     ray_shadows: Vec<super::ShadowsArg>,
+    /// CSV files of other renderers' renders of the same scene (tools/peers/: renderer,setting,
+    /// samples,seconds,threads,version,rmse,rel_rmse,flip), shown beside voltex's methods in
+    /// the tables and the chart.
+    #[arg(long, num_args = 1..)]
+    peers: Vec<PathBuf>,
 }
 
 fn parse_adaptive(s: &str) -> std::result::Result<(f64, f64), String> {
@@ -119,5 +124,6 @@ pub fn run(p: ParetoCmd) -> Result<()> {
         ray_segments: p.ray_segments.into_iter().map(segments).collect(),
         ray_adaptive: p.ray_adaptive,
         ray_shadows: p.ray_shadows.into_iter().map(|s| s.0).collect(),
+        peers: p.peers,
     })
 }

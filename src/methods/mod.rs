@@ -103,7 +103,9 @@ pub fn plan_object(
         methods.push(Box::new(base_surface::BaseSurfacePlan { vertices }));
     }
     let chosen = opts.object_methods.iter().find(|(n, _)| *n == object.name).map(|(_, m)| m);
-    let method = chosen.or(object.method.as_ref()).map(|m| opts.apply(m));
+    let volume = object.volume.is_some();
+    let method =
+        chosen.or(object.method.as_ref()).map(|m| if volume { opts.apply_volume(m) } else { opts.apply(m) });
     let mut plan = ObjectPlan { object, shell, per_pixel: false, frames: None, bake: None, methods };
     if let Some(method) = method {
         plan_method(cx, &mut plan, &method)?;

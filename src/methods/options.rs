@@ -72,6 +72,23 @@ pub const DEFAULT_AXIS_SLICES: AxisSlices = AxisSlices {
 pub const DEFAULT_PLANES: u32 = 400;
 
 impl RenderOptions {
+    /// A volume object's method after the overrides. RayMarch and Reference both draw volumes:
+    /// `--method reference` switches a RayMarch volume to the exact Reference (lit per pixel,
+    /// with shadows, when it was shaded at all) with `--step`; otherwise as [`apply`](Self::apply).
+    pub fn apply_volume(&self, method: &Method) -> Method {
+        match (self.method, method) {
+            (Some(MethodKind::Reference), Method::RayMarch(rm)) => Method::Reference(Reference {
+                step: self.step,
+                lighting: if rm.shading == Shading::None {
+                    crate::scene::Lighting::Baked
+                } else {
+                    crate::scene::Lighting::PerPixel
+                },
+            }),
+            _ => self.apply(method),
+        }
+    }
+
     /// An object's method after the overrides: switched to `method` if given, knobs replaced.
     pub fn apply(&self, method: &Method) -> Method {
         if let Method::RayMarch(rm) = method {

@@ -8,6 +8,7 @@
 
 pub mod front;
 pub mod measure;
+pub mod peers;
 mod report;
 pub mod svg;
 
@@ -20,6 +21,7 @@ use crate::gpu::GpuContext;
 use crate::io::{atomic, Image};
 use crate::methods::options::shadows_name;
 use crate::methods::reference::ReferencePlan;
+use crate::methods::volume::VolumePlan;
 use crate::progress::{Progress, Verbosity};
 use crate::render::{Blueprint, MethodKind, RenderOptions};
 use crate::scene::{Scene, Segments, Shadows, MAX_PLANES};
@@ -148,6 +150,8 @@ pub struct Args {
     /// `RayMarch` shadows, each swept over every step (`None`: Phong without shadows); empty:
     /// each object's own.
     pub ray_shadows: Vec<Option<Shadows>>,
+    /// CSV files of other renderers' rows ([`peers`]), shown beside voltex's.
+    pub peers: Vec<PathBuf>,
 }
 
 /// One point of the sweep.
@@ -325,8 +329,8 @@ pub fn sweep(scene: &Scene, args: &Args) -> Result<(Vec<Setting>, Vec<String>)> 
                 Err(e) => notes.push(format!("Reference: not measured: {e}")),
             },
             Sweep::Method(MethodKind::AxisSlices) => settings.extend(axis_slices(args)),
-            Sweep::RayMarch if scene.hypertextures.is_empty() => {
-                notes.push("RayMarch: not measured: no hypertexture".into())
+            Sweep::RayMarch if scene.hypertextures.is_empty() && scene.volumes.is_empty() => {
+                notes.push("RayMarch: not measured: no hypertexture and no volume".into())
             }
             Sweep::RayMarch => settings.extend(ray_march(args)),
         }
@@ -335,16 +339,21 @@ pub fn sweep(scene: &Scene, args: &Args) -> Result<(Vec<Setting>, Vec<String>)> 
 }
 
 /// The `Reference` method's default step for the scene: the smallest of its textured objects'
-/// default steps (half the smallest voxel extent, see `methods::reference::default_step`).
+/// default steps (half the smallest voxel extent, see `methods::reference::default_step`) and
+/// its volume objects' (a quarter voxel; the exact cells need no step, their shadow rays do).
 pub fn reference_default_step(scene: &Scene, size: (u32, u32)) -> Result<Option<f64>> {
     let opts = RenderOptions { size: Some(size), method: Some(MethodKind::Reference), ..Default::default() };
     let bp = Blueprint::new(scene, &opts)?;
-    Ok(bp.objects.iter().filter_map(|o| Some(o.method::<ReferencePlan>()?.step)).min_by(f64::total_cmp))
+    let textured = bp.objects.iter().filter_map(|o| Some(o.method::<ReferencePlan>()?.step));
+    let volumes =
+        bp.objects.iter().filter_map(|o| o.method::<VolumePlan>().filter(|p| p.exact).map(|p| p.step));
+    Ok(textured.chain(volumes).min_by(f64::total_cmp))
 }
 
 pub fn run(args: &Args) -> Result<()> {
     args.check()?;
     let scene = crate::scene::load(&args.scene)?;
+    let peer_rows = args.peers.iter().map(|p| peers::read(p)).collect::<Result<Vec<_>>>()?.concat();
     let Planned { settings, blueprints, mut notes } = plan(&scene, args)?;
     // Fail on the output folder before any GPU work.
     let out = args.out_dir();
@@ -391,9 +400,12 @@ pub fn run(args: &Args) -> Result<()> {
         args.size.1,
         args.truth
     );
-    atomic::write_bytes(&svg_path, report::chart(&rows, &title, ctx.has_timestamps()).as_bytes())?;
+    atomic::write_bytes(
+        &svg_path,
+        report::chart(&rows, &peer_rows, &title, ctx.has_timestamps()).as_bytes(),
+    )?;
     crate::io::png::write_tonemapped(&out.join("truth.png"), &truth)?;
-    report::print_report(args, &ctx, &rows, &notes, load);
+    report::print_report(args, &ctx, &rows, &peer_rows, &notes, load);
     println!("wrote {}, {} and truth.png", csv_path.display(), svg_path.display());
     Ok(())
 }

@@ -1,6 +1,7 @@
 //! What `voltex pareto` hands back: the measured rows with their fronts, `pareto.csv`, the
 //! chart's series and the printed tables.
 
+use super::peers::PeerRow;
 use super::{front, measure, svg, unique, Args, Setting};
 use crate::error::Result;
 use crate::gpu::GpuContext;
@@ -123,8 +124,8 @@ pub(super) fn csv(rows: &[Row]) -> String {
     s
 }
 
-pub(super) fn chart(rows: &[Row], title: &str, timestamps: bool) -> String {
-    let series: Vec<svg::Series> = unique(rows.iter().map(|r| r.setting.method))
+pub(super) fn chart(rows: &[Row], peers: &[PeerRow], title: &str, timestamps: bool) -> String {
+    let mut series: Vec<svg::Series> = unique(rows.iter().map(|r| r.setting.method))
         .into_iter()
         .map(|m| svg::Series {
             label: m.to_string(),
@@ -140,10 +141,27 @@ pub(super) fn chart(rows: &[Row], title: &str, timestamps: bool) -> String {
                 .collect(),
         })
         .collect();
-    let x_label = if timestamps {
-        "GPU time per frame (ms, log): sum of pass medians"
-    } else {
-        "wall time per frame (ms, log)"
+    for name in unique(peers.iter().map(|p| p.renderer.as_str())) {
+        let points = peers
+            .iter()
+            .filter(|p| p.renderer == name)
+            .map(|p| svg::Point {
+                x: p.seconds * 1e3,
+                y: p.flip,
+                label: format!(
+                    "{name} {} {} spp, {} threads, {}",
+                    p.setting, p.samples, p.threads, p.version
+                ),
+                tag: format!("{} spp", p.samples),
+            })
+            .collect();
+        series.push(svg::Series { label: name.to_string(), points });
+    }
+    let x_label = match (timestamps, peers.is_empty()) {
+        (true, true) => "GPU time per frame (ms, log): sum of pass medians",
+        (false, true) => "wall time per frame (ms, log)",
+        (true, false) => "time per frame (ms, log): voltex GPU time (pass medians), peers wall time",
+        (false, false) => "wall time per frame (ms, log), voltex and peers",
     };
     svg::render(&svg::Chart { title, x_label, y_label: "error: mean FLIP (log)", series: &series })
 }
@@ -174,7 +192,14 @@ pub(super) fn load_average() -> Option<f64> {
     std::fs::read_to_string("/proc/loadavg").ok()?.split_whitespace().next()?.parse().ok()
 }
 
-pub(super) fn print_report(args: &Args, ctx: &GpuContext, rows: &[Row], notes: &[String], load: Option<f64>) {
+pub(super) fn print_report(
+    args: &Args,
+    ctx: &GpuContext,
+    rows: &[Row],
+    peers: &[PeerRow],
+    notes: &[String],
+    load: Option<f64>,
+) {
     println!("pareto: {} at {}x{}, truth: {}", args.scene.display(), args.size.0, args.size.1, args.truth);
     println!("adapter: {}", ctx.adapter_line());
     if ctx.has_timestamps() {
@@ -221,4 +246,24 @@ pub(super) fn print_report(args: &Args, ctx: &GpuContext, rows: &[Row], notes: &
         table(&format!("{m} front:"), ids);
     }
     table("overall front:", (0..rows.len()).filter(|&i| rows[i].overall_front).collect());
+    if !peers.is_empty() {
+        println!("\npeers (--peers; wall time of the whole render on the CPU threads given):");
+        println!("| renderer | setting | samples | ms | threads | version | FLIP | rel RMSE | RMSE | from |");
+        println!("|---|---|---|---|---|---|---|---|---|---|");
+        for p in peers {
+            println!(
+                "| {} | {} | {} | {:.1} | {} | {} | {:.4} | {:.4} | {:.2e} | {} |",
+                p.renderer,
+                p.setting,
+                p.samples,
+                p.seconds * 1e3,
+                p.threads,
+                p.version,
+                p.flip,
+                p.rel_rmse,
+                p.rmse,
+                p.at
+            );
+        }
+    }
 }

@@ -1,7 +1,8 @@
 //! `voltex export`: every texel, and the hypertexture of every node that draws one, baked on the
 //! GPU by the render's own kernels at full precision (f32, [`Baker::full_precision`]) and turned
 //! into OpenVDB grids that Blender, Houdini and Mitsuba render: a float `density` (fog volume)
-//! and a vec3 `Cd` colour, with the index-to-world transform.
+//! and a vec3 `Cd` colour, with the index-to-world transform. Volume objects (nodes drawing an
+//! OpenVDB grid) are written from the grid as read, voxel for voxel ([`volume_grids`]).
 //!
 //! Density is the extinction coefficient per world unit: a voxel of opacity `a` over the opacity
 //! length `L` (a world length; every method composites `1 - (1 - a)^(step / L)`) has
@@ -12,6 +13,7 @@
 //! their baked shading.
 
 use std::path::Path;
+use std::sync::Arc;
 
 use glam::{DMat4, DVec3, DVec4};
 
@@ -23,6 +25,7 @@ use crate::io::vdb::{self, Grid, GridClass, GridData, Voxels};
 use crate::mesh::BaseSurface;
 use crate::methods::view::Lighting;
 use crate::scene::{Scene, TexelSource};
+use crate::vdb::SparseVolume;
 
 /// The transmittance of one voxel (its smallest world side) of opacity 1.
 pub const OPAQUE_TRANSMITTANCE: f64 = 1e-4;
@@ -54,14 +57,23 @@ impl Default for ExportOptions {
     }
 }
 
-/// One volume to write: its file stem, what it is, its bake and where it lies.
+/// Where an export's voxels come from.
+#[derive(Debug)]
+pub enum Source {
+    /// A texel or a hypertexture, baked on the GPU; `opacity_length` is the world length over
+    /// which a voxel's alpha is reached.
+    Bake { request: BakeRequest, opacity_length: f64 },
+    /// A volume object's grid as read from its file, with its volume's `density_scale` and
+    /// `albedo`.
+    Volume { grid: Arc<SparseVolume>, density_scale: f64, albedo: [f32; 3] },
+}
+
+/// One volume to write: its file stem, what it is, its voxels and where they lie.
 #[derive(Debug)]
 pub struct Export {
     pub name: String,
     pub what: String,
-    pub request: BakeRequest,
-    /// World length over which a voxel's alpha is reached.
-    pub opacity_length: f64,
+    pub source: Source,
     /// Voxel `(i, j, k)` (the bake's voxel centre) to world.
     pub index_to_world: DMat4,
     /// How the transform was found, when that is not exact.
@@ -100,8 +112,10 @@ pub fn plan(scene: &Scene, opts: &ExportOptions) -> Result<Vec<Export>> {
             name: name.clone(),
             what: format!("texel \"{name}\""),
             index_to_world: texel_to_world * index_to_box(DVec3::ZERO, DVec3::ONE, request.resolution),
-            request,
-            opacity_length: texel.opacity_length(&scene.hypertextures) as f64,
+            source: Source::Bake {
+                request,
+                opacity_length: texel.opacity_length(&scene.hypertextures) as f64,
+            },
             note: if lit { Some(join(note, "a slice stack: Cd holds its baked shading")) } else { note },
         });
     }
@@ -119,16 +133,35 @@ pub fn plan(scene: &Scene, opts: &ExportOptions) -> Result<Vec<Export>> {
         out.push(Export {
             name: o.name.clone(),
             what: format!("hypertexture \"{}\" of node \"{}\"", node.name, o.name),
-            request: BakeRequest {
-                resolution,
-                source: BakeSource::Hypertexture(Box::new(texel)),
-                per_pixel: true,
-                light: light.direction,
-                ambient: light.ambient,
-                axis_slices: false,
+            source: Source::Bake {
+                request: BakeRequest {
+                    resolution,
+                    source: BakeSource::Hypertexture(Box::new(texel)),
+                    per_pixel: true,
+                    light: light.direction,
+                    ambient: light.ambient,
+                    axis_slices: false,
+                },
+                opacity_length: h.opacity_length,
             },
-            opacity_length: h.opacity_length,
             index_to_world: node.to_world * index_to_box(lo, hi, resolution),
+            note: None,
+        });
+    }
+    for o in &objects {
+        let Some(node) = &o.volume else { continue };
+        let v = scene.volumes.get(&node.name).ok_or_else(|| {
+            Error::Invalid(format!("{}: unknown volume `{}`", scene.path.display(), node.name))
+        })?;
+        out.push(Export {
+            name: o.name.clone(),
+            what: format!("volume \"{}\" of node \"{}\"", node.name, o.name),
+            source: Source::Volume {
+                grid: node.grid.clone(),
+                density_scale: v.density_scale,
+                albedo: v.albedo,
+            },
+            index_to_world: node.to_world * node.grid.index_to_world,
             note: None,
         });
     }
@@ -141,13 +174,13 @@ fn select(scene: &Scene, all: Vec<Export>, only: &[String]) -> Result<Vec<Export
     if let Some(unknown) = only.iter().find(|n| !all.iter().any(|e| &e.name == *n)) {
         let names: Vec<&str> = all.iter().map(|e| e.name.as_str()).collect();
         return Err(at(format!(
-            "--only {unknown:?}: expected a texel or a hypertexture node of the scene: {}",
+            "--only {unknown:?}: expected a texel, a hypertexture node or a volume node of the scene: {}",
             if names.is_empty() { "it has none".to_string() } else { names.join(", ") }
         )));
     }
     let chosen: Vec<Export> = all.into_iter().filter(|e| only.is_empty() || only.contains(&e.name)).collect();
     if chosen.is_empty() {
-        return Err(at("the scene has no texel and no hypertexture node to export".into()));
+        return Err(at("the scene has no texel, hypertexture node or volume node to export".into()));
     }
     for (i, e) in chosen.iter().enumerate() {
         if let Some(other) = chosen[..i].iter().find(|o| o.name == e.name) {
@@ -157,14 +190,16 @@ fn select(scene: &Scene, all: Vec<Export>, only: &[String]) -> Result<Vec<Export
             )));
         }
         file_name(&e.name).map_err(|m| at(format!("{}: {m}", e.what)))?;
-        let [x, y, z] = e.request.resolution;
+        // A volume object's grid is already in memory, as sparse as its file.
+        let Source::Bake { request, .. } = &e.source else { continue };
+        let [x, y, z] = request.resolution;
         let voxels = x as u64 * y as u64 * z as u64;
         if voxels > MAX_EXPORT_VOXELS {
             return Err(at(format!(
                 "{}: {x}x{y}x{z} = {voxels} voxels, more than the {MAX_EXPORT_VOXELS} one export may have \
                  (16 bytes a voxel are read back): lower its resolution{}",
                 e.what,
-                if matches!(e.request.source, BakeSource::Hypertexture(_)) { " (--resolution)" } else { "" }
+                if matches!(request.source, BakeSource::Hypertexture(_)) { " (--resolution)" } else { "" }
             )));
         }
     }
@@ -186,32 +221,42 @@ pub fn file_name(name: &str) -> std::result::Result<String, String> {
     Ok(format!("{name}.vdb"))
 }
 
+impl Export {
+    /// Voxels per axis: the bake's, or the box of a volume's voxels with density.
+    pub fn resolution(&self) -> [u32; 3] {
+        match &self.source {
+            Source::Bake { request, .. } => request.resolution,
+            Source::Volume { grid, .. } => (grid.hi - grid.lo + 1).as_uvec3().to_array(),
+        }
+    }
+
+    /// A volume written from its grid needs no GPU.
+    pub fn needs_gpu(&self) -> bool {
+        matches!(self.source, Source::Bake { .. })
+    }
+}
+
 /// Bakes `e` with `baker` (a [`Baker::full_precision`]) and reads the volume back: premultiplied
 /// RGBA, x fastest, then y, then z.
 pub fn bake(ctx: &GpuContext, baker: &mut Baker, e: &Export) -> Result<Vec<[f32; 4]>> {
+    let Source::Bake { request, .. } = &e.source else {
+        return Err(Error::Invalid(format!("{} is not baked", e.what)));
+    };
     if baker.format() != wgpu::TextureFormat::Rgba32Float {
         return Err(Error::Invalid("export needs a full-precision baker".into()));
     }
-    let baked = baker.bake(ctx, &e.request)?;
+    let baked = baker.bake(ctx, request)?;
     let bytes = crate::bake::axis_slices::read_texture(ctx, &baked.volume, 16)?;
     Ok(bytemuck::pod_collect_to_vec(&bytes))
 }
 
-/// The `density` and `Cd` grids of `e` from its baked volume.
+/// The `density` and `Cd` grids of `e`: from its baked volume `rgba` ([`bake`]; empty for a
+/// volume object, which is written from its grid).
 pub fn grids(e: &Export, rgba: &[[f32; 4]]) -> Vec<Grid> {
-    let [nx, ny, _] = e.request.resolution;
-    let at = |[i, j, k]: [u32; 3]| rgba[(k as usize * ny as usize + j as usize) * nx as usize + i as usize];
-    let voxel = (0..3).map(|a| e.index_to_world.col(a).truncate().length()).fold(f64::INFINITY, f64::min);
-    let opaque = density(1.0 - 2f64.powi(-20), e.opacity_length).max(-OPAQUE_TRANSMITTANCE.ln() / voxel);
-    let first = [0; 3];
-    let density = Voxels::from_dense(first, e.request.resolution, |ijk| {
-        let a = at(ijk)[3] as f64;
-        (a > 0.0).then(|| if a >= 1.0 { opaque } else { density(a, e.opacity_length).min(opaque) } as f32)
-    });
-    let colour = Voxels::from_dense(first, e.request.resolution, |ijk| {
-        let [r, g, b, a] = at(ijk);
-        (a > 0.0).then(|| [r / a, g / a, b / a])
-    });
+    let (density, colour) = match &e.source {
+        Source::Bake { request, opacity_length } => baked_grids(request.resolution, *opacity_length, e, rgba),
+        Source::Volume { grid, density_scale, albedo } => volume_grids(grid, *density_scale, *albedo),
+    };
     vec![
         Grid {
             name: "density".into(),
@@ -226,6 +271,61 @@ pub fn grids(e: &Export, rgba: &[[f32; 4]]) -> Vec<Grid> {
             data: GridData::Vec3(colour),
         },
     ]
+}
+
+fn baked_grids(
+    resolution: [u32; 3],
+    opacity_length: f64,
+    e: &Export,
+    rgba: &[[f32; 4]],
+) -> (Voxels<f32>, Voxels<[f32; 3]>) {
+    let [nx, ny, _] = resolution;
+    let at = |[i, j, k]: [u32; 3]| rgba[(k as usize * ny as usize + j as usize) * nx as usize + i as usize];
+    let voxel = (0..3).map(|a| e.index_to_world.col(a).truncate().length()).fold(f64::INFINITY, f64::min);
+    let opaque = density(1.0 - 2f64.powi(-20), opacity_length).max(-OPAQUE_TRANSMITTANCE.ln() / voxel);
+    let first = [0; 3];
+    let density = Voxels::from_dense(first, resolution, |ijk| {
+        let a = at(ijk)[3] as f64;
+        (a > 0.0).then(|| if a >= 1.0 { opaque } else { density(a, opacity_length).min(opaque) } as f32)
+    });
+    let colour = Voxels::from_dense(first, resolution, |ijk| {
+        let [r, g, b, a] = at(ijk);
+        (a > 0.0).then(|| [r / a, g / a, b / a])
+    });
+    (density, colour)
+}
+
+/// A volume object's grids, at the file's own voxels: `density` is the voxel's density times
+/// `density_scale` in f32 (the product the kernel forms, so a re-import with scale 1 draws the
+/// same extinction), active where it is not 0; `Cd` is `albedo` times the colour grid (white
+/// without one), written at every voxel the brick of a leaf with density reaches, so that its
+/// interpolant over the cells with density is the one the object was drawn with.
+pub fn volume_grids(
+    grid: &SparseVolume,
+    density_scale: f64,
+    albedo: [f32; 3],
+) -> (Voxels<f32>, Voxels<[f32; 3]>) {
+    use crate::vdb::sparse::{BRICK, BRICK_VALUES, LEAF};
+    let scale = density_scale as f32;
+    let (mut density, mut colour) = (Voxels::new(), Voxels::new());
+    for (first, brick) in grid.leaf_bricks() {
+        for n in 0..BRICK_VALUES {
+            let local = glam::IVec3::new(
+                (n % BRICK) as i32,
+                (n / BRICK % BRICK) as i32,
+                (n / (BRICK * BRICK)) as i32,
+            );
+            let ijk = (first + local).to_array();
+            let at = brick * BRICK_VALUES + n;
+            let d = grid.density[at];
+            if local.max_element() < LEAF && d != 0.0 {
+                density.set(ijk, d * scale);
+            }
+            let c = grid.color.as_ref().map_or([1.0; 3], |c| c[at]);
+            colour.set(ijk, [0, 1, 2].map(|i| albedo[i] * c[i]));
+        }
+    }
+    (density, colour)
 }
 
 /// Extinction per world unit of opacity `a` reached over `length`.
@@ -295,6 +395,39 @@ fn join(a: Option<String>, b: &str) -> String {
         Some(a) => format!("{a}; {b}"),
         None => b.to_string(),
     }
+}
+
+/// The scene's view for other renderers (`voltex export --view`, read by `tools/peers/`): the
+/// output size, the camera (a pinhole through pixel centres, `fov_y` the vertical field of view
+/// in degrees), background, ambient term and lights (each travelling along `direction`), and the
+/// files written.
+pub fn view_json(scene: &Scene, exports: &[Export]) -> String {
+    let cam = &scene.camera.value;
+    let v = |d: DVec3| [d.x, d.y, d.z];
+    let lights: Vec<_> = scene
+        .lights
+        .iter()
+        .map(|l| match l {
+            crate::scene::Light::Directional { direction, color, intensity } => serde_json::json!({
+                "type": "directional", "direction": v(*direction), "color": color, "intensity": intensity,
+            }),
+        })
+        .collect();
+    let files: Vec<_> = exports
+        .iter()
+        .map(|e| serde_json::json!({ "file": format!("{}.vdb", e.name), "what": e.what }))
+        .collect();
+    let json = serde_json::json!({
+        "scene": scene.path.display().to_string(),
+        "width": scene.output.width,
+        "height": scene.output.height,
+        "camera": { "eye": v(cam.eye), "target": v(cam.target), "up": v(cam.up), "fov_y": cam.fov_y },
+        "background": scene.background,
+        "ambient": scene.ambient,
+        "lights": lights,
+        "files": files,
+    });
+    serde_json::to_string_pretty(&json).unwrap_or_default() + "\n"
 }
 
 /// The output file of `e` in `dir`.

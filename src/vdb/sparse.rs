@@ -243,6 +243,34 @@ impl SparseVolume {
         (self.density.len() / BRICK_VALUES) as u64
     }
 
+    /// Every leaf with a brick: the index of its first voxel and its brick number (table
+    /// order). A brick's values at `(x, y, z)` in `0..BRICK` are those of voxel `first + (x,
+    /// y, z)`; its last layer belongs to the next leaf.
+    pub fn leaf_bricks(&self) -> Vec<(IVec3, usize)> {
+        let mut out = Vec::new();
+        for (cell, &node) in self.table[..(self.top.x * self.top.y * self.top.z) as usize].iter().enumerate()
+        {
+            if node == NO_NODE {
+                continue;
+            }
+            let cell = cell as u32;
+            let t = UVec3::new(
+                cell % self.top.x,
+                cell / self.top.x % self.top.y,
+                cell / (self.top.x * self.top.y),
+            );
+            for (l, &brick) in self.table[node as usize..node as usize + NODE_ENTRIES].iter().enumerate() {
+                if brick != 0 {
+                    let l = l as i32;
+                    let leaf = IVec3::new(l % NODE, l / NODE % NODE, l / (NODE * NODE));
+                    let first = self.origin + t.as_ivec3() * (LEAF * NODE) + leaf * LEAF;
+                    out.push((first, brick as usize));
+                }
+            }
+        }
+        out
+    }
+
     /// The brick holding the cell whose lower corner is voxel `c`, and `c` within it.
     fn locate(&self, c: IVec3) -> Option<(usize, IVec3)> {
         let rel = c - self.origin;

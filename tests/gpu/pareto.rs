@@ -326,3 +326,54 @@ fn ray_march_step_sweep() {
     assert!(text(&none).contains("no hypertexture"), "{}", text(&none));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `--peers`: the rows of other renderers (tools/peers/ on the absorbing box, checked in as
+/// tests/peers/absorbing_box.csv) stand beside voltex's volume settings, which the sweep now
+/// measures on a volume scene (Reference switched from RayMarch, RayMarch's step): in the
+/// printed table and as their own series in the chart. A bad row fails at its file:line:col
+/// before any rendering, and nothing is written.
+#[test]
+fn peers_join_the_table_and_the_chart() {
+    let dir = temp_dir("peers");
+    let out = dir.join("result");
+    let scene = root().join("scenes/volumes/absorbing_box.ron");
+    let csv = root().join("tests/peers/absorbing_box.csv");
+    let (scene, csv, o) = (scene.to_str().unwrap(), csv.to_str().unwrap(), out.to_str().unwrap());
+    let common = ["--size", "32x32", "--frames", "1", "--methods", "reference,ray-march", "--steps", "8"];
+    let run =
+        pareto(&[&[scene], &common[..], &["--ray-steps", "0.0625", "--out", o, "--peers", csv]].concat());
+    let log = text(&run);
+    println!("{log}");
+    assert_eq!(run.status.code(), Some(0), "{log}");
+    let peers = std::fs::read_to_string(root().join("tests/peers/absorbing_box.csv")).unwrap();
+    let rows = peers.lines().filter(|l| !l.starts_with('#') && !l.trim().is_empty()).count() - 1;
+    assert!(log.contains("peers (--peers"), "{log}");
+    assert!(log.contains("| Mitsuba volpath |") && log.contains("| Cycles |"), "{log}");
+    assert!(
+        log.contains(&format!("absorbing_box.csv:{}", peers.lines().count())),
+        "every row names its line: {log}"
+    );
+    let (header, measured) = read_csv(&out.join("pareto.csv"));
+    let method = header.iter().position(|h| h == "method").unwrap();
+    for m in ["Reference", "RayMarch"] {
+        assert!(measured.iter().any(|r| r[method] == m), "{m} measured on the volume: {measured:?}");
+    }
+    let svg = std::fs::read_to_string(out.join("pareto.svg")).unwrap();
+    assert!(
+        svg.contains(">Mitsuba volpath</text>") && svg.contains(">Cycles</text>"),
+        "peer series in the legend"
+    );
+    assert_eq!(svg.matches(r#"class="point""#).count(), measured.len() + rows);
+
+    let bad = dir.join("bad.csv");
+    std::fs::write(&bad, peers.replacen(",2,", ",two,", 1)).unwrap();
+    let bad_out = dir.join("bad-result");
+    let args =
+        [&[scene], &common[..], &["--out", bad_out.to_str().unwrap(), "--peers", csv, bad.to_str().unwrap()]];
+    let run = pareto(&args.concat());
+    let log = text(&run);
+    assert_eq!(run.status.code(), Some(1), "{log}");
+    assert!(log.contains(&format!("{}:", bad.display())) && log.contains("`threads` is `two`"), "{log}");
+    assert!(!log.contains("panicked") && !bad_out.exists(), "{log}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
