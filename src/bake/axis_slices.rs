@@ -25,14 +25,21 @@ pub fn image_size(res: [u32; 3], direction: usize) -> [u32; 2] {
     }
 }
 
-/// Bytes of the slice arrays (f16 RGBA) and occupancy words of a texel.
-pub fn bytes(res: [u32; 3]) -> u64 {
-    (0..3)
-        .map(|d| {
-            let [w, h] = image_size(res, d);
-            (w as u64 * h as u64 * 8 + 4) * array_layers(res[d]) as u64
-        })
-        .sum()
+/// Bytes of the slice arrays (f16 RGBA, with their MIP levels when `mipmaps`) and occupancy
+/// words of a texel.
+pub fn bytes(res: [u32; 3], mipmaps: bool) -> u64 {
+    (0..3).map(|d| (image_bytes(image_size(res, d), mipmaps) + 4) * array_layers(res[d]) as u64).sum()
+}
+
+/// Bytes of one f16 RGBA slice image of `size`, with its MIP levels when `mipmaps`.
+pub fn image_bytes(size: [u32; 2], mipmaps: bool) -> u64 {
+    let levels = if mipmaps { mip_levels(size) } else { 1 };
+    (0..levels).map(|l| (size[0] >> l).max(1) as u64 * (size[1] >> l).max(1) as u64 * 8).sum()
+}
+
+/// MIP levels of a slice image of `size`, down to 1x1.
+pub fn mip_levels(size: [u32; 2]) -> u32 {
+    32 - size[0].max(size[1]).max(1).leading_zeros()
 }
 
 /// Records the bake of every level of every direction from `volume` (level 0 is read).
@@ -42,6 +49,7 @@ pub fn bake(
     encoder: &mut wgpu::CommandEncoder,
     volume: &wgpu::Texture,
     res: [u32; 3],
+    mipmaps: bool,
 ) -> Result<AxisBaked> {
     let max_layers = ctx.limits.max_texture_array_layers;
     if let Some(d) = (0..3).find(|&d| array_layers(res[d]) > max_layers) {
@@ -65,7 +73,7 @@ pub fn bake(
         ctx.device.create_texture(&wgpu::TextureDescriptor {
             label: Some(["axis_slices_s", "axis_slices_t", "axis_slices_w"][d]),
             size: wgpu::Extent3d { width: w, height: h, depth_or_array_layers: array_layers(res[d]) },
-            mip_level_count: 1,
+            mip_level_count: if mipmaps { mip_levels([w, h]) } else { 1 },
             sample_count: 1,
             dimension: wgpu::TextureDimension::D2,
             format: wgpu::TextureFormat::Rgba16Float,
@@ -79,6 +87,7 @@ pub fn bake(
     for (d, array) in arrays.iter().enumerate() {
         let destination = array.create_view(&wgpu::TextureViewDescriptor {
             dimension: Some(wgpu::TextureViewDimension::D2Array),
+            mip_level_count: Some(1),
             ..Default::default()
         });
         for level in 0..level_count(res[d]) {
@@ -102,11 +111,49 @@ pub fn bake(
     Ok(AxisBaked { arrays, occupancy })
 }
 
+/// Records the MIP levels of every slice image of `baked` (level 0 baked), each from the one
+/// above by a 2x2 box of premultiplied colour (`mip_axis_slices.wgsl`).
+pub fn mip(
+    ctx: &GpuContext,
+    kernel: &mut ComputeKernel,
+    encoder: &mut wgpu::CommandEncoder,
+    baked: &AxisBaked,
+) -> Result<()> {
+    for array in &baked.arrays {
+        for level in 1..array.mip_level_count() {
+            let view = |level: u32| {
+                array.create_view(&wgpu::TextureViewDescriptor {
+                    dimension: Some(wgpu::TextureViewDimension::D2Array),
+                    base_mip_level: level,
+                    mip_level_count: Some(1),
+                    ..Default::default()
+                })
+            };
+            let mut inputs = Inputs::default();
+            inputs.views.insert("finer".into(), view(level - 1));
+            inputs.views.insert("coarser".into(), view(level));
+            let (w, h) = ((array.width() >> level).max(1), (array.height() >> level).max(1));
+            kernel.dispatch(ctx, encoder, &inputs, [w, h, array.depth_or_array_layers()])?;
+        }
+    }
+    Ok(())
+}
+
 /// Reads every layer (or depth slice) of level 0 of a texture back, tightly packed, in slabs of
 /// layers whose staging buffer stays under 64 MiB (a large float volume would pass the
 /// adapter's buffer size limit in one copy).
 pub fn read_texture(ctx: &GpuContext, texture: &wgpu::Texture, bytes_per_texel: u32) -> Result<Vec<u8>> {
-    let size = texture.size();
+    read_texture_level(ctx, texture, 0, bytes_per_texel)
+}
+
+/// [`read_texture`] of MIP level `level`.
+pub fn read_texture_level(
+    ctx: &GpuContext,
+    texture: &wgpu::Texture,
+    level: u32,
+    bytes_per_texel: u32,
+) -> Result<Vec<u8>> {
+    let size = texture.size().mip_level_size(level, texture.dimension());
     let row = size.width * bytes_per_texel;
     let padded = row.div_ceil(256) * 256;
     let layer = padded as u64 * size.height as u64;
@@ -125,7 +172,7 @@ pub fn read_texture(ctx: &GpuContext, texture: &wgpu::Texture, bytes_per_texel: 
         enc.copy_texture_to_buffer(
             wgpu::TexelCopyTextureInfo {
                 texture,
-                mip_level: 0,
+                mip_level: level,
                 origin: wgpu::Origin3d { x: 0, y: 0, z: first },
                 aspect: wgpu::TextureAspect::All,
             },

@@ -114,6 +114,8 @@ pub struct BakeRequest {
     pub ambient: f32,
     /// Also bake the slice images of axis-aligned slicing.
     pub axis_slices: bool,
+    /// ... with their MIP levels (`AxisSlices(mipmaps: true)`).
+    pub axis_mipmaps: bool,
 }
 
 impl BakeRequest {
@@ -138,6 +140,9 @@ impl BakeRequest {
         if self.axis_slices {
             k.push("axis_slices/bake_axis_slices.wgsl");
         }
+        if self.axis_slices && self.axis_mipmaps {
+            k.push("axis_slices/mip_axis_slices.wgsl");
+        }
         k
     }
 }
@@ -161,9 +166,10 @@ impl BakeRequest {
             bytes(self.resolution, self.per_pixel),
         )];
         if self.axis_slices {
+            let mips = if self.axis_mipmaps { " with MIP levels" } else { "" };
             out.push((
-                format!("texel {texel} slice images (s, t, w; all levels) rgba16f"),
-                axis_slices::bytes(self.resolution),
+                format!("texel {texel} slice images (s, t, w; all levels{mips}) rgba16f"),
+                axis_slices::bytes(self.resolution, self.axis_mipmaps),
             ));
         }
         out
@@ -208,7 +214,7 @@ impl BakeRequest {
                 let layers = axis_slices::array_layers(res[d]);
                 out.push(Allocation {
                     what: format!("texel \"{texel}\"'s {} slice images", ["s", "t", "w"][d]),
-                    bytes: size[0] as u64 * size[1] as u64 * 8 * layers as u64,
+                    bytes: axis_slices::image_bytes(size, self.axis_mipmaps) * layers as u64,
                     shape: Shape::Texture2d { size, layers },
                     driver: driver.clone(),
                 });
@@ -236,6 +242,9 @@ impl BakeRequest {
         let mut s = format!("  {texel:<16} {x}x{y}x{z}  {kind}  lighting {lighting}\n");
         if self.axis_slices {
             s += "  (and its slice images: bake_axis_slices.wgsl per direction and level)\n";
+            if self.axis_mipmaps {
+                s += "  (and their MIP levels: mip_axis_slices.wgsl per direction and MIP level)\n";
+            }
         }
         s
     }
@@ -257,6 +266,7 @@ pub struct Baker {
     transfer: Option<ComputeKernel>,
     axis: Option<ComputeKernel>,
     volume: Option<ComputeKernel>,
+    axis_mip: Option<ComputeKernel>,
     sources: Sources,
     /// `Rgba32Float` for [`Baker::full_precision`], else `Rgba8Unorm`.
     format: wgpu::TextureFormat,
@@ -274,6 +284,7 @@ impl Baker {
             transfer: None,
             axis: None,
             volume: None,
+            axis_mip: None,
             sources: sources.clone(),
             format: wgpu::TextureFormat::Rgba8Unorm,
         }
@@ -445,14 +456,22 @@ impl Baker {
         }
         let axis = match req.axis_slices {
             true => {
-                let kernel = Self::kernel(
-                    &mut self.axis,
-                    ctx,
-                    &root,
-                    "axis_slices/bake_axis_slices.wgsl",
-                    self.format,
-                )?;
-                Some(axis_slices::bake(ctx, kernel, &mut encoder, &volume, req.resolution)?)
+                let format = self.format;
+                let kernel =
+                    Self::kernel(&mut self.axis, ctx, &root, "axis_slices/bake_axis_slices.wgsl", format)?;
+                let baked =
+                    axis_slices::bake(ctx, kernel, &mut encoder, &volume, req.resolution, req.axis_mipmaps)?;
+                if req.axis_mipmaps {
+                    let mip = Self::kernel(
+                        &mut self.axis_mip,
+                        ctx,
+                        &root,
+                        "axis_slices/mip_axis_slices.wgsl",
+                        format,
+                    )?;
+                    axis_slices::mip(ctx, mip, &mut encoder, &baked)?;
+                }
+                Some(baked)
             }
             false => None,
         };

@@ -37,6 +37,8 @@ pub struct RenderOptions {
     pub time: Option<f64>,
     /// AxisSlices occlusion culling for every AxisSlices object (`--occlusion-culling`).
     pub occlusion_culling: Option<bool>,
+    /// MIP-mapped slice images for every AxisSlices object (`--mipmaps`, the Pareto sweep).
+    pub mipmaps: Option<bool>,
     /// RayMarch objects' step times this (after `step`; a converged truth).
     pub step_scale: Option<f64>,
     /// AOVs to write beside the colour (`--aov`), replacing the scene's `aovs`.
@@ -66,6 +68,7 @@ pub const DEFAULT_AXIS_SLICES: AxisSlices = AxisSlices {
     occlusion_culling: false,
     empty_culling: true,
     draw_order: crate::scene::DrawOrder::Texels,
+    mipmaps: false,
 };
 
 /// Plane count when an object is switched to view slicing from a method without planes.
@@ -142,7 +145,8 @@ impl RenderOptions {
                 let a = if let Method::AxisSlices(a) = m { *a } else { DEFAULT_AXIS_SLICES };
                 let (depth, pixels) = self.axis_criteria.unwrap_or((a.depth, a.pixels));
                 let occlusion_culling = self.occlusion_culling.unwrap_or(a.occlusion_culling);
-                Method::AxisSlices(AxisSlices { depth, pixels, occlusion_culling, ..a })
+                let mipmaps = self.mipmaps.unwrap_or(a.mipmaps);
+                Method::AxisSlices(AxisSlices { depth, pixels, occlusion_culling, mipmaps, ..a })
             }
         }
     }

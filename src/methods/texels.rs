@@ -151,6 +151,7 @@ pub fn bake_index(
             light: light.direction,
             ambient: light.ambient,
             axis_slices: false,
+            axis_mipmaps: false,
         },
         opacity_length: t.opacity_length(&scene.hypertextures),
     });

@@ -141,6 +141,7 @@ pub fn plan(scene: &Scene, opts: &ExportOptions) -> Result<Vec<Export>> {
                     light: light.direction,
                     ambient: light.ambient,
                     axis_slices: false,
+                    axis_mipmaps: false,
                 },
                 opacity_length: h.opacity_length,
             },

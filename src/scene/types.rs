@@ -843,6 +843,10 @@ pub struct AxisSlices {
     /// for the texture cache), binary alpha only.
     #[serde(default)]
     pub draw_order: DrawOrder,
+    /// MIP-mapped slice images (section 2.2): each image's level chosen by its screen-space
+    /// footprint (the fragment's texture-coordinate derivatives), against minification aliasing.
+    #[serde(default)]
+    pub mipmaps: bool,
 }
 
 /// The order in which `AxisSlices` draws its slices.

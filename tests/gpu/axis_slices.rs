@@ -130,6 +130,7 @@ fn slice_image_bake_matches_its_twin() {
         light: [0.3, 0.4, 0.8],
         ambient: 0.3,
         axis_slices: true,
+        axis_mipmaps: false,
     };
     let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
     let baked = Baker::new(&voltex::gpu::sources::Sources::project().unwrap()).bake(&ctx, &request).unwrap();
@@ -162,6 +163,50 @@ fn slice_image_bake_matches_its_twin() {
     assert!(coarsest_alpha > 0.0);
 }
 
+/// `mip_axis_slices.wgsl` against its twin: every MIP level of every direction's slice images
+/// (odd sizes included: 12 and 3 repeat their last row) from the GPU's own level above.
+#[test]
+fn slice_image_mips_match_their_twin() {
+    let res = [16, 12, 8];
+    let shapes =
+        pack_shapes(&[(Shape::Sphere { center: [0.4, 0.5, 0.4], radius: 0.35 }, [0.9, 0.3, 0.2], 0.7)]);
+    let request = BakeRequest {
+        resolution: res,
+        source: BakeSource::Implicit(shapes),
+        per_pixel: false,
+        light: [0.3, 0.4, 0.8],
+        ambient: 0.3,
+        axis_slices: true,
+        axis_mipmaps: true,
+    };
+    let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
+    let baked = Baker::new(&voltex::gpu::sources::Sources::project().unwrap()).bake(&ctx, &request).unwrap();
+    let mut checked = 0;
+    for array in &baked.axis.unwrap().arrays {
+        assert_eq!(
+            array.mip_level_count(),
+            voltex::bake::axis_slices::mip_levels([array.width(), array.height()])
+        );
+        for level in 1..array.mip_level_count() {
+            let read = |l| f16s(&voltex::bake::axis_slices::read_texture_level(&ctx, array, l, 8).unwrap());
+            let (finer, coarser) = (read(level - 1), read(level));
+            let (w, h) = ((array.width() >> (level - 1)).max(1), (array.height() >> (level - 1)).max(1));
+            let per_layer = (w * h) as usize * 4;
+            for (layer, fine) in finer.chunks_exact(per_layer).enumerate() {
+                let fine: Vec<[f32; 4]> = fine.chunks_exact(4).map(|c| [c[0], c[1], c[2], c[3]]).collect();
+                let cpu = twin::mip_axis_slices(&fine, w, h);
+                let gpu = &coarser[layer * cpu.len() * 4..][..cpu.len() * 4];
+                // f16 rounding of the mean (and of the level it came from): half an ulp near 1.
+                let worst =
+                    gpu.iter().zip(cpu.iter().flatten()).map(|(g, c)| (g - c).abs()).fold(0.0, f32::max);
+                assert!(worst < 1e-3, "level {level}, layer {layer}: worst difference {worst}");
+                checked += cpu.len();
+            }
+        }
+    }
+    assert!(checked > 100, "{checked} texels checked");
+}
+
 /// The height-image bake kernel against its twin on the example's cobbles, with darkening: every
 /// voxel within one 8-bit step but where the surface crosses it (coverage is steep there).
 #[test]
@@ -188,6 +233,7 @@ fn height_image_bake_matches_its_twin() {
         light,
         ambient,
         axis_slices: false,
+        axis_mipmaps: false,
     };
     let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
     let baked = Baker::new(&voltex::gpu::sources::Sources::project().unwrap()).bake(&ctx, &request).unwrap();
@@ -391,6 +437,39 @@ fn blended_fog_box_keeps_its_brightness_at_every_level() {
         // What remains is where slices cut the box's sides (fewer slices: coarser steps there).
         assert!(e < 0.2, "depth {depth}: relative RMSE {e}");
     }
+}
+
+const TILED_TORI: &str = r#"Scene(
+    output: (width: 64, height: 64),
+    camera: (eye: (0.0, -EYE, EYE), target: (0.0, 0.0, 0.0), fov_y: 40.0),
+    ambient: 1.0,
+    texels: { "tori": (resolution: (16, 16, 8), opacity_length: 0.05, source: Implicit(shapes: [
+        Torus(center: (0.5, 0.5, 0.4), major: 0.3, minor: 0.12, color: (0.85, 0.45, 0.2), opacity: 1.0),
+    ])) },
+    nodes: [(name: "tiles", surface: Plane(size: (2.0, 2.0), cells: (2, 2)), height: (length: 0.2),
+             uv_tiling: (TILES, TILES), texel: "tori", method: AxisSlices(blend: Blended))],
+)"#;
+
+/// MIP levels are read only where slice images are minified: a close view of one tile (16
+/// texels over most of 64 pixels) is the same image with and without them; 32x32 tiles seen
+/// from afar (several texels per pixel) are not.
+#[test]
+fn mipmaps_change_only_minified_slices() {
+    let max_diff = |a: &Image, b: &Image| {
+        a.pixels
+            .iter()
+            .zip(&b.pixels)
+            .flat_map(|(p, q)| (0..4).map(move |c| (p[c] - q[c]).abs()))
+            .fold(0.0, f32::max)
+    };
+    let with = |mipmaps| RenderOptions { mipmaps: Some(mipmaps), ..Default::default() };
+    let close = TILED_TORI.replace("EYE", "1.2").replace("TILES", "1.0");
+    let magnified = max_diff(&render(&close, &with(false)), &render(&close, &with(true)));
+    let far = TILED_TORI.replace("EYE", "2.5").replace("TILES", "32.0");
+    let minified = max_diff(&render(&far, &with(false)), &render(&far, &with(true)));
+    eprintln!("largest difference with MIP levels: magnified {magnified:.2e}, minified {minified:.2e}");
+    assert!(magnified < 1e-6, "a magnified view changed by {magnified}");
+    assert!(minified > 0.02, "a minified view changed by only {minified}");
 }
 
 #[test]

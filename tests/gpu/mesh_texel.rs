@@ -105,8 +105,15 @@ fn load(dir: &Path, name: &str) -> voltex::mesh::Mesh {
 /// Bakes `source` as a texel of `resolution`: (rgba8 volume, rgba8snorm normals when per pixel).
 fn bake_res(source: BakeSource, resolution: [u32; 3], per_pixel: bool) -> (Vec<u8>, Vec<u8>) {
     let ctx = ctx().lock().unwrap();
-    let req =
-        BakeRequest { resolution, source, per_pixel, light: LIGHT, ambient: AMBIENT, axis_slices: false };
+    let req = BakeRequest {
+        resolution,
+        source,
+        per_pixel,
+        light: LIGHT,
+        ambient: AMBIENT,
+        axis_slices: false,
+        axis_mipmaps: false,
+    };
     let t = std::time::Instant::now();
     let baked =
         Baker::new(&voltex::gpu::sources::Sources::folder(&root().join("wgsl"))).bake(&ctx, &req).unwrap();

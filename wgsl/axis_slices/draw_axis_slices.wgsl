@@ -3,6 +3,8 @@
 
 // Blend semi-transparent slices back to front instead of the alpha test (set per object).
 override blended_slices: bool = false;
+// MIP-mapped slice images (`mipmaps: true`): the level from the fragment's footprint.
+override mipmapped_slices: bool = false;
 
 @group(0) @binding(0) var<uniform> frame: FrameParams;
 @group(0) @binding(1) var<uniform> object: ObjectParams;
@@ -49,13 +51,18 @@ struct SliceSample {
 }
 
 fn sample_slice(in: VsOut) -> SliceSample {
+    // Explicit gradients: the branch on the slice's direction is not uniform control flow. Zero
+    // gradients read level 0 (the only one without MIP levels).
+    let mip = f32(mipmapped_slices);
+    let ddx = dpdx(in.uv) * mip;
+    let ddy = dpdy(in.uv) * mip;
     var texel: vec4<f32>;
     if (in.direction == 2u) {
-        texel = textureSampleLevel(axis_slices_w, axis_sampler, in.uv, in.layer, 0.0);
+        texel = textureSampleGrad(axis_slices_w, axis_sampler, in.uv, in.layer, ddx, ddy);
     } else if (in.direction == 0u) {
-        texel = textureSampleLevel(axis_slices_s, axis_sampler_side, in.uv, in.layer, 0.0);
+        texel = textureSampleGrad(axis_slices_s, axis_sampler_side, in.uv, in.layer, ddx, ddy);
     } else {
-        texel = textureSampleLevel(axis_slices_t, axis_sampler_side, in.uv, in.layer, 0.0);
+        texel = textureSampleGrad(axis_slices_t, axis_sampler_side, in.uv, in.layer, ddx, ddy);
     }
     // World length of this pixel's ray through the slab the slice stands for.
     let ray = normalize(in.rel);

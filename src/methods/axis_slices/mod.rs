@@ -203,6 +203,9 @@ pub fn add_inputs(
             address_mode_v: v,
             mag_filter: wgpu::FilterMode::Linear,
             min_filter: wgpu::FilterMode::Linear,
+            // Trilinear between the MIP levels of `mipmaps: true` (level 0 is sampled otherwise).
+            mipmap_filter: wgpu::MipmapFilterMode::Linear,
+            anisotropy_clamp: ANISOTROPY,
             ..Default::default()
         })
     };
@@ -213,7 +216,12 @@ pub fn add_inputs(
     inputs.counts.insert("prisms".into(), plan.prisms.len() as u32);
     inputs.constants.push(("blended_slices".into(), plan.blended as u32 as f64));
     inputs.constants.push(("grouped_slices".into(), plan.grouped as u32 as f64));
+    inputs.constants.push(("mipmapped_slices".into(), plan.method.mipmaps as u32 as f64));
 }
+
+/// Samples the MIP levels take along a slice's stretched footprint (grazing views, side slices
+/// seen edge-on), so that the level follows its narrow side.
+const ANISOTROPY: u16 = 16;
 
 /// Reads back the per-prism choices and the drawn vertices after a frame (tests, `bench`).
 pub fn read_back(

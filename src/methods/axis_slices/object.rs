@@ -11,6 +11,7 @@ pub fn plan(cx: &mut PlanCx, object: &mut ObjectPlan, m: &AxisSlices) -> Result<
     let texel = object.object.texel.clone().unwrap_or_default();
     let bake = texels::bake_index(cx.scene, &texel, false, cx.light, cx.time, cx.bakes)?;
     cx.bakes[bake].request.axis_slices = true;
+    cx.bakes[bake].request.axis_mipmaps |= m.mipmaps;
     object.bake = Some(bake);
     let res = cx.bakes[bake].request.resolution;
     let (forward, focal) = (cx.view.forward_f32(), cx.view.focal);

@@ -1,0 +1,20 @@
+// Makes one MIP level of a direction's slice images from the level above: each texel the mean of the 2x2 premultiplied texels it covers.
+@group(0) @binding(0) var finer: texture_2d_array<f32>;
+@group(0) @binding(1) var coarser: texture_storage_2d_array<rgba16float, write>;
+
+// Premultiplied colour averages like coverage, so a minified slice keeps its mean opacity and
+// the colour it shows. An odd size repeats its last row or column (the texel past the edge).
+@compute @workgroup_size(8, 8, 1)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    let size = textureDimensions(coarser);
+    if (id.x >= size.x || id.y >= size.y || id.z >= textureNumLayers(coarser)) {
+        return;
+    }
+    let last = textureDimensions(finer) - vec2<u32>(1u);
+    var sum = vec4<f32>(0.0);
+    for (var k = 0u; k < 4u; k++) {
+        let p = min(2u * id.xy + vec2<u32>(k & 1u, k >> 1u), last);
+        sum += textureLoad(finer, p, id.z, 0);
+    }
+    textureStore(coarser, id.xy, id.z, 0.25 * sum);
+}
