@@ -564,3 +564,40 @@ fn command_checks_can_fail() {
     let exe = env!("CARGO_BIN_EXE_voltex");
     assert!(!Command::new(exe).args(["no-such-command", "--help"]).output().unwrap().status.success());
 }
+
+/// Text files of the project under `dirs` (recursively) with one of `exts`.
+fn text_files(dirs: &[&str], exts: &[&str]) -> Vec<PathBuf> {
+    let mut out = Vec::new();
+    let mut stack: Vec<PathBuf> = dirs.iter().map(|d| root().join(d)).collect();
+    while let Some(p) = stack.pop() {
+        if p.is_dir() {
+            stack.extend(std::fs::read_dir(&p).unwrap().map(|e| e.unwrap().path()));
+        } else if p.extension().and_then(|e| e.to_str()).is_some_and(|e| exts.contains(&e)) {
+            out.push(p);
+        }
+    }
+    out
+}
+
+/// A merge resolved by hand must not leave its conflict markers in a file that still builds
+/// (docs, scenes and graphs are only text to git).
+#[test]
+fn no_merge_conflict_markers() {
+    let markers = ["<", "=", ">"].map(|c| c.repeat(7));
+    let files = text_files(
+        &["README.md", "Cargo.toml", "docs/src", "src", "wgsl", "graphs", "scenes", "tests", "tools", ".ci"],
+        &["md", "rs", "wgsl", "ron", "toml", "py", "sh", "json"],
+    );
+    assert!(files.len() > 100, "{} files", files.len());
+    let mut found = Vec::new();
+    for f in &files {
+        let text = std::fs::read_to_string(f).unwrap_or_default();
+        for (i, line) in text.lines().enumerate() {
+            let opens = line.starts_with(&markers[0]) || line.starts_with(&markers[2]);
+            if (opens && line.len() > 7 && line.as_bytes()[7] == b' ') || line == markers[1] {
+                found.push(format!("{}:{}", rel(f), i + 1));
+            }
+        }
+    }
+    assert!(found.is_empty(), "merge conflict markers at {found:?}");
+}
