@@ -114,6 +114,20 @@ pub fn step_quality(src: &str, node: &[Step], m: &Method, finer: bool) -> Result
     .map(Some)
 }
 
+/// Names and paths of the nodes of the text (`nodes[i]`, `nodes[i].children[j]`, ...).
+pub fn node_paths(v: &st::Value, src: &str, at: Vec<Step>, out: &mut Vec<(String, Vec<Step>)>) {
+    let key = if at.is_empty() { "nodes" } else { "children" };
+    let Some(list) = v.child(&Step::Field(key.into()), src) else { return };
+    for (i, n) in list.items().into_iter().enumerate() {
+        let mut p = at.clone();
+        p.extend([Step::Field(key.into()), Step::Index(i)]);
+        if let Some(name) = n.child(&Step::Field("name".into()), src).and_then(|v| st::unquote(v.text(src))) {
+            out.push((name, p.clone()));
+        }
+        node_paths(n, src, p, out);
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -4,6 +4,7 @@
 //! rebuilds the last good scene on a new one.
 
 use std::path::{Path, PathBuf};
+use std::time::Instant;
 
 use crate::gpu::cache::{CacheStats, GpuCache};
 use crate::gpu::GpuContext;
@@ -20,6 +21,19 @@ pub enum Outcome {
     Failed(String),
 }
 
+/// Where the last successful rebuild's time went, in ms (`voltex preview --measure-latency`).
+#[derive(Debug, Default, Clone, Copy, PartialEq)]
+pub struct Stages {
+    /// Reading and parsing the scene file.
+    pub parse: f64,
+    /// The blueprint: objects, shells, plane sweeps, bakes to make, the graph plan.
+    pub plan: f64,
+    /// Bakes not found in the cache (texels, mesh grids, splat sets), GPU work waited for.
+    pub bake: f64,
+    /// The rest of the renderer: buffers, pipelines not found in the cache.
+    pub build: f64,
+}
+
 pub struct Session {
     pub scene_path: PathBuf,
     /// Overrides (size, graph, methods, camera) applied on every rebuild.
@@ -33,6 +47,8 @@ pub struct Session {
     logged: Option<String>,
     /// The scene's text when the panel holds edits the file does not have (else the file's).
     pub text: Option<String>,
+    /// The last successful rebuild's stages.
+    pub stages: Stages,
 }
 
 impl Session {
@@ -57,6 +73,7 @@ impl Session {
             error: None,
             logged: None,
             text,
+            stages: Stages::default(),
         };
         s.rebuild(ctx);
         s
@@ -64,12 +81,17 @@ impl Session {
 
     /// Reloads the scene, graph and kernels and makes a renderer, reusing whatever is unchanged.
     pub fn rebuild(&mut self, ctx: &GpuContext) -> Outcome {
+        let t = Instant::now();
         let scene = match &self.text {
             Some(text) => scene::parse(text, &self.scene_path),
             None => scene::load(&self.scene_path),
         };
+        let parse = ms(t);
         match scene.and_then(|scene| self.build(ctx, scene)) {
-            Ok(stats) => stats,
+            Ok(stats) => {
+                self.stages.parse = parse;
+                stats
+            }
             Err(e) => self.failed(e),
         }
     }
@@ -86,8 +108,13 @@ impl Session {
 
     fn build(&mut self, ctx: &GpuContext, scene: Scene) -> Result<Outcome> {
         self.cache.begin();
+        let t = Instant::now();
         let bp = Blueprint::new(&scene, &self.options)?;
+        let plan = ms(t);
+        let t = Instant::now();
         let renderer = Renderer::with_cache(ctx, bp, &mut self.cache)?;
+        let made = ms(t);
+        self.stages = Stages { parse: 0.0, plan, bake: renderer.bake_ms, build: made - renderer.bake_ms };
         self.cache.retain_used();
         self.scene = Some(scene);
         self.renderer = Some(renderer);
@@ -131,6 +158,10 @@ impl Session {
         self.renderer.as_mut().map(|r| r.render(ctx))
     }
 
+    pub fn renderer_mut(&mut self) -> Option<&mut Renderer> {
+        self.renderer.as_mut()
+    }
+
     pub fn renderer(&self) -> Option<&Renderer> {
         self.renderer.as_ref()
     }
@@ -164,4 +195,9 @@ impl Session {
         canonical.retain(|d| !all.iter().any(|o| o != d && d.starts_with(o)));
         canonical
     }
+}
+
+/// Milliseconds since `t`.
+pub fn ms(t: Instant) -> f64 {
+    t.elapsed().as_secs_f64() * 1e3
 }

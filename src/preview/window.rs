@@ -660,7 +660,7 @@ impl State {
     fn objects(&self, tree: Option<&st::Value>, src: &str) -> Vec<panel::Object> {
         let mut nodes = Vec::new();
         if let Some(t) = tree {
-            node_paths(t, src, Vec::new(), &mut nodes);
+            knobs::node_paths(t, src, Vec::new(), &mut nodes);
         }
         (self.methods().into_iter())
             .filter_map(|(name, _)| {
@@ -677,7 +677,7 @@ impl State {
         let src = self.editor.as_ref().map(|e| e.text().to_string()).unwrap_or_default();
         let node = st::parse(&src).ok().and_then(|t| {
             let mut nodes = Vec::new();
-            node_paths(&t, &src, Vec::new(), &mut nodes);
+            knobs::node_paths(&t, &src, Vec::new(), &mut nodes);
             nodes.into_iter().find(|(n, _)| *n == name).map(|(_, p)| p)
         });
         Some((name, m, node))
@@ -812,20 +812,6 @@ impl State {
         crate::io::exr::write(&exr, &image, &meta)?;
         crate::io::png::write_tonemapped(&exr.with_extension("png"), &image)?;
         Ok(format!("screenshot {} and .png", exr.display()))
-    }
-}
-
-/// Names and paths of the nodes of the text (`nodes[i]`, `nodes[i].children[j]`, ...).
-fn node_paths(v: &st::Value, src: &str, at: Vec<Step>, out: &mut Vec<(String, Vec<Step>)>) {
-    let key = if at.is_empty() { "nodes" } else { "children" };
-    let Some(list) = v.child(&Step::Field(key.into()), src) else { return };
-    for (i, n) in list.items().into_iter().enumerate() {
-        let mut p = at.clone();
-        p.extend([Step::Field(key.into()), Step::Index(i)]);
-        if let Some(name) = n.child(&Step::Field("name".into()), src).and_then(|v| st::unquote(v.text(src))) {
-            out.push((name, p.clone()));
-        }
-        node_paths(n, src, p, out);
     }
 }
 
