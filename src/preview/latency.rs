@@ -173,6 +173,34 @@ pub fn measure(ctx: &GpuContext, scene: &Path, options: RenderOptions, repeat: u
             samples,
         });
     }
+    // A camera drag in the window: no file, one rebuild and frame per step, at full quality and
+    // at the draft quality a drag draws at.
+    let scale = session.draft_scale();
+    for draft in if scale > 1 { vec![1, scale] } else { vec![1] } {
+        session.draft = draft;
+        let mut samples = Vec::new();
+        let mut made = Default::default();
+        for i in 0..=repeat {
+            let (sample, stats) = orbit(ctx, &mut session, i)?;
+            made = stats;
+            if i > 0 {
+                samples.push(sample);
+            }
+        }
+        let crate::gpu::cache::CacheStats { modules, pipelines, bakes } = made;
+        let size = session.renderer().map_or((0, 0), |r| r.blueprint.size);
+        rows.push(Row {
+            edit: if draft == 1 { "orbit".into() } else { "drag".into() },
+            what: format!("a camera drag step in the window, drawn at {}x{}", size.0, size.1),
+            goal_ms: GOAL_MS,
+            modules,
+            pipelines,
+            bakes,
+            median: Sample::median(&samples),
+            samples,
+        });
+    }
+    session.draft = 1;
     Ok(Report {
         command: "preview --measure-latency".into(),
         scene: scene.display().to_string(),
@@ -228,12 +256,35 @@ fn save(
     Ok((sample, stats))
 }
 
+/// Step `i` of an orbit around the scene's target (the window's left drag): rebuilt, rendered.
+fn orbit(
+    ctx: &GpuContext,
+    session: &mut Session,
+    i: usize,
+) -> Result<(Sample, crate::gpu::cache::CacheStats)> {
+    let start = Instant::now();
+    let mut cam = *session.scene().ok_or_else(|| Error::Invalid("no scene".into()))?.camera;
+    let turn = DQuat::from_axis_angle(cam.up.normalize(), (2.0 * i as f64).to_radians());
+    cam.eye = cam.target + turn * (cam.eye - cam.target);
+    session.options.camera = Some(cam);
+    let stats = match session.rebuild(ctx) {
+        Outcome::Rebuilt(stats) => stats,
+        Outcome::Failed(e) => return Err(Error::Invalid(e)),
+    };
+    let (render, readback) = frame(ctx, session)?;
+    let s = session.stages;
+    let (parse, plan, bake, build) = (s.parse, s.plan, s.bake, s.build);
+    let sample =
+        Sample { parse, plan, bake, build, render, readback, total: ms(start), ..Default::default() };
+    Ok((sample, stats))
+}
+
 /// Renders a frame and reads it back: the times of both (ms).
 fn frame(ctx: &GpuContext, session: &mut Session) -> Result<(f64, f64)> {
-    let r = session.renderer_mut().ok_or_else(|| Error::Invalid("no renderer".into()))?;
     let t = Instant::now();
-    r.render_timed(ctx)?;
+    session.draw(ctx).ok_or_else(|| Error::Invalid("no renderer".into()))??;
     let render = ms(t);
+    let r = session.renderer().ok_or_else(|| Error::Invalid("no renderer".into()))?;
     let t = Instant::now();
     r.read_texture(ctx, &r.blueprint.graph.file.outputs[0])?;
     Ok((render, ms(t)))

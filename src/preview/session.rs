@@ -6,6 +6,7 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
+use super::knobs;
 use crate::gpu::cache::{CacheStats, GpuCache};
 use crate::gpu::GpuContext;
 use crate::render::{shader_sources, Blueprint, Frame, RenderOptions, Renderer};
@@ -49,7 +50,17 @@ pub struct Session {
     pub text: Option<String>,
     /// The last successful rebuild's stages.
     pub stages: Stages,
+    /// Draft quality while a drag goes on: the frame is drawn at 1/`draft` of its width and
+    /// height (1: full quality). The next rebuild applies it; setting it back to 1 and rebuilding
+    /// refines the frame.
+    pub draft: u32,
+    /// Wall time of the last full-quality frame (ms), for [`Session::draft_scale`].
+    frame_ms: Option<f64>,
 }
+
+/// What a draft frame may take to draw (ms): with a rebuild and the panel, a drag stays near the
+/// 100 ms save-to-frame goal on a software adapter.
+pub const DRAFT_FRAME_MS: f64 = 40.0;
 
 impl Session {
     /// Builds the first renderer; a failure leaves the session without one and with `error` set.
@@ -74,6 +85,8 @@ impl Session {
             logged: None,
             text,
             stages: Stages::default(),
+            draft: 1,
+            frame_ms: None,
         };
         s.rebuild(ctx);
         s
@@ -109,7 +122,7 @@ impl Session {
     fn build(&mut self, ctx: &GpuContext, scene: Scene) -> Result<Outcome> {
         self.cache.begin();
         let t = Instant::now();
-        let bp = Blueprint::new(&scene, &self.options)?;
+        let bp = self.blueprint(&scene)?;
         let plan = ms(t);
         let t = Instant::now();
         let renderer = Renderer::with_cache(ctx, bp, &mut self.cache)?;
@@ -131,8 +144,7 @@ impl Session {
         self.cache = GpuCache::default();
         let Some(scene) = self.scene.as_ref() else { return self.rebuild(ctx) };
         self.cache.begin();
-        let built = Blueprint::new(scene, &self.options)
-            .and_then(|bp| Renderer::with_cache(ctx, bp, &mut self.cache));
+        let built = self.blueprint(scene).and_then(|bp| Renderer::with_cache(ctx, bp, &mut self.cache));
         match built {
             Ok(renderer) => {
                 self.cache.retain_used();
@@ -156,6 +168,53 @@ impl Session {
     /// Renders a frame with the last good renderer (`None` before any build succeeded).
     pub fn render(&mut self, ctx: &GpuContext) -> Option<Result<Frame>> {
         self.renderer.as_mut().map(|r| r.render(ctx))
+    }
+
+    /// Renders a frame to be shown from the renderer's output texture, without reading it back:
+    /// the per-pass GPU times. Times full-quality frames for [`Session::draft_scale`].
+    pub fn draw(&mut self, ctx: &GpuContext) -> Option<Result<Vec<(String, f64)>>> {
+        let t = Instant::now();
+        let times = self.renderer.as_mut()?.render_timed(ctx);
+        if self.draft == 1 && times.is_ok() {
+            self.frame_ms = Some(ms(t));
+        }
+        Some(times)
+    }
+
+    /// The draft scale for a drag: 1 when a full-quality frame draws within [`DRAFT_FRAME_MS`],
+    /// else how many times over it is, at most 8. A draft divides the width and height, and
+    /// the planes or steps, by it: a frame bound by its pixels gets cheaper by its cube, one
+    /// bound by its geometry at least by the scale itself.
+    pub fn draft_scale(&self) -> u32 {
+        let ms = self.frame_ms.unwrap_or(0.0);
+        ((ms / DRAFT_FRAME_MS).ceil() as u32).clamp(1, 8)
+    }
+
+    /// The blueprint of `scene` with the session's options, at draft quality while drafting.
+    fn blueprint(&self, scene: &Scene) -> Result<Blueprint> {
+        if self.draft <= 1 {
+            return Blueprint::new(scene, &self.options);
+        }
+        let objects = scene.objects_at(self.options.time.unwrap_or(scene.time))?;
+        let mut options = self.options.clone();
+        options.size = self.draft_size(scene);
+        options.supersample = None;
+        // Each object's method (the preview's switch, else the file's) made coarser.
+        for o in &objects {
+            let chosen = options.object_methods.iter().find(|(n, _)| *n == o.name).map(|(_, m)| m);
+            if let Some(m) = chosen.or(o.method.as_ref()).map(|m| knobs::coarser(m, self.draft as f64)) {
+                options.object_methods.retain(|(n, _)| *n != o.name);
+                options.object_methods.push((o.name.clone(), m));
+            }
+        }
+        // A draft the planner refuses (a knob past a limit) is drawn at full quality.
+        Blueprint::with_objects(scene, objects, &options).or_else(|_| Blueprint::new(scene, &self.options))
+    }
+
+    /// The size frames are drawn at while drafting (`None` at full quality).
+    pub fn draft_size(&self, scene: &Scene) -> Option<(u32, u32)> {
+        let (w, h) = self.options.size.unwrap_or((scene.output.width, scene.output.height));
+        (self.draft > 1).then(|| (w.div_ceil(self.draft), h.div_ceil(self.draft)))
     }
 
     pub fn renderer_mut(&mut self) -> Option<&mut Renderer> {
