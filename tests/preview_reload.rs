@@ -249,7 +249,7 @@ fn reload_sequence() {
     assert!(blue(&tinted) > blue(&burst) + 0.4 * tinted.pixels.len() as f64);
 
     eprintln!(
-        "save-to-frame latency (debounce {} ms included), {}:",
+        "save-to-frame latency (quiet time {} ms and this test's 50 ms settle included), {}:",
         voltex::preview::watch::DEBOUNCE.as_millis(),
         ctx.adapter_line()
     );
