@@ -13,6 +13,7 @@ use super::scene_text::{self as st, format_number, Step};
 use super::session::ms;
 use super::{Outcome, Session, Watcher};
 use crate::error::{Error, Result};
+use crate::gpu::cache::CacheStats;
 use crate::gpu::GpuContext;
 use crate::render::RenderOptions;
 
@@ -149,56 +150,22 @@ pub fn measure(ctx: &GpuContext, scene: &Path, options: RenderOptions, repeat: u
     let mut text = crate::input::read_text(&copy.0, "scene file")?;
     let mut rows = Vec::new();
     for probe in probes(&text, &session)? {
-        let mut samples = Vec::new();
-        let mut made = Default::default();
-        for i in 0..=repeat {
+        let what = format!("{}: {} <-> {}", st::show(&probe.path), probe.values[0], probe.values[1]);
+        rows.push(timed(probe.edit, what, probe.goal, repeat, |i| {
             text = st::set(&text, &probe.path, &probe.values[(i + 1) % 2])?.apply(&text)?;
-            let (sample, stats) = save(ctx, &mut session, &watcher, &copy.0, &text).map_err(|e| {
-                Error::Invalid(format!("{} edit of {}: {e}", probe.edit, st::show(&probe.path)))
-            })?;
-            made = stats;
-            if i > 0 {
-                samples.push(sample);
-            }
-        }
-        let crate::gpu::cache::CacheStats { modules, pipelines, bakes } = made;
-        rows.push(Row {
-            edit: probe.edit.into(),
-            what: format!("{}: {} <-> {}", st::show(&probe.path), probe.values[0], probe.values[1]),
-            goal_ms: probe.goal,
-            modules,
-            pipelines,
-            bakes,
-            median: Sample::median(&samples),
-            samples,
-        });
+            save(ctx, &mut session, &watcher, &copy.0, &text)
+                .map_err(|e| Error::Invalid(format!("{} edit of {}: {e}", probe.edit, st::show(&probe.path))))
+        })?);
     }
     // A camera drag in the window: no file, one rebuild and frame per step, at full quality and
     // at the draft quality a drag draws at.
     let scale = session.draft_scale();
     for draft in if scale > 1 { vec![1, scale] } else { vec![1] } {
         session.draft = draft;
-        let mut samples = Vec::new();
-        let mut made = Default::default();
-        for i in 0..=repeat {
-            let (sample, stats) = orbit(ctx, &mut session, i)?;
-            made = stats;
-            if i > 0 {
-                samples.push(sample);
-            }
-        }
-        let crate::gpu::cache::CacheStats { modules, pipelines, bakes } = made;
-        let size = session.renderer().map_or((0, 0), |r| r.blueprint.size);
-        rows.push(Row {
-            edit: if draft == 1 { "orbit".into() } else { "drag".into() },
-            what: format!("a camera drag step in the window, drawn at {}x{}", size.0, size.1),
-            goal_ms: GOAL_MS,
-            modules,
-            pipelines,
-            bakes,
-            median: Sample::median(&samples),
-            samples,
-        });
+        let drawn = session.scene().and_then(|s| session.draft_size(s)).unwrap_or(size);
+        let what = format!("a camera drag step in the window, drawn at {}x{}", drawn.0, drawn.1);
+        let edit = if draft == 1 { "orbit" } else { "drag" };
+        rows.push(timed(edit, what, GOAL_MS, repeat, |i| orbit(ctx, &mut session, i))?);
     }
     session.draft = 1;
     Ok(Report {
@@ -213,6 +180,28 @@ pub fn measure(ctx: &GpuContext, scene: &Path, options: RenderOptions, repeat: u
     })
 }
 
+/// The row of `edit`: `step(i)` for a warm-up (`i` = 0) and `repeat` timed repetitions.
+fn timed(
+    edit: &str,
+    what: String,
+    goal_ms: f64,
+    repeat: usize,
+    mut step: impl FnMut(usize) -> Result<(Sample, CacheStats)>,
+) -> Result<Row> {
+    let mut samples = Vec::new();
+    let mut made = CacheStats::default();
+    for i in 0..=repeat {
+        let (sample, stats) = step(i)?;
+        made = stats;
+        if i > 0 {
+            samples.push(sample);
+        }
+    }
+    let CacheStats { modules, pipelines, bakes } = made;
+    let median = Sample::median(&samples);
+    Ok(Row { edit: edit.into(), what, goal_ms, modules, pipelines, bakes, median, samples })
+}
+
 /// One save of `text` as `path`, waited for through the watcher, rebuilt, rendered, read back.
 fn save(
     ctx: &GpuContext,
@@ -220,7 +209,7 @@ fn save(
     watcher: &Watcher,
     path: &Path,
     text: &str,
-) -> Result<(Sample, crate::gpu::cache::CacheStats)> {
+) -> Result<(Sample, CacheStats)> {
     let start = Instant::now();
     st::write(path, text)?;
     let write = ms(start);
@@ -257,11 +246,7 @@ fn save(
 }
 
 /// Step `i` of an orbit around the scene's target (the window's left drag): rebuilt, rendered.
-fn orbit(
-    ctx: &GpuContext,
-    session: &mut Session,
-    i: usize,
-) -> Result<(Sample, crate::gpu::cache::CacheStats)> {
+fn orbit(ctx: &GpuContext, session: &mut Session, i: usize) -> Result<(Sample, CacheStats)> {
     let start = Instant::now();
     let mut cam = *session.scene().ok_or_else(|| Error::Invalid("no scene".into()))?.camera;
     let turn = DQuat::from_axis_angle(cam.up.normalize(), (2.0 * i as f64).to_radians());
