@@ -132,6 +132,24 @@ fn reload_sequence() {
     assert_eq!(stats(&o), CacheStats { modules: 0, pipelines: 0, bakes: 1 });
     assert_ne!(texel.pixels, camera.pixels);
 
+    // A bake kernel edited: that texel rebaked with it (bakes are kept by their request and the
+    // source of the kernels that make them), nothing else made; a touch of the kernel that leaves
+    // its text as it was rebakes nothing; the edit undone rebakes the texel as it was.
+    let bake = wgsl.join("bake/bake_implicit.wgsl");
+    let (store, halved) = (
+        "textureStore(volume, id, baked.rgba);",
+        "textureStore(volume, id, vec4<f32>(0.5 * baked.rgba.rgb, baked.rgba.a));",
+    );
+    let (o, darker) = step(&mut s, "bake kernel", &bake, &|| edit(&bake, store, halved));
+    assert_eq!(stats(&o), CacheStats { modules: 0, pipelines: 0, bakes: 1 });
+    assert!(mean(&darker) < 0.9 * mean(&texel), "{} against {}", mean(&darker), mean(&texel));
+    let (o, same) = step(&mut s, "touch kernel", &bake, &|| edit(&bake, halved, halved));
+    assert_eq!(stats(&o), CacheStats::default());
+    assert_eq!(same.pixels, darker.pixels);
+    let (o, undone) = step(&mut s, "bake kernel", &bake, &|| edit(&bake, halved, store));
+    assert_eq!(stats(&o), CacheStats { modules: 0, pipelines: 0, bakes: 1 });
+    assert_eq!(undone.pixels, texel.pixels);
+
     // Broken RON: the error names the place, the last good frame stays; the fix recovers with
     // nothing to rebuild.
     let (o, img) = step(&mut s, "broken", &scene, &|| edit(&scene, "planes: 24)", "planes: 24"));
@@ -231,7 +249,7 @@ fn reload_sequence() {
     assert!(blue(&tinted) > blue(&burst) + 0.4 * tinted.pixels.len() as f64);
 
     eprintln!(
-        "save-to-frame latency (debounce {} ms included), {}:",
+        "save-to-frame latency (quiet time {} ms and this test's 50 ms settle included), {}:",
         voltex::preview::watch::DEBOUNCE.as_millis(),
         ctx.adapter_line()
     );

@@ -257,16 +257,20 @@ pub fn bytes(res: [u32; 3], per_pixel: bool) -> u64 {
 }
 
 /// The bake kernels, loaded once and reused for every texel.
+/// Each kernel with the hash of its source, so that a baker kept across the preview's rebuilds
+/// reloads a kernel whose file (or include) changed.
+type Slot = Option<(u64, ComputeKernel)>;
+
 pub struct Baker {
-    implicit: Option<ComputeKernel>,
-    heightfield: Option<ComputeKernel>,
-    height_image: Option<ComputeKernel>,
-    mesh: Option<ComputeKernel>,
-    hyper: Option<ComputeKernel>,
-    transfer: Option<ComputeKernel>,
-    axis: Option<ComputeKernel>,
-    volume: Option<ComputeKernel>,
-    axis_mip: Option<ComputeKernel>,
+    implicit: Slot,
+    heightfield: Slot,
+    height_image: Slot,
+    mesh: Slot,
+    hyper: Slot,
+    transfer: Slot,
+    axis: Slot,
+    volume: Slot,
+    axis_mip: Slot,
     sources: Sources,
     /// `Rgba32Float` for [`Baker::full_precision`], else `Rgba8Unorm`.
     format: wgpu::TextureFormat,
@@ -303,13 +307,14 @@ impl Baker {
     }
 
     fn kernel<'a>(
-        slot: &'a mut Option<ComputeKernel>,
+        slot: &'a mut Slot,
         ctx: &GpuContext,
         sources: &Sources,
         name: &str,
         format: wgpu::TextureFormat,
     ) -> Result<&'a mut ComputeKernel> {
-        if slot.is_none() {
+        let hash = crate::gpu::shader::source_hash(sources, name)?;
+        if slot.as_ref().is_none_or(|(h, _)| *h != hash) {
             let mut kernel = crate::gpu::shader::load_from(sources, name)?;
             let writes_volume = crate::gpu::reflect::bindings(&kernel, &["main"])?.iter().any(|b| {
                 b.name == "volume"
@@ -318,9 +323,9 @@ impl Baker {
             if format == wgpu::TextureFormat::Rgba32Float && writes_volume {
                 kernel = kernel.with_storage_format("volume", naga::StorageFormat::Rgba32Float)?;
             }
-            *slot = Some(ComputeKernel::new(ctx, kernel)?);
+            *slot = Some((hash, ComputeKernel::new(ctx, kernel)?));
         }
-        Ok(slot.as_mut().unwrap())
+        Ok(&mut slot.as_mut().unwrap().1)
     }
 
     pub fn bake(&mut self, ctx: &GpuContext, req: &BakeRequest) -> Result<Baked> {

@@ -2,6 +2,7 @@
 
 use std::path::{Path, PathBuf};
 
+use voltex::preview::latency;
 use voltex::preview::present::Mode;
 use voltex::preview::window::{self, PreviewArgs as WindowArgs};
 use voltex::Result;
@@ -26,6 +27,16 @@ pub struct PreviewArgs {
     /// (JSON, rewritten after each frame).
     #[arg(long)]
     trace: Option<PathBuf>,
+    /// Open no window: measure the save-to-frame latency of typical edits (camera, light, knob,
+    /// texel, noise) written into a copy of the scene beside it, and print it stage by stage.
+    #[arg(long)]
+    measure_latency: bool,
+    /// With --measure-latency: timed saves per edit, after one warm-up.
+    #[arg(long, default_value_t = 5, requires = "measure_latency", value_parser = clap::value_parser!(u32).range(1..=1000))]
+    repeat: u32,
+    /// With --measure-latency: also write the measurements to this JSON file.
+    #[arg(long, requires = "measure_latency")]
+    json: Option<PathBuf>,
 }
 
 #[derive(clap::ValueEnum, Clone, Copy)]
@@ -36,7 +47,18 @@ enum ViewArg {
 }
 
 pub fn run(args: PreviewArgs) -> Result<()> {
-    let PreviewArgs { scene, overrides, record, quit_after, view, trace } = args;
+    let PreviewArgs { scene, overrides, record, quit_after, view, trace, measure_latency, repeat, json } =
+        args;
+    if measure_latency {
+        let ctx = voltex::gpu::GpuContext::new()?;
+        let report = latency::measure(&ctx, &scene, overrides.options()?, repeat as usize)?;
+        print!("{}", report.table());
+        if let Some(path) = &json {
+            report.write(path)?;
+            println!("wrote {}", path.display());
+        }
+        return Ok(());
+    }
     let mode = match view {
         ViewArg::Image => Mode::Image,
         ViewArg::Reference => Mode::Reference,

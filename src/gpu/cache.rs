@@ -1,7 +1,7 @@
 //! GPU objects kept across rebuilds of a frame (the preview's hot reload): shader modules by the
 //! hash of their expanded source, pipeline layouts by their bindings, pipelines by everything that
 //! defines them, and bakes (texels, hypertexture mesh grids, splat sets: any type) by their
-//! request. A rebuild asks the cache first, so an edit recompiles or rebakes only what it changed;
+//! request and the source of the kernels that make them. A rebuild asks the cache first, so an edit recompiles or rebakes only what it changed;
 //! `stats` counts what was actually made.
 
 use std::any::{Any, TypeId};
@@ -110,6 +110,20 @@ impl GpuCache {
         make: impl FnOnce() -> crate::Result<Pipeline>,
     ) -> crate::Result<Pipeline> {
         self.get_or_make(key, Made::Pipeline, make)
+    }
+
+    /// Takes the value of type `T` kept under `key` out of the cache: a helper used mutably while
+    /// the cache is (the baker and its kernels); [`GpuCache::put`] gives it back.
+    pub fn take<T: Send + 'static>(&mut self, key: u64) -> Option<T> {
+        let v = self.entries.remove(&(TypeId::of::<T>(), key))?;
+        v.downcast::<T>().ok().map(|v| *v)
+    }
+
+    /// Keeps `value` under `key`, used by this build.
+    pub fn put<T: Send + 'static>(&mut self, key: u64, value: T) {
+        let slot = (TypeId::of::<T>(), key);
+        self.used.insert(slot);
+        self.entries.insert(slot, Box::new(value));
     }
 
     /// A bake of any kind (a texel, a mesh grid, a splat set), counted in `stats.bakes`.

@@ -100,6 +100,14 @@ pub fn load_from(sources: &Sources, rel: &str) -> Result<Kernel> {
     load_expanded(rel, ex)
 }
 
+/// The hash of the expanded source of `rel` ([`Kernel::source_hash`] of the kernel it loads),
+/// without parsing it: cheap enough for every rebuild to ask whether a kernel changed.
+pub fn source_hash(sources: &Sources, rel: &str) -> Result<u64> {
+    let mut ex = Expanded { text: String::new(), origin: Vec::new(), files: Vec::new() };
+    expand(sources, rel, &mut ex, None)?;
+    Ok(crate::gpu::cache::key(&ex.text))
+}
+
 /// Validates WGSL given as text (tests and tools); `path` is only used in messages.
 pub fn load_str(path: &Path, source: &str) -> Result<Kernel> {
     let ex = Expanded {

@@ -115,6 +115,45 @@ pub fn step_quality(src: &str, node: &[Step], m: &Method, finer: bool) -> Result
     .map(Some)
 }
 
+/// The method `d` times coarser, for a frame drawn while a drag goes on: a `d`-th of the planes,
+/// a ray step (and shadow step, adaptive stride) `d` times longer, AxisSlices criteria `d` times
+/// looser. Reference at its default step stays as it is.
+pub fn coarser(m: &Method, d: f64) -> Method {
+    let mut m = m.clone();
+    match &mut m {
+        Method::ViewSlices(v) => v.planes = ((v.planes as f64 / d).round() as u32).max(1),
+        Method::RayMarch(h) => {
+            h.step = Some(h.step() * d);
+            h.shadow_step = h.shadow_step.map(|s| s * d);
+            if let Some(a) = &mut h.adaptive {
+                a.max_step *= d;
+            }
+        }
+        Method::AxisSlices(a) => {
+            a.depth = (a.depth * d).min(1024.0);
+            a.pixels *= d;
+        }
+        Method::Reference(r) => r.step = r.step.map(|s| s * d),
+        #[allow(unreachable_patterns)]
+        _ => {}
+    }
+    m
+}
+
+/// Names and paths of the nodes of the text (`nodes[i]`, `nodes[i].children[j]`, ...).
+pub fn node_paths(v: &st::Value, src: &str, at: Vec<Step>, out: &mut Vec<(String, Vec<Step>)>) {
+    let key = if at.is_empty() { "nodes" } else { "children" };
+    let Some(list) = v.child(&Step::Field(key.into()), src) else { return };
+    for (i, n) in list.items().into_iter().enumerate() {
+        let mut p = at.clone();
+        p.extend([Step::Field(key.into()), Step::Index(i)]);
+        if let Some(name) = n.child(&Step::Field("name".into()), src).and_then(|v| st::unquote(v.text(src))) {
+            out.push((name, p.clone()));
+        }
+        node_paths(n, src, p, out);
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -6,6 +6,7 @@ pub mod curves;
 pub mod editor;
 pub mod gui;
 pub mod knobs;
+pub mod latency;
 pub mod panel;
 pub mod present;
 pub mod scene_text;

@@ -4,7 +4,9 @@
 //! rebuilds the last good scene on a new one.
 
 use std::path::{Path, PathBuf};
+use std::time::Instant;
 
+use super::knobs;
 use crate::gpu::cache::{CacheStats, GpuCache};
 use crate::gpu::GpuContext;
 use crate::render::{shader_sources, Blueprint, Frame, RenderOptions, Renderer};
@@ -20,6 +22,19 @@ pub enum Outcome {
     Failed(String),
 }
 
+/// Where the last successful rebuild's time went, in ms (`voltex preview --measure-latency`).
+#[derive(Debug, Default, Clone, Copy, PartialEq)]
+pub struct Stages {
+    /// Reading and parsing the scene file.
+    pub parse: f64,
+    /// The blueprint: objects, shells, plane sweeps, bakes to make, the graph plan.
+    pub plan: f64,
+    /// Bakes not found in the cache (texels, mesh grids, splat sets), GPU work waited for.
+    pub bake: f64,
+    /// The rest of the renderer: buffers, pipelines not found in the cache.
+    pub build: f64,
+}
+
 pub struct Session {
     pub scene_path: PathBuf,
     /// Overrides (size, graph, methods, camera) applied on every rebuild.
@@ -33,7 +48,19 @@ pub struct Session {
     logged: Option<String>,
     /// The scene's text when the panel holds edits the file does not have (else the file's).
     pub text: Option<String>,
+    /// The last successful rebuild's stages.
+    pub stages: Stages,
+    /// Draft quality while a drag goes on: the frame is drawn at 1/`draft` of its width and
+    /// height (1: full quality). The next rebuild applies it; setting it back to 1 and rebuilding
+    /// refines the frame.
+    pub draft: u32,
+    /// Wall time of the last full-quality frame (ms), for [`Session::draft_scale`].
+    frame_ms: Option<f64>,
 }
+
+/// What a draft frame may take to draw (ms): with a rebuild and the panel, a drag stays near the
+/// 100 ms save-to-frame goal on a software adapter.
+pub const DRAFT_FRAME_MS: f64 = 40.0;
 
 impl Session {
     /// Builds the first renderer; a failure leaves the session without one and with `error` set.
@@ -57,6 +84,9 @@ impl Session {
             error: None,
             logged: None,
             text,
+            stages: Stages::default(),
+            draft: 1,
+            frame_ms: None,
         };
         s.rebuild(ctx);
         s
@@ -64,12 +94,17 @@ impl Session {
 
     /// Reloads the scene, graph and kernels and makes a renderer, reusing whatever is unchanged.
     pub fn rebuild(&mut self, ctx: &GpuContext) -> Outcome {
+        let t = Instant::now();
         let scene = match &self.text {
             Some(text) => scene::parse(text, &self.scene_path),
             None => scene::load(&self.scene_path),
         };
+        let parse = ms(t);
         match scene.and_then(|scene| self.build(ctx, scene)) {
-            Ok(stats) => stats,
+            Ok(stats) => {
+                self.stages.parse = parse;
+                stats
+            }
             Err(e) => self.failed(e),
         }
     }
@@ -86,8 +121,13 @@ impl Session {
 
     fn build(&mut self, ctx: &GpuContext, scene: Scene) -> Result<Outcome> {
         self.cache.begin();
-        let bp = Blueprint::new(&scene, &self.options)?;
+        let t = Instant::now();
+        let bp = self.blueprint(&scene)?;
+        let plan = ms(t);
+        let t = Instant::now();
         let renderer = Renderer::with_cache(ctx, bp, &mut self.cache)?;
+        let made = ms(t);
+        self.stages = Stages { parse: 0.0, plan, bake: renderer.bake_ms, build: made - renderer.bake_ms };
         self.cache.retain_used();
         self.scene = Some(scene);
         self.renderer = Some(renderer);
@@ -104,8 +144,7 @@ impl Session {
         self.cache = GpuCache::default();
         let Some(scene) = self.scene.as_ref() else { return self.rebuild(ctx) };
         self.cache.begin();
-        let built = Blueprint::new(scene, &self.options)
-            .and_then(|bp| Renderer::with_cache(ctx, bp, &mut self.cache));
+        let built = self.blueprint(scene).and_then(|bp| Renderer::with_cache(ctx, bp, &mut self.cache));
         match built {
             Ok(renderer) => {
                 self.cache.retain_used();
@@ -129,6 +168,57 @@ impl Session {
     /// Renders a frame with the last good renderer (`None` before any build succeeded).
     pub fn render(&mut self, ctx: &GpuContext) -> Option<Result<Frame>> {
         self.renderer.as_mut().map(|r| r.render(ctx))
+    }
+
+    /// Renders a frame to be shown from the renderer's output texture, without reading it back:
+    /// the per-pass GPU times. Times full-quality frames for [`Session::draft_scale`].
+    pub fn draw(&mut self, ctx: &GpuContext) -> Option<Result<Vec<(String, f64)>>> {
+        let t = Instant::now();
+        let times = self.renderer.as_mut()?.render_timed(ctx);
+        if self.draft == 1 && times.is_ok() {
+            self.frame_ms = Some(ms(t));
+        }
+        Some(times)
+    }
+
+    /// The draft scale for a drag: 1 when a full-quality frame draws within [`DRAFT_FRAME_MS`],
+    /// else how many times over it is, at most 8. A draft divides the width and height, and
+    /// the planes or steps, by it: a frame bound by its pixels gets cheaper by its cube, one
+    /// bound by its geometry at least by the scale itself.
+    pub fn draft_scale(&self) -> u32 {
+        let ms = self.frame_ms.unwrap_or(0.0);
+        ((ms / DRAFT_FRAME_MS).ceil() as u32).clamp(1, 8)
+    }
+
+    /// The blueprint of `scene` with the session's options, at draft quality while drafting.
+    fn blueprint(&self, scene: &Scene) -> Result<Blueprint> {
+        if self.draft <= 1 {
+            return Blueprint::new(scene, &self.options);
+        }
+        let objects = scene.objects_at(self.options.time.unwrap_or(scene.time))?;
+        let mut options = self.options.clone();
+        options.size = self.draft_size(scene);
+        options.supersample = None;
+        // Each object's method (the preview's switch, else the file's) made coarser.
+        for o in &objects {
+            let chosen = options.object_methods.iter().find(|(n, _)| *n == o.name).map(|(_, m)| m);
+            if let Some(m) = chosen.or(o.method.as_ref()).map(|m| knobs::coarser(m, self.draft as f64)) {
+                options.object_methods.retain(|(n, _)| *n != o.name);
+                options.object_methods.push((o.name.clone(), m));
+            }
+        }
+        // A draft the planner refuses (a knob past a limit) is drawn at full quality.
+        Blueprint::with_objects(scene, objects, &options).or_else(|_| Blueprint::new(scene, &self.options))
+    }
+
+    /// The size frames are drawn at while drafting (`None` at full quality).
+    pub fn draft_size(&self, scene: &Scene) -> Option<(u32, u32)> {
+        let (w, h) = self.options.size.unwrap_or((scene.output.width, scene.output.height));
+        (self.draft > 1).then(|| (w.div_ceil(self.draft), h.div_ceil(self.draft)))
+    }
+
+    pub fn renderer_mut(&mut self) -> Option<&mut Renderer> {
+        self.renderer.as_mut()
     }
 
     pub fn renderer(&self) -> Option<&Renderer> {
@@ -164,4 +254,9 @@ impl Session {
         canonical.retain(|d| !all.iter().any(|o| o != d && d.starts_with(o)));
         canonical
     }
+}
+
+/// Milliseconds since `t`.
+pub fn ms(t: Instant) -> f64 {
+    t.elapsed().as_secs_f64() * 1e3
 }

@@ -1,26 +1,31 @@
 //! Watching the files a preview depends on: folders, recursively (editors save by writing a
-//! temporary file and renaming it over the original, which a watch on the file itself loses), with
-//! a debouncer that merges such a save and bursts of saves into one change.
+//! temporary file and renaming it over the original, which a watch on the file itself loses). A
+//! change is reported once its files have been quiet for [`DEBOUNCE`], so that the steps of one
+//! save (truncate, write, close; write a temporary file, rename it) and bursts of saves come as one.
 
 use std::path::{Path, PathBuf};
 use std::sync::mpsc::{channel, Receiver, RecvTimeoutError};
 use std::time::{Duration, Instant};
 
 use notify::event::{AccessKind, AccessMode, EventKind};
-use notify::{RecommendedWatcher, RecursiveMode};
-use notify_debouncer_full::{new_debouncer, DebounceEventResult, Debouncer, RecommendedCache};
+use notify::{Event, RecommendedWatcher, RecursiveMode, Watcher as _};
 
 use crate::error::{Error, Result};
 
-/// Debounce time: peers use 100 to 300 ms; a save rarely takes longer than this.
-pub const DEBOUNCE: Duration = Duration::from_millis(100);
+/// Quiet time after a save's last event. Editors write a save's steps within microseconds to a
+/// few milliseconds of each other; a slower one may see its first step rebuilt alone (failing, or
+/// not, on a half-written file), and its last step (a writer closing the file, a rename) always
+/// triggers the rebuild that reads the finished file.
+pub const DEBOUNCE: Duration = Duration::from_millis(10);
+/// The longest a change waits for quiet (a file written without pause is still reported).
+pub const SETTLE_MAX: Duration = Duration::from_millis(100);
 
 /// File kinds a rebuild reads: scenes and graphs, kernels, meshes, height images.
 const RELEVANT: &[&str] = &["ron", "wgsl", "obj", "png"];
 
 pub struct Watcher {
-    debouncer: Debouncer<RecommendedWatcher, RecommendedCache>,
-    events: Receiver<DebounceEventResult>,
+    watcher: RecommendedWatcher,
+    events: Receiver<notify::Result<Event>>,
     dirs: Vec<PathBuf>,
     /// Folders whose changes are ours (recordings, screenshots), not the user's.
     pub ignore: Vec<PathBuf>,
@@ -28,12 +33,22 @@ pub struct Watcher {
 
 impl Watcher {
     pub fn new(dirs: &[PathBuf]) -> Result<Self> {
+        Self::with_wake(dirs, || {})
+    }
+
+    /// Like [`Watcher::new`], calling `wake` (from the watcher's thread) on every event that may
+    /// be a change, so that a window's event loop looks at once.
+    pub fn with_wake(dirs: &[PathBuf], wake: impl Fn() + Send + 'static) -> Result<Self> {
         let (tx, events) = channel();
-        let debouncer = new_debouncer(DEBOUNCE, None, move |r: DebounceEventResult| {
-            let _ = tx.send(r);
+        let watcher = notify::recommended_watcher(move |e: notify::Result<Event>| {
+            let change = e.as_ref().map_or(true, |e| changes_content(&e.kind) || e.need_rescan());
+            let _ = tx.send(e);
+            if change {
+                wake();
+            }
         })
         .map_err(|e| Error::Invalid(format!("cannot watch files: {e}")))?;
-        let mut w = Watcher { debouncer, events, dirs: Vec::new(), ignore: Vec::new() };
+        let mut w = Watcher { watcher, events, dirs: Vec::new(), ignore: Vec::new() };
         w.watch(dirs)?;
         Ok(w)
     }
@@ -42,13 +57,13 @@ impl Watcher {
     pub fn watch(&mut self, dirs: &[PathBuf]) -> Result<()> {
         for d in self.dirs.clone() {
             if !dirs.contains(&d) {
-                let _ = self.debouncer.unwatch(&d);
+                let _ = self.watcher.unwatch(&d);
                 self.dirs.retain(|x| x != &d);
             }
         }
         for d in dirs {
             if !self.dirs.contains(d) {
-                self.debouncer
+                self.watcher
                     .watch(d, RecursiveMode::Recursive)
                     .map_err(|e| Error::file(d, format!("cannot watch: {e}")))?;
                 self.dirs.push(d.clone());
@@ -57,24 +72,34 @@ impl Watcher {
         Ok(())
     }
 
-    /// Relevant paths changed since the last call, waiting up to `timeout` for the first.
+    /// Relevant paths changed since the last call, waiting up to `timeout` for the first; once
+    /// one came, until they are quiet for [`DEBOUNCE`] (at most [`SETTLE_MAX`]).
     pub fn changes(&self, timeout: Duration) -> Vec<PathBuf> {
         let deadline = Instant::now() + timeout;
         let mut out = Vec::new();
+        let mut settle: Option<Instant> = None;
         loop {
-            let left = deadline.saturating_duration_since(Instant::now());
-            match self.events.recv_timeout(if out.is_empty() { left } else { Duration::ZERO }) {
-                Ok(Ok(events)) => {
-                    for e in events.iter().filter(|e| changes_content(&e.event.kind)) {
+            let now = Instant::now();
+            let wait = match settle {
+                None => deadline.saturating_duration_since(now),
+                Some(first) => DEBOUNCE.min((first + SETTLE_MAX).saturating_duration_since(now)),
+            };
+            match self.events.recv_timeout(wait) {
+                Ok(Ok(e)) => {
+                    let before = out.len();
+                    if e.need_rescan() {
+                        // Events were lost: anything may have changed.
+                        out.extend(self.dirs.iter().cloned());
+                    } else if changes_content(&e.kind) {
                         let ours = |p: &PathBuf| self.ignore.iter().any(|d| p.starts_with(d));
-                        out.extend(e.event.paths.iter().filter(|p| relevant(p) && !ours(p)).cloned());
+                        out.extend(e.paths.iter().filter(|p| relevant(p) && !ours(p)).cloned());
+                    }
+                    if out.len() > before && settle.is_none() {
+                        settle = Some(Instant::now());
                     }
                 }
-                Ok(Err(errors)) => {
-                    for e in errors {
-                        eprintln!("warning: file watch: {e}");
-                    }
-                }
+                Ok(Err(e)) => eprintln!("warning: file watch: {e}"),
+                Err(RecvTimeoutError::Timeout) if settle.is_none() && Instant::now() < deadline => {}
                 Err(RecvTimeoutError::Timeout) | Err(RecvTimeoutError::Disconnected) => break,
             }
         }

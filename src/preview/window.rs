@@ -10,7 +10,7 @@ use std::time::{Duration, Instant};
 use glam::{DQuat, DVec3};
 use winit::application::ApplicationHandler;
 use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
-use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop};
+use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop, EventLoopProxy};
 use winit::keyboard::{Key, ModifiersState, NamedKey};
 use winit::window::{Window, WindowId};
 
@@ -48,7 +48,8 @@ const TRACE_FRAMES: usize = 100;
 
 pub fn run(args: PreviewArgs) -> Result<()> {
     let event_loop = EventLoop::new().map_err(|e| Error::Invalid(format!("cannot open a window: {e}")))?;
-    let mut app = App { args, state: None, error: None };
+    let proxy = event_loop.create_proxy();
+    let mut app = App { args, state: None, error: None, proxy };
     event_loop.run_app(&mut app).map_err(|e| Error::Invalid(format!("window event loop: {e}")))?;
     app.error.map_or(Ok(()), Err)
 }
@@ -57,6 +58,8 @@ struct App {
     args: PreviewArgs,
     state: Option<State>,
     error: Option<Error>,
+    /// Wakes the event loop when a watched file changes.
+    proxy: EventLoopProxy<()>,
 }
 
 struct State {
@@ -83,6 +86,8 @@ struct State {
     gpu_ms: Option<f64>,
     /// The scene must be rendered again.
     dirty: bool,
+    /// The renderer must be rebuilt before the next frame (the camera moved, a drag ended).
+    stale: bool,
     /// The next frame is recorded even if the image is unchanged (the user did something).
     record_next: bool,
     /// The panel is shown (`H` hides it).
@@ -104,7 +109,7 @@ struct State {
 impl ApplicationHandler for App {
     fn resumed(&mut self, event_loop: &ActiveEventLoop) {
         if self.state.is_none() {
-            match State::new(event_loop, &self.args) {
+            match State::new(event_loop, &self.args, self.proxy.clone()) {
                 Ok(s) => self.state = Some(s),
                 Err(e) => {
                     self.error = Some(e);
@@ -164,8 +169,10 @@ impl ApplicationHandler for App {
                 let on_image = !s.panel || s.cursor.0 < s.image_width() as f64;
                 if state == ElementState::Pressed && on_image {
                     s.drag = Some((button, s.cursor));
+                    s.session.draft = s.session.draft_scale();
                 } else if state == ElementState::Released {
                     s.drag = None;
+                    s.refine();
                 }
             }
             WindowEvent::CursorMoved { position, .. } => {
@@ -233,7 +240,7 @@ impl State {
         }
     }
 
-    fn new(event_loop: &ActiveEventLoop, args: &PreviewArgs) -> Result<Self> {
+    fn new(event_loop: &ActiveEventLoop, args: &PreviewArgs, proxy: EventLoopProxy<()>) -> Result<Self> {
         let window = Arc::new(
             event_loop
                 .create_window(
@@ -272,7 +279,10 @@ impl State {
             true => None,
             false => Editor::open(&args.scene).ok(),
         };
-        let mut watcher = Watcher::new(&session.watch_dirs())?;
+        // A change wakes the event loop at once (about_to_wait then reads it).
+        let mut watcher = Watcher::with_wake(&session.watch_dirs(), move || {
+            let _ = proxy.send_event(());
+        })?;
         // Recordings and screenshots are written by the preview itself.
         let cwd = std::env::current_dir().unwrap_or_default();
         watcher.ignore.push(cwd.join("out"));
@@ -299,6 +309,7 @@ impl State {
             mode: args.mode,
             gpu_ms: None,
             dirty: true,
+            stale: false,
             record_next: false,
             panel: true,
             repaint_at: None,
@@ -349,15 +360,18 @@ impl State {
 
     /// Renders the scene if something changed, runs the panel, then draws both.
     fn redraw(&mut self, args: &PreviewArgs) -> Result<()> {
+        if std::mem::take(&mut self.stale) {
+            self.session.rebuild(&self.ctx);
+        }
         let fresh = self.dirty;
         if self.dirty {
             self.dirty = false;
-            if let Some(frame) = self.session.render(&self.ctx) {
-                let frame = frame?;
-                self.gpu_ms = frame.gpu_ms();
-                if let Some(path) = &args.trace {
+            if let Some(times) = self.session.draw(&self.ctx) {
+                let times = times?;
+                self.gpu_ms = (!times.is_empty()).then(|| times.iter().map(|t| t.1).sum());
+                if let (Some(path), Some(r)) = (&args.trace, self.session.renderer()) {
                     // Written after every frame, so the file holds the latest whatever ends the preview.
-                    self.trace.frames.push(frame.spans);
+                    self.trace.frames.push(r.spans().to_vec());
                     let excess = self.trace.frames.len().saturating_sub(TRACE_FRAMES);
                     self.trace.frames.drain(..excess);
                     crate::render::trace::write(
@@ -369,12 +383,16 @@ impl State {
             }
             if self.mode != Mode::Image && self.reference.is_none() {
                 let mut options = self.session.options.clone();
+                if let Some(size) = self.session.scene().and_then(|s| self.session.draft_size(s)) {
+                    options.size = Some(size);
+                    options.supersample = None;
+                }
                 options.method = Some(MethodKind::Reference);
                 options.object_methods.clear();
                 let mut r =
                     Session::open_with(&self.ctx, &self.session.scene_path, options, self.unsaved_text());
-                if let Some(frame) = r.render(&self.ctx) {
-                    frame?;
+                if let Some(times) = r.draw(&self.ctx) {
+                    times?;
                 }
                 self.reference = Some(r);
             }
@@ -435,6 +453,7 @@ impl State {
                         e.end_gesture();
                     }
                     self.session.text = self.unsaved_text();
+                    self.refine();
                 }
                 Action::Select(i) => self.selected = i,
                 Action::Mode(m) => self.set_mode(m),
@@ -452,6 +471,9 @@ impl State {
             self.status = NO_FILE.into();
             return;
         };
+        if live && self.session.draft == 1 {
+            self.session.draft = self.session.draft_scale();
+        }
         let (session, ctx) = (&mut self.session, &self.ctx);
         if editor.edit(edit, live, |text| session.try_text(ctx, text).map(drop)) {
             self.edited();
@@ -660,7 +682,7 @@ impl State {
     fn objects(&self, tree: Option<&st::Value>, src: &str) -> Vec<panel::Object> {
         let mut nodes = Vec::new();
         if let Some(t) = tree {
-            node_paths(t, src, Vec::new(), &mut nodes);
+            knobs::node_paths(t, src, Vec::new(), &mut nodes);
         }
         (self.methods().into_iter())
             .filter_map(|(name, _)| {
@@ -677,7 +699,7 @@ impl State {
         let src = self.editor.as_ref().map(|e| e.text().to_string()).unwrap_or_default();
         let node = st::parse(&src).ok().and_then(|t| {
             let mut nodes = Vec::new();
-            node_paths(&t, &src, Vec::new(), &mut nodes);
+            knobs::node_paths(&t, &src, Vec::new(), &mut nodes);
             nodes.into_iter().find(|(n, _)| *n == name).map(|(_, p)| p)
         });
         Some((name, m, node))
@@ -692,9 +714,21 @@ impl State {
         let Some(mut cam) = self.session.options.camera.or(self.home) else { return };
         f(&mut cam, self.config.height as f64);
         self.session.options.camera = Some(cam);
-        self.session.rebuild(&self.ctx);
+        // Rebuilt once before the next frame, however many moves come before it.
+        self.stale = true;
         self.reference = None;
         self.dirty = true;
+    }
+
+    /// A drag ended: the frame drawn at draft quality is drawn again at full quality.
+    fn refine(&mut self) {
+        if self.session.draft > 1 {
+            self.session.draft = 1;
+            self.stale = true;
+            self.reference = None;
+            self.dirty = true;
+            self.window.request_redraw();
+        }
     }
 
     /// A key edit of the selected object's node (`M`, `+`, `-`).
@@ -812,20 +846,6 @@ impl State {
         crate::io::exr::write(&exr, &image, &meta)?;
         crate::io::png::write_tonemapped(&exr.with_extension("png"), &image)?;
         Ok(format!("screenshot {} and .png", exr.display()))
-    }
-}
-
-/// Names and paths of the nodes of the text (`nodes[i]`, `nodes[i].children[j]`, ...).
-fn node_paths(v: &st::Value, src: &str, at: Vec<Step>, out: &mut Vec<(String, Vec<Step>)>) {
-    let key = if at.is_empty() { "nodes" } else { "children" };
-    let Some(list) = v.child(&Step::Field(key.into()), src) else { return };
-    for (i, n) in list.items().into_iter().enumerate() {
-        let mut p = at.clone();
-        p.extend([Step::Field(key.into()), Step::Index(i)]);
-        if let Some(name) = n.child(&Step::Field("name".into()), src).and_then(|v| st::unquote(v.text(src))) {
-            out.push((name, p.clone()));
-        }
-        node_paths(n, src, p, out);
     }
 }
 

@@ -40,6 +40,8 @@ pub struct Renderer {
     readback: wgpu::Buffer,
     /// The passes of the last frame on the adapter's clock.
     spans: Vec<Span>,
+    /// Time spent making the bakes the cache did not have, GPU work included (ms).
+    pub bake_ms: f64,
 }
 
 impl Renderer {
@@ -51,12 +53,18 @@ impl Renderer {
     /// nothing that defines them changed (the preview's hot reload).
     pub fn with_cache(ctx: &GpuContext, blueprint: Blueprint, cache: &mut GpuCache) -> Result<Self> {
         blueprint.check_limits(&ctx.limits, "this adapter's limit")?;
-        let mut baker = Baker::new(&Sources::project()?);
+        let started = std::time::Instant::now();
+        let bakes_before = cache.stats.bakes;
+        // The baker keeps its kernels' pipelines across the preview's rebuilds.
+        let sources = Sources::project()?;
+        let baker_key = cache::key(&sources.describe());
+        let mut baker = cache.take::<Baker>(baker_key).unwrap_or_else(|| Baker::new(&sources));
         let baked: Vec<bake::Baked> = blueprint
             .bakes
             .iter()
-            .map(|b| cache.bake(cache::key(&b.request), || baker.bake(ctx, &b.request)))
+            .map(|b| cache.bake(bake_key(&sources, &b.request)?, || baker.bake(ctx, &b.request)))
             .collect::<Result<_>>()?;
+        cache.put(baker_key, baker);
         let sampler = ctx.device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("volume_sampler"),
             address_mode_u: wgpu::AddressMode::Repeat,
@@ -72,6 +80,11 @@ impl Renderer {
         for i in &blueprint.instances {
             prepared.push(prepare(blueprint.plan_of(i), cache)?);
         }
+        // Bakes made are waited for here, so that their time is told apart from the pipelines'.
+        if cache.stats.bakes > bakes_before {
+            ctx.wait()?;
+        }
+        let bake_ms = started.elapsed().as_secs_f64() * 1e3;
         let mut frame = Inputs::default();
         frame
             .buffers
@@ -102,7 +115,7 @@ impl Renderer {
             usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let mut r = Self { blueprint, exec, frame, objects, timer, readback, spans: Vec::new() };
+        let mut r = Self { blueprint, exec, frame, objects, timer, readback, spans: Vec::new(), bake_ms };
         // Pipelines now, so that a bad kernel fails before any frame.
         r.exec.prepare(ctx, &r.blueprint.plan, &r.frame, &r.objects, cache)?;
         ctx.wait()?;
@@ -216,6 +229,15 @@ impl Renderer {
         }
         Image::from_pixels(w, h, pixels)
     }
+}
+
+/// What a bake is kept under: its request and the source of every kernel it runs, so that an
+/// edit of a bake kernel (or of a file it includes) bakes again.
+pub fn bake_key(sources: &Sources, request: &bake::BakeRequest) -> Result<u64> {
+    let kernels: Vec<u64> = (request.kernels().iter())
+        .map(|k| crate::gpu::shader::source_hash(sources, k))
+        .collect::<Result<_>>()?;
+    Ok(cache::key(&(request, kernels)))
 }
 
 fn padded_row(w: u32) -> u32 {

@@ -13,5 +13,6 @@ mod hostile_files;
 mod install;
 mod maxima;
 mod preview_input;
+mod preview_latency;
 mod preview_window;
 mod volumes;

@@ -23,6 +23,7 @@ mod hypertexture_texel;
 mod light_volume;
 mod mesh_texel;
 mod pareto;
+mod preview_draft;
 mod reference;
 mod regress;
 mod render_scenes;
