@@ -64,6 +64,35 @@ pub struct DrawIndirect {
     pub first_instance: u32,
 }
 
+/// Screen tiles of a `Tiles` compositor (uniform `tile_params`): tiles of 16 x 16 pixels, each
+/// with one list segment per block of 32 planes (`src/methods/view_slices/tiles.rs`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct TileParams {
+    pub tiles_x: u32,
+    pub tiles_y: u32,
+    /// Blocks of 32 planes of the chunk: segments per tile.
+    pub blocks: u32,
+    /// Entries the tile lists hold; a segment past it is composited from its planes' triangles.
+    pub entry_capacity: u32,
+    pub width: u32,
+    pub height: u32,
+    pub _pad: [u32; 2],
+}
+
+/// One slice triangle projected for binning: its corners in pixels (y down, pixel centres at
+/// +0.5), the depth of its plane as the rasteriser tests it, and its plane in the chunk.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct TileTriangle {
+    /// Corner 0 (xy), corner 1 (zw).
+    pub xy01: [f32; 4],
+    /// Corner 2.
+    pub xy2: [f32; 2],
+    pub depth: f32,
+    pub plane: u32,
+}
+
 /// Per-frame parameters (uniform `frame`). Positions are camera-relative, so `view_proj` has no
 /// translation.
 #[repr(C)]

@@ -41,6 +41,11 @@ pub struct RenderOptions {
     pub step_scale: Option<f64>,
     /// GPU memory the frame may allocate (`--budget`; default `gpu::budget::DEFAULT_BUDGET`).
     pub budget: Option<u64>,
+    /// Compositor of every ViewSlices object (`--compositor`, the sweeps).
+    pub compositor: Option<crate::scene::Compositor>,
+    /// Entries of a `Tiles` compositor's tile lists (default: sized from the sweep and the
+    /// output; tests make it small to exercise the overflow path).
+    pub tile_entries: Option<u32>,
 }
 
 /// A method without its knobs, to switch every object to it (`--method`).
@@ -99,11 +104,13 @@ impl RenderOptions {
                 planes: self.planes.unwrap_or(vs.planes),
                 trivial_reject: self.trivial_reject.unwrap_or(vs.trivial_reject),
                 lighting,
+                compositor: self.compositor.unwrap_or(vs.compositor),
             }),
             (MethodKind::ViewSlices, _) => Method::ViewSlices(ViewSlices {
                 planes: self.planes.unwrap_or(DEFAULT_PLANES),
                 trivial_reject: self.trivial_reject.unwrap_or(true),
                 lighting,
+                compositor: self.compositor.unwrap_or_default(),
             }),
             (MethodKind::Reference, Method::Reference(r)) => {
                 Method::Reference(Reference { step: self.step.or(r.step), lighting })

@@ -459,6 +459,7 @@ impl State {
                             planes: DEFAULT_PLANES,
                             trivial_reject: true,
                             lighting: r.lighting,
+                            compositor: Default::default(),
                         }),
                         // Hypertextures have no texel for other methods: cycle their shading.
                         Method::RayMarch(mut h) => {

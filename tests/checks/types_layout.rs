@@ -22,6 +22,8 @@ fn wgsl_structs_match_rust() {
         layout!(SliceParams; plane_normal, first_plane, spacing, plane_count, prism_count, vertex_capacity),
         layout!(SliceVertex; position, uvw),
         layout!(DrawIndirect; vertex_count, instance_count, first_vertex, first_instance),
+        layout!(TileParams; tiles_x, tiles_y, blocks, entry_capacity, width, height, _pad),
+        layout!(TileTriangle; xy01, xy2, depth, plane),
         layout!(FrameParams; view_proj, forward, light_dir, light_color, background, viewport),
         layout!(ObjectParams; base_color, opacity_length),
         layout!(BaseVertex; position, normal),

@@ -36,6 +36,26 @@ struct DrawIndirect {
     first_instance: u32,
 }
 
+// Screen tiles of a Tiles compositor (TileParams in src/types.rs).
+struct TileParams {
+    tiles_x: u32,
+    tiles_y: u32,
+    blocks: u32,
+    entry_capacity: u32,
+    width: u32,
+    height: u32,
+    _pad0: u32,
+    _pad1: u32,
+}
+
+// One slice triangle in pixels, its plane's depth and its plane (TileTriangle in src/types.rs).
+struct TileTriangle {
+    xy01: vec4<f32>,
+    xy2: vec2<f32>,
+    depth: f32,
+    plane: u32,
+}
+
 struct FrameParams {
     view_proj: mat4x4<f32>,
     forward: vec4<f32>,

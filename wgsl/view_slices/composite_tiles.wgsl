@@ -1,0 +1,140 @@
+// Composites each pixel's slice fragments front to back in registers, a workgroup per 16 x 16 tile, stopping once opaque: a premultiplied layer.
+#include "shared/types.wgsl"
+#include "shared/tiles.wgsl"
+#include "shared/slice_shading.wgsl"
+
+override per_pixel_lighting: bool = false;
+
+@group(0) @binding(0) var<uniform> frame: FrameParams;
+@group(0) @binding(1) var<uniform> object: ObjectParams;
+@group(0) @binding(2) var<uniform> slice_params: SliceParams;
+@group(0) @binding(3) var<uniform> tile_params: TileParams;
+@group(0) @binding(4) var<storage, read> slice_vertices: array<SliceVertex>;
+@group(0) @binding(5) var<storage, read> prisms: array<Prism>;
+@group(0) @binding(6) var<storage, read> shell_vertices: array<ShellVertex>;
+@group(0) @binding(7) var volume: texture_3d<f32>;
+@group(0) @binding(8) var normals: texture_3d<f32>;
+@group(0) @binding(9) var volume_sampler: sampler;
+@group(0) @binding(10) var<storage, read> vertex_frames: array<VertexFrame>;
+@group(0) @binding(11) var<storage, read> draw_args: DrawIndirect;
+@group(0) @binding(12) var<storage, read> plane_cursors: array<u32>;
+@group(0) @binding(13) var<storage, read> tile_triangles: array<TileTriangle>;
+// After fill_tiles: the end of each (tile, block) segment; it starts where the previous ends.
+@group(0) @binding(14) var<storage, read> tile_cursors: array<u32>;
+@group(0) @binding(15) var<storage, read> tile_entries: array<u32>;
+// Depth of the opaque surfaces drawn before (base surfaces, binary axis slices).
+@group(0) @binding(16) var depth: texture_depth_2d;
+@group(0) @binding(17) var<storage, read_write> tile_layer: array<vec4<f32>>;
+
+// A pixel stops once less than this of what lies behind shows through (as the Reference does).
+const MIN_TRANSMITTANCE: f32 = 1e-4;
+
+var<workgroup> live_count: atomic<u32>;
+var<workgroup> live_pixels: u32;
+
+// The premultiplied fragment of triangle t at pixel centre p (barycentrics `bary`).
+fn tile_fragment(t: u32, bary: vec3<f32>) -> vec4<f32> {
+    let a = slice_vertices[3u * t];
+    let b = slice_vertices[3u * t + 1u];
+    let c = slice_vertices[3u * t + 2u];
+    let uvw = bary.x * a.uvw.xyz + bary.y * b.uvw.xyz + bary.z * c.uvw.xyz;
+    let rel = bary.x * a.position.xyz + bary.y * b.position.xyz + bary.z * c.position.xyz;
+    var f = SliceFrame(vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0));
+    if per_pixel_lighting {
+        let fa = slice_vertex_frame(a);
+        let fb = slice_vertex_frame(b);
+        let fc = slice_vertex_frame(c);
+        f = SliceFrame(
+            bary.x * fa.n_s + bary.y * fb.n_s + bary.z * fc.n_s,
+            bary.x * fa.n_t + bary.y * fb.n_t + bary.z * fc.n_t,
+            bary.x * fa.n_w + bary.y * fb.n_w + bary.z * fc.n_w,
+        );
+    }
+    return slice_fragment(uvw, rel, f);
+}
+
+@compute @workgroup_size(16, 16)
+fn main(
+    @builtin(workgroup_id) group: vec3<u32>,
+    @builtin(local_invocation_id) local: vec3<u32>,
+    @builtin(local_invocation_index) lid: u32,
+) {
+    let pixel = group.xy * TILE_SIZE + local.xy;
+    let inside = pixel.x < tile_params.width && pixel.y < tile_params.height;
+    let p = vec2<f32>(pixel) + 0.5;
+    let tile = group.y * tile_params.tiles_x + group.x;
+    let blocks = tile_params.blocks;
+    let capacity = min(tile_params.entry_capacity, arrayLength(&tile_entries));
+    var behind = 1.0;
+    if (inside) {
+        behind = textureLoad(depth, vec2<i32>(pixel), 0);
+    }
+    var rgb = vec3<f32>(0.0);
+    var transmittance = select(0.0, 1.0, inside);
+    // Per plane of the block: the triangle covering this pixel (one at most: the slices of one
+    // plane do not overlap), so the list's order within a segment does not matter.
+    var slots: array<u32, TILE_PLANES>;
+    for (var b = blocks; b > 0u; b--) {
+        let block = b - 1u;
+        // The whole tile stops once every pixel is opaque.
+        if (lid == 0u) {
+            atomicStore(&live_count, 0u);
+        }
+        workgroupBarrier();
+        if (transmittance > MIN_TRANSMITTANCE) {
+            atomicAdd(&live_count, 1u);
+        }
+        workgroupBarrier();
+        if (lid == 0u) {
+            live_pixels = atomicLoad(&live_count);
+        }
+        if (workgroupUniformLoad(&live_pixels) == 0u) {
+            break;
+        }
+        for (var s = 0u; s < TILE_PLANES; s++) {
+            slots[s] = NO_TRIANGLE;
+        }
+        let segment = tile * blocks + block;
+        let end = tile_cursors[segment];
+        let start = select(tile_cursors[max(segment, 1u) - 1u], 0u, segment == 0u);
+        if (end <= capacity) {
+            for (var e = start; e < end; e++) {
+                let entry = tile_entries[e];
+                if (tile_cover(tile_triangles[entry >> 5u], p).x >= 0.0) {
+                    slots[entry & (TILE_PLANES - 1u)] = entry >> 5u;
+                }
+            }
+        } else {
+            // The segment overflowed the lists: test every triangle of the block's planes.
+            let first = block * TILE_PLANES;
+            let last = min(first + TILE_PLANES, min(slice_params.plane_count, arrayLength(&plane_cursors)));
+            for (var k = first; k < last; k++) {
+                let begin = select(plane_cursors[max(k, 1u) - 1u], 0u, k == 0u) / 3u;
+                let finish = min(plane_cursors[k], draw_args.vertex_count) / 3u;
+                for (var t = begin; t < finish; t++) {
+                    if (tile_cover(tile_triangles[t], p).x >= 0.0) {
+                        slots[k - first] = t;
+                    }
+                }
+            }
+        }
+        // Front to back: higher planes are nearer.
+        for (var s = TILE_PLANES; s > 0u && transmittance > MIN_TRANSMITTANCE; s--) {
+            let t = slots[s - 1u];
+            if (t == NO_TRIANGLE) {
+                continue;
+            }
+            let tri = tile_triangles[t];
+            // The rasteriser's depth test (Less) against the opaque surfaces.
+            if (!(tri.depth < behind)) {
+                continue;
+            }
+            let f = tile_fragment(t, tile_cover(tri, p));
+            rgb += transmittance * f.rgb;
+            transmittance *= 1.0 - f.a;
+        }
+    }
+    if (inside) {
+        tile_layer[pixel.y * tile_params.width + pixel.x] = vec4<f32>(rgb, 1.0 - transmittance);
+    }
+}
