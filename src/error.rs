@@ -80,3 +80,15 @@ pub fn locate_literal(source: &str, text: &str, from: usize) -> Option<(usize, u
 pub fn ron_error(path: &Path, e: &ron::error::SpannedError) -> Error {
     Error::at(FileLoc::new(path, e.span.start.line, e.span.start.col), e.code.to_string())
 }
+
+/// Runs `f`, catching a panic without the panic hook's message (the caller reports it as the
+/// file's error). The hook is process-wide: a lock keeps two callers from swapping it at once.
+pub fn quietly<T>(f: impl FnOnce() -> T + std::panic::UnwindSafe) -> std::thread::Result<T> {
+    static HOOK: std::sync::Mutex<()> = std::sync::Mutex::new(());
+    let _held = HOOK.lock().unwrap_or_else(|e| e.into_inner());
+    let hook = std::panic::take_hook();
+    std::panic::set_hook(Box::new(|_| {}));
+    let result = std::panic::catch_unwind(f);
+    std::panic::set_hook(hook);
+    result
+}

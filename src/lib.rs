@@ -25,6 +25,7 @@ pub mod regress;
 pub mod render;
 pub mod scene;
 pub mod types;
+pub mod vdb;
 
 pub use error::{Error, FileLoc, Result};
 

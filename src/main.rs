@@ -1,5 +1,5 @@
 //! The `voltex` command line: render, bake, export, compare, plan, import, preview, regress, farm, info,
-//! bench, bench-hyper, pareto. Each subcommand lives in `src/cli/<name>.rs`; this file parses and
+//! bench, bench-hyper, bench-report, pareto. Each subcommand lives in `src/cli/<name>.rs`; this file parses and
 //! dispatches.
 
 mod cli;
@@ -43,6 +43,7 @@ fn main() -> ExitCode {
         Command::Info => cli::info::run(),
         Command::Bench(args) => cli::bench::run(args),
         Command::BenchHyper(args) => cli::bench::run_hyper(args),
+        Command::BenchReport(args) => cli::bench_report::run(args),
         Command::Pareto(args) => cli::pareto::run(args),
     };
     match result {

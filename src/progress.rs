@@ -1,4 +1,4 @@
-//! Progress of a long command on stderr (regress, pareto): a `\r`-updated bar with an ETA when
+//! Progress of a long command on stderr (regress, pareto, bake, export): a `\r`-updated bar with an ETA when
 //! stderr is a terminal (notable lines printed above it as they come), one line per finished item
 //! otherwise (logs, CI, tests); nothing with `--quiet` but errors.
 

@@ -484,6 +484,28 @@ pub struct SegmentParams {
     pub splatting: [u32; 4],
 }
 
+/// The light volume of a RayMarch object (`bake_light_volume.wgsl`; read by `shade` in
+/// wgsl/shared/march.wgsl): transmittance towards a directional light at the vertices of a grid
+/// laid in the light's frame over the object's bounds, vertex `(i, j, k)` at `origin + i u + j v
+/// + k w`, `k = 0` on the light's side and `w` pointing away from the light. Twin:
+/// `LightVolumeParams` in wgsl/shared/types.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct LightVolumeParams {
+    /// xyz: vertex (0, 0, 0) (object space); w: world length of one sub-step along the light.
+    pub origin: [f32; 4],
+    /// xyz: object-space step between vertices along i; w: the opacity length (world).
+    pub u: [f32; 4],
+    /// xyz: step along j; w: world length of one step along k (a layer).
+    pub v: [f32; 4],
+    /// xyz: step along k (away from the light); w: unused.
+    pub w: [f32; 4],
+    /// Object space to grid coordinates in vertex units (affine, column-major).
+    pub to_grid: [[f32; 4]; 4],
+    /// xyz: vertices along i, j, k; w: sub-steps per layer.
+    pub counts: [u32; 4],
+}
+
 /// A splat of a hypertexture object's splat set (object space): a surface splat is a disk with
 /// an outward normal, an interior splat a sphere (normal zero).
 #[repr(C)]
@@ -506,3 +528,32 @@ pub const FIELD_CLOSEST_SURFACE: u32 = 0;
 pub const FIELD_FROM_CENTRE: u32 = 1;
 pub const FIELD_CONSTANT: u32 = 2;
 pub const FIELD_SWIRL: u32 = 3;
+
+/// One volume object (an OpenVDB grid) as `march_volume.wgsl` and `bake_volume.wgsl` see it;
+/// twin: `VolumeParams` in wgsl/shared/types.wgsl. Index space is the grid's (voxel (i, j, k)
+/// at index point (i, j, k)).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct VolumeParams {
+    /// Camera-relative world to index space (the bake: texel space to index space).
+    pub to_index: [[f32; 4]; 4],
+    /// xyz: the camera's right, scaled by the image's half width at unit distance; w: near.
+    pub right: [f32; 4],
+    /// xyz: up, likewise; w: far.
+    pub up: [f32; 4],
+    /// xyz: index box outside which the density is 0 (lower corner); w: ray step (world units).
+    pub box_lo: [f32; 4],
+    /// xyz: upper corner; w: shadow-ray step (world units).
+    pub box_hi: [f32; 4],
+    /// rgb: albedo; w: density scale (extinction per unit density per world unit).
+    pub medium: [f32; 4],
+    /// xyz: index coordinate of the brick table's first voxel; w: unused.
+    pub origin: [i32; 4],
+    /// xyz: top cells of the brick table per axis; w: has a colour grid (1) or not (0).
+    pub table: [u32; 4],
+    /// xyz: brick slots of the atlases per axis; w: unused.
+    pub atlas: [u32; 4],
+    /// x: loop iterations per dispatch; y: most shadow samples; z: worst iterations of one
+    /// sample; w: unused.
+    pub budget: [u32; 4],
+}

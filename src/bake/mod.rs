@@ -4,6 +4,7 @@
 
 pub mod axis_slices;
 pub mod hypertexture;
+pub mod volume;
 
 use crate::gpu::sources::Sources;
 
@@ -30,6 +31,8 @@ pub enum BakeSource {
     Mesh(MeshTexel),
     /// A hypertexture sampled at the voxel centres of a box of its object space.
     Hypertexture(Box<hypertexture::HyperTexel>),
+    /// A volume (an OpenVDB grid) sampled at the voxel centres of a box of its world space.
+    Volume(Box<volume::VolumeTexel>),
 }
 
 /// A mesh texel's pattern, where its voxel centres lie, and its colouring; shown in `Debug` (the
@@ -113,6 +116,32 @@ pub struct BakeRequest {
     pub axis_slices: bool,
 }
 
+impl BakeRequest {
+    /// The kernels the bake runs (under `wgsl/`), so that `plan` can check them before any GPU
+    /// work: the same files [`Baker::bake`] loads.
+    pub fn kernels(&self) -> Vec<&'static str> {
+        let mut k = match &self.source {
+            BakeSource::Implicit(_) => vec!["bake/bake_implicit.wgsl"],
+            BakeSource::Heightfield(_) => vec!["bake/bake_heightfield.wgsl"],
+            BakeSource::HeightImage(..) => vec!["bake/bake_height_image.wgsl"],
+            BakeSource::Stack(_) => vec![],
+            BakeSource::Mesh(_) => vec!["bake/bake_mesh_grid.wgsl", "bake/bake_mesh_texel.wgsl"],
+            BakeSource::Hypertexture(h) => {
+                let mut k = vec!["ray_march/bake_transfer.wgsl", "bake/bake_hypertexture.wgsl"];
+                if h.packed.mesh.is_some() {
+                    k.push("bake/bake_mesh_grid.wgsl");
+                }
+                k
+            }
+            BakeSource::Volume(_) => vec!["bake/bake_volume.wgsl"],
+        };
+        if self.axis_slices {
+            k.push("axis_slices/bake_axis_slices.wgsl");
+        }
+        k
+    }
+}
+
 #[derive(Clone)]
 pub struct Baked {
     pub volume: wgpu::Texture,
@@ -155,6 +184,16 @@ impl BakeRequest {
         if self.per_pixel {
             out.push(volume(format!("texel \"{texel}\"'s normal volume"), res));
         }
+        if let BakeSource::Volume(v) = &self.source {
+            let size = volume::atlas_size(volume::slots(&v.grid));
+            let texels = size.iter().map(|&s| s as u64).product::<u64>();
+            out.push(Allocation {
+                what: format!("texel \"{texel}\"'s volume atlas ({} bricks)", v.grid.bricks()),
+                bytes: texels * if v.grid.color.is_some() { 12 } else { 4 },
+                shape: Shape::Texture3d { size },
+                driver: driver.clone(),
+            });
+        }
         if let BakeSource::Mesh(_) = self.source {
             out.push(Allocation {
                 what: format!("texel \"{texel}\"'s mesh grid"),
@@ -191,6 +230,7 @@ impl BakeRequest {
                 "bake_transfer.wgsl + bake_mesh_grid.wgsl + bake_hypertexture.wgsl"
             }
             BakeSource::Hypertexture(_) => "bake_transfer.wgsl + bake_hypertexture.wgsl",
+            BakeSource::Volume(_) => "bake/bake_volume.wgsl",
         };
         let lighting = if self.per_pixel { "per-pixel (albedo + normals)" } else { "baked" };
         let mut s = format!("  {texel:<16} {x}x{y}x{z}  {kind}  lighting {lighting}\n");
@@ -216,6 +256,7 @@ pub struct Baker {
     hyper: Option<ComputeKernel>,
     transfer: Option<ComputeKernel>,
     axis: Option<ComputeKernel>,
+    volume: Option<ComputeKernel>,
     sources: Sources,
     /// `Rgba32Float` for [`Baker::full_precision`], else `Rgba8Unorm`.
     format: wgpu::TextureFormat,
@@ -232,6 +273,7 @@ impl Baker {
             hyper: None,
             transfer: None,
             axis: None,
+            volume: None,
             sources: sources.clone(),
             format: wgpu::TextureFormat::Rgba8Unorm,
         }
@@ -394,6 +436,11 @@ impl Baker {
                     Self::kernel(&mut self.transfer, ctx, &root, "ray_march/bake_transfer.wgsl", format)?;
                 let hyper = Self::kernel(&mut self.hyper, ctx, &root, "bake/bake_hypertexture.wgsl", format)?;
                 ht.bake(ctx, (transfer, hyper), &mut encoder, &mut inputs, params)?;
+            }
+            BakeSource::Volume(v) => {
+                let kernel =
+                    Self::kernel(&mut self.volume, ctx, &root, "bake/bake_volume.wgsl", self.format)?;
+                v.bake(ctx, kernel, &mut encoder, &mut inputs, params)?;
             }
         }
         let axis = match req.axis_slices {

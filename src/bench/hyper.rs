@@ -18,9 +18,10 @@
 //! same frame unshaded) and FLIP against a converged render (the bounds march with a step of
 //! 0.001).
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
+use super::json::{Report, Row};
 use crate::error::Result;
 use crate::gpu::kernel::ComputeKernel;
 use crate::gpu::sources::Sources;
@@ -109,9 +110,30 @@ pub fn noise_rate(ctx: &GpuContext) -> Result<f64> {
 struct Timed {
     renderer: Renderer,
     times: Vec<f64>,
+    /// GPU ms of each timed frame (the sum over its passes), where the adapter has timestamps.
+    gpu: Vec<f64>,
 }
 
 impl Timed {
+    fn new(renderer: Renderer) -> Self {
+        Timed { renderer, times: Vec::new(), gpu: Vec::new() }
+    }
+
+    /// Renders a timed frame.
+    fn frame(&mut self, ctx: &GpuContext) -> Result<()> {
+        let t = Instant::now();
+        let passes = self.renderer.render_timed(ctx)?;
+        self.times.push(t.elapsed().as_secs_f64() * 1e3);
+        if !passes.is_empty() {
+            self.gpu.push(passes.iter().map(|p| p.1).sum());
+        }
+        Ok(())
+    }
+
+    fn gpu_ms(&self) -> Option<f64> {
+        (!self.gpu.is_empty()).then(|| median(self.gpu.clone()))
+    }
+
     fn counts(&self, ctx: &GpuContext) -> Result<(f64, f64, f64)> {
         let r = &self.renderer;
         let instance = r.blueprint.find_instance("RayMarch").unwrap_or(0);
@@ -133,7 +155,8 @@ const SEGMENTS: &[(&str, &str)] = &[
 
 /// The segment strategies on every object (IE, Phong): frame time, density evaluations and FLIP
 /// against a converged render.
-pub fn segments_table(ctx: &GpuContext, size: (u32, u32), frames: usize, quick: bool) -> Result<()> {
+pub fn segments_table(ctx: &GpuContext, args: &Args, report: &mut Report) -> Result<()> {
+    let (size, frames, quick) = (args.size, args.frames, args.quick);
     println!(
         "\n| object | segments | dispatches | frame ms (wall) | M density evals | M noise evals | M samples | FLIP vs \
          converged |"
@@ -145,26 +168,24 @@ pub fn segments_table(ctx: &GpuContext, size: (u32, u32), frames: usize, quick: 
         let parse = |method: &str| {
             crate::scene::parse(&method_scene(object, transform, method), Path::new("bench-hyper.ron"))
         };
-        let truth = parse("RayMarch(step: 0.001, shading: Phong)")?;
-        let truth = Renderer::new(ctx, Blueprint::new(&truth, &opts)?)?.render(ctx)?.image;
+        let truth_method = format!("RayMarch(step: {}, shading: Phong)", args.truth_step);
+        let truth = Renderer::new(ctx, Blueprint::new(&parse(&truth_method)?, &opts)?)?.render(ctx)?.image;
         for (label, segments) in SEGMENTS {
             let scene = parse(&format!("RayMarch(quality: IE, shading: Phong, segments: {segments})"))?;
-            let mut run =
-                Timed { renderer: Renderer::new(ctx, Blueprint::new(&scene, &opts)?)?, times: Vec::new() };
+            let mut run = Timed::new(Renderer::new(ctx, Blueprint::new(&scene, &opts)?)?);
             run.renderer.render_timed(ctx)?;
             for _ in 0..frames {
-                let t = Instant::now();
-                run.renderer.render_timed(ctx)?;
-                run.times.push(t.elapsed().as_secs_f64() * 1e3);
+                run.frame(ctx)?;
             }
             let (evals, noised, _) = run.counts(ctx)?;
             let image = run.renderer.render(ctx)?.image;
             let flip = crate::metrics::flip(&image, &truth)?.mean;
+            let rel_rmse = crate::metrics::relative_rmse(&image, &truth)?;
             // Unshaded, every density evaluation is a sample along a ray.
             let unshaded = parse(&format!("RayMarch(quality: IE, shading: None, segments: {segments})"))?;
             let mut unshaded = Renderer::new(ctx, Blueprint::new(&unshaded, &opts)?)?;
             unshaded.render_timed(ctx)?;
-            let (samples, _, _) = Timed { renderer: unshaded, times: Vec::new() }.counts(ctx)?;
+            let (samples, _, _) = Timed::new(unshaded).counts(ctx)?;
             let plan =
                 run.renderer.blueprint.objects.iter().find_map(|o| o.method::<RayMarchPlan>().cloned());
             // Splatting runs no marcher: its two passes are dispatched once each.
@@ -172,28 +193,82 @@ pub fn segments_table(ctx: &GpuContext, size: (u32, u32), frames: usize, quick: 
                 Some(_) => "1 + 1".to_string(),
                 None => p.dispatches.to_string(),
             });
+            let ms = median(run.times.clone());
             println!(
-                "| {name} | {label} | {dispatches} | {:.1} | {:.2} | {:.2} | {:.3} | {flip:.4} |",
-                median(run.times.clone()),
+                "| {name} | {label} | {dispatches} | {ms:.1} | {:.2} | {:.2} | {:.3} | {flip:.4} |",
                 evals / 1e6,
                 noised / 1e6,
                 samples / 1e6
             );
+            let extra = [("noise_evaluations", noised), ("samples", samples)];
+            report.rows.push(Row {
+                object: Some(name.to_string()),
+                quality: Some("IE".into()),
+                step: Some(0.015),
+                shading: Some("Phong".into()),
+                segments: Some(label.to_string()),
+                flip: Some(flip),
+                rel_rmse: Some(rel_rmse),
+                truth: Some(format!("RayMarch, step {}, Phong, Bounds", args.truth_step)),
+                work: Some(evals),
+                work_unit: Some("density evaluations".into()),
+                extra: extra.into_iter().map(|(k, v)| (k.to_string(), v)).collect(),
+                ..Row::new("segments", "RayMarch", ms)
+            });
+            report.trace(format!("{name} IE Phong {label}"), &run.renderer);
         }
     }
     Ok(())
 }
 
-pub fn run(size: (u32, u32), frames: usize, quick: bool, segments_only: bool) -> Result<()> {
+/// `voltex bench-hyper`'s arguments.
+pub struct Args {
+    pub size: (u32, u32),
+    pub frames: usize,
+    /// Only the first object (the sphere; the teapot for the shadows table).
+    pub quick: bool,
+    /// Only the table of segment strategies.
+    pub segments: bool,
+    /// Only the table of shadows (Phong, shadow rays, light volumes on the Figure 11 scenes).
+    pub shadows: bool,
+    /// Step of the converged renders that errors are measured against.
+    pub truth_step: f64,
+    /// Write the rows as JSON here.
+    pub json: Option<PathBuf>,
+    /// Write the timed frames' passes as a Chrome/Perfetto trace here.
+    pub trace: Option<PathBuf>,
+}
+
+pub fn run(args: &Args) -> Result<()> {
+    super::json::check_output(args.json.as_deref())?;
+    super::json::check_output(args.trace.as_deref())?;
     let ctx = GpuContext::new()?;
-    if segments_only {
+    let mut report = Report::new("bench-hyper", ctx.adapter_line(), args.size, args.frames);
+    let result = tables(&ctx, args, &mut report);
+    report.cost_models = super::cost::fit(&report.rows);
+    for f in &report.cost_models {
+        println!("{}", f.describe());
+    }
+    report.finish(args.json.as_deref(), args.trace.as_deref())?;
+    result
+}
+
+fn tables(ctx: &GpuContext, args: &Args, report: &mut Report) -> Result<()> {
+    let (size, frames, quick) = (args.size, args.frames, args.quick);
+    if args.segments || args.shadows {
         println!(
-            "bench-hyper segments on {}: {size:?}, median of {frames} frame(s) after one warm-up",
+            "bench-hyper on {}: {size:?}, median of {frames} frame(s) after one warm-up",
             ctx.adapter_line()
         );
-        return segments_table(&ctx, size, frames, quick);
+        if args.segments {
+            segments_table(ctx, args, report)?;
+        }
+        if args.shadows {
+            shadows_table(ctx, args, report)?;
+        }
+        return Ok(());
     }
-    let rate = noise_rate(&ctx)?;
+    let rate = noise_rate(ctx)?;
     println!(
         "bench-hyper on {}: {size:?}, median of {frames} frame(s) after one warm-up; simplex noise alone: {:.0} M \
          evaluations/s",
@@ -212,8 +287,8 @@ pub fn run(size: (u32, u32), frames: usize, quick: bool, segments_only: bool) ->
         // The first bake compiles the kernel.
         for _ in 0..4 {
             let t = Instant::now();
-            let grid = crate::hypertexture::mesh::bake(&ctx, shape, spec)?;
-            crate::hypertexture::mesh::read(&ctx, &grid)?;
+            let grid = crate::hypertexture::mesh::bake(ctx, shape, spec)?;
+            crate::hypertexture::mesh::read(ctx, &grid)?;
             times.push(t.elapsed().as_secs_f64() * 1e3);
         }
         println!(
@@ -232,7 +307,16 @@ pub fn run(size: (u32, u32), frames: usize, quick: bool, segments_only: bool) ->
     );
     println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
     let objects = if quick { &OBJECTS[..1] } else { OBJECTS };
+    let opts = RenderOptions { size: Some(size), ..Default::default() };
     for (name, object, transform) in objects {
+        // Converged renders per shading (shadow rays for PhongShadows), the bounds marched.
+        let mut truths = std::collections::HashMap::new();
+        for shading in SHADINGS {
+            let text = scene_text(object, transform, "HQ", shading, "Bounds")
+                .replace("RayMarch(quality: HQ,", &format!("RayMarch(step: {},", args.truth_step));
+            let scene = crate::scene::parse(&text, Path::new("bench-hyper.ron"))?;
+            truths.insert(*shading, Renderer::new(ctx, Blueprint::new(&scene, &opts)?)?.render(ctx)?.image);
+        }
         for quality in QUALITIES {
             for (shading, (label, segments)) in
                 SHADINGS.iter().flat_map(|s| SEGMENTS.iter().map(move |g| (s, g)))
@@ -247,15 +331,13 @@ pub fn run(size: (u32, u32), frames: usize, quick: bool, segments_only: bool) ->
                         .iter_mut()
                         .filter_map(|o| o.method_mut::<RayMarchPlan>())
                         .for_each(|m| m.noise = noise);
-                    let mut renderer = Renderer::new(&ctx, bp)?;
-                    renderer.render_timed(&ctx)?;
-                    runs.push(Timed { renderer, times: Vec::new() });
+                    let mut renderer = Renderer::new(ctx, bp)?;
+                    renderer.render_timed(ctx)?;
+                    runs.push(Timed::new(renderer));
                 }
                 for _ in 0..frames {
                     for run in runs.iter_mut() {
-                        let t = Instant::now();
-                        run.renderer.render_timed(&ctx)?;
-                        run.times.push(t.elapsed().as_secs_f64() * 1e3);
+                        run.frame(ctx)?;
                     }
                 }
                 let plan = runs[0]
@@ -267,11 +349,37 @@ pub fn run(size: (u32, u32), frames: usize, quick: bool, segments_only: bool) ->
                 let plan = plan.expect("a RayMarch object");
                 let ms = median(runs[0].times.clone());
                 let ms_off = median(runs[1].times.clone());
-                let (evals, noised, covered) = runs[0].counts(&ctx)?;
-                let (evals_off, _, _) = runs[1].counts(&ctx)?;
+                let (evals, noised, covered) = runs[0].counts(ctx)?;
+                let (evals_off, _, _) = runs[1].counts(ctx)?;
                 let noise_ms = noised * NOISE_COUNT / rate * 1e3;
                 // Time per density evaluation with and without the noises.
                 let ab = 1.0 - (ms_off / evals_off) / (ms / evals);
+                let image = runs[0].renderer.render(ctx)?.image;
+                let truth = &truths[shading];
+                let extra = [
+                    ("dispatches", plan.dispatches as f64),
+                    ("coverage", covered),
+                    ("noise_evaluations", noised * NOISE_COUNT),
+                    ("noise_share_rate", noise_ms / ms),
+                    ("noise_share_ab", ab),
+                ];
+                report.rows.push(Row {
+                    object: Some(name.to_string()),
+                    quality: Some(quality.to_string()),
+                    step: Some(plan.step),
+                    shading: Some(shading.to_string()),
+                    shadows: (*shading == "PhongShadows").then(|| "rays".into()),
+                    segments: Some(label.to_string()),
+                    gpu_ms: runs[0].gpu_ms(),
+                    flip: Some(crate::metrics::flip(&image, truth)?.mean),
+                    rel_rmse: Some(crate::metrics::relative_rmse(&image, truth)?),
+                    truth: Some(format!("RayMarch, step {}, same shading, Bounds", args.truth_step)),
+                    work: Some(evals),
+                    work_unit: Some("density evaluations".into()),
+                    extra: extra.into_iter().map(|(k, v)| (k.to_string(), v)).collect(),
+                    ..Row::new("figure11", "RayMarch", ms)
+                });
+                report.trace(format!("{name} {quality} {shading} {label}"), &runs[0].renderer);
                 println!(
                     "| {name} | {quality} | {} | {shading} | {label} | {} | {:.0}% | {ms:.1} | {:.2} | {:.1} | {:.1} | \
                      {noise_ms:.1} | {:.0}% | {:.0}% |",
@@ -287,5 +395,114 @@ pub fn run(size: (u32, u32), frames: usize, quick: bool, segments_only: bool) ->
             }
         }
     }
-    segments_table(&ctx, size, frames, quick)
+    segments_table(ctx, args, report)?;
+    shadows_table(ctx, args, report)
+}
+
+/// The Figure 11 scenes (scenes/hypertextures/) of the shadows table.
+const FIGURE11: &[&str] = &["teapot", "bunny", "cube"];
+/// Shadow settings of the shadows table (`--shadows` values), Phong without shadows first.
+const SHADOWS: &[&str] = &["none", "rays", "volume:32", "volume:64", "volume:128"];
+
+/// Shadows on the Figure 11 scenes at HQ: Phong without shadows, shadow rays and light volumes,
+/// timed in alternation (so load changes hit all), with the light volume's bake timed apart (it
+/// is cached: a frame pays it only when the light or the density changes), and the error against
+/// shadow rays at the truth step and against shadow rays at the same step.
+pub fn shadows_table(ctx: &GpuContext, args: &Args, report: &mut Report) -> Result<()> {
+    use crate::methods::options::parse_shadows;
+    use crate::methods::ray_march::light_volume;
+    println!(
+        "\n| object | shadows | frame ms (wall) | x Phong | light volume bake ms | M density evals | FLIP vs truth | \
+         FLIP vs rays |"
+    );
+    println!("|---|---|---|---|---|---|---|---|");
+    let scenes = if args.quick { &FIGURE11[..1] } else { FIGURE11 };
+    for name in scenes {
+        let path = crate::project_root().join(format!("scenes/hypertextures/fig11_{name}.ron"));
+        let scene = crate::scene::load(&path)?;
+        let options = |step: f64, shadows: &str| -> Result<RenderOptions> {
+            Ok(RenderOptions {
+                size: Some(args.size),
+                step: Some(step),
+                shadows: Some(parse_shadows(shadows).map_err(crate::Error::Invalid)?),
+                ..Default::default()
+            })
+        };
+        let render = |opts: &RenderOptions| -> Result<crate::io::Image> {
+            Ok(Renderer::new(ctx, Blueprint::new(&scene, opts)?)?.render(ctx)?.image)
+        };
+        let truth = render(&options(args.truth_step, "rays")?)?;
+        let mut runs = Vec::new();
+        for shadows in SHADOWS {
+            let mut r = Renderer::new(ctx, Blueprint::new(&scene, &options(0.002, shadows)?)?)?;
+            r.render_timed(ctx)?;
+            runs.push(Timed::new(r));
+        }
+        for _ in 0..args.frames {
+            for run in runs.iter_mut() {
+                run.frame(ctx)?;
+            }
+        }
+        let phong_ms = median(runs[0].times.clone());
+        let rays = runs[1].renderer.render(ctx)?.image;
+        for (shadows, run) in SHADOWS.iter().zip(&mut runs) {
+            let ms = median(run.times.clone());
+            let image = run.renderer.render(ctx)?.image;
+            let (evals, _, _) = run.counts(ctx)?;
+            let plan =
+                run.renderer.blueprint.objects.iter().find_map(|o| o.method::<RayMarchPlan>().cloned());
+            let plan = plan.expect("a RayMarch object");
+            // The bake alone (the first compiles the kernels), with a readback to wait for it.
+            let bake_ms = match &plan.light {
+                Some(grid) => {
+                    let grid_bake = plan.bake_mesh_grid(ctx)?;
+                    let mut times = Vec::new();
+                    for _ in 0..3 {
+                        let t = Instant::now();
+                        let volume = light_volume::bake(ctx, &plan, grid, grid_bake.as_ref())?;
+                        ctx.read_buffer(&volume, 0, 4)?;
+                        times.push(t.elapsed().as_secs_f64() * 1e3);
+                    }
+                    Some(median(times[1..].to_vec()))
+                }
+                None => None,
+            };
+            let flip = crate::metrics::flip(&image, &truth)?.mean;
+            let flip_rays = crate::metrics::flip(&image, &rays)?.mean;
+            println!(
+                "| fig11_{name} | {shadows} | {ms:.1} | {:.2} | {} | {:.2} | {flip:.4} | {flip_rays:.4} |",
+                ms / phong_ms,
+                bake_ms.map_or("-".into(), |b| format!("{b:.1}")),
+                evals / 1e6
+            );
+            let mut extra = std::collections::BTreeMap::new();
+            extra.insert("phong_ratio".to_string(), ms / phong_ms);
+            extra.insert("flip_vs_rays_same_step".to_string(), flip_rays);
+            if let Some(b) = bake_ms {
+                extra.insert("light_volume_bake_ms".to_string(), b);
+            }
+            report.rows.push(Row {
+                object: Some(format!("fig11_{name}")),
+                quality: Some("HQ".into()),
+                step: Some(plan.step),
+                shading: Some(if *shadows == "none" { "Phong" } else { "PhongShadows" }.into()),
+                shadows: Some(shadows.to_string()),
+                segments: Some("Bounds".into()),
+                gpu_ms: run.gpu_ms(),
+                flip: Some(flip),
+                rel_rmse: Some(crate::metrics::relative_rmse(&image, &truth)?),
+                truth: Some(format!("RayMarch, step {}, PhongShadows with shadow rays", args.truth_step)),
+                work: Some(evals),
+                work_unit: Some("density evaluations".into()),
+                extra,
+                ..Row::new("shadows", "RayMarch", ms)
+            });
+            report.trace(format!("fig11_{name} HQ shadows={shadows}"), &run.renderer);
+        }
+    }
+    println!(
+        "x Phong: frame time over Phong without shadows' (timed in alternation); the light volume's bake is cached \
+         (a frame pays it when the light or the density changes)"
+    );
+    Ok(())
 }

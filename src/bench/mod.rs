@@ -5,8 +5,15 @@
 //!
 //! Lavapipe returns near-zero compute timestamps once a render pass has run in the process, so
 //! the slicing kernels are timed first, alone (graph `slices_only.ron`), before any full frame.
+//!
+//! `--json FILE` writes the rows ([`json`]) with the cost model ([`cost`]: frame time against
+//! slice triangles, planes x visible prisms); `--limits` measures the adapter's own blend, texture
+//! and noise rates first ([`limits`]) and prints each setting's share of the blend limit.
 
+pub mod cost;
 pub mod hyper;
+pub mod json;
+pub mod limits;
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -40,28 +47,48 @@ struct Row {
     cpu_ms: f64,
     /// Fragments the slices cover: their projected area in pixels, summed.
     fragments: f64,
+    /// Slice triangles the CPU twin emits (planes x visible prisms, fanned).
+    triangles: f64,
     rel_rmse: f64,
     flip: f64,
 }
 
-pub fn run(
-    scenes: &[PathBuf],
-    planes: &[u32],
-    size: (u32, u32),
-    frames: usize,
-    reference_planes: u32,
-) -> Result<()> {
+/// `voltex bench`'s arguments.
+pub struct Args {
+    pub scenes: Vec<PathBuf>,
+    pub planes: Vec<u32>,
+    pub size: (u32, u32),
+    pub frames: usize,
+    pub reference_planes: u32,
+    /// Write the rows as JSON here.
+    pub json: Option<PathBuf>,
+    /// Measure the adapter's blend, texture and noise rates first.
+    pub limits: bool,
+    /// Write the timed frames' passes as a Chrome/Perfetto trace here.
+    pub trace: Option<PathBuf>,
+}
+
+pub fn run(args: &Args) -> Result<()> {
+    let Args { scenes, planes, size, frames, reference_planes, .. } = args;
+    let (size, frames, reference_planes) = (*size, *frames, *reference_planes);
+    json::check_output(args.json.as_deref())?;
+    json::check_output(args.trace.as_deref())?;
     let paths = if scenes.is_empty() { default_scenes() } else { scenes.to_vec() };
     let scenes: Vec<Scene> = paths.iter().map(|p| crate::scene::load(p)).collect::<Result<_>>()?;
     let mut settings = Vec::new();
     for scene in 0..scenes.len() {
-        for &n in planes {
+        for &n in planes.iter() {
             for reject in [true, false] {
                 settings.push(Setting { scene, planes: n, reject });
             }
         }
     }
     let ctx = GpuContext::new()?;
+    let mut report = json::Report::new("bench", ctx.adapter_line(), size, frames);
+    // Before any render pass: lavapipe's compute timestamps are only right until then.
+    if args.limits {
+        report.limits = Some(limits::measure(&ctx)?);
+    }
     let options = |s: &Setting, graph: Option<PathBuf>| RenderOptions {
         size: Some(size),
         planes: Some(s.planes),
@@ -77,8 +104,10 @@ pub fn run(
         let bp = Blueprint::new(&scenes[s.scene], &options(s, Some(slices_only.clone())))?;
         let mut r = Renderer::new(&ctx, bp)?;
         let (slicing, _) = timed(&ctx, &mut r, frames, None)?;
+        let stem = paths[s.scene].file_stem().unwrap_or_default().to_string_lossy();
+        report.trace(format!("{stem} planes={} reject={} slicing alone", s.planes, s.reject), &r);
         let mut cpu = Vec::new();
-        let mut fragments = 0.0;
+        let (mut fragments, mut triangles) = (0.0, 0.0);
         for o in &r.blueprint.objects {
             let Some(vs) = o.method::<crate::methods::view_slices::ViewSlicesPlan>() else { continue };
             let t = Instant::now();
@@ -90,8 +119,9 @@ pub fn run(
             );
             cpu.push(t.elapsed().as_secs_f64() * 1e3);
             fragments += covered_pixels(&r.blueprint, &out);
+            triangles += out.iter().map(|p| p.len() / 3).sum::<usize>() as f64;
         }
-        rows.push(Row { slicing, cpu_ms: cpu.iter().sum(), fragments, ..Default::default() });
+        rows.push(Row { slicing, cpu_ms: cpu.iter().sum(), fragments, triangles, ..Default::default() });
     }
 
     // Phase 2: full frames, their raster passes and wall time, and the error of each setting.
@@ -109,6 +139,8 @@ pub fn run(
         row.rel_rmse = crate::metrics::relative_rmse(&image, reference)?;
         row.flip = crate::metrics::flip(&image, reference)?.mean;
         let (passes, wall) = timed(&ctx, &mut r, frames, None)?;
+        let stem = paths[s.scene].file_stem().unwrap_or_default().to_string_lossy();
+        report.trace(format!("{stem} planes={} reject={} frame", s.planes, s.reject), &r);
         row.raster = passes.into_iter().filter(|p| p.0.starts_with("draw") || p.0 == "composite").collect();
         row.wall_ms = wall;
     }
@@ -150,7 +182,56 @@ pub fn run(
         "Mfrag = millions of fragments the slice polygons cover (projected area); Mfrag/s = Mfrag / draw;"
     );
     println!("frame (wall) = submit to idle of a whole frame; CPU twin = the same slicing on one CPU core");
-    Ok(())
+    let truth = format!("ViewSlices, {reference_planes} planes");
+    for (s, row) in settings.iter().zip(&rows) {
+        let get = |v: &[(String, f64)], p: &str| v.iter().find(|x| x.0 == p).map(|x| x.1);
+        let name = Path::new(&paths[s.scene]).file_stem().unwrap_or_default().to_string_lossy().to_string();
+        let slicing: f64 = row.slicing.iter().map(|p| p.1).sum();
+        let raster: f64 = row.raster.iter().map(|p| p.1).sum();
+        let mut extra = std::collections::BTreeMap::new();
+        for (k, v) in row.slicing.iter().chain(&row.raster) {
+            extra.insert(format!("{k}_ms"), *v);
+        }
+        extra.insert("fragments".into(), row.fragments);
+        extra.insert("cpu_twin_ms".into(), row.cpu_ms);
+        if let (Some(l), Some(draw)) = (&report.limits, get(&row.raster, "draw_slices")) {
+            extra.insert("blend_limit_share".into(), row.fragments / (draw * 1e-3) / l.blend_fragments_per_s);
+        }
+        report.rows.push(json::Row {
+            scene: Some(name),
+            planes: Some(s.planes),
+            trivial_reject: Some(s.reject),
+            gpu_ms: (!row.slicing.is_empty()).then_some(slicing + raster),
+            flip: Some(row.flip),
+            rel_rmse: Some(row.rel_rmse),
+            truth: Some(truth.clone()),
+            work: Some(row.triangles),
+            work_unit: Some("slice triangles".into()),
+            extra,
+            ..json::Row::new("table1", "ViewSlices", row.wall_ms)
+        });
+    }
+    if let Some(l) = &report.limits {
+        println!("\n{}", limits::describe(l));
+        println!("| scene | planes | reject | Mfrag/s in draw_slices | share of the blend limit |");
+        println!("|---|---|---|---|---|");
+        for r in &report.rows {
+            let share = r.extra.get("blend_limit_share").copied().unwrap_or(f64::NAN);
+            println!(
+                "| {} | {} | {} | {:.0} | {:.0}% |",
+                r.scene.as_deref().unwrap_or(""),
+                r.planes.unwrap_or(0),
+                if r.trivial_reject == Some(true) { "on" } else { "off" },
+                share * l.blend_fragments_per_s / 1e6,
+                share * 100.0
+            );
+        }
+    }
+    report.cost_models = cost::fit(&report.rows);
+    for f in &report.cost_models {
+        println!("{}", f.describe());
+    }
+    report.finish(args.json.as_deref(), args.trace.as_deref())
 }
 
 fn covered_pixels(bp: &Blueprint, planes: &[Vec<crate::types::SliceVertex>]) -> f64 {

@@ -6,6 +6,7 @@ use voltex::bake::BakeSource;
 use voltex::gpu::sources::Sources;
 use voltex::gpu::GpuContext;
 use voltex::io::stack::{Manifest, StackLighting};
+use voltex::progress::{Progress, Verbosity};
 use voltex::{io, scene, Error, Result};
 
 #[derive(clap::Args)]
@@ -24,6 +25,9 @@ pub struct BakeArgs {
     /// shaded with the scene's first light.
     #[arg(long)]
     unlit: bool,
+    /// No progress on stderr (errors still show).
+    #[arg(long, short)]
+    quiet: bool,
 }
 
 fn parse_depth(s: &str) -> std::result::Result<u32, String> {
@@ -34,7 +38,7 @@ fn parse_depth(s: &str) -> std::result::Result<u32, String> {
 }
 
 pub fn run(args: BakeArgs) -> Result<()> {
-    let BakeArgs { scene: scene_path, texels, out, depth, unlit } = args;
+    let BakeArgs { scene: scene_path, texels, out, depth, unlit, quiet } = args;
     let scene = scene::load(&scene_path)?;
     // A sequence is baked as its frames.
     let volumes =
@@ -64,8 +68,11 @@ pub fn run(args: BakeArgs) -> Result<()> {
     let ctx = GpuContext::new()?;
     // f32 volumes, so 16- and 32-bit slices hold more than the render's 8 bits.
     let mut baker = voltex::bake::Baker::full_precision(&Sources::project()?);
+    let verbosity = Verbosity::from_flags(quiet, false);
+    let mut progress = Progress::new(plans.len(), verbosity);
     for plan in plans {
         let start = std::time::Instant::now();
+        progress.started(&plan.texel);
         let baked = baker.bake(&ctx, &plan.request)?;
         let bytes = voltex::bake::axis_slices::read_texture(&ctx, &baked.volume, 16)?;
         let volume: Vec<[f32; 4]> = bytemuck::pod_collect_to_vec(&bytes);
@@ -86,8 +93,16 @@ pub fn run(args: BakeArgs) -> Result<()> {
         };
         io::stack::write(&dir, &manifest, &volume)?;
         let [w, h, d] = plan.request.resolution;
-        println!("{} ({w}x{h}x{d}, {:.0} ms)", dir.display(), start.elapsed().as_secs_f64() * 1e3);
+        let ms = start.elapsed().as_secs_f64() * 1e3;
+        progress.finished(
+            &plan.texel,
+            &format!("texel \"{}\" {w}x{h}x{d}: {ms:.0} ms", plan.texel),
+            true,
+            false,
+        );
+        println!("{} ({w}x{h}x{d}, {ms:.0} ms)", dir.display());
     }
+    progress.end();
     Ok(())
 }
 

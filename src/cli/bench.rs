@@ -22,11 +22,30 @@ pub struct BenchArgs {
     /// Plane count of the converged image that errors are measured against.
     #[arg(long, default_value_t = 4000)]
     reference_planes: u32,
+    /// Write every table row as JSON (adapter, date, knobs, times, errors, cost model).
+    #[arg(long)]
+    json: Option<PathBuf>,
+    /// Measure the adapter's blended fill rate, texture sample rate and noise rate in the same
+    /// run and print each setting's share of the blend limit.
+    #[arg(long)]
+    limits: bool,
+    /// Write the last timed frame of every setting as a Chrome/Perfetto trace (per-pass GPU times).
+    #[arg(long)]
+    trace: Option<PathBuf>,
 }
 
 pub fn run(args: BenchArgs) -> Result<()> {
-    let BenchArgs { scenes, planes, size, frames, reference_planes } = args;
-    voltex::bench::run(&scenes, &planes, size, frames, reference_planes)
+    let BenchArgs { scenes, planes, size, frames, reference_planes, json, limits, trace } = args;
+    voltex::bench::run(&voltex::bench::Args {
+        scenes,
+        planes,
+        size,
+        frames,
+        reference_planes,
+        json,
+        limits,
+        trace,
+    })
 }
 
 #[derive(clap::Args)]
@@ -42,9 +61,35 @@ pub struct BenchHyperArgs {
     /// Only the table of segment strategies (bounds, depth peeling, EWA-style splatting).
     #[arg(long)]
     segments: bool,
+    /// Only the table of shadows on the Figure 11 scenes (Phong, shadow rays, light volumes).
+    #[arg(long)]
+    shadows: bool,
+    /// Step of the converged renders that errors are measured against (world units).
+    #[arg(long, default_value_t = 0.001)]
+    truth_step: f64,
+    /// Write every table row as JSON (adapter, date, knobs, times, errors, cost model).
+    #[arg(long)]
+    json: Option<PathBuf>,
+    /// Write the last timed frame of every setting as a Chrome/Perfetto trace (per-pass GPU times).
+    #[arg(long)]
+    trace: Option<PathBuf>,
 }
 
 pub fn run_hyper(args: BenchHyperArgs) -> Result<()> {
-    let BenchHyperArgs { size, frames, quick, segments } = args;
-    voltex::bench::hyper::run(size, frames, quick, segments)
+    let BenchHyperArgs { size, frames, quick, segments, shadows, truth_step, json, trace } = args;
+    if !(truth_step.is_finite() && truth_step > 0.0) {
+        return Err(voltex::Error::Invalid(format!(
+            "--truth-step {truth_step}: expected a positive world length"
+        )));
+    }
+    voltex::bench::hyper::run(&voltex::bench::hyper::Args {
+        size,
+        frames,
+        quick,
+        segments,
+        shadows,
+        truth_step,
+        json,
+        trace,
+    })
 }

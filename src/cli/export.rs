@@ -5,6 +5,7 @@ use std::path::PathBuf;
 use voltex::gpu::sources::Sources;
 use voltex::gpu::GpuContext;
 use voltex::io::vdb::Compression;
+use voltex::progress::{Progress, Verbosity};
 use voltex::render::export::{self, ExportOptions};
 use voltex::{scene, Error, Result};
 
@@ -28,6 +29,9 @@ pub struct ExportArgs {
     /// How voxel values are stored.
     #[arg(long, value_enum, default_value_t = CompressionArg::Zip)]
     compression: CompressionArg,
+    /// No progress on stderr (errors still show).
+    #[arg(long, short)]
+    quiet: bool,
 }
 
 #[derive(clap::ValueEnum, Clone, Copy)]
@@ -65,22 +69,30 @@ pub fn run(args: ExportArgs) -> Result<()> {
         std::fs::create_dir_all(&args.out)
             .map_err(|e| Error::file(&args.out, format!("cannot make the output folder: {e}")))?;
     }
-    let result = write_all(&args.out, &exports, opts.compression);
+    let verbosity = Verbosity::from_flags(args.quiet, false);
+    let result = write_all(&args.out, &exports, opts.compression, verbosity);
     if result.is_err() && made {
         let _ = std::fs::remove_dir(&args.out); // only if still empty
     }
     result
 }
 
-fn write_all(out: &std::path::Path, exports: &[export::Export], compression: Compression) -> Result<()> {
+fn write_all(
+    out: &std::path::Path,
+    exports: &[export::Export],
+    compression: Compression,
+    verbosity: Verbosity,
+) -> Result<()> {
     voltex::io::atomic::check_writable_dir(out)?;
     let ctx = GpuContext::new()?;
     let mut baker = voltex::bake::Baker::full_precision(&Sources::project()?);
     // Every file is staged first and renamed into place only when all are written.
     let mut staged = Vec::new();
     let mut lines = Vec::new();
+    let mut progress = Progress::new(exports.len(), verbosity);
     for e in exports {
         let start = std::time::Instant::now();
+        progress.started(&e.name);
         let rgba = export::bake(&ctx, &mut baker, e)?;
         let grids = export::grids(e, &rgba);
         let path = export::path_in(out, e);
@@ -90,15 +102,17 @@ fn write_all(out: &std::path::Path, exports: &[export::Export], compression: Com
             _ => 0,
         };
         let [x, y, z] = e.request.resolution;
+        let ms = start.elapsed().as_secs_f64() * 1e3;
+        progress.finished(&e.name, &format!("{} {x}x{y}x{z}: {ms:.0} ms", e.what), true, false);
         lines.push(format!(
-            "{}  {} {x}x{y}x{z}, {active} active voxels, opacity length {}, {:.0} ms{}",
+            "{}  {} {x}x{y}x{z}, {active} active voxels, opacity length {}, {ms:.0} ms{}",
             path.display(),
             e.what,
             e.opacity_length as f32,
-            start.elapsed().as_secs_f64() * 1e3,
             e.note.as_ref().map(|n| format!("\n    note: {n}")).unwrap_or_default()
         ));
     }
+    progress.end();
     for s in staged {
         s.commit()?;
     }

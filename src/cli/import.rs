@@ -1,5 +1,5 @@
-//! `voltex import`: writes the scene that `voltex render|preview FILE` opens for a mesh asset, as
-//! an editable, commented scene file.
+//! `voltex import`: writes the scene that `voltex render|preview FILE` opens for an asset (a mesh
+//! or an OpenVDB file), as an editable, commented scene file.
 
 use std::path::PathBuf;
 
@@ -10,7 +10,7 @@ use voltex::{Error, Result};
 
 #[derive(Args)]
 pub struct ImportArgs {
-    /// A mesh asset: `.glb`, `.gltf` or `.obj`.
+    /// An asset: a mesh (`.glb`, `.gltf` or `.obj`) or an OpenVDB file (`.vdb`).
     pub file: PathBuf,
     /// The scene file to write (default: FILE with the extension `.ron`).
     #[arg(short, long)]
@@ -20,7 +20,7 @@ pub struct ImportArgs {
 pub fn run(args: ImportArgs) -> Result<()> {
     if !import::is_asset(&args.file) {
         return Err(Error::Invalid(format!(
-            "{}: expected a mesh asset (.glb, .gltf or .obj)",
+            "{}: expected an asset: a mesh (.glb, .gltf or .obj) or an OpenVDB file (.vdb)",
             args.file.display()
         )));
     }

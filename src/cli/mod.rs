@@ -3,6 +3,7 @@
 
 pub mod bake;
 pub mod bench;
+pub mod bench_report;
 pub mod compare;
 pub mod export;
 pub mod farm;
@@ -51,8 +52,9 @@ pub enum Command {
     Compare(compare::CompareArgs),
     /// Print the bakes, passes, pipelines and GPU memory a scene will use (no GPU needed).
     Plan(plan::PlanArgs),
-    /// Write the scene that `render` and `preview` open for a mesh asset (.glb, .gltf, .obj):
-    /// the mesh as a base surface under a default texel, framed by a camera, editable.
+    /// Write the scene that `render` and `preview` open for an asset: a mesh (.glb, .gltf, .obj)
+    /// as a base surface under a default texel, or an OpenVDB file (.vdb) as a volume object;
+    /// framed by a camera, editable.
     Import(import::ImportArgs),
     /// Open a window showing the scene, redrawn whenever the scene, its files, a graph or a kernel
     /// changes (keys and mouse: see the overlay and the README).
@@ -69,6 +71,9 @@ pub enum Command {
     /// Benchmark hypertexture ray marching (the 2009 paper's Figure 11 set-up): frame times and
     /// the share of noise evaluation.
     BenchHyper(bench::BenchHyperArgs),
+    /// The performance page's tables from `bench --json` and `bench-hyper --json` files: print
+    /// them as Markdown, or write them into a page between its bench-report markers.
+    BenchReport(bench_report::BenchReportArgs),
     /// Speed against error: sweep each method's quality knobs, time every setting with GPU
     /// timestamps, measure its error against a truth image, write pareto.csv and pareto.svg.
     Pareto(pareto::ParetoCmd),
@@ -109,6 +114,18 @@ pub struct Overrides {
     /// refused before any work.
     #[arg(long, value_parser = voltex::gpu::budget::parse_budget)]
     budget: Option<u64>,
+    /// Shadows of every RayMarch object: `none` (Phong), `rays` (a shadow ray per shaded sample)
+    /// or `volume:N` (a light volume of resolution N) (default: the scene's).
+    #[arg(long, value_parser = parse_shadows)]
+    shadows: Option<ShadowsArg>,
+}
+
+/// A `--shadows` value (`None`: Phong without shadows).
+#[derive(Clone, Copy, Debug)]
+pub struct ShadowsArg(pub Option<voltex::scene::Shadows>);
+
+pub fn parse_shadows(s: &str) -> std::result::Result<ShadowsArg, String> {
+    voltex::methods::options::parse_shadows(s).map(ShadowsArg)
 }
 
 #[derive(clap::ValueEnum, Clone, Copy)]
@@ -162,6 +179,7 @@ impl Overrides {
             time: self.time,
             axis_criteria: self.criteria,
             budget: self.budget,
+            shadows: self.shadows.map(|s| s.0),
             ..Default::default()
         })
     }

@@ -19,7 +19,8 @@ pub struct ParetoCmd {
     /// Output folder (default: out/pareto/<scene name>).
     #[arg(long)]
     out: Option<PathBuf>,
-    /// What errors are measured against: `reference`, `view-slices:PLANES` or `ray-march:STEP`.
+    /// What errors are measured against: `reference`, `view-slices:PLANES` or
+    /// `ray-march:STEP[:SHADOWS]` (SHADOWS as in --ray-shadows, e.g. ray-march:0.0005:rays).
     #[arg(long, default_value = "reference")]
     truth: voltex::pareto::Truth,
     /// Methods to sweep (ray-march: the step of every hypertexture object).
@@ -45,6 +46,11 @@ pub struct ParetoCmd {
     /// 0.002:0.03,0.002:0.06 (default: none).
     #[arg(long, value_delimiter = ',', value_parser = parse_adaptive)]
     ray_adaptive: Vec<(f64, f64)>,
+    /// RayMarch shadows, each swept over every step: none (Phong), rays (shadow rays), volume:N
+    /// (a light volume of resolution N), e.g. none,rays,volume:32,volume:64 (default: each
+    /// object's own shading).
+    #[arg(long, value_delimiter = ',', value_parser = super::parse_shadows)]
+    ray_shadows: Vec<super::ShadowsArg>,
 }
 
 fn parse_adaptive(s: &str) -> std::result::Result<(f64, f64), String> {
@@ -112,5 +118,6 @@ pub fn run(p: ParetoCmd) -> Result<()> {
         ray_steps: p.ray_steps,
         ray_segments: p.ray_segments.into_iter().map(segments).collect(),
         ray_adaptive: p.ray_adaptive,
+        ray_shadows: p.ray_shadows.into_iter().map(|s| s.0).collect(),
     })
 }

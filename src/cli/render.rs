@@ -4,6 +4,7 @@ use std::path::{Path, PathBuf};
 
 use voltex::gpu::cache::GpuCache;
 use voltex::gpu::GpuContext;
+use voltex::render::trace::Track;
 use voltex::render::{Blueprint, RenderOptions, Renderer};
 use voltex::{io, scene, Result};
 
@@ -22,6 +23,10 @@ pub struct RenderArgs {
     /// Frames per second of --frames.
     #[arg(long, default_value_t = 24.0, requires = "frames")]
     fps: f64,
+    /// Write each frame's per-pass GPU times as a Chrome/Perfetto trace (JSON; open it in
+    /// ui.perfetto.dev or chrome://tracing).
+    #[arg(long)]
+    trace: Option<PathBuf>,
     #[command(flatten)]
     overrides: Overrides,
 }
@@ -37,19 +42,42 @@ fn parse_frames(s: &str) -> std::result::Result<(u32, u32), String> {
 }
 
 pub fn run(args: RenderArgs) -> Result<()> {
-    let RenderArgs { scene, output, frames, fps, overrides } = args;
-    match frames {
-        None => render(&scene, output, &overrides),
-        Some(frames) => render_frames(&scene, output, frames, fps, &overrides),
+    let RenderArgs { scene, output, frames, fps, trace, overrides } = args;
+    if let Some(t) = &trace {
+        io::atomic::check_writable_dir(
+            t.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new(".")),
+        )?;
     }
+    let mut track = Track { name: format!("render {}", scene.display()), frames: Vec::new() };
+    let ctx = match frames {
+        None => render(&scene, output, &overrides, &mut track),
+        Some(frames) => render_frames(&scene, output, frames, fps, &overrides, &mut track),
+    }?;
+    if let Some(path) = &trace {
+        if track.frames.iter().all(|f| f.is_empty()) {
+            eprintln!(
+                "warning: {}: no timestamp queries on this adapter: the trace is empty",
+                path.display()
+            );
+        }
+        voltex::render::trace::write(path, &[track], &ctx.adapter_line())?;
+        println!("trace: {}", path.display());
+    }
+    Ok(())
 }
 
-fn render(scene_path: &Path, output: Option<PathBuf>, overrides: &Overrides) -> Result<()> {
+fn render(
+    scene_path: &Path,
+    output: Option<PathBuf>,
+    overrides: &Overrides,
+    track: &mut Track,
+) -> Result<GpuContext> {
     let opts = overrides.options()?;
     let scene = scene::load(scene_path)?;
     let exr_path = output_path(scene_path, output)?;
     let ctx = GpuContext::new()?;
-    render_one(&ctx, &scene, &opts, &exr_path, &mut GpuCache::default(), true)
+    render_one(&ctx, &scene, &opts, &exr_path, &mut GpuCache::default(), true, track)?;
+    Ok(ctx)
 }
 
 /// `render --frames A..B`: one scene, one device, bakes shared between frames; frame N at time
@@ -60,7 +88,8 @@ fn render_frames(
     (first, last): (u32, u32),
     fps: f64,
     overrides: &Overrides,
-) -> Result<()> {
+    track: &mut Track,
+) -> Result<GpuContext> {
     if !(fps.is_finite() && fps > 0.0) {
         return Err(voltex::Error::Invalid(format!("--fps {fps}: expected a positive frame rate")));
     }
@@ -83,12 +112,12 @@ fn render_frames(
         let frame_opts = RenderOptions { time: Some(n as f64 / fps), ..opts.clone() };
         let exr = path.with_file_name(format!("{stem}_{n:04}.exr"));
         cache.begin();
-        render_one(&ctx, &scene, &frame_opts, &exr, &mut cache, n == first)?;
+        render_one(&ctx, &scene, &frame_opts, &exr, &mut cache, n == first, track)?;
         if animated {
             cache.retain_used();
         }
     }
-    Ok(())
+    Ok(ctx)
 }
 
 /// The EXR path to write (default `out/<stem>.exr`), its folder checked writable before any GPU
@@ -116,6 +145,7 @@ fn render_one(
     exr_path: &Path,
     cache: &mut GpuCache,
     warn: bool,
+    track: &mut Track,
 ) -> Result<()> {
     let png_path = exr_path.with_extension("png");
     let bp = Blueprint::new(scene, opts)?;
@@ -130,6 +160,7 @@ fn render_one(
     // Nothing is evicted: a sequence's frames come back, and a scene's bakes are bounded.
     let mut renderer = Renderer::with_cache(ctx, bp, cache)?;
     let frame = renderer.render(ctx)?;
+    track.frames.push(frame.spans.clone());
     let metadata = renderer.metadata(ctx, &frame);
     let meta: Vec<(&str, String)> = metadata.iter().map(|(k, v)| (k.as_str(), v.clone())).collect();
     io::exr::write(exr_path, &frame.image, &meta)?;

@@ -68,9 +68,18 @@ fn expand(sources: &Sources, rel: &str, out: &mut Expanded, from: Option<FileLoc
 
 impl Expanded {
     fn locate(&self, line: u32, col: u32) -> FileLoc {
-        let (file, orig) =
-            self.origin.get((line as usize).saturating_sub(1)).copied().unwrap_or((0, line as usize));
-        FileLoc::new(&self.files[file], orig, col as usize)
+        match self.origin.get((line as usize).saturating_sub(1)) {
+            Some(&(file, orig)) => FileLoc::new(&self.files[file], orig, col as usize),
+            // Past the last line (an error at the end of the input, after the newline each
+            // expanded line ends with): the end of the last line, in the file it came from.
+            None => match self.origin.last() {
+                Some(&(file, orig)) => {
+                    let width = self.text.lines().last().map_or(0, |l| l.chars().count());
+                    FileLoc::new(&self.files[file], orig, width + 1)
+                }
+                None => FileLoc::new(&self.files[0], 1, 1),
+            },
+        }
     }
 }
 

@@ -73,6 +73,11 @@ impl Timer {
 
     /// Per-pass durations in milliseconds, in submission order (after the frame was submitted).
     pub fn read(&self, ctx: &GpuContext) -> Result<Vec<(String, f64)>> {
+        Ok(self.read_spans(ctx)?.into_iter().map(|s| (s.name, s.ms)).collect())
+    }
+
+    /// Per-pass spans on the adapter's timestamp clock, in submission order.
+    pub fn read_spans(&self, ctx: &GpuContext) -> Result<Vec<Span>> {
         let Some(buf) = &self.resolve else {
             return Ok(Vec::new());
         };
@@ -81,12 +86,25 @@ impl Timer {
         }
         let bytes = ctx.read_buffer(buf, 0, self.labels.len() as u64 * 16)?;
         let ticks: Vec<u64> = bytemuck::pod_collect_to_vec(&bytes);
-        let period = ctx.queue.get_timestamp_period() as f64;
+        let ms = ctx.queue.get_timestamp_period() as f64 * 1e-6;
         Ok(self
             .labels
             .iter()
             .enumerate()
-            .map(|(i, l)| (l.clone(), ticks[2 * i + 1].saturating_sub(ticks[2 * i]) as f64 * period * 1e-6))
+            .map(|(i, l)| Span {
+                name: l.clone(),
+                begin_ms: ticks[2 * i] as f64 * ms,
+                ms: ticks[2 * i + 1].saturating_sub(ticks[2 * i]) as f64 * ms,
+            })
             .collect())
     }
+}
+
+/// One pass of a frame on the adapter's timestamp clock: its name (the graph pass's), when it
+/// began (ms since the clock's origin, which only the adapter knows) and how long it took.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Span {
+    pub name: String,
+    pub begin_ms: f64,
+    pub ms: f64,
 }

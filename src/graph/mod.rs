@@ -467,6 +467,13 @@ impl Graph {
                     );
                     return Err(self.error_at(p.name(), msg));
                 }
+                // wgpu refuses a texture attached twice only when the frame is recorded.
+                let twice =
+                    |(k, t): &(usize, &Target)| targets[..*k].iter().any(|o| o.resource == t.resource);
+                if let Some((_, t)) = targets.iter().enumerate().find(twice) {
+                    let msg = format!("pass `{}`: target `{}` is attached twice", p.name(), t.resource);
+                    return Err(self.error_in_pass(p.name(), "targets", &t.resource, msg));
+                }
                 let colour = targets.iter().map(|t| (&t.resource, false));
                 for (t, is_depth) in colour.chain(depth.iter().map(|d| (&d.resource, true))) {
                     let Some(ResourceDecl::Texture { format, .. }) = f.resources.get(t) else {

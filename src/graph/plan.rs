@@ -9,7 +9,9 @@ use crate::gpu::reflect::{self, Binding};
 use crate::gpu::shader::{self, Kernel};
 use crate::gpu::sources::Sources;
 use crate::graph::expr::Expr;
-use crate::graph::{BufferClear, Draw, Graph, Instances, PassDecl, ResourceDecl, Value, Vocabulary};
+use crate::graph::{
+    BufferClear, Draw, Format, Graph, Instances, PassDecl, ResourceDecl, TextureSize, Value, Vocabulary,
+};
 
 /// What the planner needs to know of a scene object.
 #[derive(Debug, Clone)]
@@ -63,6 +65,63 @@ pub const FRAME_COUNTS: &[&str] = &["width", "height"];
 /// Plans `graph` for `objects` and an output of `size` pixels, its shaders looked up in `sources`
 /// (the graph's folder first when the caller put it there: see [`Sources::beside`]), its filters
 /// and counts checked against `vocabulary`, whose resource names its own resources may not take.
+/// A first output that is a texture is read back as the frame's image (what a render writes):
+/// it must be Rgba32Float or R32Float and of the frame's size, which the readback found only
+/// after the GPU work. A buffer output (a debug or benchmark graph) is left to what reads it.
+pub fn check_image_output(graph: &Graph, size: (u32, u32)) -> Result<()> {
+    let Some(first) = graph.file.outputs.first() else { return Ok(()) };
+    let Some(ResourceDecl::Texture { format, size: texture_size, .. }) = graph.file.resources.get(first)
+    else {
+        return Ok(());
+    };
+    let extent = match texture_size {
+        TextureSize::Output => size,
+        TextureSize::Fixed(w, h) => (*w, *h),
+    };
+    let msg = if !matches!(format, Format::Rgba32Float | Format::R32Float) {
+        format!("output `{first}` is {format:?}: the first output is read back as the image, from an Rgba32Float or R32Float texture")
+    } else if extent != size {
+        format!(
+            "output `{first}` is {}x{}: the first output is read back as the image, at the frame's size {}x{}",
+            extent.0, extent.1, size.0, size.1
+        )
+    } else {
+        return Ok(());
+    };
+    Err(graph.error_at_output(first, msg))
+}
+
+/// The targets of a raster pass must have one size (at the frame's `size`): wgpu refuses
+/// differing attachments only when the frame is recorded.
+fn check_target_sizes(graph: &Graph, decl: &PassDecl, size: (u32, u32)) -> Result<()> {
+    let PassDecl::Raster { targets, depth, .. } = decl else { return Ok(()) };
+    let extent = |name: &str| match graph.file.resources.get(name) {
+        Some(ResourceDecl::Texture { size: TextureSize::Fixed(w, h), .. }) => Some((*w, *h)),
+        Some(ResourceDecl::Texture { .. }) => Some(size),
+        _ => None,
+    };
+    let colour = targets.iter().map(|t| (&t.resource, "targets"));
+    let mut first: Option<(&String, (u32, u32))> = None;
+    for (name, field) in colour.chain(depth.iter().map(|d| (&d.resource, "depth"))) {
+        let Some(e) = extent(name) else { continue };
+        match first {
+            None => first = Some((name, e)),
+            Some((f, (w, h))) if (w, h) != e => {
+                let msg = format!(
+                    "pass `{}`: target `{name}` is {}x{} but target `{f}` is {w}x{h}: the targets of a raster pass \
+                     must have one size",
+                    decl.name(),
+                    e.0,
+                    e.1
+                );
+                return Err(graph.error_in_pass(decl.name(), field, name, msg));
+            }
+            Some(_) => {}
+        }
+    }
+    Ok(())
+}
+
 pub fn plan(
     graph: &Graph,
     sources: &Sources,
@@ -102,6 +161,7 @@ pub fn plan(
                 Some(ids)
             }
         };
+        check_target_sizes(graph, decl, size)?;
         let kernel = match kernels.get(decl.shader()) {
             Some(k) => k.clone(),
             None => {

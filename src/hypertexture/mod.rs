@@ -65,7 +65,7 @@ pub fn pack(h: &Hypertexture) -> Packed {
         field: [0.0; 4],
         field_center: [0.0; 4],
         perturb: [0.0; 4],
-        kinds: [kind, FIELD_CLOSEST_SURFACE, h.noises.len() as u32, 0],
+        kinds: [kind, FIELD_CLOSEST_SURFACE, h.enabled_noises().count() as u32, 0],
         noises: Vec::new(),
         functions: Vec::new(),
         points: Vec::new(),
@@ -99,7 +99,7 @@ pub fn pack(h: &Hypertexture) -> Packed {
         // Validation refuses a perturbed field inside another.
         Field::ClosestSurface | Field::Perturbed { .. } => {}
     }
-    for n in h.noises.iter() {
+    for n in h.enabled_noises() {
         let table = p.functions.len() as u32;
         let rows = n.shape.rows().map_or(1, |r| r.len() as u32);
         let (scale, tile) = n.tiling();

@@ -26,7 +26,7 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<Mesh> {
     check_position_accessors(bytes).map_err(fail)?;
     // The loader's validation has panicked on input it should reject (see above): a panic is
     // still this file's error, not voltex's.
-    let file = quietly(|| gltf::Gltf::from_slice(bytes))
+    let file = crate::error::quietly(|| gltf::Gltf::from_slice(bytes))
         .map_err(|_| fail("not a valid glTF 2.0 file: the glTF loader failed on it".into()))?
         .map_err(|e| fail(format!("not a valid glTF 2.0 file: {e}")))?;
     let buffers = file
@@ -45,18 +45,6 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<Mesh> {
         return Err(fail("expected at least one triangle primitive in the scene's nodes".into()));
     }
     Ok(out.finish())
-}
-
-/// Runs `f`, catching a panic without the panic hook's message (the caller reports it as the
-/// file's error). The hook is process-wide: a lock keeps two callers from swapping it at once.
-fn quietly<T>(f: impl FnOnce() -> T + std::panic::UnwindSafe) -> std::thread::Result<T> {
-    static HOOK: std::sync::Mutex<()> = std::sync::Mutex::new(());
-    let _held = HOOK.lock().unwrap_or_else(|e| e.into_inner());
-    let hook = std::panic::take_hook();
-    std::panic::set_hook(Box::new(|_| {}));
-    let result = std::panic::catch_unwind(f);
-    std::panic::set_hook(hook);
-    result
 }
 
 /// gltf-json 1.4 validates a primitive's `POSITION` accessor by indexing the accessor list

@@ -12,6 +12,7 @@ pub mod reference;
 pub mod texels;
 pub mod view;
 pub mod view_slices;
+pub mod volume;
 
 pub use plan::{BakePlan, InputCx, MethodPlan, ObjectPlan, PartDecl};
 
@@ -44,6 +45,7 @@ pub const REGISTRY: &[&Contribution] = &[
     &axis_slices::CONTRIBUTION,
     &reference::CONTRIBUTION,
     &ray_march::CONTRIBUTION,
+    &volume::CONTRIBUTION,
 ];
 
 /// What planning an object may read, and the frame's bakes it adds to.
@@ -61,6 +63,9 @@ pub struct PlanCx<'a> {
 /// Plans `object` for the scene method `method` (knobs resolved): adds its plan to
 /// `object.methods` and its bake, lighting and frames to the object.
 pub fn plan_method(cx: &mut PlanCx, object: &mut ObjectPlan, method: &Method) -> Result<()> {
+    if object.object.volume.is_some() {
+        return volume::plan(cx, object, method);
+    }
     match method {
         Method::ViewSlices(m) => view_slices::plan(cx, object, m),
         Method::AxisSlices(m) => axis_slices::plan(cx, object, m),

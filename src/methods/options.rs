@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 
-use crate::scene::{AxisSlices, Camera, Method, RayMarch, Reference, ViewSlices};
+use crate::scene::{AxisSlices, Camera, Method, RayMarch, Reference, Shading, Shadows, ViewSlices};
 
 /// Overrides of what the scene file says, from the command line or tests.
 #[derive(Debug, Clone, Default)]
@@ -46,6 +46,9 @@ pub struct RenderOptions {
     /// Entries of a `Tiles` compositor's tile lists (default: sized from the sweep and the
     /// output; tests make it small to exercise the overflow path).
     pub tile_entries: Option<u32>,
+    /// Shadows of every RayMarch object (`--shadows`, the Pareto sweep): `Some(None)` is Phong
+    /// without shadows, `Some(Some(s))` `PhongShadows` with `s`.
+    pub shadows: Option<Option<crate::scene::Shadows>>,
 }
 
 /// A method without its knobs, to switch every object to it (`--method`).
@@ -82,10 +85,17 @@ impl RenderOptions {
             };
             let step = self.step.or(rm.step);
             let step = self.step_scale.map_or(step, |k| Some(k * step.unwrap_or(rm.step())));
+            let (shading, shadows) = match self.shadows {
+                None => (rm.shading, rm.shadows),
+                Some(None) => (Shading::Phong, Shadows::Rays),
+                Some(Some(s)) => (Shading::PhongShadows, s),
+            };
             return Method::RayMarch(RayMarch {
                 step,
                 segments: self.segments.unwrap_or(rm.segments),
                 adaptive,
+                shading,
+                shadows,
                 ..*rm
             });
         }
@@ -123,5 +133,32 @@ impl RenderOptions {
                 Method::AxisSlices(AxisSlices { depth, pixels, occlusion_culling, ..a })
             }
         }
+    }
+}
+
+/// Parses `--shadows` values: `none` (Phong without shadows), `rays` (shadow rays) or
+/// `volume:N` (a light volume of resolution N).
+pub fn parse_shadows(s: &str) -> std::result::Result<Option<Shadows>, String> {
+    use crate::scene::MAX_LIGHT_RESOLUTION;
+    match s {
+        "none" => Ok(None),
+        "rays" => Ok(Some(Shadows::Rays)),
+        _ => match s.strip_prefix("volume:").map(|n| n.parse::<u32>()) {
+            Some(Ok(resolution)) if (4..=MAX_LIGHT_RESOLUTION).contains(&resolution) => {
+                Ok(Some(Shadows::LightVolume { resolution }))
+            }
+            _ => Err(format!(
+                "`{s}`: expected `none`, `rays` or `volume:N` with a resolution N in 4..={MAX_LIGHT_RESOLUTION}"
+            )),
+        },
+    }
+}
+
+/// `--shadows` as written: `none`, `rays` or `volume:N`.
+pub fn shadows_name(s: Option<Shadows>) -> String {
+    match s {
+        None => "none".into(),
+        Some(Shadows::Rays) => "rays".into(),
+        Some(Shadows::LightVolume { resolution }) => format!("volume:{resolution}"),
     }
 }

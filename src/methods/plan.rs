@@ -115,6 +115,11 @@ pub trait MethodPlan: Any + Send {
         Ok(None)
     }
 
+    /// The kernels (under `wgsl/`) that `prepare` runs outside the graph, checked by `plan`.
+    fn kernels(&self) -> Vec<&'static str> {
+        Vec::new()
+    }
+
     /// Adds the buffers, views, samplers, counts and constants of instance `part` to `inputs`.
     fn add_inputs(&self, cx: &InputCx, object: &ObjectPlan, part: usize, inputs: &mut Inputs);
 

@@ -1,6 +1,7 @@
 //! Scene texels as bake requests: only texels some object draws, each (texel, lighting) once.
 
 use crate::bake::hypertexture::HyperTexel;
+use crate::bake::volume::VolumeTexel;
 use crate::bake::{BakeRequest, BakeSource, Heights, MeshTexel, StackTexels};
 use crate::cpu::bake::{pack_shapes, Shape as BakeShape};
 use crate::error::{Error, Result};
@@ -124,6 +125,16 @@ pub fn bake_index(
             })?;
             let bounds = bounds.as_ref().map(|b| (b.lo, b.hi));
             BakeSource::Hypertexture(Box::new(HyperTexel::new(h, bounds, t.resolution, time)))
+        }
+        TexelSource::Volume { name, bounds } => {
+            let missing = || {
+                Error::Invalid(format!("{}: volume `{}` was not loaded", scene.path.display(), name.value))
+            };
+            let v = scene.volumes.get(&name.value).ok_or_else(missing)?;
+            let grid = scene.volume(&name.value).ok_or_else(missing)?.clone();
+            let bounds = bounds.as_ref().map(|b| (b.lo, b.hi));
+            let length = t.opacity_length(&scene.hypertextures);
+            BakeSource::Volume(Box::new(VolumeTexel::new(grid, bounds, v.albedo, v.density_scale, length)))
         }
         TexelSource::Constant { color, opacity } => {
             BakeSource::Implicit(pack_shapes(&[(BakeShape::Constant, *color, *opacity)]))

@@ -51,6 +51,9 @@ impl View {
                     far = far.max((c - cam.eye).dot(forward));
                 }
             }
+            for c in o.volume.iter().flat_map(|v| v.corners()) {
+                far = far.max((c - cam.eye).dot(forward));
+            }
         }
         far *= 1.01;
         let near = (far * 1e-4).max(1e-6);

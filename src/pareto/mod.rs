@@ -18,10 +18,11 @@ use std::str::FromStr;
 use crate::error::{Error, Result};
 use crate::gpu::GpuContext;
 use crate::io::{atomic, Image};
+use crate::methods::options::shadows_name;
 use crate::methods::reference::ReferencePlan;
 use crate::progress::{Progress, Verbosity};
 use crate::render::{Blueprint, MethodKind, RenderOptions};
-use crate::scene::{Scene, Segments, MAX_PLANES};
+use crate::scene::{Scene, Segments, Shadows, MAX_PLANES};
 use report::Row;
 
 /// Default plane counts of the `ViewSlices` sweep.
@@ -50,21 +51,27 @@ pub enum Truth {
     /// Every textured object sliced by `ViewSlices` with this many planes (a converged slicing).
     ViewSlices(u32),
     /// Every hypertexture ray-marched (and every textured object ray cast by `Reference`) with
-    /// this step in world units: a converged march.
-    RayMarch(f64),
+    /// this step in world units: a converged march; with `Some(shadows)` every hypertexture
+    /// shaded with them (`ray-march:STEP:rays`: shadow rays).
+    RayMarch(f64, Option<Option<Shadows>>),
 }
 
 impl FromStr for Truth {
     type Err = String;
     fn from_str(s: &str) -> std::result::Result<Self, String> {
         const EXPECTED: &str =
-            "expected `reference`, `view-slices:PLANES` or `ray-march:STEP`, e.g. view-slices:4096 or ray-march:0.0005";
+            "expected `reference`, `view-slices:PLANES` or `ray-march:STEP[:SHADOWS]`, e.g. \
+             view-slices:4096, ray-march:0.0005 or ray-march:0.0005:rays";
         if s == "reference" {
             return Ok(Truth::Reference);
         }
-        if let Some(step) = s.strip_prefix("ray-march:") {
+        if let Some(rest) = s.strip_prefix("ray-march:") {
+            let (step, shadows) = match rest.split_once(':') {
+                Some((step, shadows)) => (step, Some(crate::methods::options::parse_shadows(shadows)?)),
+                None => (rest, None),
+            };
             return match step.parse::<f64>() {
-                Ok(v) if v.is_finite() && v > 0.0 => Ok(Truth::RayMarch(v)),
+                Ok(v) if v.is_finite() && v > 0.0 => Ok(Truth::RayMarch(v, shadows)),
                 _ => Err(format!("`{step}`: expected a positive step in world units")),
             };
         }
@@ -81,7 +88,10 @@ impl fmt::Display for Truth {
         match self {
             Truth::Reference => write!(f, "Reference, default step"),
             Truth::ViewSlices(n) => write!(f, "ViewSlices, {n} planes"),
-            Truth::RayMarch(step) => write!(f, "RayMarch, step {step}"),
+            Truth::RayMarch(step, None) => write!(f, "RayMarch, step {step}"),
+            Truth::RayMarch(step, Some(s)) => {
+                write!(f, "RayMarch, step {step}, shadows {}", shadows_name(*s))
+            }
         }
     }
 }
@@ -100,10 +110,11 @@ impl Truth {
                 trivial_reject: Some(true),
                 ..Default::default()
             },
-            Truth::RayMarch(step) => RenderOptions {
+            Truth::RayMarch(step, shadows) => RenderOptions {
                 size,
                 method: Some(MethodKind::Reference),
                 step: Some(step),
+                shadows,
                 ..Default::default()
             },
         }
@@ -134,6 +145,9 @@ pub struct Args {
     pub ray_segments: Vec<Segments>,
     /// `RayMarch` with an adaptive stride: `(step, max_step)` pairs (world units).
     pub ray_adaptive: Vec<(f64, f64)>,
+    /// `RayMarch` shadows, each swept over every step (`None`: Phong without shadows); empty:
+    /// each object's own.
+    pub ray_shadows: Vec<Option<Shadows>>,
 }
 
 /// One point of the sweep.
@@ -245,15 +259,25 @@ pub fn reference(args: &Args, default_step: f64) -> Vec<Setting> {
         .collect()
 }
 
-/// `RayMarch`: every hypertexture object marched with each segment strategy, at each fixed step
-/// and then with each adaptive stride (textured objects keep their methods).
+/// `RayMarch`: every hypertexture object marched with each segment strategy and each shadow
+/// option, at each fixed step and then with each adaptive stride (textured objects keep their
+/// methods).
 pub fn ray_march(args: &Args) -> Vec<Setting> {
     let mut steps = unique(args.ray_steps.iter().copied());
     steps.sort_by(f64::total_cmp);
     let mut pairs = args.ray_adaptive.clone();
     pairs.dedup();
+    // No shadow options: each object's own shading.
+    let shadows: Vec<Option<Option<Shadows>>> = if args.ray_shadows.is_empty() {
+        vec![None]
+    } else {
+        unique(args.ray_shadows.iter().copied()).into_iter().map(Some).collect()
+    };
     let mut v = Vec::new();
-    for segments in unique(args.ray_segments.iter().copied()) {
+    for (segments, shadows) in unique(args.ray_segments.iter().copied())
+        .into_iter()
+        .flat_map(|g| shadows.iter().map(move |s| (g, *s)))
+    {
         let (name, short) = match segments {
             Segments::Bounds => ("Bounds".to_string(), ""),
             Segments::DepthPeeling { passes, .. } => (format!("DepthPeeling({passes})"), " peel"),
@@ -266,15 +290,20 @@ pub fn ray_march(args: &Args) -> Vec<Setting> {
                 None => (String::new(), String::new()),
                 Some(m) => (format!(" max_step={m}"), format!("<{m}")),
             };
+            let (shadow_knob, shadow_tag) = match shadows {
+                None => (String::new(), String::new()),
+                Some(s) => (format!(" shadows={}", shadows_name(s)), format!(" {}", shadows_name(s))),
+            };
             v.push(Setting {
                 method: "RayMarch",
-                knobs: format!("step={step}{knob} segments={name}"),
-                tag: format!("{step}{tag}{short}"),
+                knobs: format!("step={step}{knob} segments={name}{shadow_knob}"),
+                tag: format!("{step}{tag}{short}{shadow_tag}"),
                 options: RenderOptions {
                     size: Some(args.size),
                     step: Some(step),
                     max_step: Some(max_step),
                     segments: Some(segments),
+                    shadows,
                     ..Default::default()
                 },
             });

@@ -77,7 +77,7 @@ pub fn write_camera(path: &Path, cam: &Camera) -> Result<()> {
     if crate::scene::import::is_asset(path) {
         return Err(Error::file(
             path,
-            "a mesh opened directly has no scene file: `voltex import` writes one",
+            "an asset (a mesh or a .vdb) opened directly has no scene file: `voltex import` writes one",
         ));
     }
     let text = crate::input::read_text(path, "a scene file")?;

@@ -31,11 +31,23 @@ pub struct Session {
     pub error: Option<String>,
     /// The last error printed, so each distinct error is logged once.
     logged: Option<String>,
+    /// The scene's text when the panel holds edits the file does not have (else the file's).
+    pub text: Option<String>,
 }
 
 impl Session {
     /// Builds the first renderer; a failure leaves the session without one and with `error` set.
     pub fn open(ctx: &GpuContext, scene_path: &Path, options: RenderOptions) -> Self {
+        Self::open_with(ctx, scene_path, options, None)
+    }
+
+    /// As [`Session::open`], from `text` instead of the file when given (edits the file lacks).
+    pub fn open_with(
+        ctx: &GpuContext,
+        scene_path: &Path,
+        options: RenderOptions,
+        text: Option<String>,
+    ) -> Self {
         let mut s = Session {
             scene_path: scene_path.to_path_buf(),
             options,
@@ -44,6 +56,7 @@ impl Session {
             renderer: None,
             error: None,
             logged: None,
+            text,
         };
         s.rebuild(ctx);
         s
@@ -51,23 +64,36 @@ impl Session {
 
     /// Reloads the scene, graph and kernels and makes a renderer, reusing whatever is unchanged.
     pub fn rebuild(&mut self, ctx: &GpuContext) -> Outcome {
-        self.cache.begin();
-        let built = scene::load(&self.scene_path).and_then(|scene| {
-            let bp = Blueprint::new(&scene, &self.options)?;
-            let renderer = Renderer::with_cache(ctx, bp, &mut self.cache)?;
-            Ok((scene, renderer))
-        });
-        match built {
-            Ok((scene, renderer)) => {
-                self.cache.retain_used();
-                self.scene = Some(scene);
-                self.renderer = Some(renderer);
-                self.error = None;
-                self.logged = None;
-                Outcome::Rebuilt(self.cache.stats)
-            }
+        let scene = match &self.text {
+            Some(text) => scene::parse(text, &self.scene_path),
+            None => scene::load(&self.scene_path),
+        };
+        match scene.and_then(|scene| self.build(ctx, scene)) {
+            Ok(stats) => stats,
             Err(e) => self.failed(e),
         }
+    }
+
+    /// Builds the scene of `text` (an edit the panel proposes). On success it is current; on
+    /// failure nothing changes (the panel refuses the edit and says why at the field).
+    pub fn try_text(&mut self, ctx: &GpuContext, text: &str) -> std::result::Result<CacheStats, String> {
+        match scene::parse(text, &self.scene_path).and_then(|scene| self.build(ctx, scene)) {
+            Ok(Outcome::Rebuilt(stats)) => Ok(stats),
+            Ok(Outcome::Failed(e)) => Err(e),
+            Err(e) => Err(e.to_string()),
+        }
+    }
+
+    fn build(&mut self, ctx: &GpuContext, scene: Scene) -> Result<Outcome> {
+        self.cache.begin();
+        let bp = Blueprint::new(&scene, &self.options)?;
+        let renderer = Renderer::with_cache(ctx, bp, &mut self.cache)?;
+        self.cache.retain_used();
+        self.scene = Some(scene);
+        self.renderer = Some(renderer);
+        self.error = None;
+        self.logged = None;
+        Ok(Outcome::Rebuilt(self.cache.stats))
     }
 
     /// After the device was lost: drops everything made on it and rebuilds the last good scene

@@ -1,5 +1,7 @@
 //! The preview window: a winit event loop around a [`Session`], redrawing when a watched file
-//! changes or the user moves the camera, switches a method or steps its knobs.
+//! changes or the user moves the camera, edits the scene in the panel or presses a key. The
+//! panel's edits and the method keys go into the scene file ([`Editor`]); the camera moves stay
+//! in the window until `C` writes them.
 
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -12,25 +14,37 @@ use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop};
 use winit::keyboard::{Key, ModifiersState, NamedKey};
 use winit::window::{Window, WindowId};
 
+use super::editor::Editor;
+use super::gui::Gui;
+use super::panel::{self, Action};
 use super::present::{Mode, Presenter};
-use super::{camera_file, Session, Watcher};
+use super::scene_text::{self as st, Step};
+use super::{camera_file, knobs, Session, Watcher};
 use crate::error::{Error, Result};
 use crate::gpu::GpuContext;
 use crate::io::Image;
-use crate::render::{MethodKind, RenderOptions, DEFAULT_PLANES};
-use crate::scene::{Camera, Method, Reference, Shading, ViewSlices, MAX_PLANES};
+use crate::render::{MethodKind, RenderOptions};
+use crate::scene::{Camera, Method};
 
 /// `voltex preview` options.
 pub struct PreviewArgs {
     pub scene: PathBuf,
     pub options: RenderOptions,
-    /// Write each newly shown frame, as presented, to `DIR/frame-N.png` (tests, recordings).
+    /// Write each newly shown frame, as presented, to `DIR/frame-N.png` (tests, recordings), with
+    /// what it shows in `DIR/frame-N.json`.
     pub record: Option<PathBuf>,
     /// Close the window after this many seconds (tests).
     pub quit_after: Option<f64>,
     /// The view to start in.
     pub mode: Mode,
+    /// Keep the per-pass GPU times of the last frames rendered in this Chrome/Perfetto trace.
+    pub trace: Option<PathBuf>,
 }
+
+/// Said when a key or the panel would edit a scene that has no file of its own.
+const NO_FILE: &str = "a mesh opened directly has no scene file to edit: `voltex import` writes one";
+/// Frames a preview trace keeps (the latest).
+const TRACE_FRAMES: usize = 100;
 
 pub fn run(args: PreviewArgs) -> Result<()> {
     let event_loop = EventLoop::new().map_err(|e| Error::Invalid(format!("cannot open a window: {e}")))?;
@@ -53,22 +67,38 @@ struct State {
     config: wgpu::SurfaceConfiguration,
     ctx: GpuContext,
     presenter: Presenter,
+    gui: Gui,
     session: Session,
     /// The same frame with every object as `Reference`, made when the reference or difference
     /// view is first shown after a change.
     reference: Option<Session>,
     watcher: Watcher,
+    /// The scene file's edits (`None` for a mesh opened directly).
+    editor: Option<Editor>,
+    /// The scene file, canonical, to tell its changes from those of other watched files.
+    scene_file: PathBuf,
     home: Option<Camera>,
     selected: usize,
     mode: Mode,
     gpu_ms: Option<f64>,
+    /// The scene must be rendered again.
     dirty: bool,
+    /// The next frame is recorded even if the image is unchanged (the user did something).
+    record_next: bool,
+    /// The panel is shown (`H` hides it).
+    panel: bool,
+    /// When egui wants its next frame.
+    repaint_at: Option<Instant>,
+    /// The panel's curve editors by path, from its last frame.
+    rects: Vec<(String, egui::Rect)>,
     status: String,
     drag: Option<(MouseButton, (f64, f64))>,
     cursor: (f64, f64),
     modifiers: ModifiersState,
     recorded: usize,
     started: Instant,
+    /// `--trace`: the passes of the frames rendered so far (the last `TRACE_FRAMES`).
+    trace: crate::render::trace::Track,
 }
 
 impl ApplicationHandler for App {
@@ -86,6 +116,13 @@ impl ApplicationHandler for App {
 
     fn window_event(&mut self, event_loop: &ActiveEventLoop, _: WindowId, event: WindowEvent) {
         let Some(s) = self.state.as_mut() else { return };
+        // Keys go to the panel only while one of its fields has the focus (typing a value).
+        let typing = s.gui.ctx.egui_wants_keyboard_input();
+        if (!matches!(event, WindowEvent::KeyboardInput { .. }) || typing)
+            && s.gui.on_event(&s.window, &event).repaint
+        {
+            s.window.request_redraw();
+        }
         match event {
             WindowEvent::CloseRequested => event_loop.exit(),
             WindowEvent::Resized(size) => {
@@ -103,14 +140,33 @@ impl ApplicationHandler for App {
                 }
             }
             WindowEvent::ModifiersChanged(m) => s.modifiers = m.state(),
-            WindowEvent::KeyboardInput { event, .. } if event.state == ElementState::Pressed => {
+            // The modifier keys' own events: synthetic input (xdotool under Xvfb) can leave the
+            // modifiers' state event late or stale.
+            WindowEvent::KeyboardInput {
+                event: winit::event::KeyEvent { logical_key: Key::Named(k), state, .. },
+                ..
+            } if matches!(k, NamedKey::Control | NamedKey::Shift) => {
+                let held = state == ElementState::Pressed;
+                s.modifiers.set(
+                    if k == NamedKey::Control { ModifiersState::CONTROL } else { ModifiersState::SHIFT },
+                    held,
+                );
+            }
+            WindowEvent::KeyboardInput { event, .. } if event.state == ElementState::Pressed && !typing => {
                 if matches!(event.logical_key, Key::Named(NamedKey::Escape)) {
                     event_loop.exit();
                 }
                 s.key(&event.logical_key);
+                s.record_next = true;
+                s.window.request_redraw();
             }
             WindowEvent::MouseInput { state, button, .. } => {
-                s.drag = (state == ElementState::Pressed).then_some((button, s.cursor));
+                let on_image = !s.panel || s.cursor.0 < s.image_width() as f64;
+                if state == ElementState::Pressed && on_image {
+                    s.drag = Some((button, s.cursor));
+                } else if state == ElementState::Released {
+                    s.drag = None;
+                }
             }
             WindowEvent::CursorMoved { position, .. } => {
                 s.cursor = (position.x, position.y);
@@ -121,7 +177,7 @@ impl ApplicationHandler for App {
                     s.move_camera(|c, h| if pan { pan_camera(c, d, h) } else { orbit(c, d) });
                 }
             }
-            WindowEvent::MouseWheel { delta, .. } => {
+            WindowEvent::MouseWheel { delta, .. } if !s.panel || s.cursor.0 < s.image_width() as f64 => {
                 let lines = match delta {
                     MouseScrollDelta::LineDelta(_, y) => y as f64,
                     MouseScrollDelta::PixelDelta(p) => p.y / 40.0,
@@ -140,10 +196,11 @@ impl ApplicationHandler for App {
         }
         let changed = s.watcher.changes(Duration::ZERO);
         if !changed.is_empty() {
-            s.session.rebuild(&s.ctx);
-            s.reference = None;
-            s.dirty = true;
-            let _ = s.watcher.watch(&s.session.watch_dirs());
+            s.files_changed(&changed);
+        }
+        if s.repaint_at.is_some_and(|t| Instant::now() >= t) {
+            s.repaint_at = None;
+            s.window.request_redraw();
         }
         if s.dirty {
             s.window.request_redraw();
@@ -153,8 +210,8 @@ impl ApplicationHandler for App {
 }
 
 impl State {
-    /// A lost device: opens a new one on the same adapter, remakes the surface configuration and
-    /// the presenter, and re-renders the last good scene on it.
+    /// A lost device: opens a new one on the same adapter, remakes the surface configuration, the
+    /// presenter and the panel's renderer, and re-renders the last good scene on it.
     fn recover_device(&mut self) {
         let why = self.ctx.lost().unwrap_or_default();
         eprintln!("GPU device lost ({why}); opening a new one");
@@ -164,6 +221,7 @@ impl State {
             Ok((ctx, presenter)) => {
                 self.surface.configure(&ctx.device, &self.config);
                 self.session.recover(&ctx);
+                self.gui.reset(&ctx.device, self.config.format);
                 self.reference = None;
                 self.ctx = ctx;
                 self.presenter = presenter;
@@ -208,7 +266,12 @@ impl State {
         config.usage = wgpu::TextureUsages::RENDER_ATTACHMENT;
         surface.configure(&ctx.device, &config);
         let presenter = Presenter::new(&ctx, config.format)?;
+        let gui = Gui::new(&window, &ctx.device, config.format);
         let session = Session::open(&ctx, &args.scene, args.options.clone());
+        let editor = match crate::scene::import::is_asset(&args.scene) {
+            true => None,
+            false => Editor::open(&args.scene).ok(),
+        };
         let mut watcher = Watcher::new(&session.watch_dirs())?;
         // Recordings and screenshots are written by the preview itself.
         let cwd = std::env::current_dir().unwrap_or_default();
@@ -225,52 +288,203 @@ impl State {
             config,
             ctx,
             presenter,
+            gui,
+            scene_file: std::fs::canonicalize(&args.scene).unwrap_or(args.scene.clone()),
             session,
             reference: None,
             watcher,
+            editor,
             home,
             selected: 0,
             mode: args.mode,
             gpu_ms: None,
             dirty: true,
+            record_next: false,
+            panel: true,
+            repaint_at: None,
+            rects: Vec::new(),
             status: String::new(),
             drag: None,
             cursor: (0.0, 0.0),
             modifiers: ModifiersState::empty(),
             recorded: 0,
             started: Instant::now(),
+            trace: crate::render::trace::Track { name: "preview".into(), frames: Vec::new() },
         })
     }
 
-    /// Renders the scene if something changed, then draws the current image and overlay.
+    /// Watched files changed: the scene file is re-read (our own writes are no change; an edit
+    /// the panel held is dropped, the file wins), and the scene rebuilt if anything it reads
+    /// changed.
+    fn files_changed(&mut self, changed: &[PathBuf]) {
+        let scene_file = &self.scene_file;
+        let is_scene =
+            |p: &PathBuf| p == scene_file || std::fs::canonicalize(p).is_ok_and(|c| c == *scene_file);
+        let scene_touched = changed.iter().any(is_scene);
+        let others = changed.iter().any(|p| !is_scene(p));
+        let scene_changed = match &mut self.editor {
+            Some(e) if scene_touched => e.reload(),
+            _ => scene_touched,
+        };
+        if others || scene_changed {
+            self.session.text = self.unsaved_text();
+            self.session.rebuild(&self.ctx);
+            self.reference = None;
+            self.dirty = true;
+            let _ = self.watcher.watch(&self.session.watch_dirs());
+        }
+    }
+
+    /// The text the panel holds that the file does not have.
+    fn unsaved_text(&self) -> Option<String> {
+        self.editor.as_ref().filter(|e| e.unsaved()).map(|e| e.text().to_string())
+    }
+
+    /// Width of the image's part of the window (the rest is the panel's).
+    fn image_width(&self) -> u32 {
+        let panel =
+            if self.panel { (panel::WIDTH as f64 * self.window.scale_factor()).ceil() as u32 } else { 0 };
+        self.config.width.saturating_sub(panel).max(1)
+    }
+
+    /// Renders the scene if something changed, runs the panel, then draws both.
     fn redraw(&mut self, args: &PreviewArgs) -> Result<()> {
         let fresh = self.dirty;
         if self.dirty {
             self.dirty = false;
             if let Some(frame) = self.session.render(&self.ctx) {
-                self.gpu_ms = frame?.gpu_ms();
+                let frame = frame?;
+                self.gpu_ms = frame.gpu_ms();
+                if let Some(path) = &args.trace {
+                    // Written after every frame, so the file holds the latest whatever ends the preview.
+                    self.trace.frames.push(frame.spans);
+                    let excess = self.trace.frames.len().saturating_sub(TRACE_FRAMES);
+                    self.trace.frames.drain(..excess);
+                    crate::render::trace::write(
+                        path,
+                        std::slice::from_ref(&self.trace),
+                        &self.ctx.adapter_line(),
+                    )?;
+                }
             }
             if self.mode != Mode::Image && self.reference.is_none() {
                 let mut options = self.session.options.clone();
                 options.method = Some(MethodKind::Reference);
                 options.object_methods.clear();
-                let mut r = Session::open(&self.ctx, &self.session.scene_path, options);
+                let mut r =
+                    Session::open_with(&self.ctx, &self.session.scene_path, options, self.unsaved_text());
                 if let Some(frame) = r.render(&self.ctx) {
                     frame?;
                 }
                 self.reference = Some(r);
             }
         }
-        let Some(image) = self.session.renderer().and_then(|r| r.output_texture()) else {
-            // No good build yet: only the overlay (with the error) on black.
-            return self.present(None, false, args);
-        };
-        let image = image.clone();
-        self.present(Some(image), fresh, args)
+        let actions = self.run_panel();
+        let image = self.session.renderer().and_then(|r| r.output_texture()).cloned();
+        let record = fresh || std::mem::take(&mut self.record_next);
+        self.present(image, record, args)?;
+        self.act(actions);
+        Ok(())
     }
 
-    fn present(&mut self, image: Option<wgpu::Texture>, fresh: bool, args: &PreviewArgs) -> Result<()> {
-        let lines = self.overlay();
+    /// Runs the panel's code for this frame: what the user did in it.
+    fn run_panel(&mut self) -> Vec<Action> {
+        if !self.panel {
+            return Vec::new();
+        }
+        let src = match (&self.editor, self.session.scene()) {
+            (Some(e), _) => e.text().to_string(),
+            (None, Some(s)) => s.source().to_string(),
+            (None, None) => String::new(),
+        };
+        let tree = st::parse(&src).ok();
+        let objects = self.objects(tree.as_ref(), &src);
+        let lines = self.info_lines();
+        let editor = self.editor.as_ref();
+        let view = panel::View {
+            src: &src,
+            tree: tree.as_ref(),
+            scene: self.session.scene(),
+            objects: &objects,
+            selected: self.selected % objects.len().max(1),
+            mode: self.mode,
+            lines: &lines,
+            error: self.session.error.as_deref(),
+            note: editor.and_then(|e| e.note.as_deref()),
+            refused: editor.and_then(|e| e.refused.as_ref()),
+            read_only: editor.is_some_and(|e| e.read_only),
+            can_undo: editor.is_some_and(|e| e.can_undo()),
+            can_redo: editor.is_some_and(|e| e.can_redo()),
+        };
+        let mut out = (Vec::new(), Vec::new());
+        let delay = self.gui.run(&self.ctx, &self.window, |ui| out = panel::show(ui, &view));
+        self.repaint_at = delay.map(|d| Instant::now() + d);
+        self.rects = out.1;
+        out.0
+    }
+
+    /// Makes what the user did in the panel.
+    fn act(&mut self, actions: Vec<Action>) {
+        for a in actions {
+            self.record_next = true;
+            self.window.request_redraw();
+            match a {
+                Action::Edit { edit, live } => self.edit(edit, live),
+                Action::EndGesture => {
+                    if let Some(e) = &mut self.editor {
+                        e.end_gesture();
+                    }
+                    self.session.text = self.unsaved_text();
+                }
+                Action::Select(i) => self.selected = i,
+                Action::Mode(m) => self.set_mode(m),
+                Action::Undo => self.history(true),
+                Action::Redo => self.history(false),
+                Action::Note(n) => self.status = n,
+            }
+        }
+    }
+
+    /// An edit of the scene text: built (refused with the reason at its field if it cannot be),
+    /// then written into the file (a drag's steps when it ends).
+    fn edit(&mut self, edit: st::Edit, live: bool) {
+        let Some(editor) = self.editor.as_mut() else {
+            self.status = NO_FILE.into();
+            return;
+        };
+        let (session, ctx) = (&mut self.session, &self.ctx);
+        if editor.edit(edit, live, |text| session.try_text(ctx, text).map(drop)) {
+            self.edited();
+        }
+    }
+
+    fn history(&mut self, undo: bool) {
+        let Some(editor) = self.editor.as_mut() else { return };
+        let (session, ctx) = (&mut self.session, &self.ctx);
+        let build = |text: &str| session.try_text(ctx, text).map(drop);
+        let done = if undo { editor.undo(build) } else { editor.redo(build) };
+        self.status = match (done, undo) {
+            (true, true) => "undone".into(),
+            (true, false) => "redone".into(),
+            (false, true) => "nothing to undo".into(),
+            (false, false) => "nothing to redo".into(),
+        };
+        if done {
+            self.edited();
+        }
+    }
+
+    /// The scene was rebuilt from the editor's text.
+    fn edited(&mut self) {
+        self.session.text = self.unsaved_text();
+        self.reference = None;
+        self.dirty = true;
+        self.window.request_redraw();
+    }
+
+    fn present(&mut self, image: Option<wgpu::Texture>, record: bool, args: &PreviewArgs) -> Result<()> {
+        // Without the panel, a few lines of text over the image say what it would.
+        let lines = if self.panel { Vec::new() } else { self.hidden_lines() };
         let reference =
             self.reference.as_ref().and_then(|r| r.renderer()).and_then(|r| r.output_texture()).cloned();
         let blank = || {
@@ -287,8 +501,9 @@ impl State {
         };
         let image = image.unwrap_or_else(blank);
         let size = (self.config.width, self.config.height);
-        if let (Some(dir), true) = (&args.record, fresh) {
-            self.record(dir, size, &image, reference.as_ref(), &lines)?;
+        let area = (self.image_width(), size.1);
+        if let (Some(dir), true) = (&args.record, record) {
+            self.record(dir, size, &image, reference.as_ref(), &lines, area)?;
         }
         let frame = match self.surface.get_current_texture() {
             wgpu::CurrentSurfaceTexture::Success(f) | wgpu::CurrentSurfaceTexture::Suboptimal(f) => f,
@@ -301,7 +516,10 @@ impl State {
             _ => return Ok(()),
         };
         let view = frame.texture.create_view(&Default::default());
-        self.presenter.draw(&self.ctx, &view, size, &image, reference.as_ref(), self.mode, &lines);
+        self.presenter.draw(&self.ctx, &view, area, &image, reference.as_ref(), self.mode, &lines);
+        if self.panel {
+            self.gui.paint(&self.ctx, &view, size);
+        }
         self.window.pre_present_notify();
         self.ctx.queue.present(frame);
         Ok(())
@@ -315,6 +533,7 @@ impl State {
         image: &wgpu::Texture,
         reference: Option<&wgpu::Texture>,
         lines: &[String],
+        area: (u32, u32),
     ) -> Result<()> {
         let target = self.ctx.device.create_texture(&wgpu::TextureDescriptor {
             label: Some("recording"),
@@ -327,7 +546,10 @@ impl State {
             view_formats: &[],
         });
         let view = target.create_view(&Default::default());
-        self.presenter.draw(&self.ctx, &view, size, image, reference, self.mode, lines);
+        self.presenter.draw(&self.ctx, &view, area, image, reference, self.mode, lines);
+        if self.panel {
+            self.gui.paint(&self.ctx, &view, size);
+        }
         let row = (size.0 * 4).div_ceil(256) * 256;
         let buffer = self.ctx.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("recording readback"),
@@ -361,12 +583,39 @@ impl State {
             }
         }
         let path = dir.join(format!("frame-{}.png", self.recorded));
+        // What the frame shows besides its pixels, for tests: the selection, view and messages,
+        // and where the curve editors are (window pixels).
+        let scale = self.window.scale_factor() as f32;
+        let editors: serde_json::Map<String, serde_json::Value> = (self.rects.iter())
+            .map(|(p, r)| {
+                (
+                    p.clone(),
+                    serde_json::json!([r.min.x * scale, r.min.y * scale, r.max.x * scale, r.max.y * scale]),
+                )
+            })
+            .collect();
+        let objects = self.methods();
+        let state = serde_json::json!({
+            "selected": objects.get(self.selected % objects.len().max(1)).map(|o| o.0.clone()),
+            "method": objects.get(self.selected % objects.len().max(1)).map(|o| describe(&o.1)),
+            "mode": format!("{:?}", self.mode),
+            "panel": self.panel,
+            "status": self.status,
+            "note": self.editor.as_ref().and_then(|e| e.note.clone()),
+            "refused": self.editor.as_ref().and_then(|e| e.refused.as_ref().map(|r| (st::show(&r.0), r.1.clone()))),
+            "read_only": self.editor.as_ref().is_some_and(|e| e.read_only),
+            "error": self.session.error,
+            "editors": editors,
+        });
+        let json = path.with_extension("json");
+        crate::io::atomic::write_bytes(&json, state.to_string().as_bytes())?;
         crate::io::png::write_rgba8(&path, size.0, size.1, &pixels)?;
         self.recorded += 1;
         Ok(())
     }
 
-    fn overlay(&self) -> Vec<String> {
+    /// The panel's first lines: scene and view, GPU time and adapter, the last action.
+    fn info_lines(&self) -> Vec<String> {
         let mode = match self.mode {
             Mode::Image => "image",
             Mode::Reference => "reference",
@@ -375,6 +624,15 @@ impl State {
         let mut lines = vec![format!("{}  [{mode}]", self.session.scene_path.display())];
         let gpu = self.gpu_ms.map(|t| format!("{t:.2} ms GPU")).unwrap_or_else(|| "no GPU timestamps".into());
         lines.push(format!("{gpu}  {}", self.ctx.info.name));
+        if !self.status.is_empty() {
+            lines.push(self.status.clone());
+        }
+        lines
+    }
+
+    /// What the image shows when the panel is hidden.
+    fn hidden_lines(&self) -> Vec<String> {
+        let mut lines = self.info_lines();
         let objects = self.methods();
         if let Some((name, m)) = objects.get(self.selected % objects.len().max(1)) {
             lines.push(format!(
@@ -384,16 +642,10 @@ impl State {
                 describe(m)
             ));
         }
-        lines.push("drag: orbit | right or shift drag: pan | wheel: zoom | R: reset | C: save camera".into());
-        lines.push("Tab: next object | M: method | +/-: quality | 1 2 3: image, reference, difference | S: screenshot".into());
-        if !self.status.is_empty() {
-            lines.push(self.status.clone());
-        }
+        lines.push("H: show the panel".into());
         if let Some(e) = &self.session.error {
             let chars: Vec<char> = e.chars().collect();
-            for chunk in chars.chunks(100).take(6) {
-                lines.push(chunk.iter().collect());
-            }
+            lines.extend(chars.chunks(100).take(6).map(|c| c.iter().collect::<String>()));
         }
         lines
     }
@@ -404,10 +656,35 @@ impl State {
         r.blueprint.objects.iter().filter_map(|o| Some((o.object.name.clone(), o.scene_method()?))).collect()
     }
 
-    fn set_method(&mut self, name: String, m: Method) {
-        self.session.options.object_methods.retain(|(n, _)| *n != name);
-        self.session.options.object_methods.push((name, m));
-        self.session.rebuild(&self.ctx);
+    /// The drawn objects with the paths of their nodes in the text.
+    fn objects(&self, tree: Option<&st::Value>, src: &str) -> Vec<panel::Object> {
+        let mut nodes = Vec::new();
+        if let Some(t) = tree {
+            node_paths(t, src, Vec::new(), &mut nodes);
+        }
+        (self.methods().into_iter())
+            .filter_map(|(name, _)| {
+                let node = nodes.iter().find(|(n, _)| *n == name)?.1.clone();
+                Some(panel::Object { name, node })
+            })
+            .collect()
+    }
+
+    /// The selected object: its name, method and node path (when the text has it).
+    fn selected(&self) -> Option<(String, Method, Option<Vec<Step>>)> {
+        let objects = self.methods();
+        let (name, m) = objects.get(self.selected % objects.len().max(1))?.clone();
+        let src = self.editor.as_ref().map(|e| e.text().to_string()).unwrap_or_default();
+        let node = st::parse(&src).ok().and_then(|t| {
+            let mut nodes = Vec::new();
+            node_paths(&t, &src, Vec::new(), &mut nodes);
+            nodes.into_iter().find(|(n, _)| *n == name).map(|(_, p)| p)
+        });
+        Some((name, m, node))
+    }
+
+    fn set_mode(&mut self, mode: Mode) {
+        self.mode = mode;
         self.dirty = true;
     }
 
@@ -420,16 +697,50 @@ impl State {
         self.dirty = true;
     }
 
+    /// A key edit of the selected object's node (`M`, `+`, `-`).
+    fn node_edit(&mut self, make: impl FnOnce(&str, &[Step], &Method) -> Result<Option<st::Edit>>) {
+        let Some(editor) = &self.editor else {
+            self.status = NO_FILE.into();
+            return;
+        };
+        let Some((name, m, node)) = self.selected() else { return };
+        let Some(node) = node else {
+            self.status = format!("no node \"{name}\" in the scene text");
+            return;
+        };
+        match make(editor.text(), &node, &m) {
+            Ok(Some(edit)) => {
+                let what = format!("{name}: {}", st::show(&edit.path));
+                self.edit(edit, false);
+                if let Some((_, why)) = self.editor.as_ref().and_then(|e| e.refused.clone()) {
+                    self.status = format!("{what}: refused: {why}");
+                } else {
+                    let objects = self.methods();
+                    let now =
+                        objects.iter().find(|o| o.0 == name).map(|o| describe(&o.1)).unwrap_or_default();
+                    self.status = format!("{name}: {now}");
+                }
+            }
+            Ok(None) => self.status = format!("{name}: no knob to step"),
+            Err(e) => self.status = format!("error: {e}"),
+        }
+    }
+
     fn key(&mut self, key: &Key) {
-        let objects = self.methods();
-        let selected = objects.get(self.selected % objects.len().max(1)).cloned();
+        let n = self.methods().len().max(1);
         let Key::Character(c) = key else {
             if matches!(key, Key::Named(NamedKey::Tab)) {
-                self.selected = (self.selected + 1) % objects.len().max(1);
-                self.dirty = true;
+                self.selected = (self.selected + 1) % n;
             }
             return;
         };
+        if self.modifiers.control_key() {
+            // Shift may reach us as the key's case before the modifiers' own event.
+            if c.eq_ignore_ascii_case("z") {
+                self.history(!(self.modifiers.shift_key() || c == "Z"));
+            }
+            return;
+        }
         match c.as_str() {
             "r" | "R" => {
                 self.session.options.camera = None;
@@ -439,82 +750,38 @@ impl State {
                 self.status = "camera reset to the scene's".into();
             }
             "c" | "C" => {
-                if let Some(cam) = self.session.options.camera {
-                    self.status = match camera_file::write_camera(&self.session.scene_path, &cam) {
-                        Ok(()) => format!("camera written to {}", self.session.scene_path.display()),
-                        Err(e) => format!("error: {e}"),
-                    };
-                    self.home = Some(cam);
-                }
-            }
-            "m" | "M" => {
-                if let Some((name, m)) = selected {
-                    // ViewSlices -> AxisSlices -> Reference -> ViewSlices (lighting kept where it exists).
-                    let next = match m {
-                        Method::ViewSlices(_) => Method::AxisSlices(crate::render::DEFAULT_AXIS_SLICES),
-                        Method::AxisSlices(_) => {
-                            Method::Reference(Reference { step: None, lighting: Default::default() })
+                let Some(cam) = self.session.options.camera else { return };
+                match &self.editor {
+                    Some(e) => {
+                        let edit = st::set(
+                            e.text(),
+                            &[Step::Field("camera".into())],
+                            &camera_file::format_camera(&cam),
+                        );
+                        match edit {
+                            Ok(edit) => self.edit(edit, false),
+                            Err(e) => self.status = format!("error: {e}"),
                         }
-                        Method::Reference(r) => Method::ViewSlices(ViewSlices {
-                            planes: DEFAULT_PLANES,
-                            trivial_reject: true,
-                            lighting: r.lighting,
-                            compositor: Default::default(),
-                        }),
-                        // Hypertextures have no texel for other methods: cycle their shading.
-                        Method::RayMarch(mut h) => {
-                            h.shading = match h.shading {
-                                Shading::None => Shading::Phong,
-                                Shading::Phong => Shading::PhongShadows,
-                                Shading::PhongShadows => Shading::None,
+                        let e = self.editor.as_ref();
+                        self.status =
+                            match (e.and_then(|e| e.note.clone()), e.and_then(|e| e.refused.clone())) {
+                                (Some(note), _) => note,
+                                (_, Some((_, why))) => format!("camera not written: {why}"),
+                                _ => format!("camera written to {}", self.session.scene_path.display()),
                             };
-                            Method::RayMarch(h)
-                        }
-                        // A method without keys here keeps its knobs.
-                        #[allow(unreachable_patterns)]
-                        other => other,
-                    };
-                    self.set_method(name, next);
+                    }
+                    None => self.status = NO_FILE.into(),
                 }
+                self.home = Some(cam);
             }
+            "m" | "M" => self.node_edit(|src, node, m| knobs::next_method(src, node, m).map(Some)),
             "+" | "=" | "-" => {
                 let finer = c.as_str() != "-";
-                if let Some((name, m)) = selected {
-                    let next = match m {
-                        Method::ViewSlices(mut v) => {
-                            v.planes =
-                                if finer { (v.planes * 2).min(MAX_PLANES) } else { (v.planes / 2).max(1) };
-                            Method::ViewSlices(v)
-                        }
-                        Method::Reference(mut r) => {
-                            r.step = r.step.map(|s| if finer { s / 2.0 } else { s * 2.0 });
-                            Method::Reference(r)
-                        }
-                        // Finer: see less deep inside contours (more slices).
-                        Method::AxisSlices(mut a) => {
-                            a.depth = if finer {
-                                (a.depth / 2.0).max(1.0 / 64.0)
-                            } else {
-                                (a.depth * 2.0).min(1024.0)
-                            };
-                            Method::AxisSlices(a)
-                        }
-                        Method::RayMarch(mut h) => {
-                            // The adaptive stride's longest step scales with the step, so the
-                            // stride stays on rather than vanishing below two steps.
-                            let scale = if finer { 0.5 } else { 2.0 };
-                            h.step = Some(h.step() * scale);
-                            if let Some(a) = &mut h.adaptive {
-                                a.max_step *= scale;
-                            }
-                            Method::RayMarch(h)
-                        }
-                        // A method without keys here keeps its knobs.
-                        #[allow(unreachable_patterns)]
-                        other => other,
-                    };
-                    self.set_method(name, next);
-                }
+                self.node_edit(|src, node, m| knobs::step_quality(src, node, m, finer));
+            }
+            "h" | "H" => {
+                self.panel = !self.panel;
+                self.dirty = true;
             }
             "1" => self.set_mode(Mode::Image),
             "2" => self.set_mode(Mode::Reference),
@@ -522,11 +789,6 @@ impl State {
             "s" | "S" => self.status = self.screenshot().unwrap_or_else(|e| format!("error: {e}")),
             _ => {}
         }
-    }
-
-    fn set_mode(&mut self, mode: Mode) {
-        self.mode = mode;
-        self.dirty = true;
     }
 
     /// Writes the shown image (the reference in the reference view) as EXR and PNG under out/.
@@ -550,6 +812,20 @@ impl State {
         crate::io::exr::write(&exr, &image, &meta)?;
         crate::io::png::write_tonemapped(&exr.with_extension("png"), &image)?;
         Ok(format!("screenshot {} and .png", exr.display()))
+    }
+}
+
+/// Names and paths of the nodes of the text (`nodes[i]`, `nodes[i].children[j]`, ...).
+fn node_paths(v: &st::Value, src: &str, at: Vec<Step>, out: &mut Vec<(String, Vec<Step>)>) {
+    let key = if at.is_empty() { "nodes" } else { "children" };
+    let Some(list) = v.child(&Step::Field(key.into()), src) else { return };
+    for (i, n) in list.items().into_iter().enumerate() {
+        let mut p = at.clone();
+        p.extend([Step::Field(key.into()), Step::Index(i)]);
+        if let Some(name) = n.child(&Step::Field("name".into()), src).and_then(|v| st::unquote(v.text(src))) {
+            out.push((name, p.clone()));
+        }
+        node_paths(n, src, p, out);
     }
 }
 

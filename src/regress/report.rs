@@ -179,7 +179,7 @@ fn href(path: &Path) -> String {
 }
 
 /// `YYYY-MM-DD HH:MM` of Unix seconds (H. Hinnant's days-to-civil algorithm).
-fn utc(secs: u64) -> String {
+pub fn utc(secs: u64) -> String {
     let days = (secs / 86400) as i64;
     let (hh, mm) = ((secs % 86400) / 3600, (secs % 3600) / 60);
     let z = days + 719_468;

@@ -146,13 +146,15 @@ impl Blueprint {
             Some(Failure::Budget(d, msg)) => return Err(self.error_for(d.as_ref(), msg, false)),
             None => {}
         }
+        // A method's own limits, at the node that asks for them (a frame-wide plan's first).
         for o in &self.objects {
             for m in &o.methods {
-                m.check_limits(o, limits)?;
+                m.check_limits(o, limits).map_err(|e| self.positions.at_object(&o.object.name, e))?;
             }
         }
         for g in &self.groups {
-            g.check_limits(&self.objects[g.members()[0]], limits)?;
+            let first = &self.objects[g.members()[0]];
+            g.check_limits(first, limits).map_err(|e| self.positions.at_object(&first.object.name, e))?;
         }
         Ok(())
     }

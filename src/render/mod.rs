@@ -5,6 +5,7 @@ mod budget;
 mod describe;
 pub mod export;
 mod renderer;
+pub mod trace;
 
 pub use budget::Positions;
 
@@ -136,6 +137,7 @@ impl Blueprint {
         let groups = crate::methods::gather(&mut objects, &bakes, &view);
         let (instances, infos) = instances(&objects, &groups, view.eye);
         let plan = plan::plan(&graph, &sources, &infos, size, &vocabulary())?;
+        plan::check_image_output(&graph, size)?;
         check_bindings(&graph, &plan)?;
         let texel_resources: Vec<&str> = REGISTRY.iter().flat_map(|c| c.texel_resources).copied().collect();
         let samples_texels =
@@ -145,6 +147,7 @@ impl Blueprint {
             bakes.clear();
             objects.iter_mut().for_each(|o| o.bake = None);
         }
+        check_kernels(&bakes, &objects, &groups)?;
         let frame = view.frame_params(scene, size, &light);
         Ok(Self {
             scene_path: scene.path.clone(),
@@ -213,6 +216,22 @@ fn instances(
         }
     }
     (instances, infos)
+}
+
+/// Loads and validates the kernels the frame runs outside its graph (bakes, and what methods
+/// prepare), so that a broken or unreadable one (a FIFO `#include`d, say) is a `plan` error at
+/// its line rather than a failure after other GPU work.
+fn check_kernels(bakes: &[BakePlan], objects: &[ObjectPlan], groups: &[Box<dyn MethodPlan>]) -> Result<()> {
+    let mut kernels: Vec<&str> = bakes.iter().flat_map(|b| b.request.kernels()).collect();
+    let plans = objects.iter().flat_map(|o| o.methods.iter()).chain(groups);
+    kernels.extend(plans.flat_map(|p| p.kernels()));
+    kernels.sort_unstable();
+    kernels.dedup();
+    let sources = Sources::project()?;
+    for k in kernels {
+        crate::gpu::shader::load_from(&sources, k)?;
+    }
+    Ok(())
 }
 
 /// Resources the renderer itself binds by name: per frame, and per instance of any method.

@@ -4,7 +4,7 @@ use crate::bake::{self, Baker};
 use crate::error::{Error, Result};
 use crate::gpu::cache::{self, GpuCache};
 use crate::gpu::sources::Sources;
-use crate::gpu::timing::Timer;
+use crate::gpu::timing::{Span, Timer};
 use crate::gpu::Inputs;
 use crate::gpu::{buffers, GpuContext};
 use crate::graph::exec::Executor;
@@ -18,6 +18,8 @@ pub struct Frame {
     pub image: Image,
     /// Per-pass GPU time (ms) from timestamp queries; empty without TIMESTAMP_QUERY.
     pub pass_times: Vec<(String, f64)>,
+    /// The same passes on the adapter's clock (traces, `render --trace`).
+    pub spans: Vec<Span>,
 }
 
 impl Frame {
@@ -34,6 +36,8 @@ pub struct Renderer {
     objects: Vec<Inputs>,
     timer: Timer,
     readback: wgpu::Buffer,
+    /// The passes of the last frame on the adapter's clock.
+    spans: Vec<Span>,
 }
 
 impl Renderer {
@@ -96,7 +100,7 @@ impl Renderer {
             usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let mut r = Self { blueprint, exec, frame, objects, timer, readback };
+        let mut r = Self { blueprint, exec, frame, objects, timer, readback, spans: Vec::new() };
         // Pipelines now, so that a bad kernel fails before any frame.
         r.exec.prepare(ctx, &r.blueprint.plan, &r.frame, &r.objects, cache)?;
         ctx.wait()?;
@@ -107,9 +111,10 @@ impl Renderer {
     pub fn render(&mut self, ctx: &GpuContext) -> Result<Frame> {
         self.timer.reset();
         self.exec.run(ctx, &self.blueprint.plan, &self.frame, &self.objects, &mut self.timer)?;
-        let pass_times = self.timer.read(ctx)?;
+        self.spans = self.timer.read_spans(ctx)?;
+        let pass_times = self.spans.iter().map(|s| (s.name.clone(), s.ms)).collect();
         let image = self.read_output(ctx)?.box_downsample(self.blueprint.supersample);
-        Ok(Frame { image, pass_times })
+        Ok(Frame { image, pass_times, spans: self.spans.clone() })
     }
 
     /// Renders without reading the image back (benchmarks); returns per-pass GPU times.
@@ -117,7 +122,13 @@ impl Renderer {
         self.timer.reset();
         self.exec.run(ctx, &self.blueprint.plan, &self.frame, &self.objects, &mut self.timer)?;
         ctx.wait()?;
-        self.timer.read(ctx)
+        self.spans = self.timer.read_spans(ctx)?;
+        Ok(self.spans.iter().map(|s| (s.name.clone(), s.ms)).collect())
+    }
+
+    /// The passes of the last frame rendered, on the adapter's clock (empty without timestamps).
+    pub fn spans(&self) -> &[Span] {
+        &self.spans
     }
 
     fn read_output(&self, ctx: &GpuContext) -> Result<Image> {
@@ -155,8 +166,12 @@ impl Renderer {
     /// Reads a graph texture back as a linear image: Rgba32Float as it is, R32Float as grey with
     /// alpha 1.
     pub fn read_texture(&self, ctx: &GpuContext, name: &str) -> Result<Image> {
-        let texture =
-            self.exec.texture(name).ok_or_else(|| Error::Invalid(format!("output `{name}` was pruned")))?;
+        let texture = self.exec.texture(name).ok_or_else(|| {
+            let msg = format!(
+                "output `{name}` is not a graph texture of this frame: it cannot be read back as an image"
+            );
+            self.blueprint.graph.error_at_output(name, msg)
+        })?;
         let grey = texture.format() == wgpu::TextureFormat::R32Float;
         if texture.format() != wgpu::TextureFormat::Rgba32Float && !grey {
             return Err(self

@@ -19,6 +19,24 @@ pub struct SceneObject {
     pub report: PrismReport,
     /// A hypertexture node (its `surface` is empty).
     pub hypertexture: Option<HyperNode>,
+    /// A volume node (its `surface` is empty).
+    pub volume: Option<VolumeNode>,
+}
+
+/// A node drawing a volume: its name in `Scene::volumes`, its grid as read, and the node's frame.
+#[derive(Debug, Clone)]
+pub struct VolumeNode {
+    pub name: String,
+    pub grid: Arc<crate::vdb::SparseVolume>,
+    /// The node's frame to world (the grid's own index-to-world transform comes first).
+    pub to_world: DMat4,
+}
+
+impl VolumeNode {
+    /// World-space corners of the box outside which the density is 0.
+    pub fn corners(&self) -> [glam::DVec3; 8] {
+        self.grid.world_corners(&self.to_world)
+    }
 }
 
 /// A node drawing a hypertexture: its name in `Scene::hypertextures` and the node's frame.
@@ -65,6 +83,7 @@ impl Scene {
                 base_color: n.base_color,
                 report,
                 hypertexture: None,
+                volume: None,
             });
         } else if let Some(h) = &n.hypertexture {
             // Without a method, a hypertexture node is ray-marched with the defaults.
@@ -77,6 +96,23 @@ impl Scene {
                 base_color: None,
                 report: PrismReport::default(),
                 hypertexture: Some(HyperNode { name: h.value.clone(), to_world: world }),
+                volume: None,
+            });
+        } else if let Some(v) = &n.volume {
+            // Without a method, a volume node is ray-marched with the defaults.
+            let method = n.method.as_ref().map_or(Method::RayMarch(Default::default()), |m| m.value.clone());
+            let grid = self.assets.volumes.get(&v.value).cloned().ok_or_else(|| {
+                Error::Invalid(format!("object \"{}\": volume \"{}\" was not loaded", n.name, v.value))
+            })?;
+            out.push(SceneObject {
+                name: n.name.clone(),
+                surface: Default::default(),
+                texel: None,
+                method: Some(method),
+                base_color: None,
+                report: PrismReport::default(),
+                hypertexture: None,
+                volume: Some(VolumeNode { name: v.value.clone(), grid, to_world: world }),
             });
         }
         for c in &n.children {

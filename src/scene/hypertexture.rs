@@ -151,6 +151,9 @@ fn one() -> f64 {
 fn half() -> f64 {
     0.5
 }
+fn yes() -> bool {
+    true
+}
 
 /// One noise of eq. 5: `t = T((1 + noise(frequency (x + shift V))) / 2)`, added to k as
 /// `amplitude t` (Sum) or blended over it, `k (1 - t) + amplitude t` (Blend).
@@ -178,6 +181,9 @@ pub struct Noise {
     /// so that each period holds a whole multiple of 3 noise cells (see `simplex3_tiled`).
     #[serde(default)]
     pub period: Option<Mark<[f64; 3]>>,
+    /// `false` switches the noise off (kept in the file; the preview's panel toggles it).
+    #[serde(default = "yes")]
+    pub enabled: bool,
 }
 
 /// The largest noise-cell count per period (keeps the wrapped corner class in i32).
@@ -284,9 +290,15 @@ pub struct RampPoint(
 );
 
 impl Hypertexture {
-    /// The largest shift `k` can reach: the sum of the amplitudes (Blend never exceeds it).
+    /// The largest shift `k` can reach: the sum of the enabled noises' amplitudes (Blend never
+    /// exceeds it).
     pub fn max_shift(&self) -> f64 {
-        self.noises.iter().map(|n| n.amplitude).sum()
+        self.enabled_noises().map(|n| n.amplitude).sum()
+    }
+
+    /// The noises switched on, in order: those combined into k.
+    pub fn enabled_noises(&self) -> impl Iterator<Item = &Noise> {
+        self.noises.iter().filter(|n| n.enabled)
     }
 
     /// The object's bounds enlarged by the largest shift, so no detail is clipped.
@@ -337,6 +349,8 @@ pub(super) fn check(h: &Hypertexture, fail: &mut dyn FnMut(usize, String)) {
     let n = h.noises.len();
     if n == 0 || n > MAX_NOISES {
         fail(h.noises.seq, format!("expected 1 to {MAX_NOISES} noises, found {n}"));
+    } else if h.enabled_noises().next().is_none() {
+        fail(h.noises.seq, "expected at least one noise switched on (`enabled: true`)".into());
     }
     for noise in h.noises.iter() {
         if let Some(p) = &noise.period {

@@ -1,7 +1,7 @@
-//! Open and look: a scene written around a mesh asset (`.glb`, `.gltf`, `.obj`) so that
-//! `voltex render|preview|plan FILE.glb` show it directly and `voltex import` writes it out as an
-//! editable, commented scene file. The mesh is a base surface under a default texel, framed by a
-//! camera and lit by one light.
+//! Open and look: a scene written around an asset (a mesh: `.glb`, `.gltf`, `.obj`; a volume:
+//! `.vdb`) so that `voltex render|preview|plan FILE` show it directly and `voltex import` writes
+//! it out as an editable, commented scene file. A mesh is a base surface under a default texel,
+//! a volume a volume object; either is framed by a camera and lit by one light.
 
 use std::path::{Path, PathBuf};
 
@@ -9,15 +9,22 @@ use glam::{DMat4, DVec3};
 
 use crate::error::{Error, Result};
 
-/// Whether `path` names a mesh asset rather than a scene file.
+/// Whether `path` names an asset (a mesh or an OpenVDB file) rather than a scene file.
 pub fn is_asset(path: &Path) -> bool {
     let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
-    matches!(ext.as_deref(), Some("glb" | "gltf" | "obj"))
+    matches!(ext.as_deref(), Some("glb" | "gltf" | "obj" | "vdb"))
 }
 
-/// Scene text around the mesh asset `asset`, which the scene names as `mesh_path` (relative to
-/// the scene file's folder, or absolute).
+fn is_volume(path: &Path) -> bool {
+    path.extension().is_some_and(|e| e.eq_ignore_ascii_case("vdb"))
+}
+
+/// Scene text around the asset `asset`, which the scene names as `mesh_path` (relative to the
+/// scene file's folder, or absolute).
 pub fn scene_text(asset: &Path, mesh_path: &str) -> Result<String> {
+    if is_volume(asset) {
+        return volume_scene_text(asset, mesh_path);
+    }
     let mesh = crate::mesh::load(asset)?;
     let gltf = !asset.extension().is_some_and(|e| e.eq_ignore_ascii_case("obj"));
     if mesh.uvs_missing {
@@ -91,6 +98,102 @@ Scene(
         height = num(height),
         mesh = ron_string(mesh_path),
         up = if gltf { "glTF" } else { "An OBJ export" },
+    ))
+}
+
+/// Scene text around the OpenVDB file `asset` (named `vdb_path` by the scene): its density grid
+/// (`density`, else its first float grid) with `Cd` as colour when the file has it, as a volume
+/// object framed by a camera and lit by one light.
+fn volume_scene_text(asset: &Path, vdb_path: &str) -> Result<String> {
+    let grids = crate::vdb::grids(asset)?;
+    let float = |g: &&crate::vdb::GridInfo| g.value == "float";
+    let density = grids.iter().find(|g| g.name == "density" && float(g)).or_else(|| grids.iter().find(float));
+    let Some(density) = density else {
+        return Err(Error::file(
+            asset,
+            format!("expected a float grid to draw as density: {}", crate::vdb::list(&grids)),
+        ));
+    };
+    let color = grids.iter().find(|g| g.name == "Cd" && g.value == "vec3s").map(|g| g.name.clone());
+    let request = crate::vdb::Request { density: density.name.clone(), color: color.clone(), band: 1.0 };
+    let grid = crate::vdb::load(asset, &request)?;
+    let corners = grid.world_corners(&DMat4::IDENTITY);
+    let (lo, hi) = corners.iter().fold((corners[0], corners[0]), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
+    let centre = 0.5 * (lo + hi);
+    let radius = (0.5 * (hi - lo).length()).max(1e-6);
+    let fov: f64 = 40.0;
+    let distance = 1.15 * radius / (0.5 * fov.to_radians()).sin();
+    let eye = centre + DVec3::new(0.55, -1.0, 0.6).normalize() * distance;
+    // The file's densities as extinction per world unit when they make a visible volume (an
+    // optical depth between 1/2 and 50 across 16 voxels at the densest voxel), else scaled so
+    // that it is 4.
+    let across = grid.max_density as f64 * 16.0 * crate::vdb::voxel_size(&grid.index_to_world);
+    let (scale, why) = if (0.5..=50.0).contains(&across) {
+        (1.0, "the file's densities as they are".to_string())
+    } else {
+        let why =
+            format!("the file's densities would give an optical depth of {} across 16 voxels", num(across));
+        (4.0 / across.max(1e-30), why)
+    };
+    let v = |p: DVec3| format!("({}, {}, {})", num(p.x), num(p.y), num(p.z));
+    let names: Vec<String> = grids
+        .iter()
+        .map(|g| {
+            format!(
+                "{} ({}{})",
+                g.name,
+                g.value,
+                if g.class.is_empty() { String::new() } else { format!(", {}", g.class) }
+            )
+        })
+        .collect();
+    let name = asset.file_stem().and_then(|s| s.to_str()).unwrap_or("volume").replace('"', "'");
+    let color_line = match &color {
+        Some(c) => format!("color: {},", ron_string(c)),
+        None => "// color: \"Cd\", (a vec3s grid of the file; white without one)".into(),
+    };
+    let band = if density.is_level_set() {
+        "\n            band: 1.0, // a level set: density 1 inside, 0 outside, over 1 voxel"
+    } else {
+        ""
+    };
+    Ok(format!(
+        r#"// Written by `voltex import` around {file}: grids {grids}.
+// Edit freely: the grid "{grid}" is a volume object, ray-marched; density x density_scale is the
+// extinction per world unit, the light it scatters albedo x color (docs: volumes.md).
+#![enable(implicit_some)]
+Scene(
+    output: (width: 512, height: 512),
+    regress: (size: (128, 128)),
+    // Framing the density's bounds {lo} to {hi}.
+    camera: (eye: {eye}, target: {centre}, up: (0.0, 0.0, 1.0), fov_y: {fov:.1}),
+    background: (0.05, 0.05, 0.07),
+    ambient: 0.25,
+    lights: [Directional(direction: (-0.4, 0.55, -0.75), intensity: 1.0)],
+    volumes: {{
+        "{name}": (
+            file: {path},
+            grid: {grid_string},
+            {color_line}
+            density_scale: {scale}, // {why}
+            albedo: (0.9, 0.9, 0.9),{band}
+        ),
+    }},
+    nodes: [
+        (name: "{name}", volume: "{name}", method: RayMarch(shading: PhongShadows)),
+    ],
+)
+"#,
+        file = asset.file_name().and_then(|s| s.to_str()).unwrap_or("the file"),
+        grids = names.join(", "),
+        grid = density.name,
+        grid_string = ron_string(&density.name),
+        lo = v(lo),
+        hi = v(hi),
+        eye = v(eye),
+        centre = v(centre),
+        path = ron_string(vdb_path),
+        scale = num(scale),
     ))
 }
 

@@ -18,7 +18,7 @@ mod validate;
 mod values;
 
 pub use budget::{MAX_NODES, MAX_SHAPE_VOXELS, MAX_TRIANGLES};
-pub use flatten::{HyperNode, SceneObject};
+pub use flatten::{HyperNode, SceneObject, VolumeNode};
 pub use hypertexture::Hypertexture;
 pub use image::HeightImage;
 pub use types::*;
@@ -45,6 +45,7 @@ impl Scene {
             .chain(a.images.keys())
             .chain(a.stacks.keys())
             .chain(a.shapes.keys())
+            .chain(a.volume_files.iter())
             .cloned()
             .collect()
     }
@@ -72,6 +73,11 @@ impl Scene {
             Some(s) => Some((s.clone(), true)),
             None => self.assets.texel_meshes.get(&(full, false)).map(|s| (s.clone(), false)),
         }
+    }
+
+    /// A volume of `volumes` as read from its file (by its name).
+    pub fn volume(&self, name: &str) -> Option<&std::sync::Arc<crate::vdb::SparseVolume>> {
+        self.assets.volumes.get(name)
     }
 
     /// The scene file's text.

@@ -26,6 +26,10 @@ pub struct Scene {
     /// Hypertextures (Gilet & Dischler 2009) that nodes draw with `RayMarch`.
     #[serde(default, deserialize_with = "crate::input::unique_keys")]
     pub hypertextures: BTreeMap<String, super::hypertexture::Hypertexture>,
+    /// Volumes read from OpenVDB files, drawn by nodes with `volume: "name"` or baked into
+    /// texels (`TexelSource::Volume`).
+    #[serde(default, deserialize_with = "crate::input::unique_keys")]
+    pub volumes: BTreeMap<String, Volume>,
     #[serde(default)]
     pub nodes: Vec<Node>,
     /// Time of the frame in seconds (animated hypertextures; `--time` overrides it).
@@ -278,6 +282,16 @@ pub enum TexelSource {
         #[serde(default)]
         bounds: Option<Mark<MeshBounds>>,
     },
+    /// A volume of `volumes` sampled at the voxel centres of the box `bounds` of its world
+    /// space (default: the box its density fills), which maps onto texel space `[0, 1]^3`:
+    /// colour `albedo * color`, opacity `1 - exp(-density * density_scale * opacity_length)`
+    /// (`bake_volume.wgsl`), so that drawn at any place the texel absorbs as the volume would
+    /// per world unit there.
+    Volume {
+        name: Mark<String>,
+        #[serde(default)]
+        bounds: Option<Mark<MeshBounds>>,
+    },
     /// A uniform volume (analytic tests).
     Constant {
         #[serde(deserialize_with = "v::color")]
@@ -285,6 +299,34 @@ pub enum TexelSource {
         #[serde(default = "one_f32", deserialize_with = "v::unit_f32")]
         opacity: f32,
     },
+}
+
+/// A volume from an OpenVDB file: the float grid `grid` (a fog volume's densities, or a level
+/// set's signed distances turned into density: 1 inside, 0 outside, linear over `band` voxels
+/// across the surface), times `density_scale`, is the extinction coefficient per world unit
+/// (Blender's, Houdini's and Mitsuba's convention); the light it scatters is `albedo` times the
+/// vec3 grid `color` (Houdini's `Cd`; white without one). `albedo: (0, 0, 0)` is a purely
+/// absorbing, black medium.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Volume {
+    /// The `.vdb` file, relative to the scene file.
+    pub file: Mark<String>,
+    #[serde(default = "default_grid")]
+    pub grid: String,
+    #[serde(default)]
+    pub color: Option<String>,
+    #[serde(default = "one_f64", deserialize_with = "v::positive")]
+    pub density_scale: f64,
+    #[serde(default = "white", deserialize_with = "v::color")]
+    pub albedo: [f32; 3],
+    /// Level sets: the width, in voxels, of the band over which density falls from 1 to 0.
+    #[serde(default = "one_f64", deserialize_with = "v::positive")]
+    pub band: f64,
+}
+
+fn default_grid() -> String {
+    "density".into()
 }
 
 /// `(lo: (x, y, z), hi: (x, y, z))`: a box of a mesh's object space.
@@ -378,6 +420,10 @@ pub struct Node {
     /// A hypertexture drawn in this node's frame (instead of a surface with a texel).
     #[serde(default)]
     pub hypertexture: Option<Mark<String>>,
+    /// A volume of `volumes` drawn in this node's frame (its grid's index-to-world transform,
+    /// then the node's), with `RayMarch` (the default) or `Reference`.
+    #[serde(default)]
+    pub volume: Option<Mark<String>>,
     #[serde(default)]
     pub method: Option<Mark<Method>>,
     /// Draw the base surface opaque with this colour.
@@ -582,6 +628,34 @@ pub struct RayMarch {
     /// the fine `step` where there is matter (default: off, every step sampled).
     #[serde(default)]
     pub adaptive: Option<Adaptive>,
+    /// How `PhongShadows` finds the light reaching a sample: exact shadow rays (the default) or
+    /// a transmittance grid marched once per light.
+    #[serde(default)]
+    pub shadows: Shadows,
+}
+
+/// Shadows of `RayMarch(shading: PhongShadows)`.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum Shadows {
+    /// A shadow ray from every shaded sample to the bounds' exit, step `shadow_step`: exact.
+    #[default]
+    Rays,
+    /// A light volume: transmittance towards the light on a grid over the object's bounds
+    /// (`resolution` samples along its longest axis, in the light's frame), marched once per
+    /// light and density by `bake_light_volume.wgsl` and read trilinearly by the shading.
+    LightVolume {
+        #[serde(default = "default_light_resolution", deserialize_with = "v::light_resolution")]
+        resolution: u32,
+    },
+}
+
+/// `LightVolume`'s default and largest resolution (samples along the longest axis).
+pub const DEFAULT_LIGHT_RESOLUTION: u32 = 64;
+pub const MAX_LIGHT_RESOLUTION: u32 = 256;
+
+fn default_light_resolution() -> u32 {
+    DEFAULT_LIGHT_RESOLUTION
 }
 
 /// `RayMarch(adaptive: (max_step: ..))`: on the lattice of `step`, strides of 1, 2, 4, ... steps

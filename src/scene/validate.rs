@@ -3,7 +3,8 @@
 
 use super::image::HeightImage;
 use super::types::{
-    DrawOrder, HeightScale, MeshBounds, Method, Node, Scene, SliceBlend, Surface, Texel, TexelSource,
+    DrawOrder, HeightScale, MeshBounds, Method, Node, Scene, Shading, Shadows, SliceBlend, Surface, Texel,
+    TexelSource,
 };
 use super::values::Mark;
 use crate::error::Error;
@@ -25,6 +26,10 @@ pub struct Assets {
     pub shapes: BTreeMap<PathBuf, Arc<MeshShape>>,
     /// Mesh texels' patterns by (path, filled): closed parts when filled, else one open part.
     pub texel_meshes: BTreeMap<(PathBuf, bool), Arc<MeshShape>>,
+    /// Volumes read from their OpenVDB files, by name in `Scene::volumes`.
+    pub volumes: BTreeMap<String, Arc<crate::vdb::SparseVolume>>,
+    /// The OpenVDB files read, resolved (for the preview's watch list).
+    pub volume_files: Vec<PathBuf>,
 }
 
 /// What the checks found: messages for marks (positioned by a second parse), and the first error
@@ -282,6 +287,87 @@ impl Checker<'_> {
         }
     }
 
+    /// Reads each volume's grids from its file; a failure is reported at the file's path.
+    fn volumes(&mut self) {
+        for (name, v) in &self.scene.volumes {
+            let full = self.f.assets.dir.join(&v.file.value);
+            if std::fs::metadata(&full).is_err() {
+                let msg = format!(
+                    "volume \"{name}\": expected an OpenVDB file, but {} does not exist",
+                    full.display()
+                );
+                self.fail(&v.file, msg);
+                continue;
+            }
+            let request =
+                crate::vdb::Request { density: v.grid.clone(), color: v.color.clone(), band: v.band };
+            match crate::vdb::load(&full, &request) {
+                Ok(grid) => {
+                    self.f.assets.volumes.insert(name.clone(), Arc::new(grid));
+                    self.f.assets.volume_files.push(full);
+                }
+                Err(e) => self.fail(&v.file, format!("volume \"{name}\": {e}")),
+            }
+        }
+    }
+
+    /// A volume texel names a known volume and a box with volume.
+    fn texel_volume(&mut self, name: &Mark<String>, bounds: Option<&Mark<MeshBounds>>) {
+        if !self.scene.volumes.contains_key(&name.value) {
+            let msg = format!(
+                "unknown volume \"{}\": {}",
+                name.value,
+                expected_names(self.scene.volumes.keys(), "volumes")
+            );
+            self.fail(name, msg);
+        }
+        if let Some(b) = bounds {
+            if let Some(a) = (0..3).find(|&a| b.lo[a] >= b.hi[a]) {
+                let msg = format!(
+                    "expected `lo` below `hi` on every axis, found {} >= {} on {}",
+                    b.lo[a],
+                    b.hi[a],
+                    ["x", "y", "z"][a]
+                );
+                self.fail(b, msg);
+            }
+        }
+    }
+
+    /// A volume node draws a known volume with `RayMarch` (no segments or adaptive stride: the
+    /// brick table skips empty space) or `Reference`, and nothing else.
+    fn volume_node(&mut self, n: &Node) {
+        let Some(v) = &n.volume else { return };
+        if n.surface.is_some() || n.texel.is_some() || n.hypertexture.is_some() {
+            let msg =
+                "a node draws a `surface` with a `texel`, a `hypertexture` or a `volume`: one of them".into();
+            return self.fail(v, msg);
+        }
+        if !self.scene.volumes.contains_key(&v.value) {
+            let msg = format!(
+                "unknown volume \"{}\": {}",
+                v.value,
+                expected_names(self.scene.volumes.keys(), "volumes")
+            );
+            return self.fail(v, msg);
+        }
+        if let Some(m) = &n.method {
+            match &m.value {
+                Method::RayMarch(rm)
+                    if rm.segments != crate::scene::Segments::Bounds || rm.adaptive.is_some() =>
+                {
+                    let msg =
+                        "a volume node's RayMarch takes `step`, `quality`, `shading` and `shadow_step`: its \
+                               brick table skips empty space (no `segments` or `adaptive`)"
+                            .into();
+                    self.fail(m, msg)
+                }
+                Method::RayMarch(_) | Method::Reference(_) => {}
+                _ => self.fail(m, "a volume node is drawn with RayMarch(...) or Reference(...)".into()),
+            }
+        }
+    }
+
     /// Loads the slice stack at `path` and checks it has the texel's resolution.
     fn stack(&mut self, path: &Mark<String>, resolution: [u32; 3]) {
         let full = self.f.assets.dir.join(&path.value);
@@ -321,8 +407,13 @@ impl Checker<'_> {
 
     fn node(&mut self, n: &Node, parent: glam::DMat4) {
         let world = parent * n.transform.matrix();
-        self.hypertexture_node(n, &world);
-        if let Some(m) = n.method.as_ref().filter(|m| !matches!(m.value, Method::RayMarch(_))) {
+        self.volume_node(n);
+        if n.volume.is_none() {
+            self.hypertexture_node(n, &world);
+        }
+        if let Some(m) =
+            n.method.as_ref().filter(|m| !matches!(m.value, Method::RayMarch(_)) && n.volume.is_none())
+        {
             if let Method::AxisSlices(a) = &m.value {
                 if a.draw_order == DrawOrder::Slices && a.blend == SliceBlend::Blended {
                     self.fail(m, format!(
@@ -451,6 +542,14 @@ impl Checker<'_> {
                 );
                 self.fail(ray_march.unwrap(), msg);
             }
+            if rm.shadows != Shadows::Rays && rm.shading != Shading::PhongShadows {
+                let msg = format!(
+                    "RayMarch(shadows: LightVolume(..)) with shading: {:?}: expected shading: PhongShadows (the \
+                     light volume replaces its shadow rays)",
+                    rm.shading
+                );
+                self.fail(ray_march.unwrap(), msg);
+            }
         }
     }
 }
@@ -483,6 +582,7 @@ pub(super) fn check(scene: &Scene, dir: &Path, source: &str, path: &Path) -> Fin
             c.f.fail.entry(seq).or_insert(msg);
         });
     }
+    c.volumes();
     for (name, t) in &scene.texels {
         match &t.source {
             TexelSource::Mesh { path, bounds, fill, .. } => c.texel_mesh(name, t, path, bounds, *fill),
@@ -492,6 +592,7 @@ pub(super) fn check(scene: &Scene, dir: &Path, source: &str, path: &Path) -> Fin
             TexelSource::Hypertexture { name: h, bounds } => {
                 c.texel_hypertexture(name, t, h, bounds.as_ref())
             }
+            TexelSource::Volume { name: v, bounds } => c.texel_volume(v, bounds.as_ref()),
             _ => {}
         }
     }
@@ -516,4 +617,14 @@ pub(super) fn check(scene: &Scene, dir: &Path, source: &str, path: &Path) -> Fin
         c.other(e);
     }
     c.f
+}
+
+/// "expected one of \"a\", \"b\"", or that none are defined in `what`.
+fn expected_names<'a>(names: impl Iterator<Item = &'a String>, what: &str) -> String {
+    let names: Vec<String> = names.map(|k| format!("\"{k}\"")).collect();
+    if names.is_empty() {
+        format!("no {what} are defined in `{what}`")
+    } else {
+        format!("expected one of {}", names.join(", "))
+    }
 }

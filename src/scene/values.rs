@@ -80,6 +80,12 @@ checked_u32!(
     super::types::MAX_SPLAT_GRID,
     "a splat lattice size (cells along the longest axis)"
 );
+checked_u32!(
+    LightResolution,
+    4,
+    super::types::MAX_LIGHT_RESOLUTION,
+    "a light volume resolution (samples along the longest axis)"
+);
 checked_u32!(SplatSlabs, 1, super::types::MAX_SPLAT_SLABS, "a depth slab count");
 checked_u32!(
     GridResolution,
@@ -137,6 +143,7 @@ adapter!(octaves, u32, Octaves, |v| v.0);
 adapter!(grid_resolution, u32, GridResolution, |v| v.0);
 adapter!(peel_passes, u32, PeelPasses, |v| v.0);
 adapter!(splat_grid, u32, SplatGrid, |v| v.0);
+adapter!(light_resolution, u32, LightResolution, |v| v.0);
 adapter!(splat_slabs, u32, SplatSlabs, |v| v.0);
 adapter!(frequency, u32, Frequency, |v| v.0);
 adapter!(cells, [u32; 2], [Cells; 2], |v| v.map(|x| x.0));

@@ -142,6 +142,7 @@ const SNIPPET_FOLDERS: &[&str] = &[
     "scenes/meyer_neyret",
     "scenes/hypertextures",
     "scenes/hard_cases",
+    "scenes/volumes",
     "scenes/reference",
 ];
 
@@ -265,7 +266,7 @@ fn scene_registry() -> Registry {
     use voltex::scene::hypertexture as h;
     use voltex::scene::*;
     trace!(Scene; Light, TexelSource, Shape, Surface, HeightScale, Method, Lighting, Quality, Shading,
-        Segments, SliceDirections, SliceBlend, DrawOrder, h::SoftObject, h::Field, h::Operator,
+        Segments, Shadows, SliceDirections, SliceBlend, DrawOrder, h::SoftObject, h::Field, h::Operator,
         h::ShapeTransfer, h::ColorTransfer)
 }
 

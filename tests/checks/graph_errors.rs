@@ -130,6 +130,7 @@ fn frame_graph_parses_and_plans() {
         &["RayMarch"],
         &["RayMarch", "RayMarchPeeling"],
         &["RayMarch", "RayMarchSplatting"],
+        &["Volume"],
     ];
     let p = plan(&g, &wgsl_root(), &objects(all)).unwrap();
     assert_eq!(
@@ -156,6 +157,8 @@ fn frame_graph_parses_and_plans() {
             "splat_segments",
             "resolve_splats",
             "composite_ray_march",
+            "march_volume",
+            "composite_volume",
             "composite"
         ]
     );

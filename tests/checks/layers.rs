@@ -12,8 +12,8 @@ const LAYERS: &[&[&str]] = &[
     &["error", "fault", "progress", "types"],
     // Bounded reads of user files (every reader above uses them).
     &["input"],
-    // Device, shader sources, reflection, caches; file formats; meshes, shells, BVHs.
-    &["gpu", "io", "mesh"],
+    // Device, shader sources, reflection, caches; file formats; meshes, shells, BVHs; OpenVDB grids.
+    &["gpu", "io", "mesh", "vdb"],
     // Render graphs; image metrics; scene files (no GPU).
     &["graph", "metrics", "scene"],
     // CPU twins shared by several methods.

@@ -12,3 +12,4 @@ mod strict;
 mod truth;
 mod twins;
 mod types_layout;
+mod write_back;

@@ -229,5 +229,17 @@ fn work_over_a_budget_is_refused_from_the_counts() {
         "Scene(\n    output: (width: 8, height: 8),\n    camera: (eye: (0.0, -3.0, 2.0), target: (0.0, 0.0, 0.0), fov_y: 40.0),\n    texels: {{\n        \"many\": (resolution: (1024, 1024, 1024), source: Implicit(shapes: [{}])),\n    }},\n)\n",
         sphere.repeat(5)
     );
-    scene_err(&text, "5:9", &["texel \"many\": 5 shapes x 1073741824 voxels", "at most 4294967296"]);
+    scene_err(&text, "5:9", &["texel \"many\": 5 shapes x 1073741824 voxels", "at most 536870912"]);
+    // Issue 19: 10,000 spheres at 64^3 took minutes on llvmpipe; the budget is the scene's, so
+    // two texels of 1,500 spheres each are over it together (the second is named).
+    let texel = |name: &str, n: usize| {
+        format!("\"{name}\": (resolution: (64, 64, 64), source: Implicit(shapes: [{}])),\n", sphere.repeat(n))
+    };
+    let scene = |texels: String| {
+        format!("Scene(\n    output: (width: 8, height: 8),\n    camera: (eye: (0.0, -3.0, 2.0), target: (0.0, 0.0, 0.0), fov_y: 40.0),\n    texels: {{\n{texels}    }},\n)\n")
+    };
+    scene_err(&scene(texel("many", 10_000)), "5:1", &["10000 shapes x 262144 voxels", "at most 536870912"]);
+    let text = scene(texel("a", 1500) + &texel("b", 1500));
+    scene_err(&text, "6:1", &["texel \"b\": 1500 shapes", "with 393216000 of the other Implicit texels"]);
+    assert!(voltex::scene::parse(&scene(texel("a", 1500)), Path::new("s.ron")).is_ok());
 }

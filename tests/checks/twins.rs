@@ -59,6 +59,11 @@ const NO_TWIN: &[(&str, &str)] = &[
          checked by the golden images",
     ),
     (
+        "composite_volume",
+        "raster: blends the march state the march_volume twin computes over the frame (one line); \
+         checked by tests/gpu/volume.rs's analytic transmittance and the golden images",
+    ),
+    (
         "composite_reference",
         "raster: copies the trace_reference layer (premultiplied-over blending by the pipeline); \
          checked by tests/gpu/reference.rs and the golden images",
@@ -83,6 +88,16 @@ const NO_TWIN: &[(&str, &str)] = &[
     (
         "draw_slice_coverage",
         "debug view: counts the slice polygons covering each pixel (additive white), no math",
+    ),
+    (
+        "bench_blend",
+        "benchmark only (`voltex bench --limits` times it): full-screen layers blended with one \
+         3D texture fetch each, a fill rate; its output is never read",
+    ),
+    (
+        "bench_texture",
+        "benchmark only (`voltex bench --limits` times it): sums trilinear 3D texture samples, a \
+         sample rate; its output is never read",
     ),
     (
         "present",

@@ -48,8 +48,10 @@ fn wgsl_structs_match_rust() {
         layout!(TransferFunction; first, count, kind, _pad),
         layout!(TransferPoint; x, y, slope, _pad),
         layout!(MarchState; color, resume),
+        layout!(VolumeParams; to_index, right, up, box_lo, box_hi, medium, origin, table, atlas, budget),
         layout!(SegmentParams; from_local, lattice_min, lattice, surface, counts, splatting),
         layout!(Splat; center, normal),
+        layout!(LightVolumeParams; origin, u, v, w, to_grid, counts),
     ];
     let mut seen = 0;
     for (_, ty) in kernel.module.types.iter() {

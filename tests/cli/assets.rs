@@ -120,7 +120,9 @@ fn an_asset_opens_directly_and_imports_as_the_same_scene() {
     // Not an asset: a clear error, nothing written.
     let run = voltex(&["import", s(&scene), "-o", s(&dir.join("x.ron"))]);
     assert_eq!(run.status.code(), Some(1));
-    assert!(stderr(&run).contains("expected a mesh asset (.glb, .gltf or .obj)"));
+    assert!(
+        stderr(&run).contains("expected an asset: a mesh (.glb, .gltf or .obj) or an OpenVDB file (.vdb)")
+    );
     assert!(!dir.join("x.ron").exists());
 }
 

@@ -35,7 +35,10 @@ fn export_writes_one_vdb_per_texel_into_a_new_folder() {
     let dir = temp("ok");
     let scene = common::root().join("scenes/view_slices/flat_box.ron");
     let out = dir.join("vdb");
-    let text = common::ok(voltex(&["export", scene.to_str().unwrap(), "--out", out.to_str().unwrap()]));
+    let run = voltex(&["export", scene.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    let progress = String::from_utf8_lossy(&run.stderr).into_owned();
+    assert!(progress.contains("[1/1] texel \"fog\" 8x8x8: "), "{progress}");
+    let text = common::ok(run);
     assert!(text.contains("fog.vdb") && text.contains("8x8x8, 512 active voxels"), "{text}");
     assert_eq!(entries(&out), ["fog.vdb"]);
     let file = std::fs::File::open(out.join("fog.vdb")).unwrap();

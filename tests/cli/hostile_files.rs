@@ -83,6 +83,28 @@ fn fifo_included_by_a_kernel_is_an_error_at_the_include() {
     fails(&out, &[&format!("{}:1:1: cannot include shared/pipe.wgsl", kernel.display()), "found a FIFO"]);
 }
 
+/// Issue 19: an include in a bake kernel passed `plan` and hung `render`; bake kernels are now
+/// loaded and checked by `plan` too, so the error comes before any GPU work.
+#[test]
+fn fifo_included_by_a_bake_kernel_is_a_plan_error() {
+    let dir = scratch_dir("voltex-hostile-bake-include");
+    let r = dir.join("root");
+    common::copy_dir(&root().join("wgsl"), &r.join("wgsl"));
+    common::copy_dir(&root().join("graphs"), &r.join("graphs"));
+    let kernel = r.join("wgsl/bake/bake_implicit.wgsl");
+    let text = std::fs::read_to_string(&kernel).unwrap();
+    std::fs::write(&kernel, format!("{text}#include \"shared/pipe.wgsl\"\n")).unwrap();
+    mkfifo(&r.join("wgsl/shared/pipe.wgsl"));
+    let line = text.lines().count() + 1;
+    let scene = root().join("scenes/meyer_neyret/pear_grazing.ron");
+    let at = format!("{}:{line}:1: cannot include shared/pipe.wgsl", kernel.display());
+    let exr = dir.join("x.exr");
+    for args in [&["plan", s(&scene)][..], &["render", s(&scene), "--size", "8x8", "-o", s(&exr)]] {
+        fails(&voltex_env(args, &[("VOLTEX_ROOT", s(&r))]), &[&at, "found a FIFO"]);
+    }
+    assert!(!exr.exists());
+}
+
 #[test]
 fn sparse_giant_and_fifo_as_obj_paths() {
     let dir = scratch_dir("voltex-hostile-obj");

@@ -4,6 +4,7 @@
 mod common;
 
 mod assets;
+mod bench_json;
 mod cli_errors;
 mod export;
 mod farm;
@@ -11,4 +12,6 @@ mod faults;
 mod hostile_files;
 mod install;
 mod maxima;
+mod preview_input;
 mod preview_window;
+mod volumes;

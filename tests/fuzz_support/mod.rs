@@ -1,7 +1,10 @@
 //! Helpers of the fuzz targets: token-level mutations of example files, the error-position
 //! property, and an allocator that records the peak of live bytes per thread.
 
+pub mod ron_items;
+pub mod runner;
 pub mod slice;
+pub mod special;
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
@@ -25,7 +28,8 @@ pub enum Mutation {
     Truncate(Index),
 }
 
-const NUMBERS: &[&str] = &[
+/// Awkward numbers a mutation puts in place of a number.
+pub const NUMBERS: &[&str] = &[
     "NaN",
     "inf",
     "-inf",

@@ -11,7 +11,11 @@ fn a_baked_stack_renders_like_its_recipe() {
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
     let recipe = root().join("scenes/meyer_neyret/heightfield_image.ron");
-    let printed = ok(voltex(&["bake", s(&recipe), "--out", s(&dir)]));
+    let out = voltex(&["bake", s(&recipe), "--out", s(&dir)]);
+    // Progress on stderr, one line per texel when it is not a terminal.
+    let progress = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert!(progress.contains("[1/1] texel \"cobbles\" 64x64x16: "), "{progress}");
+    let printed = ok(out);
     assert!(printed.contains("cobbles (64x64x16"), "{printed}");
     assert!(dir.join("cobbles/slice_015.png").is_file() && !dir.join("cobbles/slice_016.png").exists());
 

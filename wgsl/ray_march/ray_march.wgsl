@@ -25,6 +25,9 @@ override peeling: bool = false;
 // Depth peeling's segments (stand-ins without it); the marcher keeps its segment in word 0.
 @group(0) @binding(8) var<uniform> segments: SegmentParams;
 @group(0) @binding(9) var<storage, read_write> segment_bounds: array<u32>;
+// `shadows: LightVolume(..)`: the object's light volume (stand-ins otherwise).
+@group(0) @binding(10) var<uniform> light_grid: LightVolumeParams;
+@group(0) @binding(11) var<storage, read> light_volume: array<u32>;
 
 @compute @workgroup_size(8, 8, 1)
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {

@@ -25,6 +25,9 @@ const SIGMA: f32 = 0.5;
 @group(0) @binding(7) var<uniform> segments: SegmentParams;
 @group(0) @binding(8) var<storage, read> interior_splats: array<Splat>;
 @group(0) @binding(9) var<storage, read_write> splat_slabs: array<atomic<u32>>;
+// `shadows: LightVolume(..)`: the object's light volume (stand-ins otherwise).
+@group(0) @binding(10) var<uniform> light_grid: LightVolumeParams;
+@group(0) @binding(11) var<storage, read> light_volume: array<u32>;
 
 // Adds one splat's stretch of slab j: `count` samples from `first`, optical depth `tau`, colour
 // times optical depth `colour`, out of the slab's `samples`.

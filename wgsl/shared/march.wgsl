@@ -1,12 +1,15 @@
 // Sampling and shading of hypertexture rays, shared by ray_march.wgsl and splat_segments.wgsl:
 // the ray's span and step, the step-corrected opacity, Phong and shadow rays. Reads the kernel's
-// `frame`, `hyper` and `depth`. CPU twin: src/methods/ray_march/march.rs.
+// `frame`, `hyper`, `depth`, `light_grid` and `light_volume`. CPU twin: src/methods/ray_march/march.rs.
+#include "shared/light_volume.wgsl"
 
 // Shading, compiled out when off (set per object from `RayMarch(shading: ...)`): Phong with the
 // density gradient by central differences (six more density evaluations), and a secondary ray
 // towards the light for shadows.
 override phong: bool = false;
 override shadows: bool = false;
+// `shadows: LightVolume(..)`: the shadows are read from the light volume, not marched.
+override volume_shadows: bool = false;
 const MIN_TRANSMITTANCE: f32 = 1e-4;
 const MAX_ALPHA: f32 = 0.999999;
 // Raster depth is coarse far from the camera: opaque surfaces are moved back by this margin.
@@ -60,6 +63,12 @@ fn shade(x: vec3<f32>, ray: vec3<f32>, albedo: vec3<f32>) -> vec4<f32> {
         n = u32(clamp(ceil(exit / hyper.march.x), 1.0, f32(hyper.budget.y)));
         h = exit / f32(n);
     }
+    // The light volume: the shadow ray's first sample, then the volume from the end of its step
+    // on. The first sample decides how much light a sample just inside dense matter gets (a
+    // skin far thinner than the volume's cells); from there on the volume holds the shadow ray.
+    if (volume_shadows) {
+        n = min(n, 1u);
+    }
     var g = vec3<f32>(0.0);
     var lit = 1.0;
     var j = 0u;
@@ -77,6 +86,9 @@ fn shade(x: vec3<f32>, ray: vec3<f32>, albedo: vec3<f32>) -> vec4<f32> {
             lit *= 1.0 - step_alpha(hyper_opacity(density), h);
         }
         j++;
+    }
+    if (shadows && volume_shadows && lit >= MIN_TRANSMITTANCE) {
+        lit *= light_transmittance(x + l * h);
     }
     let len = length(g);
     let normal = select(-ray, -g / len, len > 1e-12);

@@ -262,7 +262,31 @@ struct SegmentParams {
     splatting: vec4<u32>,
 }
 
+// The light volume of a RayMarch object (twin: LightVolumeParams in src/types.rs).
+struct LightVolumeParams {
+    origin: vec4<f32>,
+    u: vec4<f32>,
+    v: vec4<f32>,
+    w: vec4<f32>,
+    to_grid: mat4x4<f32>,
+    counts: vec4<u32>,
+}
+
 struct Splat {
     center: vec4<f32>,
     normal: vec4<f32>,
+}
+
+// Volume objects (twin: VolumeParams in src/types.rs).
+struct VolumeParams {
+    to_index: mat4x4<f32>,
+    right: vec4<f32>,
+    up: vec4<f32>,
+    box_lo: vec4<f32>,
+    box_hi: vec4<f32>,
+    medium: vec4<f32>,
+    origin: vec4<i32>,
+    table: vec4<u32>,
+    atlas: vec4<u32>,
+    budget: vec4<u32>,
 }

@@ -7,7 +7,9 @@
 
 use glam::{DMat4, DVec3, DVec4};
 
+use super::light_volume;
 use crate::cpu::hypertexture::Model;
+use crate::types::LightVolumeParams;
 
 pub const MIN_TRANSMITTANCE: f64 = 1e-4;
 pub const MAX_ALPHA: f64 = 0.999999;
@@ -44,6 +46,8 @@ impl MarchView {
 pub struct Shade {
     pub phong: bool,
     pub shadows: bool,
+    /// Shadows read from a light volume (override `volume_shadows`) instead of shadow rays.
+    pub volume: bool,
 }
 
 fn v3(a: [f32; 4]) -> DVec3 {
@@ -55,7 +59,11 @@ struct Ray<'a> {
     to_local: DMat4,
     view: &'a MarchView,
     shade: Shade,
+    light: Option<LightVolume<'a>>,
 }
+
+/// A light volume as [`light_volume::bake_light_volume`] makes it, and its grid.
+pub type LightVolume<'a> = (&'a LightVolumeParams, &'a [[f64; 2]]);
 
 impl Ray<'_> {
     fn bounds_span(&self, o: DVec3, d: DVec3) -> (f64, f64) {
@@ -90,8 +98,11 @@ impl Ray<'_> {
         let p = self.model.params;
         let l = (self.to_local * self.view.light_dir.extend(0.0)).truncate();
         let exit = self.bounds_span(x, l).1.max(0.0);
-        let n = (exit / p.march[0] as f64).ceil().clamp(1.0, p.budget[1] as f64) as u32;
+        let mut n = (exit / p.march[0] as f64).ceil().clamp(1.0, p.budget[1] as f64) as u32;
         let h = exit / n as f64;
+        if self.light.is_some() {
+            n = n.min(1);
+        }
         let mut transmittance = 1.0;
         for j in 0..n {
             if transmittance < MIN_TRANSMITTANCE {
@@ -100,7 +111,12 @@ impl Ray<'_> {
             let a = self.model.hyper_color(self.model.hyper_density(x + l * ((j as f64 + 0.5) * h)))[3];
             transmittance *= 1.0 - self.step_alpha(a, h);
         }
-        transmittance
+        match self.light {
+            Some((grid, volume)) if transmittance >= MIN_TRANSMITTANCE => {
+                transmittance * light_volume::light_transmittance(volume, grid, x + l * h)
+            }
+            _ => transmittance,
+        }
     }
 
     fn phong_shade(&self, albedo: DVec3, n: DVec3, ray: DVec3, lit: f64) -> DVec3 {
@@ -165,9 +181,20 @@ impl Ray<'_> {
 /// The premultiplied layer (rgb times the light colour, coverage) of the whole image, rows top to
 /// bottom, as `composite_ray_march.wgsl` blends it.
 pub fn ray_march(view: &MarchView, model: Model, shade: Shade) -> Vec<[f64; 4]> {
+    ray_march_lit(view, model, shade, None)
+}
+
+/// [`ray_march`] with shadows read from a light volume (`shade.volume`) instead of shadow rays.
+pub fn ray_march_lit(
+    view: &MarchView,
+    model: Model,
+    shade: Shade,
+    light: Option<LightVolume>,
+) -> Vec<[f64; 4]> {
+    assert_eq!(shade.volume, light.is_some(), "a light volume exactly when the shading reads one");
     let p = model.params;
     let to_local = DMat4::from_cols_array_2d(&p.to_local.map(|c| c.map(|x| x as f64)));
-    let ray = Ray { model, to_local, view, shade };
+    let ray = Ray { model, to_local, view, shade, light };
     let (right, up) = (v3(p.right), v3(p.up));
     let mut out = Vec::with_capacity((view.width * view.height) as usize);
     for y in 0..view.height {

@@ -6,6 +6,7 @@
 //! or with EWA-style splatting the work blocks of `splat_segments.wgsl` and the per-pixel depth
 //! slabs `resolve_splats.wgsl` composites.
 
+pub mod light_volume;
 pub mod march;
 mod object;
 pub mod peel_segments;
@@ -22,8 +23,8 @@ use crate::hypertexture::splats::{self, Lattice, SplatSet, FOOTPRINT_BLOCK};
 use crate::hypertexture::{self, Packed};
 use crate::methods::ray_march::march::Shade;
 use crate::scene::hypertexture::diagonal;
-use crate::scene::{Hypertexture, RayMarch, Segments, Shading};
-use crate::types::{HyperParams, MarchState, SegmentParams};
+use crate::scene::{Hypertexture, RayMarch, Segments, Shading, Shadows};
+use crate::types::{HyperParams, LightVolumeParams, MarchState, SegmentParams};
 
 /// What RayMarch brings to the render graph.
 pub const CONTRIBUTION: super::Contribution = super::Contribution {
@@ -44,6 +45,8 @@ pub const CONTRIBUTION: super::Contribution = super::Contribution {
         "interior_splats",
         "peel_tickets",
         "splat_slabs",
+        "light_grid",
+        "light_volume",
     ],
     counts: &[
         "ray_march_dispatches",
@@ -75,6 +78,8 @@ pub use crate::methods::view::RayCamera as Camera;
 #[derive(Debug, Clone)]
 pub struct RayMarchPlan {
     pub hypertexture: String,
+    /// The method as the scene (and the overrides) gave it: what the preview shows and steps.
+    pub method: RayMarch,
     pub packed: Packed,
     pub params: HyperParams,
     pub shade: Shade,
@@ -92,29 +97,37 @@ pub struct RayMarchPlan {
     pub splatting: Option<(u32, Lattice)>,
     /// The camera and splat lattice as `bake_splats.wgsl` and the peeling kernels see them.
     pub segments: SegmentParams,
+    /// `shadows: LightVolume(..)`: the light volume's grid (`None`: shadow rays, or no shadows).
+    pub light: Option<LightVolumeParams>,
 }
 
-/// `name`: the object's; `node`: its hypertexture's name and frame.
+/// `name`: the object's; `node`: its hypertexture's name and frame; `cx`: the frame's camera,
+/// light, time and size.
 pub fn plan(
     name: &str,
     node: &crate::scene::HyperNode,
     h: &Hypertexture,
     method: &RayMarch,
-    camera: &Camera,
-    time: f64,
-    size: (u32, u32),
+    cx: &super::PlanCx,
 ) -> Result<RayMarchPlan> {
+    let (camera, light_dir, time, size) = (&cx.view.camera(), cx.light.direction, cx.time, cx.view.size);
     let packed = hypertexture::pack(h);
     let to_world = &node.to_world;
     let corners = h.world_corners(to_world);
     let diagonal = diagonal(&corners);
     let step = method.step();
     let shadow_step = method.shadow_step.unwrap_or(2.0 * step);
-    let shade =
-        Shade { phong: method.shading != Shading::None, shadows: method.shading == Shading::PhongShadows };
+    let shadows = method.shading == Shading::PhongShadows;
+    let resolution = match method.shadows {
+        Shadows::LightVolume { resolution } if shadows => Some(resolution),
+        _ => None,
+    };
+    let shade = Shade { phong: method.shading != Shading::None, shadows, volume: resolution.is_some() };
     let evals = LOOP_BUDGET / (packed.noises.len() as u32 + 1);
     let shadow_samples = ((diagonal / shadow_step).ceil() as u32).clamp(1, MAX_SHADOW_SAMPLES);
-    let worst = 1 + 6 * shade.phong as u32 + shadow_samples * shade.shadows as u32;
+    // A light volume replaces all but the first sample of each shadow ray.
+    let shadow_cost = if shade.volume { 1 } else { shadow_samples };
+    let worst = 1 + 6 * shade.phong as u32 + shadow_cost * shade.shadows as u32;
     let lattice = |grid| Lattice::new(h.bounds(), packed.tested_shift(), grid);
     let (peel, splatting) = match method.segments {
         Segments::Bounds => (None, None),
@@ -134,7 +147,9 @@ pub fn plan(
         )));
     }
     // Camera-relative world to the node's frame.
-    let to_local = (to_world.inverse() * DMat4::from_translation(camera.eye)).as_mat4();
+    let to_local = to_world.inverse() * DMat4::from_translation(camera.eye);
+    let light_local = to_local.transform_vector3(DVec3::from(light_dir.map(|c| c as f64)));
+    let to_local = to_local.as_mat4();
     let mut params = packed.params(time);
     params.to_local = to_local.to_cols_array_2d();
     params.right = [camera.right.x as f32, camera.right.y as f32, camera.right.z as f32, camera.near as f32];
@@ -162,8 +177,16 @@ pub fn plan(
         // The slabs are resolved into the march state: the marcher has nothing to do.
         dispatches = 0.0;
     }
+    let light = resolution
+        .map(|r| {
+            let noises = packed.noises.len() as u32;
+            light_volume::grid(&params, light_local, r, shadow_step, noises, LOOP_BUDGET)
+                .map_err(|e| Error::Invalid(format!("object \"{name}\": {e}")))
+        })
+        .transpose()?;
     Ok(RayMarchPlan {
         hypertexture: node.name.clone(),
+        method: *method,
         packed,
         params,
         shade,
@@ -175,6 +198,7 @@ pub fn plan(
         peel,
         splatting,
         segments,
+        light,
     })
 }
 
@@ -253,6 +277,9 @@ impl RayMarchPlan {
         if self.peel.is_some() {
             c.push(("peeling".into(), 1.0));
         }
+        if self.light.is_some() {
+            c.push(("volume_shadows".into(), 1.0));
+        }
         c
     }
 
@@ -280,8 +307,14 @@ impl RayMarchPlan {
         } else {
             String::new()
         };
+        let shadows = self.light.map_or(String::new(), |l| {
+            format!(
+                ", shadows: LightVolume({}x{}x{}, {} sub-step(s) per layer)",
+                l.counts[0], l.counts[1], l.counts[2], l.counts[3]
+            )
+        });
         format!(
-            "RayMarch(step: {:.6}, shading: {shading}, shadow_step: {:.6}{segments}{adaptive})",
+            "RayMarch(step: {:.6}, shading: {shading}, shadow_step: {:.6}{segments}{adaptive}{shadows})",
             self.step, self.shadow_step
         )
     }
@@ -302,6 +335,7 @@ impl RayMarchPlan {
                 .splatting
                 .as_ref()
                 .map_or(0, |(slabs, lattice)| splats::bytes(lattice.cells()) + slab_bytes(size, *slabs))
+            + self.light.as_ref().map_or(0, light_volume::bytes)
     }
 
     /// The splat lattice of a depth-peeled or splatted object.
@@ -364,8 +398,20 @@ impl RayMarchPlan {
         self.packed.mesh.as_ref().map(|(shape, spec)| mesh::bake(ctx, shape, spec)).transpose()
     }
 
+    /// The light volume's cache key: its grid and everything the density depends on (not the
+    /// camera, the step or the image), for objects with `shadows: LightVolume(..)`.
+    pub fn light_key(&self) -> Option<u64> {
+        let mut p = self.params;
+        (p.to_local, p.right, p.up, p.budget) = Default::default();
+        (p.bounds_min[3], p.march[1]) = (0.0, 0.0);
+        let k = &self.packed;
+        let key = ("light volume", self.mesh_grid_key(), p, &k.noises, &k.points, &k.functions, self.light?);
+        Some(crate::gpu::cache::key(&key))
+    }
+
     /// Buffers, counts and constants of the object's graph instance; `grid`: the baked mesh
-    /// grid of a mesh object; `splats`: the splat set of a depth-peeled one.
+    /// grid of a mesh object; `splats`: the splat set of a depth-peeled one; `light`: the light
+    /// volume of one with `shadows: LightVolume(..)`.
     pub fn add_inputs(
         &self,
         ctx: &GpuContext,
@@ -373,8 +419,16 @@ impl RayMarchPlan {
         size: (u32, u32),
         grid: Option<&MeshGrid>,
         splats: Option<&SplatSet>,
+        light: Option<&wgpu::Buffer>,
     ) {
         use crate::gpu::buffers::{storage, uniform};
+        // The light volume (stand-ins without one).
+        let light_grid = self.light.unwrap_or_default();
+        inputs
+            .buffers
+            .insert("light_grid".into(), uniform(ctx, "light_grid", bytemuck::bytes_of(&light_grid)));
+        let light = light.cloned().unwrap_or_else(|| storage(ctx, "light_volume", &[0u8; 16]));
+        inputs.buffers.insert("light_volume".into(), light);
         let grid = grid.cloned().unwrap_or_else(|| mesh::unused(ctx));
         // Segments: the splats and per-pixel boundaries (stand-ins without depth peeling).
         let mut segments = self.segments;
@@ -455,7 +509,7 @@ pub fn probe(ctx: &GpuContext, plan: &RayMarchPlan, points: &[[f32; 4]]) -> Resu
     let root = crate::gpu::sources::Sources::project()?;
     let mut inputs = Inputs::default();
     let grid = plan.bake_mesh_grid(ctx)?;
-    plan.add_inputs(ctx, &mut inputs, (1, 1), grid.as_ref(), None);
+    plan.add_inputs(ctx, &mut inputs, (1, 1), grid.as_ref(), None, None);
     let b = &mut inputs.buffers;
     b.insert("probe_points".into(), storage(ctx, "probe_points", bytemuck::cast_slice(points)));
     let zeros = vec![0u8; points.len() * 64];

@@ -23,13 +23,14 @@ pub fn plan_object(cx: &mut PlanCx, object: &mut ObjectPlan, m: &RayMarch) -> Re
     let h = cx.scene.hypertextures.get(&node.name).ok_or_else(|| {
         Error::Invalid(format!("{}: unknown hypertexture `{}`", cx.scene.path.display(), node.name))
     })?;
-    let plan = plan(name, node, h, m, &cx.view.camera(), cx.time, cx.view.size)?;
+    let plan = plan(name, node, h, m, cx)?;
     object.methods.push(Box::new(plan));
     Ok(())
 }
 
-/// What `prepare` bakes: the mesh grid of a mesh object, the splat set of a segmented one.
-type Prepared = (Option<MeshGrid>, Option<SplatSet>);
+/// What `prepare` bakes: the mesh grid of a mesh object, the splat set of a segmented one, the
+/// light volume of one with `shadows: LightVolume(..)`.
+type Prepared = (Option<MeshGrid>, Option<SplatSet>, Option<wgpu::Buffer>);
 
 impl MethodPlan for RayMarchPlan {
     fn parts(&self) -> Vec<PartDecl> {
@@ -49,7 +50,8 @@ impl MethodPlan for RayMarchPlan {
         RayMarchPlan::constants(self)
     }
 
-    /// Mesh grids and splat sets, baked once per mesh, grid and lattice while the cache holds them.
+    /// Mesh grids, splat sets and light volumes, baked once per mesh, grid, lattice, and light
+    /// and density while the cache holds them.
     fn prepare(&self, ctx: &GpuContext, cache: &mut GpuCache) -> Result<Option<Box<dyn Any + Send>>> {
         let grid = match self.mesh_grid_key() {
             Some(key) => Some(cache.bake(key, || Ok(self.bake_mesh_grid(ctx)?.expect("a mesh object")))?),
@@ -59,14 +61,27 @@ impl MethodPlan for RayMarchPlan {
             Some(key) => Some(cache.bake(key, || self.bake_splats(ctx, grid.as_ref()))?),
             None => None,
         };
-        let prepared: Prepared = (grid, splats);
+        let light = match (self.light_key(), &self.light) {
+            (Some(key), Some(l)) => {
+                Some(cache.bake(key, || super::light_volume::bake(ctx, self, l, grid.as_ref()))?)
+            }
+            _ => None,
+        };
+        let prepared: Prepared = (grid, splats, light);
         Ok(Some(Box::new(prepared)))
+    }
+
+    fn kernels(&self) -> Vec<&'static str> {
+        let grid = self.mesh_grid_key().map(|_| "bake/bake_mesh_grid.wgsl");
+        let splats = self.splat_key().map(|_| "ray_march/bake_splats.wgsl");
+        grid.into_iter().chain(splats).collect()
     }
 
     fn add_inputs(&self, cx: &InputCx, _object: &ObjectPlan, _part: usize, inputs: &mut Inputs) {
         let prepared = cx.prepared.and_then(|p| p.downcast_ref::<Prepared>());
-        let (grid, splats) = prepared.map_or((None, None), |(g, s)| (g.as_ref(), s.as_ref()));
-        RayMarchPlan::add_inputs(self, cx.ctx, inputs, cx.size, grid, splats);
+        let (grid, splats, light) =
+            prepared.map_or((None, None, None), |(g, s, l)| (g.as_ref(), s.as_ref(), l.as_ref()));
+        RayMarchPlan::add_inputs(self, cx.ctx, inputs, cx.size, grid, splats, light);
     }
 
     fn bake_lines(&self, object: &ObjectPlan) -> Vec<String> {
@@ -78,6 +93,12 @@ impl MethodPlan for RayMarchPlan {
                 "{name:<16} {x}x{y}x{z}  bake_mesh_grid.wgsl  mesh grid of {} triangles in {} part(s)",
                 shape.triangles.len(),
                 shape.parts.len(),
+            ));
+        }
+        if let Some(l) = &self.light {
+            let [x, y, z, m] = l.counts;
+            lines.push(format!(
+                "{name:<16} {x}x{y}x{z}  bake_light_volume.wgsl  transmittance towards the light, {m} sub-step(s) per layer"
             ));
         }
         if let Some(l) = self.lattice() {
@@ -105,6 +126,10 @@ impl MethodPlan for RayMarchPlan {
         self.describe()
     }
 
+    fn scene_method(&self, _object: &ObjectPlan) -> Option<crate::scene::Method> {
+        Some(crate::scene::Method::RayMarch(self.method))
+    }
+
     fn allocations(&self, _object: &ObjectPlan, size: (u32, u32)) -> Vec<Allocation> {
         self.per_pixel_buffers(size)
             .into_iter()
@@ -123,7 +148,8 @@ impl MethodPlan for RayMarchPlan {
             object.object.name,
             if self.packed.mesh.is_some() { ", mesh grid" } else { "" }
         ) + if self.peel.is_some() { ", splat sets, per-pixel segment bounds" } else { "" }
-            + if self.splatting.is_some() { ", splat sets, per-pixel depth slabs" } else { "" };
+            + if self.splatting.is_some() { ", splat sets, per-pixel depth slabs" } else { "" }
+            + if self.light.is_some() { ", light volume" } else { "" };
         vec![(what, self.bytes(size))]
     }
 

@@ -227,8 +227,8 @@ impl ReferenceSet {
         }
         for (what, words) in [("texel", self.atlas_words), ("normal", self.normal_words)] {
             if words * 4 > max_binding {
-                return Err(Error::Gpu(format!(
-                    "the Reference objects' {what} volumes need {} MiB in one storage buffer, beyond this \
+                return Err(Error::Invalid(format!(
+                    "the Reference objects' {what} volumes need {} MiB in one storage buffer, beyond the \
                      adapter's limit of {} MiB: use smaller texel resolutions or another method",
                     (words * 4) >> 20,
                     max_binding >> 20

@@ -1,0 +1,247 @@
+//! The fuzz driver: a target's inputs under proptest, each with bounds on time and memory, and
+//! the counts a campaign reports (inputs tried and accepted, the slowest and largest input).
+//!
+//! Time: an input over [`case_secs`] (10 s by default, `VOLTEX_FUZZ_CASE_SECS`) of its thread's
+//! CPU time fails the target when it returns; the GPU targets, whose work runs in the driver's
+//! threads, have three times the bound in wall time. One still running after three times its
+//! bound in wall time is a hang: a watchdog thread prints the input and aborts the test binary
+//! (a blocked read cannot be interrupted).
+//! Memory: the Rust heap a case has live at once (the counting allocator, per thread), and for
+//! the GPU targets the growth of the process's resident memory, sampled by the watchdog (the
+//! driver allocates outside Rust).
+
+use super::Tracked;
+use proptest::prelude::*;
+use proptest::test_runner::{RngAlgorithm, TestCaseError, TestRng, TestRunner};
+use std::cell::Cell;
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+
+/// Memory bounds of one input.
+#[derive(Debug, Clone, Copy)]
+pub struct Bounds {
+    /// Most bytes of Rust heap one case may have live at once.
+    pub heap: usize,
+    /// Most growth of the process's resident memory during one case; `None`: not sampled.
+    pub rss: Option<u64>,
+}
+
+const MIB: usize = 1 << 20;
+
+/// Inputs of a few KiB: a case has no reason to allocate more than this.
+pub const SMALL: Bounds = Bounds { heap: 256 * MIB, rss: None };
+/// Inputs that are large by design (counts near the budgets): the issue's bound of 1 GiB.
+pub const LARGE: Bounds = Bounds { heap: 1024 * MIB, rss: None };
+/// Renders: 1 GiB of Rust heap, and 1 GiB of resident memory (the driver's allocations).
+pub const GPU: Bounds = Bounds { heap: 1024 * MIB, rss: Some(1 << 30) };
+
+thread_local! {
+    /// Inputs of the running target that got through every stage without an error.
+    static ACCEPTED: Cell<u64> = const { Cell::new(0) };
+}
+
+/// Counts the input as accepted (a target's test returns this after every stage passed).
+pub fn accepted() -> Result<(), String> {
+    ACCEPTED.with(|a| a.set(a.get() + 1));
+    Ok(())
+}
+
+fn env<T: std::str::FromStr>(name: &str) -> Option<T> {
+    std::env::var(name).ok().and_then(|v| v.parse().ok())
+}
+
+/// Seconds one input may take (`VOLTEX_FUZZ_CASE_SECS`, default 10).
+pub fn case_secs() -> f64 {
+    env("VOLTEX_FUZZ_CASE_SECS").unwrap_or(10.0)
+}
+
+/// CPU time of the calling thread, in seconds: the work of a case whatever the machine's load.
+pub fn thread_cpu() -> f64 {
+    let mut t = libc::timespec { tv_sec: 0, tv_nsec: 0 };
+    // SAFETY: a valid timespec to fill.
+    unsafe { libc::clock_gettime(libc::CLOCK_THREAD_CPUTIME_ID, &mut t) };
+    t.tv_sec as f64 + t.tv_nsec as f64 * 1e-9
+}
+
+/// The process's resident memory in bytes (Linux; 0 elsewhere).
+pub fn rss() -> u64 {
+    let statm = std::fs::read_to_string("/proc/self/statm").unwrap_or_default();
+    let pages: u64 = statm.split_whitespace().nth(1).and_then(|p| p.parse().ok()).unwrap_or(0);
+    pages * 4096
+}
+
+/// What the watchdog knows of the running case.
+#[derive(Default)]
+struct Watch {
+    /// Start of the running case and its input (`Debug`, shortened).
+    case: Option<(Instant, String)>,
+    rss_start: u64,
+    rss_peak: u64,
+    stop: bool,
+}
+
+/// Clears the running case when it ends, also by a panic.
+struct CaseGuard<'a>(&'a Mutex<Watch>);
+
+impl Drop for CaseGuard<'_> {
+    fn drop(&mut self) {
+        self.0.lock().unwrap().case = None;
+    }
+}
+
+fn watchdog(
+    name: String,
+    watch: Arc<Mutex<Watch>>,
+    sample_rss: bool,
+    limit: f64,
+) -> std::thread::JoinHandle<()> {
+    let hang = Duration::from_secs_f64(3.0 * limit);
+    std::thread::spawn(move || loop {
+        std::thread::sleep(Duration::from_millis(if sample_rss { 20 } else { 200 }));
+        let mut w = watch.lock().unwrap();
+        if w.stop {
+            return;
+        }
+        if sample_rss && w.case.is_some() {
+            w.rss_peak = w.rss_peak.max(rss());
+        }
+        if let Some((start, input)) = &w.case {
+            if start.elapsed() > hang {
+                eprintln!(
+                    "fuzz {name}: an input still runs after {:.0} s (a hang; the bound is {limit} s), aborting: {input}",
+                    start.elapsed().as_secs_f64(),
+                );
+                std::process::abort();
+            }
+        }
+    })
+}
+
+fn shorten(mut s: String, max: usize) -> String {
+    if s.len() > max {
+        let mut cut = max;
+        while !s.is_char_boundary(cut) {
+            cut -= 1;
+        }
+        s.truncate(cut);
+        s += "…";
+    }
+    s
+}
+
+/// Runs `test` on `cases` inputs of `strategy` (`VOLTEX_FUZZ_CASES` overrides `default_cases`;
+/// `VOLTEX_FUZZ_SEED` picks the seed, default 0) within `bounds`; proptest shrinks a failure.
+/// Prints the inputs tried and accepted, the slowest input, the largest heap and resident
+/// memory of one input, and the target's wall time.
+pub fn fuzz<S: Strategy>(
+    name: &str,
+    default_cases: u32,
+    bounds: Bounds,
+    strategy: S,
+    test: impl Fn(S::Value) -> Result<(), String>,
+) where
+    S::Value: std::fmt::Debug,
+{
+    let cases = env("VOLTEX_FUZZ_CASES").unwrap_or(default_cases);
+    let seed: u64 = env("VOLTEX_FUZZ_SEED").unwrap_or(0);
+    let config = ProptestConfig {
+        cases,
+        failure_persistence: None,
+        max_shrink_iters: 4096,
+        // Shrinking a slow input runs it again and again: two minutes, then the input as it is.
+        max_shrink_time: 120_000,
+        ..ProptestConfig::default()
+    };
+    let mut seed_bytes = [0u8; 32];
+    seed_bytes[..8].copy_from_slice(&seed.to_le_bytes());
+    let rng = TestRng::from_seed(RngAlgorithm::ChaCha, &seed_bytes);
+    let mut runner = TestRunner::new_with_rng(config, rng);
+    let rss_text = |grew: u64| match bounds.rss {
+        Some(_) => format!(", resident +{} MiB", grew >> 20),
+        None => String::new(),
+    };
+    let watch = Arc::new(Mutex::new(Watch::default()));
+    // GPU targets: wall time, and three times the bound (llvmpipe shares the machine's cores).
+    let limit = if bounds.rss.is_some() { 3.0 * case_secs() } else { case_secs() };
+    let dog = watchdog(name.to_string(), watch.clone(), bounds.rss.is_some(), limit);
+    let (tried, slowest, heap_peak, rss_peak) =
+        (Cell::new(0u64), Cell::new(0f64), Cell::new(0usize), Cell::new(0u64));
+    let start = Instant::now();
+    let last_report = Cell::new(start);
+    let accepted_before = ACCEPTED.with(Cell::get);
+    let result = runner.run(&strategy, |value| {
+        tried.set(tried.get() + 1);
+        // A long campaign's progress, once a minute (its figures if it is stopped).
+        if last_report.get().elapsed() > Duration::from_secs(60) {
+            last_report.set(Instant::now());
+            eprintln!(
+                "fuzz {name}: {} inputs so far, {} accepted, {:.0} s; slowest input {:.2} s, largest heap {} MiB{}",
+                tried.get() - 1,
+                ACCEPTED.with(Cell::get) - accepted_before,
+                start.elapsed().as_secs_f64(),
+                slowest.get(),
+                heap_peak.get() >> 20,
+                rss_text(rss_peak.get()),
+            );
+        }
+        let input = shorten(format!("{value:?}"), 2000);
+        {
+            let mut w = watch.lock().unwrap();
+            w.rss_start = if bounds.rss.is_some() { rss() } else { 0 };
+            w.rss_peak = w.rss_start;
+            w.case = Some((Instant::now(), input.clone()));
+        }
+        let guard = CaseGuard(&watch);
+        let (wall, cpu) = (Instant::now(), thread_cpu());
+        let heap_start = Tracked::begin_case();
+        let outcome = test(value);
+        let heap = Tracked::peak_since(heap_start);
+        // GPU targets: the driver works in threads of its own, so wall time; else the thread's
+        // CPU time, which a loaded machine does not inflate.
+        let secs = match bounds.rss {
+            Some(_) => wall.elapsed().as_secs_f64(),
+            None => thread_cpu() - cpu,
+        };
+        let grew = match bounds.rss {
+            Some(_) => {
+                let w = watch.lock().unwrap();
+                w.rss_peak.max(rss()).saturating_sub(w.rss_start)
+            }
+            None => 0,
+        };
+        drop(guard);
+        slowest.set(slowest.get().max(secs));
+        heap_peak.set(heap_peak.get().max(heap));
+        rss_peak.set(rss_peak.get().max(grew));
+        outcome.map_err(TestCaseError::fail)?;
+        if secs > limit {
+            return Err(TestCaseError::fail(format!("took {secs:.1} s, over the bound of {limit} s")));
+        }
+        if heap > bounds.heap {
+            let msg =
+                format!("allocated {} MiB at once, over the bound of {} MiB", heap >> 20, bounds.heap >> 20);
+            return Err(TestCaseError::fail(msg));
+        }
+        if let Some(max) = bounds.rss.filter(|&m| grew > m) {
+            let msg =
+                format!("resident memory grew by {} MiB, over the bound of {} MiB", grew >> 20, max >> 20);
+            return Err(TestCaseError::fail(msg));
+        }
+        Ok(())
+    });
+    watch.lock().unwrap().stop = true;
+    dog.join().unwrap();
+    eprintln!(
+        "fuzz {name}: {} inputs tried, {} accepted (seed {seed}, {cases} cases asked, {:.1} s; slowest input \
+         {:.2} s, largest heap {} MiB{})",
+        tried.get(),
+        ACCEPTED.with(Cell::get) - accepted_before,
+        start.elapsed().as_secs_f64(),
+        slowest.get(),
+        heap_peak.get() >> 20,
+        rss_text(rss_peak.get()),
+    );
+    if let Err(e) = result {
+        panic!("fuzz {name}: {e}");
+    }
+}

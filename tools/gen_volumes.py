@@ -1,0 +1,189 @@
+#!/usr/bin/env python3
+"""Writes the OpenVDB files of scenes/volumes/ and the bad inputs of tests/vdb/ with the OpenVDB
+library itself (version 12, as bundled by Blender's `bpy` wheel), so that voltex reads files as
+Houdini, Blender and EmberGen write them. Nothing is downloaded but the wheel.
+
+    python3 -m venv /tmp/bpy && /tmp/bpy/bin/pip install bpy numpy
+    /tmp/bpy/bin/python tools/gen_volumes.py
+
+Conventions (OpenVDB's): voxel (i, j, k) sits at index point (i, j, k), mapped to world space by
+the grid's transform; a fog volume's values are densities (0 = empty, the background); a level
+set stores signed distances in world units (negative inside), active in a narrow band.
+`copyFromArray` reads the array's raw buffer: arrays are made C-contiguous with index [i, j, k].
+"""
+
+import glob
+import os
+import sys
+
+import numpy as np
+
+here = os.path.dirname(os.path.abspath(__file__))
+root = os.path.dirname(here)
+# bpy bundles the openvdb module in its own Python tree.
+for p in glob.glob(os.path.join(sys.prefix, "lib/python3*/site-packages/bpy/*/python/lib/python3*/site-packages")):
+    sys.path.insert(0, p)
+import openvdb as vdb  # noqa: E402
+
+SCENES = os.path.join(root, "scenes", "volumes")
+BAD = os.path.join(root, "tests", "vdb")
+
+
+def transform(voxel, origin=(0.0, 0.0, 0.0)):
+    """Uniform voxel size `voxel`; index (0, 0, 0) at world `origin`."""
+    t = vdb.createLinearTransform(voxelSize=voxel)
+    t.postTranslate(origin)
+    return t
+
+
+def fog(name, array, t, tolerance=0.0, half=False):
+    """A fog volume from a C-contiguous float array indexed [i, j, k] (voxel (0, 0, 0) first)."""
+    g = vdb.FloatGrid()
+    g.copyFromArray(np.ascontiguousarray(array, dtype=np.float32), tolerance=tolerance)
+    g.name = name
+    g.transform = t
+    g.gridClass = vdb.GridClass.FOG_VOLUME
+    g.saveFloatAsHalf = half
+    return g
+
+
+def color(name, rgb, t, half=True):
+    """A vec3 grid (Houdini's `Cd`) from an array [i, j, k, 3]."""
+    g = vdb.Vec3SGrid()
+    g.copyFromArray(np.ascontiguousarray(rgb, dtype=np.float32))
+    g.name = name
+    g.transform = t
+    g.saveFloatAsHalf = half
+    return g
+
+
+def grid_coords(n):
+    """Index coordinates of an n^3 block, each in [-1, 1] at the block's faces."""
+    i = (np.arange(n) + 0.5) / n * 2.0 - 1.0
+    return np.meshgrid(i, i, i, indexing="ij")
+
+
+def blob(n, seed):
+    """A soft noisy blob: density in [0, 1], 0 beyond the unit ball."""
+    x, y, z = grid_coords(n)
+    r = np.sqrt(x * x + y * y + z * z)
+    rng = np.random.default_rng(seed)
+    wobble = sum(
+        a * np.sin(f[0] * x + f[1] * y + f[2] * z + p)
+        for a, f, p in [(0.12, rng.normal(0, 4, 3), rng.uniform(0, 6.3)) for _ in range(4)]
+    )
+    d = np.clip(1.0 - (r + wobble) / 0.8, 0.0, 1.0)
+    return np.where(r < 0.95, d, 0.0) ** 0.7
+
+
+def write(path, grids):
+    os.makedirs(os.path.dirname(path), exist_ok=True)
+    vdb.write(path, grids=grids)
+    print(f"{os.path.relpath(path, root)}: {os.path.getsize(path)} bytes, grids "
+          + ", ".join(f"{g.name} ({g.valueTypeName}, {g.activeVoxelCount()} active)" for g in grids))
+
+
+def examples():
+    # The analytic case: a 16^3 box of constant density 1 (tiles after pruning), voxel 1/16,
+    # centred on the origin: index (0, 0, 0) at -15/32, so voxel centres lie at the cells of
+    # [-1/2, 1/2]^3 (cell-centred data on a unit cube needs the half-voxel translation).
+    n = 16
+    box_t = transform(1.0 / n, (-0.5 + 0.5 / n,) * 3)
+    box = fog("density", np.ones((n, n, n)), box_t, tolerance=1e-6)  # eight 8^3 tiles, no leaves
+    # A second, non-constant analytic density on the same box: 0.25 + 1.5 x' (x' in [0, 1]
+    # along i at the voxel centres), linear, so its trilinear interpolant is exact.
+    ramp = 0.25 + 1.5 * (np.arange(n) + 0.5)[:, None, None] / n * np.ones((1, n, n))
+    write(os.path.join(SCENES, "box.vdb"), [box, fog("ramp", ramp, box_t)])
+
+    # A fog blob with Houdini's `Cd`: 32^3 voxels of 1/16 (half-precision colour).
+    n = 32
+    t = transform(1.0 / 16, (-1.0 + 0.5 / 16,) * 3)
+    d = blob(n, 3)
+    x, y, z = grid_coords(n)
+    rgb = np.stack([0.6 + 0.4 * x, 0.55 + 0.35 * z, 0.9 - 0.5 * (x + 1) / 2], axis=-1)
+    write(os.path.join(SCENES, "smoke.vdb"), [fog("density", d, t, tolerance=1e-4), color("Cd", rgb * (d > 0)[..., None], t)])
+
+    # A narrow-band level set: a sphere of radius 0.8, voxel 0.08, half width 3 voxels.
+    ls = vdb.createLevelSetSphere(radius=0.8, center=(0.0, 0.0, 0.0), voxelSize=0.08, halfWidth=3.0)
+    ls.name = "surface"
+    ls.saveFloatAsHalf = True
+    write(os.path.join(SCENES, "sphere_level_set.vdb"), [ls])
+
+    # Several grids in one file: density, temperature and Cd (chosen by name in the scene).
+    n = 24
+    t = transform(1.0 / 12, (-1.0 + 0.5 / 12,) * 3)
+    d = blob(n, 7)
+    x, y, z = grid_coords(n)
+    temperature = np.clip(d * (1.0 - z) * 0.8, 0, None)
+    rgb = np.stack([np.ones_like(x), 0.3 + 0.35 * (z + 1), 0.2 + 0.2 * (y + 1)], axis=-1)
+    write(os.path.join(SCENES, "several_grids.vdb"), [
+        fog("density", d, t, tolerance=1e-4),
+        fog("temperature", temperature, t, tolerance=1e-4),
+        color("Cd", rgb * (d > 0)[..., None], t),
+    ])
+
+    # The sparse case: two 16^3 blobs 1000 voxels apart along the diagonal (a dense grid over
+    # their bounds would be 1016^3 voxels). Both blobs into one grid through an accessor.
+    g = fog("density", blob(16, 11), transform(0.01))
+    other = fog("density", blob(16, 12), transform(0.01))
+    acc = g.getAccessor()
+    for (i, j, k), v in _active(other):
+        acc.setValueOn((i + 1000, j + 1000, k + 1000), v)
+    write(os.path.join(SCENES, "far_apart.vdb"), [g])
+
+    # A half-precision fog (`saveFloatAsHalf`), rotated and scaled: an AffineMap transform.
+    n = 24
+    t = vdb.createLinearTransform(voxelSize=1.0 / 12)
+    t.postRotate(0.5, vdb.Axis.Z)
+    t.postTranslate((0.2, -0.1, 0.0))
+    write(os.path.join(SCENES, "half_rotated.vdb"), [fog("density", blob(n, 5), t, tolerance=1e-4, half=True)])
+
+
+def _active(grid):
+    for it in grid.citerOnValues():
+        if it.count == 1:
+            yield it.min, it.value
+        else:  # a tile: every voxel of it
+            lo, hi = it.min, it.max
+            for i in range(lo[0], hi[0] + 1):
+                for j in range(lo[1], hi[1] + 1):
+                    for k in range(lo[2], hi[2] + 1):
+                        yield (i, j, k), it.value
+
+
+def bad():
+    t = transform(0.1)
+    small = np.zeros((8, 8, 8), dtype=np.float32)
+    small[2:6, 2:6, 2:6] = 1.0
+    ints = vdb.Int32Grid()
+    ints.copyFromArray(np.ascontiguousarray(small.astype(np.int32)))
+    ints.name = "density"
+    write(os.path.join(BAD, "int.vdb"), [ints])
+    bools = vdb.BoolGrid()
+    bools.copyFromArray(np.ascontiguousarray(small > 0))
+    bools.name = "density"
+    write(os.path.join(BAD, "bool.vdb"), [bools])
+    points = vdb.PointDataGrid()
+    points.name = "points"
+    write(os.path.join(BAD, "points.vdb"), [points])
+    nan = fog("density", small, t)
+    nan.getAccessor().setValueOn((3, 3, 3), float("nan"))
+    write(os.path.join(BAD, "nan.vdb"), [nan])
+    empty = vdb.FloatGrid()
+    empty.name = "density"
+    write(os.path.join(BAD, "empty.vdb"), [empty])
+    # Absurd index extents: two voxels 2^30 apart on every axis.
+    far = vdb.FloatGrid()
+    far.name = "density"
+    acc = far.getAccessor()
+    acc.setValueOn((-(1 << 29), -(1 << 29), -(1 << 29)), 1.0)
+    acc.setValueOn(((1 << 29), (1 << 29), (1 << 29)), 1.0)
+    write(os.path.join(BAD, "absurd_extents.vdb"), [far])
+    # A frustum transform (nonlinear: voltex reads linear transforms only).
+    frustum = fog("density", small, vdb.createFrustumTransform(xyzMin=(0, 0, 0), xyzMax=(8, 8, 8), taper=0.5, depth=1.0))
+    write(os.path.join(BAD, "frustum.vdb"), [frustum])
+
+
+if __name__ == "__main__":
+    examples()
+    bad()
