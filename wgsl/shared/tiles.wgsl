@@ -42,22 +42,26 @@ fn tile_range(t: TileTriangle, tiles: vec2<u32>, size: vec2<f32>) -> vec4<u32> {
     return vec4<u32>(p0 / TILE_SIZE, min(p1 / TILE_SIZE, tiles - 1u));
 }
 
-// Edge function of a -> b at p, computed with the endpoints in a canonical order so that the two
-// triangles sharing an edge get exactly opposite values. x: the value; y: +1 when the canonical
-// order is a -> b, else -1.
+// Edge function of a -> b at p ((b - a) x (p - a), positive on its left in y-down pixels),
+// computed with the endpoints in a canonical order so that the two triangles sharing an edge get
+// exactly opposite values. x: the value; y: +1 when its positive side owns pixel centres on the
+// edge by the rasteriser's top-left rule (the side's inward normal points right, or straight
+// down for a horizontal edge), else -1.
 fn tile_edge(a: vec2<f32>, b: vec2<f32>, p: vec2<f32>) -> vec2<f32> {
     let swap = a.y > b.y || (a.y == b.y && a.x > b.x);
     let lo = select(a, b, swap);
     let hi = select(b, a, swap);
-    let e = (p.x - lo.x) * (hi.y - lo.y) - (p.y - lo.y) * (hi.x - lo.x);
-    let s = select(1.0, -1.0, swap);
-    return vec2<f32>(e * s, s);
+    let e = (hi.x - lo.x) * (p.y - lo.y) - (hi.y - lo.y) * (p.x - lo.x);
+    // The value's gradient in p: the positive side's inward normal.
+    let g = vec2<f32>(a.y - b.y, b.x - a.x);
+    let owns = g.x > 0.0 || (g.x == 0.0 && g.y > 0.0);
+    return vec2<f32>(select(e, -e, swap), select(-1.0, 1.0, owns));
 }
 
-// Whether an edge (value and canonical sign from tile_edge) lets p in, for a triangle of
-// orientation `orient` (+1 or -1): strictly inside, or on the edge when the triangle lies on the
-// positive side of the canonical edge function, so a pixel centre on an edge shared by two
-// triangles is covered by exactly one (the one holding p + (eps, -eps^2)).
+// Whether an edge (value and tie owner from tile_edge) lets p in, for a triangle of orientation
+// `orient` (+1 or -1, the side its inside lies on): strictly inside, or on the edge when the
+// inside owns it, so a pixel centre on an edge shared by two triangles is covered by exactly one,
+// and the same one as the rasteriser's.
 fn tile_edge_inside(e: vec2<f32>, orient: f32) -> bool {
     return e.x * orient > 0.0 || (e.x == 0.0 && orient * e.y > 0.0);
 }

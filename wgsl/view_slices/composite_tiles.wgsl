@@ -5,10 +5,13 @@
 
 override per_pixel_lighting: bool = false;
 
-@group(0) @binding(0) var<uniform> frame: FrameParams;
-@group(0) @binding(1) var<uniform> object: ObjectParams;
-@group(0) @binding(2) var<uniform> slice_params: SliceParams;
-@group(0) @binding(3) var<uniform> tile_params: TileParams;
+// The parameters are read as storage, not uniforms: lavapipe (Mesa 22.3) inlines uniforms that
+// loop and branch conditions depend on, and overflows a fixed array doing it for this kernel.
+
+@group(0) @binding(0) var<storage, read> frame: FrameParams;
+@group(0) @binding(1) var<storage, read> object: ObjectParams;
+@group(0) @binding(2) var<storage, read> slice_params: SliceParams;
+@group(0) @binding(3) var<storage, read> tile_params: TileParams;
 @group(0) @binding(4) var<storage, read> slice_vertices: array<SliceVertex>;
 @group(0) @binding(5) var<storage, read> prisms: array<Prism>;
 @group(0) @binding(6) var<storage, read> shell_vertices: array<ShellVertex>;

@@ -74,13 +74,15 @@ pub fn tile_range(t: &TileTriangle, tiles: [u32; 2], size: [f32; 2]) -> Option<[
     Some([p0[0], p0[1], p1[0], p1[1]])
 }
 
-/// Edge function of `a -> b` at `p` with the endpoints in canonical order: (value, +1 or -1).
+/// Edge function of `a -> b` at `p` with the endpoints in canonical order: (value, +1 when its
+/// positive side owns pixel centres on the edge by the top-left rule, else -1).
 pub fn tile_edge(a: [f32; 2], b: [f32; 2], p: [f32; 2]) -> (f32, f32) {
     let swap = a[1] > b[1] || (a[1] == b[1] && a[0] > b[0]);
     let (lo, hi) = if swap { (b, a) } else { (a, b) };
-    let e = (p[0] - lo[0]) * (hi[1] - lo[1]) - (p[1] - lo[1]) * (hi[0] - lo[0]);
-    let s = if swap { -1.0 } else { 1.0 };
-    (e * s, s)
+    let e = (hi[0] - lo[0]) * (p[1] - lo[1]) - (hi[1] - lo[1]) * (p[0] - lo[0]);
+    let g = [a[1] - b[1], b[0] - a[0]];
+    let owns = g[0] > 0.0 || (g[0] == 0.0 && g[1] > 0.0);
+    (if swap { -e } else { e }, if owns { 1.0 } else { -1.0 })
 }
 
 fn tile_edge_inside(e: (f32, f32), orient: f32) -> bool {
