@@ -127,8 +127,7 @@ mod tests {
 
     #[test]
     fn keys_edit_the_method_in_place() {
-        let v =
-            Method::ViewSlices(ViewSlices {
+        let v = Method::ViewSlices(ViewSlices {
             planes: 24,
             trivial_reject: true,
             lighting: Default::default(),

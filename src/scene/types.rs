@@ -807,7 +807,7 @@ pub enum Compositor {
     /// Indirect draws of the slice triangles, back to front, premultiplied-over blending.
     #[default]
     Raster,
-    /// Compute: the slice triangles binned into 16 x 16 pixel tiles, each pixel's fragments
+    /// Compute: the slice triangles binned into 8 x 8 pixel tiles, each pixel's fragments
     /// composited front to back in registers, stopping once opaque; the layer blended once.
     Tiles,
 }

@@ -520,9 +520,8 @@ mod fuzz_regressions {
         let opts =
             RenderOptions { method: Some(voltex::render::MethodKind::Reference), ..Default::default() };
         let limits = voltex::gpu::budget::plan_limits();
-        let e = Blueprint::new(&scene, &opts)
-            .and_then(|bp| bp.check_limits(&limits, "x"))
-            .expect_err("an error");
+        let e =
+            Blueprint::new(&scene, &opts).and_then(|bp| bp.check_limits(&limits, "x")).expect_err("an error");
         let line = text[..text.find("name: \"box\"").unwrap()].matches('\n').count() + 1;
         let e = e.to_string();
         assert!(e.starts_with(&format!("{}:{line}:", path.display())), "{e}");

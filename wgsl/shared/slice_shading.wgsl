@@ -1,6 +1,6 @@
 // One slice fragment as draw_slices and composite_tiles shade it: the texel at level 0, the
 // step-corrected opacity, baked or per-pixel (Phong) lighting; premultiplied. The including
-// kernel declares `frame`, `object`, `slice_params`, `volume`, `normals`, `volume_sampler`,
+// kernel declares `frame`, `slice_params`, `volume`, `normals`, `volume_sampler`,
 // `prisms`, `shell_vertices`, `vertex_frames` and the override `per_pixel_lighting`.
 #include "shared/shading.wgsl"
 #include "shared/barycentrics.wgsl"
@@ -33,19 +33,24 @@ fn slice_vertex_frame(v: SliceVertex) -> SliceFrame {
     return SliceFrame(cross(dt, dw) * sign_j, cross(dw, ds) * sign_j, cross(ds, dt) * sign_j);
 }
 
-// The premultiplied colour and opacity of a fragment at texel coordinates `uvw` and
-// camera-relative position `rel`, with the interpolated frame `f` (per-pixel lighting only).
-fn slice_fragment(uvw: vec3<f32>, rel: vec3<f32>, f: SliceFrame) -> vec4<f32> {
+// The exponent of the step correction for a fragment seen along the unit `ray` (camera to
+// fragment): this pixel's world length between two planes, spacing / cos(angle to the view
+// axis), over the texel's opacity length. The same for every fragment of a pixel.
+fn slice_exponent(ray: vec3<f32>, opacity_length: f32) -> f32 {
+    let step = slice_params.spacing / max(dot(ray, frame.forward.xyz), 1e-4);
+    return step / opacity_length;
+}
+
+// The premultiplied colour and opacity of a fragment at texel coordinates `uvw` along the unit
+// `ray`, with step-correction `exponent` and the interpolated frame `f` (per-pixel lighting only).
+fn slice_fragment(uvw: vec3<f32>, ray: vec3<f32>, exponent: f32, f: SliceFrame) -> vec4<f32> {
     // Level 0, as the Reference samples it. Mipmaps chosen by the sampler's implicit level cost
     // accuracy (a 3D mip also blurs along w, the shell's height profile) and depend on the adapter:
     // on torus_egg at 128x128 they doubled the FLIP against a 4x4-supersampled Reference (0.131
     // against 0.062) and differed by 0.029 between llvmpipe and an NVIDIA H100.
     let texel = textureSampleLevel(volume, volume_sampler, uvw, 0.0);
-    // World length of this pixel's ray between two planes: spacing / cos(angle to the view axis).
-    let ray = normalize(rel);
-    let step = slice_params.spacing / max(dot(ray, frame.forward.xyz), 1e-4);
     let a = clamp(texel.a, 0.0, 1.0);
-    let corrected = 1.0 - pow(1.0 - min(a, 0.999999), step / object.opacity_length);
+    let corrected = 1.0 - pow(1.0 - min(a, 0.999999), exponent);
     var rgb = texel.rgb * select(0.0, corrected / a, a > 1e-6);
     if per_pixel_lighting {
         let tex_normal = textureSampleLevel(normals, volume_sampler, uvw, 0.0).xyz;

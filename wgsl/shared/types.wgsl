@@ -48,12 +48,26 @@ struct TileParams {
     _pad1: u32,
 }
 
-// One slice triangle in pixels, its plane's depth and its plane (TileTriangle in src/types.rs).
+// One slice triangle binned into tiles (TileTriangle in src/types.rs): its edges oriented so
+// its inside is positive (x, y, constant; w = 1 when the inside owns centres on the edge), its
+// inclusive tile range, its plane's depth and its plane.
 struct TileTriangle {
-    xy01: vec4<f32>,
-    xy2: vec2<f32>,
+    e0: vec4<f32>,
+    e1: vec4<f32>,
+    e2: vec4<f32>,
+    tiles: vec4<u32>,
     depth: f32,
     plane: u32,
+    _pad0: u32,
+    _pad1: u32,
+}
+
+// Texel coordinates over a binned triangle (TileAttributes in src/types.rs): at corner a (xyz)
+// with a's pixel x (w), their steps per pixel in x (xyz) with a's pixel y (w), and in y.
+struct TileAttributes {
+    at_a: vec4<f32>,
+    d_x: vec4<f32>,
+    d_y: vec4<f32>,
 }
 
 struct FrameParams {

@@ -1,4 +1,4 @@
-// Composites each pixel's slice fragments front to back in registers, a workgroup per 16 x 16 tile, stopping once opaque: a premultiplied layer.
+// Composites each pixel's slice fragments front to back in registers, a workgroup per tile, stopping once opaque: a premultiplied layer.
 #include "shared/types.wgsl"
 #include "shared/tiles.wgsl"
 #include "shared/slice_shading.wgsl"
@@ -27,73 +27,49 @@ override per_pixel_lighting: bool = false;
 @group(0) @binding(15) var<storage, read> tile_entries: array<u32>;
 // Depth of the opaque surfaces drawn before (base surfaces, binary axis slices).
 @group(0) @binding(16) var depth: texture_depth_2d;
-@group(0) @binding(17) var<storage, read_write> tile_layer: array<vec4<f32>>;
+@group(0) @binding(17) var<storage, read> tile_attributes: array<TileAttributes>;
+@group(0) @binding(18) var<storage, read_write> tile_layer: array<vec4<f32>>;
 
 // A pixel stops once less than this of what lies behind shows through (as the Reference does).
 const MIN_TRANSMITTANCE: f32 = 1e-4;
 
-var<workgroup> live_count: atomic<u32>;
-var<workgroup> live_pixels: u32;
-
-// The premultiplied fragment of triangle t at pixel centre p (barycentrics `bary`).
-fn tile_fragment(t: u32, bary: vec3<f32>) -> vec4<f32> {
-    let a = slice_vertices[3u * t];
-    let b = slice_vertices[3u * t + 1u];
-    let c = slice_vertices[3u * t + 2u];
-    let uvw = bary.x * a.uvw.xyz + bary.y * b.uvw.xyz + bary.z * c.uvw.xyz;
-    let rel = bary.x * a.position.xyz + bary.y * b.position.xyz + bary.z * c.position.xyz;
-    var f = SliceFrame(vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0));
-    if per_pixel_lighting {
-        let fa = slice_vertex_frame(a);
-        let fb = slice_vertex_frame(b);
-        let fc = slice_vertex_frame(c);
-        f = SliceFrame(
-            bary.x * fa.n_s + bary.y * fb.n_s + bary.z * fc.n_s,
-            bary.x * fa.n_t + bary.y * fb.n_t + bary.z * fc.n_t,
-            bary.x * fa.n_w + bary.y * fb.n_w + bary.z * fc.n_w,
-        );
-    }
-    return slice_fragment(uvw, rel, f);
+// The interpolation frame of triangle t at barycentrics `bary` (per-pixel lighting).
+fn tile_frame(t: u32, bary: vec3<f32>) -> SliceFrame {
+    let fa = slice_vertex_frame(slice_vertices[3u * t]);
+    let fb = slice_vertex_frame(slice_vertices[3u * t + 1u]);
+    let fc = slice_vertex_frame(slice_vertices[3u * t + 2u]);
+    return SliceFrame(
+        bary.x * fa.n_s + bary.y * fb.n_s + bary.z * fc.n_s,
+        bary.x * fa.n_t + bary.y * fb.n_t + bary.z * fc.n_t,
+        bary.x * fa.n_w + bary.y * fb.n_w + bary.z * fc.n_w,
+    );
 }
 
-@compute @workgroup_size(16, 16)
-fn main(
-    @builtin(workgroup_id) group: vec3<u32>,
-    @builtin(local_invocation_id) local: vec3<u32>,
-    @builtin(local_invocation_index) lid: u32,
-) {
+// One workgroup per tile, one invocation per pixel. No barrier: a pixel (on a CPU adapter, a
+// SIMD row of pixels) stops on its own once opaque.
+@compute @workgroup_size(TILE_SIZE, TILE_SIZE)
+fn main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_id) local: vec3<u32>) {
     let pixel = group.xy * TILE_SIZE + local.xy;
     let inside = pixel.x < tile_params.width && pixel.y < tile_params.height;
     let p = vec2<f32>(pixel) + 0.5;
     let tile = group.y * tile_params.tiles_x + group.x;
     let blocks = tile_params.blocks;
     let capacity = min(tile_params.entry_capacity, arrayLength(&tile_entries));
+    let opacity_length = object.opacity_length;
     var behind = 1.0;
     if (inside) {
         behind = textureLoad(depth, vec2<i32>(pixel), 0);
     }
     var rgb = vec3<f32>(0.0);
     var transmittance = select(0.0, 1.0, inside);
+    // This pixel's ray and step correction, from its first fragment (the same for all).
+    var ray = vec3<f32>(0.0, 0.0, 1.0);
+    var exponent = -1.0;
     // Per plane of the block: the triangle covering this pixel (one at most: the slices of one
     // plane do not overlap), so the list's order within a segment does not matter.
     var slots: array<u32, TILE_PLANES>;
-    for (var b = blocks; b > 0u; b--) {
+    for (var b = blocks; b > 0u && transmittance > MIN_TRANSMITTANCE; b--) {
         let block = b - 1u;
-        // The whole tile stops once every pixel is opaque.
-        if (lid == 0u) {
-            atomicStore(&live_count, 0u);
-        }
-        workgroupBarrier();
-        if (transmittance > MIN_TRANSMITTANCE) {
-            atomicAdd(&live_count, 1u);
-        }
-        workgroupBarrier();
-        if (lid == 0u) {
-            live_pixels = atomicLoad(&live_count);
-        }
-        if (workgroupUniformLoad(&live_pixels) == 0u) {
-            break;
-        }
         for (var s = 0u; s < TILE_PLANES; s++) {
             slots[s] = NO_TRIANGLE;
         }
@@ -121,20 +97,38 @@ fn main(
                 }
             }
         }
-        // Front to back: higher planes are nearer.
-        for (var s = TILE_PLANES; s > 0u && transmittance > MIN_TRANSMITTANCE; s--) {
-            let t = slots[s - 1u];
-            if (t == NO_TRIANGLE) {
-                continue;
+        // Front to back (higher planes are nearer), one fragment per iteration: each pixel skips
+        // its empty slots first, so a SIMD row shades as often as its busiest pixel has
+        // fragments, not once per plane any of its pixels has one.
+        var s = TILE_PLANES;
+        loop {
+            while (s > 0u && slots[s - 1u] == NO_TRIANGLE) {
+                s--;
             }
-            let tri = tile_triangles[t];
+            if (s == 0u || transmittance <= MIN_TRANSMITTANCE) {
+                break;
+            }
+            s--;
+            let t = slots[s];
             // The rasteriser's depth test (Less) against the opaque surfaces.
-            if (!(tri.depth < behind)) {
+            if (!(tile_triangles[t].depth < behind)) {
                 continue;
             }
-            let f = tile_fragment(t, tile_cover(tri, p));
-            rgb += transmittance * f.rgb;
-            transmittance *= 1.0 - f.a;
+            var f = SliceFrame(vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0));
+            if (exponent < 0.0 || per_pixel_lighting) {
+                let bary = tile_cover(tile_triangles[t], p);
+                let rel = bary.x * slice_vertices[3u * t].position.xyz
+                    + bary.y * slice_vertices[3u * t + 1u].position.xyz
+                    + bary.z * slice_vertices[3u * t + 2u].position.xyz;
+                ray = normalize(rel);
+                exponent = slice_exponent(ray, opacity_length);
+                if per_pixel_lighting {
+                    f = tile_frame(t, bary);
+                }
+            }
+            let c = slice_fragment(tile_attribute(tile_attributes[t], p), ray, exponent, f);
+            rgb += transmittance * c.rgb;
+            transmittance *= 1.0 - c.a;
         }
     }
     if (inside) {

@@ -44,5 +44,6 @@ fn vs_main(@builtin(vertex_index) index: u32) -> VsOut {
 
 @fragment
 fn fs_main(in: VsOut) -> @location(0) vec4<f32> {
-    return slice_fragment(in.uvw, in.rel, SliceFrame(in.n_s, in.n_t, in.n_w));
+    let ray = normalize(in.rel);
+    return slice_fragment(in.uvw, ray, slice_exponent(ray, object.opacity_length), SliceFrame(in.n_s, in.n_t, in.n_w));
 }

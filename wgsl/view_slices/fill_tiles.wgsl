@@ -1,4 +1,4 @@
-// Appends every slice triangle to the list segment of each (tile, block of planes) its bounding box meets; entries past the capacity are dropped and their segments marked by their end.
+// Appends every slice triangle to the list segment of each (tile, block of planes) it touches; entries past the capacity are dropped and their segments marked by their end.
 #include "shared/types.wgsl"
 #include "shared/tiles.wgsl"
 
@@ -16,13 +16,15 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         return;
     }
     let tri = tile_triangles[t];
-    let size = vec2<f32>(f32(tile_params.width), f32(tile_params.height));
-    let r = tile_range(tri, vec2<u32>(tile_params.tiles_x, tile_params.tiles_y), size);
+    let r = tri.tiles;
     let block = tri.plane / TILE_PLANES;
     let entry = (t << 5u) | (tri.plane % TILE_PLANES);
     let capacity = min(tile_params.entry_capacity, arrayLength(&tile_entries));
     for (var y = r.y; y <= r.w; y++) {
         for (var x = r.x; x <= r.z; x++) {
+            if (!tile_touches(tri, x, y)) {
+                continue;
+            }
             let at = atomicAdd(&tile_cursors[(y * tile_params.tiles_x + x) * tile_params.blocks + block], 1u);
             // A segment that does not fit is composited from all its planes' triangles instead.
             if (at < capacity) {

@@ -29,6 +29,7 @@ pub const CONTRIBUTION: super::Contribution = super::Contribution {
         "vertex_frames",
         "tile_params",
         "tile_triangles",
+        "tile_attributes",
         "tile_cursors",
         "tile_entries",
         "tile_layer",

@@ -170,7 +170,7 @@ impl MethodPlan for ViewSlicesPlan {
         if tile_memory > 0 {
             let entries: u64 = self.tile_entries.iter().map(|&e| e as u64).sum();
             items.push((
-                format!("object {name}: Tiles compositor (triangles, cursors, {entries} list entries, layer)"),
+                format!("object {name}: Tiles compositor (triangles, texel coordinates, cursors, {entries} list entries, layer)"),
                 tile_memory,
             ));
         }

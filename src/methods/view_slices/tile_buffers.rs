@@ -4,7 +4,7 @@
 use super::tiles::{tile_params, MAX_TRIANGLES, TILE_SIZE};
 use crate::gpu::buffers::{uniform, work_buffer};
 use crate::mesh::shell::Shell;
-use crate::types::{SliceParams, TileParams, TileTriangle};
+use crate::types::{SliceParams, TileAttributes, TileParams, TileTriangle};
 
 /// Most bytes of tile-list entries per chunk by default: past them, segments are composited from
 /// their planes' triangles (slower, same image).
@@ -54,11 +54,14 @@ pub fn entry_capacity(bound: u64, requested: Option<u32>) -> u32 {
     requested.unwrap_or(bound.clamp(1024, MAX_ENTRY_BYTES / 4) as u32).max(1)
 }
 
-/// Bytes of each buffer the compositor adds for a chunk: triangles, cursors, entries, layer.
-pub fn tile_bytes(params: &TileParams, vertex_capacity: u64) -> [(&'static str, u64); 4] {
+/// Bytes of each buffer the compositor adds for a chunk: triangles, their texel coordinates,
+/// cursors, entries, layer.
+pub fn tile_bytes(params: &TileParams, vertex_capacity: u64) -> [(&'static str, u64); 5] {
     let segments = (params.tiles_x * params.tiles_y * params.blocks) as u64;
+    let triangles = (vertex_capacity / 3).max(1);
     [
-        ("tile_triangles", (vertex_capacity / 3).max(1) * std::mem::size_of::<TileTriangle>() as u64),
+        ("tile_triangles", triangles * std::mem::size_of::<TileTriangle>() as u64),
+        ("tile_attributes", triangles * std::mem::size_of::<TileAttributes>() as u64),
         ("tile_cursors", segments * 4),
         ("tile_entries", params.entry_capacity as u64 * 4),
         ("tile_layer", params.width as u64 * params.height as u64 * 16),

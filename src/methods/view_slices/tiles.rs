@@ -3,18 +3,19 @@
 //! `composite_tiles.wgsl`). Geometry in f32 with the same arithmetic as the WGSL, shading in f64.
 //!
 //! The slice triangles (plane by plane, back to front, as `emit_slices` wrote them) are projected
-//! to pixels and binned into 16 x 16 pixel tiles. A tile's list has one segment per block of 32
+//! to pixels and binned into the 8 x 8 pixel tiles they touch. A tile's list has one segment per block of 32
 //! planes, so a pixel walks the segments front to back; within a segment it keeps, per plane, the
 //! one triangle covering it (the slices of one plane do not overlap), so the order in which atomics
 //! filled the segment does not matter. Each pixel composites its fragments front to back in
-//! registers and stops once opaque; the tile stops once all its pixels are. A segment whose
+//! registers and stops once opaque (texel coordinates from per-triangle affine functions of the
+//! pixel, exact on a view plane). A segment whose
 //! entries did not fit the lists is composited from every triangle of its planes.
 
 use crate::methods::reference::trace_reference::Volume;
-use crate::types::{FrameParams, SliceVertex, TileParams, TileTriangle};
+use crate::types::{FrameParams, SliceVertex, TileAttributes, TileParams, TileTriangle};
 
 /// Tile side in pixels (`TILE_SIZE` in `wgsl/shared/tiles.wgsl`).
-pub const TILE_SIZE: u32 = 16;
+pub const TILE_SIZE: u32 = 8;
 /// Planes per list segment (`TILE_PLANES`): the per-pixel slots of `composite_tiles`.
 pub const TILE_PLANES: u32 = 32;
 /// Transmittance below which a pixel stops (`MIN_TRANSMITTANCE` in `composite_tiles.wgsl`).
@@ -46,60 +47,115 @@ pub fn project_to_pixels(p: [f32; 3], view_proj: &[[f32; 4]; 4], size: [f32; 2])
     [(ndc[0] * 0.5 + 0.5) * size[0], (0.5 - ndc[1] * 0.5) * size[1], ndc[2]]
 }
 
-fn corners(t: &TileTriangle) -> [[f32; 2]; 3] {
-    [[t.xy01[0], t.xy01[1]], [t.xy01[2], t.xy01[3]], t.xy2]
-}
-
-/// Twice the signed area of a projected triangle.
-pub fn tile_triangle_area(t: &TileTriangle) -> f32 {
-    let [a, b, c] = corners(t);
+/// Twice the signed area of the triangle `a b c`.
+pub fn tile_area(a: [f32; 2], b: [f32; 2], c: [f32; 2]) -> f32 {
     (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
 }
 
-/// Inclusive tile range `[x0, y0, x1, y1]` of a triangle's bounding box, `None` when it covers
-/// no pixel centre.
-pub fn tile_range(t: &TileTriangle, tiles: [u32; 2], size: [f32; 2]) -> Option<[u32; 4]> {
-    let area = tile_triangle_area(t);
-    if !(area.abs() > 0.0) {
-        return None;
-    }
-    let [a, b, c] = corners(t);
-    let lo = [a[0].min(b[0]).min(c[0]) - 0.5, a[1].min(b[1]).min(c[1]) - 0.5];
-    let hi = [a[0].max(b[0]).max(c[0]) - 0.5, a[1].max(b[1]).max(c[1]) - 0.5];
-    if !(hi[0] >= 0.0 && hi[1] >= 0.0 && lo[0] <= size[0] && lo[1] <= size[1]) {
-        return None;
-    }
-    let p0 = [0, 1].map(|i| lo[i].floor().clamp(0.0, size[i] - 1.0) as u32 / TILE_SIZE);
-    let p1 = [0, 1].map(|i| (hi[i].ceil().clamp(0.0, size[i] - 1.0) as u32 / TILE_SIZE).min(tiles[i] - 1));
-    Some([p0[0], p0[1], p1[0], p1[1]])
-}
-
-/// Edge function of `a -> b` at `p` with the endpoints in canonical order: (value, +1 when its
-/// positive side owns pixel centres on the edge by the top-left rule, else -1).
-pub fn tile_edge(a: [f32; 2], b: [f32; 2], p: [f32; 2]) -> (f32, f32) {
+/// The edge function of `a -> b` as coefficients (x, y, constant), from the endpoints in
+/// canonical order, negated if they were swapped.
+pub fn tile_edge(a: [f32; 2], b: [f32; 2]) -> [f32; 3] {
     let swap = a[1] > b[1] || (a[1] == b[1] && a[0] > b[0]);
     let (lo, hi) = if swap { (b, a) } else { (a, b) };
-    let e = (hi[0] - lo[0]) * (p[1] - lo[1]) - (hi[1] - lo[1]) * (p[0] - lo[0]);
-    let g = [a[1] - b[1], b[0] - a[0]];
-    let owns = g[0] > 0.0 || (g[0] == 0.0 && g[1] > 0.0);
-    (if swap { -e } else { e }, if owns { 1.0 } else { -1.0 })
+    let n = [lo[1] - hi[1], hi[0] - lo[0]];
+    let e = [n[0], n[1], -(n[0] * lo[0] + n[1] * lo[1])];
+    if swap {
+        e.map(|v| -v)
+    } else {
+        e
+    }
 }
 
-fn tile_edge_inside(e: (f32, f32), orient: f32) -> bool {
-    e.0 * orient > 0.0 || (e.0 == 0.0 && orient * e.1 > 0.0)
+/// The edge oriented so the inside is positive, `w` 1 when the inside owns centres on it.
+pub fn tile_oriented_edge(e: [f32; 3], orient: f32) -> [f32; 4] {
+    let n = e.map(|v| v * orient);
+    let owns = n[0] > 0.0 || (n[0] == 0.0 && n[1] > 0.0);
+    [n[0], n[1], n[2], if owns { 1.0 } else { -1.0 }]
+}
+
+/// Twin of `tile_triangle`: corners in pixels with their depth.
+pub fn tile_triangle(
+    a: [f32; 3],
+    b: [f32; 3],
+    c: [f32; 3],
+    plane: u32,
+    tiles: [u32; 2],
+    size: [f32; 2],
+) -> TileTriangle {
+    let (a2, b2, c2) = ([a[0], a[1]], [b[0], b[1]], [c[0], c[1]]);
+    let area = tile_area(a2, b2, c2);
+    let orient = if area > 0.0 { 1.0 } else { -1.0 };
+    let mut t = TileTriangle {
+        e0: tile_oriented_edge(tile_edge(b2, c2), orient),
+        e1: tile_oriented_edge(tile_edge(c2, a2), orient),
+        e2: tile_oriented_edge(tile_edge(a2, b2), orient),
+        tiles: [1, 1, 0, 0],
+        depth: (a[2] + b[2] + c[2]) / 3.0,
+        plane,
+        _pad: [0; 2],
+    };
+    let lo = [0, 1].map(|i| a[i].min(b[i]).min(c[i]) - 0.5);
+    let hi = [0, 1].map(|i| a[i].max(b[i]).max(c[i]) - 0.5);
+    if area.abs() > 0.0 && hi[0] >= 0.0 && hi[1] >= 0.0 && lo[0] <= size[0] && lo[1] <= size[1] {
+        let p0 = [0, 1].map(|i| lo[i].floor().clamp(0.0, size[i] - 1.0) as u32 / TILE_SIZE);
+        let p1 =
+            [0, 1].map(|i| (hi[i].ceil().clamp(0.0, size[i] - 1.0) as u32 / TILE_SIZE).min(tiles[i] - 1));
+        t.tiles = [p0[0], p0[1], p1[0], p1[1]];
+    }
+    t
+}
+
+fn tile_edge_touches(e: &[f32; 4], x: u32, y: u32) -> bool {
+    let lo = [(x * TILE_SIZE) as f32 + 0.5, (y * TILE_SIZE) as f32 + 0.5];
+    let hi = lo.map(|v| v + (TILE_SIZE - 1) as f32);
+    let corner = [if e[0] > 0.0 { hi[0] } else { lo[0] }, if e[1] > 0.0 { hi[1] } else { lo[1] }];
+    e[0] * corner[0] + e[1] * corner[1] + e[2] >= -(e[0].abs() + e[1].abs()) / 1024.0
+}
+
+/// Twin of `tile_touches`: whether the triangle may cover a pixel centre of tile (x, y).
+pub fn tile_touches(t: &TileTriangle, x: u32, y: u32) -> bool {
+    [&t.e0, &t.e1, &t.e2].iter().all(|e| tile_edge_touches(e, x, y))
+}
+
+/// Twin of `tile_attributes_of`: texel coordinates as an affine function of the pixel position.
+pub fn tile_attributes_of(
+    a: [f32; 2],
+    b: [f32; 2],
+    c: [f32; 2],
+    fa: [f32; 3],
+    fb: [f32; 3],
+    fc: [f32; 3],
+) -> TileAttributes {
+    let d1 = [b[0] - a[0], b[1] - a[1]];
+    let d2 = [c[0] - a[0], c[1] - a[1]];
+    let det = d1[0] * d2[1] - d1[1] * d2[0];
+    let inv = if det != 0.0 { 1.0 / det } else { 0.0 };
+    let f1: [f32; 3] = std::array::from_fn(|i| fb[i] - fa[i]);
+    let f2: [f32; 3] = std::array::from_fn(|i| fc[i] - fa[i]);
+    let dx: [f32; 3] = std::array::from_fn(|i| (f1[i] * d2[1] - f2[i] * d1[1]) * inv);
+    let dy: [f32; 3] = std::array::from_fn(|i| (f2[i] * d1[0] - f1[i] * d2[0]) * inv);
+    TileAttributes {
+        at_a: [fa[0], fa[1], fa[2], a[0]],
+        d_x: [dx[0], dx[1], dx[2], a[1]],
+        d_y: [dy[0], dy[1], dy[2], 0.0],
+    }
+}
+
+fn tile_edge_inside(e: &[f32; 4], p: [f32; 2]) -> Option<f32> {
+    let v = e[0] * p[0] + e[1] * p[1] + e[2];
+    (v > 0.0 || (v == 0.0 && e[3] > 0.0)).then_some(v)
 }
 
 /// Barycentrics of pixel centre `p` in the triangle, `None` when it is not covered.
 pub fn tile_cover(t: &TileTriangle, p: [f32; 2]) -> Option<[f32; 3]> {
-    let [a, b, c] = corners(t);
-    let area = tile_triangle_area(t);
-    let orient = if area > 0.0 { 1.0 } else { -1.0 };
-    let e = [tile_edge(b, c, p), tile_edge(c, a, p), tile_edge(a, b, p)];
-    if !(area.abs() > 0.0) || !e.iter().all(|&e| tile_edge_inside(e, orient)) {
-        return None;
-    }
-    let sum = e[0].0 + e[1].0 + e[2].0;
-    Some(e.map(|e| e.0 / sum))
+    let e = [tile_edge_inside(&t.e0, p)?, tile_edge_inside(&t.e1, p)?, tile_edge_inside(&t.e2, p)?];
+    let sum = e[0] + e[1] + e[2];
+    Some(e.map(|v| v / sum))
+}
+
+/// The tile range of a binned triangle, `None` when it covers no pixel.
+pub fn tile_range(t: &TileTriangle) -> Option<[u32; 4]> {
+    (t.tiles[0] <= t.tiles[2] && t.tiles[1] <= t.tiles[3]).then_some(t.tiles)
 }
 
 /// The plane whose vertex range (ends in `plane_ends`) holds vertex `v`.
@@ -107,40 +163,39 @@ fn plane_of(plane_ends: &[u32], v: u32) -> u32 {
     plane_ends.partition_point(|&end| end <= v) as u32
 }
 
-/// Twin of `bin_slices`: the projected triangles and the triangle count of every segment
-/// (`(tile_y * tiles_x + tile_x) * blocks + block`).
+/// Twin of `bin_slices`: the projected triangles, their texel coordinates, and the triangle count
+/// of every segment (`(tile_y * tiles_x + tile_x) * blocks + block`).
 pub fn bin_slices(
     frame: &FrameParams,
     params: &TileParams,
     vertices: &[SliceVertex],
     plane_ends: &[u32],
-) -> (Vec<TileTriangle>, Vec<u32>) {
+) -> (Vec<TileTriangle>, Vec<TileAttributes>, Vec<u32>) {
     let size = [params.width as f32, params.height as f32];
     let tiles = [params.tiles_x, params.tiles_y];
     let mut counts = vec![0u32; (params.tiles_x * params.tiles_y * params.blocks) as usize];
     let mut triangles = Vec::with_capacity(vertices.len() / 3);
+    let mut attributes = Vec::with_capacity(vertices.len() / 3);
     for (t, tri) in vertices.chunks_exact(3).enumerate() {
         let p: [[f32; 3]; 3] = std::array::from_fn(|i| {
             let v = tri[i].position;
             project_to_pixels([v[0], v[1], v[2]], &frame.view_proj, size)
         });
-        let plane = plane_of(plane_ends, 3 * t as u32);
-        let tt = TileTriangle {
-            xy01: [p[0][0], p[0][1], p[1][0], p[1][1]],
-            xy2: [p[2][0], p[2][1]],
-            depth: (p[0][2] + p[1][2] + p[2][2]) / 3.0,
-            plane,
-        };
-        if let Some(r) = tile_range(&tt, tiles, size) {
+        let plane = plane_of(plane_ends, 3 * t as u32).min(plane_ends.len().max(1) as u32 - 1);
+        let tt = tile_triangle(p[0], p[1], p[2], plane, tiles, size);
+        if let Some(r) = tile_range(&tt) {
             for y in r[1]..=r[3] {
-                for x in r[0]..=r[2] {
+                for x in (r[0]..=r[2]).filter(|&x| tile_touches(&tt, x, y)) {
                     counts[((y * params.tiles_x + x) * params.blocks + plane / TILE_PLANES) as usize] += 1;
                 }
             }
         }
         triangles.push(tt);
+        let uvw = |i: usize| [tri[i].uvw[0], tri[i].uvw[1], tri[i].uvw[2]];
+        let xy = |i: usize| [p[i][0], p[i][1]];
+        attributes.push(tile_attributes_of(xy(0), xy(1), xy(2), uvw(0), uvw(1), uvw(2)));
     }
-    (triangles, counts)
+    (triangles, attributes, counts)
 }
 
 /// Twin of `scan_tiles`: where each segment starts.
@@ -160,17 +215,15 @@ pub fn scan_tiles(counts: &[u32]) -> Vec<u32> {
 /// entries (`t << 5 | plane % 32`), each segment's in triangle order (the kernel's order within a
 /// segment depends on its atomics). Entries at or past `entry_capacity` are dropped.
 pub fn fill_tiles(params: &TileParams, triangles: &[TileTriangle], starts: &[u32]) -> (Vec<u32>, Vec<u32>) {
-    let size = [params.width as f32, params.height as f32];
-    let tiles = [params.tiles_x, params.tiles_y];
     let mut cursors = starts.to_vec();
-    let ranges: Vec<Option<[u32; 4]>> = triangles.iter().map(|t| tile_range(t, tiles, size)).collect();
+    let ranges: Vec<Option<[u32; 4]>> = triangles.iter().map(tile_range).collect();
     let area = |r: &[u32; 4]| ((r[2] - r[0] + 1) * (r[3] - r[1] + 1)) as usize;
     let total: usize = ranges.iter().flatten().map(area).sum();
     let mut entries = vec![0u32; total.min(params.entry_capacity as usize)];
     for ((t, tri), r) in triangles.iter().enumerate().zip(ranges) {
         let Some(r) = r else { continue };
         for y in r[1]..=r[3] {
-            for x in r[0]..=r[2] {
+            for x in (r[0]..=r[2]).filter(|&x| tile_touches(tri, x, y)) {
                 let seg = ((y * params.tiles_x + x) * params.blocks + tri.plane / TILE_PLANES) as usize;
                 let at = cursors[seg] as usize;
                 cursors[seg] += 1;
@@ -289,7 +342,14 @@ mod tests {
     use super::*;
 
     fn tri(a: [f32; 2], b: [f32; 2], c: [f32; 2]) -> TileTriangle {
-        TileTriangle { xy01: [a[0], a[1], b[0], b[1]], xy2: c, depth: 0.5, plane: 0 }
+        tile_triangle(
+            [a[0], a[1], 0.5],
+            [b[0], b[1], 0.5],
+            [c[0], c[1], 0.5],
+            0,
+            [40u32.div_ceil(TILE_SIZE), 24u32.div_ceil(TILE_SIZE)],
+            [40.0, 24.0],
+        )
     }
 
     /// Pixel centres on an edge or a vertex shared by triangles are covered exactly once, in
@@ -338,24 +398,25 @@ mod tests {
 
     #[test]
     fn tile_ranges_hold_every_covered_pixel() {
-        let size = [40.0, 24.0];
-        let tiles = [3, 2];
         for t in [
             tri([15.6, 3.0], [16.4, 3.0], [16.0, 20.0]),
             tri([-30.0, -5.0], [70.0, 10.0], [0.0, 60.0]),
             tri([31.5, 15.5], [32.5, 15.5], [32.0, 16.5]),
         ] {
-            let r = tile_range(&t, tiles, size).unwrap();
+            let r = tile_range(&t).unwrap();
             for y in 0..24u32 {
                 for x in 0..40u32 {
                     if tile_cover(&t, [x as f32 + 0.5, y as f32 + 0.5]).is_some() {
                         let (tx, ty) = (x / TILE_SIZE, y / TILE_SIZE);
-                        assert!(tx >= r[0] && tx <= r[2] && ty >= r[1] && ty <= r[3], "{x},{y} outside {r:?}");
+                        assert!(
+                            tx >= r[0] && tx <= r[2] && ty >= r[1] && ty <= r[3],
+                            "{x},{y} outside {r:?}"
+                        );
                     }
                 }
             }
         }
-        assert_eq!(tile_range(&tri([50.0, 1.0], [60.0, 1.0], [55.0, 9.0]), tiles, size), None);
-        assert_eq!(tile_range(&tri([1.0, 1.0], [5.0, 5.0], [9.0, 9.0]), tiles, size), None);
+        assert_eq!(tile_range(&tri([50.0, 1.0], [60.0, 1.0], [55.0, 9.0])), None);
+        assert_eq!(tile_range(&tri([1.0, 1.0], [5.0, 5.0], [9.0, 9.0])), None);
     }
 }
