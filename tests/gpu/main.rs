@@ -25,4 +25,5 @@ mod pareto;
 mod reference;
 mod regress;
 mod render_scenes;
+mod tile_compositor;
 mod volume;
