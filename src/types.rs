@@ -64,6 +64,49 @@ pub struct DrawIndirect {
     pub first_instance: u32,
 }
 
+/// Screen tiles of a `Tiles` compositor (uniform `tile_params`): tiles of 8 x 8 pixels, each
+/// with one list segment per block of 32 planes (`src/methods/view_slices/tiles.rs`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct TileParams {
+    pub tiles_x: u32,
+    pub tiles_y: u32,
+    /// Blocks of 32 planes of the chunk: segments per tile.
+    pub blocks: u32,
+    /// Entries the tile lists hold; a segment past it is composited from its planes' triangles.
+    pub entry_capacity: u32,
+    pub width: u32,
+    pub height: u32,
+    pub _pad: [u32; 2],
+}
+
+/// One slice triangle binned into tiles (`wgsl/shared/tiles.wgsl`): its edges in pixels (y
+/// down) as `x, y, constant` oriented so its inside is positive, with `w` 1 when the inside owns
+/// pixel centres on the edge (top-left rule), else -1; the inclusive tile range its bounding box
+/// meets (`x0 > x1`: none); the depth of its plane as the rasteriser tests it, and its plane.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct TileTriangle {
+    pub e0: [f32; 4],
+    pub e1: [f32; 4],
+    pub e2: [f32; 4],
+    pub tiles: [u32; 4],
+    pub depth: f32,
+    pub plane: u32,
+    pub _pad: [u32; 2],
+}
+
+/// Texel coordinates over a binned triangle as an affine function of the pixel position
+/// (`wgsl/shared/tiles.wgsl`): at corner a (xyz) with a's pixel x (w), their steps per pixel in x
+/// (xyz) with a's pixel y (w), and in y.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct TileAttributes {
+    pub at_a: [f32; 4],
+    pub d_x: [f32; 4],
+    pub d_y: [f32; 4],
+}
+
 /// Per-frame parameters (uniform `frame`). Positions are camera-relative, so `view_proj` has no
 /// translation.
 #[repr(C)]

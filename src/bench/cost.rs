@@ -18,6 +18,9 @@ pub struct Fit {
     /// RayMarch: fitted per segment strategy (their costs per evaluation differ).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub segments: Option<String>,
+    /// ViewSlices: fitted per compositor (raster and tiles spend differently per triangle).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub compositor: Option<String>,
     pub work_unit: String,
     pub rows: usize,
     /// ms = intercept_ms + ms_per_unit * work
@@ -32,7 +35,11 @@ impl Fit {
             "cost model, table `{}`, {}{}: frame ms = {:.2} + {:.3e} x {} over {} rows: R^2 = {:.3}{}",
             self.table,
             self.method,
-            self.segments.as_ref().map_or(String::new(), |s| format!(" {s}")),
+            [&self.segments, &self.compositor]
+                .iter()
+                .filter_map(|s| s.as_ref())
+                .map(|s| format!(" {s}"))
+                .collect::<String>(),
             self.intercept_ms,
             self.ms_per_unit,
             self.work_unit,
@@ -60,10 +67,12 @@ pub fn fit_line(points: &[(f64, f64)]) -> (f64, f64, f64) {
     (a, b, r2)
 }
 
-/// One fit per (table, method, segments, work unit) over the rows that have work, with at least
-/// three rows.
+/// One fit per (table, method, segments, compositor, work unit) over the rows that have work,
+/// with at least three rows.
 pub fn fit(rows: &[Row]) -> Vec<Fit> {
-    let key = |r: &Row| (r.table.clone(), r.method.clone(), r.segments.clone(), r.work_unit.clone());
+    let key = |r: &Row| {
+        (r.table.clone(), r.method.clone(), r.segments.clone(), r.compositor.clone(), r.work_unit.clone())
+    };
     let mut groups = Vec::new();
     for r in rows.iter().filter(|r| r.work.is_some() && r.work_unit.is_some()) {
         if !groups.contains(&key(r)) {
@@ -79,11 +88,21 @@ pub fn fit(rows: &[Row]) -> Vec<Fit> {
                 .filter_map(|r| Some((r.work?, r.frame_ms)))
                 .filter(|p| p.0.is_finite() && p.1.is_finite())
                 .collect();
-            let (table, method, segments, work_unit) = g;
+            let (table, method, segments, compositor, work_unit) = g;
             (points.len() >= 3).then(|| {
                 let (intercept_ms, ms_per_unit, r2) = fit_line(&points);
                 let work_unit = work_unit.unwrap_or_default();
-                Fit { table, method, segments, work_unit, rows: points.len(), intercept_ms, ms_per_unit, r2 }
+                Fit {
+                    table,
+                    method,
+                    segments,
+                    compositor,
+                    work_unit,
+                    rows: points.len(),
+                    intercept_ms,
+                    ms_per_unit,
+                    r2,
+                }
             })
         })
         .collect()

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use voltex::Result;
 
-use super::parse_size;
+use super::{parse_size, CompositorArg};
 
 #[derive(clap::Args)]
 pub struct BenchArgs {
@@ -32,10 +32,14 @@ pub struct BenchArgs {
     /// Write the last timed frame of every setting as a Chrome/Perfetto trace (per-pass GPU times).
     #[arg(long)]
     trace: Option<PathBuf>,
+    /// Compositors to measure, each on every setting: `raster` (blended draws), `tiles` (binned
+    /// into screen tiles, composited front to back by compute).
+    #[arg(long, value_enum, value_delimiter = ',', default_values_t = vec![CompositorArg::Raster])]
+    compositor: Vec<CompositorArg>,
 }
 
 pub fn run(args: BenchArgs) -> Result<()> {
-    let BenchArgs { scenes, planes, size, frames, reference_planes, json, limits, trace } = args;
+    let BenchArgs { scenes, planes, size, frames, reference_planes, json, limits, trace, compositor } = args;
     voltex::bench::run(&voltex::bench::Args {
         scenes,
         planes,
@@ -45,6 +49,7 @@ pub fn run(args: BenchArgs) -> Result<()> {
         json,
         limits,
         trace,
+        compositors: compositor.into_iter().map(Into::into).collect(),
     })
 }
 

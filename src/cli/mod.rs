@@ -123,6 +123,26 @@ pub struct Overrides {
     /// or `volume:N` (a light volume of resolution N) (default: the scene's).
     #[arg(long, value_parser = parse_shadows)]
     shadows: Option<ShadowsArg>,
+    /// How every ViewSlices object composites its slices: `raster` (blended draws) or `tiles`
+    /// (binned into screen tiles, composited front to back by compute) (default: the scene's).
+    #[arg(long, value_enum)]
+    compositor: Option<CompositorArg>,
+}
+
+/// A `--compositor` value.
+#[derive(clap::ValueEnum, Clone, Copy, Debug)]
+pub enum CompositorArg {
+    Raster,
+    Tiles,
+}
+
+impl From<CompositorArg> for voltex::scene::Compositor {
+    fn from(c: CompositorArg) -> Self {
+        match c {
+            CompositorArg::Raster => Self::Raster,
+            CompositorArg::Tiles => Self::Tiles,
+        }
+    }
 }
 
 /// A `--shadows` value (`None`: Phong without shadows).
@@ -186,6 +206,7 @@ impl Overrides {
             budget: self.budget,
             aovs: self.aov.clone(),
             shadows: self.shadows.map(|s| s.0),
+            compositor: self.compositor.map(Into::into),
             ..Default::default()
         })
     }

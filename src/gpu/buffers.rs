@@ -2,9 +2,16 @@
 
 use crate::gpu::GpuContext;
 
-/// A uniform buffer holding `bytes` (padded to 4).
+/// A uniform buffer holding `bytes` (padded to 4). Also bindable as read-only storage: kernels
+/// whose loops depend on their parameters read them so (`composite_tiles`), since lavapipe's
+/// uniform inlining overflows a fixed array on such kernels (a crash in Mesa 22.3).
 pub fn uniform(ctx: &GpuContext, label: &str, bytes: &[u8]) -> wgpu::Buffer {
-    filled(ctx, label, bytes, wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST)
+    filled(
+        ctx,
+        label,
+        bytes,
+        wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+    )
 }
 
 /// A buffer holding `bytes` (padded to 4). Written through the queue: wgpu's

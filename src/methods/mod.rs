@@ -56,6 +56,8 @@ pub struct PlanCx<'a> {
     /// The frame's time (animated texels are baked at it).
     pub time: f64,
     pub bakes: &'a mut Vec<BakePlan>,
+    /// Tile-list entries of `Tiles` compositors (`RenderOptions::tile_entries`).
+    pub tile_entries: Option<u32>,
 }
 
 /// Plans `object` for the scene method `method` (knobs resolved): adds its plan to

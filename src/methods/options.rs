@@ -45,6 +45,11 @@ pub struct RenderOptions {
     pub aovs: Option<Vec<String>>,
     /// GPU memory the frame may allocate (`--budget`; default `gpu::budget::DEFAULT_BUDGET`).
     pub budget: Option<u64>,
+    /// Compositor of every ViewSlices object (`--compositor`, the sweeps).
+    pub compositor: Option<crate::scene::Compositor>,
+    /// Entries of a `Tiles` compositor's tile lists (default: sized from the sweep and the
+    /// output; tests make it small to exercise the overflow path).
+    pub tile_entries: Option<u32>,
     /// Shadows of every RayMarch object (`--shadows`, the Pareto sweep): `Some(None)` is Phong
     /// without shadows, `Some(Some(s))` `PhongShadows` with `s`.
     pub shadows: Option<Option<crate::scene::Shadows>>,
@@ -131,11 +136,13 @@ impl RenderOptions {
                 planes: self.planes.unwrap_or(vs.planes),
                 trivial_reject: self.trivial_reject.unwrap_or(vs.trivial_reject),
                 lighting,
+                compositor: self.compositor.unwrap_or(vs.compositor),
             }),
             (MethodKind::ViewSlices, _) => Method::ViewSlices(ViewSlices {
                 planes: self.planes.unwrap_or(DEFAULT_PLANES),
                 trivial_reject: self.trivial_reject.unwrap_or(true),
                 lighting,
+                compositor: self.compositor.unwrap_or_default(),
             }),
             (MethodKind::Reference, Method::Reference(r)) => {
                 Method::Reference(Reference { step: self.step.or(r.step), lighting })

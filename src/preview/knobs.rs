@@ -167,8 +167,12 @@ mod tests {
 
     #[test]
     fn keys_edit_the_method_in_place() {
-        let v =
-            Method::ViewSlices(ViewSlices { planes: 24, trivial_reject: true, lighting: Default::default() });
+        let v = Method::ViewSlices(ViewSlices {
+            planes: 24,
+            trivial_reject: true,
+            lighting: Default::default(),
+            compositor: Default::default(),
+        });
         let e = step_quality(SRC, &node(0), &v, true).unwrap().unwrap();
         assert_eq!(e.apply(SRC).unwrap(), SRC.replace("planes: 24", "planes: 48"));
         let e = next_method(SRC, &node(0), &v).unwrap();

@@ -129,7 +129,14 @@ impl Blueprint {
         let light = Lighting::of(scene);
         let mut bakes: Vec<BakePlan> = Vec::new();
         let time = opts.time.unwrap_or(scene.time);
-        let mut cx = PlanCx { scene, view: &view, light: &light, time, bakes: &mut bakes };
+        let mut cx = PlanCx {
+            scene,
+            view: &view,
+            light: &light,
+            time,
+            bakes: &mut bakes,
+            tile_entries: opts.tile_entries,
+        };
         let positions = Positions::of(scene, opts.size.is_some());
         let mut objects = objects
             .into_iter()

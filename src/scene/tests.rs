@@ -56,7 +56,12 @@ fn spec_example_parses() {
     assert_eq!(o[0].texel.as_deref(), Some("torus_egg"));
     assert_eq!(
         o[0].method,
-        Some(Method::ViewSlices(ViewSlices { planes: 400, trivial_reject: true, lighting: Lighting::Baked }))
+        Some(Method::ViewSlices(ViewSlices {
+            planes: 400,
+            trivial_reject: true,
+            lighting: Lighting::Baked,
+            compositor: Default::default()
+        }))
     );
     // uv tiling applied to corners: the torus seam reaches u = 4.
     let max_u = o[0].surface.corner_uvs.iter().flatten().map(|uv| uv.x).fold(0.0, f64::max);

@@ -809,6 +809,22 @@ pub struct ViewSlices {
     pub trivial_reject: bool,
     #[serde(default)]
     pub lighting: Lighting,
+    /// How the slices reach the frame: drawn and blended by the rasteriser, or composited per
+    /// screen tile by compute kernels.
+    #[serde(default)]
+    pub compositor: Compositor,
+}
+
+/// How `ViewSlices` composites its slice polygons into the frame.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum Compositor {
+    /// Indirect draws of the slice triangles, back to front, premultiplied-over blending.
+    #[default]
+    Raster,
+    /// Compute: the slice triangles binned into 8 x 8 pixel tiles, each pixel's fragments
+    /// composited front to back in registers, stopping once opaque; the layer blended once.
+    Tiles,
 }
 
 /// Meyer & Neyret 1998: the texel baked into slice images along s, t and w with power-of-two

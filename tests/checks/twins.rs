@@ -79,6 +79,11 @@ const NO_TWIN: &[(&str, &str)] = &[
          checked by tests/gpu/reference.rs and the golden images",
     ),
     (
+        "blend_tiles",
+        "raster: copies the layer composite_tiles made (premultiplied-over blending by the \
+         pipeline); checked against the raster compositor's image in tests/gpu/tile_compositor.rs",
+    ),
+    (
         "draw_base",
         "raster: draws the opaque base surface with depth, lit two-sided by ambient plus Lambert \
          (one line); checked by the golden images",

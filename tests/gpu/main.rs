@@ -27,4 +27,5 @@ mod preview_draft;
 mod reference;
 mod regress;
 mod render_scenes;
+mod tile_compositor;
 mod volume;

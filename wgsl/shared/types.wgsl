@@ -36,6 +36,40 @@ struct DrawIndirect {
     first_instance: u32,
 }
 
+// Screen tiles of a Tiles compositor (TileParams in src/types.rs).
+struct TileParams {
+    tiles_x: u32,
+    tiles_y: u32,
+    blocks: u32,
+    entry_capacity: u32,
+    width: u32,
+    height: u32,
+    _pad0: u32,
+    _pad1: u32,
+}
+
+// One slice triangle binned into tiles (TileTriangle in src/types.rs): its edges oriented so
+// its inside is positive (x, y, constant; w = 1 when the inside owns centres on the edge), its
+// inclusive tile range, its plane's depth and its plane.
+struct TileTriangle {
+    e0: vec4<f32>,
+    e1: vec4<f32>,
+    e2: vec4<f32>,
+    tiles: vec4<u32>,
+    depth: f32,
+    plane: u32,
+    _pad0: u32,
+    _pad1: u32,
+}
+
+// Texel coordinates over a binned triangle (TileAttributes in src/types.rs): at corner a (xyz)
+// with a's pixel x (w), their steps per pixel in x (xyz) with a's pixel y (w), and in y.
+struct TileAttributes {
+    at_a: vec4<f32>,
+    d_x: vec4<f32>,
+    d_y: vec4<f32>,
+}
+
 struct FrameParams {
     view_proj: mat4x4<f32>,
     forward: vec4<f32>,

@@ -1,7 +1,6 @@
 // Draws view-aligned slice polygons with trilinear texel sampling, step-corrected opacity, premultiplied.
 #include "shared/types.wgsl"
-#include "shared/shading.wgsl"
-#include "shared/barycentrics.wgsl"
+#include "shared/slice_shading.wgsl"
 
 // Per-pixel (Phong) lighting from the baked normals instead of the shading baked into the texel.
 override per_pixel_lighting: bool = false;
@@ -40,26 +39,10 @@ fn vs_main(@builtin(vertex_index) index: u32) -> VsOut {
     out.uvw = v.uvw.xyz;
     out.rel = v.position.xyz;
     if per_pixel_lighting {
-        // The Jacobian J = [dP/ds, dP/dt, dP/dw] interpolated from the prism's vertices at this
-        // point (barycentrics in the prism's cross-section at height w), so it is continuous
-        // across prism edges; normals transform with cofactor(J) = det(J) inverse(J)^T.
-        let prism = prisms[bitcast<u32>(v.position.w)];
-        let ids = prism.vertices.xyz;
-        let a = shell_vertices[ids.x];
-        let b = shell_vertices[ids.y];
-        let c = shell_vertices[ids.z];
-        let w = v.uvw.z;
-        let bary = barycentrics(v.position.xyz, mix(a.bottom.xyz, a.top.xyz, w), mix(b.bottom.xyz, b.top.xyz, w), mix(c.bottom.xyz, c.top.xyz, w), vec3<f32>(1.0 / 3.0));
-        let fa = vertex_frames[ids.x];
-        let fb = vertex_frames[ids.y];
-        let fc = vertex_frames[ids.z];
-        let ds = bary.x * fa.ds.xyz + bary.y * fb.ds.xyz + bary.z * fc.ds.xyz;
-        let dt = bary.x * fa.dt.xyz + bary.y * fb.dt.xyz + bary.z * fc.dt.xyz;
-        let dw = bary.x * (a.top.xyz - a.bottom.xyz) + bary.y * (b.top.xyz - b.bottom.xyz) + bary.z * (c.top.xyz - c.bottom.xyz);
-        let sign_j = select(-1.0, 1.0, dot(ds, cross(dt, dw)) >= 0.0);
-        out.n_s = cross(dt, dw) * sign_j;
-        out.n_t = cross(dw, ds) * sign_j;
-        out.n_w = cross(ds, dt) * sign_j;
+        let f = slice_vertex_frame(v);
+        out.n_s = f.n_s;
+        out.n_t = f.n_t;
+        out.n_w = f.n_w;
     }
     return out;
 }
@@ -74,25 +57,8 @@ fn slice_alpha(in: VsOut) -> vec2<f32> {
 
 @fragment
 fn fs_main(in: VsOut) -> @location(0) vec4<f32> {
-    // Level 0, as the Reference samples it. Mipmaps chosen by the sampler's implicit level cost
-    // accuracy (a 3D mip also blurs along w, the shell's height profile) and depend on the adapter:
-    // on torus_egg at 128x128 they doubled the FLIP against a 4x4-supersampled Reference (0.131
-    // against 0.062) and differed by 0.029 between llvmpipe and an NVIDIA H100.
-    let texel = textureSampleLevel(volume, volume_sampler, in.uvw, 0.0);
-    // World length of this pixel's ray between two planes: spacing / cos(angle to the view axis).
     let ray = normalize(in.rel);
-    let step = slice_params.spacing / max(dot(ray, frame.forward.xyz), 1e-4);
-    let a = clamp(texel.a, 0.0, 1.0);
-    let corrected = 1.0 - pow(1.0 - min(a, 0.999999), step / object.opacity_length);
-    var rgb = texel.rgb * select(0.0, corrected / a, a > 1e-6);
-    if per_pixel_lighting {
-        let tex_normal = textureSampleLevel(normals, volume_sampler, in.uvw, 0.0).xyz;
-        var n = in.n_s * tex_normal.x + in.n_t * tex_normal.y + in.n_w * tex_normal.z;
-        n = select(-ray, normalize(n), dot(n, n) > 1e-20);
-        let albedo = texel.rgb * select(0.0, 1.0 / a, a > 1e-6);
-        rgb = corrected * shade_phong(albedo, n, frame.light_dir, -ray, PIXEL_SPECULAR, PIXEL_SHININESS);
-    }
-    return vec4<f32>(rgb * frame.light_color.rgb, corrected);
+    return slice_fragment(in.uvw, ray, slice_exponent(ray, object.opacity_length), SliceFrame(in.n_s, in.n_t, in.n_w));
 }
 
 // Coverage AOV: the opacity fs_main draws with, into the object's slot.

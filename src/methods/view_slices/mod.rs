@@ -3,6 +3,8 @@
 
 mod object;
 pub mod slice_prisms;
+pub mod tile_buffers;
+pub mod tiles;
 
 pub use object::{plan, ViewSlicesPlan};
 
@@ -13,7 +15,7 @@ use crate::types::{SliceParams, SliceVertex};
 /// What ViewSlices brings to the render graph.
 pub const CONTRIBUTION: super::Contribution = super::Contribution {
     method: "ViewSlices",
-    filters: &["ViewSlices"],
+    filters: &["ViewSlices", "ViewSlicesRaster", "ViewSlicesTiles"],
     resources: &[
         "slice_params",
         "shell_vertices",
@@ -25,8 +27,14 @@ pub const CONTRIBUTION: super::Contribution = super::Contribution {
         "volume",
         "normals",
         "vertex_frames",
+        "tile_params",
+        "tile_triangles",
+        "tile_attributes",
+        "tile_cursors",
+        "tile_entries",
+        "tile_layer",
     ],
-    counts: &["prisms", "planes", "plane_blocks"],
+    counts: &["prisms", "planes", "plane_blocks", "slice_triangles", "tiles_x", "tiles_y"],
     texel_resources: &["volume", "normals"],
     gather: None,
 };
@@ -71,27 +79,10 @@ pub struct SliceChunk {
 /// pentagon is 3 triangles) on every plane its depth range crosses. Allocating this, not
 /// planes x prisms x 9, keeps memory proportional to what is drawn.
 pub fn plane_bounds(shell: &Shell, params: &SliceParams) -> Vec<u64> {
-    let n = params.plane_normal.map(|x| x as f64);
-    let spacing = params.spacing as f64;
-    let first = params.first_plane as f64;
-    let last = params.plane_count as i64 - 1;
     // Difference array: +9 where a prism's plane range starts, -9 after it ends.
     let mut diff = vec![0i64; params.plane_count as usize + 1];
     for p in &shell.prisms {
-        let mut lo = f64::INFINITY;
-        let mut hi = f64::NEG_INFINITY;
-        for &v in &p.vertices[..3] {
-            let sv = &shell.vertices[v as usize];
-            for c in [sv.bottom, sv.top] {
-                let d = n[0] * c[0] as f64 + n[1] * c[1] as f64 + n[2] * c[2] as f64;
-                lo = lo.min(d);
-                hi = hi.max(d);
-            }
-        }
-        // Planes k with lo <= first - k*spacing <= hi, widened by one plane for f32 rounding.
-        let k_min = (((first - hi) / spacing).floor() as i64 - 1).max(0);
-        let k_max = (((first - lo) / spacing).ceil() as i64 + 1).min(last);
-        if k_max >= k_min {
+        if let Some((k_min, k_max)) = prism_planes(shell, p, params) {
             diff[k_min as usize] += 9;
             diff[k_max as usize + 1] -= 9;
         }
@@ -104,6 +95,29 @@ pub fn plane_bounds(shell: &Shell, params: &SliceParams) -> Vec<u64> {
             running as u64
         })
         .collect()
+}
+
+/// The planes `[k_min, k_max]` of a sweep (or chunk) whose depth range the prism's corners span,
+/// widened by one plane for f32 rounding; `None` when there is none.
+pub fn prism_planes(shell: &Shell, p: &crate::types::Prism, params: &SliceParams) -> Option<(u32, u32)> {
+    let n = params.plane_normal.map(|x| x as f64);
+    let spacing = params.spacing as f64;
+    let first = params.first_plane as f64;
+    let last = params.plane_count as i64 - 1;
+    let mut lo = f64::INFINITY;
+    let mut hi = f64::NEG_INFINITY;
+    for &v in &p.vertices[..3] {
+        let sv = &shell.vertices[v as usize];
+        for c in [sv.bottom, sv.top] {
+            let d = n[0] * c[0] as f64 + n[1] * c[1] as f64 + n[2] * c[2] as f64;
+            lo = lo.min(d);
+            hi = hi.max(d);
+        }
+    }
+    // Planes k with lo <= first - k*spacing <= hi.
+    let k_min = (((first - hi) / spacing).floor() as i64 - 1).max(0);
+    let k_max = (((first - lo) / spacing).ceil() as i64 + 1).min(last);
+    (k_max >= k_min).then_some((k_min as u32, k_max as u32))
 }
 
 /// Total slice-vertex capacity of a sweep (see [`plane_bounds`]).

@@ -1,10 +1,10 @@
 //! One ViewSlices object of a frame: its plane sweep in chunks, and what the renderer asks of it.
 
-use super::{add_inputs, check_budget, check_capacity, chunks, sweep, SliceChunk};
+use super::{add_inputs, check_budget, check_capacity, chunks, sweep, tile_buffers, tiles, SliceChunk};
 use crate::error::{Error, Result};
 use crate::gpu::{buffers, Inputs};
 use crate::methods::{texels, InputCx, MethodPlan, ObjectPlan, PartDecl, PlanCx};
-use crate::scene::{Lighting, Method, ViewSlices, MAX_PLANES};
+use crate::scene::{Compositor, Lighting, Method, ViewSlices, MAX_PLANES};
 use crate::types::{SliceParams, SliceVertex, VertexFrame};
 
 pub struct ViewSlicesPlan {
@@ -12,6 +12,11 @@ pub struct ViewSlicesPlan {
     pub sweep: SliceParams,
     pub chunks: Vec<SliceChunk>,
     pub trivial_reject: bool,
+    pub compositor: Compositor,
+    /// `Tiles`: the tile-list entries of each chunk.
+    pub tile_entries: Vec<u32>,
+    /// The rendered size the tiles were planned for.
+    pub size: (u32, u32),
 }
 
 /// Plans `object`'s sweep, its texel bake and its lighting.
@@ -27,7 +32,27 @@ pub fn plan(cx: &mut PlanCx, object: &mut ObjectPlan, m: &ViewSlices) -> Result<
     object.frames = object.per_pixel.then(|| crate::mesh::shell::vertex_frames(&object.object.surface));
     let texel = object.object.texel.clone().unwrap_or_default();
     object.bake = Some(texels::bake_index(cx.scene, &texel, object.per_pixel, cx.light, cx.time, cx.bakes)?);
-    object.methods.push(Box::new(ViewSlicesPlan { sweep, chunks, trivial_reject: m.trivial_reject }));
+    let tile_entries = match m.compositor {
+        Compositor::Raster => Vec::new(),
+        Compositor::Tiles => {
+            let view_proj = cx.view.frame_params(cx.scene, cx.view.size, cx.light).view_proj;
+            chunks
+                .iter()
+                .map(|c| {
+                    let bound = tile_buffers::entry_bound(&object.shell, &c.params, &view_proj, cx.view.size);
+                    tile_buffers::entry_capacity(bound, cx.tile_entries)
+                })
+                .collect()
+        }
+    };
+    object.methods.push(Box::new(ViewSlicesPlan {
+        sweep,
+        chunks,
+        trivial_reject: m.trivial_reject,
+        compositor: m.compositor,
+        tile_entries,
+        size: cx.view.size,
+    }));
     Ok(())
 }
 
@@ -41,7 +66,13 @@ fn lighting(object: &ObjectPlan) -> &'static str {
 
 impl MethodPlan for ViewSlicesPlan {
     fn parts(&self) -> Vec<PartDecl> {
-        (0..self.chunks.len()).map(|c| PartDecl { filters: vec!["ViewSlices"], order: c as u32 }).collect()
+        let compositor = match self.compositor {
+            Compositor::Raster => "ViewSlicesRaster",
+            Compositor::Tiles => "ViewSlicesTiles",
+        };
+        (0..self.chunks.len())
+            .map(|c| PartDecl { filters: vec!["ViewSlices", compositor], order: c as u32 })
+            .collect()
     }
 
     fn constants(&self) -> Vec<(String, f64)> {
@@ -53,12 +84,32 @@ impl MethodPlan for ViewSlicesPlan {
         for c in &self.chunks {
             check_capacity(c.capacity, max, &object.object.name, c.params.plane_count)?;
         }
+        for (c, &entries) in self.chunks.iter().zip(&self.tile_entries) {
+            let params = tiles::tile_params(self.size, c.params.plane_count, entries);
+            for (buffer, bytes) in tile_buffers::tile_bytes(&params, c.capacity) {
+                if bytes > max {
+                    return Err(Error::Gpu(format!(
+                        "object `{}`: the Tiles compositor's `{buffer}` needs {:.1} MiB in one binding at \
+                         {}x{}, beyond this adapter's storage-binding limit of {:.1} MiB; use a smaller \
+                         output or `compositor: Raster`",
+                        object.object.name,
+                        bytes as f64 / 1048576.0,
+                        self.size.0,
+                        self.size.1,
+                        max as f64 / 1048576.0
+                    )));
+                }
+            }
+        }
         Ok(())
     }
 
     fn add_inputs(&self, cx: &InputCx, object: &ObjectPlan, part: usize, inputs: &mut Inputs) {
         let c = &self.chunks[part];
         add_inputs(cx.ctx, inputs, &object.shell, &c.params, c.capacity, self.trivial_reject);
+        if let Some(&entries) = self.tile_entries.get(part) {
+            tile_buffers::add_inputs(cx.ctx, inputs, cx.size, c.params.plane_count, entries, c.capacity);
+        }
         // Bound even when unlit per pixel (the binding exists in the kernel): one entry then.
         let frames = object.frames.as_deref().unwrap_or(&[VertexFrame { ds: [0.0; 4], dt: [0.0; 4] }]);
         let frames = buffers::storage(cx.ctx, "vertex_frames", bytemuck::cast_slice(frames));
@@ -71,29 +122,36 @@ impl MethodPlan for ViewSlicesPlan {
 
     fn summary(&self, object: &ObjectPlan) -> String {
         format!(
-            "ViewSlices planes {} spacing {:.4} trivial_reject {} lighting {}, {} chunk(s)",
+            "ViewSlices planes {} spacing {:.4} trivial_reject {} lighting {} compositor {:?}, {} chunk(s)",
             self.sweep.plane_count,
             self.sweep.spacing,
             self.trivial_reject,
             lighting(object),
+            self.compositor,
             self.chunks.len()
         )
     }
 
     fn metadata(&self, object: &ObjectPlan) -> String {
         format!(
-            "ViewSlices(planes: {}, trivial_reject: {}, lighting: {})",
+            "ViewSlices(planes: {}, trivial_reject: {}, lighting: {}, compositor: {:?})",
             self.sweep.plane_count,
             self.trivial_reject,
-            lighting(object)
+            lighting(object),
+            self.compositor
         )
     }
 
-    fn memory(&self, object: &ObjectPlan, _size: (u32, u32)) -> Vec<(String, u64)> {
+    fn memory(&self, object: &ObjectPlan, size: (u32, u32)) -> Vec<(String, u64)> {
         let name = &object.object.name;
         let shell = &object.shell;
         let cap: u64 = self.chunks.iter().map(|c| c.capacity).sum();
-        vec![
+        let mut tile_memory = 0u64;
+        for (c, &entries) in self.chunks.iter().zip(&self.tile_entries) {
+            let params = tiles::tile_params(size, c.params.plane_count, entries);
+            tile_memory += tile_buffers::tile_bytes(&params, c.capacity).iter().map(|b| b.1).sum::<u64>();
+        }
+        let mut items = vec![
             (
                 format!("object {name}: shell ({} prisms)", shell.prisms.len()),
                 (shell.vertices.len() * 32 + shell.prisms.len() * 64) as u64,
@@ -108,7 +166,15 @@ impl MethodPlan for ViewSlicesPlan {
                     + self.sweep.plane_count as u64 * 4
                     + self.chunks.len() as u64 * (16 + 48),
             ),
-        ]
+        ];
+        if tile_memory > 0 {
+            let entries: u64 = self.tile_entries.iter().map(|&e| e as u64).sum();
+            items.push((
+                format!("object {name}: Tiles compositor (triangles, texel coordinates, cursors, {entries} list entries, layer)"),
+                tile_memory,
+            ));
+        }
+        items
     }
 
     fn scene_method(&self, object: &ObjectPlan) -> Option<Method> {
@@ -117,6 +183,7 @@ impl MethodPlan for ViewSlicesPlan {
             planes: self.sweep.plane_count,
             trivial_reject: self.trivial_reject,
             lighting,
+            compositor: self.compositor,
         }))
     }
 

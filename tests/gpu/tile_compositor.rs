@@ -1,0 +1,138 @@
+//! ViewSlices' `Tiles` compositor: the same image as the raster path up to coverage and blending
+//! rounding, as close to the Reference, the binning kernel against its CPU twin, and the lists'
+//! overflow path drawing the same image.
+
+use crate::common;
+
+use common::ctx;
+use std::path::PathBuf;
+
+use voltex::io::Image;
+use voltex::methods::view_slices::{tiles, ViewSlicesPlan};
+use voltex::render::{Blueprint, MethodKind, RenderOptions, Renderer};
+use voltex::scene::{self, Compositor};
+use voltex::types::{DrawIndirect, SliceVertex, TileAttributes, TileTriangle};
+
+fn example(name: &str) -> PathBuf {
+    voltex::project_root().join("scenes/view_slices").join(name)
+}
+
+fn options(compositor: Compositor) -> RenderOptions {
+    RenderOptions { size: Some((64, 64)), compositor: Some(compositor), ..Default::default() }
+}
+
+fn render(name: &str, opts: &RenderOptions) -> Image {
+    let scene = scene::load(&example(name)).unwrap();
+    let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
+    let mut r = Renderer::new(&ctx, Blueprint::new(&scene, opts).unwrap()).unwrap();
+    r.render(&ctx).unwrap().image
+}
+
+/// Per pixel, the largest channel difference.
+fn pixel_differences(a: &Image, b: &Image) -> Vec<f64> {
+    a.pixels
+        .iter()
+        .zip(&b.pixels)
+        .map(|(p, q)| (0..3).map(|c| (p[c] as f64 - q[c] as f64).abs()).fold(0.0, f64::max))
+        .collect()
+}
+
+/// Both compositors on torus_egg and flat_box at 64x64: the tiles path composites front to back
+/// in f32 registers and stops at transmittance 1e-4, the rasteriser blends back to front, so
+/// most pixels agree to 2e-3; the rest are pixel centres on or within rounding of a slice's
+/// silhouette edge, which llvmpipe's fixed-point edge test and the tiles' f32 one can place on
+/// either side (one fragment, at most 0.01 here). Against the Reference, the tiles image is as
+/// close as the raster one.
+#[test]
+fn tiles_composite_the_raster_image() {
+    for name in ["torus_egg.ron", "flat_box.ron"] {
+        let raster = render(name, &options(Compositor::Raster));
+        let tiles = render(name, &options(Compositor::Tiles));
+        let truth = render(
+            name,
+            &RenderOptions { method: Some(MethodKind::Reference), ..options(Compositor::Raster) },
+        );
+        let d = pixel_differences(&raster, &tiles);
+        let mean = d.iter().sum::<f64>() / d.len() as f64;
+        let far = d.iter().filter(|&&v| v > 2e-3).count();
+        let max = d.iter().copied().fold(0.0, f64::max);
+        eprintln!("{name}: mean {mean:.2e}, max {max:.2e}, {far} of {} pixels over 2e-3", d.len());
+        assert!(mean < 2e-4, "{name}: mean difference {mean}");
+        assert!(max < 0.01, "{name}: largest difference {max}");
+        assert!(far * 25 < d.len(), "{name}: {far} pixels differ by more than 2e-3");
+        let flip_raster = voltex::metrics::flip(&raster, &truth).unwrap().mean;
+        let flip_tiles = voltex::metrics::flip(&tiles, &truth).unwrap().mean;
+        eprintln!("{name}: FLIP against the Reference: raster {flip_raster:.4}, tiles {flip_tiles:.4}");
+        assert!(flip_tiles <= flip_raster + 2e-3, "{name}: tiles {flip_tiles} against raster {flip_raster}");
+    }
+}
+
+/// Lists too small for the sweep: every overflowing segment is composited from all the
+/// triangles of its planes, which draws the same image (up to which of two slices of one plane
+/// a pixel keeps where adjacent prisms' slices overlap by rounding).
+#[test]
+fn overflowing_lists_draw_the_same_image() {
+    let full = render("torus_egg.ron", &options(Compositor::Tiles));
+    let small =
+        render("torus_egg.ron", &RenderOptions { tile_entries: Some(4096), ..options(Compositor::Tiles) });
+    let max = voltex::metrics::max_abs_diff(&full, &small).unwrap();
+    assert!(max < 1e-4, "largest difference {max}");
+}
+
+fn read<T: bytemuck::Pod>(r: &Renderer, i: usize, name: &str) -> Vec<T> {
+    let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
+    let bytes = r.read_instance_buffer(&ctx, i, name).unwrap();
+    bytemuck::pod_collect_to_vec(&bytes[..bytes.len() / std::mem::size_of::<T>() * std::mem::size_of::<T>()])
+}
+
+/// `bin_slices`, `scan_tiles` and `fill_tiles` against their twins on the slices the GPU emitted
+/// for torus_egg: the same triangles (edges, tile ranges, planes) and texel-coordinate planes,
+/// the same segment ends, and the same entries in each segment (their order is the atomics').
+#[test]
+fn binning_matches_its_twin() {
+    let scene = scene::load(&example("torus_egg.ron")).unwrap();
+    let opts = RenderOptions { planes: Some(96), ..options(Compositor::Tiles) };
+    let r = {
+        let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
+        let mut r = Renderer::new(&ctx, Blueprint::new(&scene, &opts).unwrap()).unwrap();
+        r.render(&ctx).unwrap();
+        r
+    };
+    let i = r.blueprint.find_instance("ViewSlicesTiles").expect("a Tiles instance");
+    let vs = r.blueprint.objects[0].method::<ViewSlicesPlan>().unwrap();
+    let params = tiles::tile_params(r.blueprint.size, vs.sweep.plane_count, vs.tile_entries[0]);
+    let frame = r.blueprint.frame;
+    let count = read::<DrawIndirect>(&r, i, "draw_args")[0].vertex_count as usize;
+    let vertices = &read::<SliceVertex>(&r, i, "slice_vertices")[..count];
+    let plane_ends = &read::<u32>(&r, i, "plane_cursors")[..vs.sweep.plane_count as usize];
+    let (triangles, attributes, counts) = tiles::bin_slices(&frame, &params, vertices, plane_ends);
+    assert!(triangles.len() > 1000, "{} triangles", triangles.len());
+    let gpu_triangles = read::<TileTriangle>(&r, i, "tile_triangles");
+    let gpu_attributes = read::<TileAttributes>(&r, i, "tile_attributes");
+    let close = |a: &[f32], b: &[f32], what: &str, t: usize| {
+        for (x, y) in a.iter().zip(b) {
+            assert!((x - y).abs() <= 1e-3 * (1.0 + x.abs()), "triangle {t} {what}: {a:?} against {b:?}");
+        }
+    };
+    for (t, (c, g)) in triangles.iter().zip(&gpu_triangles).enumerate() {
+        assert_eq!((c.plane, c.tiles), (g.plane, g.tiles), "triangle {t}");
+        for (a, b) in [(&c.e0, &g.e0), (&c.e1, &g.e1), (&c.e2, &g.e2)] {
+            close(&a[..3], &b[..3], "edge", t);
+            assert_eq!(a[3], b[3], "triangle {t}: tie owner");
+        }
+        let (a, b) = (&attributes[t], &gpu_attributes[t]);
+        close(&[a.at_a, a.d_x, a.d_y].concat(), &[b.at_a, b.d_x, b.d_y].concat(), "texel coordinates", t);
+    }
+    let starts = tiles::scan_tiles(&counts);
+    let (ends, entries) = tiles::fill_tiles(&params, &triangles, &starts);
+    let gpu_ends = read::<u32>(&r, i, "tile_cursors");
+    assert_eq!(ends[..], gpu_ends[..ends.len()]);
+    let gpu_entries = read::<u32>(&r, i, "tile_entries");
+    for (s, (&start, &end)) in starts.iter().zip(&ends).enumerate() {
+        let (start, end) = (start as usize, end as usize);
+        let (mut a, mut b) = (entries[start..end].to_vec(), gpu_entries[start..end].to_vec());
+        a.sort_unstable();
+        b.sort_unstable();
+        assert_eq!(a, b, "segment {s}");
+    }
+}
