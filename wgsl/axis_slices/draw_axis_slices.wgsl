@@ -51,18 +51,24 @@ struct SliceSample {
 }
 
 fn sample_slice(in: VsOut) -> SliceSample {
-    // Explicit gradients: the branch on the slice's direction is not uniform control flow. Zero
-    // gradients read level 0 (the only one without MIP levels).
-    let mip = f32(mipmapped_slices);
-    let ddx = dpdx(in.uv) * mip;
-    let ddy = dpdy(in.uv) * mip;
     var texel: vec4<f32>;
-    if (in.direction == 2u) {
-        texel = textureSampleGrad(axis_slices_w, axis_sampler, in.uv, in.layer, ddx, ddy);
+    if (mipmapped_slices) {
+        // Explicit gradients: the branch on the slice's direction is not uniform control flow.
+        let ddx = dpdx(in.uv);
+        let ddy = dpdy(in.uv);
+        if (in.direction == 2u) {
+            texel = textureSampleGrad(axis_slices_w, axis_sampler, in.uv, in.layer, ddx, ddy);
+        } else if (in.direction == 0u) {
+            texel = textureSampleGrad(axis_slices_s, axis_sampler_side, in.uv, in.layer, ddx, ddy);
+        } else {
+            texel = textureSampleGrad(axis_slices_t, axis_sampler_side, in.uv, in.layer, ddx, ddy);
+        }
+    } else if (in.direction == 2u) {
+        texel = textureSampleLevel(axis_slices_w, axis_sampler, in.uv, in.layer, 0.0);
     } else if (in.direction == 0u) {
-        texel = textureSampleGrad(axis_slices_s, axis_sampler_side, in.uv, in.layer, ddx, ddy);
+        texel = textureSampleLevel(axis_slices_s, axis_sampler_side, in.uv, in.layer, 0.0);
     } else {
-        texel = textureSampleGrad(axis_slices_t, axis_sampler_side, in.uv, in.layer, ddx, ddy);
+        texel = textureSampleLevel(axis_slices_t, axis_sampler_side, in.uv, in.layer, 0.0);
     }
     // World length of this pixel's ray through the slab the slice stands for.
     let ray = normalize(in.rel);

@@ -196,6 +196,11 @@ pub fn add_inputs(
         });
         inputs.views.insert(name.to_string(), view);
     }
+    // Trilinear and anisotropic between the MIP levels of `mipmaps: true`.
+    let (mipmap_filter, anisotropy_clamp) = match plan.method.mipmaps {
+        true => (wgpu::MipmapFilterMode::Linear, ANISOTROPY),
+        false => (wgpu::MipmapFilterMode::Nearest, 1),
+    };
     let sampler = |label: &str, v: wgpu::AddressMode| {
         ctx.device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some(label),
@@ -203,9 +208,8 @@ pub fn add_inputs(
             address_mode_v: v,
             mag_filter: wgpu::FilterMode::Linear,
             min_filter: wgpu::FilterMode::Linear,
-            // Trilinear between the MIP levels of `mipmaps: true` (level 0 is sampled otherwise).
-            mipmap_filter: wgpu::MipmapFilterMode::Linear,
-            anisotropy_clamp: ANISOTROPY,
+            mipmap_filter,
+            anisotropy_clamp,
             ..Default::default()
         })
     };
