@@ -122,7 +122,8 @@ fn assert_err(e: voltex::Error, at: &str, words: &[&str]) {
 fn frame_graph_parses_and_plans() {
     let g = Graph::load(&root().join("graphs/frame.ron")).unwrap();
     let all: &[&[&str]] = &[
-        &["ViewSlices", "BaseSurface"],
+        &["ViewSlices", "ViewSlicesRaster", "BaseSurface"],
+        &["ViewSlices", "ViewSlicesTiles"],
         &["Reference"],
         &["AxisSlices", "AxisSlicesBinary"],
         &["AxisSlices", "AxisSlicesBinary", "AxisSlicesBySlice"],
@@ -147,6 +148,11 @@ fn frame_graph_parses_and_plans() {
             "scan_plane_offsets",
             "emit_slices",
             "draw_slices",
+            "bin_slices",
+            "scan_tiles",
+            "fill_tiles",
+            "composite_tiles",
+            "blend_tiles",
             "blend_axis_slices",
             "trace_reference",
             "composite_reference",

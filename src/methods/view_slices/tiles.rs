@@ -228,7 +228,7 @@ pub fn fill_tiles(params: &TileParams, triangles: &[TileTriangle], starts: &[u32
                 let at = cursors[seg] as usize;
                 cursors[seg] += 1;
                 if let Some(e) = entries.get_mut(at) {
-                    *e = (t as u32) << 5 | tri.plane % TILE_PLANES;
+                    *e = ((t as u32) << 5) | (tri.plane % TILE_PLANES);
                 }
             }
         }
@@ -319,7 +319,8 @@ pub fn composite_tiles(f: &TileFrame) -> Vec<[f32; 4]> {
                         break;
                     }
                     let tri = &f.triangles[*t];
-                    if !(tri.depth < behind) {
+                    // The rasteriser's `Less` (NaN fails).
+                    if tri.depth.partial_cmp(&behind) != Some(std::cmp::Ordering::Less) {
                         continue;
                     }
                     let bary = tile_cover(tri, centre).expect("covered");
