@@ -15,37 +15,11 @@ camera is view.json's pinhole, as voltex casts it. Writes an RGBA float EXR (Ope
 Blender's bundle)."""
 
 import argparse
-import glob
-import importlib.util
 import json
-import os
-import sys
 
 import numpy as np
 
-
-def bundled():
-    base = os.path.dirname(importlib.util.find_spec("bpy").origin)
-    for sp in glob.glob(os.path.join(base, "*", "python", "lib", "python3.*", "site-packages")):
-        sys.path.insert(0, sp)
-
-
-def grid(vdb, path):
-    d = {g.name: g for g in vdb.readAll(path)[0]}["density"]
-    lo, hi = d.evalActiveVoxelBoundingBox()
-    lo = np.array(lo) - 2  # two voxels of background: lookups clamped to the array read zeros
-    hi = np.array(hi) + 2
-    a = np.zeros(tuple(hi - lo + 1), dtype=np.float32)
-    d.copyToArray(a, ijk=tuple(int(v) for v in lo))
-    t = d.transform
-    o = np.array(t.indexToWorld((0, 0, 0)))
-    m = np.eye(4)
-    for k in range(3):
-        e = [0, 0, 0]
-        e[k] = 1
-        m[:3, k] = np.array(t.indexToWorld(tuple(e))) - o
-    m[:3, 3] = o
-    return a.astype(np.float64), lo, m
+import common
 
 
 def density(a, lo, p):
@@ -95,12 +69,12 @@ def main():
     ap.add_argument("--out", required=True)
     ap.add_argument("--supersample", type=int, default=1)
     args = ap.parse_args()
-    bundled()
-    import OpenImageIO as oiio
-    import openvdb
+    # Two voxels of background: lookups clamped to the array read zeros.
+    a, lo, m, _ = common.dense_density(args.vdb, 2)
+    a = a.astype(np.float64)
+    import OpenImageIO as oiio  # bundled with bpy, on the path dense_density set
 
     view = json.load(open(args.view))
-    a, lo, m = grid(openvdb, args.vdb)
     inv = np.linalg.inv(m)
     cam = view["camera"]
     w, h, n = view["width"], view["height"], args.supersample

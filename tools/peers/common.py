@@ -13,6 +13,44 @@ VOLTEX = os.environ.get("VOLTEX", os.path.join(ROOT, "target", "release", "volte
 COLUMNS = ["renderer", "setting", "samples", "seconds", "threads", "version", "rmse", "rel_rmse", "flip"]
 
 
+def bundled_openvdb():
+    """The `openvdb` module bundled with Blender's Python module (`pip install bpy`)."""
+    import glob
+    import importlib.util
+
+    base = os.path.dirname(importlib.util.find_spec("bpy").origin)
+    for sp in glob.glob(os.path.join(base, "*", "python", "lib", "python3.*", "site-packages")):
+        sys.path.insert(0, sp)
+    import openvdb
+
+    return openvdb
+
+
+def dense_density(path, rim):
+    """The `density` grid of the VDB at `path` over its active box grown by `rim` voxels of
+    background: (float32 array [x, y, z], index of its first voxel, index_to_world 4x4, all grids
+    by name)."""
+    import numpy as np
+
+    vdb = bundled_openvdb()
+    grids = {g.name: g for g in vdb.readAll(path)[0]}
+    d = grids["density"]
+    lo, hi = (np.array(c) for c in d.evalActiveVoxelBoundingBox())
+    lo, hi = lo - rim, hi + rim
+    a = np.zeros(tuple(int(v) for v in hi - lo + 1), dtype=np.float32)
+    d.copyToArray(a, ijk=tuple(int(v) for v in lo))
+    # index_to_world (column vectors): the images of the unit axes and of the origin.
+    t = d.transform
+    o = np.array(t.indexToWorld((0, 0, 0)))
+    m = np.eye(4)
+    for k in range(3):
+        e = [0, 0, 0]
+        e[k] = 1
+        m[:3, k] = np.array(t.indexToWorld(tuple(e))) - o
+    m[:3, 3] = o
+    return a, lo, m, grids
+
+
 def load_view(path):
     with open(path) as f:
         return json.load(f)

@@ -17,8 +17,6 @@ interpolant then equals OpenVDB's everywhere in the box (within half a voxel of 
 it clamps to the background 0, as OpenVDB's is there), and to_world = index_to_world *
 translate(lo - 1.5) * scale(n)."""
 
-import glob
-import importlib.util
 import json
 import os
 import struct
@@ -26,14 +24,7 @@ import sys
 
 import numpy as np
 
-
-def bundled_openvdb():
-    base = os.path.dirname(importlib.util.find_spec("bpy").origin)
-    for sp in glob.glob(os.path.join(base, "*", "python", "lib", "python3.*", "site-packages")):
-        sys.path.insert(0, sp)
-    import openvdb
-
-    return openvdb
+import common
 
 
 def write_vol(path, a):
@@ -52,35 +43,20 @@ def write_vol(path, a):
 
 def main():
     src, stem = sys.argv[1], sys.argv[2]
-    vdb = bundled_openvdb()
-    grids = {g.name: g for g in vdb.readAll(src)[0]}
-    d = grids["density"]
-    lo, hi = d.evalActiveVoxelBoundingBox()
-    lo = tuple(v - 1 for v in lo)
-    hi = tuple(v + 1 for v in hi)
-    n = tuple(h - l + 1 for l, h in zip(lo, hi))
-    dense = np.zeros(n, dtype=np.float32)
-    d.copyToArray(dense, ijk=lo)
+    dense, lo, m, grids = common.dense_density(src, 1)
+    n = dense.shape
+    lo = tuple(int(v) for v in lo)
     write_vol(stem + ".density.vol", dense)
     if "Cd" in grids:
         cd = np.zeros(n + (3,), dtype=np.float32)
         grids["Cd"].copyToArray(cd, ijk=lo)
         write_vol(stem + ".Cd.vol", cd)
-    # index_to_world as a 4x4 (column vectors): the images of the unit axes and the origin.
-    t = d.transform
-    o = np.array(t.indexToWorld((0, 0, 0)))
-    m = np.eye(4)
-    for a in range(3):
-        e = [0, 0, 0]
-        e[a] = 1
-        m[:3, a] = np.array(t.indexToWorld(tuple(e))) - o
-    m[:3, 3] = o
     place = np.eye(4)
     place[:3, :3] = np.diag(n)
     place[:3, 3] = np.array(lo) - 0.5
     to_world = m @ place
     info = {"to_world": to_world.tolist(), "resolution": n, "index_lo": lo, "has_cd": "Cd" in grids,
-            "max_density": float(dense.max()), "openvdb": ".".join(map(str, vdb.LIBRARY_VERSION))}
+            "max_density": float(dense.max())}
     with open(stem + ".json", "w") as f:
         json.dump(info, f, indent=1)
     print(f"{src}: {n[0]}x{n[1]}x{n[2]} voxels (with a rim of background) -> {stem}.density.vol")
