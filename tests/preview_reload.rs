@@ -174,9 +174,11 @@ fn reload_sequence() {
     assert_eq!(stats(&o), CacheStats::default());
 
     // A kernel edit recompiles that kernel and its pipeline only.
-    let (o, darker) = step(&mut s, "wgsl", &draw, &|| {
+    // The slices' shading is an include of draw_slices.wgsl (shared with the Tiles compositor).
+    let shading = wgsl.join("shared/slice_shading.wgsl");
+    let (o, darker) = step(&mut s, "wgsl", &shading, &|| {
         edit(
-            &draw,
+            &shading,
             "return vec4<f32>(rgb * frame.light_color.rgb, corrected);",
             "return vec4<f32>(0.5 * rgb * frame.light_color.rgb, corrected);",
         )
