@@ -4,7 +4,7 @@ library itself (version 12, as bundled by Blender's `bpy` wheel), so that voltex
 Houdini, Blender and EmberGen write them. Nothing is downloaded but the wheel.
 
     python3 -m venv /tmp/bpy && /tmp/bpy/bin/pip install bpy numpy
-    /tmp/bpy/bin/python tools/gen_volumes.py
+    /tmp/bpy/bin/python tools/gen_volumes.py [examples|bad|paper2002 ...]   # default: all
 
 Conventions (OpenVDB's): voxel (i, j, k) sits at index point (i, j, k), mapped to world space by
 the grid's transform; a fog volume's values are densities (0 = empty, the background); a level
@@ -184,6 +184,114 @@ def bad():
     write(os.path.join(BAD, "frustum.vdb"), [frustum])
 
 
+# The 2002 slicing paper's external data sets (Figures 9, 11 and 12) are 128^3 volumes we do not
+# have; these look-alikes are built from simple shapes with the same make-up (opaque parts,
+# semi-transparent parts, empty space) and written to scenes/view_slices/. World space is the unit
+# cube (voxel 1/128, z up), which the scenes map onto a texel with `bounds: ((0,0,0), (1,1,1))`.
+N2002 = 128
+
+
+def unit_coords(n=N2002):
+    c = (np.arange(n) + 0.5) / n
+    return np.meshgrid(c, c, c, indexing="ij")
+
+
+def solid(distance, n=N2002):
+    """An opaque solid from a signed distance (negative inside): density 1 inside, a one-voxel
+    ramp across the surface (antialiased slices), 0 outside."""
+    return np.clip(0.5 - distance * n, 0.0, 1.0)
+
+
+def torus_distance(p, centre, axis, major, minor):
+    """Signed distance to a torus around `axis` (a unit vector) through `centre`."""
+    q = [p[i] - centre[i] for i in range(3)]
+    along = sum(q[i] * axis[i] for i in range(3))
+    radial = np.sqrt(np.maximum(sum(q[i] * q[i] for i in range(3)) - along * along, 0.0))
+    return np.sqrt((radial - major) ** 2 + along ** 2) - minor
+
+
+def box_distance(p, lo, hi):
+    """Signed distance to an axis-aligned box (exact outside, max-norm inside)."""
+    c = [(lo[i] + hi[i]) / 2 for i in range(3)]
+    h = [(hi[i] - lo[i]) / 2 for i in range(3)]
+    q = [np.abs(p[i] - c[i]) - h[i] for i in range(3)]
+    outside = np.sqrt(sum(np.maximum(q[i], 0.0) ** 2 for i in range(3)))
+    inside = np.minimum(np.maximum(np.maximum(q[0], q[1]), q[2]), 0.0)
+    return outside + inside
+
+
+def painted(parts, n=N2002):
+    """Density and Cd from (density, rgb) parts; where parts overlap the densest one paints."""
+    density = np.zeros((n, n, n))
+    rgb = np.zeros((n, n, n, 3))
+    for d, c in parts:
+        mask = d > density
+        density = np.where(mask, d, density)
+        rgb[mask] = np.broadcast_to(np.asarray(c, dtype=float), rgb.shape)[mask]
+    return density, rgb
+
+
+def paper2002():
+    t = transform(1.0 / N2002, (0.5 / N2002,) * 3)
+    x, y, z = unit_coords()
+    p = (x, y, z)
+    out = os.path.join(root, "scenes", "view_slices")
+
+    # Figure 9: two interlocked chain links, opaque: one ring standing in the xz plane, one lying
+    # in the xy plane through it.
+    links = [
+        (solid(torus_distance(p, (0.38, 0.5, 0.5), (0, 1, 0), 0.2, 0.065)), (0.75, 0.76, 0.8)),
+        (solid(torus_distance(p, (0.62, 0.5, 0.5), (0, 0, 1), 0.2, 0.065)), (0.85, 0.62, 0.3)),
+    ]
+    d, rgb = painted(links)
+    write(os.path.join(out, "fig9_chain.vdb"), [fog("density", d, t, tolerance=1e-3, half=True), color("Cd", rgb, t)])
+
+    # Figure 11: an opaque volcano with a crater on an opaque floor, two semi-transparent smoke
+    # rings above it, empty space around.
+    rho = np.sqrt((x - 0.5) ** 2 + (y - 0.5) ** 2)
+    cone = np.minimum(0.58 - 1.2 * rho, 0.42 + 1.5 * np.maximum(rho - 0.1, 0.0) * (rho > 0.1))
+    height = np.maximum(np.where(rho < 0.1, 0.42 - 0.5 * (0.1 - rho), cone), 0.06)
+    ground = solid(z - height)
+    rock = (0.32, 0.26, 0.22) * np.ones_like(x)[..., None]
+    lava = np.clip((z - 0.3) / 0.15, 0, 1) * (rho < 0.16)
+    rock_rgb = rock * (1 - lava[..., None]) + np.array([0.9, 0.35, 0.1]) * lava[..., None]
+    grass = (z < 0.075)[..., None] * np.array([0.25, 0.45, 0.2])
+    ground_rgb = np.where((z < 0.075)[..., None], grass, rock_rgb)
+    rings = sum(
+        a * np.exp(-(torus_distance(p, (0.5, 0.5, h), (0, 0, 1), r, 0.0) / w) ** 2)
+        for h, r, w, a in [(0.66, 0.1, 0.035, 0.008), (0.8, 0.15, 0.04, 0.006), (0.92, 0.2, 0.04, 0.004)]
+    )
+    density = np.where(ground > 0, ground, np.where(rings > 2e-4, rings, 0.0))
+    rgb = np.where((ground > 0)[..., None], ground_rgb, np.array([0.85, 0.85, 0.88]))
+    rgb = rgb * (density > 0)[..., None]
+    write(os.path.join(out, "fig11_volcano.vdb"), [fog("density", density, t, tolerance=1e-4, half=True), color("Cd", rgb, t)])
+
+    # Figure 12: a car park: a ground plane with painted bays, two rows of cars (a body and a
+    # cabin each) and trees (a trunk and a round crown), all opaque.
+    bays = ((np.abs((x * 8) % 1.0 - 0.5) > 0.47) & (np.abs(y - 0.5) > 0.08)).astype(float)
+    ground_rgb = np.array([0.25, 0.25, 0.27]) * (1 - bays[..., None]) + np.array([0.9, 0.9, 0.85]) * bays[..., None]
+    parts = [(solid(z - 0.04), ground_rgb)]
+    colours = [(0.8, 0.1, 0.1), (0.1, 0.3, 0.8), (0.9, 0.85, 0.8), (0.15, 0.55, 0.2), (0.9, 0.7, 0.1), (0.2, 0.2, 0.22)]
+    k = 0
+    for row, cy in [(0, 0.28), (1, 0.72)]:
+        for bay in range(1, 7):
+            if (row, bay) in [(0, 3), (1, 5)]:
+                continue  # empty bays
+            cx = (bay + 0.5) / 8
+            c = colours[k % len(colours)]
+            k += 1
+            parts.append((solid(box_distance(p, (cx - 0.045, cy - 0.1, 0.045), (cx + 0.045, cy + 0.1, 0.1))), c))
+            parts.append((solid(box_distance(p, (cx - 0.04, cy - 0.05, 0.1), (cx + 0.04, cy + 0.04, 0.14))), (0.15, 0.2, 0.25)))
+    for tx, ty in [(0.06, 0.08), (0.94, 0.08), (0.06, 0.92), (0.94, 0.92), (0.5, 0.5)]:
+        trunk = np.sqrt((x - tx) ** 2 + (y - ty) ** 2) - 0.012
+        parts.append((solid(np.maximum(trunk, z - 0.25)), (0.35, 0.22, 0.1)))
+        crown = np.sqrt((x - tx) ** 2 + (y - ty) ** 2 + ((z - 0.3) / 1.3) ** 2) - 0.07
+        parts.append((solid(crown), (0.12, 0.42, 0.15)))
+    d, rgb = painted(parts)
+    write(os.path.join(out, "fig12_car_park.vdb"), [fog("density", d, t, tolerance=1e-3, half=True), color("Cd", rgb, t)])
+
+
 if __name__ == "__main__":
-    examples()
-    bad()
+    # Arguments name the sets to write (default all): examples, bad, paper2002.
+    for name in sys.argv[1:] or ["examples", "bad", "paper2002"]:
+        {"examples": examples, "bad": bad, "paper2002": paper2002}[name]()
