@@ -140,13 +140,7 @@ impl MethodPlan for ViewSlicesPlan {
     }
 
     fn summary(&self, object: &ObjectPlan) -> String {
-        let lod = match self.lod {
-            Some(c) => format!(
-                " lod Auto ({} of {} planes, texel level {}: a pixel {:.4} against voxels {:.4} to {:.4} at the nearest depth)",
-                c.planes, self.max_planes, c.level, c.pixel, c.voxel_min, c.voxel_max
-            ),
-            None => String::new(),
-        };
+        let lod = self.choices(object).map(|c| format!(" {c}")).unwrap_or_default();
         format!(
             "ViewSlices planes {} spacing {:.4} trivial_reject {} lighting {} compositor {:?}{lod}, {} chunk(s)",
             self.sweep.plane_count,
@@ -156,6 +150,15 @@ impl MethodPlan for ViewSlicesPlan {
             self.compositor,
             self.chunks.len()
         )
+    }
+
+    fn choices(&self, _object: &ObjectPlan) -> Option<String> {
+        self.lod.map(|c| {
+            format!(
+                "lod Auto ({} of {} planes, texel level {}: a pixel {:.4} against voxels {:.4} to {:.4} at the nearest depth)",
+                c.planes, self.max_planes, c.level, c.pixel, c.voxel_min, c.voxel_max
+            )
+        })
     }
 
     fn metadata(&self, object: &ObjectPlan) -> String {
