@@ -17,7 +17,7 @@ use voltex::scene::{self, Lod};
 /// torus_egg with its camera `k` times as far from the target, at 64x64.
 fn torus_egg(k: f64) -> (scene::Scene, RenderOptions) {
     let scene = scene::load(&voltex::project_root().join("scenes/view_slices/torus_egg.ron")).unwrap();
-    let mut camera = scene.camera.value.clone();
+    let mut camera = scene.camera.value;
     camera.eye = camera.target + (camera.eye - camera.target) * k;
     (scene, RenderOptions { size: Some((64, 64)), camera: Some(camera), ..Default::default() })
 }
