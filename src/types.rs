@@ -41,7 +41,9 @@ pub struct SliceParams {
     pub prism_count: u32,
     /// Capacity of the slice-vertex buffer, in vertices.
     pub vertex_capacity: u32,
-    pub _pad: [u32; 3],
+    /// MIP level of the texel volume the slices sample (`lod: Auto`; 0: full resolution).
+    pub texel_level: f32,
+    pub _pad: [u32; 2],
 }
 
 /// One vertex of a slice polygon, triangulated as a fan into a triangle list.

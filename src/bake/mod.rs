@@ -1,9 +1,11 @@
 //! Host side of the bake kernels: a texel source becomes an RGBA texel volume (3D texture,
-//! premultiplied `rgba8unorm`, level 0 only: every method samples it at full resolution), plus a normal volume when a per-pixel-lit object
-//! uses it. Only texels some object draws are baked, each (texel, lighting) pair once.
+//! premultiplied `rgba8unorm`; level 0 only, which every method samples at full resolution,
+//! unless `ViewSlices(lod: Auto)` asks for its MIP levels), plus a normal volume when a
+//! per-pixel-lit object uses it. Only texels some object draws are baked, each (texel, lighting) pair once.
 
 pub mod axis_slices;
 pub mod hypertexture;
+pub mod texel_mips;
 pub mod volume;
 
 use crate::gpu::sources::Sources;
@@ -116,6 +118,8 @@ pub struct BakeRequest {
     pub axis_slices: bool,
     /// ... with their MIP levels (`AxisSlices(mipmaps: true)`).
     pub axis_mipmaps: bool,
+    /// The MIP levels of the volume (and normal volume) too (`ViewSlices(lod: Auto)`).
+    pub volume_mipmaps: bool,
 }
 
 impl BakeRequest {
@@ -143,6 +147,9 @@ impl BakeRequest {
         if self.axis_slices && self.axis_mipmaps {
             k.push("axis_slices/mip_axis_slices.wgsl");
         }
+        if self.volume_mipmaps {
+            k.push(MIP_KERNEL);
+        }
         k
     }
 }
@@ -161,9 +168,10 @@ impl BakeRequest {
     pub fn memory(&self, texel: &str) -> Vec<(String, u64)> {
         let [x, y, z] = self.resolution;
         let normals = if self.per_pixel { " + normals" } else { "" };
+        let mips = if self.volume_mipmaps { " with MIP levels" } else { "" };
         let mut out = vec![(
-            format!("texel {texel} {x}x{y}x{z} rgba8{normals}"),
-            bytes(self.resolution, self.per_pixel),
+            format!("texel {texel} {x}x{y}x{z} rgba8{normals}{mips}"),
+            bytes(self.resolution, self.per_pixel, self.volume_mipmaps),
         )];
         if self.axis_slices {
             let mips = if self.axis_mipmaps { " with MIP levels" } else { "" };
@@ -179,10 +187,11 @@ impl BakeRequest {
     pub fn allocations(&self, texel: &str) -> Vec<Allocation> {
         let res = self.resolution;
         let voxels = res.iter().map(|&r| r as u64).product::<u64>();
+        let with_mips = texel_mips::voxels(res, self.volume_mipmaps);
         let driver = Driver::Texel(texel.to_string());
         let volume = |what: String, size| Allocation {
             what,
-            bytes: voxels * 4,
+            bytes: with_mips * 4,
             shape: Shape::Texture3d { size },
             driver: driver.clone(),
         };
@@ -240,6 +249,9 @@ impl BakeRequest {
         };
         let lighting = if self.per_pixel { "per-pixel (albedo + normals)" } else { "baked" };
         let mut s = format!("  {texel:<16} {x}x{y}x{z}  {kind}  lighting {lighting}\n");
+        if self.volume_mipmaps {
+            s += "  (and its MIP levels: mip_texel_volume.wgsl per level)\n";
+        }
         if self.axis_slices {
             s += "  (and its slice images: bake_axis_slices.wgsl per direction and level)\n";
             if self.axis_mipmaps {
@@ -250,11 +262,15 @@ impl BakeRequest {
     }
 }
 
-/// Bytes a bake allocates on the GPU (volume, plus normals at the same resolution).
-pub fn bytes(res: [u32; 3], per_pixel: bool) -> u64 {
-    let volume = res.iter().map(|&x| x as u64).product::<u64>() * 4;
+/// Bytes a bake allocates on the GPU (volume, plus normals at the same resolution; both with
+/// their MIP levels when `mipmaps`).
+pub fn bytes(res: [u32; 3], per_pixel: bool, mipmaps: bool) -> u64 {
+    let volume = texel_mips::voxels(res, mipmaps) * 4;
     volume + if per_pixel { volume } else { 4 }
 }
+
+/// The kernel making a texel volume's MIP levels.
+const MIP_KERNEL: &str = "bake/mip_texel_volume.wgsl";
 
 /// The bake kernels, loaded once and reused for every texel.
 /// Each kernel with the hash of its source, so that a baker kept across the preview's rebuilds
@@ -271,6 +287,9 @@ pub struct Baker {
     axis: Slot,
     volume: Slot,
     axis_mip: Slot,
+    /// `mip_texel_volume` writing the volume's format, and writing normals (`rgba8snorm`).
+    volume_mip: Slot,
+    normals_mip: Slot,
     sources: Sources,
     /// `Rgba32Float` for [`Baker::full_precision`], else `Rgba8Unorm`.
     format: wgpu::TextureFormat,
@@ -289,6 +308,8 @@ impl Baker {
             axis: None,
             volume: None,
             axis_mip: None,
+            volume_mip: None,
+            normals_mip: None,
             sources: sources.clone(),
             format: wgpu::TextureFormat::Rgba8Unorm,
         }
@@ -328,6 +349,29 @@ impl Baker {
         Ok(&mut slot.as_mut().unwrap().1)
     }
 
+    /// `mip_texel_volume` with its `coarser` declared in `format`.
+    fn mip_kernel<'a>(
+        slot: &'a mut Slot,
+        ctx: &GpuContext,
+        sources: &Sources,
+        format: wgpu::TextureFormat,
+    ) -> Result<&'a mut ComputeKernel> {
+        let hash = crate::gpu::shader::source_hash(sources, MIP_KERNEL)?;
+        if slot.as_ref().is_none_or(|(h, _)| *h != hash) {
+            let mut kernel = crate::gpu::shader::load_from(sources, MIP_KERNEL)?;
+            let storage = match format {
+                wgpu::TextureFormat::Rgba32Float => Some(naga::StorageFormat::Rgba32Float),
+                wgpu::TextureFormat::Rgba8Snorm => Some(naga::StorageFormat::Rgba8Snorm),
+                _ => None,
+            };
+            if let Some(storage) = storage {
+                kernel = kernel.with_storage_format("coarser", storage)?;
+            }
+            *slot = Some((hash, ComputeKernel::new(ctx, kernel)?));
+        }
+        Ok(&mut slot.as_mut().unwrap().1)
+    }
+
     pub fn bake(&mut self, ctx: &GpuContext, req: &BakeRequest) -> Result<Baked> {
         let max3d = ctx.limits.max_texture_dimension_3d;
         if req.resolution.iter().any(|&r| r == 0 || r > max3d) {
@@ -336,9 +380,16 @@ impl Baker {
                 req.resolution
             )));
         }
-        let volume = volume_texture(ctx, "texel volume", req.resolution, self.format);
+        let mips = |res| if req.volume_mipmaps { texel_mips::mip_levels(res) } else { 1 };
+        let volume = volume_texture(ctx, "texel volume", req.resolution, mips(req.resolution), self.format);
         let normals_res = if req.per_pixel { req.resolution } else { [1, 1, 1] };
-        let normals = volume_texture(ctx, "texel normals", normals_res, wgpu::TextureFormat::Rgba8Snorm);
+        let normals = volume_texture(
+            ctx,
+            "texel normals",
+            normals_res,
+            mips(normals_res),
+            wgpu::TextureFormat::Rgba8Snorm,
+        );
         let params = crate::cpu::bake::bake_params(req.resolution, 0, req.light, req.ambient);
         let mut inputs = Inputs::default();
         inputs.constants.push(("per_pixel_lighting".into(), req.per_pixel as u32 as f64));
@@ -459,6 +510,12 @@ impl Baker {
                 v.bake(ctx, kernel, &mut encoder, &mut inputs, params)?;
             }
         }
+        if req.volume_mipmaps {
+            for (slot, texture) in [(&mut self.volume_mip, &volume), (&mut self.normals_mip, &normals)] {
+                let kernel = Self::mip_kernel(slot, ctx, &root, texture.format())?;
+                texel_mips::record(ctx, kernel, &mut encoder, texture)?;
+            }
+        }
         let axis = match req.axis_slices {
             true => {
                 let format = self.format;
@@ -490,12 +547,13 @@ fn volume_texture(
     ctx: &GpuContext,
     label: &str,
     res: [u32; 3],
+    mip_level_count: u32,
     format: wgpu::TextureFormat,
 ) -> wgpu::Texture {
     ctx.device.create_texture(&wgpu::TextureDescriptor {
         label: Some(label),
         size: wgpu::Extent3d { width: res[0], height: res[1], depth_or_array_layers: res[2] },
-        mip_level_count: 1,
+        mip_level_count,
         sample_count: 1,
         dimension: wgpu::TextureDimension::D3,
         format,

@@ -127,6 +127,27 @@ pub struct Overrides {
     /// (binned into screen tiles, composited front to back by compute) (default: the scene's).
     #[arg(long, value_enum)]
     compositor: Option<CompositorArg>,
+    /// Level of detail of every ViewSlices object: `off` (the scene's planes, the texel at full
+    /// resolution) or `auto` (planes and texel MIP level from the object's size on screen)
+    /// (default: the scene's).
+    #[arg(long, value_enum)]
+    lod: Option<LodArg>,
+}
+
+/// A `--lod` value.
+#[derive(clap::ValueEnum, Clone, Copy, Debug)]
+pub enum LodArg {
+    Off,
+    Auto,
+}
+
+impl From<LodArg> for voltex::scene::Lod {
+    fn from(l: LodArg) -> Self {
+        match l {
+            LodArg::Off => Self::Off,
+            LodArg::Auto => Self::Auto,
+        }
+    }
 }
 
 /// A `--compositor` value.
@@ -207,6 +228,7 @@ impl Overrides {
             aovs: self.aov.clone(),
             shadows: self.shadows.map(|s| s.0),
             compositor: self.compositor.map(Into::into),
+            lod: self.lod.map(Into::into),
             ..Default::default()
         })
     }

@@ -29,6 +29,10 @@ pub struct ParetoCmd {
     /// ViewSlices plane counts (each with the trivial reject on and off).
     #[arg(long, value_delimiter = ',', default_values_t = voltex::pareto::DEFAULT_PLANES)]
     planes: Vec<u32>,
+    /// Also sweep ViewSlices with `lod: Auto` (planes and texel MIP level from the size on
+    /// screen), each plane count its most planes.
+    #[arg(long)]
+    lod: bool,
     /// Reference ray steps, as multiples of the default step.
     #[arg(long, value_delimiter = ',', default_values_t = voltex::pareto::DEFAULT_STEP_FACTORS)]
     steps: Vec<f64>,
@@ -118,6 +122,7 @@ pub fn run(p: ParetoCmd) -> Result<()> {
         truth: p.truth,
         methods: p.methods.into_iter().map(sweep).collect(),
         planes: p.planes,
+        lod: p.lod,
         steps: p.steps,
         criteria: p.criteria,
         ray_steps: p.ray_steps,

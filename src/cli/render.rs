@@ -187,6 +187,11 @@ fn render_one(
         frame.image.height,
         ctx.adapter_line()
     );
+    for o in &renderer.blueprint.objects {
+        for c in o.methods.iter().filter_map(|m| m.choices(o)) {
+            println!("  object {}: {c}", o.object.name);
+        }
+    }
     for (pass, ms) in &frame.pass_times {
         println!("  {pass:<20} {ms:>9.3} ms");
     }

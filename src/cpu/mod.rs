@@ -7,5 +7,6 @@ pub mod bake_mesh_texel;
 pub mod bake_splats;
 pub mod bake_transfer;
 pub mod hypertexture;
+pub mod mip_texel_volume;
 pub mod noise_simplex;
 pub mod prism_map;

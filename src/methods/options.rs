@@ -47,6 +47,8 @@ pub struct RenderOptions {
     pub budget: Option<u64>,
     /// Compositor of every ViewSlices object (`--compositor`, the sweeps).
     pub compositor: Option<crate::scene::Compositor>,
+    /// Level of detail of every ViewSlices object (`--lod`, the sweeps).
+    pub lod: Option<crate::scene::Lod>,
     /// Entries of a `Tiles` compositor's tile lists (default: sized from the sweep and the
     /// output; tests make it small to exercise the overflow path).
     pub tile_entries: Option<u32>,
@@ -137,12 +139,14 @@ impl RenderOptions {
                 trivial_reject: self.trivial_reject.unwrap_or(vs.trivial_reject),
                 lighting,
                 compositor: self.compositor.unwrap_or(vs.compositor),
+                lod: self.lod.unwrap_or(vs.lod),
             }),
             (MethodKind::ViewSlices, _) => Method::ViewSlices(ViewSlices {
                 planes: self.planes.unwrap_or(DEFAULT_PLANES),
                 trivial_reject: self.trivial_reject.unwrap_or(true),
                 lighting,
                 compositor: self.compositor.unwrap_or_default(),
+                lod: self.lod.unwrap_or_default(),
             }),
             (MethodKind::Reference, Method::Reference(r)) => {
                 Method::Reference(Reference { step: self.step.or(r.step), lighting })

@@ -134,6 +134,11 @@ pub trait MethodPlan: Any + Send {
     /// The method and knobs written into EXR metadata.
     fn metadata(&self, object: &ObjectPlan) -> String;
 
+    /// What the plan chose from the view (a level of detail), for the render log.
+    fn choices(&self, _object: &ObjectPlan) -> Option<String> {
+        None
+    }
+
     /// GPU memory the plan allocates, by item.
     fn memory(&self, object: &ObjectPlan, size: (u32, u32)) -> Vec<(String, u64)>;
 

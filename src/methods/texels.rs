@@ -152,6 +152,7 @@ pub fn bake_index(
             ambient: light.ambient,
             axis_slices: false,
             axis_mipmaps: false,
+            volume_mipmaps: false,
         },
         opacity_length: t.opacity_length(&scene.hypertextures),
     });

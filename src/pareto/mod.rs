@@ -110,6 +110,7 @@ impl Truth {
                 method: Some(MethodKind::ViewSlices),
                 planes: Some(n),
                 trivial_reject: Some(true),
+                lod: Some(crate::scene::Lod::Off),
                 ..Default::default()
             },
             Truth::RayMarch(step, shadows) => RenderOptions {
@@ -137,6 +138,8 @@ pub struct Args {
     pub methods: Vec<Sweep>,
     /// `ViewSlices` plane counts (each with the trivial reject on and off).
     pub planes: Vec<u32>,
+    /// `ViewSlices` with `lod: Auto` too, each plane count its most planes (trivial reject on).
+    pub lod: bool,
     /// `Reference` steps as multiples of the default step.
     pub steps: Vec<f64>,
     /// `AxisSlices` criteria, `d = p` (voxels and pixels).
@@ -201,7 +204,8 @@ impl Args {
     }
 }
 
-/// `ViewSlices`: each plane count with the trivial reject on and off (a speed knob only).
+/// `ViewSlices`: each plane count with the trivial reject on and off (a speed knob only), at
+/// full detail; with `lod`, also `lod: Auto` under each count.
 pub fn view_slices(args: &Args) -> Vec<Setting> {
     let mut v = Vec::new();
     for planes in unique(args.planes.iter().copied()) {
@@ -215,6 +219,22 @@ pub fn view_slices(args: &Args) -> Vec<Setting> {
                     method: Some(MethodKind::ViewSlices),
                     planes: Some(planes),
                     trivial_reject: Some(reject),
+                    lod: Some(crate::scene::Lod::Off),
+                    ..Default::default()
+                },
+            });
+        }
+        if args.lod {
+            v.push(Setting {
+                method: "ViewSlices",
+                knobs: format!("planes={planes} reject=on lod=auto"),
+                tag: format!("{planes} lod"),
+                options: RenderOptions {
+                    size: Some(args.size),
+                    method: Some(MethodKind::ViewSlices),
+                    planes: Some(planes),
+                    trivial_reject: Some(true),
+                    lod: Some(crate::scene::Lod::Auto),
                     ..Default::default()
                 },
             });

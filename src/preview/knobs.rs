@@ -172,6 +172,7 @@ mod tests {
             trivial_reject: true,
             lighting: Default::default(),
             compositor: Default::default(),
+            lod: Default::default(),
         });
         let e = step_quality(SRC, &node(0), &v, true).unwrap().unwrap();
         assert_eq!(e.apply(SRC).unwrap(), SRC.replace("planes: 24", "planes: 48"));

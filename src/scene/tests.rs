@@ -60,7 +60,8 @@ fn spec_example_parses() {
             planes: 400,
             trivial_reject: true,
             lighting: Lighting::Baked,
-            compositor: Default::default()
+            compositor: Default::default(),
+            lod: Default::default()
         }))
     );
     // uv tiling applied to corners: the torus seam reaches u = 4.

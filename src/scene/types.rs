@@ -813,6 +813,24 @@ pub struct ViewSlices {
     /// screen tile by compute kernels.
     #[serde(default)]
     pub compositor: Compositor,
+    /// Level of detail: `Off` draws `planes` planes and the texel at full resolution; `Auto`
+    /// chooses the plane count (at most `planes`) and the texel's MIP level from the object's
+    /// size on screen (Meyer & Neyret 1998).
+    #[serde(default)]
+    pub lod: Lod,
+}
+
+/// Level of detail of `ViewSlices`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum Lod {
+    /// `planes` planes, the texel at full resolution.
+    #[default]
+    Off,
+    /// Planes about two per pixel (or per texel voxel, when a voxel covers more than a pixel) of
+    /// the depth extent at the object's nearest depth, at most `planes`; the texel at the MIP
+    /// level whose voxels cover at most a pixel there.
+    Auto,
 }
 
 /// How `ViewSlices` composites its slice polygons into the frame.

@@ -28,4 +28,5 @@ mod reference;
 mod regress;
 mod render_scenes;
 mod tile_compositor;
+mod view_slices_lod;
 mod volume;

@@ -1,4 +1,4 @@
-// One slice fragment as draw_slices and composite_tiles shade it: the texel at level 0, the
+// One slice fragment as draw_slices and composite_tiles shade it: the texel at its level, the
 // step-corrected opacity, baked or per-pixel (Phong) lighting; premultiplied. The including
 // kernel declares `frame`, `slice_params`, `volume`, `normals`, `volume_sampler`,
 // `prisms`, `shell_vertices`, `vertex_frames` and the override `per_pixel_lighting`.
@@ -44,16 +44,17 @@ fn slice_exponent(ray: vec3<f32>, opacity_length: f32) -> f32 {
 // The premultiplied colour and opacity of a fragment at texel coordinates `uvw` along the unit
 // `ray`, with step-correction `exponent` and the interpolated frame `f` (per-pixel lighting only).
 fn slice_fragment(uvw: vec3<f32>, ray: vec3<f32>, exponent: f32, f: SliceFrame) -> vec4<f32> {
-    // Level 0, as the Reference samples it. Mipmaps chosen by the sampler's implicit level cost
+    // Level 0 as the Reference samples it, or the object's level chosen by `lod: Auto`, explicit
+    // and the same for every fragment. Mipmaps chosen by the sampler's implicit level cost
     // accuracy (a 3D mip also blurs along w, the shell's height profile) and depend on the adapter:
     // on torus_egg at 128x128 they doubled the FLIP against a 4x4-supersampled Reference (0.131
     // against 0.062) and differed by 0.029 between llvmpipe and an NVIDIA H100.
-    let texel = textureSampleLevel(volume, volume_sampler, uvw, 0.0);
+    let texel = textureSampleLevel(volume, volume_sampler, uvw, slice_params.texel_level);
     let a = clamp(texel.a, 0.0, 1.0);
     let corrected = 1.0 - pow(1.0 - min(a, 0.999999), exponent);
     var rgb = texel.rgb * select(0.0, corrected / a, a > 1e-6);
     if per_pixel_lighting {
-        let tex_normal = textureSampleLevel(normals, volume_sampler, uvw, 0.0).xyz;
+        let tex_normal = textureSampleLevel(normals, volume_sampler, uvw, slice_params.texel_level).xyz;
         var n = f.n_s * tex_normal.x + f.n_t * tex_normal.y + f.n_w * tex_normal.z;
         n = select(-ray, normalize(n), dot(n, n) > 1e-20);
         let albedo = texel.rgb * select(0.0, 1.0 / a, a > 1e-6);

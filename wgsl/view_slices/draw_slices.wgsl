@@ -49,7 +49,7 @@ fn vs_main(@builtin(vertex_index) index: u32) -> VsOut {
 
 // The texel's opacity over `opacity_length` (x) and over this pixel's ray between two planes (y).
 fn slice_alpha(in: VsOut) -> vec2<f32> {
-    let texel = textureSampleLevel(volume, volume_sampler, in.uvw, 0.0);
+    let texel = textureSampleLevel(volume, volume_sampler, in.uvw, slice_params.texel_level);
     let step = slice_params.spacing / max(dot(normalize(in.rel), frame.forward.xyz), 1e-4);
     let a = clamp(texel.a, 0.0, 1.0);
     return vec2<f32>(a, 1.0 - pow(1.0 - min(a, 0.999999), step / object.opacity_length));

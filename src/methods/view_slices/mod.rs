@@ -1,6 +1,7 @@
 //! Host side of view-aligned prism slicing (2002 paper): the plane sweep of one object and the
 //! buffers its kernels (`count_slices`, `scan_plane_offsets`, `emit_slices`) and `draw_slices` use.
 
+pub mod lod;
 mod object;
 pub mod slice_prisms;
 pub mod tile_buffers;
@@ -54,7 +55,8 @@ pub fn sweep(shell: &Shell, forward: [f32; 3], planes: u32, near: f64) -> SliceP
         plane_count: planes,
         prism_count: shell.prisms.len() as u32,
         vertex_capacity: 0,
-        _pad: [0; 3],
+        texel_level: 0.0,
+        _pad: [0; 2],
     }
 }
 

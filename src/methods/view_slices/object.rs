@@ -1,10 +1,11 @@
 //! One ViewSlices object of a frame: its plane sweep in chunks, and what the renderer asks of it.
 
+use super::lod::{self, LodChoice};
 use super::{add_inputs, check_budget, check_capacity, chunks, sweep, tile_buffers, tiles, SliceChunk};
 use crate::error::{Error, Result};
 use crate::gpu::{buffers, Inputs};
 use crate::methods::{texels, InputCx, MethodPlan, ObjectPlan, PartDecl, PlanCx};
-use crate::scene::{Compositor, Lighting, Method, ViewSlices, MAX_PLANES};
+use crate::scene::{Compositor, Lighting, Lod, Method, ViewSlices, MAX_PLANES};
 use crate::types::{SliceParams, SliceVertex, VertexFrame};
 
 pub struct ViewSlicesPlan {
@@ -17,6 +18,10 @@ pub struct ViewSlicesPlan {
     pub tile_entries: Vec<u32>,
     /// The rendered size the tiles were planned for.
     pub size: (u32, u32),
+    /// The scene's plane count (`lod: Auto`: the most it may draw).
+    pub max_planes: u32,
+    /// What `lod: Auto` chose; `None` when off.
+    pub lod: Option<LodChoice>,
 }
 
 /// Plans `object`'s sweep, its texel bake and its lighting.
@@ -26,12 +31,24 @@ pub fn plan(cx: &mut PlanCx, object: &mut ObjectPlan, m: &ViewSlices) -> Result<
         return Err(Error::Invalid(format!("{planes} planes: expected a plane count in 1..={MAX_PLANES}")));
     }
     object.per_pixel = m.lighting == Lighting::PerPixel;
-    let sweep = sweep(&object.shell, cx.view.forward_f32(), planes, cx.view.near);
+    let texel = object.object.texel.clone().unwrap_or_default();
+    let bake = texels::bake_index(cx.scene, &texel, object.per_pixel, cx.light, cx.time, cx.bakes)?;
+    object.bake = Some(bake);
+    let forward = cx.view.forward_f32();
+    let lod = (m.lod == Lod::Auto).then(|| {
+        let res = cx.bakes[bake].request.resolution;
+        let levels = crate::bake::texel_mips::mip_levels(res);
+        lod::choose(&object.shell, forward, cx.view.focal, cx.view.near, res, levels, planes)
+    });
+    // The MIP levels are baked only when some object samples them.
+    if lod.is_some_and(|c| c.level > 0) {
+        cx.bakes[bake].request.volume_mipmaps = true;
+    }
+    let mut sweep = sweep(&object.shell, forward, lod.map_or(planes, |c| c.planes), cx.view.near);
+    sweep.texel_level = lod.map_or(0.0, |c| c.level as f32);
     let chunks = chunks(&object.shell, &sweep);
     check_budget(&chunks, &object.object.name, planes)?;
     object.frames = object.per_pixel.then(|| crate::mesh::shell::vertex_frames(&object.object.surface));
-    let texel = object.object.texel.clone().unwrap_or_default();
-    object.bake = Some(texels::bake_index(cx.scene, &texel, object.per_pixel, cx.light, cx.time, cx.bakes)?);
     let tile_entries = match m.compositor {
         Compositor::Raster => Vec::new(),
         Compositor::Tiles => {
@@ -52,6 +69,8 @@ pub fn plan(cx: &mut PlanCx, object: &mut ObjectPlan, m: &ViewSlices) -> Result<
         compositor: m.compositor,
         tile_entries,
         size: cx.view.size,
+        max_planes: planes,
+        lod,
     }));
     Ok(())
 }
@@ -121,8 +140,9 @@ impl MethodPlan for ViewSlicesPlan {
     }
 
     fn summary(&self, object: &ObjectPlan) -> String {
+        let lod = self.choices(object).map(|c| format!(" {c}")).unwrap_or_default();
         format!(
-            "ViewSlices planes {} spacing {:.4} trivial_reject {} lighting {} compositor {:?}, {} chunk(s)",
+            "ViewSlices planes {} spacing {:.4} trivial_reject {} lighting {} compositor {:?}{lod}, {} chunk(s)",
             self.sweep.plane_count,
             self.sweep.spacing,
             self.trivial_reject,
@@ -132,9 +152,22 @@ impl MethodPlan for ViewSlicesPlan {
         )
     }
 
+    fn choices(&self, _object: &ObjectPlan) -> Option<String> {
+        self.lod.map(|c| {
+            format!(
+                "lod Auto ({} of {} planes, texel level {}: a pixel {:.4} against voxels {:.4} to {:.4} at the nearest depth)",
+                c.planes, self.max_planes, c.level, c.pixel, c.voxel_min, c.voxel_max
+            )
+        })
+    }
+
     fn metadata(&self, object: &ObjectPlan) -> String {
+        let lod = match self.lod {
+            Some(c) => format!(", lod: Auto, max planes: {}, texel level: {}", self.max_planes, c.level),
+            None => String::new(),
+        };
         format!(
-            "ViewSlices(planes: {}, trivial_reject: {}, lighting: {}, compositor: {:?})",
+            "ViewSlices(planes: {}, trivial_reject: {}, lighting: {}, compositor: {:?}{lod})",
             self.sweep.plane_count,
             self.trivial_reject,
             lighting(object),
@@ -180,10 +213,11 @@ impl MethodPlan for ViewSlicesPlan {
     fn scene_method(&self, object: &ObjectPlan) -> Option<Method> {
         let lighting = if object.per_pixel { Lighting::PerPixel } else { Lighting::Baked };
         Some(Method::ViewSlices(ViewSlices {
-            planes: self.sweep.plane_count,
+            planes: self.max_planes,
             trivial_reject: self.trivial_reject,
             lighting,
             compositor: self.compositor,
+            lod: if self.lod.is_some() { Lod::Auto } else { Lod::Off },
         }))
     }
 

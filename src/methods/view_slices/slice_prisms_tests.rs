@@ -437,7 +437,8 @@ fn flat_shell_cross_section_area_at_30_degrees() {
         plane_count: 1,
         prism_count: prisms.len() as u32,
         vertex_capacity: u32::MAX,
-        _pad: [0; 3],
+        texel_level: 0.0,
+        _pad: [0; 2],
     };
     let tris = &emit_slices(&v, &prisms, &params, true)[0];
     let total: f64 =
@@ -469,7 +470,8 @@ fn counts_scan_and_slices_agree_and_trivial_reject_changes_nothing() {
         plane_count: 64,
         prism_count: prisms.len() as u32,
         vertex_capacity: 1000,
-        _pad: [0; 3],
+        texel_level: 0.0,
+        _pad: [0; 2],
     };
     let slices = emit_slices(&v, &prisms, &params, true);
     assert_eq!(slices, emit_slices(&v, &prisms, &params, false));
