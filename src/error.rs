@@ -63,21 +63,21 @@ pub fn line_col(source: &str, offset: usize) -> (usize, usize) {
 }
 
 /// Byte offset of 1-based `line` and `col` in `source` (the inverse of [`line_col`]).
-pub fn offset_of(source: &str, line: usize, col: usize) -> usize {
+pub(crate) fn offset_of(source: &str, line: usize, col: usize) -> usize {
     let start: usize = source.split_inclusive('\n').take(line.saturating_sub(1)).map(str::len).sum();
     (start + col.saturating_sub(1)).min(source.len())
 }
 
 /// Position of the string literal `"text"` in a RON source (the first one at or after byte
 /// `from`), for errors found after parsing, when serde no longer knows where a value was.
-pub fn locate_literal(source: &str, text: &str, from: usize) -> Option<(usize, usize)> {
+pub(crate) fn locate_literal(source: &str, text: &str, from: usize) -> Option<(usize, usize)> {
     let needle = format!("\"{text}\"");
     let start = from.min(source.len());
     source[start..].find(&needle).map(|i| line_col(source, start + i))
 }
 
 /// Turns a ron error into `path:line:col: message`.
-pub fn ron_error(path: &Path, e: &ron::error::SpannedError) -> Error {
+pub(crate) fn ron_error(path: &Path, e: &ron::error::SpannedError) -> Error {
     Error::at(FileLoc::new(path, e.span.start.line, e.span.start.col), e.code.to_string())
 }
 

@@ -30,7 +30,7 @@ pub struct Progress {
     worked: usize,
     running: Vec<String>,
     tty: bool,
-    pub verbosity: Verbosity,
+    pub(crate) verbosity: Verbosity,
     start: Instant,
 }
 
@@ -84,7 +84,7 @@ impl Progress {
     }
 
     /// A line that is not about one item (a fatal error, say); errors show even with `--quiet`.
-    pub fn note(&self, text: &str) {
+    pub(crate) fn note(&self, text: &str) {
         if self.verbosity == Verbosity::Quiet && !text.starts_with("error") {
             return;
         }

@@ -13,7 +13,7 @@
 pub mod cost;
 pub mod hyper;
 pub mod json;
-pub mod limits;
+pub(crate) mod limits;
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -25,7 +25,7 @@ use crate::pareto::measure::timed;
 use crate::render::{Blueprint, RenderOptions, Renderer};
 use crate::scene::{Compositor, Scene};
 
-pub fn default_scenes() -> Vec<PathBuf> {
+pub(crate) fn default_scenes() -> Vec<PathBuf> {
     let root = crate::project_root().join("scenes/view_slices");
     vec![root.join("torus_egg.ron"), root.join("terrain.ron")]
 }
