@@ -6,12 +6,16 @@ use std::path::{Path, PathBuf};
 /// A position in a user file, 1-based, printed as `path:line:col`.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct FileLoc {
+    /// The user file.
     pub path: PathBuf,
+    /// Line, from 1.
     pub line: usize,
+    /// Column, from 1.
     pub col: usize,
 }
 
 impl FileLoc {
+    /// Line `line`, column `col` (both 1-based) of `path`.
     pub fn new(path: impl AsRef<Path>, line: usize, col: usize) -> Self {
         Self { path: path.as_ref().to_path_buf(), line, col }
     }
@@ -23,14 +27,25 @@ impl fmt::Display for FileLoc {
     }
 }
 
+/// The library's error: where it happened (a position or a whole file) and what was expected.
 #[derive(Debug, thiserror::Error)]
 pub enum Error {
     /// Something wrong at a known place in a user file.
     #[error("{loc}: {message}")]
-    At { loc: FileLoc, message: String },
+    At {
+        /// Where.
+        loc: FileLoc,
+        /// What is wrong and what was expected.
+        message: String,
+    },
     /// A file that cannot be read or written, or is wrong as a whole.
     #[error("{}: {message}", path.display())]
-    File { path: PathBuf, message: String },
+    File {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong with it.
+        message: String,
+    },
     /// The GPU, its adapter or its limits.
     #[error("GPU: {0}")]
     Gpu(String),
@@ -44,14 +59,18 @@ pub enum Error {
 }
 
 impl Error {
+    /// An error at `loc` in a user file.
     pub fn at(loc: FileLoc, message: impl Into<String>) -> Self {
         Error::At { loc, message: message.into() }
     }
+
+    /// An error about file `path` as a whole.
     pub fn file(path: impl AsRef<Path>, message: impl fmt::Display) -> Self {
         Error::File { path: path.as_ref().to_path_buf(), message: message.to_string() }
     }
 }
 
+/// `Result` with the library's [`Error`].
 pub type Result<T, E = Error> = std::result::Result<T, E>;
 
 /// Line and column (1-based) of byte `offset` in `source`.

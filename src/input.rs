@@ -4,7 +4,7 @@
 //! a cap, and it is read through a reader that stops one byte past the cap (a file that grows
 //! while it is read, or lies about its size, cannot exhaust memory).
 //!
-//! Caps: [`TEXT_CAP`] for text voltex parses whole (scene, graph, WGSL, camera), [`ASSET_CAP`]
+//! Caps: `TEXT_CAP` for text voltex parses whole (scene, graph, WGSL, camera), `ASSET_CAP`
 //! for assets (OBJ, PNG, EXR). `VOLTEX_MAX_FILE_BYTES` (bytes, or with a `K`, `M` or `G` suffix)
 //! replaces both.
 //!
@@ -172,7 +172,7 @@ pub(crate) fn read(path: &Path, kind: Kind, role: &str) -> Result<Vec<u8>> {
     Ok(out)
 }
 
-/// The text of `path` (see [`open`]); invalid UTF-8 is an error at its `line:col`.
+/// The text of `path` (see `open`); invalid UTF-8 is an error at its `line:col`.
 pub fn read_text(path: &Path, role: &str) -> Result<String> {
     utf8(path, read(path, Kind::Text, role)?)
 }

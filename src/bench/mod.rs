@@ -8,7 +8,7 @@
 //!
 //! `--json FILE` writes the rows ([`json`]) with the cost model ([`cost`]: frame time against
 //! slice triangles, planes x visible prisms); `--limits` measures the adapter's own blend, texture
-//! and noise rates first ([`limits`]) and prints each setting's share of the blend limit.
+//! and noise rates first (`limits`) and prints each setting's share of the blend limit.
 
 pub mod cost;
 pub mod hyper;

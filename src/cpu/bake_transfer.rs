@@ -1,5 +1,5 @@
 //! CPU twin (f64) of `wgsl/ray_march/bake_transfer.wgsl`: transfer functions sampled into tables of
-//! [`TRANSFER_SIZE`] entries over [0, 1].
+//! `TRANSFER_SIZE` entries over [0, 1].
 
 use crate::types::{TransferFunction, TransferPoint};
 

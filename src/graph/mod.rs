@@ -130,7 +130,7 @@ pub enum ResourceDecl {
 }
 
 /// The size of a graph buffer. Counts are size expressions: integer literals and the frame's
-/// counts (`width`, `height`) joined by `*` and `+`, e.g. `"width * height"` (see [`expr`]).
+/// counts (`width`, `height`) joined by `*` and `+`, e.g. `"width * height"` (see `expr`).
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub enum BufferSize {

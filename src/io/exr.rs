@@ -68,7 +68,7 @@ pub struct CameraAttributes {
     pub(crate) far: f32,
 }
 
-/// Like [`write`], with AOV channels and camera attributes. A channel name must be 1–255 Latin-1
+/// Like [`write()`], with AOV channels and camera attributes. A channel name must be 1–255 Latin-1
 /// bytes, not R, G, B or A, and appear once; each channel has one sample per pixel.
 pub fn write_with(path: &Path, image: &Image, metadata: &[(&str, String)], extras: &Extras) -> Result<()> {
     if image.pixels.len() != image.width as usize * image.height as usize {

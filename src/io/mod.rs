@@ -124,7 +124,7 @@ impl Image {
         self.width == other.width && self.height == other.height
     }
 
-    /// The image tonemapped with [`tonemap`] into 8-bit sRGB; alpha is clamped to [0, 1] and
+    /// The image tonemapped with `tonemap` into 8-bit sRGB; alpha is clamped to [0, 1] and
     /// quantized linearly.
     pub fn to_srgb8(&self) -> Vec<[u8; 4]> {
         self.pixels

@@ -9,7 +9,7 @@ use super::atomic::write_atomic;
 use super::Image;
 use crate::{Error, Result};
 
-/// Writes `image` tonemapped with [`super::tonemap`] as an 8-bit sRGB PNG, atomically. Alpha is
+/// Writes `image` tonemapped with `super::tonemap` as an 8-bit sRGB PNG, atomically. Alpha is
 /// dropped (the PNG is opaque): it is a preview of the colour; alpha stays in the EXR.
 pub fn write_tonemapped(path: &Path, image: &Image) -> Result<()> {
     let mut rgba = image.to_srgb8();

@@ -223,7 +223,7 @@ pub fn write(path: &Path, grids: &[Grid], compression: Compression) -> Result<()
     stage(path, grids, compression)?.commit()
 }
 
-/// Like [`write`], but leaves the file at its temporary name until [`Staged::commit`], so that
+/// Like [`write()`], but leaves the file at its temporary name until [`Staged::commit`], so that
 /// several files can be written all or none.
 pub fn stage(path: &Path, grids: &[Grid], compression: Compression) -> Result<Staged> {
     check(grids).map_err(|e| Error::file(path, e))?;

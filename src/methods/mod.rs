@@ -1,7 +1,7 @@
 //! Host side of each method: view-aligned prism slicing, axis-aligned slices, the reference ray
 //! caster, hypertexture ray marching, and the opaque base surface. Each lives in its own folder,
 //! declares what it brings to the render graph ([`Contribution`]), plans objects into a
-//! [`MethodPlan`], and is registered once, in [`REGISTRY`] and [`plan_method`].
+//! [`MethodPlan`], and is registered once, in [`REGISTRY`] and `plan_method`.
 
 pub mod axis_slices;
 pub(crate) mod base_surface;

@@ -40,7 +40,7 @@ fn relative_sq(a: &[f32; 4], r: &[f32; 4]) -> f64 {
 }
 
 /// Relative RMSE: `sqrt(mean over pixels and R, G, B of (a - r)² / (r² + ε))` with
-/// ε = [`RELATIVE_EPSILON`] = 1e-2. Alpha is ignored. A non-finite value in either image makes the
+/// ε = `RELATIVE_EPSILON` = 1e-2. Alpha is ignored. A non-finite value in either image makes the
 /// result NaN (so any `<= threshold` check fails). Size mismatch is an error.
 pub fn relative_rmse(actual: &Image, reference: &Image) -> Result<f64> {
     check_sizes(actual, reference)?;
@@ -74,8 +74,8 @@ pub struct FlipResult {
     pub map: Vec<f32>,
 }
 
-/// LDR FLIP (Andersson et al. 2020) between the tonemapped images (see [`crate::io::tonemap`]),
-/// at [`DEFAULT_PIXELS_PER_DEGREE`]. 0 means identical; 1 is the largest perceived difference.
+/// LDR FLIP (Andersson et al. 2020) between the tonemapped images (see `crate::io::tonemap`),
+/// at `DEFAULT_PIXELS_PER_DEGREE`. 0 means identical; 1 is the largest perceived difference.
 pub fn flip(actual: &Image, reference: &Image) -> Result<FlipResult> {
     flip_with_ppd(actual, reference, DEFAULT_PIXELS_PER_DEGREE)
 }

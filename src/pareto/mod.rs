@@ -1,10 +1,10 @@
 //! `voltex pareto SCENE`: speed against error. Sweeps each method's quality knobs over the
-//! scene's textured objects, measures every setting's GPU time per frame ([`measure`]) and its
+//! scene's textured objects, measures every setting's GPU time per frame (`measure`) and its
 //! error against a truth image (mean FLIP, relative RMSE), and writes `pareto.csv` and
-//! `pareto.svg` ([`svg`]) with the Pareto fronts ([`front`]) per method and overall.
+//! `pareto.svg` (`svg`) with the Pareto fronts (`front`) per method and overall.
 //!
 //! A setting is a method label, a description of its knobs and the [`RenderOptions`] that apply
-//! them; a new method adds a function like [`view_slices`] and one line in [`sweep`].
+//! them; a new method adds a function like `view_slices` and one line in `sweep`.
 
 pub(crate) mod front;
 pub(crate) mod measure;
@@ -150,7 +150,7 @@ pub struct Args {
     /// `RayMarch` shadows, each swept over every step (`None`: Phong without shadows); empty:
     /// each object's own.
     pub ray_shadows: Vec<Option<Shadows>>,
-    /// CSV files of other renderers' rows ([`peers`]), shown beside voltex's.
+    /// CSV files of other renderers' rows (`peers`), shown beside voltex's.
     pub peers: Vec<PathBuf>,
 }
 

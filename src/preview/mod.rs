@@ -1,5 +1,5 @@
 //! `voltex preview`: a window showing a scene, rebuilt whenever a file it depends on changes.
-//! [`session`] is the reload machinery (headless, tested on its own), [`watch`] the file watcher.
+//! `session` is the reload machinery (headless, tested on its own), [`watch`] the file watcher.
 
 pub(crate) mod camera_file;
 pub(crate) mod curves;

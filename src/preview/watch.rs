@@ -73,7 +73,7 @@ impl Watcher {
     }
 
     /// Relevant paths changed since the last call, waiting up to `timeout` for the first; once
-    /// one came, until they are quiet for [`DEBOUNCE`] (at most [`SETTLE_MAX`]).
+    /// one came, until they are quiet for [`DEBOUNCE`] (at most `SETTLE_MAX`).
     pub fn changes(&self, timeout: Duration) -> Vec<PathBuf> {
         let deadline = Instant::now() + timeout;
         let mut out = Vec::new();

@@ -2,13 +2,13 @@
 //! GPU by the render's own kernels at full precision (f32, [`Baker::full_precision`]) and turned
 //! into OpenVDB grids that Blender, Houdini and Mitsuba render: a float `density` (fog volume)
 //! and a vec3 `Cd` colour, with the index-to-world transform. Volume objects (nodes drawing an
-//! OpenVDB grid) are written from the grid as read, voxel for voxel ([`volume_grids`]).
+//! OpenVDB grid) are written from the grid as read, voxel for voxel (`volume_grids`).
 //!
 //! Density is the extinction coefficient per world unit: a voxel of opacity `a` over the opacity
 //! length `L` (a world length; every method composites `1 - (1 - a)^(step / L)`) has
 //! `sigma_t = -ln(1 - a) / L`, so `exp(-sigma_t * step)` is voltex's own transmittance.
 //! Voxels of opacity 0 are inactive. Opacity 1 (an opaque voxel: infinitely dense for voltex)
-//! becomes [`OPAQUE_TRANSMITTANCE`] through one voxel. `Cd` is the colour without the opacity
+//! becomes `OPAQUE_TRANSMITTANCE` through one voxel. `Cd` is the colour without the opacity
 //! (the premultiplied colour over alpha): unlit albedo, except for slice stacks, which hold
 //! their baked shading.
 
@@ -82,7 +82,7 @@ pub struct Export {
 
 /// Every volume the scene exports (or those `only` names), in a fixed order: texels by name,
 /// then hypertexture nodes in document order. CPU only: unknown names, file-name clashes and
-/// volumes over [`MAX_EXPORT_VOXELS`] fail here, before any GPU work.
+/// volumes over `MAX_EXPORT_VOXELS` fail here, before any GPU work.
 pub fn plan(scene: &Scene, opts: &ExportOptions) -> Result<Vec<Export>> {
     let time = opts.time.unwrap_or(scene.time);
     let objects = scene.objects_at(time)?;

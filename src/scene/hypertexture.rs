@@ -1,7 +1,7 @@
 //! Scene types of hypertextures (Gilet & Dischler 2009, section 4): a soft object, a vector field,
 //! noises filtered by shape transfer functions, and an RGBA transfer function on density. Value
 //! ranges are checked while parsing; list lengths and control-point order by `check` (positioned
-//! through [`Mark`]s).
+//! through `Mark`s).
 
 use std::sync::Arc;
 
@@ -28,7 +28,7 @@ pub struct Hypertexture {
     pub(crate) object: Mark<SoftObject>,
     #[serde(default)]
     pub(crate) field: Field,
-    /// Combined in order into the distortion factor k (eq. 5); 1 to [`MAX_NOISES`].
+    /// Combined in order into the distortion factor k (eq. 5); 1 to `MAX_NOISES`.
     pub noises: Mark<Vec<Noise>>,
     /// Colour and opacity by density.
     pub(crate) color: ColorTransfer,

@@ -3,7 +3,7 @@
 //!
 //! Range checks run while deserializing (ron attaches the position); checks that need the whole
 //! scene run after a first parse and are positioned by a second parse that fails at the
-//! offending value ([`Mark`]). Files the scene refers to (OBJ, PNG) are loaded by [`load`].
+//! offending value (`Mark`). Files the scene refers to (OBJ, PNG) are loaded by [`load`].
 
 /// Most planes one ViewSlices object may use (the scan kernel and the dispatch height allow it).
 pub const MAX_PLANES: u32 = 16384;

@@ -181,7 +181,7 @@ impl Texel {
     /// The world length over which a voxel's stored alpha is reached: as given, else for a
     /// hypertexture source the hypertexture's own opacity length (a baked voxel stores the
     /// transfer function's opacity, which RayMarch reaches over that world length), else
-    /// [`DEFAULT_OPACITY_LENGTH`].
+    /// `DEFAULT_OPACITY_LENGTH`.
     pub fn opacity_length(&self, hypertextures: &BTreeMap<String, super::Hypertexture>) -> f32 {
         let own = match &self.source {
             TexelSource::Hypertexture { name, .. } => {

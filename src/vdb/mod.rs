@@ -1,7 +1,7 @@
 //! OpenVDB files in: a density grid (a fog volume, or a level set turned into density) and an
 //! optional colour grid (`Cd`), read with `vdb-rs` behind a structural walk of the file
-//! ([`walk`]: no length, panic or C decoder reached unchecked), and kept sparse for the GPU
-//! ([`sparse`]: a brick atlas and a two-level table). Errors name the file and the grid.
+//! (`walk`: no length, panic or C decoder reached unchecked), and kept sparse for the GPU
+//! (`sparse`: a brick atlas and a two-level table). Errors name the file and the grid.
 
 pub(crate) mod sparse;
 mod spliced;

@@ -12,7 +12,7 @@ use std::path::{Path, PathBuf};
 /// `pub` declarations (not `pub(crate)`) in the library, fields included.
 const PUB_DECLARATIONS: usize = 1205;
 /// Of those, the ones without a `///` doc comment.
-const UNDOCUMENTED: usize = 365;
+const UNDOCUMENTED: usize = 352;
 
 fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
     for entry in std::fs::read_dir(dir).unwrap() {

@@ -4,8 +4,8 @@
 //! thread per column, from the light's side away from it) and read trilinearly by the shading
 //! instead of a shadow ray per sample: a shaded sample takes its shadow ray's first sample
 //! exactly (whether a sample just inside dense matter is lit is decided within a skin far thinner
-//! than a cell) and the volume from the end of that step on. This file plans the grid ([`grid`]), bakes it on the GPU
-//! ([`bake`]) and holds the CPU twins (f64, same names as the kernel and its lookup):
+//! than a cell) and the volume from the end of that step on. This file plans the grid (`grid`), bakes it on the GPU
+//! (`bake`) and holds the CPU twins (f64, same names as the kernel and its lookup):
 //! [`bake_light_volume`] and [`light_transmittance`].
 //!
 //! Each vertex stores its transmittance (the shadow ray from the vertex, sampled at `m` sub-steps

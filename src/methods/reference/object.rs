@@ -77,7 +77,7 @@ pub(super) fn gather(
 }
 
 /// Inputs of the f64 twin for a frame, from its objects, bakes and set and the atlases the kernel
-/// read (see [`twin_inputs`]).
+/// read (see `twin_inputs`).
 pub fn frame_twin_inputs(
     objects: &[ObjectPlan],
     bakes: &[BakePlan],

@@ -124,12 +124,12 @@ pub(crate) fn prism_planes(
     (k_max >= k_min).then_some((k_min as u32, k_max as u32))
 }
 
-/// Total slice-vertex capacity of a sweep (see [`plane_bounds`]).
+/// Total slice-vertex capacity of a sweep (see `plane_bounds`).
 pub fn vertex_capacity(shell: &Shell, params: &SliceParams) -> u64 {
     plane_bounds(shell, params).iter().sum()
 }
 
-/// Splits a sweep into chunks of consecutive planes whose vertex bound fits [`CHUNK_BYTES`],
+/// Splits a sweep into chunks of consecutive planes whose vertex bound fits `CHUNK_BYTES`,
 /// back to front.
 pub fn chunks(shell: &Shell, params: &SliceParams) -> Vec<SliceChunk> {
     let budget = CHUNK_BYTES / std::mem::size_of::<SliceVertex>() as u64;

@@ -100,7 +100,7 @@ fn crossed(sa: f32, sb: f32) -> bool {
 /// The paper's per-edge classification from the signed distances of bottom and top: b if they
 /// are on different sides, else a if `|s_top| < |s_bottom|`, else c (parallel edges included).
 /// For reference and tests: the slicer emits edges by their sign crossings and uses
-/// [`classify_oriented`] only to pick the paper's order where its walk is free.
+/// `classify_oriented` only to pick the paper's order where its walk is free.
 pub fn classify(s_bottom: f32, s_top: f32) -> EdgeClass {
     if crossed(s_bottom, s_top) {
         EdgeClass::Within
