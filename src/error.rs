@@ -6,12 +6,16 @@ use std::path::{Path, PathBuf};
 /// A position in a user file, 1-based, printed as `path:line:col`.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct FileLoc {
+    /// The user file.
     pub path: PathBuf,
+    /// Line, from 1.
     pub line: usize,
+    /// Column, from 1.
     pub col: usize,
 }
 
 impl FileLoc {
+    /// Line `line`, column `col` (both 1-based) of `path`.
     pub fn new(path: impl AsRef<Path>, line: usize, col: usize) -> Self {
         Self { path: path.as_ref().to_path_buf(), line, col }
     }
@@ -23,14 +27,25 @@ impl fmt::Display for FileLoc {
     }
 }
 
+/// The library's error: where it happened (a position or a whole file) and what was expected.
 #[derive(Debug, thiserror::Error)]
 pub enum Error {
     /// Something wrong at a known place in a user file.
     #[error("{loc}: {message}")]
-    At { loc: FileLoc, message: String },
+    At {
+        /// Where.
+        loc: FileLoc,
+        /// What is wrong and what was expected.
+        message: String,
+    },
     /// A file that cannot be read or written, or is wrong as a whole.
     #[error("{}: {message}", path.display())]
-    File { path: PathBuf, message: String },
+    File {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong with it.
+        message: String,
+    },
     /// The GPU, its adapter or its limits.
     #[error("GPU: {0}")]
     Gpu(String),
@@ -44,14 +59,18 @@ pub enum Error {
 }
 
 impl Error {
+    /// An error at `loc` in a user file.
     pub fn at(loc: FileLoc, message: impl Into<String>) -> Self {
         Error::At { loc, message: message.into() }
     }
+
+    /// An error about file `path` as a whole.
     pub fn file(path: impl AsRef<Path>, message: impl fmt::Display) -> Self {
         Error::File { path: path.as_ref().to_path_buf(), message: message.to_string() }
     }
 }
 
+/// `Result` with the library's [`Error`].
 pub type Result<T, E = Error> = std::result::Result<T, E>;
 
 /// Line and column (1-based) of byte `offset` in `source`.
@@ -63,21 +82,21 @@ pub fn line_col(source: &str, offset: usize) -> (usize, usize) {
 }
 
 /// Byte offset of 1-based `line` and `col` in `source` (the inverse of [`line_col`]).
-pub fn offset_of(source: &str, line: usize, col: usize) -> usize {
+pub(crate) fn offset_of(source: &str, line: usize, col: usize) -> usize {
     let start: usize = source.split_inclusive('\n').take(line.saturating_sub(1)).map(str::len).sum();
     (start + col.saturating_sub(1)).min(source.len())
 }
 
 /// Position of the string literal `"text"` in a RON source (the first one at or after byte
 /// `from`), for errors found after parsing, when serde no longer knows where a value was.
-pub fn locate_literal(source: &str, text: &str, from: usize) -> Option<(usize, usize)> {
+pub(crate) fn locate_literal(source: &str, text: &str, from: usize) -> Option<(usize, usize)> {
     let needle = format!("\"{text}\"");
     let start = from.min(source.len());
     source[start..].find(&needle).map(|i| line_col(source, start + i))
 }
 
 /// Turns a ron error into `path:line:col: message`.
-pub fn ron_error(path: &Path, e: &ron::error::SpannedError) -> Error {
+pub(crate) fn ron_error(path: &Path, e: &ron::error::SpannedError) -> Error {
     Error::at(FileLoc::new(path, e.span.start.line, e.span.start.col), e.code.to_string())
 }
 

@@ -16,7 +16,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::OnceLock;
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Fault {
+pub(crate) enum Fault {
     DeviceLost,
     OutOfMemory,
     Abort,
@@ -84,12 +84,12 @@ fn hit(point: Point, counter: &AtomicU64) -> Option<Fault> {
 }
 
 /// Called before each graph pass is recorded: the fault planned for this pass, if any.
-pub fn at_pass() -> Option<Fault> {
+pub(crate) fn at_pass() -> Option<Fault> {
     hit(Point::Pass, &PASSES)
 }
 
 /// Called when an atomic write's temporary file is complete: aborts if planned.
-pub fn at_write() {
+pub(crate) fn at_write() {
     if hit(Point::Write, &WRITES) == Some(Fault::Abort) {
         eprintln!("VOLTEX_FAULT: aborting in the middle of an atomic write");
         std::process::abort();
@@ -97,7 +97,7 @@ pub fn at_write() {
 }
 
 /// Called when a headless device is about to be opened: whether it must fail.
-pub fn at_open() -> bool {
+pub(crate) fn at_open() -> bool {
     hit(Point::Open, &OPENS) == Some(Fault::NoDevice)
 }
 

@@ -4,7 +4,7 @@
 //! a cap, and it is read through a reader that stops one byte past the cap (a file that grows
 //! while it is read, or lies about its size, cannot exhaust memory).
 //!
-//! Caps: [`TEXT_CAP`] for text voltex parses whole (scene, graph, WGSL, camera), [`ASSET_CAP`]
+//! Caps: `TEXT_CAP` for text voltex parses whole (scene, graph, WGSL, camera), `ASSET_CAP`
 //! for assets (OBJ, PNG, EXR). `VOLTEX_MAX_FILE_BYTES` (bytes, or with a `K`, `M` or `G` suffix)
 //! replaces both.
 //!
@@ -16,22 +16,22 @@ use std::io::Read;
 use std::path::Path;
 
 /// Default cap on text files parsed whole: scene, graph, WGSL, camera files.
-pub const TEXT_CAP: u64 = 16 << 20;
+pub(crate) const TEXT_CAP: u64 = 16 << 20;
 /// Default cap on asset files: OBJ meshes, PNG and EXR images.
-pub const ASSET_CAP: u64 = 256 << 20;
+pub(crate) const ASSET_CAP: u64 = 256 << 20;
 /// The environment variable that replaces both caps.
-pub const CAP_VAR: &str = "VOLTEX_MAX_FILE_BYTES";
+pub(crate) const CAP_VAR: &str = "VOLTEX_MAX_FILE_BYTES";
 
 /// What a file is read as, which picks its default cap.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Kind {
+pub(crate) enum Kind {
     Text,
     Asset,
 }
 
 /// The cap for `kind`: `VOLTEX_MAX_FILE_BYTES` when set, else the default. A malformed value is
 /// an error naming the variable (a typo must not silently lift or keep a limit).
-pub fn cap(kind: Kind) -> Result<u64> {
+pub(crate) fn cap(kind: Kind) -> Result<u64> {
     match std::env::var(CAP_VAR) {
         Ok(v) if !v.trim().is_empty() => parse_bytes(v.trim()).ok_or_else(|| {
             Error::Invalid(format!(
@@ -46,7 +46,7 @@ pub fn cap(kind: Kind) -> Result<u64> {
 }
 
 /// A byte count, or one with a `K`, `M` or `G` suffix (binary units).
-pub fn parse_bytes(v: &str) -> Option<u64> {
+pub(crate) fn parse_bytes(v: &str) -> Option<u64> {
     let (digits, shift) = match v.as_bytes().last()?.to_ascii_uppercase() {
         b'K' => (&v[..v.len() - 1], 10),
         b'M' => (&v[..v.len() - 1], 20),
@@ -57,7 +57,7 @@ pub fn parse_bytes(v: &str) -> Option<u64> {
 }
 
 /// `n` bytes for messages: `16 MiB (16777216 bytes)`.
-pub fn bytes(n: u64) -> String {
+pub(crate) fn bytes(n: u64) -> String {
     const MIB: u64 = 1 << 20;
     if n >= MIB {
         format!("{:.1} MiB ({n} bytes)", n as f64 / MIB as f64)
@@ -96,7 +96,7 @@ fn what(meta: &std::fs::Metadata) -> Option<&'static str> {
 
 /// Checks that `path` is a regular file within the cap for `kind`, without opening it; returns
 /// its size. `role` names what voltex expected ("a scene file", "an OBJ file").
-pub fn check(path: &Path, kind: Kind, role: &str) -> Result<u64> {
+pub(crate) fn check(path: &Path, kind: Kind, role: &str) -> Result<u64> {
     let meta = std::fs::metadata(path).map_err(|e| match e.kind() {
         std::io::ErrorKind::NotFound => Error::file(path, format!("expected {role}, but it does not exist")),
         _ => Error::file(path, format!("expected {role}, but cannot read it: {e}")),
@@ -119,7 +119,7 @@ fn too_large(path: &Path, role: &str, len: u64, cap: u64) -> Error {
 }
 
 /// A reader that fails instead of reading more than `cap` bytes.
-pub struct Bounded<R> {
+pub(crate) struct Bounded<R> {
     inner: R,
     left: u64,
     cap: u64,
@@ -143,7 +143,7 @@ impl<R: Read> Read for Bounded<R> {
 
 /// Opens `path` after [`check`]: non-blocking (a file swapped for a FIFO after the check cannot
 /// hang the open) and checked again on the open handle.
-pub fn open(path: &Path, kind: Kind, role: &str) -> Result<Bounded<std::fs::File>> {
+pub(crate) fn open(path: &Path, kind: Kind, role: &str) -> Result<Bounded<std::fs::File>> {
     check(path, kind, role)?;
     let mut options = std::fs::OpenOptions::new();
     options.read(true);
@@ -165,25 +165,25 @@ pub fn open(path: &Path, kind: Kind, role: &str) -> Result<Bounded<std::fs::File
 }
 
 /// The bytes of `path` (see [`open`]).
-pub fn read(path: &Path, kind: Kind, role: &str) -> Result<Vec<u8>> {
+pub(crate) fn read(path: &Path, kind: Kind, role: &str) -> Result<Vec<u8>> {
     let mut reader = open(path, kind, role)?;
     let mut out = Vec::new();
     reader.read_to_end(&mut out).map_err(|e| Error::file(path, format!("cannot read {role}: {e}")))?;
     Ok(out)
 }
 
-/// The text of `path` (see [`open`]); invalid UTF-8 is an error at its `line:col`.
+/// The text of `path` (see `open`); invalid UTF-8 is an error at its `line:col`.
 pub fn read_text(path: &Path, role: &str) -> Result<String> {
     utf8(path, read(path, Kind::Text, role)?)
 }
 
 /// Like [`read_text`] under the asset cap (OBJ files are text but may be large).
-pub fn read_asset_text(path: &Path, role: &str) -> Result<String> {
+pub(crate) fn read_asset_text(path: &Path, role: &str) -> Result<String> {
     utf8(path, read(path, Kind::Asset, role)?)
 }
 
 /// `bytes` as UTF-8, or an error at the first invalid byte.
-pub fn utf8(path: &Path, bytes: Vec<u8>) -> Result<String> {
+pub(crate) fn utf8(path: &Path, bytes: Vec<u8>) -> Result<String> {
     String::from_utf8(bytes).map_err(|e| {
         let valid = e.utf8_error().valid_up_to();
         let bytes = e.into_bytes();
@@ -200,7 +200,9 @@ pub fn utf8(path: &Path, bytes: Vec<u8>) -> Result<String> {
 /// A map read from a user file with each key at most once (`deserialize_with`): serde's maps
 /// let the last duplicate win silently. The error comes as the duplicate key is read, so the
 /// parser positions it there.
-pub fn unique_keys<'de, D, V>(d: D) -> std::result::Result<std::collections::BTreeMap<String, V>, D::Error>
+pub(crate) fn unique_keys<'de, D, V>(
+    d: D,
+) -> std::result::Result<std::collections::BTreeMap<String, V>, D::Error>
 where
     D: serde::Deserializer<'de>,
     V: serde::Deserialize<'de>,

@@ -9,7 +9,7 @@ pub mod bake;
 pub mod bench;
 pub mod cpu;
 pub mod error;
-pub mod fault;
+pub(crate) mod fault;
 pub mod gpu;
 pub mod graph;
 pub mod hypertexture;

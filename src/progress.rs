@@ -8,12 +8,16 @@ use std::time::Instant;
 /// How much a command says on stderr.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Verbosity {
+    /// Errors only (`--quiet`).
     Quiet,
+    /// One line per finished item, or the bar on a terminal.
     Normal,
+    /// Each item's warnings too (`--verbose`).
     Verbose,
 }
 
 impl Verbosity {
+    /// From the `--quiet` and `--verbose` flags (`--quiet` wins).
     pub fn from_flags(quiet: bool, verbose: bool) -> Self {
         match (quiet, verbose) {
             (true, _) => Verbosity::Quiet,
@@ -23,6 +27,7 @@ impl Verbosity {
     }
 }
 
+/// The progress of one command's items on stderr.
 pub struct Progress {
     total: usize,
     done: usize,
@@ -30,13 +35,14 @@ pub struct Progress {
     worked: usize,
     running: Vec<String>,
     tty: bool,
-    pub verbosity: Verbosity,
+    pub(crate) verbosity: Verbosity,
     start: Instant,
 }
 
 const WIDTH: usize = 100;
 
 impl Progress {
+    /// Progress over `total` items, drawn at once on a terminal.
     pub fn new(total: usize, verbosity: Verbosity) -> Self {
         let tty = std::io::stderr().is_terminal() && verbosity != Verbosity::Quiet;
         let p =
@@ -56,6 +62,7 @@ impl Progress {
         format!(", ETA {}:{:02}", secs / 60, secs % 60)
     }
 
+    /// `item` started (shown in the bar while it runs).
     pub fn started(&mut self, item: &str) {
         self.running.push(item.to_string());
         self.draw();
@@ -84,7 +91,7 @@ impl Progress {
     }
 
     /// A line that is not about one item (a fatal error, say); errors show even with `--quiet`.
-    pub fn note(&self, text: &str) {
+    pub(crate) fn note(&self, text: &str) {
         if self.verbosity == Verbosity::Quiet && !text.starts_with("error") {
             return;
         }
@@ -95,6 +102,7 @@ impl Progress {
         self.draw();
     }
 
+    /// Clears the bar: the command is done.
     pub fn end(&self) {
         if self.tty {
             eprint!("\r{:WIDTH$}\r", "");

@@ -137,7 +137,7 @@ pub struct ObjectParams {
     pub opacity_length: f32,
     /// The object's index in the scene (its slot in per-object AOVs such as coverage).
     pub index: u32,
-    pub _pad: [f32; 2],
+    pub(crate) _pad: [f32; 2],
 }
 
 /// Texel-to-world derivatives at a welded vertex, `dP/ds` and `dP/dt` (w unused), averaged over
@@ -406,7 +406,7 @@ pub struct MeshGridParams {
     pub counts: [u32; 4],
     /// xyz: samples per axis; w: 1 to test inside by ray parity, 0 for a shell (every distance
     /// negative).
-    pub size: [u32; 4],
+    pub(crate) size: [u32; 4],
 }
 
 /// What `bake_mesh_texel.wgsl` turns a mesh grid into: a texel's premultiplied colour (Meyer &
@@ -538,16 +538,16 @@ pub struct Splat {
 }
 
 /// `HyperParams::kinds[0]` (mirrored in wgsl/shared/fields.wgsl).
-pub const OBJECT_SPHERE: u32 = 0;
-pub const OBJECT_ELLIPSOID: u32 = 1;
-pub const OBJECT_TORUS: u32 = 2;
-pub const OBJECT_BOX: u32 = 3;
-pub const OBJECT_MESH: u32 = 4;
+pub(crate) const OBJECT_SPHERE: u32 = 0;
+pub(crate) const OBJECT_ELLIPSOID: u32 = 1;
+pub(crate) const OBJECT_TORUS: u32 = 2;
+pub(crate) const OBJECT_BOX: u32 = 3;
+pub(crate) const OBJECT_MESH: u32 = 4;
 /// `HyperParams::kinds[1]`.
-pub const FIELD_CLOSEST_SURFACE: u32 = 0;
-pub const FIELD_FROM_CENTRE: u32 = 1;
-pub const FIELD_CONSTANT: u32 = 2;
-pub const FIELD_SWIRL: u32 = 3;
+pub(crate) const FIELD_CLOSEST_SURFACE: u32 = 0;
+pub(crate) const FIELD_FROM_CENTRE: u32 = 1;
+pub(crate) const FIELD_CONSTANT: u32 = 2;
+pub(crate) const FIELD_SWIRL: u32 = 3;
 
 /// One volume object (an OpenVDB grid) as `march_volume.wgsl` and `bake_volume.wgsl` see it;
 /// twin: `VolumeParams` in wgsl/shared/types.wgsl. Index space is the grid's (voxel (i, j, k)

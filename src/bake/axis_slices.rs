@@ -17,7 +17,7 @@ pub struct AxisBaked {
 }
 
 /// Image size of a direction's slices: s slices are (t, w) images, t slices (s, w), w slices (s, t).
-pub fn image_size(res: [u32; 3], direction: usize) -> [u32; 2] {
+pub(crate) fn image_size(res: [u32; 3], direction: usize) -> [u32; 2] {
     match direction {
         0 => [res[1], res[2]],
         1 => [res[0], res[2]],
@@ -27,12 +27,12 @@ pub fn image_size(res: [u32; 3], direction: usize) -> [u32; 2] {
 
 /// Bytes of the slice arrays (f16 RGBA, with their MIP levels when `mipmaps`) and occupancy
 /// words of a texel.
-pub fn bytes(res: [u32; 3], mipmaps: bool) -> u64 {
+pub(crate) fn bytes(res: [u32; 3], mipmaps: bool) -> u64 {
     (0..3).map(|d| (image_bytes(image_size(res, d), mipmaps) + 4) * array_layers(res[d]) as u64).sum()
 }
 
 /// Bytes of one f16 RGBA slice image of `size`, with its MIP levels when `mipmaps`.
-pub fn image_bytes(size: [u32; 2], mipmaps: bool) -> u64 {
+pub(crate) fn image_bytes(size: [u32; 2], mipmaps: bool) -> u64 {
     let levels = if mipmaps { mip_levels(size) } else { 1 };
     (0..levels).map(|l| (size[0] >> l).max(1) as u64 * (size[1] >> l).max(1) as u64 * 8).sum()
 }
@@ -43,7 +43,7 @@ pub fn mip_levels(size: [u32; 2]) -> u32 {
 }
 
 /// Records the bake of every level of every direction from `volume` (level 0 is read).
-pub fn bake(
+pub(crate) fn bake(
     ctx: &GpuContext,
     kernel: &mut ComputeKernel,
     encoder: &mut wgpu::CommandEncoder,
@@ -113,7 +113,7 @@ pub fn bake(
 
 /// Records the MIP levels of every slice image of `baked` (level 0 baked), each from the one
 /// above by a 2x2 box of premultiplied colour (`mip_axis_slices.wgsl`).
-pub fn mip(
+pub(crate) fn mip(
     ctx: &GpuContext,
     kernel: &mut ComputeKernel,
     encoder: &mut wgpu::CommandEncoder,
@@ -216,11 +216,11 @@ pub fn array_layers(r: u32) -> u32 {
 }
 
 /// First occupancy word of (direction, level): directions s, t, w one after the other.
-pub fn occupancy_base(resolution: [u32; 3], direction: u32, level: u32) -> u32 {
+pub(crate) fn occupancy_base(resolution: [u32; 3], direction: u32, level: u32) -> u32 {
     (0..direction).map(|d| array_layers(resolution[d as usize])).sum::<u32>()
         + level_layer(resolution[direction as usize], level)
 }
 
-pub fn slice_layer(g: i32, n: u32) -> u32 {
+pub(crate) fn slice_layer(g: i32, n: u32) -> u32 {
     g.rem_euclid(n as i32) as u32
 }

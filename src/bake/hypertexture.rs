@@ -56,7 +56,7 @@ impl HyperTexel {
     }
 
     /// The kernels' override constants.
-    pub fn constants(&self) -> Vec<(String, f64)> {
+    pub(crate) fn constants(&self) -> Vec<(String, f64)> {
         match hypertexture::animated(&self.packed.noises) {
             true => vec![("animated".into(), 1.0)],
             false => Vec::new(),
@@ -65,7 +65,7 @@ impl HyperTexel {
 
     /// Bakes the transfer tables and then the volume (`inputs` holds `volume`, `normals` and
     /// `per_pixel_lighting`); `params` is the bake's `BakeParams`.
-    pub fn bake(
+    pub(crate) fn bake(
         &self,
         ctx: &GpuContext,
         kernels: (&mut ComputeKernel, &mut ComputeKernel),

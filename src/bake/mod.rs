@@ -125,7 +125,7 @@ pub struct BakeRequest {
 impl BakeRequest {
     /// The kernels the bake runs (under `wgsl/`), so that `plan` can check them before any GPU
     /// work: the same files [`Baker::bake`] loads.
-    pub fn kernels(&self) -> Vec<&'static str> {
+    pub(crate) fn kernels(&self) -> Vec<&'static str> {
         let mut k = match &self.source {
             BakeSource::Implicit(_) => vec!["bake/bake_implicit.wgsl"],
             BakeSource::Heightfield(_) => vec!["bake/bake_heightfield.wgsl"],
@@ -165,7 +165,7 @@ pub struct Baked {
 
 impl BakeRequest {
     /// GPU memory of the bake of `texel`, by item (`voltex plan`).
-    pub fn memory(&self, texel: &str) -> Vec<(String, u64)> {
+    pub(crate) fn memory(&self, texel: &str) -> Vec<(String, u64)> {
         let [x, y, z] = self.resolution;
         let normals = if self.per_pixel { " + normals" } else { "" };
         let mips = if self.volume_mipmaps { " with MIP levels" } else { "" };
@@ -184,7 +184,7 @@ impl BakeRequest {
     }
 
     /// Each texture and large buffer of the bake of `texel`, for the checks against the limits.
-    pub fn allocations(&self, texel: &str) -> Vec<Allocation> {
+    pub(crate) fn allocations(&self, texel: &str) -> Vec<Allocation> {
         let res = self.resolution;
         let voxels = res.iter().map(|&r| r as u64).product::<u64>();
         let with_mips = texel_mips::voxels(res, self.volume_mipmaps);
@@ -233,7 +233,7 @@ impl BakeRequest {
     }
 
     /// The bake's lines in `voltex plan`: size, kernels and lighting.
-    pub fn describe(&self, texel: &str) -> String {
+    pub(crate) fn describe(&self, texel: &str) -> String {
         let [x, y, z] = self.resolution;
         let kind = match self.source {
             BakeSource::Implicit(_) => "bake/bake_implicit.wgsl",
@@ -264,7 +264,7 @@ impl BakeRequest {
 
 /// Bytes a bake allocates on the GPU (volume, plus normals at the same resolution; both with
 /// their MIP levels when `mipmaps`).
-pub fn bytes(res: [u32; 3], per_pixel: bool, mipmaps: bool) -> u64 {
+pub(crate) fn bytes(res: [u32; 3], per_pixel: bool, mipmaps: bool) -> u64 {
     let volume = texel_mips::voxels(res, mipmaps) * 4;
     volume + if per_pixel { volume } else { 4 }
 }
@@ -323,7 +323,7 @@ impl Baker {
     }
 
     /// The format of the texel volumes this baker makes.
-    pub fn format(&self) -> wgpu::TextureFormat {
+    pub(crate) fn format(&self) -> wgpu::TextureFormat {
         self.format
     }
 
@@ -566,7 +566,7 @@ fn volume_texture(
 }
 
 /// A view of one mip level.
-pub fn level_view(t: &wgpu::Texture, level: u32) -> wgpu::TextureView {
+pub(crate) fn level_view(t: &wgpu::Texture, level: u32) -> wgpu::TextureView {
     t.create_view(&wgpu::TextureViewDescriptor {
         base_mip_level: level,
         mip_level_count: Some(1),

@@ -15,19 +15,19 @@ use crate::vdb::SparseVolume;
 
 /// The atlases' brick slots are laid out for 3D textures of this side (WebGPU's guaranteed
 /// `max_texture_dimension_3d`), so a plan holds on every adapter.
-pub const ATLAS_SIDE: u32 = 2048;
+pub(crate) const ATLAS_SIDE: u32 = 2048;
 
 /// A grid's brick table and atlases on the GPU.
 #[derive(Clone)]
-pub struct Uploaded {
-    pub table: wgpu::Buffer,
-    pub density: wgpu::TextureView,
-    pub color: wgpu::TextureView,
+pub(crate) struct Uploaded {
+    pub(crate) table: wgpu::Buffer,
+    pub(crate) density: wgpu::TextureView,
+    pub(crate) color: wgpu::TextureView,
 }
 
 impl Uploaded {
     /// Binds the table and atlases by their kernel names.
-    pub fn bind(&self, inputs: &mut Inputs) {
+    pub(crate) fn bind(&self, inputs: &mut Inputs) {
         inputs.buffers.insert("volume_table".into(), self.table.clone());
         inputs.views.insert("volume_density".into(), self.density.clone());
         inputs.views.insert("volume_color".into(), self.color.clone());
@@ -35,17 +35,17 @@ impl Uploaded {
 }
 
 /// Brick slots of `grid`'s atlases per axis.
-pub fn slots(grid: &SparseVolume) -> [u32; 3] {
+pub(crate) fn slots(grid: &SparseVolume) -> [u32; 3] {
     SparseVolume::atlas_slots(grid.bricks(), ATLAS_SIDE)
 }
 
 /// Atlas texture size: slots times the brick side.
-pub fn atlas_size(slots: [u32; 3]) -> [u32; 3] {
+pub(crate) fn atlas_size(slots: [u32; 3]) -> [u32; 3] {
     slots.map(|s| s * BRICK as u32)
 }
 
 /// The parts of `VolumeParams` that describe `grid` itself: table and atlas layout.
-pub fn grid_params(grid: &SparseVolume, params: &mut VolumeParams) {
+pub(crate) fn grid_params(grid: &SparseVolume, params: &mut VolumeParams) {
     let s = slots(grid);
     params.origin = [grid.origin.x, grid.origin.y, grid.origin.z, 0];
     params.table = [grid.top.x, grid.top.y, grid.top.z, grid.color.is_some() as u32];
@@ -54,7 +54,7 @@ pub fn grid_params(grid: &SparseVolume, params: &mut VolumeParams) {
 
 /// Uploads `grid`'s table and bricks (value (x, y, z) of brick b at atlas texel
 /// `slot(b) * 9 + (x, y, z)`, slots x fastest).
-pub fn upload(ctx: &GpuContext, grid: &SparseVolume) -> Uploaded {
+pub(crate) fn upload(ctx: &GpuContext, grid: &SparseVolume) -> Uploaded {
     let slots = slots(grid);
     let size = atlas_size(slots);
     let texels = size.iter().map(|&s| s as usize).product::<usize>();
@@ -137,9 +137,9 @@ fn texture(
 /// A volume texel: a box of a volume's world space mapped onto texel space.
 #[derive(Clone)]
 pub struct VolumeTexel {
-    pub grid: Arc<SparseVolume>,
+    pub(crate) grid: Arc<SparseVolume>,
     /// Texel space to index space, the medium and the opacity length (see `bake_volume.wgsl`).
-    pub params: VolumeParams,
+    pub(crate) params: VolumeParams,
 }
 
 impl std::fmt::Debug for VolumeTexel {
@@ -175,7 +175,7 @@ impl VolumeTexel {
     }
 
     /// Runs `bake_volume.wgsl` into the texel volume bound in `inputs`.
-    pub fn bake(
+    pub(crate) fn bake(
         &self,
         ctx: &GpuContext,
         kernel: &mut ComputeKernel,

@@ -8,29 +8,29 @@ use serde::{Deserialize, Serialize};
 use super::json::Row;
 
 /// R^2 under this is a finding to explain.
-pub const GOOD_FIT: f64 = 0.95;
+pub(crate) const GOOD_FIT: f64 = 0.95;
 
 #[derive(Debug, Clone, Default, Serialize, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct Fit {
-    pub table: String,
-    pub method: String,
+    pub(crate) table: String,
+    pub(crate) method: String,
     /// RayMarch: fitted per segment strategy (their costs per evaluation differ).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub segments: Option<String>,
+    pub(crate) segments: Option<String>,
     /// ViewSlices: fitted per compositor (raster and tiles spend differently per triangle).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub compositor: Option<String>,
-    pub work_unit: String,
+    pub(crate) compositor: Option<String>,
+    pub(crate) work_unit: String,
     pub rows: usize,
     /// ms = intercept_ms + ms_per_unit * work
-    pub intercept_ms: f64,
-    pub ms_per_unit: f64,
+    pub(crate) intercept_ms: f64,
+    pub(crate) ms_per_unit: f64,
     pub r2: f64,
 }
 
 impl Fit {
-    pub fn describe(&self) -> String {
+    pub(crate) fn describe(&self) -> String {
         format!(
             "cost model, table `{}`, {}{}: frame ms = {:.2} + {:.3e} x {} over {} rows: R^2 = {:.3}{}",
             self.table,
@@ -51,7 +51,7 @@ impl Fit {
 }
 
 /// Least squares of `y = a + b x`: (a, b, R^2); R^2 is 1 when y does not vary and the line fits it.
-pub fn fit_line(points: &[(f64, f64)]) -> (f64, f64, f64) {
+pub(crate) fn fit_line(points: &[(f64, f64)]) -> (f64, f64, f64) {
     let n = points.len() as f64;
     let (mx, my) = points.iter().fold((0.0, 0.0), |(a, b), p| (a + p.0 / n, b + p.1 / n));
     let (mut sxx, mut sxy, mut syy) = (0.0, 0.0, 0.0);

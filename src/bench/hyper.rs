@@ -82,7 +82,7 @@ fn median(mut v: Vec<f64>) -> f64 {
 }
 
 /// Simplex evaluations per second of `bench_simplex.wgsl` (wall clock, median of 5, after warm-up).
-pub fn noise_rate(ctx: &GpuContext) -> Result<f64> {
+pub(crate) fn noise_rate(ctx: &GpuContext) -> Result<f64> {
     const PER_THREAD: u32 = 1024;
     let threads = [4096u32, 16, 1];
     let mut kernel = ComputeKernel::load(ctx, &Sources::project()?, "ray_march/bench_simplex.wgsl")?;
@@ -155,7 +155,7 @@ const SEGMENTS: &[(&str, &str)] = &[
 
 /// The segment strategies on every object (IE, Phong): frame time, density evaluations and FLIP
 /// against a converged render.
-pub fn segments_table(ctx: &GpuContext, args: &Args, report: &mut Report) -> Result<()> {
+pub(crate) fn segments_table(ctx: &GpuContext, args: &Args, report: &mut Report) -> Result<()> {
     let (size, frames, quick) = (args.size, args.frames, args.quick);
     println!(
         "\n| object | segments | dispatches | frame ms (wall) | M density evals | M noise evals | M samples | FLIP vs \
@@ -408,7 +408,7 @@ const SHADOWS: &[&str] = &["none", "rays", "volume:32", "volume:64", "volume:128
 /// timed in alternation (so load changes hit all), with the light volume's bake timed apart (it
 /// is cached: a frame pays it only when the light or the density changes), and the error against
 /// shadow rays at the truth step and against shadow rays at the same step.
-pub fn shadows_table(ctx: &GpuContext, args: &Args, report: &mut Report) -> Result<()> {
+pub(crate) fn shadows_table(ctx: &GpuContext, args: &Args, report: &mut Report) -> Result<()> {
     use crate::methods::options::parse_shadows;
     use crate::methods::ray_march::light_volume;
     println!(

@@ -96,7 +96,7 @@ pub struct Report {
     /// UTC, `YYYY-MM-DD HH:MM`.
     pub date: String,
     /// The 1-minute load average when the run began (software adapters share the CPU).
-    pub load: Option<f64>,
+    pub(crate) load: Option<f64>,
     pub size: [u32; 2],
     pub frames: usize,
     pub rows: Vec<Row>,
@@ -106,7 +106,7 @@ pub struct Report {
     pub cost_models: Vec<super::cost::Fit>,
     /// The timed frames' passes, for `--trace` (not part of the JSON).
     #[serde(skip)]
-    pub traces: Vec<crate::render::trace::Track>,
+    pub(crate) traces: Vec<crate::render::trace::Track>,
 }
 
 impl Report {
@@ -127,12 +127,12 @@ impl Report {
     }
 
     /// Keeps the last frame of `renderer` as a trace track named `name`.
-    pub fn trace(&mut self, name: String, renderer: &crate::render::Renderer) {
+    pub(crate) fn trace(&mut self, name: String, renderer: &crate::render::Renderer) {
         self.traces.push(crate::render::trace::Track { name, frames: vec![renderer.spans().to_vec()] });
     }
 
     /// Writes `--json` and `--trace` where asked.
-    pub fn finish(&self, json: Option<&Path>, trace: Option<&Path>) -> Result<()> {
+    pub(crate) fn finish(&self, json: Option<&Path>, trace: Option<&Path>) -> Result<()> {
         if let Some(path) = json {
             self.write(path)?;
             println!("wrote {}", path.display());
@@ -302,7 +302,7 @@ pub fn splice(page: &str, section: &str) -> std::result::Result<String, String> 
 }
 
 /// Fails early (before any GPU work) when the folder of an output file is not writable.
-pub fn check_output(path: Option<&Path>) -> Result<()> {
+pub(crate) fn check_output(path: Option<&Path>) -> Result<()> {
     match path {
         Some(p) => crate::io::atomic::check_writable_dir(
             p.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new(".")),

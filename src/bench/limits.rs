@@ -86,7 +86,7 @@ fn module(ctx: &GpuContext, name: &str) -> Result<wgpu::ShaderModule> {
 }
 
 /// Blended fragments per second (see the module's comment).
-pub fn blend_rate(ctx: &GpuContext) -> Result<f64> {
+pub(crate) fn blend_rate(ctx: &GpuContext) -> Result<f64> {
     let (view, sampler) = volume(ctx);
     let module = module(ctx, "bench/bench_blend.wgsl")?;
     let format = wgpu::TextureFormat::Rgba32Float;
@@ -165,7 +165,7 @@ pub fn blend_rate(ctx: &GpuContext) -> Result<f64> {
 }
 
 /// Trilinear 3D texture samples per second in a compute kernel.
-pub fn texture_rate(ctx: &GpuContext) -> Result<f64> {
+pub(crate) fn texture_rate(ctx: &GpuContext) -> Result<f64> {
     let (view, sampler) = volume(ctx);
     let module = module(ctx, "bench/bench_texture.wgsl")?;
     let constants = [("samples", TEXTURE_SAMPLES as f64)];
@@ -207,14 +207,14 @@ pub fn texture_rate(ctx: &GpuContext) -> Result<f64> {
 
 /// All three rates. Compute first: lavapipe's compute timing is only trusted before any render
 /// pass (wall clock here, but keep the habit).
-pub fn measure(ctx: &GpuContext) -> Result<Limits> {
+pub(crate) fn measure(ctx: &GpuContext) -> Result<Limits> {
     let texture_samples_per_s = texture_rate(ctx)?;
     let noise_per_s = super::hyper::noise_rate(ctx)?;
     let blend_fragments_per_s = blend_rate(ctx)?;
     Ok(Limits { blend_fragments_per_s, texture_samples_per_s, noise_per_s })
 }
 
-pub fn describe(l: &Limits) -> String {
+pub(crate) fn describe(l: &Limits) -> String {
     format!(
         "adapter limits (same run, median of 5 after warm-up, wall clock): blended fragments into Rgba32Float with one \
          3D texture fetch {:.0} M/s; trilinear 3D texture samples {:.0} M/s; 3D simplex noise {:.0} M/s",

@@ -8,12 +8,12 @@
 //!
 //! `--json FILE` writes the rows ([`json`]) with the cost model ([`cost`]: frame time against
 //! slice triangles, planes x visible prisms); `--limits` measures the adapter's own blend, texture
-//! and noise rates first ([`limits`]) and prints each setting's share of the blend limit.
+//! and noise rates first (`limits`) and prints each setting's share of the blend limit.
 
 pub mod cost;
 pub mod hyper;
 pub mod json;
-pub mod limits;
+pub(crate) mod limits;
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -25,7 +25,7 @@ use crate::pareto::measure::timed;
 use crate::render::{Blueprint, RenderOptions, Renderer};
 use crate::scene::{Compositor, Scene};
 
-pub fn default_scenes() -> Vec<PathBuf> {
+pub(crate) fn default_scenes() -> Vec<PathBuf> {
     let root = crate::project_root().join("scenes/view_slices");
     vec![root.join("torus_egg.ron"), root.join("terrain.ron")]
 }

@@ -5,11 +5,11 @@
 use crate::types::{BakeParams, HeightImageParams, HeightfieldParams, ImplicitShape};
 
 /// `ImplicitShape::kind` values; mirrored as `SHAPE_*` consts in `wgsl/bake/bake_implicit.wgsl`.
-pub const SPHERE: u32 = 0;
-pub const TORUS: u32 = 1;
-pub const ELLIPSOID: u32 = 2;
-pub const METABALLS: u32 = 3;
-pub const CONSTANT: u32 = 4;
+pub(crate) const SPHERE: u32 = 0;
+pub(crate) const TORUS: u32 = 1;
+pub(crate) const ELLIPSOID: u32 = 2;
+pub(crate) const METABALLS: u32 = 3;
+pub(crate) const CONSTANT: u32 = 4;
 
 /// Distance standing for "infinitely far" (outside) or, negated, "infinitely deep" (constant).
 pub const FAR: f32 = 1.0e9;
@@ -112,7 +112,7 @@ pub fn perlin_fbm_periodic(p: [f32; 2], frequency: u32, octaves: u32, seed: u32)
 // ---- shared/shading.wgsl ----
 
 /// Unit outward normal from a gradient; (0,0,1) where the gradient vanishes.
-pub fn gradient_normal(g: V3) -> V3 {
+pub(crate) fn gradient_normal(g: V3) -> V3 {
     let len = length(g);
     if len < 1.0e-6 {
         return [0.0, 0.0, 1.0];
@@ -121,7 +121,7 @@ pub fn gradient_normal(g: V3) -> V3 {
 }
 
 /// `albedo * (ambient + (1 - ambient) * max(N.L, 0))`, `light` = (direction to the light, ambient).
-pub fn shade_lambert(albedo: V3, normal: V3, light: [f32; 4]) -> V3 {
+pub(crate) fn shade_lambert(albedo: V3, normal: V3, light: [f32; 4]) -> V3 {
     let l = gradient_normal(xyz(light));
     scale(albedo, light[3] + (1.0 - light[3]) * dot(normal, l).max(0.0))
 }
@@ -269,18 +269,18 @@ pub fn heightfield_sample(hf: &HeightfieldParams, st: [f32; 2]) -> [f32; 3] {
 }
 
 /// What `shared/height_voxel.wgsl` takes besides the height sample and the voxel.
-pub struct HeightLook {
-    pub opacity: f32,
-    pub darkening: f32,
-    pub color_low: [f32; 4],
-    pub color_high: [f32; 4],
+pub(crate) struct HeightLook {
+    pub(crate) opacity: f32,
+    pub(crate) darkening: f32,
+    pub(crate) color_low: [f32; 4],
+    pub(crate) color_high: [f32; 4],
     /// The highest possible height.
-    pub top: f32,
+    pub(crate) top: f32,
 }
 
 /// `shared/height_voxel.wgsl`: (premultiplied rgba, outward normal) of the voxel at `p` below or
 /// above the height sample `h = (h, dh/ds, dh/dt)`.
-pub fn height_voxel(
+pub(crate) fn height_voxel(
     params: &BakeParams,
     h: [f32; 3],
     p: V3,
@@ -337,7 +337,7 @@ fn image_height(hi: &HeightImageParams, heights: &[f32], st: [f32; 2]) -> f32 {
 
 /// `(h, dh/ds, dh/dt)` with `h = base + amplitude * image(s, t)`, the slopes by central
 /// differences one pixel apart.
-pub fn height_image_sample(hi: &HeightImageParams, heights: &[f32], st: [f32; 2]) -> [f32; 3] {
+pub(crate) fn height_image_sample(hi: &HeightImageParams, heights: &[f32], st: [f32; 2]) -> [f32; 3] {
     let e = [1.0 / hi.width as f32, 1.0 / hi.height as f32];
     let at = |ds: f32, dt: f32| image_height(hi, heights, [st[0] + ds, st[1] + dt]);
     let ds = (at(e[0], 0.0) - at(-e[0], 0.0)) / (2.0 * e[0]);
@@ -370,8 +370,8 @@ pub fn bake_height_image_voxel(
 /// A CPU RGBA volume, x fastest: texel (x,y,z) at `x + X * (y + Y * z)`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Volume {
-    pub size: [u32; 3],
-    pub texels: Vec<[f32; 4]>,
+    pub(crate) size: [u32; 3],
+    pub(crate) texels: Vec<[f32; 4]>,
 }
 
 impl Volume {
@@ -472,9 +472,9 @@ pub enum Shape {
 /// bindings are invalid); `shape_count` is what goes into `BakeParams::resolution[3]`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct PackedShapes {
-    pub shapes: Vec<ImplicitShape>,
-    pub balls: Vec<[f32; 4]>,
-    pub shape_count: u32,
+    pub(crate) shapes: Vec<ImplicitShape>,
+    pub(crate) balls: Vec<[f32; 4]>,
+    pub(crate) shape_count: u32,
 }
 
 /// Packs a union of (shape, albedo rgb, opacity) into `ImplicitShape`s and the metaball buffer.

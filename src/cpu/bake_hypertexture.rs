@@ -9,7 +9,7 @@ use super::hypertexture::Model;
 use crate::types::BakeParams;
 
 /// Below this opacity a voxel is empty (mirrors `MIN_OPACITY`).
-pub const MIN_OPACITY: f64 = 1e-6;
+pub(crate) const MIN_OPACITY: f64 = 1e-6;
 
 /// Voxel `voxel` of the texel `params` describes, `model.params` holding the texel's box and
 /// gradient offset as `HyperTexel` packs them: (premultiplied rgba, texel-space normal).

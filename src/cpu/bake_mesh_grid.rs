@@ -8,7 +8,7 @@ use glam::DVec3;
 use crate::mesh::shape::{GridSpec, MeshShape};
 
 /// Mirrors DIR0..DIR2 of the kernel.
-pub const DIRECTIONS: [[f64; 3]; 3] =
+pub(crate) const DIRECTIONS: [[f64; 3]; 3] =
     [[0.99947, 0.02718, 0.01732], [0.01414, 0.99935, 0.03317], [0.03162, 0.02236, 0.99925]];
 
 fn on_segment(p: DVec3, a: DVec3, b: DVec3) -> DVec3 {
@@ -77,7 +77,7 @@ fn crosses(o: DVec3, d: DVec3, [a, b, c]: [DVec3; 3]) -> bool {
 
 /// Whether p is inside the part made of `triangles`: odd crossings along at least two of the
 /// three directions.
-pub fn inside(shape: &MeshShape, triangles: std::ops::Range<usize>, p: DVec3) -> bool {
+pub(crate) fn inside(shape: &MeshShape, triangles: std::ops::Range<usize>, p: DVec3) -> bool {
     let votes = DIRECTIONS
         .iter()
         .filter(|d| {

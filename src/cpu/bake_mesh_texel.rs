@@ -7,7 +7,7 @@ use crate::types::{BakeParams, MeshTexelParams};
 
 /// One voxel: (premultiplied rgba, texel-space normal); `color`: a coloured mesh's colour at the
 /// closest surface point (tints the texel's).
-pub fn bake_mesh_texel_voxel(
+pub(crate) fn bake_mesh_texel_voxel(
     params: &BakeParams,
     texel: &MeshTexelParams,
     cell: [f32; 4],

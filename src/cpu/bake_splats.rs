@@ -7,9 +7,9 @@ use super::hypertexture::Model;
 use crate::types::{SegmentParams, Splat};
 
 /// Mirrors the kernel's constants (in cells).
-pub const HALF_DIAGONAL: f64 = 0.8660254;
-pub const SURFACE_RADIUS: f64 = 1.8;
-pub const INTERIOR_RADIUS: f64 = 2.0;
+pub(crate) const HALF_DIAGONAL: f64 = 0.8660254;
+pub(crate) const SURFACE_RADIUS: f64 = 1.8;
+pub(crate) const INTERIOR_RADIUS: f64 = 2.0;
 
 fn splat(c: DVec3, r: f64, n: DVec3) -> Splat {
     Splat {
@@ -82,8 +82,8 @@ fn interior_splat(lattice: &Lattice, level: &impl Fn(DVec3) -> f64, id: [u32; 3]
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Lattice {
     /// Cells along the bounds' longest axis (the scene's `splat_grid`).
-    pub grid: u32,
-    pub min: DVec3,
+    pub(crate) grid: u32,
+    pub(crate) min: DVec3,
     pub cell: f64,
     pub counts: [u32; 3],
     /// Support distance of the splat surface.
@@ -93,7 +93,7 @@ pub struct Lattice {
 impl Lattice {
     /// `bounds`: the enlarged bounds; `shift`: the largest shift (as the kernels test it);
     /// `grid`: cells along the longest axis.
-    pub fn new(bounds: (DVec3, DVec3), shift: f64, grid: u32) -> Self {
+    pub(crate) fn new(bounds: (DVec3, DVec3), shift: f64, grid: u32) -> Self {
         let cell = (bounds.1 - bounds.0).max_element() / grid as f64;
         let level = shift + 0.5 * cell;
         // Beyond the bounds by the level and a cell: mesh support distances are lower bounds
@@ -104,17 +104,17 @@ impl Lattice {
         Lattice { grid, min: lo, cell, counts, level }
     }
 
-    pub fn cells(&self) -> u32 {
+    pub(crate) fn cells(&self) -> u32 {
         self.counts.iter().product()
     }
 
     /// The centre of cell `(i, j, k)` (object space).
-    pub fn centre(&self, i: u32, j: u32, k: u32) -> DVec3 {
+    pub(crate) fn centre(&self, i: u32, j: u32, k: u32) -> DVec3 {
         self.min + (DVec3::new(i as f64, j as f64, k as f64) + 0.5) * self.cell
     }
 
     /// Fills the lattice fields of `params`.
-    pub fn write(&self, params: &mut SegmentParams) {
+    pub(crate) fn write(&self, params: &mut SegmentParams) {
         let m = self.min;
         params.lattice_min = [m.x as f32, m.y as f32, m.z as f32, self.cell as f32];
         let c = self.counts;

@@ -1,18 +1,18 @@
 //! CPU twin (f64) of `wgsl/ray_march/bake_transfer.wgsl`: transfer functions sampled into tables of
-//! [`TRANSFER_SIZE`] entries over [0, 1].
+//! `TRANSFER_SIZE` entries over [0, 1].
 
 use crate::types::{TransferFunction, TransferPoint};
 
 /// Entries per table (mirrors `TRANSFER_SIZE` in wgsl/shared/transfer.wgsl).
-pub const TRANSFER_SIZE: usize = 256;
+pub(crate) const TRANSFER_SIZE: usize = 256;
 /// `TransferFunction::kind`: a cubic Hermite curve through points with slopes.
-pub const HERMITE: u32 = 0;
+pub(crate) const HERMITE: u32 = 0;
 /// `TransferFunction::kind`: straight lines between points.
-pub const LINEAR: u32 = 1;
+pub(crate) const LINEAR: u32 = 1;
 
 /// The function at `x`: constant beyond its first and last points, a Hermite or linear segment
 /// between them (Hermite clamped to [0, 1]).
-pub fn transfer_curve(f: &TransferFunction, points: &[TransferPoint], x: f64) -> f64 {
+pub(crate) fn transfer_curve(f: &TransferFunction, points: &[TransferPoint], x: f64) -> f64 {
     let p = &points[f.first as usize..(f.first + f.count) as usize];
     let (first, last) = (p[0], p[p.len() - 1]);
     if x <= first.x as f64 {

@@ -12,7 +12,7 @@ use crate::types::{
 };
 
 /// Vectors shorter than this have no direction (mirrors `TINY`).
-pub const TINY: f64 = 1e-12;
+pub(crate) const TINY: f64 = 1e-12;
 
 /// A packed hypertexture and its sampled transfer tables, as the kernels see them.
 #[derive(Clone, Copy)]
@@ -28,7 +28,7 @@ fn v3(a: [f32; 4]) -> DVec3 {
     DVec3::new(a[0] as f64, a[1] as f64, a[2] as f64)
 }
 
-pub fn unit_or_zero(v: DVec3) -> DVec3 {
+pub(crate) fn unit_or_zero(v: DVec3) -> DVec3 {
     let len = v.length();
     if len > TINY {
         v / len
@@ -38,7 +38,7 @@ pub fn unit_or_zero(v: DVec3) -> DVec3 {
 }
 
 /// Table `table` at `x`, linearly interpolated (clamped to [0, 1]).
-pub fn transfer_lookup(tables: &[f64], table: u32, x: f64) -> f64 {
+pub(crate) fn transfer_lookup(tables: &[f64], table: u32, x: f64) -> f64 {
     let u = x.clamp(0.0, 1.0) * (TRANSFER_SIZE - 1) as f64;
     let i = (u as usize).min(TRANSFER_SIZE - 2);
     let base = table as usize * TRANSFER_SIZE + i;
@@ -49,7 +49,7 @@ pub fn transfer_lookup(tables: &[f64], table: u32, x: f64) -> f64 {
 impl Model<'_> {
     /// The mesh grid at x (clamped to the grid), trilinear: vector to the closest surface point
     /// and signed distance (mirrors `mesh_sample`).
-    pub fn mesh_sample(&self, x: DVec3) -> (DVec3, f64) {
+    pub(crate) fn mesh_sample(&self, x: DVec3) -> (DVec3, f64) {
         let (cells, _) = self.grid.expect("a mesh object's grid");
         let n = self.params.grid_min[3] as usize;
         let lo = v3(self.params.grid_min);
@@ -80,7 +80,7 @@ impl Model<'_> {
     }
 
     /// A lower bound of the distance from x to where the density is positive.
-    pub fn support_distance(&self, x: DVec3) -> f64 {
+    pub(crate) fn support_distance(&self, x: DVec3) -> f64 {
         let s = v3(self.params.object);
         match self.params.kinds[0] {
             OBJECT_ELLIPSOID => ((x / s).length() - 1.0) * s.min_element(),
@@ -102,7 +102,7 @@ impl Model<'_> {
     }
 
     /// The closest point of the object's boundary (ellipsoid: radial projection).
-    pub fn closest_surface_point(&self, x: DVec3) -> DVec3 {
+    pub(crate) fn closest_surface_point(&self, x: DVec3) -> DVec3 {
         let s = v3(self.params.object);
         match self.params.kinds[0] {
             OBJECT_ELLIPSOID => {
@@ -158,7 +158,7 @@ impl Model<'_> {
     }
 
     /// The unperturbed vector field.
-    pub fn base_field(&self, x: DVec3) -> DVec3 {
+    pub(crate) fn base_field(&self, x: DVec3) -> DVec3 {
         let c = self.closest_surface_point(x) - x;
         let f = self.params.field;
         match self.params.kinds[1] {
@@ -225,7 +225,7 @@ impl Model<'_> {
     }
 
     /// The density modulation functions (`bias`, `gain`: 0.5 is the identity).
-    pub fn modulate(&self, density: f64) -> f64 {
+    pub(crate) fn modulate(&self, density: f64) -> f64 {
         let [b, g, ..] = self.params.modulation.map(|m| m as f64);
         if b == 0.5 && g == 0.5 {
             return density;
@@ -234,7 +234,7 @@ impl Model<'_> {
     }
 
     /// A noise's shape transfer function at noise value u (2D: bilinear with the density o).
-    pub fn shape_lookup(&self, n: &HyperNoise, u: f64, o: f64) -> f64 {
+    pub(crate) fn shape_lookup(&self, n: &HyperNoise, u: f64, o: f64) -> f64 {
         if n.rows <= 1 {
             return transfer_lookup(self.tables, n.table, u);
         }
@@ -246,7 +246,7 @@ impl Model<'_> {
     }
 
     /// The first colour table: after the last noise's shape tables.
-    pub fn color_tables(&self) -> u32 {
+    pub(crate) fn color_tables(&self) -> u32 {
         let last = &self.noises[self.params.kinds[2] as usize - 1];
         last.table + last.rows.max(1)
     }
@@ -277,6 +277,6 @@ pub fn perlin_gain(g: f64, t: f64) -> f64 {
 
 /// Whether a hypertexture's noises are 4D (some noise has a speed): the kernels' override
 /// `animated`.
-pub fn animated(noises: &[HyperNoise]) -> bool {
+pub(crate) fn animated(noises: &[HyperNoise]) -> bool {
     noises.iter().any(|n| n.speed != 0.0)
 }

@@ -6,7 +6,7 @@ use glam::{DVec3, DVec4};
 use super::bake::pcg_hash;
 
 /// The gradient of corner `c` dotted with `x` (Perlin 2002's 12 cube-edge directions).
-pub fn simplex_gradient(c: [i32; 3], seed: u32, x: DVec3) -> f64 {
+pub(crate) fn simplex_gradient(c: [i32; 3], seed: u32, x: DVec3) -> f64 {
     let h = pcg_hash((c[0] as u32).wrapping_add(pcg_hash(
         (c[1] as u32).wrapping_add(pcg_hash((c[2] as u32).wrapping_add(pcg_hash(seed)))),
     ))) & 15;
@@ -22,7 +22,7 @@ pub fn simplex_gradient(c: [i32; 3], seed: u32, x: DVec3) -> f64 {
 }
 
 /// `simplex_wrap`: the class of corner `c` modulo the periods (3a, 3b, 3c) of `tile` (0: none).
-pub fn simplex_wrap(c: [i32; 3], tile: [i32; 3]) -> [i32; 3] {
+pub(crate) fn simplex_wrap(c: [i32; 3], tile: [i32; 3]) -> [i32; 3] {
     if tile[0] <= 0 {
         return c;
     }
@@ -68,7 +68,7 @@ pub fn simplex3_tiled(p: DVec3, seed: u32, tile: [i32; 3]) -> f64 {
 }
 
 /// The gradient of 4D corner `c` dotted with `x` (the 32 tesseract-edge directions).
-pub fn simplex_gradient4(c: [i32; 4], seed: u32, x: DVec4) -> f64 {
+pub(crate) fn simplex_gradient4(c: [i32; 4], seed: u32, x: DVec4) -> f64 {
     let h = pcg_hash((c[0] as u32).wrapping_add(pcg_hash((c[1] as u32).wrapping_add(pcg_hash(
         (c[2] as u32).wrapping_add(pcg_hash((c[3] as u32).wrapping_add(pcg_hash(seed)))),
     )))))

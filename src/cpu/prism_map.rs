@@ -16,7 +16,7 @@ pub struct PrismCorners {
 
 /// Roots of `c0 + c1 x + c2 x^2` without dividing by a leading coefficient that may vanish: the
 /// quadratic degrades to the linear case smoothly (the root far away leaves the range instead).
-pub fn quadratic_roots(c0: f64, c1: f64, c2: f64) -> [Option<f64>; 2] {
+pub(crate) fn quadratic_roots(c0: f64, c1: f64, c2: f64) -> [Option<f64>; 2] {
     let disc = c1 * c1 - 4.0 * c2 * c0;
     if disc < 0.0 {
         return [None, None];
@@ -28,7 +28,7 @@ pub fn quadratic_roots(c0: f64, c1: f64, c2: f64) -> [Option<f64>; 2] {
 }
 
 /// Ray (origin 0, direction `d`) against triangle `a b c`: the hit distance (two-sided).
-pub fn ray_triangle(d: DVec3, a: DVec3, b: DVec3, c: DVec3) -> Option<f64> {
+pub(crate) fn ray_triangle(d: DVec3, a: DVec3, b: DVec3, c: DVec3) -> Option<f64> {
     let (e1, e2) = (b - a, c - a);
     let p = d.cross(e2);
     let det = e1.dot(p);
@@ -47,7 +47,7 @@ pub fn ray_triangle(d: DVec3, a: DVec3, b: DVec3, c: DVec3) -> Option<f64> {
 
 /// Ray (origin 0, direction `d`) against the bilinear patch with bottom edge `q00 q10` and top edge
 /// `q01 q11`: up to two hit distances.
-pub fn ray_patch(d: DVec3, q00: DVec3, q10: DVec3, q01: DVec3, q11: DVec3) -> [Option<f64>; 2] {
+pub(crate) fn ray_patch(d: DVec3, q00: DVec3, q10: DVec3, q01: DVec3, q11: DVec3) -> [Option<f64>; 2] {
     // For each u the patch holds the segment A(u) + v B(u); the ray meets it where A(u), B(u) and d
     // are coplanar: a quadratic in u.
     let e10 = q10 - q00;
@@ -74,7 +74,7 @@ pub fn ray_patch(d: DVec3, q00: DVec3, q10: DVec3, q01: DVec3, q11: DVec3) -> [O
 }
 
 /// Every distance at which the ray crosses the prism's boundary.
-pub fn boundary_hits(d: DVec3, p: &PrismCorners) -> Vec<f64> {
+pub(crate) fn boundary_hits(d: DVec3, p: &PrismCorners) -> Vec<f64> {
     let mut hits = Vec::with_capacity(8);
     hits.extend(ray_triangle(d, p.bottom[0], p.bottom[1], p.bottom[2]));
     hits.extend(ray_triangle(d, p.top[0], p.top[1], p.top[2]));
@@ -87,7 +87,7 @@ pub fn boundary_hits(d: DVec3, p: &PrismCorners) -> Vec<f64> {
 
 /// `f(w) = det(q1 - q0, q2 - q0, x - q0)` over the cross-section `q_i = p_i + w h_i` at height w, as
 /// cubic coefficients (relative to `p_0` for precision). `f` vanishes where the section holds x.
-pub fn section_cubic(x: DVec3, p: &PrismCorners) -> [f64; 4] {
+pub(crate) fn section_cubic(x: DVec3, p: &PrismCorners) -> [f64; 4] {
     let h = [0, 1, 2].map(|i| p.top[i] - p.bottom[i]);
     let (e1, e2) = (p.bottom[1] - p.bottom[0], p.bottom[2] - p.bottom[0]);
     let (g1, g2) = (h[1] - h[0], h[2] - h[0]);
@@ -134,7 +134,7 @@ fn bracketed_root(c: &[f64; 4], mut lo: f64, mut hi: f64) -> f64 {
 /// As ratios of areas against the normal `n = e1 x e2`: rounding is amplified by 1/sin of the
 /// triangle's smallest angle. (The normal equations, `d11 d22 - d12^2`, amplify it by 1/sin^2:
 /// a sliver of altitude 1e-6 lost all but 5 digits of its barycentrics in f64, all in f32.)
-pub fn barycentrics(x: DVec3, q: [DVec3; 3]) -> Option<[f64; 3]> {
+pub(crate) fn barycentrics(x: DVec3, q: [DVec3; 3]) -> Option<[f64; 3]> {
     let (e1, e2, e) = (q[1] - q[0], q[2] - q[0], x - q[0]);
     let n = e1.cross(e2);
     let nn = n.dot(n);
@@ -147,7 +147,7 @@ pub fn barycentrics(x: DVec3, q: [DVec3; 3]) -> Option<[f64; 3]> {
 }
 
 /// Tolerance on barycentrics for a point to count as inside a prism.
-pub const INSIDE_EPS: f64 = 1e-9;
+pub(crate) const INSIDE_EPS: f64 = 1e-9;
 /// Relative to the section cubic's coefficients, what counts as a root at w = 0 or 1.
 const ZERO_TOL: f64 = 1e-13;
 

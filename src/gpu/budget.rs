@@ -3,7 +3,7 @@
 //! "invalid texture view" naming no file) or what would exhaust the machine.
 
 /// The GPU memory a frame may allocate when `--budget` is not given.
-pub const DEFAULT_BUDGET: u64 = 4 << 30;
+pub(crate) const DEFAULT_BUDGET: u64 = 4 << 30;
 
 /// The limits `voltex plan` checks when no adapter is open: wgpu's defaults (what WebGPU
 /// guarantees), raised where every desktop Vulkan, D3D12 and Metal adapter, and lavapipe, offers
@@ -20,7 +20,7 @@ pub fn plan_limits() -> wgpu::Limits {
 
 /// What one allocation is, for the limit that applies to it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Shape {
+pub(crate) enum Shape {
     /// A buffer; `storage` when a kernel binds it whole (the binding-size limit applies).
     Buffer {
         storage: bool,
@@ -37,7 +37,7 @@ pub enum Shape {
 
 /// The value in a user file that sizes an allocation, for the error's position and hint.
 #[derive(Debug, Clone, PartialEq, Eq)]
-pub enum Driver {
+pub(crate) enum Driver {
     /// The output size (the scene's `output`, or `--size`).
     Output,
     /// A texel's `resolution`.
@@ -51,10 +51,10 @@ pub enum Driver {
 /// One texture or buffer a frame allocates.
 #[derive(Debug, Clone)]
 pub struct Allocation {
-    pub what: String,
-    pub bytes: u64,
-    pub shape: Shape,
-    pub driver: Driver,
+    pub(crate) what: String,
+    pub(crate) bytes: u64,
+    pub(crate) shape: Shape,
+    pub(crate) driver: Driver,
 }
 
 fn mib(n: u64) -> String {
@@ -66,7 +66,7 @@ fn mib(n: u64) -> String {
 /// wgpu's limits bound buffers but not a texture's bytes; drivers refuse a texture larger than
 /// their largest allocation, which wgpu reports as `max_buffer_size` (Vulkan's
 /// `maxMemoryAllocationSize`), so textures are held to it too.
-pub fn over_limit(a: &Allocation, limits: &wgpu::Limits) -> Option<String> {
+pub(crate) fn over_limit(a: &Allocation, limits: &wgpu::Limits) -> Option<String> {
     let dims = |size: &[u32], max: u32, name: &str| {
         size.iter().any(|&d| d > max).then(|| {
             let s: Vec<String> = size.iter().map(u32::to_string).collect();
@@ -107,7 +107,7 @@ pub fn parse_budget(s: &str) -> std::result::Result<u64, String> {
 }
 
 /// The total against `budget`, naming the largest items.
-pub fn over_budget(items: &[(String, u64)], budget: u64) -> Option<String> {
+pub(crate) fn over_budget(items: &[(String, u64)], budget: u64) -> Option<String> {
     let total: u64 = items.iter().map(|i| i.1).sum();
     if total <= budget {
         return None;
@@ -130,13 +130,13 @@ pub fn over_budget(items: &[(String, u64)], budget: u64) -> Option<String> {
 
 /// Why a frame cannot be allocated: one allocation over a limit, or the total over the budget
 /// (with the driver of the largest allocation, the value most worth changing).
-pub enum Failure {
+pub(crate) enum Failure {
     Limit(Driver, String),
     Budget(Option<Driver>, String),
 }
 
 /// Checks every allocation against `limits`, then the total of `memory` against `budget`.
-pub fn check(
+pub(crate) fn check(
     allocations: &[Allocation],
     memory: &[(String, u64)],
     limits: &wgpu::Limits,

@@ -5,7 +5,7 @@ use crate::gpu::GpuContext;
 /// A uniform buffer holding `bytes` (padded to 4). Also bindable as read-only storage: kernels
 /// whose loops depend on their parameters read them so (`composite_tiles`), since lavapipe's
 /// uniform inlining overflows a fixed array on such kernels (a crash in Mesa 22.3).
-pub fn uniform(ctx: &GpuContext, label: &str, bytes: &[u8]) -> wgpu::Buffer {
+pub(crate) fn uniform(ctx: &GpuContext, label: &str, bytes: &[u8]) -> wgpu::Buffer {
     filled(
         ctx,
         label,
@@ -33,7 +33,12 @@ fn filled(ctx: &GpuContext, label: &str, bytes: &[u8], usage: wgpu::BufferUsages
 
 /// An uninitialised storage buffer of `size` bytes (at least 16: empty bindings are invalid),
 /// copyable both ways, with `extra` usages (e.g. INDIRECT).
-pub fn work_buffer(ctx: &GpuContext, label: &str, size: u64, extra: wgpu::BufferUsages) -> wgpu::Buffer {
+pub(crate) fn work_buffer(
+    ctx: &GpuContext,
+    label: &str,
+    size: u64,
+    extra: wgpu::BufferUsages,
+) -> wgpu::Buffer {
     ctx.device.create_buffer(&wgpu::BufferDescriptor {
         label: Some(label),
         size: size.max(16),
@@ -45,7 +50,7 @@ pub fn work_buffer(ctx: &GpuContext, label: &str, size: u64, extra: wgpu::Buffer
     })
 }
 
-pub fn storage(ctx: &GpuContext, label: &str, bytes: &[u8]) -> wgpu::Buffer {
+pub(crate) fn storage(ctx: &GpuContext, label: &str, bytes: &[u8]) -> wgpu::Buffer {
     let usage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC;
     filled(ctx, label, bytes, usage)
 }

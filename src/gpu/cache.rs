@@ -17,15 +17,15 @@ pub struct CacheStats {
 }
 
 #[derive(Clone)]
-pub enum Pipeline {
+pub(crate) enum Pipeline {
     Compute(wgpu::ComputePipeline),
     Render(wgpu::RenderPipeline),
 }
 
 #[derive(Clone)]
-pub struct Layout {
-    pub groups: Vec<wgpu::BindGroupLayout>,
-    pub pipeline: wgpu::PipelineLayout,
+pub(crate) struct Layout {
+    pub(crate) groups: Vec<wgpu::BindGroupLayout>,
+    pub(crate) pipeline: wgpu::PipelineLayout,
 }
 
 /// Entries by their type and key.
@@ -49,7 +49,7 @@ enum Made {
 }
 
 /// A key from anything printable (the descriptors' fields, in order).
-pub fn key(parts: &impl std::fmt::Debug) -> u64 {
+pub(crate) fn key(parts: &impl std::fmt::Debug) -> u64 {
     let mut h = std::collections::hash_map::DefaultHasher::new();
     format!("{parts:?}").hash(&mut h);
     h.finish()
@@ -92,7 +92,7 @@ impl GpuCache {
         Ok(v)
     }
 
-    pub fn module(
+    pub(crate) fn module(
         &mut self,
         key: u64,
         make: impl FnOnce() -> crate::Result<wgpu::ShaderModule>,
@@ -100,11 +100,11 @@ impl GpuCache {
         self.get_or_make(key, Made::Module, make)
     }
 
-    pub fn layout(&mut self, key: u64, make: impl FnOnce() -> Layout) -> Layout {
+    pub(crate) fn layout(&mut self, key: u64, make: impl FnOnce() -> Layout) -> Layout {
         self.get_or_make(key, Made::Layout, || Ok(make())).expect("making a layout cannot fail")
     }
 
-    pub fn pipeline(
+    pub(crate) fn pipeline(
         &mut self,
         key: u64,
         make: impl FnOnce() -> crate::Result<Pipeline>,
@@ -114,20 +114,20 @@ impl GpuCache {
 
     /// Takes the value of type `T` kept under `key` out of the cache: a helper used mutably while
     /// the cache is (the baker and its kernels); [`GpuCache::put`] gives it back.
-    pub fn take<T: Send + 'static>(&mut self, key: u64) -> Option<T> {
+    pub(crate) fn take<T: Send + 'static>(&mut self, key: u64) -> Option<T> {
         let v = self.entries.remove(&(TypeId::of::<T>(), key))?;
         v.downcast::<T>().ok().map(|v| *v)
     }
 
     /// Keeps `value` under `key`, used by this build.
-    pub fn put<T: Send + 'static>(&mut self, key: u64, value: T) {
+    pub(crate) fn put<T: Send + 'static>(&mut self, key: u64, value: T) {
         let slot = (TypeId::of::<T>(), key);
         self.used.insert(slot);
         self.entries.insert(slot, Box::new(value));
     }
 
     /// A bake of any kind (a texel, a mesh grid, a splat set), counted in `stats.bakes`.
-    pub fn bake<T: Clone + Send + 'static>(
+    pub(crate) fn bake<T: Clone + Send + 'static>(
         &mut self,
         key: u64,
         make: impl FnOnce() -> crate::Result<T>,

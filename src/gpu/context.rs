@@ -9,15 +9,15 @@ use crate::error::{Error, Result};
 use crate::fault::Fault;
 
 /// Features voltex uses when the adapter has them (none is required).
-pub const OPTIONAL_FEATURES: wgpu::Features = wgpu::Features::TIMESTAMP_QUERY
+pub(crate) const OPTIONAL_FEATURES: wgpu::Features = wgpu::Features::TIMESTAMP_QUERY
     .union(wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS)
     .union(wgpu::Features::FLOAT32_BLENDABLE);
 
 pub struct GpuContext {
     pub device: wgpu::Device,
-    pub queue: wgpu::Queue,
-    pub info: wgpu::AdapterInfo,
-    pub features: wgpu::Features,
+    pub(crate) queue: wgpu::Queue,
+    pub(crate) info: wgpu::AdapterInfo,
+    pub(crate) features: wgpu::Features,
     pub limits: wgpu::Limits,
     errors: Arc<Mutex<Vec<String>>>,
     /// Why the device was lost, once it is.
@@ -62,7 +62,7 @@ impl GpuContext {
     }
 
     /// Opens a device on `adapter` (the preview picks one compatible with its window).
-    pub fn open(adapter: wgpu::Adapter) -> Result<Self> {
+    pub(crate) fn open(adapter: wgpu::Adapter) -> Result<Self> {
         let info = adapter.get_info();
         let features = adapter.features() & OPTIONAL_FEATURES;
         let limits = adapter.limits();
@@ -107,7 +107,7 @@ impl GpuContext {
     }
 
     /// Fails with [`Error::DeviceLost`] once the device is lost.
-    pub fn check_alive(&self) -> Result<()> {
+    pub(crate) fn check_alive(&self) -> Result<()> {
         match self.lost() {
             Some(why) => Err(Error::DeviceLost(format!("{} ({why})", self.info.name))),
             None => Ok(()),
@@ -117,7 +117,7 @@ impl GpuContext {
     /// Applies the fault `VOLTEX_FAULT` plans for the next graph pass, if any (see [`fault`]).
     ///
     /// [`fault`]: crate::fault
-    pub fn fault_at_pass(&self) {
+    pub(crate) fn fault_at_pass(&self) {
         match crate::fault::at_pass() {
             Some(Fault::DeviceLost) => {
                 eprintln!("VOLTEX_FAULT: destroying the GPU device");
@@ -144,13 +144,13 @@ impl GpuContext {
         )
     }
 
-    pub fn has_timestamps(&self) -> bool {
+    pub(crate) fn has_timestamps(&self) -> bool {
         self.features
             .contains(wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS)
     }
 
     /// Fails with the first wgpu error raised outside an error scope since the last call.
-    pub fn take_errors(&self) -> Result<()> {
+    pub(crate) fn take_errors(&self) -> Result<()> {
         self.check_alive()?;
         let mut errors = self.errors.lock().unwrap();
         if errors.is_empty() {
@@ -168,7 +168,7 @@ impl GpuContext {
     }
 
     /// Runs `f` inside a validation error scope, turning wgpu validation errors into `Error::Gpu`.
-    pub fn scoped<T>(&self, what: &str, f: impl FnOnce() -> T) -> Result<T> {
+    pub(crate) fn scoped<T>(&self, what: &str, f: impl FnOnce() -> T) -> Result<T> {
         self.check_alive()?;
         let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
         let value = f();
@@ -178,7 +178,7 @@ impl GpuContext {
         }
     }
 
-    pub fn wait(&self) -> Result<()> {
+    pub(crate) fn wait(&self) -> Result<()> {
         self.check_alive()?;
         self.device
             .poll(wgpu::PollType::wait_indefinitely())
@@ -201,7 +201,7 @@ impl GpuContext {
     }
 
     /// Maps a MAP_READ buffer after the queue is idle and returns its bytes.
-    pub fn map_read(&self, staging: &wgpu::Buffer) -> Result<Vec<u8>> {
+    pub(crate) fn map_read(&self, staging: &wgpu::Buffer) -> Result<Vec<u8>> {
         let slice = staging.slice(..);
         slice.map_async(wgpu::MapMode::Read, |_| {});
         self.wait()?;

@@ -7,19 +7,19 @@ use std::collections::HashMap;
 #[derive(Default)]
 pub struct Inputs {
     pub buffers: HashMap<String, wgpu::Buffer>,
-    pub views: HashMap<String, wgpu::TextureView>,
-    pub samplers: HashMap<String, wgpu::Sampler>,
-    pub counts: HashMap<String, u32>,
+    pub(crate) views: HashMap<String, wgpu::TextureView>,
+    pub(crate) samplers: HashMap<String, wgpu::Sampler>,
+    pub(crate) counts: HashMap<String, u32>,
     /// Values for WGSL `override` constants, by name.
-    pub constants: Vec<(String, f64)>,
+    pub(crate) constants: Vec<(String, f64)>,
     /// View depth of each plane of a slice sweep, back to front: draws of instances whose depth
     /// ranges overlap are interleaved plane by plane (`Draw::DepthSorted`).
-    pub plane_depths: Vec<f64>,
+    pub(crate) plane_depths: Vec<f64>,
 }
 
 /// Values of a kernel's `override` constants, looked up by name in `sources` (first match wins);
 /// the name of one without a default that no source sets as the error.
-pub fn override_values<'a>(
+pub(crate) fn override_values<'a>(
     kernel: &crate::gpu::shader::Kernel,
     sources: &[&'a Inputs],
 ) -> std::result::Result<Vec<(&'a str, f64)>, String> {

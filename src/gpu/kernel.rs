@@ -11,8 +11,8 @@ use crate::gpu::shader;
 use crate::gpu::sources::Sources;
 use crate::gpu::GpuContext;
 
-pub struct ComputeKernel {
-    pub name: String,
+pub(crate) struct ComputeKernel {
+    pub(crate) name: String,
     kernel: shader::Kernel,
     bindings: Vec<Binding>,
     bgl: wgpu::BindGroupLayout,
@@ -23,12 +23,12 @@ pub struct ComputeKernel {
 }
 
 impl ComputeKernel {
-    pub fn load(ctx: &GpuContext, sources: &Sources, name: &str) -> Result<Self> {
+    pub(crate) fn load(ctx: &GpuContext, sources: &Sources, name: &str) -> Result<Self> {
         Self::new(ctx, shader::load_from(sources, name)?)
     }
 
     /// A kernel from validated WGSL (e.g. [`shader::Kernel::with_storage_format`]).
-    pub fn new(ctx: &GpuContext, kernel: shader::Kernel) -> Result<Self> {
+    pub(crate) fn new(ctx: &GpuContext, kernel: shader::Kernel) -> Result<Self> {
         let name = kernel.name.clone();
         let name = name.as_str();
         let bindings = reflect::bindings(&kernel, &["main"])?;
@@ -65,7 +65,7 @@ impl ComputeKernel {
     }
 
     /// Records a dispatch covering `threads` invocations in its own compute pass.
-    pub fn dispatch(
+    pub(crate) fn dispatch(
         &mut self,
         ctx: &GpuContext,
         encoder: &mut wgpu::CommandEncoder,

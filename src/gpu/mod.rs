@@ -1,12 +1,12 @@
 //! Device, shader lookup (embedded defaults and folders on disk), loading and validation, reflection, timestamps.
 
 pub mod budget;
-pub mod buffers;
+pub(crate) mod buffers;
 pub mod cache;
-pub mod context;
-pub mod inputs;
-pub mod kernel;
-pub mod reflect;
+pub(crate) mod context;
+pub(crate) mod inputs;
+pub(crate) mod kernel;
+pub(crate) mod reflect;
 pub mod shader;
 pub mod sources;
 pub mod timing;

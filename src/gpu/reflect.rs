@@ -6,7 +6,7 @@ use crate::gpu::shader::Kernel;
 
 /// What kind of resource a WGSL global is.
 #[derive(Clone, Debug, PartialEq)]
-pub enum BindingKind {
+pub(crate) enum BindingKind {
     Uniform,
     Storage {
         read_only: bool,
@@ -28,7 +28,7 @@ pub enum BindingKind {
 
 impl BindingKind {
     /// Whether a pass with this binding writes the bound resource (for pass ordering).
-    pub fn writes(&self) -> bool {
+    pub(crate) fn writes(&self) -> bool {
         matches!(self, BindingKind::Storage { read_only: false } | BindingKind::StorageTexture { .. })
     }
 }
@@ -36,14 +36,14 @@ impl BindingKind {
 #[derive(Clone, Debug)]
 pub struct Binding {
     pub name: String,
-    pub group: u32,
+    pub(crate) group: u32,
     pub binding: u32,
-    pub kind: BindingKind,
-    pub visibility: wgpu::ShaderStages,
+    pub(crate) kind: BindingKind,
+    pub(crate) visibility: wgpu::ShaderStages,
 }
 
 /// Bindings used by the given entry points, merged across stages, sorted by (group, binding).
-pub fn bindings(kernel: &Kernel, entry_points: &[&str]) -> Result<Vec<Binding>> {
+pub(crate) fn bindings(kernel: &Kernel, entry_points: &[&str]) -> Result<Vec<Binding>> {
     let module = &kernel.module;
     let sampled = sampled_globals(module);
     let mut out: Vec<Binding> = Vec::new();
@@ -151,7 +151,7 @@ fn texture_format(f: naga::StorageFormat) -> Result<wgpu::TextureFormat, String>
 }
 
 /// The bind group layout entry of a reflected binding.
-pub fn layout_entry(b: &Binding) -> wgpu::BindGroupLayoutEntry {
+pub(crate) fn layout_entry(b: &Binding) -> wgpu::BindGroupLayoutEntry {
     let ty = match &b.kind {
         BindingKind::Uniform => wgpu::BindingType::Buffer {
             ty: wgpu::BufferBindingType::Uniform,
@@ -187,7 +187,7 @@ pub fn layout_entry(b: &Binding) -> wgpu::BindGroupLayoutEntry {
 }
 
 /// Names of the `override` constants a module declares, with whether each has a default.
-pub fn overrides(kernel: &Kernel) -> Vec<(String, bool)> {
+pub(crate) fn overrides(kernel: &Kernel) -> Vec<(String, bool)> {
     kernel
         .module
         .overrides
@@ -197,6 +197,6 @@ pub fn overrides(kernel: &Kernel) -> Vec<(String, bool)> {
 }
 
 /// Workgroup size of a compute entry point.
-pub fn workgroup_size(kernel: &Kernel, entry_point: &str) -> Option<[u32; 3]> {
+pub(crate) fn workgroup_size(kernel: &Kernel, entry_point: &str) -> Option<[u32; 3]> {
     kernel.module.entry_points.iter().find(|e| e.name == entry_point).map(|e| e.workgroup_size)
 }

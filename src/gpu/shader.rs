@@ -12,12 +12,12 @@ use crate::gpu::sources::{Source, Sources};
 /// `<embedded>/wgsl/...`).
 pub struct Kernel {
     /// Path relative to the WGSL root, e.g. `view_slices/emit_slices.wgsl`.
-    pub name: String,
+    pub(crate) name: String,
     pub module: naga::Module,
-    pub info: naga::valid::ModuleInfo,
+    pub(crate) info: naga::valid::ModuleInfo,
     pub files: Vec<PathBuf>,
     /// Hash of the expanded source: the GPU module is reused while it is unchanged.
-    pub source_hash: u64,
+    pub(crate) source_hash: u64,
 }
 
 /// Expanded source plus, for each expanded line, the file and line it came from.
@@ -84,7 +84,7 @@ impl Expanded {
 }
 
 /// The naga capabilities voltex kernels may use on any adapter it supports.
-pub fn capabilities() -> naga::valid::Capabilities {
+pub(crate) fn capabilities() -> naga::valid::Capabilities {
     naga::valid::Capabilities::empty()
 }
 
@@ -102,7 +102,7 @@ pub fn load_from(sources: &Sources, rel: &str) -> Result<Kernel> {
 
 /// The hash of the expanded source of `rel` ([`Kernel::source_hash`] of the kernel it loads),
 /// without parsing it: cheap enough for every rebuild to ask whether a kernel changed.
-pub fn source_hash(sources: &Sources, rel: &str) -> Result<u64> {
+pub(crate) fn source_hash(sources: &Sources, rel: &str) -> Result<u64> {
     let mut ex = Expanded { text: String::new(), origin: Vec::new(), files: Vec::new() };
     expand(sources, rel, &mut ex, None)?;
     Ok(crate::gpu::cache::key(&ex.text))
@@ -150,7 +150,7 @@ impl Kernel {
     /// The same kernel with the storage texture `global` declared in `format` (same access and
     /// dimension), re-validated: e.g. a bake writing `rgba8unorm` made to write `rgba32float`,
     /// so its results can be read back at full precision (`voltex export`).
-    pub fn with_storage_format(mut self, global: &str, format: naga::StorageFormat) -> Result<Kernel> {
+    pub(crate) fn with_storage_format(mut self, global: &str, format: naga::StorageFormat) -> Result<Kernel> {
         let wrong = |what: &str| Error::Invalid(format!("{}: `{global}` {what}", self.name));
         let (_, var) = (self.module.global_variables.iter_mut())
             .find(|(_, g)| g.name.as_deref() == Some(global))
@@ -173,7 +173,7 @@ impl Kernel {
 
 /// Most bytes of `var<private>` or `var<function>` memory one variable may take: naga accepts
 /// any size, and drivers fail late (or crash) on huge per-invocation arrays.
-pub const MAX_PRIVATE_BYTES: u64 = 64 << 10;
+pub(crate) const MAX_PRIVATE_BYTES: u64 = 64 << 10;
 
 /// Checks naga accepts but a device may not: workgroup sizes and workgroup memory against
 /// WebGPU's default limits (what every adapter offers), and per-invocation arrays against

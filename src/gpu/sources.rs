@@ -20,26 +20,26 @@ use crate::error::{Error, Result};
 static EMBEDDED: &[(&str, &str)] = include!(concat!(env!("OUT_DIR"), "/embedded.rs"));
 
 /// How embedded files are named in messages: `<embedded>/wgsl/composite.wgsl`.
-pub const EMBEDDED_PREFIX: &str = "<embedded>";
+pub(crate) const EMBEDDED_PREFIX: &str = "<embedded>";
 
 /// The embedded file at `rel` (`wgsl/x.wgsl`, `graphs/frame.ron`), if any.
-pub fn embedded(rel: &str) -> Option<&'static str> {
+pub(crate) fn embedded(rel: &str) -> Option<&'static str> {
     EMBEDDED.binary_search_by(|(p, _)| (*p).cmp(rel)).ok().map(|i| EMBEDDED[i].1)
 }
 
 /// Every embedded file as (`wgsl/...` or `graphs/...`, contents).
-pub fn embedded_files() -> &'static [(&'static str, &'static str)] {
+pub(crate) fn embedded_files() -> &'static [(&'static str, &'static str)] {
     EMBEDDED
 }
 
 /// A file found by [`Sources`]: its text and where it came from.
 #[derive(Debug, Clone)]
-pub struct Source {
+pub(crate) struct Source {
     /// The file on disk, or `<embedded>/wgsl/...` for an embedded one (for messages).
-    pub path: PathBuf,
-    pub text: String,
+    pub(crate) path: PathBuf,
+    pub(crate) text: String,
     /// False for an embedded file (nothing to watch for changes).
-    pub on_disk: bool,
+    pub(crate) on_disk: bool,
 }
 
 /// The places shaders and graphs are looked up in, in order (see the module documentation).
@@ -93,7 +93,7 @@ impl Sources {
 
     /// The shader `rel` (relative to the WGSL root), from the first place that has it; `None`
     /// when no place has it. A file that exists but cannot be read is an error.
-    pub fn shader(&self, rel: &str) -> Result<Option<Source>> {
+    pub(crate) fn shader(&self, rel: &str) -> Result<Option<Source>> {
         for dir in &self.dirs {
             let path = dir.join(rel);
             // Anything at the path counts as found, so a FIFO or a folder there is an error
@@ -108,7 +108,7 @@ impl Sources {
 
     /// The graph `name` of the project (e.g. `frame.ron`): the file in the project tree's
     /// `graphs/` when present, else the embedded copy.
-    pub fn graph(&self, name: &str) -> Result<Option<Source>> {
+    pub(crate) fn graph(&self, name: &str) -> Result<Option<Source>> {
         if let Some(path) = self.graphs.as_ref().map(|g| g.join(name)).filter(|p| p.exists()) {
             let text = crate::input::read_text(&path, "a graph file")?;
             return Ok(Some(Source { path, text, on_disk: true }));
@@ -132,7 +132,7 @@ impl Sources {
     }
 
     /// The places searched, for "not found" messages: `/g, /p/wgsl or the embedded kernels`.
-    pub fn describe(&self) -> String {
+    pub(crate) fn describe(&self) -> String {
         let mut places: Vec<String> = self.dirs.iter().map(|d| d.display().to_string()).collect();
         if self.embedded {
             places.push("the embedded kernels".into());

@@ -32,7 +32,7 @@ impl Timer {
         Self { set: Some(set), resolve: Some(resolve), labels: Vec::new(), capacity }
     }
 
-    pub fn reset(&mut self) {
+    pub(crate) fn reset(&mut self) {
         self.labels.clear();
     }
 
@@ -47,7 +47,7 @@ impl Timer {
         Some((set, index))
     }
 
-    pub fn compute(&mut self, label: &str) -> Option<wgpu::ComputePassTimestampWrites<'_>> {
+    pub(crate) fn compute(&mut self, label: &str) -> Option<wgpu::ComputePassTimestampWrites<'_>> {
         self.next(label).map(|(query_set, i)| wgpu::ComputePassTimestampWrites {
             query_set,
             beginning_of_pass_write_index: Some(i),
@@ -55,7 +55,7 @@ impl Timer {
         })
     }
 
-    pub fn render(&mut self, label: &str) -> Option<wgpu::RenderPassTimestampWrites<'_>> {
+    pub(crate) fn render(&mut self, label: &str) -> Option<wgpu::RenderPassTimestampWrites<'_>> {
         self.next(label).map(|(query_set, i)| wgpu::RenderPassTimestampWrites {
             query_set,
             beginning_of_pass_write_index: Some(i),
@@ -63,7 +63,7 @@ impl Timer {
         })
     }
 
-    pub fn resolve(&self, encoder: &mut wgpu::CommandEncoder) {
+    pub(crate) fn resolve(&self, encoder: &mut wgpu::CommandEncoder) {
         if let (Some(set), Some(buf)) = (&self.set, &self.resolve) {
             if !self.labels.is_empty() {
                 encoder.resolve_query_set(set, 0..self.labels.len() as u32 * 2, buf, 0);
@@ -71,13 +71,8 @@ impl Timer {
         }
     }
 
-    /// Per-pass durations in milliseconds, in submission order (after the frame was submitted).
-    pub fn read(&self, ctx: &GpuContext) -> Result<Vec<(String, f64)>> {
-        Ok(self.read_spans(ctx)?.into_iter().map(|s| (s.name, s.ms)).collect())
-    }
-
     /// Per-pass spans on the adapter's timestamp clock, in submission order.
-    pub fn read_spans(&self, ctx: &GpuContext) -> Result<Vec<Span>> {
+    pub(crate) fn read_spans(&self, ctx: &GpuContext) -> Result<Vec<Span>> {
         let Some(buf) = &self.resolve else {
             return Ok(Vec::new());
         };
@@ -104,7 +99,7 @@ impl Timer {
 /// began (ms since the clock's origin, which only the adapter knows) and how long it took.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Span {
-    pub name: String,
-    pub begin_ms: f64,
-    pub ms: f64,
+    pub(crate) name: String,
+    pub(crate) begin_ms: f64,
+    pub(crate) ms: f64,
 }

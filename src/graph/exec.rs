@@ -150,12 +150,12 @@ impl Executor {
         Ok(Self { graph, textures, buffers, modules, layouts, pipelines: HashMap::new() })
     }
 
-    pub fn texture(&self, name: &str) -> Option<&wgpu::Texture> {
+    pub(crate) fn texture(&self, name: &str) -> Option<&wgpu::Texture> {
         self.textures.get(name).map(|t| &t.texture)
     }
 
     /// A graph buffer (or a parameter's uniform buffer).
-    pub fn buffer(&self, name: &str) -> Option<&wgpu::Buffer> {
+    pub(crate) fn buffer(&self, name: &str) -> Option<&wgpu::Buffer> {
         self.buffers.get(name).map(|b| &b.buffer)
     }
 
@@ -705,7 +705,7 @@ fn count(name: &str, inst: &Inputs, frame: &Inputs) -> u32 {
 
 /// Checks the dispatch and draw counts of a pass against the runtime's `counts` (called by the
 /// planner, so `voltex plan` reports them without a GPU).
-pub fn check_counts(graph: &Graph, decl: &PassDecl, counts: &[&str]) -> Result<()> {
+pub(crate) fn check_counts(graph: &Graph, decl: &PassDecl, counts: &[&str]) -> Result<()> {
     match decl {
         PassDecl::Compute {
             dispatch: Dispatch::Threads(x, y, z) | Dispatch::Groups(x, y, z),

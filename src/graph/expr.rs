@@ -3,22 +3,22 @@
 
 /// A term of a sum: the product of its factors.
 #[derive(Debug, Clone, PartialEq)]
-pub enum Factor {
+pub(crate) enum Factor {
     Number(u64),
     Name(String),
 }
 
 /// A parsed expression: a sum of products.
 #[derive(Debug, Clone, PartialEq)]
-pub struct Expr {
-    pub terms: Vec<Vec<(Factor, usize)>>,
+pub(crate) struct Expr {
+    pub(crate) terms: Vec<Vec<(Factor, usize)>>,
 }
 
 /// A parse or evaluation error with the byte offset in the expression text it is about.
 #[derive(Debug, Clone, PartialEq)]
-pub struct ExprError {
-    pub offset: usize,
-    pub message: String,
+pub(crate) struct ExprError {
+    pub(crate) offset: usize,
+    pub(crate) message: String,
 }
 
 fn err<T>(offset: usize, message: impl Into<String>) -> Result<T, ExprError> {
@@ -26,7 +26,7 @@ fn err<T>(offset: usize, message: impl Into<String>) -> Result<T, ExprError> {
 }
 
 impl Expr {
-    pub fn parse(text: &str) -> Result<Self, ExprError> {
+    pub(crate) fn parse(text: &str) -> Result<Self, ExprError> {
         let bytes = text.as_bytes();
         let mut i = 0;
         let skip = |i: &mut usize| {
@@ -75,7 +75,7 @@ impl Expr {
     }
 
     /// Count names the expression uses, with their offsets.
-    pub fn names(&self) -> impl Iterator<Item = (&str, usize)> {
+    pub(crate) fn names(&self) -> impl Iterator<Item = (&str, usize)> {
         self.terms.iter().flatten().filter_map(|(f, at)| match f {
             Factor::Name(n) => Some((n.as_str(), *at)),
             Factor::Number(_) => None,
@@ -84,7 +84,7 @@ impl Expr {
 
     /// The value, names looked up in `count` (which reports an unknown one); an overflow of 64
     /// bits is an error at the start of the expression.
-    pub fn eval(&self, count: impl Fn(&str) -> Option<u64>) -> Result<u64, ExprError> {
+    pub(crate) fn eval(&self, count: impl Fn(&str) -> Option<u64>) -> Result<u64, ExprError> {
         let mut sum: u64 = 0;
         for term in &self.terms {
             let mut product: u64 = 1;

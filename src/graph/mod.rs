@@ -3,7 +3,7 @@
 //! not use is pruned ([`plan`]); [`exec`] records and runs a frame.
 
 pub mod exec;
-pub mod expr;
+pub(crate) mod expr;
 pub mod plan;
 
 use std::collections::BTreeMap;
@@ -22,8 +22,8 @@ pub struct GraphFile {
     /// of them are pruned.
     pub outputs: Vec<String>,
     #[serde(default, deserialize_with = "crate::input::unique_keys")]
-    pub resources: BTreeMap<String, ResourceDecl>,
-    pub passes: Vec<PassDecl>,
+    pub(crate) resources: BTreeMap<String, ResourceDecl>,
+    pub(crate) passes: Vec<PassDecl>,
     /// Extra images a render may ask for by name (`--aov NAME`, a scene's `output.aovs`): their
     /// textures become outputs, so the passes that write them are kept only then, and are
     /// written beside the colour as EXR channels.
@@ -37,10 +37,10 @@ pub struct GraphFile {
 #[serde(deny_unknown_fields)]
 pub struct AovDecl {
     pub textures: Vec<String>,
-    pub channels: AovChannels,
+    pub(crate) channels: AovChannels,
     /// How `supersample` reduces a block of samples to a pixel.
     #[serde(default)]
-    pub downsample: Downsample,
+    pub(crate) downsample: Downsample,
 }
 
 /// EXR channel names of an AOV's texture channels.
@@ -68,12 +68,12 @@ pub enum Downsample {
 }
 
 /// Longest EXR channel name (OpenEXR 2's long names).
-pub const MAX_CHANNEL_BYTES: usize = 255;
+pub(crate) const MAX_CHANNEL_BYTES: usize = 255;
 
 impl AovDecl {
     /// Channels per texture of `format` this AOV reads: 1 for R32Float, 3 (objects) or 4 for
     /// Rgba32Float.
-    pub fn channels_of(&self, format: Format) -> usize {
+    pub(crate) fn channels_of(&self, format: Format) -> usize {
         match (format, &self.channels) {
             (Format::R32Float, _) => 1,
             (_, AovChannels::Objects(_)) => 3,
@@ -83,7 +83,7 @@ impl AovDecl {
 
     /// The EXR channel name of each texture channel read, `None` where none is written, for a
     /// scene whose objects are `objects` (in order), given the graph's texture formats.
-    pub fn channel_names(&self, formats: &[Format], objects: &[&str]) -> Vec<Option<String>> {
+    pub(crate) fn channel_names(&self, formats: &[Format], objects: &[&str]) -> Vec<Option<String>> {
         let per: Vec<usize> = formats.iter().map(|f| self.channels_of(*f)).collect();
         let total: usize = per.iter().sum();
         match &self.channels {
@@ -130,7 +130,7 @@ pub enum ResourceDecl {
 }
 
 /// The size of a graph buffer. Counts are size expressions: integer literals and the frame's
-/// counts (`width`, `height`) joined by `*` and `+`, e.g. `"width * height"` (see [`expr`]).
+/// counts (`width`, `height`) joined by `*` and `+`, e.g. `"width * height"` (see `expr`).
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub enum BufferSize {
@@ -144,7 +144,7 @@ pub enum BufferSize {
 
 impl BufferSize {
     /// The expression and the bytes per unit it counts.
-    pub fn expr(&self) -> (&str, u64) {
+    pub(crate) fn expr(&self) -> (&str, u64) {
         match self {
             BufferSize::Bytes(c) => (c, 1),
             BufferSize::Words(c) => (c, 4),
@@ -175,7 +175,7 @@ pub enum Value {
 
 impl Value {
     /// The WGSL type a `var<uniform>` bound to this value must have.
-    pub fn wgsl_type(&self) -> &'static str {
+    pub(crate) fn wgsl_type(&self) -> &'static str {
         match self {
             Value::F32(_) => "f32",
             Value::U32(_) => "u32",
@@ -184,7 +184,7 @@ impl Value {
         }
     }
     /// The value's bytes as WGSL lays them out.
-    pub fn bytes(&self) -> Vec<u8> {
+    pub(crate) fn bytes(&self) -> Vec<u8> {
         match *self {
             Value::F32(v) => v.to_le_bytes().to_vec(),
             Value::U32(v) => v.to_le_bytes().to_vec(),
@@ -216,7 +216,7 @@ pub enum Format {
 }
 
 impl Format {
-    pub fn wgpu(self) -> wgpu::TextureFormat {
+    pub(crate) fn wgpu(self) -> wgpu::TextureFormat {
         match self {
             Format::Rgba8Unorm => wgpu::TextureFormat::Rgba8Unorm,
             Format::Rgba16Float => wgpu::TextureFormat::Rgba16Float,
@@ -225,7 +225,7 @@ impl Format {
             Format::Depth32Float => wgpu::TextureFormat::Depth32Float,
         }
     }
-    pub fn bytes_per_pixel(self) -> u64 {
+    pub(crate) fn bytes_per_pixel(self) -> u64 {
         match self {
             Format::Rgba8Unorm | Format::R32Float | Format::Depth32Float => 4,
             Format::Rgba16Float => 8,
@@ -244,7 +244,7 @@ pub enum TextureSize {
 }
 
 /// Most colour targets of one raster pass (WebGPU's `maxColorAttachments`).
-pub const MAX_TARGETS: usize = 8;
+pub(crate) const MAX_TARGETS: usize = 8;
 
 // Value checks run while deserializing, so ron positions the error at the value.
 fn side<'de, D: serde::Deserializer<'de>>(d: D) -> Result<u32, D::Error> {
@@ -350,17 +350,17 @@ impl PassDecl {
             PassDecl::Compute { name, .. } | PassDecl::Raster { name, .. } => name,
         }
     }
-    pub fn shader(&self) -> &str {
+    pub(crate) fn shader(&self) -> &str {
         match self {
             PassDecl::Compute { shader, .. } | PassDecl::Raster { shader, .. } => shader,
         }
     }
-    pub fn instances(&self) -> &Instances {
+    pub(crate) fn instances(&self) -> &Instances {
         match self {
             PassDecl::Compute { instances, .. } | PassDecl::Raster { instances, .. } => instances,
         }
     }
-    pub fn entry_points(&self) -> Vec<&str> {
+    pub(crate) fn entry_points(&self) -> Vec<&str> {
         match self {
             PassDecl::Compute { entry, .. } => vec![entry],
             PassDecl::Raster { vertex, fragment, .. } => vec![vertex, fragment],
@@ -370,7 +370,7 @@ impl PassDecl {
 
 /// A count: a number, or a name the runtime (`width`, `height`) or a method's contribution
 /// provides (`prisms`, `planes`, ...: `render::vocabulary().counts`, listed in the graph reference).
-pub type Count = String;
+pub(crate) type Count = String;
 
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -384,9 +384,9 @@ pub enum Dispatch {
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Target {
-    pub resource: String,
+    pub(crate) resource: String,
     #[serde(default)]
-    pub blend: Blend,
+    pub(crate) blend: Blend,
 }
 
 #[derive(Debug, Clone, Copy, Default, PartialEq, Deserialize)]
@@ -403,10 +403,10 @@ pub enum Blend {
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct DepthTarget {
-    pub resource: String,
-    pub write: bool,
+    pub(crate) resource: String,
+    pub(crate) write: bool,
     #[serde(default)]
-    pub compare: Compare,
+    pub(crate) compare: Compare,
 }
 
 #[derive(Debug, Clone, Copy, Default, PartialEq, Deserialize)]
@@ -419,7 +419,7 @@ pub enum Compare {
 }
 
 impl Compare {
-    pub fn wgpu(self) -> wgpu::CompareFunction {
+    pub(crate) fn wgpu(self) -> wgpu::CompareFunction {
         match self {
             Compare::Less => wgpu::CompareFunction::Less,
             Compare::LessEqual => wgpu::CompareFunction::LessEqual,
@@ -447,8 +447,8 @@ pub enum Draw {
 /// A parsed graph file with its source, so later checks can point at `file:line:col`.
 #[derive(Debug, Clone)]
 pub struct Graph {
-    pub path: PathBuf,
-    pub source: String,
+    pub(crate) path: PathBuf,
+    pub(crate) source: String,
     pub file: GraphFile,
 }
 
@@ -469,20 +469,26 @@ impl Graph {
     }
 
     /// An error at the first occurrence of the string literal `text` (or the file start).
-    pub fn error_at(&self, text: &str, message: impl Into<String>) -> Error {
+    pub(crate) fn error_at(&self, text: &str, message: impl Into<String>) -> Error {
         let (line, col) = locate_literal(&self.source, text, 0).unwrap_or((1, 1));
         Error::at(FileLoc::new(&self.path, line, col), message)
     }
 
     /// An error at output `name` in the graph's `outputs` list.
-    pub fn error_at_output(&self, name: &str, message: impl Into<String>) -> Error {
+    pub(crate) fn error_at_output(&self, name: &str, message: impl Into<String>) -> Error {
         let from = self.source.find("outputs").unwrap_or(0);
         let (line, col) = locate_literal(&self.source, name, from).unwrap_or((1, 1));
         Error::at(FileLoc::new(&self.path, line, col), message)
     }
 
     /// An error at the string literal `text` inside pass `pass`, after its field `field`.
-    pub fn error_in_pass(&self, pass: &str, field: &str, text: &str, message: impl Into<String>) -> Error {
+    pub(crate) fn error_in_pass(
+        &self,
+        pass: &str,
+        field: &str,
+        text: &str,
+        message: impl Into<String>,
+    ) -> Error {
         let mut from = self.source.find(&format!("\"{pass}\"")).unwrap_or(0);
         from += self.source[from..].find(&format!("{field}:")).unwrap_or(0);
         let (line, col) = locate_literal(&self.source, text, from).unwrap_or((1, 1));
@@ -491,7 +497,7 @@ impl Graph {
 
     /// Byte offset of the key of resource `name` in `resources` (`"name":`), or of its first
     /// mention.
-    pub fn resource_offset(&self, name: &str) -> usize {
+    pub(crate) fn resource_offset(&self, name: &str) -> usize {
         let needle = format!("\"{name}\"");
         let mut from = 0;
         while let Some(i) = self.source[from..].find(&needle) {
@@ -505,14 +511,14 @@ impl Graph {
     }
 
     /// An error at the declaration of resource `name`.
-    pub fn error_at_resource(&self, name: &str, message: impl Into<String>) -> Error {
+    pub(crate) fn error_at_resource(&self, name: &str, message: impl Into<String>) -> Error {
         let (line, col) = crate::error::line_col(&self.source, self.resource_offset(name));
         Error::at(FileLoc::new(&self.path, line, col), message)
     }
 
     /// An error at byte `offset` inside the string literal `text` that follows the declaration
     /// of resource `name` (a size expression).
-    pub fn error_in_literal(
+    pub(crate) fn error_in_literal(
         &self,
         name: &str,
         text: &str,

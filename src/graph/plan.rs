@@ -27,7 +27,7 @@ pub struct ObjectInfo {
 
 pub struct PlannedPass {
     pub decl: PassDecl,
-    pub kernel: Arc<Kernel>,
+    pub(crate) kernel: Arc<Kernel>,
     pub bindings: Vec<Binding>,
     pub reads: BTreeSet<String>,
     pub writes: BTreeSet<String>,
@@ -42,7 +42,7 @@ pub struct PlannedBuffer {
     /// Zeroed every frame before the first pass that uses it.
     pub clear: bool,
     /// Some pass draws with it as indirect arguments.
-    pub indirect: bool,
+    pub(crate) indirect: bool,
 }
 
 pub struct Plan {
@@ -56,11 +56,11 @@ pub struct Plan {
     /// One line per pruned pass or resource, saying why.
     pub pruned: Vec<String>,
     /// The runtime's names it was planned against.
-    pub vocabulary: Vocabulary,
+    pub(crate) vocabulary: Vocabulary,
 }
 
 /// Counts known for the whole frame when the graph is planned: graph buffers are sized by them.
-pub const FRAME_COUNTS: &[&str] = &["width", "height"];
+pub(crate) const FRAME_COUNTS: &[&str] = &["width", "height"];
 
 /// Plans `graph` for `objects` and an output of `size` pixels, its shaders looked up in `sources`
 /// (the graph's folder first when the caller put it there: see [`Sources::beside`]), its filters
@@ -68,7 +68,7 @@ pub const FRAME_COUNTS: &[&str] = &["width", "height"];
 /// A first output that is a texture is read back as the frame's image (what a render writes):
 /// it must be Rgba32Float or R32Float and of the frame's size, which the readback found only
 /// after the GPU work. A buffer output (a debug or benchmark graph) is left to what reads it.
-pub fn check_image_output(graph: &Graph, size: (u32, u32)) -> Result<()> {
+pub(crate) fn check_image_output(graph: &Graph, size: (u32, u32)) -> Result<()> {
     let Some(first) = graph.file.outputs.first() else { return Ok(()) };
     let Some(ResourceDecl::Texture { format, size: texture_size, .. }) = graph.file.resources.get(first)
     else {
@@ -407,7 +407,7 @@ fn wgsl_type(module: &naga::Module, ty: naga::Handle<naga::Type>) -> String {
 
 /// Checks the graph buffers of a plan against an adapter's limits (`voltex plan` has no adapter:
 /// the executor calls this).
-pub fn check_buffer_limits(graph: &Graph, plan: &Plan, limits: &wgpu::Limits) -> Result<()> {
+pub(crate) fn check_buffer_limits(graph: &Graph, plan: &Plan, limits: &wgpu::Limits) -> Result<()> {
     let max = limits.max_storage_buffer_binding_size.min(limits.max_buffer_size);
     for (name, b) in &plan.buffers {
         if b.bytes > max {
@@ -558,7 +558,7 @@ fn live(outputs: &[String], passes: Vec<PlannedPass>, pruned: &mut Vec<String>) 
 
 impl Plan {
     /// Whether `name` is a graph resource (texture, buffer or parameter) the plan allocates.
-    pub fn declares(&self, name: &str) -> bool {
+    pub(crate) fn declares(&self, name: &str) -> bool {
         self.textures.contains_key(name)
             || self.buffers.contains_key(name)
             || self.parameters.contains_key(name)
@@ -571,14 +571,14 @@ impl Plan {
 }
 
 /// Checks a count name against those the runtime provides.
-pub fn check_count(graph: &Graph, count: &str, known: &[&str]) -> Result<()> {
+pub(crate) fn check_count(graph: &Graph, count: &str, known: &[&str]) -> Result<()> {
     if count.parse::<u32>().is_ok() || known.contains(&count) {
         return Ok(());
     }
     Err(graph.error_at(count, format!("unknown count `{count}`; expected a number or one of {known:?}")))
 }
 
-pub fn unknown_resource(graph: &Graph, pass: &str, name: &str) -> Error {
+pub(crate) fn unknown_resource(graph: &Graph, pass: &str, name: &str) -> Error {
     graph.error_at(
         pass,
         format!(

@@ -22,8 +22,8 @@ use obvhs::aabb::Aabb;
 /// signed distance, positive inside) and the largest inside distance (f32 bits, one word).
 #[derive(Clone)]
 pub struct MeshGrid {
-    pub grid: wgpu::Buffer,
-    pub depth: wgpu::Buffer,
+    pub(crate) grid: wgpu::Buffer,
+    pub(crate) depth: wgpu::Buffer,
     /// Coloured meshes: per sample the colour at its closest surface point (rgb, w = 1),
     /// interpolated from the closest triangle's corners.
     pub colors: Option<wgpu::Buffer>,
@@ -131,7 +131,7 @@ pub fn read(ctx: &GpuContext, g: &MeshGrid) -> Result<(Vec<[f32; 4]>, f32)> {
 }
 
 /// Stand-ins bound for objects that are not meshes (the kernels declare the bindings).
-pub fn unused(ctx: &GpuContext) -> MeshGrid {
+pub(crate) fn unused(ctx: &GpuContext) -> MeshGrid {
     let b = |label| crate::gpu::buffers::storage(ctx, label, &[0u8; 16]);
     MeshGrid { grid: b("mesh_grid"), depth: b("mesh_depth"), colors: None }
 }

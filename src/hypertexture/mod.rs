@@ -10,12 +10,12 @@ pub mod splats;
 use glam::DVec3;
 
 use crate::cpu::bake_transfer::{HERMITE, LINEAR, TRANSFER_SIZE};
-pub use crate::cpu::hypertexture::animated;
+pub(crate) use crate::cpu::hypertexture::animated;
 use crate::scene::hypertexture::{ColorTransfer, Field, Operator, ShapeTransfer, SoftObject};
 use crate::scene::Hypertexture;
 use crate::types::{HyperNoise, HyperParams, TransferFunction, TransferPoint};
 
-pub use crate::types::{
+pub(crate) use crate::types::{
     FIELD_CLOSEST_SURFACE, FIELD_CONSTANT, FIELD_FROM_CENTRE, FIELD_SWIRL, OBJECT_BOX, OBJECT_ELLIPSOID,
     OBJECT_MESH, OBJECT_SPHERE, OBJECT_TORUS,
 };
@@ -24,22 +24,22 @@ pub use crate::types::{
 /// added by `methods::ray_march`), its noises and its transfer functions.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Packed {
-    pub object: [f32; 4],
-    pub field: [f32; 4],
-    pub field_center: [f32; 4],
-    pub perturb: [f32; 4],
+    pub(crate) object: [f32; 4],
+    pub(crate) field: [f32; 4],
+    pub(crate) field_center: [f32; 4],
+    pub(crate) perturb: [f32; 4],
     /// Object kind, field kind, noise count, perturbation seed.
-    pub kinds: [u32; 4],
+    pub(crate) kinds: [u32; 4],
     pub noises: Vec<HyperNoise>,
     pub functions: Vec<TransferFunction>,
     pub points: Vec<TransferPoint>,
     /// Object-space bounds enlarged by the largest shift.
     pub bounds: (DVec3, DVec3),
-    pub opacity_length: f64,
+    pub(crate) opacity_length: f64,
     /// Bias and gain of the density (0.5: none).
-    pub modulation: [f32; 4],
+    pub(crate) modulation: [f32; 4],
     /// The largest shift the noises reach (object space).
-    pub max_shift: f64,
+    pub(crate) max_shift: f64,
     /// Mesh objects: the mesh and where its grid samples lie.
     pub mesh: Option<(std::sync::Arc<crate::mesh::shape::MeshShape>, crate::mesh::shape::GridSpec)>,
 }
@@ -48,7 +48,7 @@ fn f4(v: DVec3, w: f64) -> [f32; 4] {
     [v.x as f32, v.y as f32, v.z as f32, w as f32]
 }
 
-pub fn pack(h: &Hypertexture) -> Packed {
+pub(crate) fn pack(h: &Hypertexture) -> Packed {
     let (kind, object) = match &h.object.value {
         SoftObject::Sphere { radius } => (OBJECT_SPHERE, f4(DVec3::splat(*radius), 0.0)),
         SoftObject::Ellipsoid { radii } => (OBJECT_ELLIPSOID, f4(*radii, 0.0)),
@@ -156,14 +156,14 @@ pub fn pack(h: &Hypertexture) -> Packed {
 impl Packed {
     /// The largest shift as the kernels test it (rounding slack added): no point farther from
     /// the object can have density, which the march and the splat lattice both rely on.
-    pub fn tested_shift(&self) -> f64 {
+    pub(crate) fn tested_shift(&self) -> f64 {
         self.max_shift * (1.0 + 1e-4) + 1e-6
     }
 
     /// The `HyperParams` the hypertexture fixes at `time` (object, field, noise count, reach of
     /// the noises, mesh grid, enlarged bounds, opacity length); the camera and march fields are
     /// the method's to fill.
-    pub fn params(&self, time: f64) -> HyperParams {
+    pub(crate) fn params(&self, time: f64) -> HyperParams {
         let (lo, hi) = self.bounds;
         let mut params = HyperParams {
             bounds_min: [lo.x as f32, lo.y as f32, lo.z as f32, 0.0],

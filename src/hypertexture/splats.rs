@@ -14,27 +14,27 @@ use crate::types::{HyperParams, SegmentParams, Splat};
 
 /// Footprint pixels one invocation of `peel_segments.wgsl` tests at most (lavapipe ends every
 /// loop of an invocation after 65535 iterations).
-pub const FOOTPRINT_BLOCK: u32 = 32768;
+pub(crate) const FOOTPRINT_BLOCK: u32 = 32768;
 
-pub use crate::cpu::bake_splats::Lattice;
+pub(crate) use crate::cpu::bake_splats::Lattice;
 
 /// A baked splat set on the GPU: both sets at full capacity (one splat per lattice cell) and how
 /// many each holds.
 #[derive(Debug, Clone)]
 pub struct SplatSet {
-    pub surface: wgpu::Buffer,
-    pub interior: wgpu::Buffer,
-    pub counts: [u32; 2],
+    pub(crate) surface: wgpu::Buffer,
+    pub(crate) interior: wgpu::Buffer,
+    pub(crate) counts: [u32; 2],
 }
 
 /// Bytes of a splat set with `cells` lattice cells.
-pub fn bytes(cells: u32) -> u64 {
+pub(crate) fn bytes(cells: u32) -> u64 {
     2 * cells as u64 * std::mem::size_of::<Splat>() as u64 + 16
 }
 
 /// Runs `bake_splats.wgsl` for an object (`grid`: its mesh grid, or stand-ins) and reads back
 /// the splat counts.
-pub fn bake(
+pub(crate) fn bake(
     ctx: &GpuContext,
     hyper: &HyperParams,
     segments: &SegmentParams,

@@ -62,13 +62,13 @@ pub struct Extras<'a> {
 /// direction; NDC has (0, 0) at the top-left corner of the image and (1, 1) at the bottom-right.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CameraAttributes {
-    pub world_to_camera: [f32; 16],
-    pub world_to_ndc: [f32; 16],
-    pub near: f32,
-    pub far: f32,
+    pub(crate) world_to_camera: [f32; 16],
+    pub(crate) world_to_ndc: [f32; 16],
+    pub(crate) near: f32,
+    pub(crate) far: f32,
 }
 
-/// Like [`write`], with AOV channels and camera attributes. A channel name must be 1–255 Latin-1
+/// Like [`write()`], with AOV channels and camera attributes. A channel name must be 1–255 Latin-1
 /// bytes, not R, G, B or A, and appear once; each channel has one sample per pixel.
 pub fn write_with(path: &Path, image: &Image, metadata: &[(&str, String)], extras: &Extras) -> Result<()> {
     if image.pixels.len() != image.width as usize * image.height as usize {
@@ -189,7 +189,7 @@ pub fn read(path: &Path) -> Result<(Image, Vec<(String, String)>)> {
 }
 
 /// Named planes of f32 samples, row-major from the top row.
-pub type Channels = Vec<(String, Vec<f32>)>;
+pub(crate) type Channels = Vec<(String, Vec<f32>)>;
 
 /// The first layer's channels of any EXR (any names, f16/f32/u32 samples) as f32 planes in the
 /// order R, G, B, A where present, then the others in the file's (alphabetical) order:

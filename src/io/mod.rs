@@ -54,7 +54,7 @@ impl Image {
     }
 
     /// Index of pixel (x, y) in `pixels`. Panics when out of bounds (a programming error).
-    pub fn index(&self, x: u32, y: u32) -> usize {
+    pub(crate) fn index(&self, x: u32, y: u32) -> usize {
         assert!(x < self.width && y < self.height, "pixel ({x}, {y}) outside {}x{}", self.width, self.height);
         y as usize * self.width as usize + x as usize
     }
@@ -102,7 +102,7 @@ impl Image {
 
     /// Like [`Image::box_downsample`], keeping each block's smallest value per channel (a depth:
     /// the nearest hit, not a mean of near and far).
-    pub fn min_downsample(self, n: u32) -> Image {
+    pub(crate) fn min_downsample(self, n: u32) -> Image {
         if n <= 1 {
             return self;
         }
@@ -124,7 +124,7 @@ impl Image {
         self.width == other.width && self.height == other.height
     }
 
-    /// The image tonemapped with [`tonemap`] into 8-bit sRGB; alpha is clamped to [0, 1] and
+    /// The image tonemapped with `tonemap` into 8-bit sRGB; alpha is clamped to [0, 1] and
     /// quantized linearly.
     pub fn to_srgb8(&self) -> Vec<[u8; 4]> {
         self.pixels
@@ -139,13 +139,13 @@ impl Image {
 }
 
 /// Maps a [0, 1] value to 0..=255, rounding to nearest.
-pub fn quantize(v: f32) -> u8 {
+pub(crate) fn quantize(v: f32) -> u8 {
     (v.clamp(0.0, 1.0) * 255.0 + 0.5) as u8
 }
 
 /// Linear HDR RGB → display sRGB in [0, 1]: exposure 1, the ACES filmic curve as fitted by
 /// K. Narkowicz (2015), then the sRGB OETF. Negative values clamp to 0, non-finite values map to 0.
-pub fn tonemap(rgb: [f32; 3]) -> [f32; 3] {
+pub(crate) fn tonemap(rgb: [f32; 3]) -> [f32; 3] {
     rgb.map(|v| {
         if !v.is_finite() {
             return 0.0;
@@ -158,7 +158,7 @@ pub fn tonemap(rgb: [f32; 3]) -> [f32; 3] {
 }
 
 /// The sRGB opto-electronic transfer function (linear [0, 1] → encoded [0, 1]).
-pub fn srgb_oetf(v: f32) -> f32 {
+pub(crate) fn srgb_oetf(v: f32) -> f32 {
     if v <= 0.003_130_8 {
         12.92 * v
     } else {

@@ -9,7 +9,7 @@ use super::atomic::write_atomic;
 use super::Image;
 use crate::{Error, Result};
 
-/// Writes `image` tonemapped with [`super::tonemap`] as an 8-bit sRGB PNG, atomically. Alpha is
+/// Writes `image` tonemapped with `super::tonemap` as an 8-bit sRGB PNG, atomically. Alpha is
 /// dropped (the PNG is opaque): it is a preview of the colour; alpha stays in the EXR.
 pub fn write_tonemapped(path: &Path, image: &Image) -> Result<()> {
     let mut rgba = image.to_srgb8();
@@ -108,7 +108,7 @@ pub fn write_rgba16(path: &Path, width: u32, height: u32, pixels: &[[u16; 4]]) -
 /// Reads any PNG as 16-bit RGBA at its own precision (8-bit samples `v` become `v * 257`, so
 /// they convert back exactly; grey and palette expand; missing alpha is opaque), and its bit
 /// depth (8 or 16; lower depths count as 8). Returns `(width, height, depth, pixels)`.
-pub fn read_rgba16(path: &Path) -> Result<(u32, u32, u8, Vec<[u16; 4]>)> {
+pub(crate) fn read_rgba16(path: &Path) -> Result<(u32, u32, u8, Vec<[u16; 4]>)> {
     let err = |e: &dyn std::fmt::Display| Error::file(path, format!("cannot read PNG: {e}"));
     let bytes = crate::input::read(path, crate::input::Kind::Asset, "a PNG image")?;
     let mut decoder = ::png::Decoder::new(std::io::Cursor::new(bytes));

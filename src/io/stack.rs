@@ -17,7 +17,7 @@ use crate::error::{Error, Result};
 use crate::io::atomic::check_writable_dir;
 
 /// The manifest's file name in a stack's folder.
-pub const MANIFEST: &str = "manifest.json";
+pub(crate) const MANIFEST: &str = "manifest.json";
 /// The manifest's `format` value.
 pub const FORMAT: &str = "voltex slice stack";
 /// Most slices, and pixels per side, in a stack: a texel's largest resolution.
@@ -58,8 +58,8 @@ pub enum StackLighting {
 /// first), then z; and the manifest it was read by, if any.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SliceStack {
-    pub resolution: [u32; 3],
-    pub texels: Vec<u16>,
+    pub(crate) resolution: [u32; 3],
+    pub(crate) texels: Vec<u16>,
     pub manifest: Option<Manifest>,
 }
 
@@ -144,7 +144,7 @@ fn straight(p: [f32; 4]) -> [f32; 4] {
 
 /// Reads the stack `dir`: by its manifest when it has one, else the 8-bit PNG slices
 /// `slice_000.png` onwards, consecutive, all of one size.
-pub fn read(dir: &Path) -> Result<SliceStack> {
+pub(crate) fn read(dir: &Path) -> Result<SliceStack> {
     if !dir.is_dir() {
         return Err(Error::file(
             dir,

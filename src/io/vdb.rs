@@ -38,7 +38,7 @@ const NODE5_LOG2: u32 = 5;
 const LEAF_DIM: i32 = 1 << LEAF_LOG2;
 const NODE5_DIM: i32 = 1 << (LEAF_LOG2 + NODE4_LOG2 + NODE5_LOG2);
 /// Voxels of a leaf.
-pub const LEAF_VOXELS: usize = 1 << (3 * LEAF_LOG2);
+pub(crate) const LEAF_VOXELS: usize = 1 << (3 * LEAF_LOG2);
 
 /// A voxel value type OpenVDB knows: its name in grid types and metadata.
 pub trait Value: Copy + PartialEq + bytemuck::Pod + Default {
@@ -63,9 +63,9 @@ impl Value for [f32; 3] {
 /// An 8^3 block of voxels: which are active, and their values (x slowest, z fastest, as in
 /// OpenVDB's `LeafNode::coordToOffset`).
 #[derive(Clone, Debug, PartialEq)]
-pub struct Leaf<T> {
-    pub mask: [u64; LEAF_VOXELS / 64],
-    pub values: Vec<T>,
+pub(crate) struct Leaf<T> {
+    pub(crate) mask: [u64; LEAF_VOXELS / 64],
+    pub(crate) values: Vec<T>,
 }
 
 /// Index of voxel `(x, y, z)` (any coordinates) in its leaf.
@@ -82,16 +82,16 @@ fn origin(ijk: [i32; 3], dim: i32) -> [i32; 3] {
 /// A sparse grid: its leaves by origin. Only leaves holding an active voxel are kept.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Voxels<T> {
-    pub leaves: BTreeMap<[i32; 3], Leaf<T>>,
+    pub(crate) leaves: BTreeMap<[i32; 3], Leaf<T>>,
 }
 
 impl<T: Value> Voxels<T> {
-    pub fn new() -> Self {
+    pub(crate) fn new() -> Self {
         Voxels { leaves: BTreeMap::new() }
     }
 
     /// Sets voxel `ijk` to `value` and makes it active.
-    pub fn set(&mut self, ijk: [i32; 3], value: T) {
+    pub(crate) fn set(&mut self, ijk: [i32; 3], value: T) {
         let leaf = self
             .leaves
             .entry(origin(ijk, LEAF_DIM))
@@ -111,7 +111,11 @@ impl<T: Value> Voxels<T> {
     /// A box of `dims` voxels whose first voxel is `first`: voxel `first + (i, j, k)` is active
     /// with value `f([i, j, k])` where that is `Some`. Walks leaf by leaf, keeping only leaves
     /// with an active voxel, so memory follows the active voxels, not the box.
-    pub fn from_dense(first: [i32; 3], dims: [u32; 3], mut f: impl FnMut([u32; 3]) -> Option<T>) -> Self {
+    pub(crate) fn from_dense(
+        first: [i32; 3],
+        dims: [u32; 3],
+        mut f: impl FnMut([u32; 3]) -> Option<T>,
+    ) -> Self {
         let mut leaves = BTreeMap::new();
         let last = [0, 1, 2].map(|a| first[a] + dims[a] as i32 - 1);
         if dims.contains(&0) {
@@ -153,7 +157,7 @@ impl<T: Value> Voxels<T> {
     }
 
     /// The active voxels' bounding box (inclusive), or `None` for an empty grid.
-    pub fn bbox(&self) -> Option<([i32; 3], [i32; 3])> {
+    pub(crate) fn bbox(&self) -> Option<([i32; 3], [i32; 3])> {
         let mut lo = [i32::MAX; 3];
         let mut hi = [i32::MIN; 3];
         for (o, leaf) in &self.leaves {
@@ -178,7 +182,7 @@ pub enum GridData {
 
 /// OpenVDB's grid classes (the `class` metadata) that voltex writes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum GridClass {
+pub(crate) enum GridClass {
     /// Density, 0 outside: Blender, Houdini and Mitsuba read it as a fog volume.
     FogVolume,
     /// Anything else (a colour grid).
@@ -187,10 +191,10 @@ pub enum GridClass {
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct Grid {
-    pub name: String,
-    pub class: GridClass,
+    pub(crate) name: String,
+    pub(crate) class: GridClass,
     /// Index space (voxel `(i, j, k)` at point `(i, j, k)`) to world.
-    pub index_to_world: DMat4,
+    pub(crate) index_to_world: DMat4,
     pub data: GridData,
 }
 
@@ -219,7 +223,7 @@ pub fn write(path: &Path, grids: &[Grid], compression: Compression) -> Result<()
     stage(path, grids, compression)?.commit()
 }
 
-/// Like [`write`], but leaves the file at its temporary name until [`Staged::commit`], so that
+/// Like [`write()`], but leaves the file at its temporary name until [`Staged::commit`], so that
 /// several files can be written all or none.
 pub fn stage(path: &Path, grids: &[Grid], compression: Compression) -> Result<Staged> {
     check(grids).map_err(|e| Error::file(path, e))?;
@@ -233,7 +237,7 @@ pub fn stage(path: &Path, grids: &[Grid], compression: Compression) -> Result<St
 }
 
 /// What makes `grids` unwritable, said in a sentence.
-pub fn check(grids: &[Grid]) -> std::result::Result<(), String> {
+pub(crate) fn check(grids: &[Grid]) -> std::result::Result<(), String> {
     let mut names = std::collections::BTreeSet::new();
     for g in grids {
         if g.name.is_empty() || g.name.len() > 255 || g.name.contains('\0') {
@@ -263,7 +267,11 @@ pub fn check(grids: &[Grid]) -> std::result::Result<(), String> {
 
 /// Writes a whole VDB file to `out` (seekable: grid offsets are patched in, as OpenVDB does
 /// for files, so readers can load one grid without the others).
-pub fn encode<W: Write + Seek>(out: &mut W, grids: &[Grid], compression: Compression) -> std::io::Result<()> {
+pub(crate) fn encode<W: Write + Seek>(
+    out: &mut W,
+    grids: &[Grid],
+    compression: Compression,
+) -> std::io::Result<()> {
     out.write_all(&MAGIC.to_le_bytes())?;
     out.write_all(&FILE_VERSION.to_le_bytes())?;
     out.write_all(&LIBRARY_VERSION.0.to_le_bytes())?;

@@ -9,7 +9,7 @@ use crate::types::ReferenceNode;
 /// A BVH2 over `boxes` (obvhs) flattened for the kernels, and the primitive order its leaves
 /// index: a node's `min.w` is its primitive count as u32 bits (0: inner node), `max.w` its first
 /// primitive (leaf, in that order) or its first child (inner; the second follows it).
-pub fn flat_bvh(boxes: &[Aabb]) -> (Vec<ReferenceNode>, Vec<u32>) {
+pub(crate) fn flat_bvh(boxes: &[Aabb]) -> (Vec<ReferenceNode>, Vec<u32>) {
     let mut time = Default::default();
     let bvh = build_bvh2(boxes, BvhBuildParams::medium_build(), &mut time);
     let nodes = bvh

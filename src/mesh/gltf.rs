@@ -15,7 +15,7 @@ use super::{area_weighted_normals, Mesh};
 use crate::error::{Error, Result};
 
 /// Reads and parses a `.gltf` or `.glb` file; external buffers are read beside it.
-pub fn load(path: &Path) -> Result<Mesh> {
+pub(crate) fn load(path: &Path) -> Result<Mesh> {
     let bytes = crate::input::read(path, crate::input::Kind::Asset, "a glTF file")?;
     parse(&bytes, path)
 }

@@ -1,10 +1,10 @@
 //! Base surfaces: triangle meshes whose welded vertices carry height vectors, the generators and OBJ
 //! and glTF loaders that make them, and the prism checks that say whether their extrusions are usable.
 
-pub mod bvh;
+pub(crate) mod bvh;
 pub mod generate;
 pub mod gltf;
-pub mod motion;
+pub(crate) mod motion;
 pub mod obj;
 pub mod prism;
 pub mod shape;
@@ -39,13 +39,13 @@ pub struct BaseSurface {
 
 impl BaseSurface {
     /// Unnormalised normal (twice the area) of triangle `t`.
-    pub fn face_normal(&self, t: usize) -> DVec3 {
+    pub(crate) fn face_normal(&self, t: usize) -> DVec3 {
         let [a, b, c] = self.triangles[t].map(|i| self.positions[i as usize]);
         (b - a).cross(c - a)
     }
 
     /// The six corners of triangle `t`'s prism: `p_0..p_2` then `p_0 + h_0 .. p_2 + h_2`.
-    pub fn prism(&self, t: usize) -> [DVec3; 6] {
+    pub(crate) fn prism(&self, t: usize) -> [DVec3; 6] {
         let [a, b, c] = self.triangles[t].map(|i| i as usize);
         let p = &self.positions;
         let h = &self.heights;
@@ -55,7 +55,7 @@ impl BaseSurface {
     /// Applies an affine transform. Height vectors transform as directions with the model matrix
     /// (not the inverse transpose) so a prism maps exactly onto the transformed prism; a mirroring
     /// transform reverses the winding so triangles stay counter-clockwise seen from outside.
-    pub fn transformed(&self, m: &DMat4) -> BaseSurface {
+    pub(crate) fn transformed(&self, m: &DMat4) -> BaseSurface {
         let flip = m.determinant() < 0.0;
         BaseSurface {
             positions: self.positions.iter().map(|&p| m.transform_point3(p)).collect(),
@@ -84,15 +84,15 @@ pub struct Mesh {
     /// Per corner, one tile = `[0, 1]^2`, no tiling.
     pub corner_uvs: Vec<[DVec2; 3]>,
     /// One uv per welded vertex (from its first corner) for sampling height textures.
-    pub vertex_uvs: Vec<DVec2>,
+    pub(crate) vertex_uvs: Vec<DVec2>,
     /// Optional scalar per vertex (OBJ: first colour channel of `v x y z r g b`).
-    pub attribute: Option<Vec<f64>>,
+    pub(crate) attribute: Option<Vec<f64>>,
     /// Optional colour per vertex (OBJ: `v x y z r g b`; white where a vertex has none).
     pub colors: Option<Vec<[f64; 3]>>,
     /// OBJ: the line of the `f` statement of each triangle, for errors (empty when generated).
-    pub face_lines: Vec<u32>,
+    pub(crate) face_lines: Vec<u32>,
     /// glTF: some primitive had no `TEXCOORD_0` (its corners' uvs are planar).
-    pub uvs_missing: bool,
+    pub(crate) uvs_missing: bool,
 }
 
 impl Mesh {

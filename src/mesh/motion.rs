@@ -9,44 +9,44 @@ use super::BaseSurface;
 /// A travelling wave: each vertex moves along its height vector's direction by
 /// `amplitude * sin(2 pi (p . direction / wavelength - speed * t))`.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Wave {
-    pub amplitude: f64,
-    pub wavelength: f64,
+pub(crate) struct Wave {
+    pub(crate) amplitude: f64,
+    pub(crate) wavelength: f64,
     /// Wavelengths per second.
-    pub speed: f64,
+    pub(crate) speed: f64,
     /// Direction the wave travels in (unit).
-    pub direction: DVec3,
+    pub(crate) direction: DVec3,
 }
 
 /// Wind: each height vector leans towards `direction` by `strength * sin(2 pi (frequency * t -
 /// p . direction / wavelength))` (a fraction of its length) and keeps its length.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Wind {
-    pub strength: f64,
+pub(crate) struct Wind {
+    pub(crate) strength: f64,
     /// Sways per second.
-    pub frequency: f64,
+    pub(crate) frequency: f64,
     /// Distance between gusts along `direction`.
-    pub wavelength: f64,
+    pub(crate) wavelength: f64,
     /// Direction the wind blows towards (unit).
-    pub direction: DVec3,
+    pub(crate) direction: DVec3,
 }
 
 const TAU: f64 = std::f64::consts::TAU;
 
 impl Wave {
-    pub fn offset(&self, p: DVec3, t: f64) -> f64 {
+    pub(crate) fn offset(&self, p: DVec3, t: f64) -> f64 {
         self.amplitude * (TAU * (p.dot(self.direction) / self.wavelength - self.speed * t)).sin()
     }
 }
 
 impl Wind {
-    pub fn lean(&self, p: DVec3, t: f64) -> f64 {
+    pub(crate) fn lean(&self, p: DVec3, t: f64) -> f64 {
         self.strength * (TAU * (self.frequency * t - p.dot(self.direction) / self.wavelength)).sin()
     }
 }
 
 /// `base` at time `t`: positions moved by the wave, then heights leaned by the wind.
-pub fn animate(base: &mut BaseSurface, wave: Option<&Wave>, wind: Option<&Wind>, t: f64) {
+pub(crate) fn animate(base: &mut BaseSurface, wave: Option<&Wave>, wind: Option<&Wind>, t: f64) {
     for (p, h) in base.positions.iter_mut().zip(&mut base.heights) {
         let rest = *p;
         if let Some(w) = wave {

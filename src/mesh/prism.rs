@@ -21,7 +21,7 @@ impl PrismReport {
 const TWIST_W: [f64; 5] = [0.0, 0.25, 0.5, 0.75, 1.0];
 /// Largest coordinate of a position, height vector or prism corner: kernels square f32
 /// distances, which overflow near 1e19.
-pub const MAX_COORD: f64 = 1e15;
+pub(crate) const MAX_COORD: f64 = 1e15;
 /// A triangle is degenerate when its smallest altitude is below this fraction of its longest edge.
 const SLIVER: f64 = 1e-3;
 

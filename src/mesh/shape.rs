@@ -15,25 +15,25 @@ use crate::mesh::Mesh;
 use crate::types::MeshGridParams;
 
 /// Most samples per axis of a mesh grid (16 bytes each: 32 MiB at 128).
-pub const MAX_RESOLUTION: u32 = 128;
+pub(crate) const MAX_RESOLUTION: u32 = 128;
 /// Most voxels of a mesh texel (its grid: 256 MiB, e.g. 256^3).
-pub const MAX_TEXEL_SAMPLES: u64 = 1 << 24;
+pub(crate) const MAX_TEXEL_SAMPLES: u64 = 1 << 24;
 /// Most closed parts of one mesh (the bake walks each part's BVH per sample).
-pub const MAX_PARTS: usize = 16;
+pub(crate) const MAX_PARTS: usize = 16;
 
 /// A closed triangle mesh in its node's frame, vertices welded by position.
 #[derive(Debug, Clone, PartialEq)]
 pub struct MeshShape {
-    pub positions: Vec<DVec3>,
+    pub(crate) positions: Vec<DVec3>,
     pub triangles: Vec<[u32; 3]>,
     pub lo: DVec3,
     pub hi: DVec3,
     /// Closed parts: (first triangle, triangle count); triangles are grouped by part.
     pub parts: Vec<(u32, u32)>,
     /// Per triangle, its corners' colours (OBJ vertex colours), when the mesh has any.
-    pub colors: Option<Vec<[[f32; 3]; 3]>>,
+    pub(crate) colors: Option<Vec<[[f32; 3]; 3]>>,
     /// Of positions and triangles: the bake cache's key.
-    pub hash: u64,
+    pub(crate) hash: u64,
 }
 
 /// Where a mesh grid's samples lie: `n[a]` along axis `a` at the vertices of the box `lo..hi`.
@@ -56,11 +56,11 @@ impl GridSpec {
     }
 
     /// Samples in all.
-    pub fn samples(&self) -> u64 {
+    pub(crate) fn samples(&self) -> u64 {
         self.n.iter().map(|&n| n as u64).product()
     }
 
-    pub fn params(&self, triangles: u32, nodes: u32, parts: u32) -> MeshGridParams {
+    pub(crate) fn params(&self, triangles: u32, nodes: u32, parts: u32) -> MeshGridParams {
         let f = |v: DVec3| [v.x as f32, v.y as f32, v.z as f32, 0.0];
         let [x, y, z] = self.n;
         MeshGridParams {

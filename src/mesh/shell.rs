@@ -45,7 +45,7 @@ impl Shell {
     }
 
     /// Range of `dot(n, x)` over all corners.
-    pub fn depth_range(&self, n: [f32; 3]) -> (f64, f64) {
+    pub(crate) fn depth_range(&self, n: [f32; 3]) -> (f64, f64) {
         let mut lo = f64::INFINITY;
         let mut hi = f64::NEG_INFINITY;
         for v in &self.vertices {
@@ -60,7 +60,7 @@ impl Shell {
 }
 
 /// Triangle corners of the base surface with face normals, for the opaque base pass.
-pub fn base_vertices(surface: &BaseSurface, eye: DVec3) -> Vec<BaseVertex> {
+pub(crate) fn base_vertices(surface: &BaseSurface, eye: DVec3) -> Vec<BaseVertex> {
     let mut out = Vec::with_capacity(surface.triangles.len() * 3);
     for t in &surface.triangles {
         let p = t.map(|i| surface.positions[i as usize]);
@@ -82,7 +82,7 @@ pub fn base_vertices(surface: &BaseSurface, eye: DVec3) -> Vec<BaseVertex> {
 /// An average, not a sum: the lengths matter (the Jacobian's cofactors mix `ds x dt` with
 /// `dt x dw`, and the Reference's default step is taken from them), and a sum would scale them
 /// with the area around the vertex.
-pub fn vertex_frames(surface: &BaseSurface) -> Vec<VertexFrame> {
+pub(crate) fn vertex_frames(surface: &BaseSurface) -> Vec<VertexFrame> {
     let n = surface.positions.len();
     let mut sum = vec![(DVec3::ZERO, DVec3::ZERO, 0.0); n];
     for (t, uv) in surface.triangles.iter().zip(&surface.corner_uvs) {

@@ -5,7 +5,7 @@ use crate::gpu::buffers;
 use crate::gpu::Inputs;
 use crate::types::BaseVertex;
 
-pub const CONTRIBUTION: super::Contribution = super::Contribution {
+pub(crate) const CONTRIBUTION: super::Contribution = super::Contribution {
     method: "base surface",
     filters: &["BaseSurface"],
     resources: &["base_vertices"],
@@ -15,8 +15,8 @@ pub const CONTRIBUTION: super::Contribution = super::Contribution {
 };
 
 /// The object's base triangles, camera-relative.
-pub struct BaseSurfacePlan {
-    pub vertices: Vec<BaseVertex>,
+pub(crate) struct BaseSurfacePlan {
+    pub(crate) vertices: Vec<BaseVertex>,
 }
 
 impl MethodPlan for BaseSurfacePlan {

@@ -1,15 +1,15 @@
 //! Host side of each method: view-aligned prism slicing, axis-aligned slices, the reference ray
 //! caster, hypertexture ray marching, and the opaque base surface. Each lives in its own folder,
 //! declares what it brings to the render graph ([`Contribution`]), plans objects into a
-//! [`MethodPlan`], and is registered once, in [`REGISTRY`] and [`plan_method`].
+//! [`MethodPlan`], and is registered once, in [`REGISTRY`] and `plan_method`.
 
 pub mod axis_slices;
-pub mod base_surface;
+pub(crate) mod base_surface;
 pub mod options;
 pub mod plan;
 pub mod ray_march;
 pub mod reference;
-pub mod texels;
+pub(crate) mod texels;
 pub mod view;
 pub mod view_slices;
 pub mod volume;
@@ -26,17 +26,17 @@ use view::{Lighting, View};
 pub struct Contribution {
     pub method: &'static str,
     pub filters: &'static [&'static str],
-    pub resources: &'static [&'static str],
-    pub counts: &'static [&'static str],
+    pub(crate) resources: &'static [&'static str],
+    pub(crate) counts: &'static [&'static str],
     /// Resources that sample baked texels: a graph binding none of any method's bakes nothing.
-    pub texel_resources: &'static [&'static str],
+    pub(crate) texel_resources: &'static [&'static str],
     /// For a method that draws all its objects in one graph instance: builds that instance's
     /// plan from the frame's objects (`None` when no object uses the method).
-    pub gather: Option<Gather>,
+    pub(crate) gather: Option<Gather>,
 }
 
 /// Builds a frame-wide plan from the frame's objects, bakes and view (see [`Contribution::gather`]).
-pub type Gather = fn(&mut [ObjectPlan], &[BakePlan], &View) -> Option<Box<dyn MethodPlan>>;
+pub(crate) type Gather = fn(&mut [ObjectPlan], &[BakePlan], &View) -> Option<Box<dyn MethodPlan>>;
 
 /// Every method, registered once.
 pub const REGISTRY: &[&Contribution] = &[
@@ -50,19 +50,19 @@ pub const REGISTRY: &[&Contribution] = &[
 
 /// What planning an object may read, and the frame's bakes it adds to.
 pub struct PlanCx<'a> {
-    pub scene: &'a Scene,
-    pub view: &'a View,
-    pub light: &'a Lighting,
+    pub(crate) scene: &'a Scene,
+    pub(crate) view: &'a View,
+    pub(crate) light: &'a Lighting,
     /// The frame's time (animated texels are baked at it).
-    pub time: f64,
-    pub bakes: &'a mut Vec<BakePlan>,
+    pub(crate) time: f64,
+    pub(crate) bakes: &'a mut Vec<BakePlan>,
     /// Tile-list entries of `Tiles` compositors (`RenderOptions::tile_entries`).
-    pub tile_entries: Option<u32>,
+    pub(crate) tile_entries: Option<u32>,
 }
 
 /// Plans `object` for the scene method `method` (knobs resolved): adds its plan to
 /// `object.methods` and its bake, lighting and frames to the object.
-pub fn plan_method(cx: &mut PlanCx, object: &mut ObjectPlan, method: &Method) -> Result<()> {
+pub(crate) fn plan_method(cx: &mut PlanCx, object: &mut ObjectPlan, method: &Method) -> Result<()> {
     if object.object.volume.is_some() {
         return volume::plan(cx, object, method);
     }
@@ -75,13 +75,17 @@ pub fn plan_method(cx: &mut PlanCx, object: &mut ObjectPlan, method: &Method) ->
 }
 
 /// The frame-wide plans of methods that gather their objects (see [`Contribution::gather`]).
-pub fn gather(objects: &mut [ObjectPlan], bakes: &[BakePlan], view: &View) -> Vec<Box<dyn MethodPlan>> {
+pub(crate) fn gather(
+    objects: &mut [ObjectPlan],
+    bakes: &[BakePlan],
+    view: &View,
+) -> Vec<Box<dyn MethodPlan>> {
     REGISTRY.iter().filter_map(|c| c.gather).filter_map(|g| g(objects, bakes, view)).collect()
 }
 
 /// Plans one object of the frame: its shell, its base surface if it has one, and its method
 /// (`opts` may switch it or change its knobs).
-pub fn plan_object(
+pub(crate) fn plan_object(
     cx: &mut PlanCx,
     object: crate::scene::SceneObject,
     opts: &options::RenderOptions,

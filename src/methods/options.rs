@@ -85,7 +85,7 @@ impl RenderOptions {
     /// A volume object's method after the overrides. RayMarch and Reference both draw volumes:
     /// `--method reference` switches a RayMarch volume to the exact Reference (lit per pixel,
     /// with shadows, when it was shaded at all) with `--step`; otherwise as [`apply`](Self::apply).
-    pub fn apply_volume(&self, method: &Method) -> Method {
+    pub(crate) fn apply_volume(&self, method: &Method) -> Method {
         match (self.method, method) {
             (Some(MethodKind::Reference), Method::RayMarch(rm)) => Method::Reference(Reference {
                 step: self.step,
@@ -100,7 +100,7 @@ impl RenderOptions {
     }
 
     /// An object's method after the overrides: switched to `method` if given, knobs replaced.
-    pub fn apply(&self, method: &Method) -> Method {
+    pub(crate) fn apply(&self, method: &Method) -> Method {
         if let Method::RayMarch(rm) = method {
             // Hypertextures have no texel for other methods: only the step changes.
             let adaptive = match self.max_step {
@@ -182,7 +182,7 @@ pub fn parse_shadows(s: &str) -> std::result::Result<Option<Shadows>, String> {
 }
 
 /// `--shadows` as written: `none`, `rays` or `volume:N`.
-pub fn shadows_name(s: Option<Shadows>) -> String {
+pub(crate) fn shadows_name(s: Option<Shadows>) -> String {
     match s {
         None => "none".into(),
         Some(Shadows::Rays) => "rays".into(),

@@ -19,13 +19,13 @@ pub struct ObjectPlan {
     pub object: SceneObject,
     pub shell: Shell,
     /// Per-pixel lighting: the texel is baked as albedo + normals and lit in the kernels.
-    pub per_pixel: bool,
+    pub(crate) per_pixel: bool,
     /// Per-vertex texel frames for per-pixel lighting (only when it is on).
-    pub frames: Option<Vec<VertexFrame>>,
+    pub(crate) frames: Option<Vec<VertexFrame>>,
     /// Index into the frame's bakes.
-    pub bake: Option<usize>,
+    pub(crate) bake: Option<usize>,
     /// What the object draws, in draw order.
-    pub methods: Vec<Box<dyn MethodPlan>>,
+    pub(crate) methods: Vec<Box<dyn MethodPlan>>,
 }
 
 impl ObjectPlan {
@@ -44,7 +44,7 @@ impl ObjectPlan {
     }
 
     /// Values of the WGSL `override` constants the object's kernels are specialised with.
-    pub fn constants(&self) -> Vec<(String, f64)> {
+    pub(crate) fn constants(&self) -> Vec<(String, f64)> {
         let mut c: Vec<(String, f64)> =
             vec![("trivial_reject".into(), 1.0), ("per_pixel_lighting".into(), self.per_pixel as u32 as f64)];
         for (name, value) in self.methods.iter().flat_map(|m| m.constants()) {
@@ -68,18 +68,18 @@ pub struct BakePlan {
 /// object's instances (passes run instances back to front by object, then by this order).
 #[derive(Debug, Clone)]
 pub struct PartDecl {
-    pub filters: Vec<&'static str>,
-    pub order: u32,
+    pub(crate) filters: Vec<&'static str>,
+    pub(crate) order: u32,
 }
 
 /// What binding a method's inputs may read: the GPU, the frame's size and bakes.
 pub struct InputCx<'a> {
-    pub ctx: &'a GpuContext,
-    pub size: (u32, u32),
+    pub(crate) ctx: &'a GpuContext,
+    pub(crate) size: (u32, u32),
     pub bakes: &'a [BakePlan],
-    pub baked: &'a [Baked],
+    pub(crate) baked: &'a [Baked],
     /// What [`MethodPlan::prepare`] returned for this plan.
-    pub prepared: Option<&'a (dyn Any + Send)>,
+    pub(crate) prepared: Option<&'a (dyn Any + Send)>,
 }
 
 /// A method's plan for one object (or, for a method that draws several objects in one instance,

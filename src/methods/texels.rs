@@ -12,7 +12,7 @@ use crate::types::{HeightImageParams, HeightfieldParams};
 
 /// Index of the bake for `texel` with the given lighting, added if new; `time`: the frame's
 /// (animated hypertextures are baked at it).
-pub fn bake_index(
+pub(crate) fn bake_index(
     scene: &Scene,
     texel: &str,
     per_pixel: bool,
@@ -157,19 +157,6 @@ pub fn bake_index(
         opacity_length: t.opacity_length(&scene.hypertextures),
     });
     Ok(bakes.len() - 1)
-}
-
-/// Like [`bake_index`], with the slice images of axis-aligned slicing baked too.
-pub fn bake_index_axis(
-    scene: &Scene,
-    texel: &str,
-    light: &Lighting,
-    time: f64,
-    bakes: &mut Vec<BakePlan>,
-) -> Result<usize> {
-    let i = bake_index(scene, texel, false, light, time, bakes)?;
-    bakes[i].request.axis_slices = true;
-    Ok(i)
 }
 
 fn rgb0(v: &[f32; 3]) -> [f32; 4] {

@@ -19,21 +19,21 @@ pub struct RayCamera {
 
 /// The camera, with the depth range of everything drawn for the projection's near and far planes.
 #[derive(Debug, Clone)]
-pub struct View {
-    pub eye: DVec3,
-    pub forward: DVec3,
-    pub up: DVec3,
-    pub fov_y: f64,
-    pub near: f64,
-    pub far: f64,
+pub(crate) struct View {
+    pub(crate) eye: DVec3,
+    pub(crate) forward: DVec3,
+    pub(crate) up: DVec3,
+    pub(crate) fov_y: f64,
+    pub(crate) near: f64,
+    pub(crate) far: f64,
     /// Focal length in pixels (half the image height over tan(fov_y / 2)).
-    pub focal: f64,
+    pub(crate) focal: f64,
     /// The rendered size (for the ray casters' camera).
-    pub size: (u32, u32),
+    pub(crate) size: (u32, u32),
 }
 
 impl View {
-    pub fn new(scene: &Scene, cam: &Camera, objects: &[SceneObject]) -> Result<Self> {
+    pub(crate) fn new(scene: &Scene, cam: &Camera, objects: &[SceneObject]) -> Result<Self> {
         let forward = (cam.target - cam.eye).normalize_or_zero();
         if forward == DVec3::ZERO || forward.cross(cam.up).length_squared() < 1e-12 {
             return Err(Error::Invalid(format!(
@@ -62,7 +62,7 @@ impl View {
     }
 
     /// The camera as ray casting kernels see it: a pixel's ray is `forward + sx right + sy up`.
-    pub fn camera(&self) -> RayCamera {
+    pub(crate) fn camera(&self) -> RayCamera {
         let right_dir = self.forward.cross(self.up).normalize();
         let up_dir = right_dir.cross(self.forward);
         let half = (0.5 * self.fov_y.to_radians()).tan();
@@ -76,11 +76,11 @@ impl View {
         }
     }
 
-    pub fn forward_f32(&self) -> [f32; 3] {
+    pub(crate) fn forward_f32(&self) -> [f32; 3] {
         self.forward.as_vec3().to_array()
     }
 
-    pub fn frame_params(&self, scene: &Scene, size: (u32, u32), light: &Lighting) -> FrameParams {
+    pub(crate) fn frame_params(&self, scene: &Scene, size: (u32, u32), light: &Lighting) -> FrameParams {
         let view = view_matrix(self.forward, self.up);
         let proj = projection(self.fov_y.to_radians(), size.0 as f64 / size.1 as f64, self.near, self.far);
         let (f, l, c, b) = (self.forward_f32(), light.direction, light.color, scene.background);
@@ -97,13 +97,13 @@ impl View {
 
 /// The scene's first light (towards the light, colour times intensity) and ambient term.
 pub struct Lighting {
-    pub direction: [f32; 3],
-    pub color: [f32; 3],
-    pub ambient: f32,
+    pub(crate) direction: [f32; 3],
+    pub(crate) color: [f32; 3],
+    pub(crate) ambient: f32,
 }
 
 impl Lighting {
-    pub fn of(scene: &Scene) -> Self {
+    pub(crate) fn of(scene: &Scene) -> Self {
         let (direction, color) = match scene.lights.first() {
             Some(Light::Directional { direction, color, intensity }) => {
                 (-direction.normalize(), color.map(|c| c * intensity))

@@ -6,10 +6,10 @@ use crate::{Error, Result};
 
 /// Added to `reference²` in the relative error denominator so that near-black reference pixels
 /// do not blow the error up: an absolute error of 0.1 on black counts like a 100 % error.
-pub const RELATIVE_EPSILON: f64 = 1e-2;
+pub(crate) const RELATIVE_EPSILON: f64 = 1e-2;
 
 /// Default FLIP viewing condition: a 0.7 m wide 4K (3840 px) display seen from 0.7 m.
-pub const DEFAULT_PIXELS_PER_DEGREE: f32 = 67.0;
+pub(crate) const DEFAULT_PIXELS_PER_DEGREE: f32 = 67.0;
 
 fn check_sizes(actual: &Image, reference: &Image) -> Result<()> {
     if !actual.same_size(reference) {
@@ -40,7 +40,7 @@ fn relative_sq(a: &[f32; 4], r: &[f32; 4]) -> f64 {
 }
 
 /// Relative RMSE: `sqrt(mean over pixels and R, G, B of (a - r)² / (r² + ε))` with
-/// ε = [`RELATIVE_EPSILON`] = 1e-2. Alpha is ignored. A non-finite value in either image makes the
+/// ε = `RELATIVE_EPSILON` = 1e-2. Alpha is ignored. A non-finite value in either image makes the
 /// result NaN (so any `<= threshold` check fails). Size mismatch is an error.
 pub fn relative_rmse(actual: &Image, reference: &Image) -> Result<f64> {
     check_sizes(actual, reference)?;
@@ -74,8 +74,8 @@ pub struct FlipResult {
     pub map: Vec<f32>,
 }
 
-/// LDR FLIP (Andersson et al. 2020) between the tonemapped images (see [`crate::io::tonemap`]),
-/// at [`DEFAULT_PIXELS_PER_DEGREE`]. 0 means identical; 1 is the largest perceived difference.
+/// LDR FLIP (Andersson et al. 2020) between the tonemapped images (see `crate::io::tonemap`),
+/// at `DEFAULT_PIXELS_PER_DEGREE`. 0 means identical; 1 is the largest perceived difference.
 pub fn flip(actual: &Image, reference: &Image) -> Result<FlipResult> {
     flip_with_ppd(actual, reference, DEFAULT_PIXELS_PER_DEGREE)
 }
@@ -84,7 +84,7 @@ pub fn flip(actual: &Image, reference: &Image) -> Result<FlipResult> {
 ///
 /// Computed by NVIDIA's reference C++ implementation (crate `nv-flip`) on 8-bit sRGB images,
 /// which is how LDR FLIP is defined; quantization differences below 1/255 are not seen.
-pub fn flip_with_ppd(actual: &Image, reference: &Image, pixels_per_degree: f32) -> Result<FlipResult> {
+pub(crate) fn flip_with_ppd(actual: &Image, reference: &Image, pixels_per_degree: f32) -> Result<FlipResult> {
     check_sizes(actual, reference)?;
     if !(pixels_per_degree.is_finite() && pixels_per_degree > 0.0) {
         return Err(Error::Invalid(format!(

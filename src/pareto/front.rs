@@ -4,10 +4,10 @@
 //! floating-point blending order (the trivial reject on or off) are ties, and the faster wins.
 
 /// Relative difference below which two errors are equal.
-pub const ERROR_TOLERANCE: f64 = 1e-3;
+pub(crate) const ERROR_TOLERANCE: f64 = 1e-3;
 
 /// `a` dominates `b`: no slower, no less accurate, strictly better in time or error.
-pub fn dominates(a: (f64, f64), b: (f64, f64)) -> bool {
+pub(crate) fn dominates(a: (f64, f64), b: (f64, f64)) -> bool {
     let no_worse = a.1 <= b.1 * (1.0 + ERROR_TOLERANCE);
     let better = a.1 * (1.0 + ERROR_TOLERANCE) < b.1;
     a.0 <= b.0 && no_worse && (a.0 < b.0 || better)
@@ -19,12 +19,12 @@ fn finite(p: (f64, f64)) -> bool {
 
 /// For each point, whether it is on the front of `points`. Equal points are both on it (neither
 /// dominates the other); a point with a non-finite coordinate is never on it and dominates nothing.
-pub fn front(points: &[(f64, f64)]) -> Vec<bool> {
+pub(crate) fn front(points: &[(f64, f64)]) -> Vec<bool> {
     points.iter().map(|&p| finite(p) && !points.iter().any(|&q| finite(q) && dominates(q, p))).collect()
 }
 
 /// Indices of the front's points, fastest first (ties by error): the order of its step line.
-pub fn front_order(points: &[(f64, f64)]) -> Vec<usize> {
+pub(crate) fn front_order(points: &[(f64, f64)]) -> Vec<usize> {
     let on = front(points);
     let mut ids: Vec<usize> = (0..points.len()).filter(|&i| on[i]).collect();
     ids.sort_by(|&a, &b| points[a].0.total_cmp(&points[b].0).then(points[a].1.total_cmp(&points[b].1)));

@@ -21,31 +21,31 @@ use crate::render::{Blueprint, Renderer};
 use crate::types::MarchState;
 
 /// Frames rendered and thrown away before the timed ones...
-pub const WARM_UP_FRAMES: usize = 2;
+pub(crate) const WARM_UP_FRAMES: usize = 2;
 /// ...or only one when it took longer than this (ms): first-use costs are then lost in the noise.
-pub const LONG_FRAME_MS: f64 = 1000.0;
+pub(crate) const LONG_FRAME_MS: f64 = 1000.0;
 
 /// One pass's median GPU time.
 #[derive(Debug, Clone)]
-pub struct PassTime {
-    pub name: String,
-    pub compute: bool,
-    pub ms: f64,
+pub(crate) struct PassTime {
+    pub(crate) name: String,
+    pub(crate) compute: bool,
+    pub(crate) ms: f64,
 }
 
 /// What phase 2 gives for a setting.
-pub struct Frames {
-    pub image: Image,
+pub(crate) struct Frames {
+    pub(crate) image: Image,
     /// Median GPU ms of each raster pass.
-    pub raster: Vec<(String, f64)>,
+    pub(crate) raster: Vec<(String, f64)>,
     /// Median wall-clock ms of a whole frame: record, submit, wait until the GPU is idle, read the
     /// timestamps back.
-    pub wall_ms: f64,
+    pub(crate) wall_ms: f64,
     /// Density evaluations of RayMarch objects in one frame (0 without any).
-    pub evaluations: f64,
+    pub(crate) evaluations: f64,
 }
 
-pub fn median(mut v: Vec<f64>) -> f64 {
+pub(crate) fn median(mut v: Vec<f64>) -> f64 {
     if v.is_empty() {
         return f64::NAN;
     }
@@ -54,16 +54,16 @@ pub fn median(mut v: Vec<f64>) -> f64 {
 }
 
 /// What phase 1 gives for a setting.
-pub struct ComputeOnly {
+pub(crate) struct ComputeOnly {
     /// Median GPU ms of each compute pass.
-    pub passes: Vec<(String, f64)>,
+    pub(crate) passes: Vec<(String, f64)>,
     /// Median wall-clock ms of a compute-only frame (0 when there is no compute pass).
-    pub wall_ms: f64,
+    pub(crate) wall_ms: f64,
 }
 
 /// Phase 1: median GPU ms of each compute pass of `bp`'s frame, run without its raster passes.
 /// Call it on a device where no render pass has run yet (a fresh one).
-pub fn compute_passes(ctx: &GpuContext, mut bp: Blueprint, frames: usize) -> Result<ComputeOnly> {
+pub(crate) fn compute_passes(ctx: &GpuContext, mut bp: Blueprint, frames: usize) -> Result<ComputeOnly> {
     bp.plan.passes.retain(|p| matches!(p.decl, PassDecl::Compute { .. }));
     if bp.plan.passes.is_empty() {
         return Ok(ComputeOnly { passes: Vec::new(), wall_ms: 0.0 });
@@ -74,7 +74,7 @@ pub fn compute_passes(ctx: &GpuContext, mut bp: Blueprint, frames: usize) -> Res
 }
 
 /// Phase 2: the image of `bp`'s frame, the median GPU ms of its raster passes and of its wall time.
-pub fn full_frames(ctx: &GpuContext, bp: Blueprint, frames: usize) -> Result<Frames> {
+pub(crate) fn full_frames(ctx: &GpuContext, bp: Blueprint, frames: usize) -> Result<Frames> {
     let raster: Vec<String> = bp
         .plan
         .passes
@@ -104,13 +104,13 @@ fn evaluations(ctx: &GpuContext, r: &Renderer) -> Result<f64> {
 }
 
 /// Just the image (the truth).
-pub fn image(ctx: &GpuContext, bp: Blueprint) -> Result<Image> {
+pub(crate) fn image(ctx: &GpuContext, bp: Blueprint) -> Result<Image> {
     Ok(Renderer::new(ctx, bp)?.render(ctx)?.image)
 }
 
 /// Warm-up frames (`warmed`: the wall ms of one already rendered), then `frames` timed ones:
 /// median GPU ms per pass (submission order) and median wall ms per frame.
-pub fn timed(
+pub(crate) fn timed(
     ctx: &GpuContext,
     r: &mut Renderer,
     frames: usize,

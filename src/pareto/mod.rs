@@ -1,16 +1,16 @@
 //! `voltex pareto SCENE`: speed against error. Sweeps each method's quality knobs over the
-//! scene's textured objects, measures every setting's GPU time per frame ([`measure`]) and its
+//! scene's textured objects, measures every setting's GPU time per frame (`measure`) and its
 //! error against a truth image (mean FLIP, relative RMSE), and writes `pareto.csv` and
-//! `pareto.svg` ([`svg`]) with the Pareto fronts ([`front`]) per method and overall.
+//! `pareto.svg` (`svg`) with the Pareto fronts (`front`) per method and overall.
 //!
 //! A setting is a method label, a description of its knobs and the [`RenderOptions`] that apply
-//! them; a new method adds a function like [`view_slices`] and one line in [`sweep`].
+//! them; a new method adds a function like `view_slices` and one line in `sweep`.
 
-pub mod front;
-pub mod measure;
-pub mod peers;
+pub(crate) mod front;
+pub(crate) mod measure;
+pub(crate) mod peers;
 mod report;
-pub mod svg;
+pub(crate) mod svg;
 
 use std::fmt;
 use std::path::PathBuf;
@@ -153,19 +153,19 @@ pub struct Args {
     /// `RayMarch` shadows, each swept over every step (`None`: Phong without shadows); empty:
     /// each object's own.
     pub ray_shadows: Vec<Option<Shadows>>,
-    /// CSV files of other renderers' rows ([`peers`]), shown beside voltex's.
+    /// CSV files of other renderers' rows (`peers`), shown beside voltex's.
     pub peers: Vec<PathBuf>,
 }
 
 /// One point of the sweep.
 #[derive(Debug, Clone)]
-pub struct Setting {
-    pub method: &'static str,
+pub(crate) struct Setting {
+    pub(crate) method: &'static str,
     /// The knobs, e.g. `planes=64 reject=on` (no commas: it is a CSV field).
-    pub knobs: String,
+    pub(crate) knobs: String,
     /// A short name for the chart, e.g. `64` (`64 no-reject` with the trivial reject off).
-    pub tag: String,
-    pub options: RenderOptions,
+    pub(crate) tag: String,
+    pub(crate) options: RenderOptions,
 }
 
 impl Args {
@@ -197,7 +197,7 @@ impl Args {
         Ok(())
     }
 
-    pub fn out_dir(&self) -> PathBuf {
+    pub(crate) fn out_dir(&self) -> PathBuf {
         self.out
             .clone()
             .unwrap_or_else(|| PathBuf::from("out/pareto").join(self.scene.file_stem().unwrap_or_default()))
@@ -206,7 +206,7 @@ impl Args {
 
 /// `ViewSlices`: each plane count with the trivial reject on and off (a speed knob only), at
 /// full detail; with `lod`, also `lod: Auto` under each count.
-pub fn view_slices(args: &Args) -> Vec<Setting> {
+pub(crate) fn view_slices(args: &Args) -> Vec<Setting> {
     let mut v = Vec::new();
     for planes in unique(args.planes.iter().copied()) {
         for reject in [true, false] {
@@ -245,7 +245,7 @@ pub fn view_slices(args: &Args) -> Vec<Setting> {
 
 /// `AxisSlices`: both criteria `d` (voxels) and `p` (pixels) set to each value; each object keeps
 /// its other knobs (directions, blend, culling), or the defaults when it used another method.
-pub fn axis_slices(args: &Args) -> Vec<Setting> {
+pub(crate) fn axis_slices(args: &Args) -> Vec<Setting> {
     let mut criteria = args.criteria.clone();
     criteria.sort_by(f64::total_cmp);
     criteria.dedup();
@@ -266,7 +266,7 @@ pub fn axis_slices(args: &Args) -> Vec<Setting> {
 }
 
 /// `Reference`: the ray step as multiples of `default_step` (one step for all objects).
-pub fn reference(args: &Args, default_step: f64) -> Vec<Setting> {
+pub(crate) fn reference(args: &Args, default_step: f64) -> Vec<Setting> {
     unique(args.steps.iter().copied())
         .into_iter()
         .map(|f| Setting {
@@ -286,7 +286,7 @@ pub fn reference(args: &Args, default_step: f64) -> Vec<Setting> {
 /// `RayMarch`: every hypertexture object marched with each segment strategy and each shadow
 /// option, at each fixed step and then with each adaptive stride (textured objects keep their
 /// methods).
-pub fn ray_march(args: &Args) -> Vec<Setting> {
+pub(crate) fn ray_march(args: &Args) -> Vec<Setting> {
     let mut steps = unique(args.ray_steps.iter().copied());
     steps.sort_by(f64::total_cmp);
     let mut pairs = args.ray_adaptive.clone();
@@ -337,7 +337,7 @@ pub fn ray_march(args: &Args) -> Vec<Setting> {
 }
 
 /// Every setting of the methods asked for, with notes on what cannot be swept.
-pub fn sweep(scene: &Scene, args: &Args) -> Result<(Vec<Setting>, Vec<String>)> {
+pub(crate) fn sweep(scene: &Scene, args: &Args) -> Result<(Vec<Setting>, Vec<String>)> {
     let mut settings = Vec::new();
     let mut notes = Vec::new();
     for &m in &args.methods {
@@ -361,7 +361,7 @@ pub fn sweep(scene: &Scene, args: &Args) -> Result<(Vec<Setting>, Vec<String>)> 
 /// The `Reference` method's default step for the scene: the smallest of its textured objects'
 /// default steps (half the smallest voxel extent, see `methods::reference::default_step`) and
 /// its volume objects' (a quarter voxel; the exact cells need no step, their shadow rays do).
-pub fn reference_default_step(scene: &Scene, size: (u32, u32)) -> Result<Option<f64>> {
+pub(crate) fn reference_default_step(scene: &Scene, size: (u32, u32)) -> Result<Option<f64>> {
     let opts = RenderOptions { size: Some(size), method: Some(MethodKind::Reference), ..Default::default() };
     let bp = Blueprint::new(scene, &opts)?;
     let textured = bp.objects.iter().filter_map(|o| Some(o.method::<ReferencePlan>()?.step));

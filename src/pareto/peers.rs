@@ -9,39 +9,39 @@ use std::path::Path;
 use crate::error::{Error, FileLoc, Result};
 
 /// The columns a peer CSV has.
-pub const COLUMNS: [&str; 9] =
+pub(crate) const COLUMNS: [&str; 9] =
     ["renderer", "setting", "samples", "seconds", "threads", "version", "rmse", "rel_rmse", "flip"];
 
 /// One render by another renderer, with its error against the same truth as voltex's rows.
 #[derive(Debug, Clone, PartialEq)]
-pub struct PeerRow {
+pub(crate) struct PeerRow {
     /// e.g. `Mitsuba volpath`, `Cycles`: a series of the chart.
-    pub renderer: String,
+    pub(crate) renderer: String,
     /// Its knobs, e.g. `max_depth=-1`.
-    pub setting: String,
+    pub(crate) setting: String,
     /// Samples per pixel.
-    pub samples: u64,
+    pub(crate) samples: u64,
     /// Wall time of the render (seconds).
-    pub seconds: f64,
+    pub(crate) seconds: f64,
     /// CPU threads it ran on.
-    pub threads: u32,
-    pub version: String,
+    pub(crate) threads: u32,
+    pub(crate) version: String,
     /// RMSE, relative RMSE and mean FLIP against the truth image.
-    pub rmse: f64,
-    pub rel_rmse: f64,
-    pub flip: f64,
+    pub(crate) rmse: f64,
+    pub(crate) rel_rmse: f64,
+    pub(crate) flip: f64,
     /// Where it was read, `file:line`.
-    pub at: String,
+    pub(crate) at: String,
 }
 
 /// The rows of the peer CSV at `path`.
-pub fn read(path: &Path) -> Result<Vec<PeerRow>> {
+pub(crate) fn read(path: &Path) -> Result<Vec<PeerRow>> {
     let text = crate::input::read_text(path, "a peer CSV")?;
     parse(&text, path)
 }
 
 /// The rows of peer CSV `text`; `path` names it in errors.
-pub fn parse(text: &str, path: &Path) -> Result<Vec<PeerRow>> {
+pub(crate) fn parse(text: &str, path: &Path) -> Result<Vec<PeerRow>> {
     let mut lines = text.lines().enumerate().filter(|(_, l)| !l.trim().is_empty() && !l.starts_with('#'));
     let at = |line: usize, col: usize, msg: String| Error::at(FileLoc::new(path, line + 1, col), msg);
     let (n, header) = lines.next().ok_or_else(|| {

@@ -8,27 +8,27 @@ use super::front;
 
 /// One measured setting.
 #[derive(Debug, Clone)]
-pub struct Point {
-    pub x: f64,
-    pub y: f64,
+pub(crate) struct Point {
+    pub(crate) x: f64,
+    pub(crate) y: f64,
     /// Tooltip text (method and knobs).
-    pub label: String,
+    pub(crate) label: String,
     /// A short name written beside the point when it is on its series' front (`64`, `8x`).
-    pub tag: String,
+    pub(crate) tag: String,
 }
 
 /// The points of one method.
 #[derive(Debug, Clone)]
-pub struct Series {
-    pub label: String,
-    pub points: Vec<Point>,
+pub(crate) struct Series {
+    pub(crate) label: String,
+    pub(crate) points: Vec<Point>,
 }
 
-pub struct Chart<'a> {
-    pub title: &'a str,
-    pub x_label: &'a str,
-    pub y_label: &'a str,
-    pub series: &'a [Series],
+pub(crate) struct Chart<'a> {
+    pub(crate) title: &'a str,
+    pub(crate) x_label: &'a str,
+    pub(crate) y_label: &'a str,
+    pub(crate) series: &'a [Series],
 }
 
 const COLOURS: [&str; 6] = ["#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b"];
@@ -96,7 +96,7 @@ impl Axis {
 }
 
 /// `m * 10^k` written plainly (0.002, 20, 1e-5 for the very small or large).
-pub fn format_tick(v: f64) -> String {
+pub(crate) fn format_tick(v: f64) -> String {
     let k = v.abs().log10().floor() as i32;
     if !(-4..=5).contains(&k) {
         let m = v / 10f64.powi(k);
@@ -114,7 +114,7 @@ fn trim(s: String) -> String {
 }
 
 /// XML text and attribute escaping.
-pub fn escape(s: &str) -> String {
+pub(crate) fn escape(s: &str) -> String {
     s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;")
 }
 
@@ -132,7 +132,7 @@ fn step_path(pts: &[(f64, f64)]) -> String {
 }
 
 /// The chart as a standalone SVG document.
-pub fn render(chart: &Chart) -> String {
+pub(crate) fn render(chart: &Chart) -> String {
     let all: Vec<&Point> = chart.series.iter().flat_map(|s| &s.points).collect();
     let x = Axis::new(all.iter().map(|p| p.x), LEFT, WIDTH - RIGHT);
     let y = Axis::new(all.iter().map(|p| p.y), HEIGHT - BOTTOM, TOP);

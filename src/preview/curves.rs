@@ -179,7 +179,7 @@ fn numbers(v: &Value, src: &str) -> Vec<f64> {
 }
 
 /// `Curve([(x, y, slope), ..])` at `path` (the `Curve(..)` value).
-pub fn shape_curve(ui: &mut egui::Ui, cx: &mut Cx, v: &Value, path: &[Step]) {
+pub(crate) fn shape_curve(ui: &mut egui::Ui, cx: &mut Cx, v: &Value, path: &[Step]) {
     let src = cx.src;
     let Some(list) = v.items().first().copied() else { return };
     let mut list_path = path.to_vec();
@@ -227,7 +227,7 @@ pub fn shape_curve(ui: &mut egui::Ui, cx: &mut Cx, v: &Value, path: &[Step]) {
 }
 
 /// `Ramp([(density, (r, g, b, a)), ..])` at `path`: one curve per channel.
-pub fn color_ramp(ui: &mut egui::Ui, cx: &mut Cx, v: &Value, path: &[Step]) {
+pub(crate) fn color_ramp(ui: &mut egui::Ui, cx: &mut Cx, v: &Value, path: &[Step]) {
     let src = cx.src;
     let Some(list) = v.items().first().copied() else { return };
     let mut list_path = path.to_vec();
@@ -303,7 +303,7 @@ pub fn color_ramp(ui: &mut egui::Ui, cx: &mut Cx, v: &Value, path: &[Step]) {
 }
 
 /// A 2D shape function (rows by density from 0 at the top, columns by noise value) as an image.
-pub fn grid_image(ui: &mut egui::Ui, rows: &[Vec<f64>], key: &str) {
+pub(crate) fn grid_image(ui: &mut egui::Ui, rows: &[Vec<f64>], key: &str) {
     let (h, w) = (rows.len(), rows.first().map_or(0, Vec::len));
     if h == 0 || w == 0 {
         return;

@@ -8,8 +8,8 @@ use std::path::{Path, PathBuf};
 use super::scene_text::{Edit, Step};
 use crate::error::Result;
 
-pub struct Editor {
-    pub path: PathBuf,
+pub(crate) struct Editor {
+    pub(crate) path: PathBuf,
     /// The file's text as last read or written here.
     disk: String,
     /// The text the preview shows: `disk` plus any edit not written (a drag in progress, or a
@@ -20,11 +20,11 @@ pub struct Editor {
     /// The drag in progress, as one edit from its start to now.
     gesture: Option<Edit>,
     /// For the panel: what happened to the last edit, or to the file.
-    pub note: Option<String>,
+    pub(crate) note: Option<String>,
     /// A refused edit: the value's path and why (the panel highlights that field).
-    pub refused: Option<(Vec<Step>, String)>,
+    pub(crate) refused: Option<(Vec<Step>, String)>,
     /// The file could not be written (read-only): edits stay here.
-    pub read_only: bool,
+    pub(crate) read_only: bool,
 }
 
 /// Whether an edit goes into the undo history or the redo history.
@@ -36,7 +36,7 @@ enum History {
 }
 
 impl Editor {
-    pub fn open(path: &Path) -> Result<Self> {
+    pub(crate) fn open(path: &Path) -> Result<Self> {
         let text = read(path)?;
         Ok(Editor {
             path: path.to_path_buf(),
@@ -51,27 +51,27 @@ impl Editor {
         })
     }
 
-    pub fn text(&self) -> &str {
+    pub(crate) fn text(&self) -> &str {
         &self.text
     }
 
     /// Whether the panel holds an edit the file does not have.
-    pub fn unsaved(&self) -> bool {
+    pub(crate) fn unsaved(&self) -> bool {
         self.text != self.disk
     }
 
-    pub fn can_undo(&self) -> bool {
+    pub(crate) fn can_undo(&self) -> bool {
         !self.undo.is_empty() || self.gesture.is_some()
     }
 
-    pub fn can_redo(&self) -> bool {
+    pub(crate) fn can_redo(&self) -> bool {
         !self.redo.is_empty()
     }
 
     /// Makes `edit` (`live`: a step of a drag, written when the drag ends). `build` is asked to
     /// render the edited text and says why it cannot; then the edit is refused: nothing changes,
     /// the field is marked. Returns whether the edit was made.
-    pub fn edit(
+    pub(crate) fn edit(
         &mut self,
         edit: Edit,
         live: bool,
@@ -127,7 +127,7 @@ impl Editor {
     }
 
     /// The drag ended: its edit goes into the history and the text into the file.
-    pub fn end_gesture(&mut self) {
+    pub(crate) fn end_gesture(&mut self) {
         if self.gesture.is_some() {
             self.end_gesture_history();
             self.save();
@@ -144,7 +144,7 @@ impl Editor {
 
     /// Undoes the last edit (checked and built like any edit); false when there is none or it
     /// cannot be undone (the value changed in the file since: the note says so).
-    pub fn undo(&mut self, build: impl FnOnce(&str) -> std::result::Result<(), String>) -> bool {
+    pub(crate) fn undo(&mut self, build: impl FnOnce(&str) -> std::result::Result<(), String>) -> bool {
         self.end_gesture_history();
         let Some(e) = self.undo.pop() else { return false };
         let ok = self.make(e.inverse(), false, History::Undo, build);
@@ -154,7 +154,7 @@ impl Editor {
         ok
     }
 
-    pub fn redo(&mut self, build: impl FnOnce(&str) -> std::result::Result<(), String>) -> bool {
+    pub(crate) fn redo(&mut self, build: impl FnOnce(&str) -> std::result::Result<(), String>) -> bool {
         let Some(e) = self.redo.pop() else { return false };
         let ok = self.make(e.clone(), false, History::Redo, build);
         if !ok {
@@ -187,7 +187,7 @@ impl Editor {
     /// The file changed on disk (the watcher said so): re-reads it. Returns whether the text the
     /// preview shows changed; our own writes come back as unchanged. An unsaved edit is dropped:
     /// the file wins.
-    pub fn reload(&mut self) -> bool {
+    pub(crate) fn reload(&mut self) -> bool {
         let Ok(now) = read(&self.path) else { return false };
         if now == self.disk {
             // Ours, or a touch; a read-only file may have become writable.

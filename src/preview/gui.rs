@@ -7,8 +7,8 @@ use winit::window::Window;
 
 use crate::gpu::GpuContext;
 
-pub struct Gui {
-    pub ctx: egui::Context,
+pub(crate) struct Gui {
+    pub(crate) ctx: egui::Context,
     state: egui_winit::State,
     renderer: egui_wgpu::Renderer,
     primitives: Vec<egui::ClippedPrimitive>,
@@ -17,7 +17,7 @@ pub struct Gui {
 }
 
 impl Gui {
-    pub fn new(window: &Window, device: &wgpu::Device, format: wgpu::TextureFormat) -> Self {
+    pub(crate) fn new(window: &Window, device: &wgpu::Device, format: wgpu::TextureFormat) -> Self {
         let ctx = egui::Context::default();
         let max_side = device.limits().max_texture_dimension_2d as usize;
         let state = egui_winit::State::new(
@@ -33,7 +33,7 @@ impl Gui {
     }
 
     /// A new device (after a device loss): the renderer and its textures are made again.
-    pub fn reset(&mut self, device: &wgpu::Device, format: wgpu::TextureFormat) {
+    pub(crate) fn reset(&mut self, device: &wgpu::Device, format: wgpu::TextureFormat) {
         self.renderer = egui_wgpu::Renderer::new(device, format, egui_wgpu::RendererOptions::default());
         self.ctx = egui::Context::default();
         self.primitives.clear();
@@ -41,7 +41,7 @@ impl Gui {
     }
 
     /// Hands a window event to egui: whether egui used it, and whether it wants a repaint.
-    pub fn on_event(
+    pub(crate) fn on_event(
         &mut self,
         window: &Window,
         event: &winit::event::WindowEvent,
@@ -51,7 +51,7 @@ impl Gui {
 
     /// Runs the panel's code for one frame and uploads the textures it made; returns how soon
     /// egui wants the next frame (`None`: not until an event).
-    pub fn run(
+    pub(crate) fn run(
         &mut self,
         ctx: &GpuContext,
         window: &Window,
@@ -79,7 +79,7 @@ impl Gui {
     }
 
     /// Draws the last frame's panel over `target` (of `size` pixels).
-    pub fn paint(&mut self, ctx: &GpuContext, target: &wgpu::TextureView, size: (u32, u32)) {
+    pub(crate) fn paint(&mut self, ctx: &GpuContext, target: &wgpu::TextureView, size: (u32, u32)) {
         let screen = egui_wgpu::ScreenDescriptor {
             size_in_pixels: [size.0, size.1],
             pixels_per_point: self.pixels_per_point,
@@ -104,10 +104,5 @@ impl Gui {
             self.renderer.render(&mut pass.forget_lifetime(), &self.primitives, &screen);
         }
         ctx.queue.submit(extra.into_iter().chain([enc.finish()]));
-    }
-
-    /// Pixels per point (the window's scale factor as egui uses it).
-    pub fn scale(&self) -> f32 {
-        self.pixels_per_point
     }
 }

@@ -49,7 +49,7 @@ fn variant(m: &Method) -> &'static str {
 
 /// `M`: ViewSlices, AxisSlices, Reference in turn (lighting kept where both have it); a
 /// hypertexture's RayMarch cycles its shading: None, Phong, PhongShadows, HenyeyGreenstein.
-pub fn next_method(src: &str, node: &[Step], m: &Method) -> Result<Edit> {
+pub(crate) fn next_method(src: &str, node: &[Step], m: &Method) -> Result<Edit> {
     compound(src, node, |text| {
         let lighting = |l: crate::scene::Lighting| format!("{l:?}");
         let next = match m {
@@ -79,7 +79,7 @@ pub fn next_method(src: &str, node: &[Step], m: &Method) -> Result<Edit> {
 /// `+` (finer) and `-`: ViewSlices planes x2 or /2, a ray step /2 or x2 (an adaptive stride's
 /// `max_step` with it), AxisSlices' slice depth /2 or x2. `None` where the method has no knob
 /// to step (Reference at its default step).
-pub fn step_quality(src: &str, node: &[Step], m: &Method, finer: bool) -> Result<Option<Edit>> {
+pub(crate) fn step_quality(src: &str, node: &[Step], m: &Method, finer: bool) -> Result<Option<Edit>> {
     let scale = if finer { 0.5 } else { 2.0 };
     let (field, value) = match m {
         Method::ViewSlices(v) => {
@@ -118,7 +118,7 @@ pub fn step_quality(src: &str, node: &[Step], m: &Method, finer: bool) -> Result
 /// The method `d` times coarser, for a frame drawn while a drag goes on: a `d`-th of the planes,
 /// a ray step (and shadow step, adaptive stride) `d` times longer, AxisSlices criteria `d` times
 /// looser. Reference at its default step stays as it is.
-pub fn coarser(m: &Method, d: f64) -> Method {
+pub(crate) fn coarser(m: &Method, d: f64) -> Method {
     let mut m = m.clone();
     match &mut m {
         Method::ViewSlices(v) => v.planes = ((v.planes as f64 / d).round() as u32).max(1),
@@ -141,7 +141,7 @@ pub fn coarser(m: &Method, d: f64) -> Method {
 }
 
 /// Names and paths of the nodes of the text (`nodes[i]`, `nodes[i].children[j]`, ...).
-pub fn node_paths(v: &st::Value, src: &str, at: Vec<Step>, out: &mut Vec<(String, Vec<Step>)>) {
+pub(crate) fn node_paths(v: &st::Value, src: &str, at: Vec<Step>, out: &mut Vec<(String, Vec<Step>)>) {
     let key = if at.is_empty() { "nodes" } else { "children" };
     let Some(list) = v.child(&Step::Field(key.into()), src) else { return };
     for (i, n) in list.items().into_iter().enumerate() {

@@ -18,31 +18,31 @@ use crate::gpu::GpuContext;
 use crate::render::RenderOptions;
 
 /// The goals of issue 18: a camera, light or knob edit, and a texel rebake (ms).
-pub const GOAL_MS: f64 = 100.0;
-pub const GOAL_REBAKE_MS: f64 = 300.0;
+pub(crate) const GOAL_MS: f64 = 100.0;
+pub(crate) const GOAL_REBAKE_MS: f64 = 300.0;
 
 /// One save, from the write to the frame read back, in ms.
 #[derive(Debug, Default, Clone, Copy, Serialize, PartialEq)]
-pub struct Sample {
+pub(crate) struct Sample {
     /// Writing the file (temporary file, then rename: what the panel and most editors do).
-    pub write: f64,
+    pub(crate) write: f64,
     /// From the write to the watcher's report (the debounce included).
-    pub watch: f64,
-    pub parse: f64,
-    pub plan: f64,
-    pub bake: f64,
+    pub(crate) watch: f64,
+    pub(crate) parse: f64,
+    pub(crate) plan: f64,
+    pub(crate) bake: f64,
     /// Buffers and pipelines not in the cache.
-    pub build: f64,
+    pub(crate) build: f64,
     /// The frame's passes, submit to idle.
-    pub render: f64,
+    pub(crate) render: f64,
     /// The output read back (the window presents it instead).
-    pub readback: f64,
-    pub total: f64,
+    pub(crate) readback: f64,
+    pub(crate) total: f64,
 }
 
 /// The stages of a [`Sample`] in order, with their values.
 impl Sample {
-    pub fn stages(&self) -> [(&'static str, f64); 9] {
+    pub(crate) fn stages(&self) -> [(&'static str, f64); 9] {
         [
             ("write", self.write),
             ("watch", self.watch),
@@ -81,28 +81,28 @@ impl Sample {
 #[derive(Debug, Clone, Serialize)]
 pub struct Row {
     /// `camera`, `light`, `knob`, `texel`, `noise`.
-    pub edit: String,
+    pub(crate) edit: String,
     /// The value edited and its two values, e.g. `lights[0].direction: (..) <-> (..)`.
-    pub what: String,
-    pub goal_ms: f64,
+    pub(crate) what: String,
+    pub(crate) goal_ms: f64,
     /// What the last repetition had to make (not found in the cache).
-    pub modules: u32,
-    pub pipelines: u32,
-    pub bakes: u32,
-    pub median: Sample,
-    pub samples: Vec<Sample>,
+    pub(crate) modules: u32,
+    pub(crate) pipelines: u32,
+    pub(crate) bakes: u32,
+    pub(crate) median: Sample,
+    pub(crate) samples: Vec<Sample>,
 }
 
 #[derive(Debug, Clone, Serialize)]
 pub struct Report {
     pub command: String,
-    pub scene: String,
+    pub(crate) scene: String,
     pub adapter: String,
     /// The 1-minute load average when the run began (a software adapter shares the CPU).
-    pub load: Option<f64>,
+    pub(crate) load: Option<f64>,
     pub size: [u32; 2],
-    pub debounce_ms: f64,
-    pub repeat: usize,
+    pub(crate) debounce_ms: f64,
+    pub(crate) repeat: usize,
     pub rows: Vec<Row>,
 }
 

@@ -1,16 +1,16 @@
 //! `voltex preview`: a window showing a scene, rebuilt whenever a file it depends on changes.
-//! [`session`] is the reload machinery (headless, tested on its own), [`watch`] the file watcher.
+//! `session` is the reload machinery (headless, tested on its own), [`watch`] the file watcher.
 
-pub mod camera_file;
-pub mod curves;
-pub mod editor;
-pub mod gui;
-pub mod knobs;
+pub(crate) mod camera_file;
+pub(crate) mod curves;
+pub(crate) mod editor;
+pub(crate) mod gui;
+pub(crate) mod knobs;
 pub mod latency;
-pub mod panel;
+pub(crate) mod panel;
 pub mod present;
 pub mod scene_text;
-pub mod session;
+pub(crate) mod session;
 pub mod watch;
 pub mod window;
 

@@ -15,11 +15,11 @@ use super::scene_text::{self as st, format_number, Kind, Step, Value};
 use crate::scene::Scene;
 
 /// Width of the panel in points.
-pub const WIDTH: f32 = 340.0;
+pub(crate) const WIDTH: f32 = 340.0;
 
 /// What the user asked for in the panel.
 #[derive(Debug, Clone)]
-pub enum Action {
+pub(crate) enum Action {
     /// An edit of the scene text (`live`: a step of a drag).
     Edit {
         edit: st::Edit,
@@ -37,42 +37,42 @@ pub enum Action {
 
 /// An object of the list: its name, the path of its node in the text, its method's name.
 #[derive(Debug, Clone)]
-pub struct Object {
-    pub name: String,
-    pub node: Vec<Step>,
+pub(crate) struct Object {
+    pub(crate) name: String,
+    pub(crate) node: Vec<Step>,
 }
 
 /// What the panel shows.
-pub struct View<'a> {
-    pub src: &'a str,
-    pub tree: Option<&'a Value>,
-    pub scene: Option<&'a Scene>,
-    pub objects: &'a [Object],
-    pub selected: usize,
-    pub mode: Mode,
+pub(crate) struct View<'a> {
+    pub(crate) src: &'a str,
+    pub(crate) tree: Option<&'a Value>,
+    pub(crate) scene: Option<&'a Scene>,
+    pub(crate) objects: &'a [Object],
+    pub(crate) selected: usize,
+    pub(crate) mode: Mode,
     /// Scene, GPU time, adapter, status.
-    pub lines: &'a [String],
-    pub error: Option<&'a str>,
-    pub note: Option<&'a str>,
-    pub refused: Option<&'a (Vec<Step>, String)>,
-    pub read_only: bool,
-    pub can_undo: bool,
-    pub can_redo: bool,
+    pub(crate) lines: &'a [String],
+    pub(crate) error: Option<&'a str>,
+    pub(crate) note: Option<&'a str>,
+    pub(crate) refused: Option<&'a (Vec<Step>, String)>,
+    pub(crate) read_only: bool,
+    pub(crate) can_undo: bool,
+    pub(crate) can_redo: bool,
 }
 
 /// Drawing context: the text, the refused field, and the actions and editor rectangles made.
-pub struct Cx<'a> {
-    pub src: &'a str,
-    pub scene: Option<&'a Scene>,
+pub(crate) struct Cx<'a> {
+    pub(crate) src: &'a str,
+    pub(crate) scene: Option<&'a Scene>,
     refused: Option<&'a (Vec<Step>, String)>,
-    pub actions: Vec<Action>,
+    pub(crate) actions: Vec<Action>,
     /// Screen rectangles of the curve editors and number fields by path (window tests drive them).
-    pub rects: Vec<(String, egui::Rect)>,
+    pub(crate) rects: Vec<(String, egui::Rect)>,
 }
 
 /// Defaults of fields a file may leave out, by the struct's variant name (unnamed structs: the
 /// name [`type_key`] gives them). Shown greyed; editing one writes it into the file.
-pub const KNOBS: &[(&str, &[(&str, &str)])] = &[
+pub(crate) const KNOBS: &[(&str, &[(&str, &str)])] = &[
     ("ViewSlices", &[("planes", "64"), ("trivial_reject", "true"), ("lighting", "Baked")]),
     ("Reference", &[("step", "0.01"), ("lighting", "Baked")]),
     (
@@ -149,7 +149,7 @@ fn type_key<'a>(v: &'a Value, path: &[Step], src: &'a str) -> Option<&'a str> {
 }
 
 /// Draws the panel; returns what the user did.
-pub fn show(root: &mut egui::Ui, view: &View) -> (Vec<Action>, Vec<(String, egui::Rect)>) {
+pub(crate) fn show(root: &mut egui::Ui, view: &View) -> (Vec<Action>, Vec<(String, egui::Rect)>) {
     let mut cx = Cx {
         src: view.src,
         scene: view.scene,

@@ -35,16 +35,16 @@ pub enum Mode {
 const MAX_COLUMNS: usize = 110;
 const MAX_LINES: usize = 16;
 
-pub struct Presenter {
+pub(crate) struct Presenter {
     pipeline: wgpu::RenderPipeline,
     layout: wgpu::BindGroupLayout,
     params: wgpu::Buffer,
     text: wgpu::Buffer,
-    pub format: wgpu::TextureFormat,
+    pub(crate) format: wgpu::TextureFormat,
 }
 
 impl Presenter {
-    pub fn new(ctx: &GpuContext, format: wgpu::TextureFormat) -> Result<Self> {
+    pub(crate) fn new(ctx: &GpuContext, format: wgpu::TextureFormat) -> Result<Self> {
         let kernel = shader::load_from(&Sources::project()?, "present.wgsl")?;
         let module = ctx.scoped("present.wgsl", || {
             ctx.device.create_shader_module(wgpu::ShaderModuleDescriptor {
@@ -104,7 +104,7 @@ impl Presenter {
     /// Draws `image` (and `reference` for the reference and difference views; the image itself
     /// otherwise) into `target` of `target_size`, with `lines` of overlay text.
     #[allow(clippy::too_many_arguments)]
-    pub fn draw(
+    pub(crate) fn draw(
         &self,
         ctx: &GpuContext,
         target: &wgpu::TextureView,

@@ -32,8 +32,8 @@ pub enum Kind {
 #[derive(Debug, Clone, PartialEq)]
 pub struct Field {
     /// The field's name (`None` in a tuple).
-    pub name: Option<String>,
-    pub value: Value,
+    pub(crate) name: Option<String>,
+    pub(crate) value: Value,
 }
 
 /// One step of a path from the root value down to the value an edit changes.
@@ -119,7 +119,7 @@ impl Value {
 }
 
 /// A RON number's value (decimal, with `_` separators, or 0x/0b/0o integers).
-pub fn parse_number(t: &str) -> Option<f64> {
+pub(crate) fn parse_number(t: &str) -> Option<f64> {
     let t = t.replace('_', "");
     let (neg, body) = match t.strip_prefix('-') {
         Some(b) => (true, b),
@@ -382,7 +382,7 @@ impl Parser<'_> {
 #[derive(Debug, Clone, PartialEq)]
 pub struct Edit {
     pub path: Vec<Step>,
-    pub before: String,
+    pub(crate) before: String,
     pub after: String,
 }
 
@@ -406,7 +406,7 @@ fn locate(src: &str, path: &[Step]) -> Result<Range<usize>> {
 }
 
 /// `src` with the value at `path`, which must read `before`, replaced by `after`.
-pub fn splice(src: &str, path: &[Step], before: &str, after: &str) -> Result<String> {
+pub(crate) fn splice(src: &str, path: &[Step], before: &str, after: &str) -> Result<String> {
     let span = locate(src, path)?;
     if &src[span.clone()] != before {
         return Err(Error::Invalid(format!(
@@ -522,7 +522,7 @@ fn field_start(src: &str, f: &Field) -> usize {
 /// Writes `text` as the scene file `path`, atomically (temporary file, then rename) and keeping
 /// its permissions. A read-only file is refused (renaming over it would succeed, but the user
 /// made it read-only); a symbolic link is written through.
-pub fn write(path: &Path, text: &str) -> Result<()> {
+pub(crate) fn write(path: &Path, text: &str) -> Result<()> {
     let target = std::fs::canonicalize(path).map_err(|e| Error::file(path, e))?;
     let meta = std::fs::metadata(&target).map_err(|e| Error::file(path, e))?;
     if meta.permissions().readonly() {

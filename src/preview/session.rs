@@ -24,19 +24,19 @@ pub enum Outcome {
 
 /// Where the last successful rebuild's time went, in ms (`voltex preview --measure-latency`).
 #[derive(Debug, Default, Clone, Copy, PartialEq)]
-pub struct Stages {
+pub(crate) struct Stages {
     /// Reading and parsing the scene file.
-    pub parse: f64,
+    pub(crate) parse: f64,
     /// The blueprint: objects, shells, plane sweeps, bakes to make, the graph plan.
-    pub plan: f64,
+    pub(crate) plan: f64,
     /// Bakes not found in the cache (texels, mesh grids, splat sets), GPU work waited for.
-    pub bake: f64,
+    pub(crate) bake: f64,
     /// The rest of the renderer: buffers, pipelines not found in the cache.
-    pub build: f64,
+    pub(crate) build: f64,
 }
 
 pub struct Session {
-    pub scene_path: PathBuf,
+    pub(crate) scene_path: PathBuf,
     /// Overrides (size, graph, methods, camera) applied on every rebuild.
     pub options: RenderOptions,
     cache: GpuCache,
@@ -47,9 +47,9 @@ pub struct Session {
     /// The last error printed, so each distinct error is logged once.
     logged: Option<String>,
     /// The scene's text when the panel holds edits the file does not have (else the file's).
-    pub text: Option<String>,
+    pub(crate) text: Option<String>,
     /// The last successful rebuild's stages.
-    pub stages: Stages,
+    pub(crate) stages: Stages,
     /// Draft quality while a drag goes on: the frame is drawn at 1/`draft` of its width and
     /// height (1: full quality). The next rebuild applies it; setting it back to 1 and rebuilding
     /// refines the frame.
@@ -60,7 +60,7 @@ pub struct Session {
 
 /// What a draft frame may take to draw (ms): with a rebuild and the panel, a drag stays near the
 /// 100 ms save-to-frame goal on a software adapter.
-pub const DRAFT_FRAME_MS: f64 = 40.0;
+pub(crate) const DRAFT_FRAME_MS: f64 = 40.0;
 
 impl Session {
     /// Builds the first renderer; a failure leaves the session without one and with `error` set.
@@ -69,7 +69,7 @@ impl Session {
     }
 
     /// As [`Session::open`], from `text` instead of the file when given (edits the file lacks).
-    pub fn open_with(
+    pub(crate) fn open_with(
         ctx: &GpuContext,
         scene_path: &Path,
         options: RenderOptions,
@@ -111,7 +111,11 @@ impl Session {
 
     /// Builds the scene of `text` (an edit the panel proposes). On success it is current; on
     /// failure nothing changes (the panel refuses the edit and says why at the field).
-    pub fn try_text(&mut self, ctx: &GpuContext, text: &str) -> std::result::Result<CacheStats, String> {
+    pub(crate) fn try_text(
+        &mut self,
+        ctx: &GpuContext,
+        text: &str,
+    ) -> std::result::Result<CacheStats, String> {
         match scene::parse(text, &self.scene_path).and_then(|scene| self.build(ctx, scene)) {
             Ok(Outcome::Rebuilt(stats)) => Ok(stats),
             Ok(Outcome::Failed(e)) => Err(e),
@@ -172,7 +176,7 @@ impl Session {
 
     /// Renders a frame to be shown from the renderer's output texture, without reading it back:
     /// the per-pass GPU times. Times full-quality frames for [`Session::draft_scale`].
-    pub fn draw(&mut self, ctx: &GpuContext) -> Option<Result<Vec<(String, f64)>>> {
+    pub(crate) fn draw(&mut self, ctx: &GpuContext) -> Option<Result<Vec<(String, f64)>>> {
         let t = Instant::now();
         let times = self.renderer.as_mut()?.render_timed(ctx);
         if self.draft == 1 && times.is_ok() {
@@ -185,7 +189,7 @@ impl Session {
     /// else how many times over it is, at most 8. A draft divides the width and height, and
     /// the planes or steps, by it: a frame bound by its pixels gets cheaper by its cube, one
     /// bound by its geometry at least by the scale itself.
-    pub fn draft_scale(&self) -> u32 {
+    pub(crate) fn draft_scale(&self) -> u32 {
         let ms = self.frame_ms.unwrap_or(0.0);
         ((ms / DRAFT_FRAME_MS).ceil() as u32).clamp(1, 8)
     }
@@ -212,13 +216,9 @@ impl Session {
     }
 
     /// The size frames are drawn at while drafting (`None` at full quality).
-    pub fn draft_size(&self, scene: &Scene) -> Option<(u32, u32)> {
+    pub(crate) fn draft_size(&self, scene: &Scene) -> Option<(u32, u32)> {
         let (w, h) = self.options.size.unwrap_or((scene.output.width, scene.output.height));
         (self.draft > 1).then(|| (w.div_ceil(self.draft), h.div_ceil(self.draft)))
-    }
-
-    pub fn renderer_mut(&mut self) -> Option<&mut Renderer> {
-        self.renderer.as_mut()
     }
 
     pub fn renderer(&self) -> Option<&Renderer> {
@@ -257,6 +257,6 @@ impl Session {
 }
 
 /// Milliseconds since `t`.
-pub fn ms(t: Instant) -> f64 {
+pub(crate) fn ms(t: Instant) -> f64 {
     t.elapsed().as_secs_f64() * 1e3
 }

@@ -18,7 +18,7 @@ use crate::error::{Error, Result};
 /// triggers the rebuild that reads the finished file.
 pub const DEBOUNCE: Duration = Duration::from_millis(10);
 /// The longest a change waits for quiet (a file written without pause is still reported).
-pub const SETTLE_MAX: Duration = Duration::from_millis(100);
+pub(crate) const SETTLE_MAX: Duration = Duration::from_millis(100);
 
 /// File kinds a rebuild reads: scenes and graphs, kernels, meshes, height images.
 const RELEVANT: &[&str] = &["ron", "wgsl", "obj", "png"];
@@ -28,7 +28,7 @@ pub struct Watcher {
     events: Receiver<notify::Result<Event>>,
     dirs: Vec<PathBuf>,
     /// Folders whose changes are ours (recordings, screenshots), not the user's.
-    pub ignore: Vec<PathBuf>,
+    pub(crate) ignore: Vec<PathBuf>,
 }
 
 impl Watcher {
@@ -38,7 +38,7 @@ impl Watcher {
 
     /// Like [`Watcher::new`], calling `wake` (from the watcher's thread) on every event that may
     /// be a change, so that a window's event loop looks at once.
-    pub fn with_wake(dirs: &[PathBuf], wake: impl Fn() + Send + 'static) -> Result<Self> {
+    pub(crate) fn with_wake(dirs: &[PathBuf], wake: impl Fn() + Send + 'static) -> Result<Self> {
         let (tx, events) = channel();
         let watcher = notify::recommended_watcher(move |e: notify::Result<Event>| {
             let change = e.as_ref().map_or(true, |e| changes_content(&e.kind) || e.need_rescan());
@@ -54,7 +54,7 @@ impl Watcher {
     }
 
     /// Watches exactly `dirs` from now on.
-    pub fn watch(&mut self, dirs: &[PathBuf]) -> Result<()> {
+    pub(crate) fn watch(&mut self, dirs: &[PathBuf]) -> Result<()> {
         for d in self.dirs.clone() {
             if !dirs.contains(&d) {
                 let _ = self.watcher.unwatch(&d);
@@ -73,7 +73,7 @@ impl Watcher {
     }
 
     /// Relevant paths changed since the last call, waiting up to `timeout` for the first; once
-    /// one came, until they are quiet for [`DEBOUNCE`] (at most [`SETTLE_MAX`]).
+    /// one came, until they are quiet for [`DEBOUNCE`] (at most `SETTLE_MAX`).
     pub fn changes(&self, timeout: Duration) -> Vec<PathBuf> {
         let deadline = Instant::now() + timeout;
         let mut out = Vec::new();

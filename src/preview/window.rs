@@ -1,6 +1,6 @@
 //! The preview window: a winit event loop around a [`Session`], redrawing when a watched file
 //! changes or the user moves the camera, edits the scene in the panel or presses a key. The
-//! panel's edits and the method keys go into the scene file ([`Editor`]); the camera moves stay
+//! panel's edits and the method keys go into the scene file (`Editor`); the camera moves stay
 //! in the window until `C` writes them.
 
 use std::path::PathBuf;

@@ -23,8 +23,8 @@ struct Rendered {
 
 /// One scene's outcome: its record, and whether that is an earlier run's, still current.
 pub(super) struct Checked {
-    pub record: Record,
-    pub skipped: bool,
+    pub(crate) record: Record,
+    pub(crate) skipped: bool,
 }
 
 /// Checks one scene, or keeps its record when that is current (see [`current`]; a broken scene

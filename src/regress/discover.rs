@@ -10,12 +10,12 @@ use crate::{Error, Result};
 #[derive(Debug, Clone, PartialEq)]
 pub struct SceneEntry {
     /// Relative to the scanned folder, `/`-separated: `view_slices/torus_egg.ron`.
-    pub rel: String,
-    pub path: PathBuf,
+    pub(crate) rel: String,
+    pub(crate) path: PathBuf,
     /// `<stem>.ref.exr` beside the scene file.
-    pub reference: PathBuf,
+    pub(crate) reference: PathBuf,
     /// The scene's output folder relative to the run's output folder: `rel` without `.ron`.
-    pub folder: PathBuf,
+    pub(crate) folder: PathBuf,
 }
 
 impl SceneEntry {
@@ -38,8 +38,8 @@ impl SceneEntry {
 /// `JOB_COMPLETION_INDEX` (0-based); plain `auto` also takes `n` from `SLURM_ARRAY_TASK_COUNT`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
 pub struct Shard {
-    pub index: usize,
-    pub count: usize,
+    pub(crate) index: usize,
+    pub(crate) count: usize,
 }
 
 impl Default for Shard {
@@ -57,7 +57,7 @@ impl FromStr for Shard {
 
 impl Shard {
     /// Parses `i/n`, `auto/n` or `auto`, reading engine variables through `env`.
-    pub fn parse(s: &str, env: &dyn Fn(&str) -> Option<String>) -> std::result::Result<Self, String> {
+    pub(crate) fn parse(s: &str, env: &dyn Fn(&str) -> Option<String>) -> std::result::Result<Self, String> {
         let bad = || format!("`{s}`: expected a shard i/n with 1 <= i <= n, e.g. 1/4, or auto/n");
         let (i, n) = match s.split_once('/') {
             Some((i, n)) => (i.trim(), Some(n.trim())),

@@ -11,10 +11,10 @@ use crate::io::atomic;
 use crate::{Error, Result};
 
 /// File name of the JUnit report beside `index.html` when `--junit` names no other file.
-pub const JUNIT_FILE: &str = "junit.xml";
+pub(crate) const JUNIT_FILE: &str = "junit.xml";
 
 /// Writes the JUnit report to `path` atomically.
-pub fn write(path: &Path, found: &[Found], unreadable: &[Error], problems: &[Problem]) -> Result<()> {
+pub(crate) fn write(path: &Path, found: &[Found], unreadable: &[Error], problems: &[Problem]) -> Result<()> {
     atomic::write_bytes(path, xml(found, unreadable, problems).as_bytes())
 }
 

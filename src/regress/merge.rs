@@ -13,9 +13,9 @@ use crate::Result;
 /// One thing wrong with a merged folder; `what` names the shard or scene, `message` says what
 /// happened.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
-pub struct Problem {
-    pub what: String,
-    pub message: String,
+pub(crate) struct Problem {
+    pub(crate) what: String,
+    pub(crate) message: String,
 }
 
 impl std::fmt::Display for Problem {
@@ -25,7 +25,7 @@ impl std::fmt::Display for Problem {
 }
 
 /// Checks the records found under `out` against each other and the shard state beside them.
-pub fn check(out: &Path, found: &[Found]) -> Result<Vec<Problem>> {
+pub(crate) fn check(out: &Path, found: &[Found]) -> Result<Vec<Problem>> {
     let mut problems = Vec::new();
     let (plans, manifests) = state(out);
 

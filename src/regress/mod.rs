@@ -21,15 +21,15 @@
 
 mod check;
 mod discover;
-pub mod junit;
-pub mod merge;
+pub(crate) mod junit;
+pub(crate) mod merge;
 mod progress;
 pub mod record;
-pub mod report;
+pub(crate) mod report;
 pub mod shards;
 
 pub use discover::{find, SceneEntry, Shard};
-pub use merge::Problem;
+pub(crate) use merge::Problem;
 pub use record::{Record, Status};
 
 use std::collections::BTreeSet;
@@ -48,61 +48,61 @@ use crate::{Error, Result};
 pub struct Args {
     /// Folder searched recursively for scene files (`*.ron` except render graphs), or one scene.
     #[arg(required_unless_present = "report_only")]
-    pub dir: Option<PathBuf>,
+    pub(crate) dir: Option<PathBuf>,
     /// Output folder: a subfolder per scene and index.html.
     #[arg(long, default_value = "out/regress")]
     pub out: PathBuf,
     /// Write `<stem>.ref.exr` for scenes that are new, regressed or whose reference has another
     /// size (passing ones are left untouched). Without it no reference is ever written.
     #[arg(long)]
-    pub update: bool,
+    pub(crate) update: bool,
     /// Render size WIDTHxHEIGHT for every scene (default: the scene's regress.size, else its output).
     #[arg(long, value_parser = parse_size)]
     pub size: Option<(u32, u32)>,
     /// Scenes rendered concurrently (threads sharing one GPU device).
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=256))]
-    pub jobs: u32,
+    pub(crate) jobs: u32,
     /// Check only shard i of n (1-based), as planned from the scenes' costs (OUT/.voltex/plan-N.json,
     /// shared by the shards of one output folder). `auto/n` takes i from SLURM_ARRAY_TASK_ID or
     /// JOB_COMPLETION_INDEX.
     #[arg(long, default_value = "1/1")]
-    pub shard: Shard,
+    pub(crate) shard: Shard,
     /// Mean FLIP a scene may reach, for every scene (default: each scene's regress.max_flip).
     #[arg(long, value_parser = parse_max_flip)]
-    pub max_flip: Option<f64>,
+    pub(crate) max_flip: Option<f64>,
     /// Relative RMSE a scene may reach, for every scene (default: each scene's regress.max_rel_rmse).
     #[arg(long, value_parser = parse_max_rel_rmse)]
-    pub max_rel_rmse: Option<f64>,
+    pub(crate) max_rel_rmse: Option<f64>,
     /// Skip the truth renders (`regress.truth`): check only "unchanged against the reference".
     /// Faster (a truth render costs a Reference or fine-step render); refused with `--update`,
     /// which must never accept a reference beyond its truth bound.
     #[arg(long, conflicts_with = "update")]
-    pub no_truth: bool,
+    pub(crate) no_truth: bool,
     /// Render scenes whose record is current too (same scene, assets, reference, size, graphs,
     /// WGSL and binary); without it they are kept and not rendered again.
     #[arg(long)]
-    pub force: bool,
+    pub(crate) force: bool,
     /// Write the JUnit XML report to FILE (default: OUT/junit.xml, beside index.html).
     #[arg(long, value_name = "FILE")]
-    pub junit: Option<PathBuf>,
+    pub(crate) junit: Option<PathBuf>,
     /// Render nothing: print how N shards would split DIR (costs from the records under --out,
     /// else estimates) and the predicted makespan.
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=100_000),
           conflicts_with_all = ["update", "jobs", "shard", "force", "junit", "json"])]
-    pub plan_shards: Option<u32>,
+    pub(crate) plan_shards: Option<u32>,
     /// Print a JSON summary on stdout (verdict, exit status, counts, failures, merge problems,
     /// report paths) instead of the table.
     #[arg(long)]
     pub json: bool,
     /// No progress on stderr (errors still).
     #[arg(short, long, conflicts_with = "verbose")]
-    pub quiet: bool,
+    pub(crate) quiet: bool,
     /// Each scene's warnings in the progress too.
     #[arg(short, long)]
-    pub verbose: bool,
+    pub(crate) verbose: bool,
     /// Render nothing: rebuild OUT/index.html from the records under OUT (after merging shards).
     #[arg(long, value_name = "OUT", conflicts_with_all = ["dir", "out", "update", "size", "jobs", "shard", "force", "max_flip", "max_rel_rmse", "no_truth"])]
-    pub report_only: Option<PathBuf>,
+    pub(crate) report_only: Option<PathBuf>,
 }
 
 /// Exit statuses of `voltex regress` and `voltex farm`, by cause (other commands exit 1 on any
@@ -112,12 +112,12 @@ pub mod exit {
 
     pub const PASS: u8 = 0;
     /// A scene regressed, or is new without `--update`.
-    pub const REGRESSIONS: u8 = 1;
+    pub(crate) const REGRESSIONS: u8 = 1;
     /// A bad command line (clap's status).
     pub const USAGE: u8 = 2;
     /// Broken input: a broken scene or reference, an unreadable record, a merge that found
     /// problems, a missing or unwritable folder.
-    pub const BROKEN_INPUT: u8 = 3;
+    pub(crate) const BROKEN_INPUT: u8 = 3;
     /// The engine failed: no GPU device could be opened (or reopened after a loss), or the farm's
     /// engine is missing, refused the jobs or lost them.
     pub const ENGINE: u8 = 4;
@@ -133,11 +133,11 @@ pub mod exit {
 
 /// What every scene check of one run shares.
 pub(crate) struct RunInfo<'a> {
-    pub args: &'a Args,
-    pub shard: Shard,
-    pub suite: String,
-    pub toolchain: String,
-    pub host: String,
+    pub(crate) args: &'a Args,
+    pub(crate) shard: Shard,
+    pub(crate) suite: String,
+    pub(crate) toolchain: String,
+    pub(crate) host: String,
 }
 
 pub fn parse_max_flip(s: &str) -> std::result::Result<f64, String> {
@@ -167,25 +167,25 @@ fn parse_size(s: &str) -> std::result::Result<(u32, u32), String> {
 /// What a run or `--report-only` did.
 pub struct Outcome {
     /// Scenes checked by this run, in the sorted order (all records for `--report-only`).
-    pub records: Vec<Record>,
+    pub(crate) records: Vec<Record>,
     /// Records under the output folder that could not be read.
-    pub unreadable: Vec<Error>,
+    pub(crate) unreadable: Vec<Error>,
     /// What the merged output folder must not hide (different suites, duplicates, lost shards).
     /// They fail `--report-only` (the merge); a run only reports them, since while shards run the
     /// others' results are not there yet.
-    pub problems: Vec<Problem>,
-    pub merged: bool,
+    pub(crate) problems: Vec<Problem>,
+    pub(crate) merged: bool,
     /// Scenes of this run whose record was current, so they were not rendered again.
-    pub skipped: usize,
-    pub report: PathBuf,
-    pub junit: PathBuf,
+    pub(crate) skipped: usize,
+    pub(crate) report: PathBuf,
+    pub(crate) junit: PathBuf,
 }
 
 impl Outcome {
     /// The exit status: [`exit::BROKEN_INPUT`] if a scene or reference is broken, a record
     /// unreadable or (for a merge) the merge found problems, else [`exit::REGRESSIONS`] if a scene
     /// failed, else [`exit::PASS`].
-    pub fn exit_code(&self) -> u8 {
+    pub(crate) fn exit_code(&self) -> u8 {
         let broken = self
             .records
             .iter()
@@ -201,7 +201,7 @@ impl Outcome {
 
     /// Scenes that did not pass (and were not updated), plus unreadable records, and for a merge
     /// its problems.
-    pub fn failures(&self) -> usize {
+    pub(crate) fn failures(&self) -> usize {
         self.records.iter().filter(|r| r.failed()).count()
             + self.unreadable.len()
             + if self.merged { self.problems.len() } else { 0 }
@@ -254,7 +254,7 @@ pub fn command(args: &Args) -> Result<u8> {
 }
 
 /// The `--json` summary of a run or merge.
-pub fn summary_json(o: &Outcome) -> String {
+pub(crate) fn summary_json(o: &Outcome) -> String {
     let code = o.exit_code();
     let count = |st: Status| o.records.iter().filter(|r| r.status == st).count();
     let failed: Vec<serde_json::Value> = o
@@ -287,7 +287,7 @@ pub fn summary_json(o: &Outcome) -> String {
 }
 
 /// `--plan-shards N`: the plan of DIR's scenes on N shards from the costs under `--out`, as text.
-pub fn plan_shards(args: &Args, n: usize) -> Result<String> {
+pub(crate) fn plan_shards(args: &Args, n: usize) -> Result<String> {
     let dir = args.dir.as_deref().ok_or_else(|| Error::Invalid("regress: no scene folder given".into()))?;
     let all = find(dir)?;
     if all.is_empty() {
@@ -305,7 +305,7 @@ pub fn plan_shards(args: &Args, n: usize) -> Result<String> {
 }
 
 /// Checks the scenes of `args.dir` (this shard's share) and rewrites the report.
-pub fn run(args: &Args) -> Result<Outcome> {
+pub(crate) fn run(args: &Args) -> Result<Outcome> {
     let dir = args.dir.as_deref().ok_or_else(|| Error::Invalid("regress: no scene folder given".into()))?;
     let all = find(dir)?;
     if all.is_empty() {
@@ -391,7 +391,7 @@ fn write_reports(out: &Path, junit: &Path) -> Result<Merged> {
 }
 
 /// Rebuilds `out/index.html` (and the JUnit file) from the records under `out`.
-pub fn report_only(out: &Path, junit: Option<&Path>) -> Result<Outcome> {
+pub(crate) fn report_only(out: &Path, junit: Option<&Path>) -> Result<Outcome> {
     check_writable_dir(out)?;
     let junit = junit.map(Path::to_path_buf).unwrap_or_else(|| out.join(junit::JUNIT_FILE));
     let (found, unreadable) = record::collect(out)?;

@@ -9,13 +9,14 @@ use crate::io::atomic;
 use crate::{Error, Result};
 
 /// File name of a scene's record inside its output folder.
-pub const RECORD_FILE: &str = "result.json";
+pub(crate) const RECORD_FILE: &str = "result.json";
 
 /// Images a scene's output folder may hold, in the order the report shows them.
-pub const IMAGES: [&str; 4] = ["reference.png", "actual.png", "diff.png", "truth.png"];
+pub(crate) const IMAGES: [&str; 4] = ["reference.png", "actual.png", "diff.png", "truth.png"];
 
 /// Artefacts a run writes into a scene's folder besides the record; others are never touched.
-pub const ARTEFACTS: [&str; 5] = ["reference.png", "actual.png", "diff.png", "truth.png", "actual.exr"];
+pub(crate) const ARTEFACTS: [&str; 5] =
+    ["reference.png", "actual.png", "diff.png", "truth.png", "actual.exr"];
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -29,7 +30,7 @@ pub enum Status {
 }
 
 impl Status {
-    pub fn label(self) -> &'static str {
+    pub(crate) fn label(self) -> &'static str {
         match self {
             Status::Pass => "pass",
             Status::Regressed => "regressed",
@@ -63,13 +64,13 @@ pub struct Record {
     pub message: Option<String>,
     /// Warnings of the scene's checks (degenerate triangles, ...).
     #[serde(default)]
-    pub warnings: Vec<String>,
+    pub(crate) warnings: Vec<String>,
     /// Render size (width, height).
     pub size: Option<[u32; 2]>,
     pub flip: Option<f64>,
     pub rel_rmse: Option<f64>,
-    pub max_flip: f64,
-    pub max_rel_rmse: f64,
+    pub(crate) max_flip: f64,
+    pub(crate) max_rel_rmse: f64,
     /// Mean FLIP of the render against the scene's independent truth, and its bound (`None`:
     /// the scene states no `regress.truth`).
     #[serde(default)]
@@ -77,29 +78,29 @@ pub struct Record {
     #[serde(default)]
     pub max_truth_flip: Option<f64>,
     /// Pixels of the render with a NaN or infinite channel.
-    pub nonfinite_pixels: Option<usize>,
+    pub(crate) nonfinite_pixels: Option<usize>,
     /// GPU time of the frame from timestamp queries (none without TIMESTAMP_QUERY).
-    pub gpu_ms: Option<f64>,
+    pub(crate) gpu_ms: Option<f64>,
     /// Wall time of the whole check: load, plan, bake, render, compare, write.
-    pub wall_ms: f64,
+    pub(crate) wall_ms: f64,
     pub adapter: String,
     /// The adapter that rendered the reference (`voltex_adapter` in its EXR metadata).
-    pub reference_adapter: Option<String>,
+    pub(crate) reference_adapter: Option<String>,
     /// Images present in the scene's folder (file names from [`IMAGES`]).
-    pub images: Vec<String>,
+    pub(crate) images: Vec<String>,
     /// `i/n` of the run that wrote this record.
     pub shard: String,
     /// Host that wrote the record (for the report of a farm run).
     #[serde(default)]
-    pub host: String,
+    pub(crate) host: String,
     /// Seconds since 1970-01-01 UTC when the record was written.
-    pub finished_unix: u64,
-    pub voltex_version: String,
+    pub(crate) finished_unix: u64,
+    pub(crate) voltex_version: String,
 }
 
 impl Record {
     /// A scene failing (`status` broken or regressed, or new without `--update`)?
-    pub fn failed(&self) -> bool {
+    pub(crate) fn failed(&self) -> bool {
         self.status != Status::Pass && !self.updated
     }
 
@@ -122,7 +123,7 @@ impl Record {
 /// A record with the folder it was found in, relative to the output folder.
 #[derive(Debug, Clone)]
 pub struct Found {
-    pub folder: PathBuf,
+    pub(crate) folder: PathBuf,
     pub record: Record,
 }
 

@@ -10,14 +10,14 @@ use crate::io::atomic;
 use crate::{Error, Result};
 
 /// File name of the report inside the output folder.
-pub const INDEX_FILE: &str = "index.html";
+pub(crate) const INDEX_FILE: &str = "index.html";
 
 fn metric(v: Option<f64>) -> String {
     v.map(|v| format!("{v:.5}")).unwrap_or_else(|| "-".into())
 }
 
 /// A plain-text table: scene, status, FLIP, rel RMSE, GPU ms, then counts per status.
-pub fn summary_table<'a>(records: impl IntoIterator<Item = &'a Record>) -> String {
+pub(crate) fn summary_table<'a>(records: impl IntoIterator<Item = &'a Record>) -> String {
     let records: Vec<&Record> = records.into_iter().collect();
     let w = records.iter().map(|r| r.scene.len()).max().unwrap_or(0).max(5);
     let mut s = format!(
@@ -41,7 +41,7 @@ pub fn summary_table<'a>(records: impl IntoIterator<Item = &'a Record>) -> Strin
 }
 
 /// `5 scenes: 3 pass, 1 regressed, 1 new (1 reference updated)`.
-pub fn counts(records: &[&Record]) -> String {
+pub(crate) fn counts(records: &[&Record]) -> String {
     let mut parts = Vec::new();
     for status in [Status::Pass, Status::Regressed, Status::New, Status::BrokenScene, Status::BrokenReference]
     {
@@ -61,7 +61,12 @@ pub fn counts(records: &[&Record]) -> String {
 
 /// Writes `out/index.html` from the records found under `out` (and the unreadable ones, and what
 /// the merge found wrong).
-pub fn write_index(out: &Path, found: &[Found], bad: &[Error], problems: &[Problem]) -> Result<PathBuf> {
+pub(crate) fn write_index(
+    out: &Path,
+    found: &[Found],
+    bad: &[Error],
+    problems: &[Problem],
+) -> Result<PathBuf> {
     let path = out.join(INDEX_FILE);
     atomic::write_bytes(&path, html(found, bad, problems).as_bytes())?;
     Ok(path)
@@ -179,7 +184,7 @@ fn href(path: &Path) -> String {
 }
 
 /// `YYYY-MM-DD HH:MM` of Unix seconds (H. Hinnant's days-to-civil algorithm).
-pub fn utc(secs: u64) -> String {
+pub(crate) fn utc(secs: u64) -> String {
     let days = (secs / 86400) as i64;
     let (hh, mm) = ((secs % 86400) / 3600, (secs % 3600) / 60);
     let z = days + 719_468;

@@ -20,7 +20,7 @@ pub const STATE_DIR: &str = ".voltex";
 
 /// FNV-1a, 64 bits: stable across builds and platforms (std's hasher is not), which is all that
 /// change detection needs.
-pub struct Fnv(u64);
+pub(crate) struct Fnv(u64);
 
 impl Default for Fnv {
     fn default() -> Self {
@@ -29,20 +29,20 @@ impl Default for Fnv {
 }
 
 impl Fnv {
-    pub fn bytes(&mut self, bytes: &[u8]) -> &mut Self {
+    pub(crate) fn bytes(&mut self, bytes: &[u8]) -> &mut Self {
         // Length first, so that field boundaries count.
         for b in (bytes.len() as u64).to_le_bytes().iter().chain(bytes) {
             self.0 = (self.0 ^ u64::from(*b)).wrapping_mul(0x0100_0000_01b3);
         }
         self
     }
-    pub fn hex(&self) -> String {
+    pub(crate) fn hex(&self) -> String {
         format!("{:016x}", self.0)
     }
 }
 
 /// Fingerprint of a suite: its sorted scene list.
-pub fn suite_id(scenes: &[SceneEntry]) -> String {
+pub(crate) fn suite_id(scenes: &[SceneEntry]) -> String {
     let mut h = Fnv::default();
     for s in scenes {
         h.bytes(s.rel.as_bytes());
@@ -52,7 +52,7 @@ pub fn suite_id(scenes: &[SceneEntry]) -> String {
 
 /// Hash of what every scene's result depends on besides its own files: the binary and the
 /// graphs and WGSL as this run resolves them (files on disk win over the built-in copies).
-pub fn toolchain_hash() -> Result<String> {
+pub(crate) fn toolchain_hash() -> Result<String> {
     let mut h = Fnv::default();
     let exe = std::env::current_exe().map_err(|e| Error::Invalid(format!("cannot find this binary: {e}")))?;
     h.bytes(&std::fs::read(&exe).map_err(|e| Error::file(&exe, e))?);
@@ -71,7 +71,7 @@ pub fn toolchain_hash() -> Result<String> {
 /// Hash of one scene's inputs but its reference: the scene file, the files it refers to, the
 /// render size and the toolchain hash; [`inputs_hash`] adds the reference (which `--update` may
 /// rewrite after this is taken).
-pub fn scene_hash(
+pub(crate) fn scene_hash(
     scene: &crate::scene::Scene,
     entry: &SceneEntry,
     size: (u32, u32),
@@ -91,7 +91,7 @@ pub fn scene_hash(
 }
 
 /// The whole inputs hash: [`scene_hash`] and the reference's bytes.
-pub fn inputs_hash(scene_hash: &str, entry: &SceneEntry) -> String {
+pub(crate) fn inputs_hash(scene_hash: &str, entry: &SceneEntry) -> String {
     let mut h = Fnv::default();
     h.bytes(scene_hash.as_bytes());
     hash_path(&mut h, entry.path.parent().unwrap_or(Path::new("")), &entry.reference);
@@ -116,10 +116,10 @@ fn hash_path(h: &mut Fnv, base: &Path, path: &Path) {
 
 /// How long a scene is expected to take, in milliseconds.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct Cost {
-    pub ms: f64,
+pub(crate) struct Cost {
+    pub(crate) ms: f64,
     /// From a record of an earlier run (else estimated).
-    pub measured: bool,
+    pub(crate) measured: bool,
 }
 
 /// Estimated milliseconds per 1000 pixels of each method on software Vulkan: medians of the
@@ -132,7 +132,7 @@ const FIXED_MS: f64 = 150.0;
 
 /// A scene's cost: its record's wall time under `out`, else an estimate from its render size
 /// and the costliest method its file names (a scene that does not load costs [`FIXED_MS`]).
-pub fn cost(out: &Path, entry: &SceneEntry, size: Option<(u32, u32)>) -> Cost {
+pub(crate) fn cost(out: &Path, entry: &SceneEntry, size: Option<(u32, u32)>) -> Cost {
     if let Ok(r) = Record::read(&out.join(&entry.folder).join(RECORD_FILE)) {
         if r.wall_ms.is_finite() && r.wall_ms > 0.0 {
             return Cost { ms: r.wall_ms, measured: true };
@@ -153,24 +153,24 @@ fn estimate(entry: &SceneEntry, size: Option<(u32, u32)>) -> f64 {
 /// A plan: which shard (0-based) each scene goes to, and each shard's predicted load.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Plan {
-    pub suite: String,
-    pub count: usize,
-    pub scenes: Vec<Planned>,
+    pub(crate) suite: String,
+    pub(crate) count: usize,
+    pub(crate) scenes: Vec<Planned>,
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct Planned {
-    pub scene: String,
+pub(crate) struct Planned {
+    pub(crate) scene: String,
     /// 1-based, as `--shard i/n`.
-    pub shard: usize,
-    pub cost: Cost,
+    pub(crate) shard: usize,
+    pub(crate) cost: Cost,
 }
 
 impl Plan {
     /// Longest processing time first: scenes by falling cost (ties by path) each to the shard
     /// with the least load so far (ties to the lowest index). Loads are summed in whole
     /// microseconds so that every machine computes the same plan.
-    pub fn new(scenes: &[SceneEntry], costs: &[Cost], count: usize) -> Self {
+    pub(crate) fn new(scenes: &[SceneEntry], costs: &[Cost], count: usize) -> Self {
         let micros: Vec<u64> = costs.iter().map(|c| (c.ms.max(0.0) * 1e3).round() as u64).collect();
         let mut order: Vec<usize> = (0..scenes.len()).collect();
         order.sort_by(|&a, &b| micros[b].cmp(&micros[a]).then_with(|| scenes[a].rel.cmp(&scenes[b].rel)));
@@ -194,7 +194,7 @@ impl Plan {
     }
 
     /// Predicted milliseconds of each shard (index 0 is shard 1).
-    pub fn loads(&self) -> Vec<f64> {
+    pub(crate) fn loads(&self) -> Vec<f64> {
         let mut loads = vec![0.0; self.count];
         for p in &self.scenes {
             loads[p.shard - 1] += p.cost.ms;
@@ -208,7 +208,7 @@ impl Plan {
     }
 
     /// The scenes of shard `shard`, in the suite's order.
-    pub fn take(&self, shard: Shard, scenes: Vec<SceneEntry>) -> Vec<SceneEntry> {
+    pub(crate) fn take(&self, shard: Shard, scenes: Vec<SceneEntry>) -> Vec<SceneEntry> {
         let mine: BTreeMap<&str, usize> = self.scenes.iter().map(|p| (p.scene.as_str(), p.shard)).collect();
         scenes.into_iter().filter(|s| mine.get(s.rel.as_str()) == Some(&shard.index)).collect()
     }
@@ -244,18 +244,18 @@ impl Plan {
         s
     }
 
-    pub fn path(out: &Path, count: usize) -> PathBuf {
+    pub(crate) fn path(out: &Path, count: usize) -> PathBuf {
         out.join(STATE_DIR).join(format!("plan-{count}.json"))
     }
 
-    pub fn write(&self, out: &Path) -> Result<()> {
+    pub(crate) fn write(&self, out: &Path) -> Result<()> {
         std::fs::create_dir_all(out.join(STATE_DIR))
             .map_err(|e| Error::file(out.join(STATE_DIR), format!("cannot create folder: {e}")))?;
         write_json(&Self::path(out, self.count), self)
     }
 
     /// The plan for `count` shards stored in `out` if it is for exactly these scenes.
-    pub fn stored(out: &Path, scenes: &[SceneEntry], count: usize) -> Option<Plan> {
+    pub(crate) fn stored(out: &Path, scenes: &[SceneEntry], count: usize) -> Option<Plan> {
         let plan: Plan = read_json(&Self::path(out, count)).ok()?;
         let same = plan.count == count
             && plan.scenes.len() == scenes.len()
@@ -272,7 +272,12 @@ impl Plan {
 /// the costs under `out`, stored so that shards starting later (after records changed the
 /// costs) and reruns of a lost shard take the same scenes. Of shards planning at once, the first
 /// to store its plan wins and the others follow it.
-pub fn plan_for(out: &Path, scenes: &[SceneEntry], count: usize, size: Option<(u32, u32)>) -> Result<Plan> {
+pub(crate) fn plan_for(
+    out: &Path,
+    scenes: &[SceneEntry],
+    count: usize,
+    size: Option<(u32, u32)>,
+) -> Result<Plan> {
     if let Some(plan) = Plan::stored(out, scenes, count) {
         return Ok(plan);
     }
@@ -301,7 +306,7 @@ pub fn plan_for(out: &Path, scenes: &[SceneEntry], count: usize, size: Option<(u
 }
 
 /// A plan from the costs under `out` now, not stored.
-pub fn fresh_plan(out: &Path, scenes: &[SceneEntry], count: usize, size: Option<(u32, u32)>) -> Plan {
+pub(crate) fn fresh_plan(out: &Path, scenes: &[SceneEntry], count: usize, size: Option<(u32, u32)>) -> Plan {
     let costs: Vec<Cost> = scenes.iter().map(|s| cost(out, s, size)).collect();
     Plan::new(scenes, &costs, count)
 }
@@ -346,24 +351,24 @@ pub fn finished_shards(out: &Path) -> (usize, usize) {
 
 /// What one shard run planned and whether it finished: `OUT/.voltex/shard-K-of-N.json`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct Manifest {
-    pub suite: String,
+pub(crate) struct Manifest {
+    pub(crate) suite: String,
     /// `k/n`.
-    pub shard: String,
-    pub scenes: Vec<String>,
-    pub host: String,
-    pub pid: u32,
-    pub started_unix: u64,
+    pub(crate) shard: String,
+    pub(crate) scenes: Vec<String>,
+    pub(crate) host: String,
+    pub(crate) pid: u32,
+    pub(crate) started_unix: u64,
     /// Unset while the shard runs, and forever when it died or was killed.
-    pub finished_unix: Option<u64>,
+    pub(crate) finished_unix: Option<u64>,
 }
 
 impl Manifest {
-    pub fn path(out: &Path, shard: Shard) -> PathBuf {
+    pub(crate) fn path(out: &Path, shard: Shard) -> PathBuf {
         out.join(STATE_DIR).join(format!("shard-{}-of-{}.json", shard.index, shard.count))
     }
 
-    pub fn write(&self, out: &Path, shard: Shard) -> Result<()> {
+    pub(crate) fn write(&self, out: &Path, shard: Shard) -> Result<()> {
         std::fs::create_dir_all(out.join(STATE_DIR))
             .map_err(|e| Error::file(out.join(STATE_DIR), format!("cannot create folder: {e}")))?;
         write_json(&Self::path(out, shard), self)
@@ -373,7 +378,7 @@ impl Manifest {
 /// Another voltex process on this machine running `shard` into `out` now (its unfinished
 /// manifest names a live process of the same program), as `pid P on HOST`. Runs on other
 /// machines cannot be seen from here.
-pub fn running_elsewhere(out: &Path, shard: Shard) -> Option<String> {
+pub(crate) fn running_elsewhere(out: &Path, shard: Shard) -> Option<String> {
     let m: Manifest = read_json(&Manifest::path(out, shard)).ok()?;
     let comm = |pid: u32| std::fs::read_to_string(format!("/proc/{pid}/comm")).ok();
     let alive = m.finished_unix.is_none()
@@ -384,12 +389,12 @@ pub fn running_elsewhere(out: &Path, shard: Shard) -> Option<String> {
 }
 
 /// Seconds since 1970 now.
-pub fn unix_now() -> u64 {
+pub(crate) fn unix_now() -> u64 {
     std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map(|d| d.as_secs()).unwrap_or(0)
 }
 
 /// This machine's name (records and manifests say where they were written).
-pub fn host() -> String {
+pub(crate) fn host() -> String {
     std::fs::read_to_string("/proc/sys/kernel/hostname")
         .ok()
         .or_else(|| std::env::var("HOSTNAME").ok())

@@ -11,16 +11,16 @@ use crate::io::Image;
 pub struct PlannedAov {
     pub name: String,
     /// Graph textures read back, with how many of their channels (R, G, B, A in order) are used.
-    pub textures: Vec<(String, usize)>,
+    pub(crate) textures: Vec<(String, usize)>,
     /// Per texture channel read (texture after texture), its EXR channel name, if written.
     pub channels: Vec<Option<String>>,
-    pub downsample: Downsample,
+    pub(crate) downsample: Downsample,
 }
 
 /// Where a requested AOV name was written: the scene's `aovs` (located) or the command line.
-pub struct Requested<'a> {
-    pub names: &'a [String],
-    pub at: Option<FileLoc>,
+pub(crate) struct Requested<'a> {
+    pub(crate) names: &'a [String],
+    pub(crate) at: Option<FileLoc>,
 }
 
 /// Resolves the requested AOVs against `graph`'s declarations for a scene whose objects are
@@ -84,7 +84,7 @@ pub fn plan(graph: &mut Graph, requested: Requested, objects: &[&str]) -> Result
 
 /// The named channels of an AOV's read-back textures (rendered at `supersample` times the
 /// output size), reduced to the output size.
-pub fn channels(aov: &PlannedAov, images: Vec<Image>, supersample: u32) -> Vec<(String, Vec<f32>)> {
+pub(crate) fn channels(aov: &PlannedAov, images: Vec<Image>, supersample: u32) -> Vec<(String, Vec<f32>)> {
     let mut names = aov.channels.iter();
     let mut out = Vec::new();
     for (image, (_, used)) in images.into_iter().zip(&aov.textures) {
@@ -104,7 +104,7 @@ pub fn channels(aov: &PlannedAov, images: Vec<Image>, supersample: u32) -> Vec<(
 
 /// A per-object AOV needs each object drawn by its own graph instance: objects a method draws
 /// together in one instance (Reference's ray caster) share one layer, so at most one may ask.
-pub fn check_groups(
+pub(crate) fn check_groups(
     aovs: &[PlannedAov],
     graph: &Graph,
     groups: &[Box<dyn crate::methods::MethodPlan>],

@@ -10,15 +10,15 @@ use crate::scene::Scene;
 
 /// Where the values that size allocations are written in the scene file.
 #[derive(Debug, Clone, Default)]
-pub struct Positions {
+pub(crate) struct Positions {
     /// The scene's `output` size; `None` when `--size` replaced it.
-    pub output: Option<FileLoc>,
-    pub texels: Vec<(String, FileLoc)>,
-    pub objects: Vec<(String, FileLoc)>,
+    pub(crate) output: Option<FileLoc>,
+    pub(crate) texels: Vec<(String, FileLoc)>,
+    pub(crate) objects: Vec<(String, FileLoc)>,
 }
 
 impl Positions {
-    pub fn of(scene: &Scene, size_overridden: bool) -> Self {
+    pub(crate) fn of(scene: &Scene, size_overridden: bool) -> Self {
         let src = scene.source();
         let loc = |at: usize| {
             let (line, col) = crate::error::line_col(src, at);
@@ -51,7 +51,7 @@ impl Positions {
 impl Positions {
     /// `e`, a planning error of object `name` without a position, at the node's name (the
     /// method's knobs and surface that sized the work are in that node).
-    pub fn at_object(&self, name: &str, e: Error) -> Error {
+    pub(crate) fn at_object(&self, name: &str, e: Error) -> Error {
         match (e, self.objects.iter().find(|o| o.0 == name)) {
             (Error::Invalid(msg), Some((_, loc))) => Error::at(loc.clone(), msg),
             (e, _) => e,
@@ -93,7 +93,7 @@ impl Blueprint {
     }
 
     /// Every texture and every buffer that grows with the scene's values, one by one.
-    pub fn allocations(&self) -> Vec<Allocation> {
+    pub(crate) fn allocations(&self) -> Vec<Allocation> {
         let mut out = Vec::new();
         for (name, decl) in &self.plan.textures {
             let ResourceDecl::Texture { format, size, .. } = decl else { continue };

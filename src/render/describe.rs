@@ -7,7 +7,7 @@ use crate::render::{Blueprint, ObjectPlan};
 
 impl Blueprint {
     /// Bytes of GPU memory the frame allocates, by item.
-    pub fn memory(&self) -> Vec<(String, u64)> {
+    pub(crate) fn memory(&self) -> Vec<(String, u64)> {
         let mut out = Vec::new();
         for (name, decl) in &self.plan.textures {
             let ResourceDecl::Texture { format, size, .. } = decl else { continue };

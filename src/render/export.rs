@@ -2,13 +2,13 @@
 //! GPU by the render's own kernels at full precision (f32, [`Baker::full_precision`]) and turned
 //! into OpenVDB grids that Blender, Houdini and Mitsuba render: a float `density` (fog volume)
 //! and a vec3 `Cd` colour, with the index-to-world transform. Volume objects (nodes drawing an
-//! OpenVDB grid) are written from the grid as read, voxel for voxel ([`volume_grids`]).
+//! OpenVDB grid) are written from the grid as read, voxel for voxel (`volume_grids`).
 //!
 //! Density is the extinction coefficient per world unit: a voxel of opacity `a` over the opacity
 //! length `L` (a world length; every method composites `1 - (1 - a)^(step / L)`) has
 //! `sigma_t = -ln(1 - a) / L`, so `exp(-sigma_t * step)` is voltex's own transmittance.
 //! Voxels of opacity 0 are inactive. Opacity 1 (an opaque voxel: infinitely dense for voltex)
-//! becomes [`OPAQUE_TRANSMITTANCE`] through one voxel. `Cd` is the colour without the opacity
+//! becomes `OPAQUE_TRANSMITTANCE` through one voxel. `Cd` is the colour without the opacity
 //! (the premultiplied colour over alpha): unlit albedo, except for slice stacks, which hold
 //! their baked shading.
 
@@ -28,10 +28,10 @@ use crate::scene::{Scene, TexelSource};
 use crate::vdb::SparseVolume;
 
 /// The transmittance of one voxel (its smallest world side) of opacity 1.
-pub const OPAQUE_TRANSMITTANCE: f64 = 1e-4;
+pub(crate) const OPAQUE_TRANSMITTANCE: f64 = 1e-4;
 /// Most voxels one exported volume may have: its f32 RGBA read-back takes 16 bytes a voxel
 /// (1 GiB at this limit), and the grids as much again.
-pub const MAX_EXPORT_VOXELS: u64 = 1 << 26;
+pub(crate) const MAX_EXPORT_VOXELS: u64 = 1 << 26;
 /// Default voxels along the longest side of an exported hypertexture node.
 pub const DEFAULT_HYPER_RESOLUTION: u32 = 128;
 
@@ -82,7 +82,7 @@ pub struct Export {
 
 /// Every volume the scene exports (or those `only` names), in a fixed order: texels by name,
 /// then hypertexture nodes in document order. CPU only: unknown names, file-name clashes and
-/// volumes over [`MAX_EXPORT_VOXELS`] fail here, before any GPU work.
+/// volumes over `MAX_EXPORT_VOXELS` fail here, before any GPU work.
 pub fn plan(scene: &Scene, opts: &ExportOptions) -> Result<Vec<Export>> {
     let time = opts.time.unwrap_or(scene.time);
     let objects = scene.objects_at(time)?;
@@ -209,7 +209,7 @@ fn select(scene: &Scene, all: Vec<Export>, only: &[String]) -> Result<Vec<Export
 }
 
 /// `NAME.vdb`, or why NAME cannot be a file name on every system a scene travels to.
-pub fn file_name(name: &str) -> std::result::Result<String, String> {
+pub(crate) fn file_name(name: &str) -> std::result::Result<String, String> {
     let bad = |c: char| c.is_control() || "/\\:*?\"<>|".contains(c);
     if name.is_empty() || name == "." || name == ".." || name.starts_with('.') {
         return Err(format!("{name:?} is not a file name (empty, or starting with a dot)"));
@@ -302,7 +302,7 @@ fn baked_grids(
 /// same extinction), active where it is not 0; `Cd` is `albedo` times the colour grid (white
 /// without one), written at every voxel the brick of a leaf with density reaches, so that its
 /// interpolant over the cells with density is the one the object was drawn with.
-pub fn volume_grids(
+pub(crate) fn volume_grids(
     grid: &SparseVolume,
     density_scale: f64,
     albedo: [f32; 3],
@@ -336,7 +336,7 @@ pub fn density(a: f64, length: f64) -> f64 {
 }
 
 /// Voxel `(i, j, k)` of `n` voxels filling the box `lo..hi` (cell-centred) to the box's space.
-pub fn index_to_box(lo: DVec3, hi: DVec3, n: [u32; 3]) -> DMat4 {
+pub(crate) fn index_to_box(lo: DVec3, hi: DVec3, n: [u32; 3]) -> DMat4 {
     let voxel = (hi - lo) / DVec3::from_array(n.map(f64::from));
     DMat4::from_translation(lo + voxel / 2.0) * DMat4::from_scale(voxel)
 }
@@ -345,7 +345,7 @@ pub fn index_to_box(lo: DVec3, hi: DVec3, n: [u32; 3]) -> DMat4 {
 /// (`(uv, 0)` to the base vertex, `(uv, 1)` to its tip), exact for a flat base surface with
 /// constant height vectors and affine uvs (a plane). A curved shell has no such map: then one
 /// tile at the world origin, scaled like the shell on average, and a note says so.
-pub fn texel_frame(surface: &BaseSurface, object: &str) -> (DMat4, Option<String>) {
+pub(crate) fn texel_frame(surface: &BaseSurface, object: &str) -> (DMat4, Option<String>) {
     let mut samples = Vec::new();
     for (tri, uvs) in surface.triangles.iter().zip(&surface.corner_uvs) {
         for k in 0..3 {

@@ -1,17 +1,17 @@
 //! From a scene to an image: a [`Blueprint`] (CPU only: objects, shells, plane sweeps, bakes and
 //! the pruned graph plan, enough for `voltex plan`), then a [`Renderer`] holding the GPU resources.
 
-pub mod aov;
+pub(crate) mod aov;
 mod budget;
 mod describe;
 pub mod export;
 mod renderer;
 pub mod trace;
 
-pub use budget::Positions;
+pub(crate) use budget::Positions;
 
 pub use crate::methods::options::{MethodKind, RenderOptions, DEFAULT_AXIS_SLICES, DEFAULT_PLANES};
-pub use crate::methods::{BakePlan, ObjectPlan};
+pub(crate) use crate::methods::{BakePlan, ObjectPlan};
 pub use renderer::{Frame, Renderer};
 
 use std::path::{Path, PathBuf};
@@ -32,14 +32,14 @@ use crate::types::FrameParams;
 #[derive(Debug, Clone, PartialEq)]
 pub struct Instance {
     pub object: usize,
-    pub owner: Owner,
-    pub part: usize,
+    pub(crate) owner: Owner,
+    pub(crate) part: usize,
     pub filters: Vec<&'static str>,
 }
 
 /// Whose plan an instance draws.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Owner {
+pub(crate) enum Owner {
     /// `objects[instance.object].methods[i]`.
     Object(usize),
     /// `groups[i]`, a method drawing several objects at once.
@@ -47,29 +47,29 @@ pub enum Owner {
 }
 
 pub struct Blueprint {
-    pub scene_path: PathBuf,
+    pub(crate) scene_path: PathBuf,
     /// The size rendered at (the output size times `supersample`).
     pub size: (u32, u32),
-    pub supersample: u32,
+    pub(crate) supersample: u32,
     pub eye: DVec3,
     pub frame: FrameParams,
     pub objects: Vec<ObjectPlan>,
     /// Frame-wide plans of methods that draw several objects in one instance.
-    pub groups: Vec<Box<dyn MethodPlan>>,
+    pub(crate) groups: Vec<Box<dyn MethodPlan>>,
     /// Graph instances, in the order of `plan`'s object indices.
     pub instances: Vec<Instance>,
     pub bakes: Vec<BakePlan>,
-    pub graph: Graph,
+    pub(crate) graph: Graph,
     pub plan: Plan,
     /// GPU memory the frame may allocate (`RenderOptions::budget` or the default).
-    pub budget: u64,
+    pub(crate) budget: u64,
     /// Where the values that size the allocations are written, for the limit checks' errors.
-    pub positions: Positions,
+    pub(crate) positions: Positions,
     /// The AOVs this render writes beside the colour (`--aov`, the scene's `aovs`).
     pub aovs: Vec<aov::PlannedAov>,
     /// The camera rendered through, and the frame's time (seconds): the EXR says so.
-    pub view: View,
-    pub time: f64,
+    pub(crate) view: View,
+    pub(crate) time: f64,
 }
 
 /// The bake of `texel` with the scene's first light baked in (what `voltex bake` writes out).
@@ -80,12 +80,12 @@ pub fn baked_texel(scene: &Scene, texel: &str) -> Result<BakePlan> {
 }
 
 /// The default graph's name under `graphs/`.
-pub const DEFAULT_GRAPH: &str = "frame.ron";
+pub(crate) const DEFAULT_GRAPH: &str = "frame.ron";
 
 /// Where a render's shaders are looked up: beside the graph file `graph` (`--graph`), or beside
 /// the project's `graphs/frame.ron` when that is read from disk, then in the project's sources
 /// (see [`Sources`]). Reads no graph (the preview's watch list needs it when the graph is broken).
-pub fn shader_sources(graph: Option<&Path>) -> Result<Sources> {
+pub(crate) fn shader_sources(graph: Option<&Path>) -> Result<Sources> {
     let project = Sources::project()?;
     Ok(match graph {
         Some(path) => project.beside(path),
@@ -98,7 +98,7 @@ pub fn shader_sources(graph: Option<&Path>) -> Result<Sources> {
 
 /// The graph a render uses, `graph` (`--graph`) or else the project's `graphs/frame.ron` (the
 /// file when present, else the embedded copy), and where its shaders are looked up.
-pub fn load_graph(graph: Option<&Path>) -> Result<(Graph, Sources)> {
+pub(crate) fn load_graph(graph: Option<&Path>) -> Result<(Graph, Sources)> {
     let sources = shader_sources(graph)?;
     let graph = match graph {
         Some(path) => Graph::load(path)?,
@@ -191,7 +191,7 @@ impl Blueprint {
 
 impl Blueprint {
     /// The plan instance `i` draws.
-    pub fn plan_of(&self, i: &Instance) -> &dyn MethodPlan {
+    pub(crate) fn plan_of(&self, i: &Instance) -> &dyn MethodPlan {
         match i.owner {
             Owner::Object(m) => self.objects[i.object].methods[m].as_ref(),
             Owner::Group(g) => self.groups[g].as_ref(),
@@ -257,8 +257,8 @@ fn check_kernels(bakes: &[BakePlan], objects: &[ObjectPlan], groups: &[Box<dyn M
 }
 
 /// Resources the renderer itself binds by name: per frame, and per instance of any method.
-pub const FRAME_RESOURCES: &[&str] = &["frame", "volume_sampler"];
-pub const OBJECT_RESOURCES: &[&str] = &["object"];
+pub(crate) const FRAME_RESOURCES: &[&str] = &["frame", "volume_sampler"];
+pub(crate) const OBJECT_RESOURCES: &[&str] = &["object"];
 
 /// Every name the runtime offers graph files: the renderer's own and those the registered
 /// methods declare (`methods::REGISTRY`), each once.

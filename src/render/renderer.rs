@@ -41,7 +41,7 @@ pub struct Renderer {
     /// The passes of the last frame on the adapter's clock.
     spans: Vec<Span>,
     /// Time spent making the bakes the cache did not have, GPU work included (ms).
-    pub bake_ms: f64,
+    pub(crate) bake_ms: f64,
 }
 
 impl Renderer {
@@ -148,7 +148,7 @@ impl Renderer {
     }
 
     /// The passes of the last frame rendered, on the adapter's clock (empty without timestamps).
-    pub fn spans(&self) -> &[Span] {
+    pub(crate) fn spans(&self) -> &[Span] {
         &self.spans
     }
 
@@ -180,7 +180,7 @@ impl Renderer {
     }
 
     /// The graph's first output (the linear image), as rendered by the last frame.
-    pub fn output_texture(&self) -> Option<&wgpu::Texture> {
+    pub(crate) fn output_texture(&self) -> Option<&wgpu::Texture> {
         self.exec.texture(&self.blueprint.graph.file.outputs[0])
     }
 
@@ -233,7 +233,7 @@ impl Renderer {
 
 /// What a bake is kept under: its request and the source of every kernel it runs, so that an
 /// edit of a bake kernel (or of a file it includes) bakes again.
-pub fn bake_key(sources: &Sources, request: &bake::BakeRequest) -> Result<u64> {
+pub(crate) fn bake_key(sources: &Sources, request: &bake::BakeRequest) -> Result<u64> {
     let kernels: Vec<u64> = (request.kernels().iter())
         .map(|k| crate::gpu::shader::source_hash(sources, k))
         .collect::<Result<_>>()?;

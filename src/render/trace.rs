@@ -19,7 +19,7 @@ pub struct Track {
 }
 
 /// The trace's JSON.
-pub fn chrome_trace(tracks: &[Track], adapter: &str) -> Value {
+pub(crate) fn chrome_trace(tracks: &[Track], adapter: &str) -> Value {
     let mut events = Vec::new();
     for (tid, track) in tracks.iter().enumerate() {
         events.push(

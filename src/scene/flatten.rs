@@ -13,12 +13,12 @@ pub struct SceneObject {
     pub name: String,
     pub surface: BaseSurface,
     pub texel: Option<String>,
-    pub method: Option<Method>,
-    pub base_color: Option<[f32; 3]>,
+    pub(crate) method: Option<Method>,
+    pub(crate) base_color: Option<[f32; 3]>,
     /// Prism check of `surface` (no errors, else `objects()` fails); warnings for the user.
     pub report: PrismReport,
     /// A hypertexture node (its `surface` is empty).
-    pub hypertexture: Option<HyperNode>,
+    pub(crate) hypertexture: Option<HyperNode>,
     /// A volume node (its `surface` is empty).
     pub volume: Option<VolumeNode>,
 }
@@ -26,7 +26,7 @@ pub struct SceneObject {
 /// A node drawing a volume: its name in `Scene::volumes`, its grid as read, and the node's frame.
 #[derive(Debug, Clone)]
 pub struct VolumeNode {
-    pub name: String,
+    pub(crate) name: String,
     pub grid: Arc<crate::vdb::SparseVolume>,
     /// The node's frame to world (the grid's own index-to-world transform comes first).
     pub to_world: DMat4,
@@ -34,7 +34,7 @@ pub struct VolumeNode {
 
 impl VolumeNode {
     /// World-space corners of the box outside which the density is 0.
-    pub fn corners(&self) -> [glam::DVec3; 8] {
+    pub(crate) fn corners(&self) -> [glam::DVec3; 8] {
         self.grid.world_corners(&self.to_world)
     }
 }
@@ -42,9 +42,9 @@ impl VolumeNode {
 /// A node drawing a hypertexture: its name in `Scene::hypertextures` and the node's frame.
 #[derive(Debug, Clone)]
 pub struct HyperNode {
-    pub name: String,
+    pub(crate) name: String,
     /// The node's frame (object space of the hypertexture) to world.
-    pub to_world: DMat4,
+    pub(crate) to_world: DMat4,
 }
 
 impl Scene {

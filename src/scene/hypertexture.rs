@@ -1,7 +1,7 @@
 //! Scene types of hypertextures (Gilet & Dischler 2009, section 4): a soft object, a vector field,
 //! noises filtered by shape transfer functions, and an RGBA transfer function on density. Value
 //! ranges are checked while parsing; list lengths and control-point order by `check` (positioned
-//! through [`Mark`]s).
+//! through `Mark`s).
 
 use std::sync::Arc;
 
@@ -13,36 +13,36 @@ use crate::mesh::shape::MeshShape;
 use super::values::{self as v, Mark};
 
 /// Most noises one hypertexture combines.
-pub const MAX_NOISES: usize = 8;
+pub(crate) const MAX_NOISES: usize = 8;
 /// Most control points of a curve or ramp.
-pub const MAX_POINTS: usize = 64;
+pub(crate) const MAX_POINTS: usize = 64;
 /// Most values of a sampled table.
-pub const MAX_TABLE: usize = 256;
+pub(crate) const MAX_TABLE: usize = 256;
 /// Most rows (densities) of a 2D shape transfer function.
-pub const MAX_ROWS: usize = 64;
+pub(crate) const MAX_ROWS: usize = 64;
 
 /// `hypertextures: { "name": (object: .., field: .., noises: [..], color: ..) }`.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Hypertexture {
-    pub object: Mark<SoftObject>,
+    pub(crate) object: Mark<SoftObject>,
     #[serde(default)]
-    pub field: Field,
-    /// Combined in order into the distortion factor k (eq. 5); 1 to [`MAX_NOISES`].
+    pub(crate) field: Field,
+    /// Combined in order into the distortion factor k (eq. 5); 1 to `MAX_NOISES`.
     pub noises: Mark<Vec<Noise>>,
     /// Colour and opacity by density.
-    pub color: ColorTransfer,
+    pub(crate) color: ColorTransfer,
     /// World length over which the transfer function's opacity is reached.
     #[serde(default = "default_opacity_length", deserialize_with = "v::positive")]
-    pub opacity_length: f64,
+    pub(crate) opacity_length: f64,
     /// Perlin's bias applied to the density, `d^(ln b / ln 0.5)`: below 0.5 it thins the soft
     /// region, above it thickens it; 0.5 changes nothing. In (0, 1).
     #[serde(default = "identity_modulation", deserialize_with = "v::open_unit")]
-    pub bias: f64,
+    pub(crate) bias: f64,
     /// Perlin's gain applied after the bias: above 0.5 it sharpens the soft region towards a
     /// step at density 0.5, below it flattens it; 0.5 changes nothing. In (0, 1).
     #[serde(default = "identity_modulation", deserialize_with = "v::open_unit")]
-    pub gain: f64,
+    pub(crate) gain: f64,
 }
 
 fn identity_modulation() -> f64 {
@@ -97,7 +97,7 @@ fn default_grid() -> u32 {
 
 impl SoftObject {
     /// Where the density can be positive: (min, max) in the node's frame.
-    pub fn bounds(&self) -> (DVec3, DVec3) {
+    pub(crate) fn bounds(&self) -> (DVec3, DVec3) {
         let h = match self {
             SoftObject::Sphere { radius } => DVec3::splat(*radius),
             SoftObject::Ellipsoid { radii } => *radii,
@@ -175,36 +175,36 @@ pub struct Noise {
     pub shape: ShapeTransfer,
     /// The largest shift (world depth of the detail, in the node's frame).
     #[serde(deserialize_with = "v::non_negative")]
-    pub amplitude: f64,
+    pub(crate) amplitude: f64,
     /// Noise cycles per unit: larger is smaller detail.
     #[serde(deserialize_with = "v::positive")]
-    pub frequency: f64,
+    pub(crate) frequency: f64,
     /// r: how far along V the noise is evaluated (0: at x; 1: at x + V).
     #[serde(default, deserialize_with = "v::unit")]
-    pub shift: f64,
+    pub(crate) shift: f64,
     #[serde(default)]
-    pub operator: Operator,
+    pub(crate) operator: Operator,
     #[serde(default)]
-    pub seed: u32,
+    pub(crate) seed: u32,
     /// Animation: noise cycles per second along time (4D noise; 0: still).
     #[serde(default, deserialize_with = "v::finite")]
     pub speed: f64,
     /// Periodic noise: it repeats every `(x, y, z)` (node frame), the frequency adjusted per axis
     /// so that each period holds a whole multiple of 3 noise cells (see `simplex3_tiled`).
     #[serde(default)]
-    pub period: Option<Mark<[f64; 3]>>,
+    pub(crate) period: Option<Mark<[f64; 3]>>,
     /// `false` switches the noise off (kept in the file; the preview's panel toggles it).
     #[serde(default = "yes")]
-    pub enabled: bool,
+    pub(crate) enabled: bool,
 }
 
 /// The largest noise-cell count per period (keeps the wrapped corner class in i32).
-pub const MAX_PERIOD_CELLS: f64 = 3.0 * 4096.0;
+pub(crate) const MAX_PERIOD_CELLS: f64 = 3.0 * 4096.0;
 
 impl Noise {
     /// Per-axis frequency factors and tile counts `(a, b, c)` of a periodic noise (periods of
     /// 3a, 3b, 3c cells): ones and zeros when it is not periodic.
-    pub fn tiling(&self) -> ([f32; 4], [u32; 4]) {
+    pub(crate) fn tiling(&self) -> ([f32; 4], [u32; 4]) {
         let Some(period) = &self.period else { return ([1.0; 4], [0; 4]) };
         let mut scale = [1.0f32; 4];
         let mut tile = [0u32; 4];
@@ -304,24 +304,24 @@ pub struct RampPoint(
 impl Hypertexture {
     /// The largest shift `k` can reach: the sum of the enabled noises' amplitudes (Blend never
     /// exceeds it).
-    pub fn max_shift(&self) -> f64 {
+    pub(crate) fn max_shift(&self) -> f64 {
         self.enabled_noises().map(|n| n.amplitude).sum()
     }
 
     /// The noises switched on, in order: those combined into k.
-    pub fn enabled_noises(&self) -> impl Iterator<Item = &Noise> {
+    pub(crate) fn enabled_noises(&self) -> impl Iterator<Item = &Noise> {
         self.noises.iter().filter(|n| n.enabled)
     }
 
     /// The object's bounds enlarged by the largest shift, so no detail is clipped.
-    pub fn bounds(&self) -> (DVec3, DVec3) {
+    pub(crate) fn bounds(&self) -> (DVec3, DVec3) {
         let (lo, hi) = self.object.bounds();
         let a = DVec3::splat(self.max_shift());
         (lo - a, hi + a)
     }
 
     /// The eight corners of the enlarged bounds through `to_world`.
-    pub fn world_corners(&self, to_world: &DMat4) -> [DVec3; 8] {
+    pub(crate) fn world_corners(&self, to_world: &DMat4) -> [DVec3; 8] {
         let (lo, hi) = self.bounds();
         std::array::from_fn(|i| {
             let pick = |bit: usize, a: f64, b: f64| if i & bit == 0 { a } else { b };
@@ -336,7 +336,7 @@ impl Hypertexture {
 
 /// The length of the diagonal of the box holding `corners`: no ray crosses the bounds on a
 /// longer stretch.
-pub fn diagonal(corners: &[DVec3]) -> f64 {
+pub(crate) fn diagonal(corners: &[DVec3]) -> f64 {
     let lo = corners.iter().fold(DVec3::INFINITY, |a, &c| a.min(c));
     let hi = corners.iter().fold(DVec3::NEG_INFINITY, |a, &c| a.max(c));
     (hi - lo).length()

@@ -68,7 +68,7 @@ impl HeightImage {
     }
 
     /// Bilinear with wrapping; pixel centres at (i + 0.5) / size; v = 0 is the bottom row.
-    pub fn sample(&self, uv: DVec2, channel: usize) -> f64 {
+    pub(crate) fn sample(&self, uv: DVec2, channel: usize) -> f64 {
         let x = uv.x * self.width as f64 - 0.5;
         let y = (1.0 - uv.y) * self.height as f64 - 0.5;
         let (x0, y0) = (x.floor(), y.floor());

@@ -3,7 +3,7 @@
 //!
 //! Range checks run while deserializing (ron attaches the position); checks that need the whole
 //! scene run after a first parse and are positioned by a second parse that fails at the
-//! offending value ([`Mark`]). Files the scene refers to (OBJ, PNG) are loaded by [`load`].
+//! offending value (`Mark`). Files the scene refers to (OBJ, PNG) are loaded by [`load`].
 
 /// Most planes one ViewSlices object may use (the scan kernel and the dispatch height allow it).
 pub const MAX_PLANES: u32 = 16384;
@@ -18,11 +18,10 @@ mod validate;
 mod values;
 
 pub use budget::{MAX_NODES, MAX_SHAPE_VOXELS, MAX_TRIANGLES};
-pub use flatten::{HyperNode, SceneObject, VolumeNode};
-pub use hypertexture::Hypertexture;
+pub(crate) use flatten::{HyperNode, SceneObject, VolumeNode};
+pub(crate) use hypertexture::Hypertexture;
 pub use image::HeightImage;
 pub use types::*;
-pub use values::Mark;
 
 use crate::error::{Error, FileLoc, Result};
 use std::collections::BTreeMap;
@@ -38,7 +37,7 @@ fn options() -> ron::Options {
 impl Scene {
     /// The files (meshes, images, hypertexture meshes) and slice-stack folders the scene refers to,
     /// resolved.
-    pub fn asset_paths(&self) -> Vec<std::path::PathBuf> {
+    pub(crate) fn asset_paths(&self) -> Vec<std::path::PathBuf> {
         let a = &self.assets;
         a.meshes
             .keys()
@@ -81,12 +80,12 @@ impl Scene {
     }
 
     /// The scene file's text.
-    pub fn source(&self) -> &str {
+    pub(crate) fn source(&self) -> &str {
         &self.source
     }
 
     /// Where the top-level field `key` is written (`key:` at the start of a line), if it is.
-    pub fn locate_key(&self, key: &str) -> Option<crate::error::FileLoc> {
+    pub(crate) fn locate_key(&self, key: &str) -> Option<crate::error::FileLoc> {
         let mut offset = 0;
         for line in self.source.split_inclusive('\n') {
             let t = line.trim_start();

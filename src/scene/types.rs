@@ -12,15 +12,15 @@ pub struct Scene {
     /// The scene file (not in the file; set by `load`). Relative paths resolve against its folder.
     #[serde(skip)]
     pub path: PathBuf,
-    pub output: Output,
+    pub(crate) output: Output,
     /// Marked so that `load` can report a degenerate view (eye = target, up along the view).
     pub camera: Mark<Camera>,
     #[serde(default, deserialize_with = "v::color")]
-    pub background: [f32; 3],
+    pub(crate) background: [f32; 3],
     #[serde(default = "default_ambient", deserialize_with = "v::unit_f32")]
-    pub ambient: f32,
+    pub(crate) ambient: f32,
     #[serde(default)]
-    pub lights: Vec<Light>,
+    pub(crate) lights: Vec<Light>,
     #[serde(default, deserialize_with = "crate::input::unique_keys")]
     pub texels: BTreeMap<String, Texel>,
     /// Hypertextures (Gilet & Dischler 2009) that nodes draw with `RayMarch`.
@@ -34,11 +34,11 @@ pub struct Scene {
     pub nodes: Vec<Node>,
     /// Time of the frame in seconds (animated hypertextures; `--time` overrides it).
     #[serde(default, deserialize_with = "v::finite")]
-    pub time: f64,
+    pub(crate) time: f64,
     /// Extra images (AOVs) written as EXR channels beside the colour, by the names the graph
     /// declares (the default graph: `depth`, `coverage`, `transmittance`); `--aov` replaces it.
     #[serde(default)]
-    pub aovs: Vec<String>,
+    pub(crate) aovs: Vec<String>,
     /// Settings of `voltex regress` runs: render size and pass thresholds.
     #[serde(default)]
     pub regress: Regress,
@@ -59,11 +59,11 @@ fn default_ambient() -> f32 {
 
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct Output {
+pub(crate) struct Output {
     #[serde(deserialize_with = "v::output_size")]
-    pub width: u32,
+    pub(crate) width: u32,
     #[serde(deserialize_with = "v::output_size")]
-    pub height: u32,
+    pub(crate) height: u32,
 }
 
 /// `regress: (size: (128, 128), max_flip: 0.01, max_rel_rmse: 0.02)`, every field optional.
@@ -92,10 +92,10 @@ pub struct Regress {
 #[serde(deny_unknown_fields)]
 pub struct Truth {
     #[serde(deserialize_with = "v::unit")]
-    pub max_flip: f64,
+    pub(crate) max_flip: f64,
     /// RayMarch objects' step in the truth, as a fraction of theirs.
     #[serde(default = "default_step_scale", deserialize_with = "v::positive")]
-    pub step_scale: f64,
+    pub(crate) step_scale: f64,
 }
 
 fn default_step_scale() -> f64 {
@@ -128,7 +128,7 @@ pub struct Camera {
     #[serde(deserialize_with = "v::vec3")]
     pub target: DVec3,
     #[serde(default = "default_up", deserialize_with = "v::direction")]
-    pub up: DVec3,
+    pub(crate) up: DVec3,
     /// Vertical field of view in degrees.
     #[serde(default = "default_fov", deserialize_with = "v::fov")]
     pub fov_y: f64,
@@ -170,18 +170,18 @@ pub struct Texel {
     pub resolution: [u32; 3],
     /// World length over which a voxel's stored alpha is reached (see [`Texel::opacity_length`]).
     #[serde(default, rename = "opacity_length", deserialize_with = "v::opt_positive_f32")]
-    pub opacity_length_given: Option<f32>,
+    pub(crate) opacity_length_given: Option<f32>,
     pub source: TexelSource,
 }
 
 /// A texel's opacity length when the file gives none (and its source has no length of its own).
-pub const DEFAULT_OPACITY_LENGTH: f32 = 0.05;
+pub(crate) const DEFAULT_OPACITY_LENGTH: f32 = 0.05;
 
 impl Texel {
     /// The world length over which a voxel's stored alpha is reached: as given, else for a
     /// hypertexture source the hypertexture's own opacity length (a baked voxel stores the
     /// transfer function's opacity, which RayMarch reaches over that world length), else
-    /// [`DEFAULT_OPACITY_LENGTH`].
+    /// `DEFAULT_OPACITY_LENGTH`.
     pub fn opacity_length(&self, hypertextures: &BTreeMap<String, super::Hypertexture>) -> f32 {
         let own = match &self.source {
             TexelSource::Hypertexture { name, .. } => {
@@ -315,18 +315,18 @@ pub enum TexelSource {
 #[serde(deny_unknown_fields)]
 pub struct Volume {
     /// The `.vdb` file, relative to the scene file.
-    pub file: Mark<String>,
+    pub(crate) file: Mark<String>,
     #[serde(default = "default_grid")]
-    pub grid: String,
+    pub(crate) grid: String,
     #[serde(default)]
-    pub color: Option<String>,
+    pub(crate) color: Option<String>,
     #[serde(default = "one_f64", deserialize_with = "v::positive")]
     pub density_scale: f64,
     #[serde(default = "white", deserialize_with = "v::color")]
     pub albedo: [f32; 3],
     /// Level sets: the width, in voxels, of the band over which density falls from 1 to 0.
     #[serde(default = "one_f64", deserialize_with = "v::positive")]
-    pub band: f64,
+    pub(crate) band: f64,
 }
 
 fn default_grid() -> String {
@@ -400,9 +400,9 @@ pub enum Shape {
 #[serde(deny_unknown_fields)]
 pub struct Ball {
     #[serde(deserialize_with = "v::point_f32")]
-    pub center: [f32; 3],
+    pub(crate) center: [f32; 3],
     #[serde(deserialize_with = "v::positive_f32")]
-    pub radius: f32,
+    pub(crate) radius: f32,
 }
 
 #[derive(Debug, Clone, PartialEq, Deserialize)]
@@ -411,31 +411,31 @@ pub struct Node {
     #[serde(deserialize_with = "v::object_name")]
     pub name: String,
     #[serde(default)]
-    pub transform: Transform,
+    pub(crate) transform: Transform,
     #[serde(default)]
-    pub surface: Option<Mark<Surface>>,
+    pub(crate) surface: Option<Mark<Surface>>,
     #[serde(default)]
-    pub height: Height,
+    pub(crate) height: Height,
     /// Texture repeats over the surface's uv tile (u, v).
     #[serde(default = "one2", deserialize_with = "v::positive2")]
-    pub uv_tiling: [f64; 2],
+    pub(crate) uv_tiling: [f64; 2],
     #[serde(default)]
-    pub texel: Option<Mark<String>>,
+    pub(crate) texel: Option<Mark<String>>,
     /// A hypertexture drawn in this node's frame (instead of a surface with a texel).
     #[serde(default)]
-    pub hypertexture: Option<Mark<String>>,
+    pub(crate) hypertexture: Option<Mark<String>>,
     /// A volume of `volumes` drawn in this node's frame (its grid's index-to-world transform,
     /// then the node's), with `RayMarch` (the default) or `Reference`.
     #[serde(default)]
-    pub volume: Option<Mark<String>>,
+    pub(crate) volume: Option<Mark<String>>,
     #[serde(default)]
     pub method: Option<Mark<Method>>,
     /// Draw the base surface opaque with this colour.
     #[serde(default, deserialize_with = "v::opt_color")]
-    pub base_color: Option<[f32; 3]>,
+    pub(crate) base_color: Option<[f32; 3]>,
     /// Animation of the base surface and height vectors with the scene time.
     #[serde(default)]
-    pub motion: Motion,
+    pub(crate) motion: Motion,
     #[serde(default)]
     pub children: Vec<Node>,
 }
@@ -449,49 +449,49 @@ fn one2() -> [f64; 2] {
 /// vectors (see `mesh::motion`).
 #[derive(Debug, Clone, Copy, PartialEq, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct Motion {
+pub(crate) struct Motion {
     #[serde(default)]
-    pub wave: Option<WaveMotion>,
+    pub(crate) wave: Option<WaveMotion>,
     #[serde(default)]
-    pub wind: Option<WindMotion>,
+    pub(crate) wind: Option<WindMotion>,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct WaveMotion {
+pub(crate) struct WaveMotion {
     #[serde(deserialize_with = "v::finite")]
-    pub amplitude: f64,
+    pub(crate) amplitude: f64,
     #[serde(deserialize_with = "v::positive")]
-    pub wavelength: f64,
+    pub(crate) wavelength: f64,
     #[serde(default, deserialize_with = "v::finite")]
-    pub speed: f64,
+    pub(crate) speed: f64,
     #[serde(deserialize_with = "v::direction")]
-    pub direction: DVec3,
+    pub(crate) direction: DVec3,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct WindMotion {
+pub(crate) struct WindMotion {
     /// Lean as a fraction of the height vector's length, in [0, 1].
     #[serde(deserialize_with = "v::unit")]
-    pub strength: f64,
+    pub(crate) strength: f64,
     #[serde(default, deserialize_with = "v::finite")]
-    pub frequency: f64,
+    pub(crate) frequency: f64,
     #[serde(deserialize_with = "v::positive")]
-    pub wavelength: f64,
+    pub(crate) wavelength: f64,
     #[serde(deserialize_with = "v::direction")]
-    pub direction: DVec3,
+    pub(crate) direction: DVec3,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct Transform {
+pub(crate) struct Transform {
     #[serde(default, deserialize_with = "v::vec3")]
-    pub translate: DVec3,
+    pub(crate) translate: DVec3,
     #[serde(default, deserialize_with = "v::vec3")]
-    pub rotate: DVec3,
+    pub(crate) rotate: DVec3,
     #[serde(default = "one3", deserialize_with = "v::scale3")]
-    pub scale: DVec3,
+    pub(crate) scale: DVec3,
 }
 
 fn one3() -> DVec3 {
@@ -505,7 +505,7 @@ impl Default for Transform {
 }
 
 impl Transform {
-    pub fn matrix(&self) -> DMat4 {
+    pub(crate) fn matrix(&self) -> DMat4 {
         let r = self.rotate * std::f64::consts::PI / 180.0;
         DMat4::from_scale_rotation_translation(
             self.scale,
@@ -556,11 +556,11 @@ pub enum Surface {
 
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct Height {
+pub(crate) struct Height {
     #[serde(default = "default_height", deserialize_with = "v::non_negative")]
-    pub length: f64,
+    pub(crate) length: f64,
     #[serde(default)]
-    pub scale: Option<Mark<HeightScale>>,
+    pub(crate) scale: Option<Mark<HeightScale>>,
 }
 
 fn default_height() -> f64 {
@@ -599,7 +599,7 @@ pub enum Method {
 }
 
 impl Method {
-    pub fn lighting(&self) -> Lighting {
+    pub(crate) fn lighting(&self) -> Lighting {
         match self {
             Method::ViewSlices(m) => m.lighting,
             Method::Reference(m) => m.lighting,
@@ -655,8 +655,8 @@ pub enum Shadows {
 }
 
 /// `LightVolume`'s default and largest resolution (samples along the longest axis).
-pub const DEFAULT_LIGHT_RESOLUTION: u32 = 64;
-pub const MAX_LIGHT_RESOLUTION: u32 = 256;
+pub(crate) const DEFAULT_LIGHT_RESOLUTION: u32 = 64;
+pub(crate) const MAX_LIGHT_RESOLUTION: u32 = 256;
 
 fn default_light_resolution() -> u32 {
     DEFAULT_LIGHT_RESOLUTION
@@ -670,17 +670,17 @@ fn default_light_resolution() -> u32 {
 #[serde(deny_unknown_fields)]
 pub struct Adaptive {
     #[serde(deserialize_with = "v::positive")]
-    pub max_step: f64,
+    pub(crate) max_step: f64,
 }
 
 /// Longest adaptive stride, in steps.
-pub const MAX_STRIDE: u32 = 1 << 12;
+pub(crate) const MAX_STRIDE: u32 = 1 << 12;
 /// Most depth-peeling passes (segments per ray).
-pub const MAX_PEEL_PASSES: u32 = 8;
+pub(crate) const MAX_PEEL_PASSES: u32 = 8;
 /// Most depth slabs per pixel of EWA-style splatting.
-pub const MAX_SPLAT_SLABS: u32 = 64;
+pub(crate) const MAX_SPLAT_SLABS: u32 = 64;
 /// Largest splat lattice (cells along the bounds' longest axis).
-pub const MAX_SPLAT_GRID: u32 = 96;
+pub(crate) const MAX_SPLAT_GRID: u32 = 96;
 
 /// The segments of a ray that `RayMarch` marches.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Deserialize)]
@@ -737,7 +737,7 @@ impl RayMarch {
 
     /// The longest stride in fine steps (1: the adaptive stride is off); `max_step` below the
     /// step is refused by validation.
-    pub fn max_stride(&self) -> u32 {
+    pub(crate) fn max_stride(&self) -> u32 {
         self.adaptive.map_or(1, |a| (a.max_step / self.step()).floor().clamp(1.0, MAX_STRIDE as f64) as u32)
     }
 }
@@ -756,7 +756,7 @@ pub enum Quality {
 }
 
 impl Quality {
-    pub fn step(self) -> f64 {
+    pub(crate) fn step(self) -> f64 {
         match self {
             Quality::High => 0.002,
             Quality::Interactive => 0.015,
@@ -794,7 +794,7 @@ pub struct Reference {
     #[serde(default, deserialize_with = "v::opt_positive")]
     pub step: Option<f64>,
     #[serde(default)]
-    pub lighting: Lighting,
+    pub(crate) lighting: Lighting,
 }
 
 /// View-aligned prism slicing (2002).
@@ -806,13 +806,13 @@ pub struct ViewSlices {
     pub planes: u32,
     /// Skip prisms entirely outside the slab of a plane.
     #[serde(default = "yes")]
-    pub trivial_reject: bool,
+    pub(crate) trivial_reject: bool,
     #[serde(default)]
-    pub lighting: Lighting,
+    pub(crate) lighting: Lighting,
     /// How the slices reach the frame: drawn and blended by the rasteriser, or composited per
     /// screen tile by compute kernels.
     #[serde(default)]
-    pub compositor: Compositor,
+    pub(crate) compositor: Compositor,
     /// Level of detail: `Off` draws `planes` planes and the texel at full resolution; `Auto`
     /// chooses the plane count (at most `planes`) and the texel's MIP level from the object's
     /// size on screen (Meyer & Neyret 1998).

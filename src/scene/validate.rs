@@ -17,29 +17,29 @@ use std::sync::Arc;
 
 /// Files a scene refers to, loaded once by `load`, by resolved path.
 #[derive(Debug, Clone, Default)]
-pub struct Assets {
-    pub dir: PathBuf,
-    pub meshes: BTreeMap<PathBuf, Arc<Mesh>>,
-    pub images: BTreeMap<PathBuf, Arc<HeightImage>>,
-    pub stacks: BTreeMap<PathBuf, Arc<SliceStack>>,
+pub(crate) struct Assets {
+    pub(crate) dir: PathBuf,
+    pub(crate) meshes: BTreeMap<PathBuf, Arc<Mesh>>,
+    pub(crate) images: BTreeMap<PathBuf, Arc<HeightImage>>,
+    pub(crate) stacks: BTreeMap<PathBuf, Arc<SliceStack>>,
     /// Hypertexture mesh objects, welded and checked.
-    pub shapes: BTreeMap<PathBuf, Arc<MeshShape>>,
+    pub(crate) shapes: BTreeMap<PathBuf, Arc<MeshShape>>,
     /// Mesh texels' patterns by (path, filled): closed parts when filled, else one open part.
-    pub texel_meshes: BTreeMap<(PathBuf, bool), Arc<MeshShape>>,
+    pub(crate) texel_meshes: BTreeMap<(PathBuf, bool), Arc<MeshShape>>,
     /// Volumes read from their OpenVDB files, by name in `Scene::volumes`.
-    pub volumes: BTreeMap<String, Arc<crate::vdb::SparseVolume>>,
+    pub(crate) volumes: BTreeMap<String, Arc<crate::vdb::SparseVolume>>,
     /// The OpenVDB files read, resolved (for the preview's watch list).
-    pub volume_files: Vec<PathBuf>,
+    pub(crate) volume_files: Vec<PathBuf>,
 }
 
 /// What the checks found: messages for marks (positioned by a second parse), and the first error
 /// that has its own position (inside an OBJ file, say).
 pub(super) struct Findings {
-    pub fail: BTreeMap<usize, String>,
-    pub other: Option<Error>,
-    pub assets: Assets,
+    pub(crate) fail: BTreeMap<usize, String>,
+    pub(crate) other: Option<Error>,
+    pub(crate) assets: Assets,
     /// Warnings, with the mark to position them at where they have one.
-    pub warnings: Vec<(Option<usize>, String)>,
+    pub(crate) warnings: Vec<(Option<usize>, String)>,
 }
 
 struct Checker<'a> {
@@ -555,10 +555,10 @@ impl Checker<'_> {
 }
 
 /// Most voxels of a texel baked from a hypertexture (seven density evaluations each).
-pub const MAX_HYPERTEXTURE_VOXELS: u64 = 1 << 24;
+pub(crate) const MAX_HYPERTEXTURE_VOXELS: u64 = 1 << 24;
 
 /// More samples than this along one ray means a step far finer than any scene needs.
-pub const MAX_SAMPLES_PER_RAY: f64 = 1e5;
+pub(crate) const MAX_SAMPLES_PER_RAY: f64 = 1e5;
 
 pub(super) fn check(scene: &Scene, dir: &Path, source: &str, path: &Path) -> Findings {
     let mut c = Checker {

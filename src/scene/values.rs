@@ -8,7 +8,7 @@ use std::collections::BTreeMap;
 
 /// Largest magnitude of any number in a scene: beyond it, f32 kernels (and f32 fields such as
 /// texel shapes) overflow (the prism checks' `MAX_COORD`).
-pub const MAX_MAGNITUDE: f64 = crate::mesh::prism::MAX_COORD;
+pub(crate) const MAX_MAGNITUDE: f64 = crate::mesh::prism::MAX_COORD;
 
 macro_rules! checked_f64 {
     ($name:ident, $ok:expr, $what:literal) => {
@@ -156,7 +156,7 @@ adapter!(torus_segments, [u32; 2], [Around; 2], |v| v.map(|x| x.0));
 
 /// Longest node name: each object's name becomes the EXR attribute `voltex_object_NAME`, and
 /// EXR attribute names are at most 255 bytes.
-pub const MAX_NAME_BYTES: usize = 255 - "voltex_object_".len();
+pub(crate) const MAX_NAME_BYTES: usize = 255 - "voltex_object_".len();
 
 /// A node name that can be written as EXR metadata (checked here, not after the render).
 pub(super) fn object_name<'de, D: Deserializer<'de>>(d: D) -> Result<String, D::Error> {
@@ -202,7 +202,7 @@ pub(super) const MARK_PREFIX: &str = "\u{1}mark:";
 #[derive(Default)]
 pub(super) struct Marking {
     next: usize,
-    pub fail: BTreeMap<usize, String>,
+    pub(crate) fail: BTreeMap<usize, String>,
 }
 
 thread_local! {
@@ -231,14 +231,6 @@ pub struct Mark<T> {
     pub value: T,
     pub(super) seq: usize,
 }
-
-impl<T> Mark<T> {
-    /// A value that was not read from a file (its checks report without a position).
-    pub fn new(value: T) -> Self {
-        Mark { value, seq: usize::MAX }
-    }
-}
-
 impl<T> std::ops::Deref for Mark<T> {
     type Target = T;
     fn deref(&self) -> &T {

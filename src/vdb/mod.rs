@@ -1,20 +1,20 @@
 //! OpenVDB files in: a density grid (a fog volume, or a level set turned into density) and an
 //! optional colour grid (`Cd`), read with `vdb-rs` behind a structural walk of the file
-//! ([`walk`]: no length, panic or C decoder reached unchecked), and kept sparse for the GPU
-//! ([`sparse`]: a brick atlas and a two-level table). Errors name the file and the grid.
+//! (`walk`: no length, panic or C decoder reached unchecked), and kept sparse for the GPU
+//! (`sparse`: a brick atlas and a two-level table). Errors name the file and the grid.
 
-pub mod sparse;
+pub(crate) mod sparse;
 mod spliced;
 mod tree;
-pub mod walk;
+pub(crate) mod walk;
 
 use std::path::Path;
 use std::sync::Arc;
 
 use glam::DMat4;
 
-pub use sparse::SparseVolume;
-pub use tree::level_set_density;
+pub(crate) use sparse::SparseVolume;
+pub(crate) use tree::level_set_density;
 
 use crate::error::{Error, Result};
 use tree::{Blocks, Keep};
@@ -23,16 +23,16 @@ use walk::{GridHeader, Topology, Value};
 /// One grid of a file, as `voltex import` and the errors list them.
 #[derive(Debug, Clone)]
 pub struct GridInfo {
-    pub name: String,
+    pub(crate) name: String,
     /// OpenVDB's value type name (`float`, `vec3s`, `int32`, ...).
-    pub value: String,
+    pub(crate) value: String,
     /// `level set`, `fog volume`, ... (empty when the file says nothing).
-    pub class: String,
+    pub(crate) class: String,
     pub half: bool,
 }
 
 impl GridInfo {
-    pub fn is_level_set(&self) -> bool {
+    pub(crate) fn is_level_set(&self) -> bool {
         self.class == "level set"
     }
 }
@@ -51,7 +51,7 @@ fn read_file(path: &Path) -> Result<Arc<[u8]>> {
 }
 
 /// The grids of the file at `path`.
-pub fn grids(path: &Path) -> Result<Vec<GridInfo>> {
+pub(crate) fn grids(path: &Path) -> Result<Vec<GridInfo>> {
     let bytes = read_file(path)?;
     let archive = walk::archive(&bytes).map_err(|e| Error::file(path, e))?;
     Ok(archive.grids.iter().map(info).collect())
@@ -62,7 +62,7 @@ fn info(g: &GridHeader) -> GridInfo {
 }
 
 /// "`a` (float, level set), `b` (vec3s)": the grids for an error message.
-pub fn list(grids: &[GridInfo]) -> String {
+pub(crate) fn list(grids: &[GridInfo]) -> String {
     let items: Vec<String> = grids
         .iter()
         .map(|g| {
@@ -220,7 +220,7 @@ fn finite(blocks: &Blocks<f32>) -> std::result::Result<(), String> {
 }
 
 /// The smallest world length of a voxel edge under `m`.
-pub fn voxel_size(m: &DMat4) -> f64 {
+pub(crate) fn voxel_size(m: &DMat4) -> f64 {
     [m.x_axis, m.y_axis, m.z_axis].iter().map(|c| c.truncate().length()).fold(f64::INFINITY, f64::min)
 }
 

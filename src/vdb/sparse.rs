@@ -14,19 +14,19 @@ use glam::{DMat4, DVec3, IVec3, UVec3};
 use super::tree::{Block, Blocks};
 
 /// Voxels per leaf side.
-pub const LEAF: i32 = 8;
+pub(crate) const LEAF: i32 = 8;
 /// Values per brick side: a leaf and one more.
-pub const BRICK: usize = 9;
-pub const BRICK_VALUES: usize = BRICK * BRICK * BRICK;
+pub(crate) const BRICK: usize = 9;
+pub(crate) const BRICK_VALUES: usize = BRICK * BRICK * BRICK;
 /// Leaves per table node side (a top cell spans `LEAF * NODE` = 128 voxels).
-pub const NODE: i32 = 16;
-pub const NODE_ENTRIES: usize = (NODE * NODE * NODE) as usize;
+pub(crate) const NODE: i32 = 16;
+pub(crate) const NODE_ENTRIES: usize = (NODE * NODE * NODE) as usize;
 /// A top cell without a node.
-pub const NO_NODE: u32 = u32::MAX;
+pub(crate) const NO_NODE: u32 = u32::MAX;
 /// Most top cells: the bounding box may span about 16k voxels per side (more along one axis).
-pub const MAX_TOP_CELLS: u64 = 1 << 21;
+pub(crate) const MAX_TOP_CELLS: u64 = 1 << 21;
 /// Most bricks of one grid (2^18: 729 MiB of float bricks, 191 million values).
-pub const MAX_BRICKS: u64 = 1 << 18;
+pub(crate) const MAX_BRICKS: u64 = 1 << 18;
 
 /// A grid as bricks and table (see the module's documentation).
 #[derive(Debug, Clone, Default)]
@@ -34,23 +34,23 @@ pub struct SparseVolume {
     /// Index space to world space (the file's transform).
     pub index_to_world: DMat4,
     /// Index coordinate of the top grid's first voxel (a multiple of 128).
-    pub origin: IVec3,
+    pub(crate) origin: IVec3,
     /// Top grid cells per axis.
-    pub top: UVec3,
+    pub(crate) top: UVec3,
     /// The top grid (node offsets into this table, or `NO_NODE`), then the nodes (brick numbers).
     pub table: Vec<u32>,
     /// Bricks of density, `BRICK_VALUES` each, x fastest; brick 0 is zeros.
     pub density: Vec<f32>,
     /// Bricks of colour alike, when the volume has a colour grid.
-    pub color: Option<Vec<[f32; 3]>>,
+    pub(crate) color: Option<Vec<[f32; 3]>>,
     /// Index bounds (inclusive) of the voxels with non-zero density.
     pub lo: IVec3,
     pub hi: IVec3,
     /// Leaves (and leaf tiles) holding density, before dilation.
-    pub leaves: u64,
-    pub max_density: f32,
+    pub(crate) leaves: u64,
+    pub(crate) max_density: f32,
     /// A digest of the table and bricks (the GPU upload's cache key).
-    pub hash: u64,
+    pub(crate) hash: u64,
 }
 
 /// Cell counts of the top grid over leaves `lo..=hi` (leaf coordinates), and its origin.
@@ -64,7 +64,7 @@ fn top_grid(lo: IVec3, hi: IVec3) -> (IVec3, [u64; 3]) {
 
 /// The brick table's top grid, checked before anything is allocated: `Err` names the limit
 /// and the numbers (a grid whose voxels lie far apart).
-pub fn check_extent(blocks: &Blocks<f32>) -> Result<(), String> {
+pub(crate) fn check_extent(blocks: &Blocks<f32>) -> Result<(), String> {
     let mut keys = blocks.keys();
     let Some(first) = keys.next() else { return Ok(()) };
     let (lo, hi) = keys.fold((*first, *first), |(lo, hi), k| (lo.min(*k), hi.max(*k)));
@@ -128,7 +128,7 @@ impl SparseVolume {
     /// Builds the bricks and table of `density` (and `color`, read at the same voxels), after
     /// [`check_extent`] passed. `Ok(None)` when the density is zero everywhere; an error when
     /// it needs more than [`MAX_BRICKS`] bricks.
-    pub fn build(
+    pub(crate) fn build(
         density: &Blocks<f32>,
         color: Option<&Blocks<[f32; 3]>>,
         index_to_world: DMat4,
@@ -246,7 +246,7 @@ impl SparseVolume {
     /// Every leaf with a brick: the index of its first voxel and its brick number (table
     /// order). A brick's values at `(x, y, z)` in `0..BRICK` are those of voxel `first + (x,
     /// y, z)`; its last layer belongs to the next leaf.
-    pub fn leaf_bricks(&self) -> Vec<(IVec3, usize)> {
+    pub(crate) fn leaf_bricks(&self) -> Vec<(IVec3, usize)> {
         let mut out = Vec::new();
         for (cell, &node) in self.table[..(self.top.x * self.top.y * self.top.z) as usize].iter().enumerate()
         {
@@ -333,7 +333,7 @@ impl SparseVolume {
     }
 
     /// The world-space corners of [`index_bounds`](Self::index_bounds) under `to_world`.
-    pub fn world_corners(&self, to_world: &DMat4) -> [DVec3; 8] {
+    pub(crate) fn world_corners(&self, to_world: &DMat4) -> [DVec3; 8] {
         let (lo, hi) = self.index_bounds();
         let m = *to_world * self.index_to_world;
         std::array::from_fn(|i| {
@@ -347,7 +347,7 @@ impl SparseVolume {
     }
 
     /// Brick slots of the atlas per axis for `bricks` bricks under a 3D texture side of `max_side`.
-    pub fn atlas_slots(bricks: u64, max_side: u32) -> [u32; 3] {
+    pub(crate) fn atlas_slots(bricks: u64, max_side: u32) -> [u32; 3] {
         let per = (max_side / BRICK as u32).max(1) as u64;
         let x = bricks.clamp(1, per);
         let y = bricks.div_ceil(x).clamp(1, per);

@@ -9,7 +9,7 @@ use std::sync::Arc;
 use super::walk::Splice;
 
 /// A reader over `bytes` that reads the spliced stream once its [`Switch`] is turned on.
-pub struct Spliced {
+pub(crate) struct Spliced {
     bytes: Arc<[u8]>,
     splices: Vec<Splice>,
     on: Arc<AtomicBool>,
@@ -19,7 +19,7 @@ pub struct Spliced {
 
 impl Spliced {
     /// The reader, and the switch that turns `splices` (in file order) on.
-    pub fn new(bytes: Arc<[u8]>, splices: Vec<Splice>) -> (Self, Switch) {
+    pub(crate) fn new(bytes: Arc<[u8]>, splices: Vec<Splice>) -> (Self, Switch) {
         let on = Arc::new(AtomicBool::new(false));
         let switch = Switch {
             shifts: splices
@@ -55,7 +55,7 @@ fn slice(bytes: &[u8], from: usize, to: usize) -> &[u8] {
 }
 
 /// Turns the splices on, and maps file offsets to positions in the spliced stream.
-pub struct Switch {
+pub(crate) struct Switch {
     /// Each splice's end in the file and how much longer it makes the stream.
     shifts: Vec<(u64, i64)>,
     on: Arc<AtomicBool>,
@@ -63,12 +63,12 @@ pub struct Switch {
 
 impl Switch {
     /// Where file offset `real` (outside any splice) lies in the spliced stream.
-    pub fn position(&self, real: u64) -> u64 {
+    pub(crate) fn position(&self, real: u64) -> u64 {
         let shift: i64 = self.shifts.iter().filter(|(end, _)| *end <= real).map(|(_, d)| d).sum();
         (real as i64 + shift) as u64
     }
 
-    pub fn on(self) {
+    pub(crate) fn on(self) {
         self.on.store(true, Ordering::Relaxed);
     }
 }

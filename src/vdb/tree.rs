@@ -9,13 +9,13 @@ use glam::IVec3;
 
 /// Voxels of one leaf, in OpenVDB's order (`x * 64 + y * 8 + z`), or a tile of one value.
 #[derive(Debug, Clone)]
-pub enum Block<T> {
+pub(crate) enum Block<T> {
     Voxels(Box<[T]>),
     Tile(T),
 }
 
 /// Leaves and leaf-sized tiles by leaf coordinate (voxel index >> 3); absent is background.
-pub type Blocks<T> = HashMap<IVec3, Block<T>>;
+pub(crate) type Blocks<T> = HashMap<IVec3, Block<T>>;
 
 fn local(offset: usize, log2: u32) -> IVec3 {
     let m = (1 << log2) - 1;
@@ -25,13 +25,13 @@ fn local(offset: usize, log2: u32) -> IVec3 {
 /// How values enter the blocks: a fog keeps active values (inactive ones are the background,
 /// 0); a level set keeps every voxel and the inside tiles (signs filled first).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Keep {
+pub(crate) enum Keep {
     Active,
     LevelSet,
 }
 
 /// Most blocks (leaves and leaf-sized tiles, 2^21: 2^30 voxels) a grid may hold once read.
-pub const MAX_BLOCKS: usize = 1 << 21;
+pub(crate) const MAX_BLOCKS: usize = 1 << 21;
 
 fn too_many(blocks: usize) -> String {
     format!(
@@ -42,7 +42,7 @@ fn too_many(blocks: usize) -> String {
 
 /// The grid's leaves and tiles as blocks, at most [`MAX_BLOCKS`]. Root tiles are the caller's
 /// (the walk reads them).
-pub fn blocks<T: Copy + Default>(
+pub(crate) fn blocks<T: Copy + Default>(
     tree: &vdb_rs::Tree<T>,
     keep: Keep,
     inside: impl Fn(&T) -> bool,
@@ -95,7 +95,7 @@ fn tile<T>(keep: Keep, active: bool, value: Option<&T>, inside: &impl Fn(&T) -> 
 /// OpenVDB's signed flood fill (`tools::signedFloodFill`), on the values vdb-rs left: every
 /// inactive voxel and tile of a level set becomes `-background` inside and `background`
 /// outside, its side taken from the active values and children before it in scan order.
-pub fn signed_flood_fill(tree: &mut vdb_rs::Tree<f32>, background: f32) {
+pub(crate) fn signed_flood_fill(tree: &mut vdb_rs::Tree<f32>, background: f32) {
     let (inside, outside) = (-background.abs(), background.abs());
     for n5 in &mut tree.root_nodes {
         for n4 in n5.nodes.values_mut() {
@@ -202,12 +202,12 @@ fn fill_node(
 
 /// A level set's signed distances (world units) as density: 1 inside, 0 outside, linear over a
 /// band of width `band` (world units) centred on the surface.
-pub fn level_set_density(phi: f32, band: f32) -> f32 {
+pub(crate) fn level_set_density(phi: f32, band: f32) -> f32 {
     (0.5 - phi / band).clamp(0.0, 1.0)
 }
 
 /// Applies `f` to every value of `blocks`.
-pub fn map<T: Copy, U>(blocks: Blocks<T>, f: impl Fn(T) -> U) -> Blocks<U> {
+pub(crate) fn map<T: Copy, U>(blocks: Blocks<T>, f: impl Fn(T) -> U) -> Blocks<U> {
     blocks
         .into_iter()
         .map(|(k, b)| {

@@ -11,48 +11,47 @@ use glam::{DMat4, DVec3, IVec3};
 /// OpenVDB's magic number, as the first eight bytes (little-endian).
 const MAGIC: u64 = 0x5644_4220;
 /// File format versions read: node-mask compression (222) onwards.
-pub const MIN_VERSION: u32 = 222;
+pub(crate) const MIN_VERSION: u32 = 222;
 /// Per-grid compression flags.
 const ZIP: u32 = 1;
 const ACTIVE_MASK: u32 = 2;
 const BLOSC: u32 = 4;
 
 /// What a failed walk says, positioned by byte offset.
-pub type Fault = String;
+pub(crate) type Fault = String;
 
-/// The archive: its format version and grids in file order.
+/// The archive: its grids in file order (the format version is checked while reading).
 #[derive(Debug, Clone)]
 pub struct Archive {
-    pub version: u32,
-    pub grids: Vec<GridHeader>,
+    pub(crate) grids: Vec<GridHeader>,
 }
 
 /// A grid's descriptor and metadata.
 #[derive(Debug, Clone)]
-pub struct GridHeader {
-    pub name: String,
+pub(crate) struct GridHeader {
+    pub(crate) name: String,
     /// The tree type as stored (`Tree_float_5_4_3`, maybe with `_HalfFloat`).
-    pub type_name: String,
-    pub instance_parent: String,
-    pub grid_pos: u64,
-    pub block_pos: u64,
-    pub end_pos: u64,
-    pub compression: u32,
+    pub(crate) type_name: String,
+    pub(crate) instance_parent: String,
+    pub(crate) grid_pos: u64,
+    pub(crate) block_pos: u64,
+    pub(crate) end_pos: u64,
+    pub(crate) compression: u32,
     /// Metadata `class`: `level set`, `fog volume`, ... (empty when absent).
-    pub class: String,
-    pub half: bool,
+    pub(crate) class: String,
+    pub(crate) half: bool,
 }
 
 /// The value types voltex reads.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Value {
+pub(crate) enum Value {
     Float,
     Vec3,
 }
 
 impl GridHeader {
     /// The value type, or `None` for one voltex does not read (its name is `value_name`).
-    pub fn value(&self) -> Option<Value> {
+    pub(crate) fn value(&self) -> Option<Value> {
         match self.value_name() {
             "float" => Some(Value::Float),
             "vec3s" => Some(Value::Vec3),
@@ -61,7 +60,7 @@ impl GridHeader {
     }
 
     /// The value type as OpenVDB names it (`float`, `vec3s`, `int32`, `bool`, `ptdataidx32`, ...).
-    pub fn value_name(&self) -> &str {
+    pub(crate) fn value_name(&self) -> &str {
         let t = self.type_name.strip_suffix("_HalfFloat").unwrap_or(&self.type_name);
         let t = t.strip_prefix("Tree_").unwrap_or(t);
         t.strip_suffix("_5_4_3").unwrap_or(t)
@@ -78,29 +77,25 @@ impl GridHeader {
 
 /// A stretch of the file replaced for vdb-rs: bytes `start..end` read as `bytes`.
 #[derive(Debug, Clone)]
-pub struct Splice {
-    pub start: u64,
-    pub end: u64,
-    pub bytes: Vec<u8>,
+pub(crate) struct Splice {
+    pub(crate) start: u64,
+    pub(crate) end: u64,
+    pub(crate) bytes: Vec<u8>,
 }
 
-/// One grid's tree as walked: its transform, background, active root tiles, and its size.
+/// One grid's tree as walked: its transform, background and active root tiles.
 #[derive(Debug, Clone)]
 pub struct Topology {
     /// The map's name, e.g. `ScaleTranslateMap`.
-    pub map: String,
+    pub(crate) map: String,
     /// Index space to world space.
-    pub index_to_world: DMat4,
+    pub(crate) index_to_world: DMat4,
     /// The background (first component of a vector).
-    pub background: f32,
+    pub(crate) background: f32,
     /// Root tiles (origin, value's first component, active).
-    pub root_tiles: Vec<(IVec3, f32, bool)>,
-    /// Internal nodes and leaves (each costs vdb-rs its values in memory).
-    pub nodes: [u64; 3],
-    /// Values the tree holds in memory once read (leaves, tiles and node tables).
-    pub values: u64,
+    pub(crate) root_tiles: Vec<(IVec3, f32, bool)>,
     /// Where the stream differs for vdb-rs, in file order.
-    pub splices: Vec<Splice>,
+    pub(crate) splices: Vec<Splice>,
 }
 
 struct Cursor<'a> {
@@ -194,7 +189,7 @@ fn metadata(c: &mut Cursor) -> Result<(String, bool), Fault> {
 }
 
 /// The archive header and every grid descriptor.
-pub fn archive(bytes: &[u8]) -> Result<Archive, Fault> {
+pub(crate) fn archive(bytes: &[u8]) -> Result<Archive, Fault> {
     let mut c = Cursor { bytes, at: 0 };
     if bytes.len() < 8 || c.u64("the magic number")? != MAGIC {
         return Err("not an OpenVDB file (its first bytes are not OpenVDB's magic number)".into());
@@ -250,7 +245,7 @@ pub fn archive(bytes: &[u8]) -> Result<Archive, Fault> {
         });
         c.seek(end_pos, "the next grid descriptor")?;
     }
-    Ok(Archive { version, grids })
+    Ok(Archive { grids })
 }
 
 /// The identity `UniformScaleMap` in the stream: what vdb-rs reads in place of maps it does not
@@ -391,10 +386,10 @@ fn chunk(
 }
 
 /// Most values (voxels, tiles and node tables) a grid may hold once read: 2^26, 256 MiB of floats.
-pub const MAX_VALUES: u64 = 1 << 26;
+pub(crate) const MAX_VALUES: u64 = 1 << 26;
 
 /// Walks grid `g`'s transform, tree topology and leaf data.
-pub fn topology(bytes: &[u8], g: &GridHeader) -> Result<Topology, Fault> {
+pub(crate) fn topology(bytes: &[u8], g: &GridHeader) -> Result<Topology, Fault> {
     let mut c = Cursor { bytes, at: 0 };
     let mut splices = Vec::new();
     c.seek(g.grid_pos, "the grid")?;
@@ -478,5 +473,5 @@ pub fn topology(bytes: &[u8], g: &GridHeader) -> Result<Topology, Fault> {
     if c.at as u64 > g.end_pos {
         return Err(format!("the grid's data runs past its end at byte {}", g.end_pos));
     }
-    Ok(Topology { map, index_to_world, background, root_tiles, nodes, values, splices })
+    Ok(Topology { map, index_to_world, background, root_tiles, splices })
 }

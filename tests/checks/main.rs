@@ -1,4 +1,4 @@
-//! Checks that need no GPU: the book, the module layers, the twin list, shared struct layouts, scene and graph errors, image I/O and metrics.
+//! Checks that need no GPU: the book, the module layers, the twin list, shared struct layouts, scene and graph errors, image I/O and metrics, the library's public surface.
 
 #[path = "../common/mod.rs"]
 mod common;
@@ -10,6 +10,7 @@ mod io_metrics;
 mod layers;
 mod scene_errors;
 mod strict;
+mod surface;
 mod truth;
 mod twins;
 mod types_layout;

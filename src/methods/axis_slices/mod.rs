@@ -5,7 +5,7 @@
 mod object;
 pub mod twin;
 
-pub use object::plan;
+pub(crate) use object::plan;
 
 use crate::bake::axis_slices::AxisBaked;
 use crate::error::{Error, Result};
@@ -15,7 +15,7 @@ use crate::types::{AxisParams, AxisVertex, Prism};
 use twin::AxisFrame;
 
 /// What AxisSlices brings to the render graph.
-pub const CONTRIBUTION: super::Contribution = super::Contribution {
+pub(crate) const CONTRIBUTION: super::Contribution = super::Contribution {
     method: "AxisSlices",
     filters: &["AxisSlices", "AxisSlicesBinary", "AxisSlicesBlended", "AxisSlicesBySlice"],
     resources: &[
@@ -39,7 +39,7 @@ pub const CONTRIBUTION: super::Contribution = super::Contribution {
 };
 
 /// Slice-vertex budget of one object: the storage-binding size every WebGPU adapter offers.
-pub const MAX_VERTEX_BYTES: u64 = 128 << 20;
+pub(crate) const MAX_VERTEX_BYTES: u64 = 128 << 20;
 
 pub struct AxisPlan {
     pub params: AxisParams,
@@ -47,16 +47,16 @@ pub struct AxisPlan {
     pub prisms: Vec<Prism>,
     /// Slice-vertex capacity: every prism at its finest level in its largest direction.
     pub capacity: u64,
-    pub blended: bool,
+    pub(crate) blended: bool,
     /// Drawn grouped by slice image (`draw_order: Slices`): the vertex buffer holds a second,
     /// grouped copy after the emitted slices.
-    pub grouped: bool,
-    pub method: AxisSlices,
+    pub(crate) grouped: bool,
+    pub(crate) method: AxisSlices,
 }
 
 impl AxisPlan {
     /// `forward` is the camera's unit forward, `focal` the focal length in pixels.
-    pub fn new(
+    pub(crate) fn new(
         shell: &Shell,
         m: &AxisSlices,
         resolution: [u32; 3],
@@ -111,7 +111,7 @@ impl AxisPlan {
 /// Whether the eye (the origin of the camera-relative shell) is inside a prism of the shell: the
 /// kernels then slice the prisms whose layer holds the eye at the finest level and split the slab
 /// holding the eye at it (`eye_in_layer` in `wgsl/shared/axis_slices.wgsl`).
-pub fn eye_inside(shell: &Shell) -> bool {
+pub(crate) fn eye_inside(shell: &Shell) -> bool {
     use crate::cpu::prism_map::{inverse, PrismCorners};
     use glam::{DVec3, Vec4Swizzles};
     shell.prisms.iter().any(|p| {
@@ -154,7 +154,7 @@ fn finest_vertices(shell: &Shell, index: usize, params: &AxisParams) -> u64 {
 }
 
 /// Adds the buffers, views and samplers of one object's axis slicing to `inputs`.
-pub fn add_inputs(
+pub(crate) fn add_inputs(
     ctx: &crate::gpu::GpuContext,
     inputs: &mut crate::gpu::Inputs,
     shell: &Shell,

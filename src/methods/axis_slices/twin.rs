@@ -9,18 +9,18 @@ use crate::bake::axis_slices::{level_count, level_layer, level_slices, occupancy
 use crate::types::{AxisChoice, AxisParams, AxisVertex};
 
 /// Most slices of one direction crossing one prism.
-pub const MAX_PRISM_SLICES: u32 = 4096;
+pub(crate) const MAX_PRISM_SLICES: u32 = 4096;
 
 /// A prism as the kernels see it: camera-relative corners, uvs, slice normals and thicknesses.
 #[derive(Clone, Debug)]
 pub struct AxisFrame {
-    pub bottom: [Vec3; 3],
-    pub top: [Vec3; 3],
-    pub uv: [Vec2; 3],
+    pub(crate) bottom: [Vec3; 3],
+    pub(crate) top: [Vec3; 3],
+    pub(crate) uv: [Vec2; 3],
     /// Per direction: unit slice-plane normal (xyz) and the texel's thickness along it (w).
-    pub axes: [Vec4; 3],
-    pub centre: Vec3,
-    pub has_uv: bool,
+    pub(crate) axes: [Vec4; 3],
+    pub(crate) centre: Vec3,
+    pub(crate) has_uv: bool,
 }
 
 fn axis_of(n: Vec3, along: Vec3) -> Vec4 {
@@ -68,7 +68,7 @@ impl AxisFrame {
 }
 
 /// The quality score `(1/c^2 - 1) h^2` of a direction (section 4.2); huge when unusable.
-pub fn direction_score(f: &AxisFrame, params: &AxisParams, d: usize, view: Vec3) -> f32 {
+pub(crate) fn direction_score(f: &AxisFrame, params: &AxisParams, d: usize, view: Vec3) -> f32 {
     let axis = f.axes[d];
     let c = axis.truncate().dot(view).abs();
     if c < 1e-6 || axis.w <= 0.0 || (d < 2 && !f.has_uv) {
@@ -81,7 +81,7 @@ pub fn direction_score(f: &AxisFrame, params: &AxisParams, d: usize, view: Vec3)
 /// Slices needed by the criteria `h tan(a) / d <= 1` and `h sin(a) / (z / f) <= p` (the smaller,
 /// since meeting either suffices), with `a` clamped to the maximum view angle, for a direction
 /// of `r` slices at the finest level whose texel thickness is `thickness` at view depth `z`.
-pub fn needed_slices(params: &AxisParams, r: u32, cos_a: f32, thickness: f32, z: f32) -> f32 {
+pub(crate) fn needed_slices(params: &AxisParams, r: u32, cos_a: f32, thickness: f32, z: f32) -> f32 {
     let a = cos_a.clamp(0.0, 1.0).acos().min(params.criteria[2]);
     let depth = r as f32 * a.tan() / params.criteria[0];
     let pixels = thickness * a.sin() * params.criteria[3] / (z.max(1e-6) * params.criteria[1]);
@@ -89,7 +89,7 @@ pub fn needed_slices(params: &AxisParams, r: u32, cos_a: f32, thickness: f32, z:
 }
 
 /// The coarsest power-of-two level of `r` slices with at least `needed` slices.
-pub fn level_for(r: u32, needed: f32) -> u32 {
+pub(crate) fn level_for(r: u32, needed: f32) -> u32 {
     let mut level = 0;
     while level + 1 < level_count(r) && level_slices(r, level + 1) as f32 >= needed {
         level += 1;
@@ -100,7 +100,7 @@ pub fn level_for(r: u32, needed: f32) -> u32 {
 /// The eye's texture coordinate (s, t or w) in the prism's frame: the eye is the origin of the
 /// camera-relative positions, and a coordinate grows by 1 over the axis' thickness from the
 /// centre (s, t: the mean corner uv; w: 1/2). A huge negative value for an unusable direction.
-pub fn eye_coordinate(f: &AxisFrame, d: usize) -> f32 {
+pub(crate) fn eye_coordinate(f: &AxisFrame, d: usize) -> f32 {
     let axis = f.axes[d];
     if axis.w <= 0.0 || (d < 2 && !f.has_uv) {
         return -3.0e38;
@@ -112,14 +112,14 @@ pub fn eye_coordinate(f: &AxisFrame, d: usize) -> f32 {
 /// The eye inside the shell (the host's test, `forward[3]`) and within this prism's height
 /// range: rays from the eye may leave the layer through its top or bottom before reaching a
 /// coarse slab's one slice, so the criteria (made for an eye outside) give way to the finest level.
-pub fn eye_in_layer(f: &AxisFrame, params: &AxisParams) -> bool {
+pub(crate) fn eye_in_layer(f: &AxisFrame, params: &AxisParams) -> bool {
     let w = eye_coordinate(f, 2);
     params.forward[3] != 0.0 && (0.0..=1.0).contains(&w)
 }
 
 /// The eye in the prism's box of texture coordinates widened by one finest slice: there the
 /// camera's forward, not the direction to the centre, says which way the rays go.
-pub fn eye_near(f: &AxisFrame, params: &AxisParams) -> bool {
+pub(crate) fn eye_near(f: &AxisFrame, params: &AxisParams) -> bool {
     (0..2).all(|d| {
         let c = f.uv.map(|uv| uv[d]);
         let (lo, hi) = (c[0].min(c[1]).min(c[2]), c[0].max(c[1]).max(c[2]));
@@ -132,7 +132,7 @@ pub fn eye_near(f: &AxisFrame, params: &AxisParams) -> bool {
 /// The eye's position in slices of the chosen level (slice g spans `[g, g + 1]`) when the eye is
 /// in the prism's layer, else a huge negative value: slices are then drawn farthest from the eye
 /// first on both of its sides, and the slab holding the eye is split at it.
-pub fn eye_slice(f: &AxisFrame, params: &AxisParams, c: &AxisChoice) -> f32 {
+pub(crate) fn eye_slice(f: &AxisFrame, params: &AxisParams, c: &AxisChoice) -> f32 {
     if !eye_in_layer(f, params) {
         return -3.0e38;
     }
@@ -145,13 +145,13 @@ pub fn eye_slice(f: &AxisFrame, params: &AxisParams, c: &AxisChoice) -> f32 {
 
 /// Whether slab `g` holds the eye at `xe` (in slices): a ray from the eye sees only the part on
 /// its own side, so each part is drawn as its own slice.
-pub fn splits_at_eye(g: i32, xe: f32) -> bool {
+pub(crate) fn splits_at_eye(g: i32, xe: f32) -> bool {
     xe > g as f32 && xe < (g + 1) as f32
 }
 
 /// The two parts of slab `g` split at `xe`: texture coordinates of their middles and their
 /// thicknesses in slices, for `n` slices per tile.
-pub fn split_slab(g: i32, xe: f32, n: f32) -> ([f32; 2], [f32; 2]) {
+pub(crate) fn split_slab(g: i32, xe: f32, n: f32) -> ([f32; 2], [f32; 2]) {
     let below = xe - g as f32;
     let above = (g + 1) as f32 - xe;
     ([(g as f32 + 0.5 * below) / n, (xe + 0.5 * above) / n], [below, above])
@@ -159,7 +159,7 @@ pub fn split_slab(g: i32, xe: f32, n: f32) -> ([f32; 2], [f32; 2]) {
 
 /// The slices of a choice in draw order: back to front, or with the eye in the layer, the two
 /// ends of the remaining range, farthest from the eye first (each side of the eye back to front).
-pub fn draw_order(c: &AxisChoice, xe: f32) -> Vec<i32> {
+pub(crate) fn draw_order(c: &AxisChoice, xe: f32) -> Vec<i32> {
     let (mut lo, mut hi) = (c.first, c.first + c.count as i32 - 1);
     (0..c.count)
         .map(|j| {
@@ -231,7 +231,7 @@ pub struct Occluders<'a> {
 }
 
 /// Largest screen rectangle (pixels) the occlusion test reads; larger prisms are drawn.
-pub const MAX_OCCLUSION_PIXELS: i32 = 4096;
+pub(crate) const MAX_OCCLUSION_PIXELS: i32 = 4096;
 
 /// Tolerance of the coverage test (pixels): wider than the rasteriser's sub-pixel snapping.
 const COVER_TOLERANCE: f32 = 1.0 / 64.0;
@@ -269,7 +269,7 @@ fn in_projection(q: &[Vec2; 6], p: Vec2) -> bool {
 /// Twin of `hidden_behind_base` (wgsl/shared/occlusion.wgsl): whether every pixel centre in the
 /// prism's projection already holds a base surface nearer than its nearest corner, so that no
 /// fragment of its slices can pass the depth test.
-pub fn hidden_behind_base(f: &AxisFrame, occ: &Occluders) -> bool {
+pub(crate) fn hidden_behind_base(f: &AxisFrame, occ: &Occluders) -> bool {
     let size = glam::Vec2::new(occ.size.0 as f32, occ.size.1 as f32);
     let (mut lo, mut hi, mut near) = (Vec2::splat(3.4e38), Vec2::splat(-3.4e38), 3.4e38f32);
     let mut q = [Vec2::ZERO; 6];
@@ -305,7 +305,7 @@ pub fn hidden_behind_base(f: &AxisFrame, occ: &Occluders) -> bool {
 }
 
 /// The j-th slice position drawn (back to front).
-pub fn slice_position(c: &AxisChoice, j: u32) -> i32 {
+pub(crate) fn slice_position(c: &AxisChoice, j: u32) -> i32 {
     let k = if c.reverse == 1 { c.count - 1 - j } else { j };
     c.first + k as i32
 }

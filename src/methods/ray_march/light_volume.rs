@@ -4,8 +4,8 @@
 //! thread per column, from the light's side away from it) and read trilinearly by the shading
 //! instead of a shadow ray per sample: a shaded sample takes its shadow ray's first sample
 //! exactly (whether a sample just inside dense matter is lit is decided within a skin far thinner
-//! than a cell) and the volume from the end of that step on. This file plans the grid ([`grid`]), bakes it on the GPU
-//! ([`bake`]) and holds the CPU twins (f64, same names as the kernel and its lookup):
+//! than a cell) and the volume from the end of that step on. This file plans the grid (`grid`), bakes it on the GPU
+//! (`bake`) and holds the CPU twins (f64, same names as the kernel and its lookup):
 //! [`bake_light_volume`] and [`light_transmittance`].
 //!
 //! Each vertex stores its transmittance (the shadow ray from the vertex, sampled at `m` sub-steps
@@ -26,12 +26,12 @@ use crate::methods::ray_march::march::{MAX_ALPHA, MIN_TRANSMITTANCE};
 use crate::types::{HyperParams, LightVolumeParams};
 
 /// Weight of plain trilinear interpolation in the lookup (where every vertex is buried).
-pub const OPEN_FLOOR: f64 = 1e-3;
+pub(crate) const OPEN_FLOOR: f64 = 1e-3;
 
 /// Most sub-steps per layer: finer sampling along the light than a quarter of a cell changed
 /// FLIP against shadow rays by under 2e-4 on the Figure 11 scenes (1 to 22 sub-steps at
 /// resolution 64, HQ), at up to 5x the bake's cost.
-pub const MAX_SUB_STEPS: u32 = 4;
+pub(crate) const MAX_SUB_STEPS: u32 = 4;
 
 /// The light volume's grid for an object whose (enlarged) bounds are `params`' and whose light is
 /// `light` (object space, a world unit along the direction towards the light, as
@@ -39,7 +39,7 @@ pub const MAX_SUB_STEPS: u32 = 4;
 /// cells, `m` sub-steps per layer so that each is at most `shadow_step` (world) long, but at most
 /// [`MAX_SUB_STEPS`] and as many as the per-invocation loop budget allows (`loop_budget`
 /// iterations, `noises + 1` per density).
-pub fn grid(
+pub(crate) fn grid(
     params: &HyperParams,
     light: DVec3,
     resolution: u32,
@@ -96,7 +96,7 @@ pub fn grid(
 }
 
 /// Bytes of a light volume (one word per vertex).
-pub fn bytes(light: &LightVolumeParams) -> u64 {
+pub(crate) fn bytes(light: &LightVolumeParams) -> u64 {
     4 * light.counts[0] as u64 * light.counts[1] as u64 * light.counts[2] as u64
 }
 
@@ -165,7 +165,7 @@ pub fn unpack(words: &[u32]) -> Vec<[f64; 2]> {
 
 /// Runs `bake_transfer.wgsl` and `bake_light_volume.wgsl` for `plan`'s object (`grid`: its mesh
 /// grid): the light volume, one word per vertex.
-pub fn bake(
+pub(crate) fn bake(
     ctx: &GpuContext,
     plan: &super::RayMarchPlan,
     light: &LightVolumeParams,

@@ -11,19 +11,19 @@ use super::light_volume;
 use crate::cpu::hypertexture::Model;
 use crate::types::LightVolumeParams;
 
-pub const MIN_TRANSMITTANCE: f64 = 1e-4;
-pub const MAX_ALPHA: f64 = 0.999999;
+pub(crate) const MIN_TRANSMITTANCE: f64 = 1e-4;
+pub(crate) const MAX_ALPHA: f64 = 0.999999;
 
 /// The camera and light of a frame (from `FrameParams`); right, up, near and the object come
 /// from the model's `HyperParams`.
 pub struct MarchView {
-    pub width: u32,
-    pub height: u32,
-    pub forward: DVec3,
+    pub(crate) width: u32,
+    pub(crate) height: u32,
+    pub(crate) forward: DVec3,
     /// Unit direction towards the light, ambient term and light colour.
-    pub light_dir: DVec3,
-    pub ambient: f64,
-    pub light_color: [f64; 3],
+    pub(crate) light_dir: DVec3,
+    pub(crate) ambient: f64,
+    pub(crate) light_color: [f64; 3],
 }
 
 impl MarchView {
@@ -45,16 +45,16 @@ impl MarchView {
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Shade {
     pub phong: bool,
-    pub shadows: bool,
+    pub(crate) shadows: bool,
     /// Volumetric lighting by the Henyey-Greenstein phase function of this anisotropy g
     /// (instead of Phong).
-    pub phase: Option<f64>,
+    pub(crate) phase: Option<f64>,
     /// Shadows read from a light volume (override `volume_shadows`) instead of shadow rays.
-    pub volume: bool,
+    pub(crate) volume: bool,
 }
 
 impl Shade {
-    pub fn of(shading: crate::scene::Shading) -> Self {
+    pub(crate) fn of(shading: crate::scene::Shading) -> Self {
         use crate::scene::Shading as S;
         match shading {
             S::None => Shade::default(),
@@ -66,7 +66,7 @@ impl Shade {
 
     /// Density evaluations of shading one sample besides its own: 6 for Phong's gradient, one
     /// per shadow sample (a light volume replaces all but the first).
-    pub fn evaluations(&self, shadow_samples: u32) -> u32 {
+    pub(crate) fn evaluations(&self, shadow_samples: u32) -> u32 {
         let shadow = if self.volume { 1 } else { shadow_samples };
         6 * self.phong as u32 + shadow * self.shadows as u32
     }
@@ -92,7 +92,7 @@ struct Ray<'a> {
 }
 
 /// A light volume as [`light_volume::bake_light_volume`] makes it, and its grid.
-pub type LightVolume<'a> = (&'a LightVolumeParams, &'a [[f64; 2]]);
+pub(crate) type LightVolume<'a> = (&'a LightVolumeParams, &'a [[f64; 2]]);
 
 impl Ray<'_> {
     fn bounds_span(&self, o: DVec3, d: DVec3) -> (f64, f64) {

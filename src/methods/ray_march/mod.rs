@@ -27,7 +27,7 @@ use crate::scene::{Hypertexture, RayMarch, Segments, Shadows};
 use crate::types::{HyperParams, LightVolumeParams, MarchState, SegmentParams};
 
 /// What RayMarch brings to the render graph.
-pub const CONTRIBUTION: super::Contribution = super::Contribution {
+pub(crate) const CONTRIBUTION: super::Contribution = super::Contribution {
     method: "RayMarch",
     filters: &["RayMarch", "RayMarchPeeling", "RayMarchSplatting"],
     resources: &[
@@ -61,40 +61,38 @@ pub const CONTRIBUTION: super::Contribution = super::Contribution {
     gather: None,
 };
 
-pub use object::plan_object;
+pub(crate) use object::plan_object;
 
 /// Loop iterations one invocation may run per dispatch. Lavapipe silently ends every loop of an
 /// invocation after 65535 iterations in all; a density evaluation costs one iteration per noise
 /// plus one of the sample or shadow loop around it.
-pub const LOOP_BUDGET: u32 = 48_000;
+pub(crate) const LOOP_BUDGET: u32 = 48_000;
 /// Most samples of one shadow ray (its step grows when the bounds are longer).
-pub const MAX_SHADOW_SAMPLES: u32 = 256;
+pub(crate) const MAX_SHADOW_SAMPLES: u32 = 256;
 /// More dispatches than this means a step far finer than the scene needs.
-pub const MAX_DISPATCHES: u32 = 20_000;
-
-pub use crate::methods::view::RayCamera as Camera;
+pub(crate) const MAX_DISPATCHES: u32 = 20_000;
 
 /// One RayMarch object of a frame.
 #[derive(Debug, Clone)]
 pub struct RayMarchPlan {
-    pub hypertexture: String,
+    pub(crate) hypertexture: String,
     /// The method as the scene (and the overrides) gave it: what the preview shows and steps.
-    pub method: RayMarch,
+    pub(crate) method: RayMarch,
     pub packed: Packed,
     pub params: HyperParams,
     pub shade: Shade,
     pub step: f64,
-    pub shadow_step: f64,
+    pub(crate) shadow_step: f64,
     /// Dispatches of `ray_march.wgsl` per frame.
     pub dispatches: u32,
     /// World-space corners of the enlarged bounds.
-    pub corners: [DVec3; 8],
+    pub(crate) corners: [DVec3; 8],
     /// Benchmarks: `false` compiles the noises out (override `noise_off`).
-    pub noise: bool,
+    pub(crate) noise: bool,
     /// Depth peeling: its passes and the splat lattice (`None`: the bounds are the segment).
     pub peel: Option<(u32, Lattice)>,
     /// EWA-style splatting: its depth slabs and the splat lattice.
-    pub splatting: Option<(u32, Lattice)>,
+    pub(crate) splatting: Option<(u32, Lattice)>,
     /// The camera and splat lattice as `bake_splats.wgsl` and the peeling kernels see them.
     pub segments: SegmentParams,
     /// `shadows: LightVolume(..)`: the light volume's grid (`None`: shadow rays, or no shadows).
@@ -202,7 +200,7 @@ pub fn plan(
 
 /// Bytes of the per-pixel depth slabs of EWA-style splatting (`splat_slabs`): a header of three
 /// words and seven per slab (see `wgsl/shared/segments.wgsl`).
-pub fn slab_bytes(size: (u32, u32), slabs: u32) -> u64 {
+pub(crate) fn slab_bytes(size: (u32, u32), slabs: u32) -> u64 {
     size.0 as u64 * size.1 as u64 * (3 + 7 * slabs as u64) * 4
 }
 
@@ -252,16 +250,16 @@ fn splat_work(
 
 /// Workgroups per splat of `splat_segments.wgsl`: blocks of 64 lanes x `pixels` footprint
 /// pixels over the whole screen (the largest footprint), times the pieces of each chord.
-pub fn splat_blocks(size: (u32, u32), pixels: u32, pieces: u32) -> u32 {
+pub(crate) fn splat_blocks(size: (u32, u32), pixels: u32, pieces: u32) -> u32 {
     (size.0 * size.1).div_ceil(64 * pixels.max(1)) * pieces
 }
 
 /// Workgroups per splat of `splat_segments.wgsl` (along y: the adapters' dispatch limit).
-pub const MAX_SPLAT_BLOCKS: u32 = 65535;
+pub(crate) const MAX_SPLAT_BLOCKS: u32 = 65535;
 
 impl RayMarchPlan {
     /// Values of the kernel's override constants.
-    pub fn constants(&self) -> Vec<(String, f64)> {
+    pub(crate) fn constants(&self) -> Vec<(String, f64)> {
         let mut c = vec![
             ("phong".into(), self.shade.phong as u32 as f64),
             ("shadows".into(), self.shade.shadows as u32 as f64),
@@ -286,7 +284,7 @@ impl RayMarchPlan {
     }
 
     /// The method as written in metadata and `voltex plan`.
-    pub fn describe(&self) -> String {
+    pub(crate) fn describe(&self) -> String {
         let shading = match (self.shade.phong, self.shade.shadows, self.shade.phase) {
             (_, shadows, Some(g)) => format!("HenyeyGreenstein(g: {g}, shadows: {shadows})"),
             (false, ..) => "None".into(),
@@ -323,7 +321,7 @@ impl RayMarchPlan {
     }
 
     /// GPU bytes of the object's buffers (state per pixel included).
-    pub fn bytes(&self, size: (u32, u32)) -> u64 {
+    pub(crate) fn bytes(&self, size: (u32, u32)) -> u64 {
         (std::mem::size_of::<HyperParams>()
             + self.packed.noises.len() * 32
             + self.packed.points.len() * 16
@@ -342,12 +340,12 @@ impl RayMarchPlan {
     }
 
     /// The splat lattice of a depth-peeled or splatted object.
-    pub fn lattice(&self) -> Option<Lattice> {
+    pub(crate) fn lattice(&self) -> Option<Lattice> {
         self.peel.or(self.splatting).map(|(_, l)| l)
     }
 
     /// The buffers sized per pixel, with their bytes (as `add_inputs` creates them).
-    pub fn per_pixel_buffers(&self, size: (u32, u32)) -> Vec<(&'static str, u64)> {
+    pub(crate) fn per_pixel_buffers(&self, size: (u32, u32)) -> Vec<(&'static str, u64)> {
         let mut out = vec![(
             "ray_march_state",
             size.0 as u64 * size.1 as u64 * std::mem::size_of::<MarchState>() as u64,
@@ -367,7 +365,7 @@ impl RayMarchPlan {
     }
 
     /// The splat set's cache key (its object and lattice), for depth-peeled objects.
-    pub fn splat_key(&self) -> Option<u64> {
+    pub(crate) fn splat_key(&self) -> Option<u64> {
         let p = &self.params;
         let l = &self.segments;
         self.lattice().map(|_| {
@@ -392,7 +390,7 @@ impl RayMarchPlan {
     }
 
     /// The mesh grid's cache key and a function that bakes it, for mesh objects.
-    pub fn mesh_grid_key(&self) -> Option<u64> {
+    pub(crate) fn mesh_grid_key(&self) -> Option<u64> {
         self.packed.mesh.as_ref().map(|(shape, spec)| crate::gpu::cache::key(&(shape.hash, spec)))
     }
 
@@ -403,7 +401,7 @@ impl RayMarchPlan {
 
     /// The light volume's cache key: its grid and everything the density depends on (not the
     /// camera, the step or the image), for objects with `shadows: LightVolume(..)`.
-    pub fn light_key(&self) -> Option<u64> {
+    pub(crate) fn light_key(&self) -> Option<u64> {
         let mut p = self.params;
         (p.to_local, p.right, p.up, p.budget) = Default::default();
         (p.bounds_min[3], p.march[1]) = (0.0, 0.0);
@@ -415,7 +413,7 @@ impl RayMarchPlan {
     /// Buffers, counts and constants of the object's graph instance; `grid`: the baked mesh
     /// grid of a mesh object; `splats`: the splat set of a depth-peeled one; `light`: the light
     /// volume of one with `shadows: LightVolume(..)`.
-    pub fn add_inputs(
+    pub(crate) fn add_inputs(
         &self,
         ctx: &GpuContext,
         inputs: &mut Inputs,

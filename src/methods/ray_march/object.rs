@@ -13,7 +13,7 @@ use crate::methods::{InputCx, MethodPlan, ObjectPlan, PartDecl, PlanCx};
 use crate::scene::RayMarch;
 
 /// Plans the march through `object`'s hypertexture.
-pub fn plan_object(cx: &mut PlanCx, object: &mut ObjectPlan, m: &RayMarch) -> Result<()> {
+pub(crate) fn plan_object(cx: &mut PlanCx, object: &mut ObjectPlan, m: &RayMarch) -> Result<()> {
     let name = &object.object.name;
     let node = object
         .object

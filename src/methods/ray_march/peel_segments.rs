@@ -11,14 +11,14 @@ use crate::types::{FrameParams, SegmentParams, Splat};
 
 /// Mirrors the kernel's: exits count only where the disk is on or outside the splat surface
 /// (in cells).
-pub const EXIT_SLACK: f64 = 1e-3;
+pub(crate) const EXIT_SLACK: f64 = 1e-3;
 
 fn v3(a: [f32; 4]) -> DVec3 {
     DVec3::new(a[0] as f64, a[1] as f64, a[2] as f64)
 }
 
 /// The unit world direction through the middle of pixel `(x, y)` (mirrors `pixel_direction`).
-pub fn pixel_direction(frame: &FrameParams, model: &Model, x: u32, y: u32) -> DVec3 {
+pub(crate) fn pixel_direction(frame: &FrameParams, model: &Model, x: u32, y: u32) -> DVec3 {
     let v = frame.viewport;
     let sx = 2.0 * (x as f64 + 0.5) * v[2] as f64 - 1.0;
     let sy = 1.0 - 2.0 * (y as f64 + 0.5) * v[3] as f64;
@@ -27,7 +27,7 @@ pub fn pixel_direction(frame: &FrameParams, model: &Model, x: u32, y: u32) -> DV
 
 /// The parameters (entry, exit) of the ray o + t d inside the enlarged bounds (mirrors
 /// `bounds_span`).
-pub fn bounds_span(model: &Model, o: DVec3, d: DVec3) -> (f64, f64) {
+pub(crate) fn bounds_span(model: &Model, o: DVec3, d: DVec3) -> (f64, f64) {
     let p = model.params;
     let tiny = 1e-30;
     let safe = DVec3::from_array(d.to_array().map(|c| if c.abs() < tiny { tiny.copysign(c) } else { c }));
@@ -39,14 +39,14 @@ pub fn bounds_span(model: &Model, o: DVec3, d: DVec3) -> (f64, f64) {
 /// Pixel `(x, y)`'s ray as the segment kernels set it up: the object-space ray `origin + dir t`
 /// (world point `d t`, `d` its `pixel_direction`), its span (entry, exit) in the enlarged bounds, and
 /// where it starts (the entry or the near plane, whichever is farther).
-pub struct PixelRay {
-    pub origin: DVec3,
-    pub dir: DVec3,
-    pub span: (f64, f64),
-    pub start: f64,
+pub(crate) struct PixelRay {
+    pub(crate) origin: DVec3,
+    pub(crate) dir: DVec3,
+    pub(crate) span: (f64, f64),
+    pub(crate) start: f64,
 }
 
-pub fn pixel_ray(frame: &FrameParams, model: &Model, x: u32, y: u32) -> PixelRay {
+pub(crate) fn pixel_ray(frame: &FrameParams, model: &Model, x: u32, y: u32) -> PixelRay {
     let to_local = DMat4::from_cols_array_2d(&model.params.to_local.map(|c| c.map(|v| v as f64)));
     let d = pixel_direction(frame, model, x, y);
     let origin = to_local.w_axis.truncate();

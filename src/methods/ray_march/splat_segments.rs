@@ -14,7 +14,7 @@ use crate::cpu::hypertexture::Model;
 use crate::types::{FrameParams, SegmentParams, Splat};
 
 /// Standard deviation of the Gaussian in units of the sphere's radius (mirrors `SIGMA`).
-pub const SIGMA: f64 = 0.5;
+pub(crate) const SIGMA: f64 = 0.5;
 
 #[derive(Clone, Copy, Default)]
 struct Slab {

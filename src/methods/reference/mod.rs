@@ -26,7 +26,7 @@ use crate::types::{
 };
 
 /// What Reference brings to the render graph.
-pub const CONTRIBUTION: super::Contribution = super::Contribution {
+pub(crate) const CONTRIBUTION: super::Contribution = super::Contribution {
     method: "Reference",
     filters: &["Reference"],
     resources: &[
@@ -47,20 +47,20 @@ pub const CONTRIBUTION: super::Contribution = super::Contribution {
 /// Everything the reference kernel reads, for all Reference objects of a frame.
 pub struct ReferenceSet {
     /// Indices of the Reference objects in the blueprint.
-    pub objects: Vec<usize>,
-    pub params: ReferenceParams,
-    pub nodes: Vec<ReferenceNode>,
-    pub prisms: Vec<ReferencePrism>,
-    pub vertices: Vec<ShellVertex>,
-    pub frames: Vec<VertexFrame>,
-    pub table: Vec<ReferenceObject>,
+    pub(crate) objects: Vec<usize>,
+    pub(crate) params: ReferenceParams,
+    pub(crate) nodes: Vec<ReferenceNode>,
+    pub(crate) prisms: Vec<ReferencePrism>,
+    pub(crate) vertices: Vec<ShellVertex>,
+    pub(crate) frames: Vec<VertexFrame>,
+    pub(crate) table: Vec<ReferenceObject>,
     /// Per object: its bake, copied to `table[i].atlas.x` (volume) and `.z` (normals, per-pixel only).
-    pub copies: Vec<(usize, bool)>,
+    pub(crate) copies: Vec<(usize, bool)>,
     /// Atlas sizes in u32 words (at least 1: the bindings exist).
-    pub atlas_words: u64,
-    pub normal_words: u64,
+    pub(crate) atlas_words: u64,
+    pub(crate) normal_words: u64,
     /// Dispatches of the tracer per frame (each marches SAMPLES_PER_DISPATCH steps of a ray).
-    pub dispatches: u32,
+    pub(crate) dispatches: u32,
 }
 
 /// Mirrors the default of `samples_per_dispatch` and `WINDOW_COST` in trace_reference.wgsl.
@@ -68,7 +68,7 @@ const SAMPLES_PER_DISPATCH: f64 = 512.0;
 const WINDOW_COST: f64 = 16.0;
 const MAX_SEGMENTS: f64 = 16.0;
 /// More dispatches than this means a step far finer than the scene needs.
-pub const MAX_DISPATCHES: u32 = 20_000;
+pub(crate) const MAX_DISPATCHES: u32 = 20_000;
 
 /// A bound on the work along any ray through the object: a ray meets a shell in a few stretches
 /// (four, for a torus seen edge-on), each no longer than the shell's bounding diagonal.
@@ -92,7 +92,7 @@ fn work_bound(s: &BaseSurface, step: f64) -> f64 {
 
 /// Half the smallest world extent of a voxel over the object (height along w; `dP/ds`, `dP/dt`
 /// lengths along s and t), averaged over its vertices.
-pub fn default_step(s: &BaseSurface, resolution: [u32; 3]) -> f64 {
+pub(crate) fn default_step(s: &BaseSurface, resolution: [u32; 3]) -> f64 {
     let n = s.heights.len().max(1) as f64;
     let h = s.heights.iter().map(|h| h.length()).sum::<f64>() / n;
     let frames = shell::vertex_frames(s);
@@ -123,21 +123,21 @@ fn row_pitch(width: u32) -> u32 {
 }
 
 /// One object drawn by the Reference method, as the set needs it.
-pub struct Member<'a> {
+pub(crate) struct Member<'a> {
     /// Index of the object in the frame.
-    pub index: usize,
-    pub surface: &'a BaseSurface,
-    pub shell: &'a Shell,
+    pub(crate) index: usize,
+    pub(crate) surface: &'a BaseSurface,
+    pub(crate) shell: &'a Shell,
     /// Per-vertex texel frames (per-pixel lighting only).
-    pub frames: Option<&'a [VertexFrame]>,
+    pub(crate) frames: Option<&'a [VertexFrame]>,
     /// The base surface is drawn opaque.
-    pub opaque: bool,
+    pub(crate) opaque: bool,
     /// Ray step (world units).
-    pub step: f64,
+    pub(crate) step: f64,
     /// The bake it samples: index, resolution and opacity length.
-    pub bake: usize,
-    pub resolution: [u32; 3],
-    pub opacity_length: f32,
+    pub(crate) bake: usize,
+    pub(crate) resolution: [u32; 3],
+    pub(crate) opacity_length: f32,
 }
 
 impl Member<'_> {
@@ -146,7 +146,7 @@ impl Member<'_> {
     }
 }
 
-pub fn build(members: &[Member], params: ReferenceParams) -> ReferenceSet {
+pub(crate) fn build(members: &[Member], params: ReferenceParams) -> ReferenceSet {
     let mut set = ReferenceSet {
         objects: members.iter().map(|m| m.index).collect(),
         params,
@@ -217,7 +217,7 @@ pub fn build(members: &[Member], params: ReferenceParams) -> ReferenceSet {
 
 impl ReferenceSet {
     /// Checks the atlases against the adapter's storage-buffer limit, and the dispatch count.
-    pub fn check_limits(&self, max_binding: u64) -> Result<()> {
+    pub(crate) fn check_limits(&self, max_binding: u64) -> Result<()> {
         if self.dispatches > MAX_DISPATCHES {
             return Err(Error::Invalid(format!(
                 "the Reference step is too fine for this scene: {} dispatches per frame (at most {MAX_DISPATCHES}); \
@@ -239,7 +239,7 @@ impl ReferenceSet {
     }
 
     /// Buffers of the reference instance; the atlases are filled from the bakes by `copy_volumes`.
-    pub fn add_inputs(&self, ctx: &GpuContext, inputs: &mut Inputs, size: (u32, u32)) {
+    pub(crate) fn add_inputs(&self, ctx: &GpuContext, inputs: &mut Inputs, size: (u32, u32)) {
         inputs.counts.insert("reference_dispatches".into(), self.dispatches);
         let state = ctx.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("reference_state"),
@@ -283,7 +283,7 @@ impl ReferenceSet {
     }
 
     /// Copies level 0 of each object's volume (and normals) into the atlases.
-    pub fn copy_volumes(&self, ctx: &GpuContext, inputs: &Inputs, baked: &[crate::bake::Baked]) {
+    pub(crate) fn copy_volumes(&self, ctx: &GpuContext, inputs: &Inputs, baked: &[crate::bake::Baked]) {
         let mut enc = ctx.device.create_command_encoder(&Default::default());
         for (entry, &(bake, per_pixel)) in self.table.iter().zip(&self.copies) {
             let [w, h, d, _] = entry.resolution;
@@ -314,7 +314,7 @@ impl ReferenceSet {
 /// surfaces, volumes decoded from the atlases the kernel read (`texel_atlas`, `normal_atlas`
 /// bytes as copied from the GPU).
 /// `members` are those the set was built from; `size` and `eye` the frame's.
-pub fn twin_inputs(
+pub(crate) fn twin_inputs(
     set: &ReferenceSet,
     members: &[Member],
     (frame, size, eye): (&FrameParams, (u32, u32), DVec3),

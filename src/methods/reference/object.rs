@@ -14,9 +14,9 @@ use crate::types::{FrameParams, ReferenceParams};
 /// One Reference object: its ray step; it is drawn by the frame's [`ReferenceSet`].
 pub struct ReferencePlan {
     /// Ray step (world units).
-    pub step: f64,
+    pub(crate) step: f64,
     /// Dispatches per frame of the set that traces it.
-    pub dispatches: u32,
+    pub(crate) dispatches: u32,
 }
 
 /// Plans `object`'s bake, lighting and step.
@@ -77,7 +77,7 @@ pub(super) fn gather(
 }
 
 /// Inputs of the f64 twin for a frame, from its objects, bakes and set and the atlases the kernel
-/// read (see [`twin_inputs`]).
+/// read (see `twin_inputs`).
 pub fn frame_twin_inputs(
     objects: &[ObjectPlan],
     bakes: &[BakePlan],

@@ -14,20 +14,20 @@ use glam::{DVec2, DVec3};
 use crate::cpu::prism_map::{self, PrismCorners};
 
 /// Rays stop once the transmittance falls below this (as the kernel does).
-pub const MIN_TRANSMITTANCE: f64 = 1e-4;
+pub(crate) const MIN_TRANSMITTANCE: f64 = 1e-4;
 /// Voxel opacity is clamped below 1 so that its extinction stays finite.
-pub const MAX_ALPHA: f64 = 0.999999;
+pub(crate) const MAX_ALPHA: f64 = 0.999999;
 
 /// Level 0 of a baked volume, decoded: x fastest, then y, then z.
-pub struct Volume {
-    pub resolution: [u32; 3],
-    pub texels: Vec<[f64; 4]>,
+pub(crate) struct Volume {
+    pub(crate) resolution: [u32; 3],
+    pub(crate) texels: Vec<[f64; 4]>,
 }
 
 impl Volume {
     /// Trilinear filtering as the volume sampler does it: texel centres at `(i + 0.5) / n`,
     /// repeating in s and t, clamped in w.
-    pub fn sample(&self, uvw: DVec3) -> [f64; 4] {
+    pub(crate) fn sample(&self, uvw: DVec3) -> [f64; 4] {
         let [nx, ny, nz] = self.resolution.map(|n| n as i64);
         let axis = |c: f64, n: i64, wrap: bool| {
             let x = c * n as f64 - 0.5;
@@ -58,21 +58,21 @@ impl Volume {
 
 /// Per-pixel (Phong) lighting inputs of an object: its normal volume and, per prism corner,
 /// `dP/ds` and `dP/dt` (the same vertex frames the slicing method interpolates).
-pub struct PerPixel {
-    pub normals: Volume,
-    pub frames: Vec<[(DVec3, DVec3); 3]>,
+pub(crate) struct PerPixel {
+    pub(crate) normals: Volume,
+    pub(crate) frames: Vec<[(DVec3, DVec3); 3]>,
 }
 
 /// One object as the tracer sees it (camera-relative f64 corners).
 pub struct TraceObject {
     pub prisms: Vec<PrismCorners>,
-    pub uvs: Vec<[DVec2; 3]>,
-    pub volume: Volume,
-    pub per_pixel: Option<PerPixel>,
-    pub opacity_length: f64,
-    pub step: f64,
+    pub(crate) uvs: Vec<[DVec2; 3]>,
+    pub(crate) volume: Volume,
+    pub(crate) per_pixel: Option<PerPixel>,
+    pub(crate) opacity_length: f64,
+    pub(crate) step: f64,
     /// The base surface is drawn opaque: rays stop where they cross a prism's bottom from above.
-    pub opaque_base: bool,
+    pub(crate) opaque_base: bool,
 }
 
 /// The camera and light: a pixel's ray is `forward + sx right + sy up` (right and up scaled by the
@@ -80,14 +80,14 @@ pub struct TraceObject {
 pub struct TraceView {
     pub width: u32,
     pub height: u32,
-    pub forward: DVec3,
-    pub right: DVec3,
-    pub up: DVec3,
-    pub near: f64,
+    pub(crate) forward: DVec3,
+    pub(crate) right: DVec3,
+    pub(crate) up: DVec3,
+    pub(crate) near: f64,
     /// Towards the light (unit), its colour, and the ambient term.
-    pub light_dir: DVec3,
-    pub light_color: [f64; 3],
-    pub ambient: f64,
+    pub(crate) light_dir: DVec3,
+    pub(crate) light_color: [f64; 3],
+    pub(crate) ambient: f64,
 }
 
 impl TraceView {
@@ -118,7 +118,7 @@ pub fn trace_reference(view: &TraceView, objects: &[TraceObject]) -> Vec<[f64; 4
     out
 }
 
-pub fn trace_ray(view: &TraceView, objects: &[TraceObject], d: DVec3) -> [f64; 4] {
+pub(crate) fn trace_ray(view: &TraceView, objects: &[TraceObject], d: DVec3) -> [f64; 4] {
     let t_min = view.near / d.dot(view.forward);
     let mut t_max = f64::INFINITY;
     let mut segments = Vec::new();

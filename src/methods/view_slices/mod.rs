@@ -4,7 +4,7 @@
 pub mod lod;
 mod object;
 pub mod slice_prisms;
-pub mod tile_buffers;
+pub(crate) mod tile_buffers;
 pub mod tiles;
 
 pub use object::{plan, ViewSlicesPlan};
@@ -14,7 +14,7 @@ use crate::mesh::shell::Shell;
 use crate::types::{SliceParams, SliceVertex};
 
 /// What ViewSlices brings to the render graph.
-pub const CONTRIBUTION: super::Contribution = super::Contribution {
+pub(crate) const CONTRIBUTION: super::Contribution = super::Contribution {
     method: "ViewSlices",
     filters: &["ViewSlices", "ViewSlicesRaster", "ViewSlicesTiles"],
     resources: &[
@@ -62,11 +62,11 @@ pub fn sweep(shell: &Shell, forward: [f32; 3], planes: u32, near: f64) -> SliceP
 
 /// Planes one thread of `count_slices` / `emit_slices` loops over (WGSL override
 /// `planes_per_thread`; the dispatch's y size is the plane count divided by it).
-pub const PLANES_PER_THREAD: u32 = 32;
+pub(crate) const PLANES_PER_THREAD: u32 = 32;
 
 /// Slice-vertex budget of one chunk of a sweep: the storage-binding size every WebGPU adapter
 /// offers (128 MiB), so a chunk binds everywhere.
-pub const CHUNK_BYTES: u64 = 128 << 20;
+pub(crate) const CHUNK_BYTES: u64 = 128 << 20;
 
 /// A run of consecutive planes of a sweep with its own buffers, sized to fit one binding.
 #[derive(Clone, Copy, Debug)]
@@ -74,13 +74,13 @@ pub struct SliceChunk {
     /// The chunk's planes (`first_plane` and `plane_count` of the chunk; the spacing of the sweep).
     pub params: SliceParams,
     /// Slice-vertex capacity (an upper bound of what the chunk emits).
-    pub capacity: u64,
+    pub(crate) capacity: u64,
 }
 
 /// Upper bound of the triangle-list vertices each plane of the sweep emits: per prism, 9 (a
 /// pentagon is 3 triangles) on every plane its depth range crosses. Allocating this, not
 /// planes x prisms x 9, keeps memory proportional to what is drawn.
-pub fn plane_bounds(shell: &Shell, params: &SliceParams) -> Vec<u64> {
+pub(crate) fn plane_bounds(shell: &Shell, params: &SliceParams) -> Vec<u64> {
     // Difference array: +9 where a prism's plane range starts, -9 after it ends.
     let mut diff = vec![0i64; params.plane_count as usize + 1];
     for p in &shell.prisms {
@@ -101,7 +101,11 @@ pub fn plane_bounds(shell: &Shell, params: &SliceParams) -> Vec<u64> {
 
 /// The planes `[k_min, k_max]` of a sweep (or chunk) whose depth range the prism's corners span,
 /// widened by one plane for f32 rounding; `None` when there is none.
-pub fn prism_planes(shell: &Shell, p: &crate::types::Prism, params: &SliceParams) -> Option<(u32, u32)> {
+pub(crate) fn prism_planes(
+    shell: &Shell,
+    p: &crate::types::Prism,
+    params: &SliceParams,
+) -> Option<(u32, u32)> {
     let n = params.plane_normal.map(|x| x as f64);
     let spacing = params.spacing as f64;
     let first = params.first_plane as f64;
@@ -122,12 +126,12 @@ pub fn prism_planes(shell: &Shell, p: &crate::types::Prism, params: &SliceParams
     (k_max >= k_min).then_some((k_min as u32, k_max as u32))
 }
 
-/// Total slice-vertex capacity of a sweep (see [`plane_bounds`]).
+/// Total slice-vertex capacity of a sweep (see `plane_bounds`).
 pub fn vertex_capacity(shell: &Shell, params: &SliceParams) -> u64 {
     plane_bounds(shell, params).iter().sum()
 }
 
-/// Splits a sweep into chunks of consecutive planes whose vertex bound fits [`CHUNK_BYTES`],
+/// Splits a sweep into chunks of consecutive planes whose vertex bound fits `CHUNK_BYTES`,
 /// back to front.
 pub fn chunks(shell: &Shell, params: &SliceParams) -> Vec<SliceChunk> {
     let budget = CHUNK_BYTES / std::mem::size_of::<SliceVertex>() as u64;
@@ -153,10 +157,10 @@ pub fn chunks(shell: &Shell, params: &SliceParams) -> Vec<SliceChunk> {
 }
 
 /// Most slice-vertex memory one object may use (all chunks together).
-pub const MAX_SLICE_BYTES: u64 = 1 << 30;
+pub(crate) const MAX_SLICE_BYTES: u64 = 1 << 30;
 
 /// Checks a sweep's slice-vertex memory against [`MAX_SLICE_BYTES`].
-pub fn check_budget(chunks: &[SliceChunk], object: &str, planes: u32) -> Result<()> {
+pub(crate) fn check_budget(chunks: &[SliceChunk], object: &str, planes: u32) -> Result<()> {
     let bytes = chunks.iter().map(|c| c.capacity).sum::<u64>() * std::mem::size_of::<SliceVertex>() as u64;
     if bytes > MAX_SLICE_BYTES {
         return Err(Error::Invalid(format!(
@@ -170,7 +174,7 @@ pub fn check_budget(chunks: &[SliceChunk], object: &str, planes: u32) -> Result<
 }
 
 /// Checks that a chunk's slice-vertex buffer fits the adapter's limits.
-pub fn check_capacity(capacity: u64, max_binding: u64, object: &str, planes: u32) -> Result<()> {
+pub(crate) fn check_capacity(capacity: u64, max_binding: u64, object: &str, planes: u32) -> Result<()> {
     let bytes = capacity * std::mem::size_of::<SliceVertex>() as u64;
     if bytes > max_binding || capacity > u32::MAX as u64 {
         return Err(Error::Gpu(format!(

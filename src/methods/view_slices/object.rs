@@ -11,13 +11,13 @@ use crate::types::{SliceParams, SliceVertex, VertexFrame};
 pub struct ViewSlicesPlan {
     /// The whole sweep, and its chunks (consecutive planes with their own buffers).
     pub sweep: SliceParams,
-    pub chunks: Vec<SliceChunk>,
-    pub trivial_reject: bool,
-    pub compositor: Compositor,
+    pub(crate) chunks: Vec<SliceChunk>,
+    pub(crate) trivial_reject: bool,
+    pub(crate) compositor: Compositor,
     /// `Tiles`: the tile-list entries of each chunk.
     pub tile_entries: Vec<u32>,
     /// The rendered size the tiles were planned for.
-    pub size: (u32, u32),
+    pub(crate) size: (u32, u32),
     /// The scene's plane count (`lod: Auto`: the most it may draw).
     pub max_planes: u32,
     /// What `lod: Auto` chose; `None` when off.

@@ -6,7 +6,7 @@
 use crate::types::{DrawIndirect, Prism, ShellVertex, SliceParams, SliceVertex};
 
 /// Below this `|s_a - s_b|` an edge counts as lying in the plane (t = 0.5).
-pub const MIN_DENOM: f32 = 1e-30;
+pub(crate) const MIN_DENOM: f32 = 1e-30;
 
 /// Where the plane cuts a prolonged normal edge (paper Fig. 3(b)).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -23,7 +23,7 @@ pub enum EdgeClass {
 /// triangle; `position.w` holds the prism index as f32 bits.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Polygon {
-    pub vertices: [SliceVertex; 5],
+    pub(crate) vertices: [SliceVertex; 5],
     pub len: usize,
 }
 
@@ -84,7 +84,7 @@ fn load_prism(vertices: &[ShellVertex], prism: &Prism) -> Option<PrismCorners> {
 }
 
 /// Depth of plane `k` (0 = back-most).
-pub fn plane_offset(params: &SliceParams, k: u32) -> f32 {
+pub(crate) fn plane_offset(params: &SliceParams, k: u32) -> f32 {
     params.first_plane - k as f32 * params.spacing
 }
 
@@ -100,7 +100,7 @@ fn crossed(sa: f32, sb: f32) -> bool {
 /// The paper's per-edge classification from the signed distances of bottom and top: b if they
 /// are on different sides, else a if `|s_top| < |s_bottom|`, else c (parallel edges included).
 /// For reference and tests: the slicer emits edges by their sign crossings and uses
-/// [`classify_oriented`] only to pick the paper's order where its walk is free.
+/// `classify_oriented` only to pick the paper's order where its walk is free.
 pub fn classify(s_bottom: f32, s_top: f32) -> EdgeClass {
     if crossed(s_bottom, s_top) {
         EdgeClass::Within
@@ -115,7 +115,7 @@ pub fn classify(s_bottom: f32, s_top: f32) -> EdgeClass {
 /// (`rising`: the summed `s_top - s_bottom` is >= 0), not the edge's own. Equal to [`classify`]
 /// for every edge whose own rise has the prism's sign; it differs for edges parallel to the plane
 /// (where the paper's rule calls both sides c) and in twisted prisms.
-pub fn classify_oriented(s_bottom: f32, s_top: f32, rising: bool) -> EdgeClass {
+pub(crate) fn classify_oriented(s_bottom: f32, s_top: f32, rising: bool) -> EdgeClass {
     if crossed(s_bottom, s_top) {
         return EdgeClass::Within;
     }
@@ -269,7 +269,7 @@ pub fn slice_prism(
 }
 
 /// Triangle-list vertices of a polygon with `count` points (WGSL `fan_vertex_count`).
-pub fn fan_vertex_count(count: usize) -> u32 {
+pub(crate) fn fan_vertex_count(count: usize) -> u32 {
     if count >= 3 {
         3 * (count as u32 - 2)
     } else {
@@ -278,7 +278,7 @@ pub fn fan_vertex_count(count: usize) -> u32 {
 }
 
 /// Fan triangulation (0, f+1, f+2), in the order `emit_slices` writes it.
-pub fn triangulate(polygon: &Polygon) -> Vec<SliceVertex> {
+pub(crate) fn triangulate(polygon: &Polygon) -> Vec<SliceVertex> {
     let v = polygon.as_slice();
     let mut out = Vec::with_capacity(fan_vertex_count(v.len()) as usize);
     for f in 0..v.len().saturating_sub(2) {
@@ -330,7 +330,7 @@ pub fn count_slices(
 }
 
 /// Twin of `scan_plane_offsets`: exclusive prefix sums of `counts` and the draw arguments.
-pub fn scan_plane_offsets(counts: &[u32], vertex_capacity: u32) -> (Vec<u32>, DrawIndirect) {
+pub(crate) fn scan_plane_offsets(counts: &[u32], vertex_capacity: u32) -> (Vec<u32>, DrawIndirect) {
     let mut total = 0u32;
     let offsets = counts
         .iter()

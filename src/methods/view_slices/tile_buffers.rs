@@ -8,12 +8,17 @@ use crate::types::{SliceParams, TileAttributes, TileParams, TileTriangle};
 
 /// Most bytes of tile-list entries per chunk by default: past them, segments are composited from
 /// their planes' triangles (slower, same image).
-pub const MAX_ENTRY_BYTES: u64 = 128 << 20;
+pub(crate) const MAX_ENTRY_BYTES: u64 = 128 << 20;
 
 /// Upper bound of a chunk's tile-list entries: per prism, the triangles its slices can have (3 per
 /// plane it spans: a pentagon's fan) times the tiles its projected corners' bounding box meets
 /// (every tile when a corner lies behind the camera).
-pub fn entry_bound(shell: &Shell, params: &SliceParams, view_proj: &[[f32; 4]; 4], size: (u32, u32)) -> u64 {
+pub(crate) fn entry_bound(
+    shell: &Shell,
+    params: &SliceParams,
+    view_proj: &[[f32; 4]; 4],
+    size: (u32, u32),
+) -> u64 {
     let m = glam::Mat4::from_cols_array_2d(view_proj);
     let tiles = |n: u32| n.div_ceil(TILE_SIZE) as i64;
     let all = (tiles(size.0) * tiles(size.1)) as u64;
@@ -50,13 +55,13 @@ pub fn entry_bound(shell: &Shell, params: &SliceParams, view_proj: &[[f32; 4]; 4
 
 /// The entries a chunk's lists get: `requested` (tests, `RenderOptions::tile_entries`), else its
 /// bound up to [`MAX_ENTRY_BYTES`].
-pub fn entry_capacity(bound: u64, requested: Option<u32>) -> u32 {
+pub(crate) fn entry_capacity(bound: u64, requested: Option<u32>) -> u32 {
     requested.unwrap_or(bound.clamp(1024, MAX_ENTRY_BYTES / 4) as u32).max(1)
 }
 
 /// Bytes of each buffer the compositor adds for a chunk: triangles, their texel coordinates,
 /// cursors, entries, layer.
-pub fn tile_bytes(params: &TileParams, vertex_capacity: u64) -> [(&'static str, u64); 5] {
+pub(crate) fn tile_bytes(params: &TileParams, vertex_capacity: u64) -> [(&'static str, u64); 5] {
     let segments = (params.tiles_x * params.tiles_y * params.blocks) as u64;
     let triangles = (vertex_capacity / 3).max(1);
     [
@@ -69,7 +74,7 @@ pub fn tile_bytes(params: &TileParams, vertex_capacity: u64) -> [(&'static str, 
 }
 
 /// Adds a chunk's compositor buffers and counts to `inputs`.
-pub fn add_inputs(
+pub(crate) fn add_inputs(
     ctx: &crate::gpu::GpuContext,
     inputs: &mut crate::gpu::Inputs,
     size: (u32, u32),

@@ -15,9 +15,9 @@ use crate::methods::reference::trace_reference::Volume;
 use crate::types::{FrameParams, SliceVertex, TileAttributes, TileParams, TileTriangle};
 
 /// Tile side in pixels (`TILE_SIZE` in `wgsl/shared/tiles.wgsl`).
-pub const TILE_SIZE: u32 = 8;
+pub(crate) const TILE_SIZE: u32 = 8;
 /// Planes per list segment (`TILE_PLANES`): the per-pixel slots of `composite_tiles`.
-pub const TILE_PLANES: u32 = 32;
+pub(crate) const TILE_PLANES: u32 = 32;
 /// Transmittance below which a pixel stops (`MIN_TRANSMITTANCE` in `composite_tiles.wgsl`).
 pub const MIN_TRANSMITTANCE: f64 = 1e-4;
 /// Largest triangle index an entry can hold (`t << 5 | slot` in a u32).
@@ -41,20 +41,20 @@ fn mul(m: &[[f32; 4]; 4], p: [f32; 3]) -> [f32; 4] {
 }
 
 /// Pixel position (y down) and depth of a camera-relative point.
-pub fn project_to_pixels(p: [f32; 3], view_proj: &[[f32; 4]; 4], size: [f32; 2]) -> [f32; 3] {
+pub(crate) fn project_to_pixels(p: [f32; 3], view_proj: &[[f32; 4]; 4], size: [f32; 2]) -> [f32; 3] {
     let c = mul(view_proj, p);
     let ndc = [c[0] / c[3], c[1] / c[3], c[2] / c[3]];
     [(ndc[0] * 0.5 + 0.5) * size[0], (0.5 - ndc[1] * 0.5) * size[1], ndc[2]]
 }
 
 /// Twice the signed area of the triangle `a b c`.
-pub fn tile_area(a: [f32; 2], b: [f32; 2], c: [f32; 2]) -> f32 {
+pub(crate) fn tile_area(a: [f32; 2], b: [f32; 2], c: [f32; 2]) -> f32 {
     (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
 }
 
 /// The edge function of `a -> b` as coefficients (x, y, constant), from the endpoints in
 /// canonical order, negated if they were swapped.
-pub fn tile_edge(a: [f32; 2], b: [f32; 2]) -> [f32; 3] {
+pub(crate) fn tile_edge(a: [f32; 2], b: [f32; 2]) -> [f32; 3] {
     let swap = a[1] > b[1] || (a[1] == b[1] && a[0] > b[0]);
     let (lo, hi) = if swap { (b, a) } else { (a, b) };
     let n = [lo[1] - hi[1], hi[0] - lo[0]];
@@ -67,14 +67,14 @@ pub fn tile_edge(a: [f32; 2], b: [f32; 2]) -> [f32; 3] {
 }
 
 /// The edge oriented so the inside is positive, `w` 1 when the inside owns centres on it.
-pub fn tile_oriented_edge(e: [f32; 3], orient: f32) -> [f32; 4] {
+pub(crate) fn tile_oriented_edge(e: [f32; 3], orient: f32) -> [f32; 4] {
     let n = e.map(|v| v * orient);
     let owns = n[0] > 0.0 || (n[0] == 0.0 && n[1] > 0.0);
     [n[0], n[1], n[2], if owns { 1.0 } else { -1.0 }]
 }
 
 /// Twin of `tile_triangle`: corners in pixels with their depth.
-pub fn tile_triangle(
+pub(crate) fn tile_triangle(
     a: [f32; 3],
     b: [f32; 3],
     c: [f32; 3],
@@ -113,12 +113,12 @@ fn tile_edge_touches(e: &[f32; 4], x: u32, y: u32) -> bool {
 }
 
 /// Twin of `tile_touches`: whether the triangle may cover a pixel centre of tile (x, y).
-pub fn tile_touches(t: &TileTriangle, x: u32, y: u32) -> bool {
+pub(crate) fn tile_touches(t: &TileTriangle, x: u32, y: u32) -> bool {
     [&t.e0, &t.e1, &t.e2].iter().all(|e| tile_edge_touches(e, x, y))
 }
 
 /// Twin of `tile_attributes_of`: texel coordinates as an affine function of the pixel position.
-pub fn tile_attributes_of(
+pub(crate) fn tile_attributes_of(
     a: [f32; 2],
     b: [f32; 2],
     c: [f32; 2],
@@ -154,7 +154,7 @@ pub fn tile_cover(t: &TileTriangle, p: [f32; 2]) -> Option<[f32; 3]> {
 }
 
 /// The tile range of a binned triangle, `None` when it covers no pixel.
-pub fn tile_range(t: &TileTriangle) -> Option<[u32; 4]> {
+pub(crate) fn tile_range(t: &TileTriangle) -> Option<[u32; 4]> {
     (t.tiles[0] <= t.tiles[2] && t.tiles[1] <= t.tiles[3]).then_some(t.tiles)
 }
 
@@ -239,20 +239,20 @@ pub fn fill_tiles(params: &TileParams, triangles: &[TileTriangle], starts: &[u32
 /// What `composite_tiles` reads, for its twin (lighting `Baked` only: the per-pixel frames are
 /// `draw_slices`' own code, checked by the Tiles-against-Raster images).
 pub struct TileFrame<'a> {
-    pub frame: &'a FrameParams,
-    pub params: TileParams,
-    pub spacing: f32,
-    pub opacity_length: f32,
-    pub vertices: &'a [SliceVertex],
-    pub plane_ends: &'a [u32],
-    pub vertex_count: u32,
-    pub triangles: &'a [TileTriangle],
+    pub(crate) frame: &'a FrameParams,
+    pub(crate) params: TileParams,
+    pub(crate) spacing: f32,
+    pub(crate) opacity_length: f32,
+    pub(crate) vertices: &'a [SliceVertex],
+    pub(crate) plane_ends: &'a [u32],
+    pub(crate) vertex_count: u32,
+    pub(crate) triangles: &'a [TileTriangle],
     /// Segment ends (after `fill_tiles`).
-    pub cursors: &'a [u32],
-    pub entries: &'a [u32],
-    pub volume: &'a Volume,
+    pub(crate) cursors: &'a [u32],
+    pub(crate) entries: &'a [u32],
+    pub(crate) volume: &'a Volume,
     /// The depth buffer (row-major), `None` for all 1.0.
-    pub depth: Option<&'a [f32]>,
+    pub(crate) depth: Option<&'a [f32]>,
 }
 
 /// The premultiplied fragment of triangle `t` at barycentrics `bary` (`slice_fragment`, baked).

@@ -19,10 +19,10 @@ use crate::scene::{Method, Volume, VolumeNode};
 use crate::types::{MarchState, VolumeParams};
 use crate::vdb::SparseVolume as Grid;
 
-pub use object::plan;
+pub(crate) use object::plan;
 
 /// What volume objects bring to the render graph.
-pub const CONTRIBUTION: super::Contribution = super::Contribution {
+pub(crate) const CONTRIBUTION: super::Contribution = super::Contribution {
     method: "Volume",
     filters: &["Volume"],
     resources: &["volume_params", "volume_table", "volume_density", "volume_color", "volume_state"],
@@ -33,38 +33,38 @@ pub const CONTRIBUTION: super::Contribution = super::Contribution {
 
 /// Loop iterations one invocation may run per dispatch (lavapipe ends an invocation's loops
 /// after 65535 iterations in all).
-pub const LOOP_BUDGET: u32 = 48_000;
+pub(crate) const LOOP_BUDGET: u32 = 48_000;
 /// Most samples of one shadow ray (its step grows when the box is longer).
-pub const MAX_SHADOW_SAMPLES: u32 = 256;
+pub(crate) const MAX_SHADOW_SAMPLES: u32 = 256;
 /// More dispatches than this means a step far finer than the volume needs.
-pub const MAX_DISPATCHES: u32 = 20_000;
+pub(crate) const MAX_DISPATCHES: u32 = 20_000;
 
 /// One volume object of a frame.
 #[derive(Debug, Clone)]
 pub struct VolumePlan {
-    pub volume: String,
-    pub grid: Arc<Grid>,
+    pub(crate) volume: String,
+    pub(crate) grid: Arc<Grid>,
     pub params: VolumeParams,
     /// Reference: exact optical depth per voxel cell; else RayMarch's midpoint samples.
-    pub exact: bool,
-    pub phong: bool,
-    pub shadows: bool,
-    pub step: f64,
-    pub shadow_step: f64,
-    pub dispatches: u32,
+    pub(crate) exact: bool,
+    pub(crate) phong: bool,
+    pub(crate) shadows: bool,
+    pub(crate) step: f64,
+    pub(crate) shadow_step: f64,
+    pub(crate) dispatches: u32,
     /// World corners of the box outside which the density is 0.
-    pub corners: [DVec3; 8],
+    pub(crate) corners: [DVec3; 8],
     /// The method as resolved (the preview's switch, metadata).
-    pub method: Method,
+    pub(crate) method: Method,
 }
 
 /// The length in world units of the shortest voxel edge of `node`'s grid.
-pub fn voxel_length(node: &VolumeNode) -> f64 {
+pub(crate) fn voxel_length(node: &VolumeNode) -> f64 {
     crate::vdb::voxel_size(&(node.to_world * node.grid.index_to_world))
 }
 
 /// Plans the march of `node` drawn with `method` (RayMarch or Reference) from `camera`.
-pub fn plan_volume(
+pub(crate) fn plan_volume(
     object: &str,
     node: &VolumeNode,
     volume: &Volume,
@@ -142,7 +142,7 @@ pub fn plan_volume(
 
 impl VolumePlan {
     /// Values of the kernel's override constants.
-    pub fn constants(&self) -> Vec<(String, f64)> {
+    pub(crate) fn constants(&self) -> Vec<(String, f64)> {
         vec![
             ("exact".into(), self.exact as u32 as f64),
             ("phong".into(), self.phong as u32 as f64),
@@ -168,12 +168,12 @@ impl VolumePlan {
     }
 
     /// Bytes of the per-pixel march state.
-    pub fn state_bytes(size: (u32, u32)) -> u64 {
+    pub(crate) fn state_bytes(size: (u32, u32)) -> u64 {
         size.0 as u64 * size.1 as u64 * std::mem::size_of::<MarchState>() as u64
     }
 
     /// The brick table's and atlases' cache key: the grid's content.
-    pub fn upload_key(&self) -> u64 {
+    pub(crate) fn upload_key(&self) -> u64 {
         crate::gpu::cache::key(&("volume", self.grid.hash))
     }
 }
