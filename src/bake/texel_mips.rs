@@ -17,7 +17,7 @@ pub fn voxels(res: [u32; 3], mipmaps: bool) -> u64 {
 }
 
 /// Records every MIP level of `texture` (level 0 baked), each from the one above.
-pub fn record(
+pub(crate) fn record(
     ctx: &GpuContext,
     kernel: &mut ComputeKernel,
     encoder: &mut wgpu::CommandEncoder,

@@ -25,7 +25,7 @@ pub struct ObjectPlan {
     /// Index into the frame's bakes.
     pub(crate) bake: Option<usize>,
     /// What the object draws, in draw order.
-    pub(crate) methods: Vec<Box<dyn MethodPlan>>,
+    pub methods: Vec<Box<dyn MethodPlan>>,
 }
 
 impl ObjectPlan {
