@@ -4,6 +4,7 @@
 
 pub mod axis_slices;
 pub mod hypertexture;
+pub mod shadow;
 pub mod volume;
 
 use crate::gpu::sources::Sources;
@@ -116,6 +117,8 @@ pub struct BakeRequest {
     pub axis_slices: bool,
     /// ... with their MIP levels (`AxisSlices(mipmaps: true)`).
     pub axis_mipmaps: bool,
+    /// Self-shadowing baked into the colour after the source's bake (`shadow_texel.wgsl`).
+    pub shadow: Option<shadow::Shadow>,
 }
 
 impl BakeRequest {
@@ -137,6 +140,9 @@ impl BakeRequest {
             }
             BakeSource::Volume(_) => vec!["bake/bake_volume.wgsl"],
         };
+        if self.shadow.is_some() {
+            k.push(shadow::KERNEL);
+        }
         if self.axis_slices {
             k.push("axis_slices/bake_axis_slices.wgsl");
         }
@@ -187,6 +193,9 @@ impl BakeRequest {
             driver: driver.clone(),
         };
         let mut out = vec![volume(format!("texel \"{texel}\"'s volume"), res)];
+        if self.shadow.is_some() {
+            out.push(volume(format!("texel \"{texel}\"'s shadowed volume"), res));
+        }
         if self.per_pixel {
             out.push(volume(format!("texel \"{texel}\"'s normal volume"), res));
         }
@@ -240,6 +249,19 @@ impl BakeRequest {
         };
         let lighting = if self.per_pixel { "per-pixel (albedo + normals)" } else { "baked" };
         let mut s = format!("  {texel:<16} {x}x{y}x{z}  {kind}  lighting {lighting}\n");
+        if let Some(sh) = &self.shadow {
+            let [lx, ly, lz] = sh.toward_light.map(|c| c as f64);
+            let l = glam::DVec3::new(lx, ly, lz).normalize();
+            s += &format!(
+                "  (and its baked shadows: {} towards ({:.3}, {:.3}, {:.3}), extinction {}, ambient {})\n",
+                shadow::KERNEL,
+                l.x,
+                l.y,
+                l.z,
+                sh.extinction,
+                sh.ambient
+            );
+        }
         if self.axis_slices {
             s += "  (and its slice images: bake_axis_slices.wgsl per direction and level)\n";
             if self.axis_mipmaps {
@@ -271,6 +293,7 @@ pub struct Baker {
     axis: Slot,
     volume: Slot,
     axis_mip: Slot,
+    shadow: Slot,
     sources: Sources,
     /// `Rgba32Float` for [`Baker::full_precision`], else `Rgba8Unorm`.
     format: wgpu::TextureFormat,
@@ -289,6 +312,7 @@ impl Baker {
             axis: None,
             volume: None,
             axis_mip: None,
+            shadow: None,
             sources: sources.clone(),
             format: wgpu::TextureFormat::Rgba8Unorm,
         }
@@ -459,6 +483,13 @@ impl Baker {
                 v.bake(ctx, kernel, &mut encoder, &mut inputs, params)?;
             }
         }
+        let volume = match &req.shadow {
+            Some(sh) => {
+                let kernel = Self::kernel(&mut self.shadow, ctx, &root, shadow::KERNEL, self.format)?;
+                shadow::apply(ctx, kernel, &mut encoder, &volume, sh)?
+            }
+            None => volume,
+        };
         let axis = match req.axis_slices {
             true => {
                 let format = self.format;

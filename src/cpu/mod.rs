@@ -9,3 +9,4 @@ pub mod bake_transfer;
 pub mod hypertexture;
 pub mod noise_simplex;
 pub mod prism_map;
+pub mod shadow_texel;

@@ -1,6 +1,7 @@
 //! Scene texels as bake requests: only texels some object draws, each (texel, lighting) once.
 
 use crate::bake::hypertexture::HyperTexel;
+use crate::bake::shadow::Shadow;
 use crate::bake::volume::VolumeTexel;
 use crate::bake::{BakeRequest, BakeSource, Heights, MeshTexel, StackTexels};
 use crate::cpu::bake::{pack_shapes, Shape as BakeShape};
@@ -152,6 +153,12 @@ pub fn bake_index(
             ambient: light.ambient,
             axis_slices: false,
             axis_mipmaps: false,
+            shadow: t.shadow.map(|sh| Shadow {
+                // The direction towards the light, like `light.direction`.
+                toward_light: sh.direction.map_or(light.direction, |d| (-d).as_vec3().to_array()),
+                extinction: sh.extinction,
+                ambient: sh.ambient,
+            }),
         },
         opacity_length: t.opacity_length(&scene.hypertextures),
     });

@@ -142,6 +142,7 @@ pub fn plan(scene: &Scene, opts: &ExportOptions) -> Result<Vec<Export>> {
                     ambient: light.ambient,
                     axis_slices: false,
                     axis_mipmaps: false,
+                    shadow: None,
                 },
                 opacity_length: h.opacity_length,
             },

@@ -12,7 +12,7 @@ pub use budget::Positions;
 
 pub use crate::methods::options::{MethodKind, RenderOptions, DEFAULT_AXIS_SLICES, DEFAULT_PLANES};
 pub use crate::methods::{BakePlan, ObjectPlan};
-pub use renderer::{Frame, Renderer};
+pub use renderer::{bake_key, Frame, Renderer};
 
 use std::path::{Path, PathBuf};
 

@@ -194,6 +194,17 @@ pub(super) fn direction<'de, D: Deserializer<'de>>(d: D) -> Result<DVec3, D::Err
     }
 }
 
+/// An optional direction: finite and not zero when given.
+pub(super) fn opt_direction<'de, D: Deserializer<'de>>(d: D) -> Result<Option<DVec3>, D::Error> {
+    match Option::<[Finite; 3]>::deserialize(d)? {
+        None => Ok(None),
+        Some(v) => match DVec3::new(v[0].0, v[1].0, v[2].0) {
+            v if v.length_squared() > 0.0 => Ok(Some(v)),
+            _ => Err(D::Error::custom("expected a non-zero direction")),
+        },
+    }
+}
+
 /// Prefix of the ron message of a [`Mark`] failure; the mapping uses the span's end (where the
 /// value starts) for these and strips it.
 pub(super) const MARK_PREFIX: &str = "\u{1}mark:";

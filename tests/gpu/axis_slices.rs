@@ -131,6 +131,7 @@ fn slice_image_bake_matches_its_twin() {
         ambient: 0.3,
         axis_slices: true,
         axis_mipmaps: false,
+        shadow: None,
     };
     let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
     let baked = Baker::new(&voltex::gpu::sources::Sources::project().unwrap()).bake(&ctx, &request).unwrap();
@@ -178,6 +179,7 @@ fn slice_image_mips_match_their_twin() {
         ambient: 0.3,
         axis_slices: true,
         axis_mipmaps: true,
+        shadow: None,
     };
     let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
     let baked = Baker::new(&voltex::gpu::sources::Sources::project().unwrap()).bake(&ctx, &request).unwrap();
@@ -234,6 +236,7 @@ fn height_image_bake_matches_its_twin() {
         ambient,
         axis_slices: false,
         axis_mipmaps: false,
+        shadow: None,
     };
     let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
     let baked = Baker::new(&voltex::gpu::sources::Sources::project().unwrap()).bake(&ctx, &request).unwrap();

@@ -27,5 +27,6 @@ mod preview_draft;
 mod reference;
 mod regress;
 mod render_scenes;
+mod texel_shadow;
 mod tile_compositor;
 mod volume;
