@@ -362,7 +362,8 @@ pub struct ShadowParams {
     /// one texel unit (the box's height) of alpha-1 matter.
     pub light: [f32; 4],
     /// x: ambient, the light a voxel keeps in full shadow (colour scale `ambient + (1 -
-    /// ambient) T`); y: optical depth past which the march stops (T is taken as 0); zw unused.
+    /// ambient) T`); y: optical depth past which the march stops; z: bias, the voxels (along the
+    /// axis the light crosses fastest) the march skips from the voxel's centre; w unused.
     pub shading: [f32; 4],
 }
 

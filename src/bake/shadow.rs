@@ -17,11 +17,19 @@ pub struct Shadow {
     pub toward_light: [f32; 3],
     pub extinction: f32,
     pub ambient: f32,
+    /// Voxels the march skips from each voxel's centre (see `cpu::shadow_texel`).
+    pub bias: f32,
 }
 
 impl Shadow {
     pub fn params(&self, res: [u32; 3]) -> crate::types::ShadowParams {
-        crate::cpu::shadow_texel::shadow_params(res, self.toward_light, self.extinction, self.ambient)
+        crate::cpu::shadow_texel::shadow_params(
+            res,
+            self.toward_light,
+            self.extinction,
+            self.ambient,
+            self.bias,
+        )
     }
 }
 

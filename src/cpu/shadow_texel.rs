@@ -8,6 +8,11 @@ use crate::types::ShadowParams;
 /// stops (the transmittance left, below 1.2e-7, is under an 8-bit step by far).
 pub const OPTICAL_CUTOFF: f32 = 16.0;
 
+/// Alpha of the matter a march starting in it first leaves, counting nothing (a voxel inside a
+/// solid takes the shadow of the point where the light enters the solid, as the paper fills a
+/// solid's inside with its surface colour, 3.2).
+pub const SOLID: f64 = 0.99;
+
 /// Most voxels one march crosses for a texel of `res`: four times across the box along each
 /// axis, enough for a light 70 degrees off the vertical through a cubic texel; a longer
 /// march counts the rest of its way as empty.
@@ -16,27 +21,43 @@ pub fn max_steps(res: [u32; 3]) -> u32 {
 }
 
 /// The uniform of the kernel: `toward_light` (texel space, any length), `extinction` (optical
-/// depth of one texel unit of alpha-1 matter), `ambient` in `[0, 1]`.
-pub fn shadow_params(res: [u32; 3], toward_light: [f32; 3], extinction: f32, ambient: f32) -> ShadowParams {
+/// depth of one texel unit of alpha-1 matter), `ambient` in `[0, 1]`, `bias` (voxels, along
+/// the axis the light's direction crosses fastest, that the march skips).
+pub fn shadow_params(
+    res: [u32; 3],
+    toward_light: [f32; 3],
+    extinction: f32,
+    ambient: f32,
+    bias: f32,
+) -> ShadowParams {
     let l = glam::Vec3::from_array(toward_light).normalize();
     ShadowParams {
         resolution: [res[0], res[1], res[2], max_steps(res)],
         light: [l.x, l.y, l.z, extinction],
-        shading: [ambient, OPTICAL_CUTOFF, 0.0, 0.0],
+        shading: [ambient, OPTICAL_CUTOFF, bias, 0.0],
     }
 }
 
-/// Transmittance from the centre of `voxel` towards the light through the opacity `alpha(x, y,
+/// Transmittance from `bias` voxels off the centre of `voxel` towards the light through the opacity `alpha(x, y,
 /// z)` (nearest voxel; x and y wrap, the march ends where z leaves the box).
 pub fn transmittance(p: &ShadowParams, alpha: impl Fn([usize; 3]) -> f64, voxel: [u32; 3]) -> f64 {
     let res = [p.resolution[0] as i64, p.resolution[1] as i64, p.resolution[2] as i64];
     let dq: [f64; 3] = std::array::from_fn(|a| p.light[a] as f64 * res[a] as f64);
     let delta = dq.map(|d| if d != 0.0 { 1.0 / d.abs() } else { 1e30 });
     let advance = dq.map(|d| d.signum() as i64 * (d != 0.0) as i64);
-    let mut next = delta.map(|d| 0.5 * d);
-    let mut cell = voxel.map(i64::from);
-    let (mut t, mut optical) = (0.0, 0.0);
+    let mut t = p.shading[2] as f64 * delta.iter().copied().fold(f64::INFINITY, f64::min);
+    let start: [f64; 3] = std::array::from_fn(|a| voxel[a] as f64 + 0.5 + t * dq[a]);
+    let mut cell = start.map(|s| s.floor() as i64);
+    let mut next: [f64; 3] = std::array::from_fn(|a| match dq[a] {
+        d if d > 0.0 => t + ((cell[a] + 1) as f64 - start[a]) / d,
+        d if d < 0.0 => t + (cell[a] as f64 - start[a]) / d,
+        _ => 1e30,
+    });
+    let (mut optical, mut inside) = (0.0, true);
     for _ in 0..p.resolution[3] {
+        if cell[2] < 0 || cell[2] >= res[2] {
+            break;
+        }
         let axis = if next[0] <= next[1] && next[0] <= next[2] {
             0
         } else if next[1] <= next[2] {
@@ -45,11 +66,15 @@ pub fn transmittance(p: &ShadowParams, alpha: impl Fn([usize; 3]) -> f64, voxel:
             2
         };
         let at = [cell[0].rem_euclid(res[0]) as usize, cell[1].rem_euclid(res[1]) as usize, cell[2] as usize];
-        optical += p.light[3] as f64 * alpha(at).clamp(0.0, 1.0) * (next[axis] - t);
+        let a = alpha(at).clamp(0.0, 1.0);
+        inside = inside && a as f32 >= SOLID as f32;
+        if !inside {
+            optical += p.light[3] as f64 * a * (next[axis] - t);
+        }
         t = next[axis];
         cell[axis] += advance[axis];
         next[axis] += delta[axis];
-        if optical > p.shading[1] as f64 || cell[2] < 0 || cell[2] >= res[2] {
+        if optical > p.shading[1] as f64 {
             break;
         }
     }

@@ -158,6 +158,7 @@ pub fn bake_index(
                 toward_light: sh.direction.map_or(light.direction, |d| (-d).as_vec3().to_array()),
                 extinction: sh.extinction,
                 ambient: sh.ambient,
+                bias: sh.bias,
             }),
         },
         opacity_length: t.opacity_length(&scene.hypertextures),

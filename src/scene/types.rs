@@ -195,6 +195,14 @@ pub struct TexelShadow {
     /// Light kept in full shadow, in `[0, 1]`.
     #[serde(default, deserialize_with = "v::unit_f32")]
     pub ambient: f32,
+    /// Voxels the march skips from each voxel's centre before it counts opacity, so that a
+    /// voxelised surface does not shadow itself on its own steps (0 to 8).
+    #[serde(default = "default_shadow_bias", deserialize_with = "v::shadow_bias")]
+    pub bias: f32,
+}
+
+fn default_shadow_bias() -> f32 {
+    1.5
 }
 
 /// A texel's opacity length when the file gives none (and its source has no length of its own).

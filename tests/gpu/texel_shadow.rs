@@ -4,7 +4,7 @@
 
 use crate::common;
 
-use common::ctx;
+use common::{ctx, ok, root, s, voltex};
 
 use voltex::bake::axis_slices::read_texture;
 use voltex::bake::shadow::Shadow;
@@ -90,21 +90,24 @@ fn the_shadow_kernel_matches_its_twin() {
 
 #[test]
 fn a_constant_slab_is_shadowed_as_exp_of_depth_over_cos() {
-    // A Constant texel fills the box: an infinite slab 1 high (s and t wrap).
+    // A Constant texel fills the box: an infinite slab 1 high (s and t wrap). With a bias of b
+    // voxels the march starts b voxels higher (w crosses fastest in both directions here).
     let (alpha, sigma, n) = (0.6, 5.0, 16u32);
-    for (name, direction, cos) in
-        [("above", "(0.0, 0.0, -1.0)", 1.0), ("angled", "(-0.48, -0.64, -0.6)", 0.6)]
-    {
+    for (name, direction, cos, bias) in [
+        ("above", "(0.0, 0.0, -1.0)", 1.0, 0.0),
+        ("angled", "(-0.48, -0.64, -0.6)", 0.6, 0.0),
+        ("angled-bias", "(-0.48, -0.64, -0.6)", 0.6, 2.0),
+    ] {
         let texel = format!(
             "(resolution: (8, 8, {n}), source: Constant(color: (1.0, 1.0, 1.0), opacity: {alpha}), \
-             shadow: (extinction: {sigma}, direction: {direction}))"
+             shadow: (extinction: {sigma}, direction: {direction}, bias: {bias:?}))"
         );
         let mut p = plan(name, &texel);
         let v = bake(&p.request, true);
         p.request.shadow = None;
         let lit = bake(&p.request, true);
         for z in 0..n {
-            let depth = (n as f64 - (z as f64 + 0.5)) / n as f64;
+            let depth = ((n as f64 - (z as f64 + 0.5) - bias) / n as f64).max(0.0);
             let t = (-sigma * alpha * depth / cos).exp();
             for voxel in [(0, 0), (5, 3), (7, 7)] {
                 let i = voxel.0 + 8 * (voxel.1 + 8 * z as usize);
@@ -133,7 +136,7 @@ fn a_column_shadows_its_neighbour_across_the_tile_edge() {
             }
         }
     }
-    let shadow = Shadow { toward_light: [1.0, 0.0, 1.0], extinction: 8.0, ambient: 0.0 };
+    let shadow = Shadow { toward_light: [1.0, 0.0, 1.0], extinction: 8.0, ambient: 0.0, bias: 0.0 };
     let request = BakeRequest {
         resolution: [n, 4, n],
         source: BakeSource::Stack(StackTexels(std::sync::Arc::new(stack))),
@@ -153,7 +156,7 @@ fn a_column_shadows_its_neighbour_across_the_tile_edge() {
         assert!((at(n - 1, z)[0] - through).abs() < 1e-5, "z {z}: {:?} against {through}", at(n - 1, z));
     }
     assert!((at(1, 3)[0] - grey as f32).abs() < 1e-6, "right of the column: lit");
-    let twin = shadow_texel(&shadow_params(request.resolution, shadow.toward_light, 8.0, 0.0), &{
+    let twin = shadow_texel(&shadow_params(request.resolution, shadow.toward_light, 8.0, 0.0, 0.0), &{
         let mut r = request;
         r.shadow = None;
         bake(&r, true)
@@ -181,4 +184,16 @@ fn the_shadow_kernel_is_in_the_bake_key() {
     assert_ne!(key(&project, &shadowed), key(&edited, &shadowed));
     assert_eq!(key(&project, &plain), key(&edited, &plain));
     assert_ne!(key(&project, &plain), key(&project, &shadowed));
+}
+
+#[test]
+fn plan_lists_the_shadow_pass() {
+    let scene = root().join("scenes/meyer_neyret/shadowed_pears.ron");
+    let printed = ok(voltex(&["plan", s(&scene)]));
+    assert!(
+        printed.contains(
+            "(and its baked shadows: bake/shadow_texel.wgsl towards (0.672, -0.471, 0.572), extinction 80"
+        ),
+        "{printed}"
+    );
 }

@@ -3,7 +3,8 @@
 
 // Meyer & Neyret 1998, 3.1: the slices store colour only, so shadows are captured in the pattern
 // for a light fixed at creation. The march is an exact voxel traversal (Amanatides & Woo) of the
-// nearest-voxel opacity, from the voxel's centre towards the light, with extinction
+// nearest-voxel opacity, from `shadow.shading.z` voxels off the voxel's centre (a bias against
+// a surface shadowing itself on its own voxel steps) towards the light, with extinction
 // `shadow.light.w * alpha` per texel unit; s and t wrap (the texel tiles), the march ends where
 // it leaves through the top or the bottom (w), after `shadow.resolution.w` voxels, or once the
 // optical depth passes `shadow.shading.y`. Twin: `shadow_texel` in src/cpu/shadow_texel.rs.
@@ -13,6 +14,10 @@
 @group(0) @binding(2) var volume: texture_storage_3d<rgba8unorm, write>;
 
 const FAR: f32 = 1e30;
+// A march that starts in matter this opaque first leaves it, counting nothing: a voxel inside a
+// solid takes the shadow of the point where the light enters the solid, as the paper fills a
+// solid's inside with its surface colour (3.2), for the slices' gaps show the inside.
+const SOLID: f32 = 0.99;
 
 // Time (texel units) to cross one voxel along each axis, FAR where the ray runs parallel.
 fn crossing(dq: vec3<f32>) -> vec3<f32> {
@@ -31,11 +36,21 @@ fn transmittance(voxel: vec3<i32>) -> f32 {
     let dq = shadow.light.xyz * vec3<f32>(res);
     let delta = crossing(dq);
     let advance = vec3<i32>(sign(dq));
-    var next = 0.5 * delta; // from the centre to each axis's next boundary
-    var cell = voxel;
-    var t = 0.0;
+    // The march starts `bias` voxels (along the axis it crosses fastest) towards the light.
+    var t = shadow.shading.z * min(delta.x, min(delta.y, delta.z));
+    let start = vec3<f32>(voxel) + 0.5 + t * dq;
+    var cell = vec3<i32>(floor(start));
+    var next = vec3<f32>(FAR); // time of each axis's next boundary
+    for (var a = 0; a < 3; a++) {
+        if (dq[a] > 0.0) {
+            next[a] = t + (f32(cell[a] + 1) - start[a]) / dq[a];
+        } else if (dq[a] < 0.0) {
+            next[a] = t + (f32(cell[a]) - start[a]) / dq[a];
+        }
+    }
     var optical = 0.0;
-    for (var i = 0u; i < shadow.resolution.w; i++) {
+    var inside = true;
+    for (var i = 0u; i < shadow.resolution.w && cell.z >= 0 && cell.z < res.z; i++) {
         var axis = 2;
         if (next.x <= next.y && next.x <= next.z) {
             axis = 0;
@@ -44,11 +59,14 @@ fn transmittance(voxel: vec3<i32>) -> f32 {
         }
         let wrapped = vec3<i32>((cell.xy % res.xy + res.xy) % res.xy, cell.z);
         let alpha = clamp(textureLoad(source, wrapped, 0).a, 0.0, 1.0);
-        optical += shadow.light.w * alpha * (next[axis] - t);
+        inside = inside && alpha >= SOLID;
+        if (!inside) {
+            optical += shadow.light.w * alpha * (next[axis] - t);
+        }
         t = next[axis];
         cell[axis] += advance[axis];
         next[axis] += delta[axis];
-        if (optical > shadow.shading.y || cell.z < 0 || cell.z >= res.z) {
+        if (optical > shadow.shading.y) {
             break;
         }
     }
