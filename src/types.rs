@@ -353,6 +353,22 @@ pub struct AxisBake {
     pub level: [u32; 4],
 }
 
+/// One dispatch of `shadow_texel` (uniform `shadow`): self-shadowing baked into a texel.
+/// Mirrored as `ShadowParams` in `wgsl/shared/types.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct ShadowParams {
+    /// xyz: texel resolution (s, t, w); w: most voxels one march crosses.
+    pub resolution: [u32; 4],
+    /// xyz: unit texel-space direction towards the light; w: extinction, the optical depth of
+    /// one texel unit (the box's height) of alpha-1 matter.
+    pub light: [f32; 4],
+    /// x: ambient, the light a voxel keeps in full shadow (colour scale `ambient + (1 -
+    /// ambient) T`); y: optical depth past which the march stops; z: bias, the voxels (along the
+    /// axis the light crosses fastest) the march skips from the voxel's centre; w unused.
+    pub shading: [f32; 4],
+}
+
 /// One hypertexture object of the `RayMarch` method (uniform `hyper`). Object space is the node's
 /// local frame; the camera sits at the origin of camera-relative world space.
 #[repr(C)]

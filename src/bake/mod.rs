@@ -6,6 +6,7 @@
 pub mod axis_slices;
 pub mod hypertexture;
 pub mod texel_mips;
+pub mod shadow;
 pub mod volume;
 
 use crate::gpu::sources::Sources;
@@ -120,6 +121,8 @@ pub struct BakeRequest {
     pub axis_mipmaps: bool,
     /// The MIP levels of the volume (and normal volume) too (`ViewSlices(lod: Auto)`).
     pub volume_mipmaps: bool,
+    /// Self-shadowing baked into the colour after the source's bake (`shadow_texel.wgsl`).
+    pub shadow: Option<shadow::Shadow>,
 }
 
 impl BakeRequest {
@@ -141,6 +144,9 @@ impl BakeRequest {
             }
             BakeSource::Volume(_) => vec!["bake/bake_volume.wgsl"],
         };
+        if self.shadow.is_some() {
+            k.push(shadow::KERNEL);
+        }
         if self.axis_slices {
             k.push("axis_slices/bake_axis_slices.wgsl");
         }
@@ -196,6 +202,9 @@ impl BakeRequest {
             driver: driver.clone(),
         };
         let mut out = vec![volume(format!("texel \"{texel}\"'s volume"), res)];
+        if self.shadow.is_some() {
+            out.push(volume(format!("texel \"{texel}\"'s shadowed volume"), res));
+        }
         if self.per_pixel {
             out.push(volume(format!("texel \"{texel}\"'s normal volume"), res));
         }
@@ -252,6 +261,19 @@ impl BakeRequest {
         if self.volume_mipmaps {
             s += "  (and its MIP levels: mip_texel_volume.wgsl per level)\n";
         }
+        if let Some(sh) = &self.shadow {
+            let [lx, ly, lz] = sh.toward_light.map(|c| c as f64);
+            let l = glam::DVec3::new(lx, ly, lz).normalize();
+            s += &format!(
+                "  (and its baked shadows: {} towards ({:.3}, {:.3}, {:.3}), extinction {}, ambient {})\n",
+                shadow::KERNEL,
+                l.x,
+                l.y,
+                l.z,
+                sh.extinction,
+                sh.ambient
+            );
+        }
         if self.axis_slices {
             s += "  (and its slice images: bake_axis_slices.wgsl per direction and level)\n";
             if self.axis_mipmaps {
@@ -290,6 +312,7 @@ pub struct Baker {
     /// `mip_texel_volume` writing the volume's format, and writing normals (`rgba8snorm`).
     volume_mip: Slot,
     normals_mip: Slot,
+    shadow: Slot,
     sources: Sources,
     /// `Rgba32Float` for [`Baker::full_precision`], else `Rgba8Unorm`.
     format: wgpu::TextureFormat,
@@ -310,6 +333,7 @@ impl Baker {
             axis_mip: None,
             volume_mip: None,
             normals_mip: None,
+            shadow: None,
             sources: sources.clone(),
             format: wgpu::TextureFormat::Rgba8Unorm,
         }
@@ -510,6 +534,13 @@ impl Baker {
                 v.bake(ctx, kernel, &mut encoder, &mut inputs, params)?;
             }
         }
+        let volume = match &req.shadow {
+            Some(sh) => {
+                let kernel = Self::kernel(&mut self.shadow, ctx, &root, shadow::KERNEL, self.format)?;
+                shadow::apply(ctx, kernel, &mut encoder, &volume, sh)?
+            }
+            None => volume,
+        };
         if req.volume_mipmaps {
             for (slot, texture) in [(&mut self.volume_mip, &volume), (&mut self.normals_mip, &normals)] {
                 let kernel = Self::mip_kernel(slot, ctx, &root, texture.format())?;

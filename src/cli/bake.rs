@@ -60,6 +60,10 @@ pub fn run(args: BakeArgs) -> Result<()> {
             )));
         }
         plan.request.per_pixel = unlit;
+        if unlit {
+            // The unlit albedo carries no lighting, baked shadows included.
+            plan.request.shadow = None;
+        }
     }
     let out =
         out.unwrap_or_else(|| PathBuf::from("out/bake").join(scene_path.file_stem().unwrap_or_default()));

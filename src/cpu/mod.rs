@@ -10,3 +10,4 @@ pub mod hypertexture;
 pub mod mip_texel_volume;
 pub mod noise_simplex;
 pub mod prism_map;
+pub mod shadow_texel;

@@ -1,6 +1,7 @@
 //! Scene texels as bake requests: only texels some object draws, each (texel, lighting) once.
 
 use crate::bake::hypertexture::HyperTexel;
+use crate::bake::shadow::Shadow;
 use crate::bake::volume::VolumeTexel;
 use crate::bake::{BakeRequest, BakeSource, Heights, MeshTexel, StackTexels};
 use crate::cpu::bake::{pack_shapes, Shape as BakeShape};
@@ -153,6 +154,13 @@ pub(crate) fn bake_index(
             axis_slices: false,
             axis_mipmaps: false,
             volume_mipmaps: false,
+            shadow: t.shadow.map(|sh| Shadow {
+                // The direction towards the light, like `light.direction`.
+                toward_light: sh.direction.map_or(light.direction, |d| (-d).as_vec3().to_array()),
+                extinction: sh.extinction,
+                ambient: sh.ambient,
+                bias: sh.bias,
+            }),
         },
         opacity_length: t.opacity_length(&scene.hypertextures),
     });

@@ -143,6 +143,7 @@ pub fn plan(scene: &Scene, opts: &ExportOptions) -> Result<Vec<Export>> {
                     axis_slices: false,
                     axis_mipmaps: false,
                     volume_mipmaps: false,
+                    shadow: None,
                 },
                 opacity_length: h.opacity_length,
             },

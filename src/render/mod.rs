@@ -11,8 +11,8 @@ pub mod trace;
 pub(crate) use budget::Positions;
 
 pub use crate::methods::options::{MethodKind, RenderOptions, DEFAULT_AXIS_SLICES, DEFAULT_PLANES};
-pub(crate) use crate::methods::{BakePlan, ObjectPlan};
-pub use renderer::{Frame, Renderer};
+pub use crate::methods::{BakePlan, ObjectPlan};
+pub use renderer::{bake_key, Frame, Renderer};
 
 use std::path::{Path, PathBuf};
 

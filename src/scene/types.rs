@@ -172,6 +172,37 @@ pub struct Texel {
     #[serde(default, rename = "opacity_length", deserialize_with = "v::opt_positive_f32")]
     pub(crate) opacity_length_given: Option<f32>,
     pub source: TexelSource,
+    /// Self-shadowing baked into the texel's colour (off when absent).
+    #[serde(default)]
+    pub shadow: Option<TexelShadow>,
+}
+
+/// `shadow: (extinction: 40.0)`: every voxel's colour scaled by `ambient + (1 - ambient) T`, `T`
+/// the transmittance from its centre towards a light fixed at bake time through the texel's
+/// own opacity (extinction `extinction * alpha` per texel unit: the box is 1 high), wrapping
+/// across the tile's s and t edges and leaving through its top or bottom (Meyer & Neyret 1998,
+/// 3.1).
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TexelShadow {
+    /// Optical depth of one texel unit of alpha-1 matter.
+    #[serde(deserialize_with = "v::positive_f32")]
+    pub extinction: f32,
+    /// The direction the light travels, in texel space (s, t, w); default: the scene's first
+    /// light's, taken in texel space as the baked shading takes it.
+    #[serde(default, deserialize_with = "v::opt_direction")]
+    pub direction: Option<DVec3>,
+    /// Light kept in full shadow, in `[0, 1]`.
+    #[serde(default, deserialize_with = "v::unit_f32")]
+    pub ambient: f32,
+    /// Voxels the march skips from each voxel's centre before it counts opacity, so that a
+    /// voxelised surface does not shadow itself on its own steps (0 to 8).
+    #[serde(default = "default_shadow_bias", deserialize_with = "v::shadow_bias")]
+    pub bias: f32,
+}
+
+fn default_shadow_bias() -> f32 {
+    1.5
 }
 
 /// A texel's opacity length when the file gives none (and its source has no length of its own).

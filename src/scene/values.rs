@@ -46,6 +46,7 @@ checked_f64!(SliceDepth, |v| v > 0.0 && v <= 1024.0, "a depth in (0, 1024] voxel
 checked_f64!(SlicePixels, |v| v > 0.0 && v <= 1024.0, "a slice distance in (0, 1024] pixels");
 checked_f64!(MaxAngle, |v| v > 0.0 && v < 90.0, "a view angle in (0, 90) degrees");
 checked_f64!(FieldOfView, |v| v > 0.0 && v < 180.0, "a field of view in (0, 180) degrees");
+checked_f64!(ShadowBias, |v| (0.0..=8.0).contains(&v), "a shadow bias in [0, 8] voxels");
 
 macro_rules! checked_u32 {
     ($name:ident, $lo:expr, $hi:expr, $what:literal) => {
@@ -131,6 +132,7 @@ adapter!(positive_f32, f32, Positive, |v| v.0 as f32);
 adapter!(opt_positive_f32, Option<f32>, Option<Positive>, |v| v.map(|x| x.0 as f32));
 adapter!(non_negative_f32, f32, NonNegative, |v| v.0 as f32);
 adapter!(unit_f32, f32, Unit, |v| v.0 as f32);
+adapter!(shadow_bias, f32, ShadowBias, |v| v.0 as f32);
 adapter!(vec3, DVec3, [Finite; 3], |v| DVec3::new(v[0].0, v[1].0, v[2].0));
 adapter!(scale3, DVec3, [NonZero; 3], |v| DVec3::new(v[0].0, v[1].0, v[2].0));
 adapter!(positive2, [f64; 2], [Positive; 2], |v| [v[0].0, v[1].0]);
@@ -191,6 +193,17 @@ pub(super) fn direction<'de, D: Deserializer<'de>>(d: D) -> Result<DVec3, D::Err
         Ok(v)
     } else {
         Err(D::Error::custom("expected a non-zero direction"))
+    }
+}
+
+/// An optional direction: finite and not zero when given.
+pub(super) fn opt_direction<'de, D: Deserializer<'de>>(d: D) -> Result<Option<DVec3>, D::Error> {
+    match Option::<[Finite; 3]>::deserialize(d)? {
+        None => Ok(None),
+        Some(v) => match DVec3::new(v[0].0, v[1].0, v[2].0) {
+            v if v.length_squared() > 0.0 => Ok(Some(v)),
+            _ => Err(D::Error::custom("expected a non-zero direction")),
+        },
     }
 }
 

@@ -42,6 +42,7 @@ fn wgsl_structs_match_rust() {
         layout!(AxisChoice; direction, level, first, count, vertex_count, vertex_offset, reverse, culled),
         layout!(AxisVertex; position, texcoord, normal),
         layout!(AxisBake; resolution, level),
+        layout!(ShadowParams; resolution, light, shading),
         layout!(HyperParams; to_local, right, up, bounds_min, bounds_max, object, field, field_center, perturb, kinds, march, budget, grid_min, grid_max, modulation),
         layout!(MeshGridParams; lo, hi, counts),
         layout!(MeshTexelParams; color, extent, mode),

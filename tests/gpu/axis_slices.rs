@@ -132,6 +132,7 @@ fn slice_image_bake_matches_its_twin() {
         axis_slices: true,
         axis_mipmaps: false,
         volume_mipmaps: false,
+        shadow: None,
     };
     let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
     let baked = Baker::new(&voltex::gpu::sources::Sources::project().unwrap()).bake(&ctx, &request).unwrap();
@@ -180,6 +181,7 @@ fn slice_image_mips_match_their_twin() {
         axis_slices: true,
         axis_mipmaps: true,
         volume_mipmaps: false,
+        shadow: None,
     };
     let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
     let baked = Baker::new(&voltex::gpu::sources::Sources::project().unwrap()).bake(&ctx, &request).unwrap();
@@ -237,6 +239,7 @@ fn height_image_bake_matches_its_twin() {
         axis_slices: false,
         axis_mipmaps: false,
         volume_mipmaps: false,
+        shadow: None,
     };
     let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
     let baked = Baker::new(&voltex::gpu::sources::Sources::project().unwrap()).bake(&ctx, &request).unwrap();

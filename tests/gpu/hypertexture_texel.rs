@@ -55,6 +55,7 @@ fn bake(ht: &HyperTexel, resolution: [u32; 3], per_pixel: bool) -> (Vec<u8>, Vec
         axis_slices: false,
         axis_mipmaps: false,
         volume_mipmaps: false,
+        shadow: None,
     };
     let baked = Baker::new(&voltex::gpu::sources::Sources::project().unwrap()).bake(&ctx, &req).unwrap();
     let volume = read_texture(&ctx, &baked.volume, 4).unwrap();

@@ -114,6 +114,7 @@ fn bake_res(source: BakeSource, resolution: [u32; 3], per_pixel: bool) -> (Vec<u
         axis_slices: false,
         axis_mipmaps: false,
         volume_mipmaps: false,
+        shadow: None,
     };
     let t = std::time::Instant::now();
     let baked =

@@ -228,6 +228,7 @@ fn volume_texel_bake_matches_twin() {
             axis_slices: false,
             axis_mipmaps: false,
             volume_mipmaps: false,
+            shadow: None,
         };
         let baked = Baker::new(&voltex::gpu::sources::Sources::project().unwrap()).bake(&ctx, &req).unwrap();
         let volume = read_texture(&ctx, &baked.volume, 4).unwrap();

@@ -203,6 +203,13 @@ struct AxisBake {
     level: vec4<u32>,
 }
 
+// Baked self-shadowing of a texel (twin: ShadowParams in src/types.rs).
+struct ShadowParams {
+    resolution: vec4<u32>,
+    light: vec4<f32>,
+    shading: vec4<f32>,
+}
+
 // Hypertextures (twins: HyperParams, HyperNoise, TransferFunction, TransferPoint, MarchState in src/types.rs).
 struct HyperParams {
     to_local: mat4x4<f32>,
