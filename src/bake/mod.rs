@@ -5,8 +5,8 @@
 
 pub mod axis_slices;
 pub mod hypertexture;
-pub mod texel_mips;
 pub mod shadow;
+pub mod texel_mips;
 pub mod volume;
 
 use crate::gpu::sources::Sources;
@@ -128,7 +128,7 @@ pub struct BakeRequest {
 impl BakeRequest {
     /// The kernels the bake runs (under `wgsl/`), so that `plan` can check them before any GPU
     /// work: the same files [`Baker::bake`] loads.
-    pub(crate) fn kernels(&self) -> Vec<&'static str> {
+    pub fn kernels(&self) -> Vec<&'static str> {
         let mut k = match &self.source {
             BakeSource::Implicit(_) => vec!["bake/bake_implicit.wgsl"],
             BakeSource::Heightfield(_) => vec!["bake/bake_heightfield.wgsl"],

@@ -35,7 +35,7 @@ impl Shadow {
 
 /// Records the shadow pass reading `volume` and returns the shadowed volume (same size, format
 /// usages and MIP level count; only level 0 is written, the levels below are made afterwards).
-pub fn apply(
+pub(crate) fn apply(
     ctx: &GpuContext,
     kernel: &mut ComputeKernel,
     encoder: &mut wgpu::CommandEncoder,
@@ -44,7 +44,8 @@ pub fn apply(
 ) -> Result<wgpu::Texture> {
     let size = volume.size();
     let res = [size.width, size.height, size.depth_or_array_layers];
-    let shadowed = super::volume_texture(ctx, "shadowed texel volume", res, volume.mip_level_count(), volume.format());
+    let shadowed =
+        super::volume_texture(ctx, "shadowed texel volume", res, volume.mip_level_count(), volume.format());
     let params = shadow.params(res);
     let mut inputs = Inputs::default();
     inputs.buffers.insert("shadow".into(), uniform(ctx, "shadow", bytemuck::bytes_of(&params)));

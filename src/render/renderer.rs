@@ -233,7 +233,7 @@ impl Renderer {
 
 /// What a bake is kept under: its request and the source of every kernel it runs, so that an
 /// edit of a bake kernel (or of a file it includes) bakes again.
-pub(crate) fn bake_key(sources: &Sources, request: &bake::BakeRequest) -> Result<u64> {
+pub fn bake_key(sources: &Sources, request: &bake::BakeRequest) -> Result<u64> {
     let kernels: Vec<u64> = (request.kernels().iter())
         .map(|k| crate::gpu::shader::source_hash(sources, k))
         .collect::<Result<_>>()?;

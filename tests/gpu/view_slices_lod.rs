@@ -52,6 +52,7 @@ fn texel_volume_mips_match_their_twin() {
         axis_slices: false,
         axis_mipmaps: false,
         volume_mipmaps: true,
+        shadow: None,
     };
     let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
     let baked = Baker::new(&voltex::gpu::sources::Sources::project().unwrap()).bake(&ctx, &request).unwrap();
