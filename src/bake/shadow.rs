@@ -14,14 +14,18 @@ pub const KERNEL: &str = "bake/shadow_texel.wgsl";
 /// alpha-1 matter per texel unit and the light kept in full shadow.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Shadow {
+    /// The direction towards the light, in texel space (normalised by the kernel).
     pub toward_light: [f32; 3],
+    /// Extinction per unit of texel height at opacity 1 (times each voxel's alpha).
     pub extinction: f32,
+    /// The share of the colour left in full shadow.
     pub ambient: f32,
     /// Voxels the march skips from each voxel's centre (see `cpu::shadow_texel`).
     pub bias: f32,
 }
 
 impl Shadow {
+    /// The kernel's uniform for a texel of resolution `res`.
     pub fn params(&self, res: [u32; 3]) -> crate::types::ShadowParams {
         crate::cpu::shadow_texel::shadow_params(
             res,

@@ -10,7 +10,7 @@
 use std::path::{Path, PathBuf};
 
 /// `pub` declarations (not `pub(crate)`) in the library, fields included.
-const PUB_DECLARATIONS: usize = 1205;
+const PUB_DECLARATIONS: usize = 1258;
 /// Of those, the ones without a `///` doc comment.
 const UNDOCUMENTED: usize = 352;
 

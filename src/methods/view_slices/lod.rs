@@ -16,13 +16,16 @@ pub const MIN_LOD_PLANES: u32 = 8;
 /// What `lod: Auto` chose for an object, with the sizes it chose from (`voltex plan`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LodChoice {
+    /// Planes drawn (at most the scene's `planes`).
     pub planes: u32,
     /// MIP level of the texel volume (0: full resolution).
     pub level: u32,
     /// World size of a pixel at the depth that decided, and of the largest and smallest texel
     /// voxel axis there (level 0).
     pub pixel: f64,
+    /// The largest texel voxel axis (world units, level 0).
     pub voxel_max: f64,
+    /// The smallest texel voxel axis (world units, level 0).
     pub voxel_min: f64,
 }
 
