@@ -67,7 +67,9 @@ pub fn transmittance(p: &ShadowParams, alpha: impl Fn([usize; 3]) -> f64, voxel:
         };
         let at = [cell[0].rem_euclid(res[0]) as usize, cell[1].rem_euclid(res[1]) as usize, cell[2] as usize];
         let a = alpha(at).clamp(0.0, 1.0);
-        inside = inside && a as f32 >= SOLID as f32;
+        // A sliver (the start on a voxel's face, where f32 and f64 round apart) leaves nothing.
+        let sliver = next[axis] - t < 1e-3 * delta.iter().copied().fold(f64::INFINITY, f64::min);
+        inside = inside && (a as f32 >= SOLID as f32 || sliver);
         if !inside {
             optical += p.light[3] as f64 * a * (next[axis] - t);
         }
