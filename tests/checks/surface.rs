@@ -7,23 +7,14 @@
 //! in src/lib.rs. No GPU, no build: `cargo doc` would need every dependency checked again (minutes
 //! on CI's two cores), so rustdoc's own warnings are checked by hand (`cargo doc --no-deps`).
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
+
+use crate::layers::rust_files;
 
 /// `pub` declarations (not `pub(crate)`) in the library, fields included.
 const PUB_DECLARATIONS: usize = 1258;
 /// Of those, the ones without a `///` doc comment.
 const UNDOCUMENTED: usize = 352;
-
-fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
-    for entry in std::fs::read_dir(dir).unwrap() {
-        let path = entry.unwrap().path();
-        if path.is_dir() {
-            rust_files(&path, out);
-        } else if path.extension().is_some_and(|e| e == "rs") {
-            out.push(path);
-        }
-    }
-}
 
 /// Whether the declaration on line `n` has a `///` doc above its attributes (one-line ones, or
 /// multi-line ones from `#[` to `)]`).
