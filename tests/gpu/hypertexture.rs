@@ -658,8 +658,8 @@ fn figure10_amplitude_scales_and_frequency_zooms_the_displacement() {
     let (mut worst_a, mut worst_f, mut spread) = (0.0f64, 0.0f64, 0.0f64);
     for (i, &(a, f)) in knobs.iter().enumerate() {
         if f == 2.5 {
-            for j in 0..dirs.len() {
-                worst_a = worst_a.max((k[i][j] - a / 0.25 * k[reference][j]).abs());
+            for (v, r) in k[i].iter().zip(&k[reference]) {
+                worst_a = worst_a.max((v - a / 0.25 * r).abs());
             }
             if a == 0.0 {
                 assert!(k[i].iter().all(|&v| v.abs() < 1e-6), "a = 0 leaves the sphere undistorted");
