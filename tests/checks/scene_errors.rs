@@ -114,6 +114,17 @@ fn non_finite_numbers() {
     assert_err("inf", &[(12, l)], "scene.ron", 12, 30, "expected a finite number");
 }
 
+/// The baked texel shadow's numbers and ViewSlices' level of detail, at their positions.
+#[test]
+fn texel_shadow_and_lod_values() {
+    let t = r#"        "t": (resolution: (8, 8, 8), source: Constant(color: (1.0, 1.0, 1.0)), shadow: (extinction: -1.0)),"#;
+    assert_err("extinction", &[(6, t)], "scene.ron", 6, 101, "expected a positive finite number");
+    let t = r#"        "t": (resolution: (8, 8, 8), source: Constant(color: (1.0, 1.0, 1.0)), shadow: (extinction: 8.0, ambient: 1.5)),"#;
+    assert_err("ambient", &[(6, t)], "scene.ron", 6, 115, "expected a number in [0, 1]");
+    let l = "            method: ViewSlices(planes: 16, lod: Sometimes),";
+    assert_err("lod", &[(14, l)], "scene.ron", 14, 49, "`Auto`");
+}
+
 #[test]
 fn plane_counts() {
     let l = "            method: ViewSlices(planes: 0),";
