@@ -203,9 +203,10 @@ impl Overrides {
             return Err(voltex::Error::Invalid(format!("--time {t}: expected a finite number of seconds")));
         }
         if let Some(n) = self.supersample {
-            if !(1..=8).contains(&n) {
+            if !(1..=voltex::scene::MAX_SUPERSAMPLE).contains(&n) {
                 return Err(voltex::Error::Invalid(format!(
-                    "--supersample {n}: expected 1 to 8 samples per axis"
+                    "--supersample {n}: expected 1 to {} samples per axis",
+                    voltex::scene::MAX_SUPERSAMPLE
                 )));
             }
         }

@@ -160,7 +160,12 @@ fn file_name(path: &Path) -> String {
 
 /// Plans and renders the loaded scene; any error here makes it a broken scene.
 fn render(ctx: &GpuContext, scene: &scene::Scene, size: (u32, u32), rec: &mut Record) -> Result<Rendered> {
-    let bp = Blueprint::new(scene, &RenderOptions { size: Some(size), ..Default::default() })?;
+    let opts = RenderOptions {
+        size: Some(size),
+        supersample: Some(scene.regress.supersample),
+        ..Default::default()
+    };
+    let bp = Blueprint::new(scene, &opts)?;
     rec.warnings.extend(scene.warnings.iter().cloned());
     for o in &bp.objects {
         for w in &o.object.report.warnings {
@@ -178,6 +183,7 @@ fn truth(ctx: &GpuContext, scene: &scene::Scene, size: (u32, u32)) -> Result<Opt
     let Some(t) = scene.regress.truth else { return Ok(None) };
     let opts = RenderOptions {
         size: Some(size),
+        supersample: Some(scene.regress.supersample),
         method: Some(MethodKind::Reference),
         step_scale: Some(t.step_scale),
         segments: Some(scene::Segments::Bounds),

@@ -147,7 +147,8 @@ fn estimate(entry: &SceneEntry, size: Option<(u32, u32)>) -> f64 {
     let (w, h) =
         size.or(scene.regress.size.map(|[w, h]| (w, h))).unwrap_or((scene.output.width, scene.output.height));
     let rate = PER_KPIXEL_MS.iter().filter(|(m, _)| text.contains(m)).map(|(_, r)| *r).fold(15.0, f64::max);
-    FIXED_MS + rate * f64::from(w) * f64::from(h) / 1000.0
+    let samples = f64::from(scene.regress.supersample.pow(2));
+    FIXED_MS + rate * f64::from(w) * f64::from(h) * samples / 1000.0
 }
 
 /// A plan: which shard (0-based) each scene goes to, and each shard's predicted load.

@@ -7,6 +7,8 @@
 
 /// Most planes one ViewSlices object may use (the scan kernel and the dispatch height allow it).
 pub const MAX_PLANES: u32 = 16384;
+/// Most samples per pixel axis of a supersampled render (`--supersample`, `regress.supersample`).
+pub const MAX_SUPERSAMPLE: u32 = 8;
 
 mod budget;
 mod flatten;

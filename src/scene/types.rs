@@ -82,6 +82,11 @@ pub struct Regress {
     /// The error bound against an independent truth (see [`Truth`]).
     #[serde(default)]
     pub truth: Option<Truth>,
+    /// Samples per pixel axis of the regression render and its truth (1..=8): each pixel is the
+    /// mean of N x N samples, so a scene whose detail is finer than a pixel at `size` is checked
+    /// on pixel averages, not on where single samples happen to land.
+    #[serde(default = "default_supersample", deserialize_with = "v::supersample")]
+    pub(crate) supersample: u32,
 }
 
 /// `truth: (max_flip: 0.05)`: the scene rendered as its truth (textured objects by the exact
@@ -102,6 +107,10 @@ fn default_step_scale() -> f64 {
     0.25
 }
 
+fn default_supersample() -> u32 {
+    1
+}
+
 fn default_max_flip() -> f64 {
     0.01
 }
@@ -116,6 +125,7 @@ impl Default for Regress {
             max_flip: default_max_flip(),
             max_rel_rmse: default_max_rel_rmse(),
             truth: None,
+            supersample: default_supersample(),
         }
     }
 }

@@ -72,6 +72,7 @@ checked_u32!(OutputSize, 1, 16384, "an output size");
 checked_u32!(PlaneCount, 1, super::MAX_PLANES, "a plane count");
 checked_u32!(Resolution, 1, 1024, "a resolution");
 checked_u32!(Octaves, 1, 8, "an octave count");
+checked_u32!(Supersample, 1, super::MAX_SUPERSAMPLE, "samples per pixel axis");
 checked_u32!(Frequency, 1, 1024, "a frequency (lattice cells per tile)");
 checked_u32!(Cells, 1, 4096, "a cell count");
 checked_u32!(Around, 3, 4096, "a segment count");
@@ -146,6 +147,7 @@ adapter!(opt_size2, Option<[u32; 2]>, Option<[OutputSize; 2]>, |v| v.map(|s| s.m
 adapter!(planes, u32, PlaneCount, |v| v.0);
 adapter!(resolution, [u32; 3], [Resolution; 3], |v| v.map(|x| x.0));
 adapter!(octaves, u32, Octaves, |v| v.0);
+adapter!(supersample, u32, Supersample, |v| v.0);
 adapter!(grid_resolution, u32, GridResolution, |v| v.0);
 adapter!(peel_passes, u32, PeelPasses, |v| v.0);
 adapter!(splat_grid, u32, SplatGrid, |v| v.0);

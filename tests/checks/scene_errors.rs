@@ -126,6 +126,12 @@ fn texel_shadow_and_lod_values() {
 }
 
 #[test]
+fn regress_supersample() {
+    let l = "    output: (width: 64, height: 64), regress: (supersample: 9),";
+    assert_err("supersample9", &[(3, l)], "scene.ron", 3, 61, "expected samples per pixel axis in 1..=8");
+}
+
+#[test]
 fn plane_counts() {
     let l = "            method: ViewSlices(planes: 0),";
     assert_err("planes0", &[(14, l)], "scene.ron", 14, 40, "expected a plane count in 1..=16384");

@@ -584,3 +584,37 @@ fn truth_bounds_of_the_hard_cases_hold() {
     let r = record(&out, "thin_shell");
     assert!(r.truth_flip.is_some() && r.max_truth_flip.is_some(), "{r:?}");
 }
+
+/// `regress.supersample`: the regression render (so the reference `--update` writes) and its
+/// truth both average N x N samples a pixel, exactly as `render --supersample N` does.
+#[test]
+fn supersample_averages_the_render_and_its_truth() {
+    let dir = Temp::new("supersample");
+    let scene = flat_box(&dir.join("s"), "flat_box.ron", false, |t| {
+        t.replace(
+            "regress: (size: (128, 128))",
+            "regress: (size: (16, 16), supersample: 2, truth: (max_flip: 0.5))",
+        )
+    });
+    let out = dir.join("out");
+    let run = regress(&[p("--update"), &dir.join("s"), p("--out"), &out]);
+    assert!(run.status.success(), "{}", text(&run));
+    let render = |extra: &[&str], name: &str| {
+        let file = dir.join(name);
+        let mut cmd = Command::new(BIN);
+        cmd.args(["render", "--size", "16x16", "--supersample", "2", "-o"])
+            .arg(&file)
+            .arg(&scene)
+            .args(extra);
+        let run = cmd.env("VOLTEX_ROOT", root()).output().unwrap();
+        assert!(run.status.success(), "{}", text(&run));
+        voltex::io::exr::read(&file).unwrap().0
+    };
+    let (written, _) = voltex::io::exr::read(&reference(&scene)).unwrap();
+    let supersampled = render(&[], "ss.exr");
+    assert_eq!(voltex::metrics::max_abs_diff(&written, &supersampled).unwrap(), 0.0);
+    let truth = render(&["--method", "reference"], "truth.exr");
+    let flip = voltex::metrics::flip(&written, &truth).unwrap().mean;
+    let r = record(&out, "flat_box");
+    assert!((r.truth_flip.unwrap() - flip).abs() < 1e-9, "{r:?} against {flip}");
+}
