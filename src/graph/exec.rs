@@ -108,23 +108,27 @@ impl Executor {
                 TextureSize::Output => size,
                 TextureSize::Fixed(w, h) => (*w, *h),
             };
-            let texture = ctx.device.create_texture(&wgpu::TextureDescriptor {
-                label: Some(name),
-                size: wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format: texture_format(ctx, &graph, name, format.wgpu(), &blended),
-                usage: wgpu::TextureUsages::RENDER_ATTACHMENT
-                    | wgpu::TextureUsages::TEXTURE_BINDING
-                    | wgpu::TextureUsages::COPY_SRC
-                    | if stored.contains(&name.as_str()) {
-                        wgpu::TextureUsages::STORAGE_BINDING
-                    } else {
-                        wgpu::TextureUsages::empty()
-                    },
-                view_formats: &[],
+            // In a scope: an error left uncaptured would surface in a later, unrelated render.
+            let made = ctx.scoped(&format!("texture `{name}`"), || {
+                ctx.device.create_texture(&wgpu::TextureDescriptor {
+                    label: Some(name),
+                    size: wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
+                    mip_level_count: 1,
+                    sample_count: 1,
+                    dimension: wgpu::TextureDimension::D2,
+                    format: texture_format(ctx, &graph, name, format.wgpu(), &blended),
+                    usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+                        | wgpu::TextureUsages::TEXTURE_BINDING
+                        | wgpu::TextureUsages::COPY_SRC
+                        | if stored.contains(&name.as_str()) {
+                            wgpu::TextureUsages::STORAGE_BINDING
+                        } else {
+                            wgpu::TextureUsages::empty()
+                        },
+                    view_formats: &[],
+                })
             });
+            let texture = made.map_err(|e| graph.error_at_resource(name, e.to_string()))?;
             let view = texture.create_view(&Default::default());
             textures.insert(name.clone(), Texture { texture, view, clear: *clear });
         }

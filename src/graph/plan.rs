@@ -322,10 +322,26 @@ fn check_binding(
         )
     };
     match decl {
-        ResourceDecl::Texture { .. } => {
-            if !matches!(b.kind, K::Texture { .. } | K::StorageTexture { .. }) {
-                return Err(wrong("texture"));
-            }
+        ResourceDecl::Texture { format, .. } => {
+            // wgpu refuses these only when the texture or bind group is made; here they have a
+            // position in the graph.
+            let found = format.wgpu();
+            let needs = match b.kind {
+                K::StorageTexture { format: want, .. } if want != found => format!("{want:?}"),
+                K::Texture { depth, .. } if depth != found.is_depth_stencil_format() => {
+                    if depth { "Depth32Float" } else { "a colour format" }.to_string()
+                }
+                K::Texture { .. } | K::StorageTexture { .. } => return Ok(()),
+                _ => return Err(wrong("texture")),
+            };
+            return Err(graph.error_at_resource(
+                name,
+                format!(
+                    "texture `{name}` is {format:?}, but {shader} (pass `{}`) binds it as {}, which needs {needs}",
+                    pass.decl.name(),
+                    describe_kind(&b.kind)
+                ),
+            ));
         }
         ResourceDecl::Buffer { .. } => {
             if !matches!(b.kind, K::Storage { .. }) {
@@ -374,7 +390,8 @@ fn describe_kind(kind: &reflect::BindingKind) -> &'static str {
         K::Uniform => "`var<uniform>`",
         K::Storage { read_only: true } => "`var<storage, read>`",
         K::Storage { read_only: false } => "`var<storage, read_write>`",
-        K::Texture { .. } => "a texture",
+        K::Texture { depth: false, .. } => "a texture",
+        K::Texture { depth: true, .. } => "a depth texture",
         K::StorageTexture { .. } => "a storage texture",
         K::Sampler => "a sampler",
     }

@@ -469,6 +469,35 @@ mod fuzz_regressions {
         assert!(e.contains("target `hdr` is attached twice"), "{e}");
     }
 
+    /// render_tiny, seed 27: `reference_rgba` made `Depth32Float` in a graph: plan accepted,
+    /// and making the texture failed in wgpu outside an error scope, so the error ("usages
+    /// STORAGE_BINDING are not allowed on a texture of type Depth32Float") surfaced in the next,
+    /// unrelated render (here, 2,709 inputs in, waving_flag's). Now a plan error at the
+    /// resource, and graph textures are made inside an error scope.
+    #[test]
+    fn a_texture_format_its_kernel_cannot_bind_is_a_plan_error() {
+        let dir = std::env::temp_dir().join(format!("voltex-fuzz-format-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let graph = dir.join("frame.ron");
+        let text = std::fs::read_to_string(root().join("graphs/frame.ron")).unwrap();
+        let scene = voltex::scene::load(&root().join("scenes/reference/torus_egg.ron")).unwrap();
+        let opts = RenderOptions { size: Some((8, 8)), graph: Some(graph.clone()), ..Default::default() };
+        let from = "\"reference_rgba\": Texture(format: Rgba32Float";
+        for (format, words) in [
+            ("Depth32Float", "binds it as a storage texture, which needs Rgba32Float"),
+            ("Rgba16Float", "texture `reference_rgba` is Rgba16Float"),
+        ] {
+            assert!(text.contains(from));
+            let to = format!("\"reference_rgba\": Texture(format: {format}");
+            let text = text.replacen(from, &to, 1);
+            std::fs::write(&graph, &text).unwrap();
+            let e = Blueprint::new(&scene, &opts).err().expect("an error").to_string();
+            let line = text[..text.find(&to).unwrap()].matches('\n').count() + 1;
+            assert!(e.starts_with(&format!("{}:{line}:", graph.display())), "{e}");
+            assert!(e.contains(words), "{e}");
+        }
+    }
+
     /// preview_reload, seed 19: a texture of another format than Rgba32Float or R32Float put
     /// first in the graph's `outputs` (there `depth`): the rebuild succeeded, then every frame
     /// failed to be read back (and `render` failed after the GPU work). render_tiny, seed 19:
