@@ -5,6 +5,8 @@
 //! contributing its own → [`render`] → [`io`] (EXR, PNG). The modules form layers that import
 //! only downwards (`tests/checks/layers.rs` lists them).
 
+#![deny(missing_docs)]
+
 pub mod bake;
 pub mod bench;
 pub mod cpu;

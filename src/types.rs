@@ -8,7 +8,9 @@ use bytemuck::{Pod, Zeroable};
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
 pub struct ShellVertex {
+    /// xyz: camera-relative bottom vertex `p`; w: 1.
     pub bottom: [f32; 4],
+    /// xyz: camera-relative top vertex `p + h`; w: 1.
     pub top: [f32; 4],
 }
 
@@ -35,14 +37,19 @@ pub struct Prism {
 pub struct SliceParams {
     /// xyz: unit plane normal (the camera's forward direction); w: unused.
     pub plane_normal: [f32; 4],
+    /// Plane offset along `plane_normal` of the back-most plane (`k = 0`).
     pub first_plane: f32,
+    /// Distance between consecutive planes (world units).
     pub spacing: f32,
+    /// Planes to slice with.
     pub plane_count: u32,
+    /// Prisms of the object's shell.
     pub prism_count: u32,
     /// Capacity of the slice-vertex buffer, in vertices.
     pub vertex_capacity: u32,
     /// MIP level of the texel volume the slices sample (`lod: Auto`; 0: full resolution).
     pub texel_level: f32,
+    /// Padding to the WGSL layout (zero).
     pub _pad: [u32; 2],
 }
 
@@ -60,9 +67,13 @@ pub struct SliceVertex {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
 pub struct DrawIndirect {
+    /// Vertices per instance.
     pub vertex_count: u32,
+    /// Instances to draw.
     pub instance_count: u32,
+    /// First vertex drawn.
     pub first_vertex: u32,
+    /// First instance drawn.
     pub first_instance: u32,
 }
 
@@ -71,14 +82,19 @@ pub struct DrawIndirect {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
 pub struct TileParams {
+    /// Tiles across the frame.
     pub tiles_x: u32,
+    /// Tiles down the frame.
     pub tiles_y: u32,
     /// Blocks of 32 planes of the chunk: segments per tile.
     pub blocks: u32,
     /// Entries the tile lists hold; a segment past it is composited from its planes' triangles.
     pub entry_capacity: u32,
+    /// Frame width in pixels.
     pub width: u32,
+    /// Frame height in pixels.
     pub height: u32,
+    /// Padding to the WGSL layout (zero).
     pub _pad: [u32; 2],
 }
 
@@ -89,12 +105,19 @@ pub struct TileParams {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
 pub struct TileTriangle {
+    /// First edge `(x, y, constant, owns)`.
     pub e0: [f32; 4],
+    /// Second edge, as `e0`.
     pub e1: [f32; 4],
+    /// Third edge, as `e0`.
     pub e2: [f32; 4],
+    /// Inclusive tile range its bounding box meets: `x0, y0, x1, y1` (`x0 > x1`: none).
     pub tiles: [u32; 4],
+    /// Depth of its plane as the rasteriser tests it.
     pub depth: f32,
+    /// Index of its slicing plane.
     pub plane: u32,
+    /// Padding to the WGSL layout (zero).
     pub _pad: [u32; 2],
 }
 
@@ -104,8 +127,11 @@ pub struct TileTriangle {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
 pub struct TileAttributes {
+    /// Texel coordinates at corner a (xyz); a's pixel x (w).
     pub at_a: [f32; 4],
+    /// Texel coordinates' step per pixel in x (xyz); a's pixel y (w).
     pub d_x: [f32; 4],
+    /// Texel coordinates' step per pixel in y (xyz); w unused.
     pub d_y: [f32; 4],
 }
 
@@ -114,6 +140,7 @@ pub struct TileAttributes {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
 pub struct FrameParams {
+    /// Camera-relative world to clip space (column-major).
     pub view_proj: [[f32; 4]; 4],
     /// xyz: unit camera forward; w: near plane distance.
     pub forward: [f32; 4],
@@ -145,7 +172,9 @@ pub struct ObjectParams {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
 pub struct VertexFrame {
+    /// xyz: `dP/ds`; w unused.
     pub ds: [f32; 4],
+    /// xyz: `dP/dt`; w unused.
     pub dt: [f32; 4],
 }
 
@@ -175,10 +204,13 @@ pub struct BakeParams {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
 pub struct ImplicitShape {
+    /// Which shape: one of the `cpu::bake::{SPHERE, TORUS, ...}` constants.
     pub kind: u32,
     /// Metaballs only: the range `first_ball..first_ball + ball_count` of the `balls` buffer.
     pub first_ball: u32,
+    /// Metaballs only: how many balls from `first_ball`.
     pub ball_count: u32,
+    /// Padding to the WGSL layout (zero).
     pub _pad: u32,
     /// xyz: centre (unused by metaballs and constant); w: unused.
     pub center: [f32; 4],
@@ -198,9 +230,13 @@ pub struct HeightfieldParams {
     pub frequency: u32,
     /// Octaves (each doubles the frequency, halves the amplitude); clamped to 1..=16.
     pub octaves: u32,
+    /// Seed of the noise's permutation.
     pub seed: u32,
+    /// Padding to the WGSL layout (zero).
     pub _pad0: u32,
+    /// Height range of the noise above `base` (texel units).
     pub amplitude: f32,
+    /// Lowest height, where the noise is at its minimum (texel units).
     pub base: f32,
     /// Opacity per opacity length of the filled region.
     pub opacity: f32,
@@ -219,14 +255,23 @@ pub struct HeightfieldParams {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
 pub struct HeightImageParams {
+    /// Image width in pixels.
     pub width: u32,
+    /// Image height in pixels.
     pub height: u32,
+    /// Padding to the WGSL layout (zero).
     pub _pad0: [u32; 2],
+    /// Height at image value 1 above `base` (texel units).
     pub amplitude: f32,
+    /// Height at image value 0 (texel units).
     pub base: f32,
+    /// Opacity per opacity length of the filled region.
     pub opacity: f32,
+    /// Darkening with depth, as in [`HeightfieldParams::darkening`].
     pub darkening: f32,
+    /// rgb: albedo at w = 0; a: unused.
     pub color_low: [f32; 4],
+    /// rgb: albedo at the highest possible height; a: unused.
     pub color_high: [f32; 4],
 }
 
@@ -260,7 +305,9 @@ pub struct ReferenceNode {
 pub struct ReferencePrism {
     /// xyz: vertex ids into the frame's concatenated shell vertices; w: object index.
     pub vertices: [u32; 4],
+    /// uv of corner 0 (xy) and corner 1 (zw).
     pub uv01: [f32; 4],
+    /// uv of corner 2 (xy); zw unused.
     pub uv2: [f32; 4],
 }
 
@@ -416,7 +463,9 @@ pub struct HyperParams {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
 pub struct MeshGridParams {
+    /// xyz: the grid's lower corner (object space); w unused.
     pub lo: [f32; 4],
+    /// xyz: the grid's upper corner (object space); w unused.
     pub hi: [f32; 4],
     /// x: samples along x, y: triangles, z: BVH nodes, w: closed parts.
     pub counts: [u32; 4],
@@ -445,15 +494,22 @@ pub struct MeshTexelParams {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
 pub struct HyperNoise {
+    /// Largest shift, object units.
     pub amplitude: f32,
+    /// Noise cycles per object unit.
     pub frequency: f32,
+    /// `r` in [0, 1]: where along `V` the noise is evaluated.
     pub shift: f32,
+    /// 1 combines by `Blend`, 0 by `Sum`.
     pub blend: u32,
+    /// Seed of the noise.
     pub seed: u32,
+    /// Noise cycles per second along time (0: not animated).
     pub speed: f32,
     /// The noise's first shape table, and its row count: 1 for a 1D shape transfer function, or
     /// the rows of a 2D one (`Grid`), one table per density from 0 to 1.
     pub table: u32,
+    /// Rows of the shape table from `table` (1: a 1D shape transfer function).
     pub rows: u32,
     /// Per-axis factors of `frequency` (xyz; 1 unless periodic) that make each period a whole
     /// number of noise tiles.
@@ -468,9 +524,13 @@ pub struct HyperNoise {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
 pub struct TransferFunction {
+    /// Index of the first control point in the point buffer.
     pub first: u32,
+    /// Number of control points.
     pub count: u32,
+    /// 0: cubic Hermite curve; 1: piecewise linear.
     pub kind: u32,
+    /// Padding to the WGSL layout (zero).
     pub _pad: u32,
 }
 
@@ -478,9 +538,13 @@ pub struct TransferFunction {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
 pub struct TransferPoint {
+    /// Position in [0, 1].
     pub x: f32,
+    /// Value at `x`.
     pub y: f32,
+    /// Slope `dy/dx` (Hermite curves only).
     pub slope: f32,
+    /// Padding to the WGSL layout (zero).
     pub _pad: f32,
 }
 

@@ -8,6 +8,7 @@ use crate::gpu::GpuContext;
 use crate::gpu::Inputs;
 use crate::types::AxisBake;
 
+/// A texel's AxisSlices slice images (Meyer & Neyret 1998), baked along s, t and w.
 #[derive(Clone)]
 pub struct AxisBaked {
     /// Per direction s, t, w: `Rgba16Float` premultiplied slice images, all levels as layers.
@@ -197,10 +198,12 @@ pub fn read_texture_level(
 // Layout of the slice-image arrays: power-of-two levels, finest first (mirrored in
 // wgsl/shared/axis_slices.wgsl; the kernels and the AxisSlices twin both index by it).
 
+/// Power-of-two levels of a slice set across `r` voxels: `floor(log2 r) + 1`.
 pub fn level_count(r: u32) -> u32 {
     32 - r.max(1).leading_zeros()
 }
 
+/// Slices of `level` across `r` voxels: `ceil(r / 2^level)`.
 pub fn level_slices(r: u32, level: u32) -> u32 {
     (r + (1 << level) - 1) >> level
 }

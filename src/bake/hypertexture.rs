@@ -27,7 +27,9 @@ pub const VOXELS_PER_DISPATCH: u32 = 1 << 20;
 /// kernels read, the mesh by its digest.
 #[derive(Clone)]
 pub struct HyperTexel {
+    /// The hypertexture's noises, transfer tables and mesh, as the kernels read them.
     pub packed: Packed,
+    /// The object's parameters, with the texel's box and the gradient offset.
     pub params: HyperParams,
 }
 

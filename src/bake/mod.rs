@@ -25,8 +25,11 @@ use glam::DVec3;
 /// What a bake kernel evaluates.
 #[derive(Debug)]
 pub enum BakeSource {
+    /// A union of implicit shapes (`bake_implicit.wgsl`).
     Implicit(PackedShapes),
+    /// A periodic Perlin height field (`bake_heightfield.wgsl`).
     Heightfield(HeightfieldParams),
+    /// A height field from an image and its heights (`bake_height_image.wgsl`).
     HeightImage(HeightImageParams, Heights),
     /// A slice stack's texels (16-bit premultiplied RGBA), uploaded at the volume's precision.
     Stack(StackTexels),
@@ -42,8 +45,11 @@ pub enum BakeSource {
 /// bake cache's key) by the mesh's digest.
 #[derive(Clone)]
 pub struct MeshTexel {
+    /// The pattern mesh, shared between the bakes that use it.
     pub shape: std::sync::Arc<MeshShape>,
+    /// The grid the mesh is sampled on (bounds, samples per axis, fill or shell).
     pub spec: GridSpec,
+    /// Colour, extent and mode of the texel made from the grid.
     pub params: MeshTexelParams,
 }
 
@@ -106,14 +112,18 @@ impl std::fmt::Debug for StackTexels {
     }
 }
 
+/// One texel to bake: its resolution, its source and what the methods drawing it need.
 #[derive(Debug)]
 pub struct BakeRequest {
+    /// Voxels along s, t and w.
     pub resolution: [u32; 3],
+    /// What the kernel evaluates.
     pub source: BakeSource,
     /// Write unshaded albedo and a normal volume instead of baked shading.
     pub per_pixel: bool,
     /// Texel-space direction towards the light, and the ambient term.
     pub light: [f32; 3],
+    /// Light a voxel keeps without direct light, in [0, 1].
     pub ambient: f32,
     /// Also bake the slice images of axis-aligned slicing.
     pub axis_slices: bool,
@@ -160,8 +170,10 @@ impl BakeRequest {
     }
 }
 
+/// A baked texel: its premultiplied RGBA volume, its normals and its slice images.
 #[derive(Clone)]
 pub struct Baked {
+    /// The texel volume, with its MIP levels when the request asked for them.
     pub volume: wgpu::Texture,
     /// The normal volume (1x1x1 when `per_pixel` is off: the binding exists, nothing is stored).
     pub normals: wgpu::Texture,
@@ -294,11 +306,11 @@ pub(crate) fn bytes(res: [u32; 3], per_pixel: bool, mipmaps: bool) -> u64 {
 /// The kernel making a texel volume's MIP levels.
 const MIP_KERNEL: &str = "bake/mip_texel_volume.wgsl";
 
-/// The bake kernels, loaded once and reused for every texel.
 /// Each kernel with the hash of its source, so that a baker kept across the preview's rebuilds
 /// reloads a kernel whose file (or include) changed.
 type Slot = Option<(u64, ComputeKernel)>;
 
+/// The bake kernels, loaded once and reused for every texel.
 pub struct Baker {
     implicit: Slot,
     heightfield: Slot,
@@ -396,6 +408,8 @@ impl Baker {
         Ok(&mut slot.as_mut().unwrap().1)
     }
 
+    /// Bakes `req` on the GPU: the source's kernel, then what the request asks for (shadows, MIP
+    /// levels, slice images); a volume beyond the adapter's 3D texture limit is an error.
     pub fn bake(&mut self, ctx: &GpuContext, req: &BakeRequest) -> Result<Baked> {
         let max3d = ctx.limits.max_texture_dimension_3d;
         if req.resolution.iter().any(|&r| r == 0 || r > max3d) {

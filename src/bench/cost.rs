@@ -10,6 +10,7 @@ use super::json::Row;
 /// R^2 under this is a finding to explain.
 pub(crate) const GOOD_FIT: f64 = 0.95;
 
+/// A cost model fitted to one table's rows: frame ms as a line of the work they did.
 #[derive(Debug, Clone, Default, Serialize, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct Fit {
@@ -22,10 +23,12 @@ pub struct Fit {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub(crate) compositor: Option<String>,
     pub(crate) work_unit: String,
+    /// Rows the line is fitted to.
     pub rows: usize,
     /// ms = intercept_ms + ms_per_unit * work
     pub(crate) intercept_ms: f64,
     pub(crate) ms_per_unit: f64,
+    /// Coefficient of determination of the fit (under `GOOD_FIT` is a finding to explain).
     pub r2: f64,
 }
 

@@ -223,7 +223,9 @@ pub(crate) fn segments_table(ctx: &GpuContext, args: &Args, report: &mut Report)
 
 /// `voltex bench-hyper`'s arguments.
 pub struct Args {
+    /// Frame size in pixels (width, height).
     pub size: (u32, u32),
+    /// Timed frames per row, after warm-up.
     pub frames: usize,
     /// Only the first object (the sphere; the teapot for the shadows table).
     pub quick: bool,
@@ -239,6 +241,8 @@ pub struct Args {
     pub trace: Option<PathBuf>,
 }
 
+/// Runs `voltex bench-hyper`: the tables of the RayMarch paper's figures, printed and written as
+/// asked.
 pub fn run(args: &Args) -> Result<()> {
     super::json::check_output(args.json.as_deref())?;
     super::json::check_output(args.trace.as_deref())?;

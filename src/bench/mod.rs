@@ -56,10 +56,15 @@ struct Row {
 
 /// `voltex bench`'s arguments.
 pub struct Args {
+    /// Scene files to measure.
     pub scenes: Vec<PathBuf>,
+    /// ViewSlices plane counts to measure each scene at.
     pub planes: Vec<u32>,
+    /// Frame size in pixels (width, height).
     pub size: (u32, u32),
+    /// Timed frames per row, after warm-up.
     pub frames: usize,
+    /// Planes of the ViewSlices render the error is measured against.
     pub reference_planes: u32,
     /// Write the rows as JSON here.
     pub json: Option<PathBuf>,
@@ -80,6 +85,8 @@ fn draw_passes(c: Compositor) -> &'static [&'static str] {
     }
 }
 
+/// Runs `voltex bench`: each scene at each plane count, timed and compared, printed as a table
+/// and written as asked.
 pub fn run(args: &Args) -> Result<()> {
     let Args { scenes, planes, size, frames, reference_planes, .. } = args;
     let (size, frames, reference_planes) = (*size, *frames, *reference_planes);

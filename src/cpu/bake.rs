@@ -375,9 +375,11 @@ pub struct Volume {
 }
 
 impl Volume {
+    /// Index of voxel `v` in `texels`.
     pub fn index(&self, v: [u32; 3]) -> usize {
         (v[0] + self.size[0] * (v[1] + self.size[1] * v[2])) as usize
     }
+    /// The RGBA of voxel `v`.
     pub fn get(&self, v: [u32; 3]) -> [f32; 4] {
         self.texels[self.index(v)]
     }
@@ -445,23 +447,34 @@ fn xyz_u(v: [u32; 4]) -> [u32; 3] {
 /// A texel-space implicit shape, as the scene describes it.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Shape {
+    /// A solid sphere.
     Sphere {
+        /// Centre, texel space.
         center: V3,
+        /// Radius, texel units.
         radius: f32,
     },
     /// Axis along w.
     Torus {
+        /// Centre, texel space.
         center: V3,
+        /// Radius of the ring through the tube's centre.
         major: f32,
+        /// Radius of the tube.
         minor: f32,
     },
+    /// An axis-aligned ellipsoid.
     Ellipsoid {
+        /// Centre, texel space.
         center: V3,
+        /// Semi-axes along s, t and w.
         radii: V3,
     },
     /// Balls as (centre, radius); surface where the field equals `threshold` (in (0,1)).
     Metaballs {
+        /// The balls `(centre, radius)`, texel space.
         balls: Vec<(V3, f32)>,
+        /// Iso-value of the summed field.
         threshold: f32,
     },
     /// Fills the whole volume (analytic tests).

@@ -84,7 +84,9 @@ pub struct Lattice {
     /// Cells along the bounds' longest axis (the scene's `splat_grid`).
     pub(crate) grid: u32,
     pub(crate) min: DVec3,
+    /// Cell size, object units.
     pub cell: f64,
+    /// Cells along x, y and z.
     pub counts: [u32; 3],
     /// Support distance of the splat surface.
     pub level: f64,

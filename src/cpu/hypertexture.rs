@@ -17,8 +17,11 @@ pub(crate) const TINY: f64 = 1e-12;
 /// A packed hypertexture and its sampled transfer tables, as the kernels see them.
 #[derive(Clone, Copy)]
 pub struct Model<'a> {
+    /// The object's parameters.
     pub params: &'a HyperParams,
+    /// Its noises.
     pub noises: &'a [HyperNoise],
+    /// The sampled transfer tables.
     pub tables: &'a [f64],
     /// Mesh objects: the baked grid's samples and its largest inside distance.
     pub grid: Option<(&'a [[f32; 4]], f32)>,

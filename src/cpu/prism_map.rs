@@ -7,7 +7,9 @@ use glam::DVec3;
 /// Corners of one prism: bottom `p_i` and top `p_i + h_i`, in any common frame (camera-relative).
 #[derive(Clone, Copy, Debug)]
 pub struct PrismCorners {
+    /// Bottom corners `p_i`.
     pub bottom: [DVec3; 3],
+    /// Top corners `p_i + h_i`.
     pub top: [DVec3; 3],
     /// Welded vertex ids: a side patch is intersected with its endpoints in id order, so the two
     /// prisms sharing it get bit-identical hits (no crack, no double count).

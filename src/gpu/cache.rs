@@ -11,8 +11,11 @@ use std::hash::{Hash, Hasher};
 /// What a build created (not found in the cache).
 #[derive(Debug, Default, Clone, Copy, PartialEq, Eq)]
 pub struct CacheStats {
+    /// Shader modules compiled.
     pub modules: u32,
+    /// Pipelines created.
     pub pipelines: u32,
+    /// Texels baked.
     pub bakes: u32,
 }
 
@@ -31,11 +34,14 @@ pub(crate) struct Layout {
 /// Entries by their type and key.
 type Slot = (TypeId, u64);
 
+/// Shader modules, pipelines and bakes kept across builds (the preview's rebuilds, a bench's
+/// settings), keyed by type and content hash, so that an unchanged part is not made again.
 #[derive(Default)]
 pub struct GpuCache {
     entries: HashMap<Slot, Box<dyn Any + Send>>,
     /// Entries used since the last `begin`, so that `retain_used` can drop what a rebuild left behind.
     used: HashSet<Slot>,
+    /// What the current build created.
     pub stats: CacheStats,
 }
 

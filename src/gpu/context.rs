@@ -13,11 +13,14 @@ pub(crate) const OPTIONAL_FEATURES: wgpu::Features = wgpu::Features::TIMESTAMP_Q
     .union(wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS)
     .union(wgpu::Features::FLOAT32_BLENDABLE);
 
+/// The wgpu device and queue voltex renders with, with its adapter's info, features and limits.
 pub struct GpuContext {
+    /// The wgpu device.
     pub device: wgpu::Device,
     pub(crate) queue: wgpu::Queue,
     pub(crate) info: wgpu::AdapterInfo,
     pub(crate) features: wgpu::Features,
+    /// The device's limits (the adapter's, as requested).
     pub limits: wgpu::Limits,
     errors: Arc<Mutex<Vec<String>>>,
     /// Why the device was lost, once it is.

@@ -6,6 +6,7 @@ use std::collections::HashMap;
 /// Resources, counts and override constants of one instance: the frame, or one object.
 #[derive(Default)]
 pub struct Inputs {
+    /// Storage and uniform buffers by the name kernels bind them.
     pub buffers: HashMap<String, wgpu::Buffer>,
     pub(crate) views: HashMap<String, wgpu::TextureView>,
     pub(crate) samplers: HashMap<String, wgpu::Sampler>,

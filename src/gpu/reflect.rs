@@ -33,10 +33,13 @@ impl BindingKind {
     }
 }
 
+/// A WGSL global a pass binds, as reflection finds it: its name, group, binding and kind.
 #[derive(Clone, Debug)]
 pub struct Binding {
+    /// The global's name, which graph resources are bound by.
     pub name: String,
     pub(crate) group: u32,
+    /// Its `@binding` index.
     pub binding: u32,
     pub(crate) kind: BindingKind,
     pub(crate) visibility: wgpu::ShaderStages,

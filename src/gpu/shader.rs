@@ -13,8 +13,10 @@ use crate::gpu::sources::{Source, Sources};
 pub struct Kernel {
     /// Path relative to the WGSL root, e.g. `view_slices/emit_slices.wgsl`.
     pub(crate) name: String,
+    /// The WGSL module after includes, as naga parsed it.
     pub module: naga::Module,
     pub(crate) info: naga::valid::ModuleInfo,
+    /// The files the source was read from (the kernel and its includes), to watch for edits.
     pub files: Vec<PathBuf>,
     /// Hash of the expanded source: the GPU module is reused while it is unchanged.
     pub(crate) source_hash: u64,

@@ -4,6 +4,8 @@
 use crate::error::Result;
 use crate::gpu::GpuContext;
 
+/// GPU timestamps around labelled passes of one frame (none where the adapter has no timestamp
+/// queries).
 pub struct Timer {
     set: Option<wgpu::QuerySet>,
     resolve: Option<wgpu::Buffer>,

@@ -24,6 +24,7 @@ struct Buffer {
     clear: bool,
 }
 
+/// A planned graph with its resources allocated: records and runs frames on the GPU.
 pub struct Executor {
     graph: Graph,
     textures: HashMap<String, Texture>,

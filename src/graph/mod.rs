@@ -13,6 +13,7 @@ use serde::Deserialize;
 
 use crate::error::{locate_literal, ron_error, Error, FileLoc, Result};
 
+/// The contents of a graph file (`Graph(...)`): its outputs, resources, passes and AOVs.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 #[serde(rename = "Graph")]
@@ -36,6 +37,7 @@ pub struct GraphFile {
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct AovDecl {
+    /// The graph textures read back, in order.
     pub textures: Vec<String>,
     pub(crate) channels: AovChannels,
     /// How `supersample` reduces a block of samples to a pixel.
@@ -105,19 +107,25 @@ impl AovDecl {
     }
 }
 
+/// A resource the graph owns (a value of `resources`), allocated only when a kept pass uses it.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub enum ResourceDecl {
+    /// A texture, bound by name to WGSL texture globals and named by raster targets.
     Texture {
+        /// The texel format.
         format: Format,
+        /// Its size (default: the scene's output size).
         #[serde(default)]
         size: TextureSize,
+        /// The value it holds when a frame first uses it (none: not cleared).
         #[serde(default)]
         clear: Option<Clear>,
     },
     /// A storage buffer of the frame (one for all instances), bound by name to WGSL
     /// `var<storage, read>` or `var<storage, read_write>` globals.
     Buffer {
+        /// The buffer's size.
         size: BufferSize,
         /// `Zero`: zeroed every frame before the first pass that uses it; otherwise contents
         /// carry over from frame to frame (zero at first).
@@ -139,7 +147,12 @@ pub enum BufferSize {
     /// A size in 4-byte words (`u32`, `f32`, `atomic<u32>`).
     Words(Count),
     /// `count` elements of `stride` bytes each.
-    Elements { count: Count, stride: u32 },
+    Elements {
+        /// Element count (a size expression).
+        count: Count,
+        /// Bytes per element.
+        stride: u32,
+    },
 }
 
 impl BufferSize {
@@ -153,9 +166,11 @@ impl BufferSize {
     }
 }
 
+/// How a graph buffer is cleared each frame.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub enum BufferClear {
+    /// Zeroed before the first pass that uses it.
     Zero,
 }
 
@@ -200,18 +215,27 @@ impl Value {
 /// no method itself.
 #[derive(Debug, Clone, Default)]
 pub struct Vocabulary {
+    /// The filters passes may be instanced over (`Objects("ViewSlices")`, ...).
     pub filters: Vec<&'static str>,
+    /// The count names dispatches, draws and sizes may use (`prisms`, `planes`, ...).
     pub counts: Vec<&'static str>,
+    /// The resources the runtime provides, bound by name like the graph's own.
     pub resources: Vec<&'static str>,
 }
 
+/// The format of a graph texture.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub enum Format {
+    /// 8-bit RGBA, normalised (4 bytes a pixel).
     Rgba8Unorm,
+    /// 16-bit float RGBA (8 bytes a pixel).
     Rgba16Float,
+    /// 32-bit float RGBA (16 bytes a pixel).
     Rgba32Float,
+    /// One 32-bit float channel (4 bytes a pixel).
     R32Float,
+    /// 32-bit float depth (4 bytes a pixel).
     Depth32Float,
 }
 
@@ -234,12 +258,14 @@ impl Format {
     }
 }
 
+/// The size of a graph texture.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub enum TextureSize {
     /// The scene's output size.
     #[default]
     Output,
+    /// A fixed `(width, height)` in pixels, each 1..=16384.
     Fixed(#[serde(deserialize_with = "side")] u32, #[serde(deserialize_with = "side")] u32),
 }
 
@@ -271,6 +297,7 @@ fn depth<'de, D: serde::Deserializer<'de>>(d: D) -> Result<f32, D::Error> {
     }
 }
 
+/// The value a graph texture holds when a frame first uses it.
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub enum Clear {
@@ -281,6 +308,7 @@ pub enum Clear {
         #[serde(deserialize_with = "finite")] f32,
         #[serde(deserialize_with = "finite")] f32,
     ),
+    /// A depth in [0, 1], for `Depth32Float` textures.
     Depth(#[serde(deserialize_with = "depth")] f32),
 }
 
@@ -295,37 +323,53 @@ pub enum Instances {
     Objects(String),
 }
 
+/// A pass of the graph: a compute dispatch or a raster draw naming one WGSL file.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub enum PassDecl {
+    /// A compute dispatch of one kernel.
     Compute {
+        /// Unique among the graph's passes; names the pass in errors and timings.
         name: String,
+        /// The WGSL file, looked up beside the graph first, then in the project.
         shader: String,
+        /// The kernel's entry point (default `main`).
         #[serde(default = "default_compute_entry")]
         entry: String,
+        /// Once per frame (default) or per matching object.
         #[serde(default)]
         instances: Instances,
         /// Buffers zeroed before the pass (per instance).
         #[serde(default)]
         clear: Vec<String>,
+        /// How many invocations or workgroups to dispatch.
         dispatch: Dispatch,
         /// Dispatches per frame (a count name or number): kernels that resume their work from a
         /// state buffer, so no single dispatch runs long (watchdogs, software loop limits).
         #[serde(default = "one")]
         repeat: String,
     },
+    /// A raster draw into colour and depth targets.
     Raster {
+        /// Unique among the graph's passes; names the pass in errors and timings.
         name: String,
+        /// The WGSL file, looked up beside the graph first, then in the project.
         shader: String,
+        /// The vertex entry point (default `vs_main`).
         #[serde(default = "default_vertex_entry")]
         vertex: String,
+        /// The fragment entry point (default `fs_main`).
         #[serde(default = "default_fragment_entry")]
         fragment: String,
+        /// Once per frame (default) or per matching object.
         #[serde(default)]
         instances: Instances,
+        /// Colour targets, at most 8, each a graph texture with a blend mode.
         targets: Vec<Target>,
+        /// The depth target, tested (and written when asked) by the draw.
         #[serde(default)]
         depth: Option<DepthTarget>,
+        /// What to draw.
         draw: Draw,
     },
 }
@@ -345,6 +389,7 @@ fn default_fragment_entry() -> String {
 }
 
 impl PassDecl {
+    /// The pass's name.
     pub fn name(&self) -> &str {
         match self {
             PassDecl::Compute { name, .. } | PassDecl::Raster { name, .. } => name,
@@ -372,6 +417,7 @@ impl PassDecl {
 /// provides (`prisms`, `planes`, ...: `render::vocabulary().counts`, listed in the graph reference).
 pub(crate) type Count = String;
 
+/// How much a compute pass dispatches: invocations or workgroups per axis.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub enum Dispatch {
@@ -381,6 +427,7 @@ pub enum Dispatch {
     Groups(Count, Count, Count),
 }
 
+/// A colour target of a raster pass: `(resource, blend)`.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Target {
@@ -389,9 +436,11 @@ pub struct Target {
     pub(crate) blend: Blend,
 }
 
+/// How a raster pass writes its colour target.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub enum Blend {
+    /// Overwrite (the default).
     #[default]
     Replace,
     /// `src + dst * (1 - src.a)` on premultiplied colours: back-to-front compositing.
@@ -400,6 +449,7 @@ pub enum Blend {
     Add,
 }
 
+/// The depth target of a raster pass: `(resource, write, compare)`.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct DepthTarget {
@@ -409,12 +459,16 @@ pub struct DepthTarget {
     pub(crate) compare: Compare,
 }
 
+/// The depth test of a raster pass.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub enum Compare {
+    /// Pass when nearer (the default).
     #[default]
     Less,
+    /// Pass when nearer or equal.
     LessEqual,
+    /// Always pass.
     Always,
 }
 
@@ -428,9 +482,11 @@ impl Compare {
     }
 }
 
+/// What a raster pass draws.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub enum Draw {
+    /// A vertex count (a count name or number), one instance.
     Vertices(Count),
     /// Indirect draw from a buffer holding `DrawIndirect` arguments.
     Indirect(String),
@@ -439,7 +495,9 @@ pub enum Draw {
     /// overlapping instances are drawn one by one (`per_plane`, one `DrawIndirect` per plane),
     /// interleaved by depth.
     DepthSorted {
+        /// Buffer of `DrawIndirect` arguments for instances drawn whole.
         whole: String,
+        /// Buffer of `DrawIndirect` arguments, one per plane, for overlapping instances.
         per_plane: String,
     },
 }
@@ -449,15 +507,18 @@ pub enum Draw {
 pub struct Graph {
     pub(crate) path: PathBuf,
     pub(crate) source: String,
+    /// The parsed file.
     pub file: GraphFile,
 }
 
 impl Graph {
+    /// Reads and parses the graph file at `path` (see [`Graph::parse`]).
     pub fn load(path: &Path) -> Result<Self> {
         let source = crate::input::read_text(path, "a graph file")?;
         Self::parse(path, source)
     }
 
+    /// Parses `source` as the graph file `path`, checking its names; errors are at `file:line:col`.
     pub fn parse(path: &Path, source: String) -> Result<Self> {
         let file: GraphFile = ron::Options::default()
             .with_default_extension(ron::extensions::Extensions::IMPLICIT_SOME)

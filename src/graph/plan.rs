@@ -16,6 +16,7 @@ use crate::graph::{
 /// What the planner needs to know of a scene object.
 #[derive(Debug, Clone)]
 pub struct ObjectInfo {
+    /// The object's name in the scene.
     pub name: String,
     /// Filters this object matches (e.g. `ViewSlices` for objects drawn by that method).
     pub filters: Vec<&'static str>,
@@ -25,11 +26,16 @@ pub struct ObjectInfo {
     pub order: u32,
 }
 
+/// A pass of the plan: its declaration, kernel, bindings and what it reads and writes.
 pub struct PlannedPass {
+    /// The pass as the graph file declares it.
     pub decl: PassDecl,
     pub(crate) kernel: Arc<Kernel>,
+    /// The WGSL globals it binds, as reflection found them.
     pub bindings: Vec<Binding>,
+    /// Resources it reads.
     pub reads: BTreeSet<String>,
+    /// Resources it writes.
     pub writes: BTreeSet<String>,
     /// `None`: once per frame; otherwise the object indices, back to front.
     pub instances: Option<Vec<usize>>,
@@ -38,6 +44,7 @@ pub struct PlannedPass {
 /// A graph buffer some kept pass uses, sized for the frame.
 #[derive(Debug, Clone)]
 pub struct PlannedBuffer {
+    /// Size in bytes.
     pub bytes: u64,
     /// Zeroed every frame before the first pass that uses it.
     pub clear: bool,
@@ -45,7 +52,9 @@ pub struct PlannedBuffer {
     pub(crate) indirect: bool,
 }
 
+/// A graph planned against a scene: the kept passes in order and the resources they use.
 pub struct Plan {
+    /// The kept passes, in execution order.
     pub passes: Vec<PlannedPass>,
     /// Graph textures some kept pass uses.
     pub textures: BTreeMap<String, ResourceDecl>,
@@ -122,6 +131,9 @@ fn check_target_sizes(graph: &Graph, decl: &PassDecl, size: (u32, u32)) -> Resul
     Ok(())
 }
 
+/// Plans `graph` for the scene's `objects` at `size`: instances per pass, kernels loaded and
+/// reflected, passes ordered by reads and writes, and what no output needs pruned; errors at the
+/// graph's `file:line:col`.
 pub fn plan(
     graph: &Graph,
     sources: &Sources,

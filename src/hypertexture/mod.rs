@@ -30,8 +30,11 @@ pub struct Packed {
     pub(crate) perturb: [f32; 4],
     /// Object kind, field kind, noise count, perturbation seed.
     pub(crate) kinds: [u32; 4],
+    /// The noises, in combining order.
     pub noises: Vec<HyperNoise>,
+    /// The shape and colour transfer functions, indexing `points`.
     pub functions: Vec<TransferFunction>,
+    /// Control points of the transfer functions.
     pub points: Vec<TransferPoint>,
     /// Object-space bounds enlarged by the largest shift.
     pub bounds: (DVec3, DVec3),

@@ -13,7 +13,9 @@ use crate::{Error, Result};
 /// A linear (scene-referred) HDR RGBA image, row-major, top row first.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Image {
+    /// Width in pixels.
     pub width: u32,
+    /// Height in pixels.
     pub height: u32,
     /// `width * height` pixels; `pixels[y * width + x]`.
     pub pixels: Vec<[f32; 4]>,
@@ -75,6 +77,7 @@ impl Image {
         self.pixels.len()
     }
 
+    /// Whether the image has no pixel.
     pub fn is_empty(&self) -> bool {
         self.pixels.is_empty()
     }
@@ -120,6 +123,7 @@ impl Image {
         })
     }
 
+    /// Whether `other` has the same width and height.
     pub fn same_size(&self, other: &Image) -> bool {
         self.width == other.width && self.height == other.height
     }

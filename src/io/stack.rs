@@ -47,10 +47,13 @@ pub struct Manifest {
     pub slices: Vec<String>,
 }
 
+/// What a slice stack's colours hold (`lighting` in `manifest.json`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum StackLighting {
+    /// Shading baked in with the scene's first light.
     Baked,
+    /// The unlit albedo.
     Unlit,
 }
 
@@ -60,6 +63,7 @@ pub enum StackLighting {
 pub struct SliceStack {
     pub(crate) resolution: [u32; 3],
     pub(crate) texels: Vec<u16>,
+    /// The stack's `manifest.json` (none: an older folder of 8-bit premultiplied PNGs).
     pub manifest: Option<Manifest>,
 }
 

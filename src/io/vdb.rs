@@ -42,7 +42,9 @@ pub(crate) const LEAF_VOXELS: usize = 1 << (3 * LEAF_LOG2);
 
 /// A voxel value type OpenVDB knows: its name in grid types and metadata.
 pub trait Value: Copy + PartialEq + bytemuck::Pod + Default {
+    /// The type's name in OpenVDB grid types (`float`, `vec3s`).
     const TYPE: &'static str;
+    /// Whether every component is finite.
     fn is_finite(&self) -> bool;
 }
 
@@ -176,7 +178,9 @@ impl<T: Value> Voxels<T> {
 /// What a grid holds.
 #[derive(Clone, Debug, PartialEq)]
 pub enum GridData {
+    /// Scalar voxels (`float`).
     Float(Voxels<f32>),
+    /// Vector voxels (`vec3s`).
     Vec3(Voxels<[f32; 3]>),
 }
 
@@ -189,12 +193,14 @@ pub(crate) enum GridClass {
     Unknown,
 }
 
+/// One OpenVDB grid: its name, class, index-to-world transform and voxels.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Grid {
     pub(crate) name: String,
     pub(crate) class: GridClass,
     /// Index space (voxel `(i, j, k)` at point `(i, j, k)`) to world.
     pub(crate) index_to_world: DMat4,
+    /// The grid's voxels.
     pub data: GridData,
 }
 

@@ -28,6 +28,7 @@ pub fn load(path: &std::path::Path) -> Result<Mesh> {
 /// so shared edges extrude to identical prism faces (no cracks). Uvs live per triangle corner.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct BaseSurface {
+    /// Welded vertex positions, object space.
     pub positions: Vec<DVec3>,
     /// Height vector per welded vertex (direction and length of the texel's `w` axis).
     pub heights: Vec<DVec3>,
@@ -77,9 +78,11 @@ impl BaseSurface {
 /// A surface before heights are assigned: what generators and the OBJ loader produce.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Mesh {
+    /// Welded vertex positions, object space.
     pub positions: Vec<DVec3>,
     /// Unit outward normal per welded vertex (zero where undefined).
     pub normals: Vec<DVec3>,
+    /// Triangles as indices into `positions`.
     pub triangles: Vec<[u32; 3]>,
     /// Per corner, one tile = `[0, 1]^2`, no tiling.
     pub corner_uvs: Vec<[DVec2; 3]>,

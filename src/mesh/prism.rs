@@ -5,13 +5,17 @@
 use super::BaseSurface;
 use glam::DVec3;
 
+/// What [`check`] found wrong with a base surface's prisms.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct PrismReport {
+    /// Questionable but drawable: degenerate triangles, zero-length height vectors.
     pub warnings: Vec<String>,
+    /// Not drawable: missing vertices, non-finite values, inward-flipped height vectors, twisted prisms.
     pub errors: Vec<String>,
 }
 
 impl PrismReport {
+    /// Whether no error was found.
     pub fn is_ok(&self) -> bool {
         self.errors.is_empty()
     }
@@ -35,6 +39,7 @@ fn list(items: &[usize]) -> String {
     s
 }
 
+/// Checks every prism of `s`, listing the triangles at fault.
 pub fn check(s: &BaseSurface) -> PrismReport {
     let mut r = PrismReport::default();
     if s.heights.len() != s.positions.len() || s.corner_uvs.len() != s.triangles.len() {

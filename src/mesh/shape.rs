@@ -25,8 +25,11 @@ pub(crate) const MAX_PARTS: usize = 16;
 #[derive(Debug, Clone, PartialEq)]
 pub struct MeshShape {
     pub(crate) positions: Vec<DVec3>,
+    /// Triangles as indices into the welded positions, grouped by part.
     pub triangles: Vec<[u32; 3]>,
+    /// Lowest corner of the mesh's bounding box.
     pub lo: DVec3,
+    /// Highest corner of the mesh's bounding box.
     pub hi: DVec3,
     /// Closed parts: (first triangle, triangle count); triangles are grouped by part.
     pub parts: Vec<(u32, u32)>,
@@ -41,9 +44,13 @@ pub struct MeshShape {
 /// then negative.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct GridSpec {
+    /// Lowest corner of the sampled box.
     pub lo: DVec3,
+    /// Highest corner of the sampled box.
     pub hi: DVec3,
+    /// Samples along each axis.
     pub n: [u32; 3],
+    /// Test inside by ray parity (a closed mesh); `false`: distances only (a shell).
     pub parity: bool,
 }
 
@@ -190,6 +197,7 @@ impl MeshShape {
         GridSpec { lo: self.lo - DVec3::splat(pad), hi: self.hi + DVec3::splat(pad), n: [n; 3], parity: true }
     }
 
+    /// The positions of triangle `t`'s corners.
     pub fn triangle(&self, t: usize) -> [DVec3; 3] {
         self.triangles[t].map(|i| self.positions[i as usize])
     }

@@ -6,8 +6,12 @@ use glam::DVec3;
 use crate::mesh::{prism, BaseSurface};
 use crate::types::{BaseVertex, Prism, ShellVertex, VertexFrame};
 
+/// The prisms of one object, as the kernels read them: shell vertices (camera-relative) and
+/// prisms.
 pub struct Shell {
+    /// Bottom and top of each welded vertex, camera-relative.
     pub vertices: Vec<ShellVertex>,
+    /// One prism per base triangle.
     pub prisms: Vec<Prism>,
 }
 
@@ -17,6 +21,7 @@ fn rel(p: DVec3, eye: DVec3) -> [f32; 4] {
 }
 
 impl Shell {
+    /// The shell of `surface` with positions made relative to the camera at `eye` (in f64, then f32).
     pub fn new(surface: &BaseSurface, eye: DVec3) -> Self {
         let vertices = surface
             .positions

@@ -24,7 +24,9 @@ use view::{Lighting, View};
 /// instanced over them), and the per-object resources and counts its inputs provide (graph files
 /// bind and use them by name). The graph core checks graph files against the union of these.
 pub struct Contribution {
+    /// The method's name in scene files (`ViewSlices`, ...).
     pub method: &'static str,
+    /// The filters passes may be instanced over for this method's objects.
     pub filters: &'static [&'static str],
     pub(crate) resources: &'static [&'static str],
     pub(crate) counts: &'static [&'static str],

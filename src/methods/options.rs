@@ -8,9 +8,13 @@ use crate::scene::{AxisSlices, Camera, Method, RayMarch, Reference, Shading, Sha
 /// Overrides of what the scene file says, from the command line or tests.
 #[derive(Debug, Clone, Default)]
 pub struct RenderOptions {
+    /// Render size in pixels (width, height), instead of the scene's `output`.
     pub size: Option<(u32, u32)>,
+    /// The graph file to render with, instead of `graphs/frame.ron`.
     pub graph: Option<PathBuf>,
+    /// ViewSlices: plane count of every ViewSlices object.
     pub planes: Option<u32>,
+    /// ViewSlices: whether prisms outside a plane's slab are skipped.
     pub trivial_reject: Option<bool>,
     /// Render every textured object with this method (keeping its lighting mode).
     pub method: Option<MethodKind>,
@@ -60,8 +64,11 @@ pub struct RenderOptions {
 /// A method without its knobs, to switch every object to it (`--method`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum MethodKind {
+    /// View-aligned prism slicing.
     ViewSlices,
+    /// Exact ray casting (the ground truth).
     Reference,
+    /// Axis-aligned slice stacks.
     AxisSlices,
 }
 

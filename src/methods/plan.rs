@@ -16,7 +16,9 @@ use crate::types::VertexFrame;
 /// One object as the frame sees it: its shell, the texel bake and lighting its method chose,
 /// and what it draws (the base surface first, then its method).
 pub struct ObjectPlan {
+    /// The scene object: its name, base surface (world space), texel and method.
     pub object: SceneObject,
+    /// Its prisms, camera-relative.
     pub shell: Shell,
     /// Per-pixel lighting: the texel is baked as albedo + normals and lit in the kernels.
     pub(crate) per_pixel: bool,
@@ -34,6 +36,7 @@ impl ObjectPlan {
         self.methods.iter().find_map(|m| m.as_any().downcast_ref())
     }
 
+    /// The object's plan of type `T` to change (the preview's knobs, tests), if it has one.
     pub fn method_mut<T: MethodPlan>(&mut self) -> Option<&mut T> {
         self.methods.iter_mut().find_map(|m| m.as_any_mut().downcast_mut())
     }
@@ -59,8 +62,11 @@ impl ObjectPlan {
 
 /// One texel bake of the frame, shared by the objects that sample it.
 pub struct BakePlan {
+    /// The texel's name in the scene.
     pub texel: String,
+    /// What to bake.
     pub request: BakeRequest,
+    /// World length over which a voxel's stored opacity is reached.
     pub opacity_length: f32,
 }
 
@@ -76,6 +82,7 @@ pub struct PartDecl {
 pub struct InputCx<'a> {
     pub(crate) ctx: &'a GpuContext,
     pub(crate) size: (u32, u32),
+    /// The frame's texel bakes (objects find theirs by index).
     pub bakes: &'a [BakePlan],
     pub(crate) baked: &'a [Baked],
     /// What [`MethodPlan::prepare`] returned for this plan.
@@ -153,7 +160,9 @@ pub trait MethodPlan: Any + Send {
         None
     }
 
+    /// The plan as `Any`, to downcast to its own type (see [`ObjectPlan::method`]).
     fn as_any(&self) -> &dyn Any;
+    /// The plan as mutable `Any` (see [`ObjectPlan::method_mut`]).
     fn as_any_mut(&mut self) -> &mut dyn Any;
 }
 

@@ -9,11 +9,15 @@ use crate::types::FrameParams;
 /// The camera as the kernels see it (see `ReferenceParams`).
 #[derive(Debug, Clone, Copy)]
 pub struct RayCamera {
+    /// The camera's position, world space.
     pub eye: DVec3,
     /// Right and up scaled by the half extents of the image at unit distance.
     pub right: DVec3,
+    /// The camera's up, scaled as `right`.
     pub up: DVec3,
+    /// Distance of the near plane.
     pub near: f64,
+    /// Distance of the far plane.
     pub far: f64,
 }
 

@@ -70,7 +70,9 @@ pub fn relative_error_map(actual: &Image, reference: &Image) -> Result<Vec<f32>>
 /// Result of [`flip`]: the mean FLIP error and the per-pixel error map (row-major, in [0, 1]).
 #[derive(Debug, Clone)]
 pub struct FlipResult {
+    /// Mean FLIP over the image, in [0, 1].
     pub mean: f64,
+    /// Per-pixel FLIP, row-major.
     pub map: Vec<f32>,
 }
 

@@ -41,7 +41,9 @@ pub const DEFAULT_RAY_STEPS: [f64; 5] = [0.002, 0.004, 0.008, 0.015, 0.03];
 /// to themselves; `RayMarch` varies the step of every hypertexture object.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Sweep {
+    /// One of the texel methods (`ViewSlices`, `AxisSlices`, `Reference`).
     Method(MethodKind),
+    /// The RayMarch step of every hypertexture object.
     RayMarch,
 }
 
@@ -127,12 +129,15 @@ impl Truth {
 /// The command's arguments.
 #[derive(Debug, Clone)]
 pub struct Args {
+    /// The scene file to sweep.
     pub scene: PathBuf,
+    /// Render size in pixels (width, height).
     pub size: (u32, u32),
     /// Timed frames per setting (after warm-up); medians are reported.
     pub frames: usize,
     /// Output folder (default `out/pareto/<scene stem>`), created if missing.
     pub out: Option<PathBuf>,
+    /// What the error is measured against.
     pub truth: Truth,
     /// Methods to sweep.
     pub methods: Vec<Sweep>,
@@ -370,6 +375,8 @@ pub(crate) fn reference_default_step(scene: &Scene, size: (u32, u32)) -> Result<
     Ok(textured.chain(volumes).min_by(f64::total_cmp))
 }
 
+/// Runs `voltex pareto`: renders each setting of the swept methods, times it, measures its
+/// error against the truth, and writes `pareto.csv` and `pareto.svg` with the Pareto fronts.
 pub fn run(args: &Args) -> Result<()> {
     args.check()?;
     let scene = crate::scene::load(&args.scene)?;

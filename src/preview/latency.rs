@@ -93,16 +93,20 @@ pub struct Row {
     pub(crate) samples: Vec<Sample>,
 }
 
+/// A whole `--json` file of `voltex preview-latency`: the run's settings and one row per edit.
 #[derive(Debug, Clone, Serialize)]
 pub struct Report {
-    pub command: String,
+    pub(crate) command: String,
     pub(crate) scene: String,
+    /// The adapter, as [`GpuContext::adapter_line`](crate::gpu::GpuContext::adapter_line) names it.
     pub adapter: String,
     /// The 1-minute load average when the run began (a software adapter shares the CPU).
     pub(crate) load: Option<f64>,
+    /// Render size in pixels (width, height).
     pub size: [u32; 2],
     pub(crate) debounce_ms: f64,
     pub(crate) repeat: usize,
+    /// One row per edit measured.
     pub rows: Vec<Row>,
 }
 

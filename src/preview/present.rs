@@ -27,8 +27,11 @@ struct PresentParams {
 /// What the window shows.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Mode {
+    /// The render.
     Image = 0,
+    /// The same frame with every textured object drawn by the exact `Reference` method.
     Reference = 1,
+    /// The difference between the render and the reference.
     Difference = 2,
 }
 

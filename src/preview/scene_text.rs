@@ -12,23 +12,31 @@ use crate::error::{Error, Result};
 /// One value of the text.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Value {
+    /// Byte range of the value in the text.
     pub span: Range<usize>,
+    /// What the value is.
     pub kind: Kind,
 }
 
+/// The shape of a [`Value`].
 #[derive(Debug, Clone, PartialEq)]
 pub enum Kind {
     /// A number, bool, identifier (unit variant), string or char: its text is the span.
     Atom,
     /// `Name(..)` or `(..)`: a struct when its fields are named, else a tuple.
     Paren {
+        /// The struct's name (`None` for `(..)`).
         name: Option<String>,
+        /// Its fields, in order.
         fields: Vec<Field>,
     },
+    /// `[..]`: a list.
     List(Vec<Value>),
+    /// `{..}`: a map's keys and values.
     Map(Vec<(Value, Value)>),
 }
 
+/// A field of a `Paren` value.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Field {
     /// The field's name (`None` in a tuple).
@@ -65,6 +73,7 @@ pub fn show(path: &[Step]) -> String {
 }
 
 impl Value {
+    /// The value's text in `src`.
     pub fn text<'a>(&self, src: &'a str) -> &'a str {
         &src[self.span.clone()]
     }
@@ -86,6 +95,7 @@ impl Value {
         }
     }
 
+    /// The value at `path` below this one, if there is one.
     pub fn at(&self, path: &[Step], src: &str) -> Option<&Value> {
         path.iter().try_fold(self, |v, s| v.child(s, src))
     }
@@ -381,8 +391,10 @@ impl Parser<'_> {
 /// and removals of list items, `path` is the list; for an added field, the struct).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Edit {
+    /// Where the edit applies: the value's path from the root.
     pub path: Vec<Step>,
     pub(crate) before: String,
+    /// The text after the edit.
     pub after: String,
 }
 
@@ -393,6 +405,7 @@ impl Edit {
         splice(src, &self.path, &self.before, &self.after)
     }
 
+    /// The edit that undoes this one.
     pub fn inverse(&self) -> Edit {
         Edit { path: self.path.clone(), before: self.after.clone(), after: self.before.clone() }
     }

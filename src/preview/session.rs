@@ -35,6 +35,8 @@ pub(crate) struct Stages {
     pub(crate) build: f64,
 }
 
+/// The preview's state without a window: the scene, its renderer and what the last rebuild
+/// found; rebuilt when a file it reads changes, keeping the last good state on an error.
 pub struct Session {
     pub(crate) scene_path: PathBuf,
     /// Overrides (size, graph, methods, camera) applied on every rebuild.
@@ -221,10 +223,12 @@ impl Session {
         (self.draft > 1).then(|| (w.div_ceil(self.draft), h.div_ceil(self.draft)))
     }
 
+    /// The current renderer (none before the first good build).
     pub fn renderer(&self) -> Option<&Renderer> {
         self.renderer.as_ref()
     }
 
+    /// The current scene (none before the first good load).
     pub fn scene(&self) -> Option<&Scene> {
         self.scene.as_ref()
     }

@@ -23,6 +23,8 @@ pub(crate) const SETTLE_MAX: Duration = Duration::from_millis(100);
 /// File kinds a rebuild reads: scenes and graphs, kernels, meshes, height images.
 const RELEVANT: &[&str] = &["ron", "wgsl", "obj", "png"];
 
+/// Watches folders for changes to the files a rebuild reads (scenes, graphs, kernels, meshes,
+/// images).
 pub struct Watcher {
     watcher: RecommendedWatcher,
     events: Receiver<notify::Result<Event>>,
@@ -32,6 +34,7 @@ pub struct Watcher {
 }
 
 impl Watcher {
+    /// Watches `dirs` recursively.
     pub fn new(dirs: &[PathBuf]) -> Result<Self> {
         Self::with_wake(dirs, || {})
     }

@@ -28,7 +28,9 @@ use crate::scene::{Camera, Method};
 
 /// `voltex preview` options.
 pub struct PreviewArgs {
+    /// The scene file.
     pub scene: PathBuf,
+    /// Overrides of the scene applied on every rebuild.
     pub options: RenderOptions,
     /// Write each newly shown frame, as presented, to `DIR/frame-N.png` (tests, recordings), with
     /// what it shows in `DIR/frame-N.json`.
@@ -46,6 +48,8 @@ const NO_FILE: &str = "a mesh opened directly has no scene file to edit: `voltex
 /// Frames a preview trace keeps (the latest).
 const TRACE_FRAMES: usize = 100;
 
+/// Runs `voltex preview`: opens the window and renders the scene, rebuilding when its files
+/// change, until the window closes.
 pub fn run(args: PreviewArgs) -> Result<()> {
     let event_loop = EventLoop::new().map_err(|e| Error::Invalid(format!("cannot open a window: {e}")))?;
     let proxy = event_loop.create_proxy();

@@ -110,6 +110,7 @@ pub struct Args {
 pub mod exit {
     use crate::Error;
 
+    /// Every scene passed.
     pub const PASS: u8 = 0;
     /// A scene regressed, or is new without `--update`.
     pub(crate) const REGRESSIONS: u8 = 1;
@@ -140,6 +141,7 @@ pub(crate) struct RunInfo<'a> {
     pub(crate) host: String,
 }
 
+/// Parses `--max-flip`: a mean FLIP in [0, 1].
 pub fn parse_max_flip(s: &str) -> std::result::Result<f64, String> {
     s.parse::<f64>()
         .ok()
@@ -147,6 +149,7 @@ pub fn parse_max_flip(s: &str) -> std::result::Result<f64, String> {
         .ok_or_else(|| format!("`{s}`: expected a mean FLIP in [0, 1]"))
 }
 
+/// Parses `--max-rel-rmse`: a relative RMSE >= 0.
 pub fn parse_max_rel_rmse(s: &str) -> std::result::Result<f64, String> {
     s.parse::<f64>()
         .ok()

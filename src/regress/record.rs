@@ -18,14 +18,19 @@ pub(crate) const IMAGES: [&str; 4] = ["reference.png", "actual.png", "diff.png",
 pub(crate) const ARTEFACTS: [&str; 5] =
     ["reference.png", "actual.png", "diff.png", "truth.png", "actual.exr"];
 
+/// The outcome of one scene's regression check.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Status {
     /// Failures first (the report sorts by this order).
     BrokenScene,
+    /// The reference image is unreadable, or of another size than the render.
     BrokenReference,
+    /// The render is beyond the scene's thresholds against its reference.
     Regressed,
+    /// The scene has no reference yet.
     New,
+    /// Within the thresholds.
     Pass,
 }
 
@@ -49,6 +54,7 @@ pub struct Record {
     /// The scene file and its reference image relative to the suite root (the scanned folder),
     /// `/`-separated, so that records written on other machines merge.
     pub scene_path: String,
+    /// The reference image, as `scene_path`.
     pub reference_path: String,
     /// Fingerprint of the suite's sorted scene list: records of different suites do not merge.
     #[serde(default)]
@@ -57,6 +63,7 @@ pub struct Record {
     /// graphs, WGSL, the binary): a rerun skips a scene whose record has the same hash.
     #[serde(default)]
     pub inputs: String,
+    /// The outcome.
     pub status: Status,
     /// `--update` wrote the reference in this run (the scene was new, regressed or of another size).
     pub updated: bool,
@@ -67,7 +74,9 @@ pub struct Record {
     pub(crate) warnings: Vec<String>,
     /// Render size (width, height).
     pub size: Option<[u32; 2]>,
+    /// Mean FLIP against the reference.
     pub flip: Option<f64>,
+    /// Relative RMSE against the reference.
     pub rel_rmse: Option<f64>,
     pub(crate) max_flip: f64,
     pub(crate) max_rel_rmse: f64,
@@ -75,6 +84,7 @@ pub struct Record {
     /// the scene states no `regress.truth`).
     #[serde(default)]
     pub truth_flip: Option<f64>,
+    /// The scene's bound on `truth_flip` (`regress.truth.max_flip`).
     #[serde(default)]
     pub max_truth_flip: Option<f64>,
     /// Pixels of the render with a NaN or infinite channel.
@@ -83,6 +93,8 @@ pub struct Record {
     pub(crate) gpu_ms: Option<f64>,
     /// Wall time of the whole check: load, plan, bake, render, compare, write.
     pub(crate) wall_ms: f64,
+    /// The adapter that rendered, as
+    /// [`GpuContext::adapter_line`](crate::gpu::GpuContext::adapter_line) names it.
     pub adapter: String,
     /// The adapter that rendered the reference (`voltex_adapter` in its EXR metadata).
     pub(crate) reference_adapter: Option<String>,
@@ -112,6 +124,7 @@ impl Record {
         atomic::write_bytes(&path, (text + "\n").as_bytes())
     }
 
+    /// Reads a `result.json`, naming the file in errors.
     pub fn read(path: &Path) -> Result<Self> {
         let text = std::fs::read_to_string(path).map_err(|e| Error::file(path, e))?;
         serde_json::from_str(&text).map_err(|e| {
@@ -124,6 +137,7 @@ impl Record {
 #[derive(Debug, Clone)]
 pub struct Found {
     pub(crate) folder: PathBuf,
+    /// The record.
     pub record: Record,
 }
 

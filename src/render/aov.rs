@@ -9,6 +9,7 @@ use crate::io::Image;
 /// An AOV a render writes.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PlannedAov {
+    /// The AOV's name in the graph (`--aov NAME`).
     pub name: String,
     /// Graph textures read back, with how many of their channels (R, G, B, A in order) are used.
     pub(crate) textures: Vec<(String, usize)>,

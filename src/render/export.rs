@@ -35,6 +35,7 @@ pub(crate) const MAX_EXPORT_VOXELS: u64 = 1 << 26;
 /// Default voxels along the longest side of an exported hypertexture node.
 pub const DEFAULT_HYPER_RESOLUTION: u32 = 128;
 
+/// `voltex export`'s options.
 #[derive(Debug, Clone)]
 pub struct ExportOptions {
     /// Texels and nodes to export (default: all).
@@ -43,6 +44,7 @@ pub struct ExportOptions {
     pub time: Option<f64>,
     /// Voxels along the longest side of a hypertexture node's box.
     pub resolution: u32,
+    /// How the voxel values are stored.
     pub compression: vdb::Compression,
 }
 
@@ -62,17 +64,32 @@ impl Default for ExportOptions {
 pub enum Source {
     /// A texel or a hypertexture, baked on the GPU; `opacity_length` is the world length over
     /// which a voxel's alpha is reached.
-    Bake { request: BakeRequest, opacity_length: f64 },
+    Bake {
+        /// What to bake.
+        request: BakeRequest,
+        /// World length over which a voxel's alpha is reached.
+        opacity_length: f64,
+    },
     /// A volume object's grid as read from its file, with its volume's `density_scale` and
     /// `albedo`.
-    Volume { grid: Arc<SparseVolume>, density_scale: f64, albedo: [f32; 3] },
+    Volume {
+        /// The grid's voxels.
+        grid: Arc<SparseVolume>,
+        /// Extinction per unit density per world unit.
+        density_scale: f64,
+        /// Linear RGB scaling the scattered light.
+        albedo: [f32; 3],
+    },
 }
 
 /// One volume to write: its file stem, what it is, its voxels and where they lie.
 #[derive(Debug)]
 pub struct Export {
+    /// The file stem.
     pub name: String,
+    /// What the volume is, for the listing (e.g. `texel "grass"`).
     pub what: String,
+    /// Where its voxels come from.
     pub source: Source,
     /// Voxel `(i, j, k)` (the bake's voxel centre) to world.
     pub index_to_world: DMat4,

@@ -31,9 +31,11 @@ use crate::types::FrameParams;
 /// object it is bound as (its `object` uniform) and the filters it matches.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Instance {
+    /// Index of the object in `objects`, bound as its `object` uniform.
     pub object: usize,
     pub(crate) owner: Owner,
     pub(crate) part: usize,
+    /// The filters it matches (which per-object passes run for it).
     pub filters: Vec<&'static str>,
 }
 
@@ -46,20 +48,26 @@ pub(crate) enum Owner {
     Group(usize),
 }
 
+/// A scene planned for rendering, before any GPU resource: its objects, bakes and graph plan.
 pub struct Blueprint {
     pub(crate) scene_path: PathBuf,
     /// The size rendered at (the output size times `supersample`).
     pub size: (u32, u32),
     pub(crate) supersample: u32,
+    /// The camera's position, world space; positions reach the kernels relative to it.
     pub eye: DVec3,
+    /// The per-frame uniform `frame`.
     pub frame: FrameParams,
+    /// The scene's objects, each with its method plans.
     pub objects: Vec<ObjectPlan>,
     /// Frame-wide plans of methods that draw several objects in one instance.
     pub(crate) groups: Vec<Box<dyn MethodPlan>>,
     /// Graph instances, in the order of `plan`'s object indices.
     pub instances: Vec<Instance>,
+    /// The texel bakes the objects share.
     pub bakes: Vec<BakePlan>,
     pub(crate) graph: Graph,
+    /// The graph planned for this scene.
     pub plan: Plan,
     /// GPU memory the frame may allocate (`RenderOptions::budget` or the default).
     pub(crate) budget: u64,
@@ -113,6 +121,7 @@ pub(crate) fn load_graph(graph: Option<&Path>) -> Result<(Graph, Sources)> {
 }
 
 impl Blueprint {
+    /// Plans `scene` with the overrides `opts` at the scene's time (or `opts.time`).
     pub fn new(scene: &Scene, opts: &RenderOptions) -> Result<Self> {
         Self::with_objects(scene, scene.objects_at(opts.time.unwrap_or(scene.time))?, opts)
     }

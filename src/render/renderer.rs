@@ -15,6 +15,7 @@ use crate::types::ObjectParams;
 
 /// A rendered frame.
 pub struct Frame {
+    /// The linear HDR colour.
     pub image: Image,
     /// Per-pass GPU time (ms) from timestamp queries; empty without TIMESTAMP_QUERY.
     pub pass_times: Vec<(String, f64)>,
@@ -25,6 +26,7 @@ pub struct Frame {
 }
 
 impl Frame {
+    /// GPU time of the whole frame (the sum over its passes), when timestamps were taken.
     pub fn gpu_ms(&self) -> Option<f64> {
         (!self.pass_times.is_empty()).then(|| self.pass_times.iter().map(|p| p.1).sum())
     }
@@ -32,6 +34,7 @@ impl Frame {
 
 /// GPU resources of a blueprint, ready to render frames.
 pub struct Renderer {
+    /// The plan it renders.
     pub blueprint: Blueprint,
     exec: Executor,
     frame: Inputs,
@@ -45,6 +48,7 @@ pub struct Renderer {
 }
 
 impl Renderer {
+    /// Creates the blueprint's GPU resources (bakes, buffers, pipelines) on `ctx`.
     pub fn new(ctx: &GpuContext, blueprint: Blueprint) -> Result<Self> {
         Self::with_cache(ctx, blueprint, &mut GpuCache::default())
     }

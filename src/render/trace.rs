@@ -14,7 +14,9 @@ use crate::gpu::timing::Span;
 /// The frames of one renderer.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Track {
+    /// The renderer's name in the trace.
     pub name: String,
+    /// Per frame, its passes' timed spans.
     pub frames: Vec<Vec<Span>>,
 }
 

@@ -10,8 +10,12 @@ use std::sync::Arc;
 /// A node with a surface, in world space.
 #[derive(Debug, Clone)]
 pub struct SceneObject {
+    /// The node's name.
     pub name: String,
+    /// The base surface, world space, with its height vectors (empty for hypertexture and volume
+    /// nodes).
     pub surface: BaseSurface,
+    /// The texel it draws, by name in `Scene::texels`.
     pub texel: Option<String>,
     pub(crate) method: Option<Method>,
     pub(crate) base_color: Option<[f32; 3]>,
@@ -27,6 +31,7 @@ pub struct SceneObject {
 #[derive(Debug, Clone)]
 pub struct VolumeNode {
     pub(crate) name: String,
+    /// The grid's voxels as read from the file.
     pub grid: Arc<crate::vdb::SparseVolume>,
     /// The node's frame to world (the grid's own index-to-world transform comes first).
     pub to_world: DMat4,

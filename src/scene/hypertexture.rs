@@ -59,30 +59,37 @@ fn default_opacity_length() -> f64 {
 pub enum SoftObject {
     /// `1 - |x| / radius`.
     Sphere {
+        /// Radius, > 0.
         #[serde(deserialize_with = "v::positive")]
         radius: f64,
     },
     /// `1 - |x / radii|`.
     Ellipsoid {
+        /// Semi-axes along x, y and z, each > 0.
         #[serde(deserialize_with = "v::positive3")]
         radii: DVec3,
     },
     /// Axis z: `1 - (distance to the core circle of radius major) / minor`.
     Torus {
+        /// Radius of the core circle, > 0.
         #[serde(deserialize_with = "v::positive")]
         major: f64,
+        /// Radius of the tube, > 0 and below `major`.
         #[serde(deserialize_with = "v::positive")]
         minor: f64,
     },
     /// Edge lengths `size`, centred: `1 - max_i |x_i| / (size_i / 2)`.
     Box {
+        /// Edge lengths along x, y and z, each > 0.
         #[serde(deserialize_with = "v::positive3")]
         size: DVec3,
     },
     /// A closed triangle mesh (OBJ, relative to the scene file) baked into a grid of
     /// `resolution^3` samples: inside distance to the surface over the largest inside distance.
     Mesh {
+        /// The OBJ or glTF file: a closed mesh of at most 16 parts.
         path: Mark<String>,
+        /// Samples per axis, 4..=128 (default 64).
         #[serde(default = "default_grid", deserialize_with = "v::grid_resolution")]
         resolution: u32,
         /// Loaded and checked by `scene::load`.
@@ -121,20 +128,25 @@ pub enum Field {
     /// Away from `center` inside the object (towards it outside), with the length of the
     /// closest-surface vector: the closest-surface field of a sphere seen from a shifted centre.
     FromCentre {
+        /// The centre, in the node's frame.
         #[serde(deserialize_with = "v::vec3")]
         center: DVec3,
     },
     /// The same vector everywhere (its length matters where noises are shifted by it).
     Constant {
+        /// The vector, non-zero.
         #[serde(deserialize_with = "v::direction")]
         direction: DVec3,
     },
     /// The closest-surface vector plus `twist` times its length around `axis` (through `center`).
     Swirl {
+        /// The axis's direction, non-zero (default `(0, 0, 1)`).
         #[serde(default = "z_axis", deserialize_with = "v::direction")]
         axis: DVec3,
+        /// A point on the axis (default the origin).
         #[serde(default, deserialize_with = "v::vec3")]
         center: DVec3,
+        /// Length of the part around the axis, times the closest-surface vector's, finite (default 1).
         #[serde(default = "one", deserialize_with = "v::finite")]
         twist: f64,
     },
@@ -142,13 +154,18 @@ pub enum Field {
     /// `amount` times its length and its length scaled by `1 + magnitude * noise`, noises at
     /// `frequency` (cycles per unit of the node's frame).
     Perturbed {
+        /// The field perturbed.
         field: Box<Mark<Field>>,
+        /// Direction perturbation, a fraction of the field's length, >= 0 (default 0.5).
         #[serde(default = "half", deserialize_with = "v::non_negative")]
         amount: f64,
+        /// Noise cycles per unit of the node's frame, > 0.
         #[serde(deserialize_with = "v::positive")]
         frequency: f64,
+        /// Length perturbation, in [0, 1] (default 0).
         #[serde(default, deserialize_with = "v::unit")]
         magnitude: f64,
+        /// Seed of the perturbing noises (default 0).
         #[serde(default)]
         seed: u32,
     },
@@ -172,6 +189,7 @@ fn yes() -> bool {
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Noise {
+    /// The shape transfer function `T` filtering the noise.
     pub shape: ShapeTransfer,
     /// The largest shift (world depth of the detail, in the node's frame).
     #[serde(deserialize_with = "v::non_negative")]
@@ -218,11 +236,14 @@ impl Noise {
     }
 }
 
+/// How a noise's term combines into the distortion factor k.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub enum Operator {
+    /// `k += amplitude t` (the default).
     #[default]
     Sum,
+    /// `k = k (1 - t) + amplitude t`.
     Blend,
 }
 
@@ -243,6 +264,7 @@ pub enum ShapeTransfer {
     /// first channel): columns are noise values from 0 (left) to 1, rows densities from 0 (top)
     /// to 1, as a `Grid` whose rows are the image's.
     Image {
+        /// The PNG file, relative to the scene file.
         path: Mark<String>,
         /// Filled by `scene::load` from the image.
         #[serde(skip)]
@@ -261,10 +283,12 @@ impl ShapeTransfer {
     }
 }
 
+/// The rows of a `Grid` shape transfer function, each value in [0, 1].
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(transparent)]
 pub struct GridRows(#[serde(deserialize_with = "v::unit_rows")] pub Vec<Vec<f64>>);
 
+/// A control point `(x, y, slope)` of a `Curve`: x and y in [0, 1], slope finite.
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct CurvePoint(
@@ -273,6 +297,7 @@ pub struct CurvePoint(
     #[serde(deserialize_with = "v::finite")] pub f64,
 );
 
+/// The values of a `Table` shape transfer function, each in [0, 1].
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(transparent)]
 pub struct TableValues(#[serde(deserialize_with = "v::unit_list")] pub Vec<f64>);
@@ -285,15 +310,19 @@ pub enum ColorTransfer {
     Ramp(Mark<Vec<Mark<RampPoint>>>),
     /// Transparent below `threshold`, `color` and `opacity` from it on: an iso-surface look.
     Step {
+        /// The density from which the colour shows, in [0, 1].
         #[serde(deserialize_with = "v::unit")]
         threshold: f64,
+        /// Linear RGB in [0, 1].
         #[serde(deserialize_with = "v::color")]
         color: [f32; 3],
+        /// Opacity per opacity length, in [0, 1] (default 1).
         #[serde(default = "one", deserialize_with = "v::unit")]
         opacity: f64,
     },
 }
 
+/// A control point `(density, (r, g, b, a))` of a `Ramp`, all in [0, 1].
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RampPoint(

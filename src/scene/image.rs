@@ -5,10 +5,14 @@ use crate::error::{Error, Result};
 use glam::DVec2;
 use std::path::Path;
 
+/// A height image: PNG or EXR values per pixel and channel.
 #[derive(Debug, Clone, PartialEq)]
 pub struct HeightImage {
+    /// Width in pixels.
     pub width: usize,
+    /// Height in pixels.
     pub height: usize,
+    /// Channels per pixel.
     pub channels: usize,
     /// Row-major from the top row, `channels` values per pixel: in `[0, 1]` from a PNG, as
     /// stored (finite) from an EXR.

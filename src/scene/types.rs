@@ -6,6 +6,8 @@ use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 
+/// A scene file (`Scene(...)`), parsed and checked by `scene::load`: output size, camera, lights,
+/// the named texels, hypertextures and volumes, and the tree of nodes that draw them.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Scene {
@@ -21,6 +23,7 @@ pub struct Scene {
     pub(crate) ambient: f32,
     #[serde(default)]
     pub(crate) lights: Vec<Light>,
+    /// Texels by name, drawn by nodes with `texel: "name"` (and named as frames by `Sequence` ones).
     #[serde(default, deserialize_with = "crate::input::unique_keys")]
     pub texels: BTreeMap<String, Texel>,
     /// Hypertextures (Gilet & Dischler 2009) that nodes draw with `RayMarch`.
@@ -30,6 +33,7 @@ pub struct Scene {
     /// texels (`TexelSource::Volume`).
     #[serde(default, deserialize_with = "crate::input::unique_keys")]
     pub volumes: BTreeMap<String, Volume>,
+    /// The roots of the node tree; transforms compose parent times child.
     #[serde(default)]
     pub nodes: Vec<Node>,
     /// Time of the frame in seconds (animated hypertextures; `--time` overrides it).
@@ -130,11 +134,14 @@ impl Default for Regress {
     }
 }
 
+/// `camera: (eye, target, up, fov_y)`: a pinhole camera looking from `eye` at `target`.
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Camera {
+    /// The camera's position, world space.
     #[serde(deserialize_with = "v::vec3")]
     pub eye: DVec3,
+    /// The point looked at, world space; must differ from `eye`.
     #[serde(deserialize_with = "v::vec3")]
     pub target: DVec3,
     #[serde(default = "default_up", deserialize_with = "v::direction")]
@@ -151,15 +158,19 @@ fn default_fov() -> f64 {
     45.0
 }
 
+/// A light of `lights`; baked lighting uses the scene's first.
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub enum Light {
     /// Light travelling along `direction` (world space, not normalised in the file).
     Directional {
+        /// Where the light travels, world space (non-zero).
         #[serde(deserialize_with = "v::direction")]
         direction: DVec3,
+        /// Linear RGB, each >= 0 (default `(1, 1, 1)`).
         #[serde(default = "white", deserialize_with = "v::light_color")]
         color: [f32; 3],
+        /// Factor on `color`, >= 0 (default 1).
         #[serde(default = "one_f32", deserialize_with = "v::non_negative_f32")]
         intensity: f32,
     },
@@ -176,11 +187,13 @@ fn one_f32() -> f32 {
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Texel {
+    /// Voxels along s, t and w, each 1..=1024 (sources add their own limits).
     #[serde(deserialize_with = "v::resolution")]
     pub resolution: [u32; 3],
     /// World length over which a voxel's stored alpha is reached (see [`Texel::opacity_length`]).
     #[serde(default, rename = "opacity_length", deserialize_with = "v::opt_positive_f32")]
     pub(crate) opacity_length_given: Option<f32>,
+    /// What fills the pattern volume.
     pub source: TexelSource,
     /// Self-shadowing baked into the texel's colour (off when absent).
     #[serde(default)]
@@ -234,30 +247,42 @@ impl Texel {
     }
 }
 
+/// What a texel is baked from (`source:` of a [`Texel`]).
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub enum TexelSource {
     /// Union of implicit shapes: each voxel takes colour, opacity and normal from the shape
     /// nearest to it (the deepest where they overlap; the first listed on a tie).
-    Implicit { shapes: Vec<Shape> },
+    Implicit {
+        /// The shapes of the union, in texel space.
+        shapes: Vec<Shape>,
+    },
     /// Periodic Perlin height field: voxel filled where `w < base + amplitude * noise(s, t)`,
     /// colour from `color_low` (w = 0) to `color_high` (w = base + amplitude, the highest
     /// possible height).
     PerlinHeight {
+        /// Lattice cells of the noise per tile, 1..=1024.
         #[serde(deserialize_with = "v::frequency")]
         frequency: u32,
+        /// fBm octaves, 1..=8 (default 1).
         #[serde(default = "one_u32", deserialize_with = "v::octaves")]
         octaves: u32,
+        /// Height range of the noise above `base` (texel units, finite).
         #[serde(deserialize_with = "v::finite_f32")]
         amplitude: f32,
+        /// Lowest height, where the noise is at its minimum (texel units, finite).
         #[serde(deserialize_with = "v::finite_f32")]
         base: f32,
+        /// Seed of the noise's permutation (default 0).
         #[serde(default)]
         seed: u32,
+        /// Linear RGB at `w = 0`.
         #[serde(deserialize_with = "v::color")]
         color_low: [f32; 3],
+        /// Linear RGB at the highest possible height.
         #[serde(deserialize_with = "v::color")]
         color_high: [f32; 3],
+        /// Opacity of filled voxels, in [0, 1] (default 1).
         #[serde(default = "one_f32", deserialize_with = "v::unit_f32")]
         opacity: f32,
         /// Albedo darkened with depth: times `1 - darkening * (top - w) / top`, `top` the highest
@@ -269,31 +294,43 @@ pub enum TexelSource {
     /// `w < base + amplitude * image(s, t)`, the image sampled bilinearly with wrapping (t = 0 is
     /// its bottom row) and its slopes by central differences one pixel apart.
     ImageHeight {
+        /// The PNG or EXR file, relative to the scene file.
         image: Mark<String>,
         /// Channel of the image holding the height (0 for grey images).
         #[serde(default)]
         channel: u32,
+        /// Height at image value 1 above `base` (texel units, finite).
         #[serde(deserialize_with = "v::finite_f32")]
         amplitude: f32,
+        /// Height at image value 0 (texel units, finite; default 0).
         #[serde(default, deserialize_with = "v::finite_f32")]
         base: f32,
+        /// Linear RGB at `w = 0`.
         #[serde(deserialize_with = "v::color")]
         color_low: [f32; 3],
+        /// Linear RGB at the highest possible height.
         #[serde(deserialize_with = "v::color")]
         color_high: [f32; 3],
+        /// Opacity of filled voxels, in [0, 1] (default 1).
         #[serde(default = "one_f32", deserialize_with = "v::unit_f32")]
         opacity: f32,
+        /// Albedo darkened with depth, in [0, 1] (default 0), as for `PerlinHeight`.
         #[serde(default, deserialize_with = "v::unit_f32")]
         darkening: f32,
     },
     /// A slice stack written by `voltex bake` (one RGBA PNG per `w` slice, premultiplied, shading
     /// baked in): the texel's `resolution` must be the stack's. Drawn with baked lighting only.
-    Slices { dir: Mark<String> },
+    Slices {
+        /// The folder `voltex bake` wrote (slices and `manifest.json`), relative to the scene file.
+        dir: Mark<String>,
+    },
     /// Cycling volume sequence (Meyer & Neyret 1998, section 5): at time `t` the texel is
     /// `texels[floor(t * fps) mod n]`, each frame a texel of this map with this resolution.
     Sequence {
+        /// Names of the frame texels, of this texel's resolution and not sequences themselves.
         #[serde(deserialize_with = "v::frames")]
         texels: Vec<Mark<String>>,
+        /// Frames per second of scene time, > 0.
         #[serde(deserialize_with = "v::positive")]
         fps: f64,
     },
@@ -305,12 +342,17 @@ pub enum TexelSource {
     /// patterns, leaves; no inside test). Any resolution of at least 2 voxels per axis and at
     /// most 2^24 in all.
     Mesh {
+        /// The OBJ or glTF file, relative to the scene file.
         path: Mark<String>,
+        /// The box of the mesh's object space that maps onto texel space.
         bounds: Mark<MeshBounds>,
+        /// Linear RGB, tinting the OBJ's vertex colours if it has any (default white).
         #[serde(default = "white", deserialize_with = "v::color")]
         color: [f32; 3],
+        /// Opacity of the covered voxels, in [0, 1] (default 1).
         #[serde(default = "one_f32", deserialize_with = "v::unit_f32")]
         opacity: f32,
+        /// Fill the inside (default); `false`: a one-voxel shell around the surface.
         #[serde(default = "yes")]
         fill: bool,
     },
@@ -323,7 +365,9 @@ pub enum TexelSource {
     /// scale, the texel is as opaque as RayMarch draws the hypertexture at that scale. Another
     /// length given in the file is used, with a warning.
     Hypertexture {
+        /// A key of the scene's `hypertextures`.
         name: Mark<String>,
+        /// The box of its object space that maps onto texel space (default: its enlarged bounds).
         #[serde(default)]
         bounds: Option<Mark<MeshBounds>>,
     },
@@ -333,14 +377,18 @@ pub enum TexelSource {
     /// (`bake_volume.wgsl`), so that drawn at any place the texel absorbs as the volume would
     /// per world unit there.
     Volume {
+        /// A key of the scene's `volumes`.
         name: Mark<String>,
+        /// The box of its world space that maps onto texel space (default: the box its density fills).
         #[serde(default)]
         bounds: Option<Mark<MeshBounds>>,
     },
     /// A uniform volume (analytic tests).
     Constant {
+        /// Linear RGB in [0, 1].
         #[serde(deserialize_with = "v::color")]
         color: [f32; 3],
+        /// Opacity of every voxel, in [0, 1] (default 1).
         #[serde(default = "one_f32", deserialize_with = "v::unit_f32")]
         opacity: f32,
     },
@@ -361,8 +409,10 @@ pub struct Volume {
     pub(crate) grid: String,
     #[serde(default)]
     pub(crate) color: Option<String>,
+    /// Extinction per unit density per world unit, > 0 (default 1).
     #[serde(default = "one_f64", deserialize_with = "v::positive")]
     pub density_scale: f64,
+    /// Linear RGB in [0, 1] scaling the scattered light (default white; black absorbs only).
     #[serde(default = "white", deserialize_with = "v::color")]
     pub albedo: [f32; 3],
     /// Level sets: the width, in voxels, of the band over which density falls from 1 to 0.
@@ -378,8 +428,10 @@ fn default_grid() -> String {
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct MeshBounds {
+    /// The box's lowest corner.
     #[serde(deserialize_with = "v::vec3")]
     pub lo: DVec3,
+    /// The box's highest corner, above `lo` on every axis.
     #[serde(deserialize_with = "v::vec3")]
     pub hi: DVec3,
 }
@@ -392,51 +444,71 @@ fn one_u32() -> u32 {
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub enum Shape {
+    /// A solid sphere.
     Sphere {
+        /// Centre, texel space.
         #[serde(deserialize_with = "v::point_f32")]
         center: [f32; 3],
+        /// Radius, texel units, > 0.
         #[serde(deserialize_with = "v::positive_f32")]
         radius: f32,
+        /// Linear RGB in [0, 1].
         #[serde(deserialize_with = "v::color")]
         color: [f32; 3],
+        /// Opacity in [0, 1] (default 1).
         #[serde(default = "one_f32", deserialize_with = "v::unit_f32")]
         opacity: f32,
     },
     /// Axis along w.
     Torus {
+        /// Centre, texel space.
         #[serde(deserialize_with = "v::point_f32")]
         center: [f32; 3],
+        /// Radius of the ring through the tube's centre, texel units, > 0 and above `minor`.
         #[serde(deserialize_with = "v::positive_f32")]
         major: f32,
+        /// Radius of the tube, texel units, > 0.
         #[serde(deserialize_with = "v::positive_f32")]
         minor: f32,
+        /// Linear RGB in [0, 1].
         #[serde(deserialize_with = "v::color")]
         color: [f32; 3],
+        /// Opacity in [0, 1] (default 1).
         #[serde(default = "one_f32", deserialize_with = "v::unit_f32")]
         opacity: f32,
     },
+    /// An axis-aligned ellipsoid.
     Ellipsoid {
+        /// Centre, texel space.
         #[serde(deserialize_with = "v::point_f32")]
         center: [f32; 3],
+        /// Semi-axes along s, t and w, texel units, each > 0.
         #[serde(deserialize_with = "v::radii_f32")]
         radii: [f32; 3],
+        /// Linear RGB in [0, 1].
         #[serde(deserialize_with = "v::color")]
         color: [f32; 3],
+        /// Opacity in [0, 1] (default 1).
         #[serde(default = "one_f32", deserialize_with = "v::unit_f32")]
         opacity: f32,
     },
     /// Inside where `sum (radius_i / |x - center_i|)^2 >= threshold`.
     Metaballs {
+        /// The balls `(center, radius)` whose fields add up.
         balls: Vec<Ball>,
+        /// Iso-value of the summed field, > 0.
         #[serde(deserialize_with = "v::positive_f32")]
         threshold: f32,
+        /// Linear RGB in [0, 1].
         #[serde(deserialize_with = "v::color")]
         color: [f32; 3],
+        /// Opacity in [0, 1] (default 1).
         #[serde(default = "one_f32", deserialize_with = "v::unit_f32")]
         opacity: f32,
     },
 }
 
+/// One ball of `Shape::Metaballs`: `(center, radius)` in texel space.
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Ball {
@@ -446,9 +518,12 @@ pub struct Ball {
     pub(crate) radius: f32,
 }
 
+/// A node of the scene tree: a base surface with a texel and a method, a hypertexture, a volume,
+/// an opaque base surface alone, or a group for its children.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Node {
+    /// Names the object in errors, metadata and the preview (Latin-1, at most 241 bytes).
     #[serde(deserialize_with = "v::object_name")]
     pub name: String,
     #[serde(default)]
@@ -469,6 +544,8 @@ pub struct Node {
     /// then the node's), with `RayMarch` (the default) or `Reference`.
     #[serde(default)]
     pub(crate) volume: Option<Mark<String>>,
+    /// How the node's texel, hypertexture or volume is drawn (none: a textured node draws only
+    /// its base surface; hypertexture and volume nodes use `RayMarch`).
     #[serde(default)]
     pub method: Option<Mark<Method>>,
     /// Draw the base surface opaque with this colour.
@@ -477,6 +554,7 @@ pub struct Node {
     /// Animation of the base surface and height vectors with the scene time.
     #[serde(default)]
     pub(crate) motion: Motion,
+    /// Nodes placed in this node's frame.
     #[serde(default)]
     pub children: Vec<Node>,
 }
@@ -556,43 +634,57 @@ impl Transform {
     }
 }
 
+/// A node's base surface (`surface:`), in the node's object space.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub enum Surface {
     /// Grid in the xy plane centred at the origin, normal +z.
     Plane {
+        /// Extent along x and y, > 0.
         #[serde(deserialize_with = "v::positive2")]
         size: [f64; 2],
+        /// Grid cells along x and y, 1..=4096 each.
         #[serde(deserialize_with = "v::cells")]
         cells: [u32; 2],
         /// Fraction of a cell by which interior vertices move.
         #[serde(default, deserialize_with = "v::jitter")]
         jitter: f64,
+        /// Seed of the jitter (default 0).
         #[serde(default)]
         seed: u32,
     },
     /// UV sphere around the origin; segments = (around z, pole to pole).
     Sphere {
+        /// Radius, > 0.
         #[serde(deserialize_with = "v::positive")]
         radius: f64,
+        /// Segments around z (3..=4096) and from pole to pole (2..=4096).
         #[serde(deserialize_with = "v::sphere_segments")]
         segments: [u32; 2],
     },
     /// Torus around z; segments = (around z, around the tube).
     Torus {
+        /// Radius of the ring through the tube's centre, > 0.
         #[serde(deserialize_with = "v::positive")]
         major: f64,
+        /// Radius of the tube, > 0 and below `major`.
         #[serde(deserialize_with = "v::positive")]
         minor: f64,
+        /// Segments around z and around the tube, 3..=4096 each.
         #[serde(deserialize_with = "v::torus_segments")]
         segments: [u32; 2],
+        /// Smooth bumps on the tube radius, a fraction of `minor` in [0, 0.9) (default 0).
         #[serde(default, deserialize_with = "v::distortion")]
         distortion: f64,
+        /// Seed of the bumps' phase (default 0).
         #[serde(default)]
         seed: u32,
     },
     /// Wavefront OBJ, path relative to the scene file.
-    Obj { path: Mark<String> },
+    Obj {
+        /// The OBJ, `.gltf` or `.glb` file.
+        path: Mark<String>,
+    },
 }
 
 #[derive(Debug, Clone, PartialEq, Deserialize)]
@@ -623,7 +715,9 @@ pub enum HeightScale {
     /// PNG (grey, grey+alpha, RGB, RGBA), sampled bilinearly with wrapping at the vertex uv
     /// (before tiling); v = 0 is the bottom row.
     Texture {
+        /// The PNG or EXR file, relative to the scene file.
         path: Mark<String>,
+        /// The image channel holding the factor (default 0).
         #[serde(default)]
         channel: u32,
     },
@@ -633,9 +727,13 @@ pub enum HeightScale {
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub enum Method {
+    /// View-aligned prism slicing (2002).
     ViewSlices(ViewSlices),
+    /// Exact ray casting through the prisms: the ground truth.
     Reference(Reference),
+    /// Ray marching of a hypertexture or volume (Gilet & Dischler 2009).
     RayMarch(RayMarch),
+    /// Axis-aligned slice stacks (Meyer & Neyret 1998).
     AxisSlices(AxisSlices),
 }
 
@@ -661,6 +759,7 @@ pub struct RayMarch {
     /// Ray step in world units (replaces the preset's).
     #[serde(default, deserialize_with = "v::opt_positive")]
     pub step: Option<f64>,
+    /// How each sample is lit (default `None`: the transfer function's colour as is).
     #[serde(default)]
     pub shading: Shading,
     /// Step of shadow rays (world units; default twice the ray step).
@@ -690,6 +789,7 @@ pub enum Shadows {
     /// (`resolution` samples along its longest axis, in the light's frame), marched once per
     /// light and density by `bake_light_volume.wgsl` and read trilinearly by the shading.
     LightVolume {
+        /// Samples along the grid's longest axis, 4..=256 (default 64).
         #[serde(default = "default_light_resolution", deserialize_with = "v::light_resolution")]
         resolution: u32,
     },
@@ -735,8 +835,10 @@ pub enum Segments {
     /// objects give several per ray. `splat_grid`: lattice cells along the bounds' longest axis
     /// from which the splats are made (their spacing).
     DepthPeeling {
+        /// Segments per ray, 1..=8 (default 4).
         #[serde(default = "default_passes", deserialize_with = "v::peel_passes")]
         passes: u32,
+        /// Lattice cells along the bounds' longest axis the splats are made from, 4..=96 (default 32).
         #[serde(default = "default_splat_grid", deserialize_with = "v::splat_grid")]
         splat_grid: u32,
     },
@@ -745,8 +847,10 @@ pub enum Segments {
     /// its centre; contributions are summed per depth slab (`slabs` along each ray's span in the
     /// bounds) and the slabs composited front to back.
     Splatting {
+        /// Depth slabs along each ray's span in the bounds, 1..=64 (default 16).
         #[serde(default = "default_slabs", deserialize_with = "v::splat_slabs")]
         slabs: u32,
+        /// Lattice cells along the bounds' longest axis the splats are made from, 4..=96 (default 32).
         #[serde(default = "default_splat_grid", deserialize_with = "v::splat_grid")]
         splat_grid: u32,
     },
@@ -759,8 +863,9 @@ fn default_slabs() -> u32 {
     DEFAULT_SPLAT_SLABS
 }
 
-/// `DepthPeeling`'s defaults: passes (segments per ray) and splat lattice cells.
+/// `DepthPeeling`'s default passes (segments per ray).
 pub const DEFAULT_PEEL_PASSES: u32 = 4;
+/// `DepthPeeling`'s default splat lattice cells along the bounds' longest axis.
 pub const DEFAULT_SPLAT_GRID: u32 = 32;
 
 fn default_passes() -> u32 {
@@ -772,6 +877,7 @@ fn default_splat_grid() -> u32 {
 }
 
 impl RayMarch {
+    /// The ray step in world units: `step` if given, else the quality preset's.
     pub fn step(&self) -> f64 {
         self.step.unwrap_or(self.quality.step())
     }
@@ -811,17 +917,22 @@ impl Quality {
 #[derive(Debug, Clone, Copy, Default, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub enum Shading {
+    /// The transfer function's colour, unlit.
     #[default]
     None,
+    /// Phong shading with the density gradient (central differences) as the normal.
     Phong,
+    /// Phong shading times the transmittance towards the light (`shadows` says how it is found).
     PhongShadows,
     /// Single scattering of the light with the phase function `p_HG(g, cos)`: the colour is the
     /// transfer's times `ambient + (1 - ambient) 4 pi p_HG` (so `g: 0`, isotropic, is the
     /// unshaded colour), times the transmittance towards the light with `shadows`. `g` in
     /// (-1, 1): above 0 forward scattering (bright towards the light), below 0 backward.
     HenyeyGreenstein {
+        /// Anisotropy in (-1, 1): above 0 forward scattering, below 0 backward, 0 isotropic.
         #[serde(deserialize_with = "v::anisotropy")]
         g: f64,
+        /// Multiply by the transmittance towards the light along a shadow ray (default `false`).
         #[serde(default)]
         shadows: bool,
     },
@@ -902,8 +1013,10 @@ pub struct AxisSlices {
     /// Largest view angle (degrees from a slice set's normal) the criteria are evaluated at.
     #[serde(default = "default_max_angle", deserialize_with = "v::max_angle")]
     pub max_angle: f64,
+    /// Which slice sets may be chosen (default `Three`).
     #[serde(default)]
     pub directions: SliceDirections,
+    /// How slices are composited: binary alpha (default) or blended.
     #[serde(default)]
     pub blend: SliceBlend,
     /// Skip prisms hidden behind the opaque base surfaces: exact (every pixel a prism's corners
@@ -942,6 +1055,7 @@ fn default_max_angle() -> f64 {
     80.0
 }
 
+/// The slice sets `AxisSlices` chooses from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub enum SliceDirections {
@@ -952,6 +1066,7 @@ pub enum SliceDirections {
     Horizontal,
 }
 
+/// How `AxisSlices` composites its slices.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub enum SliceBlend {
@@ -968,6 +1083,7 @@ fn yes() -> bool {
     true
 }
 
+/// Where a textured object's shading comes from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub enum Lighting {

@@ -243,6 +243,7 @@ pub(super) fn with_marking<T>(fail: BTreeMap<usize, String>, f: impl FnOnce() ->
 /// the second parse fails at the marks whose checks failed, and ron attaches the position.
 #[derive(Clone, PartialEq)]
 pub struct Mark<T> {
+    /// The parsed value.
     pub value: T,
     pub(super) seq: usize,
 }

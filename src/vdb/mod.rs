@@ -28,6 +28,7 @@ pub struct GridInfo {
     pub(crate) value: String,
     /// `level set`, `fog volume`, ... (empty when the file says nothing).
     pub(crate) class: String,
+    /// Whether the file stores the grid's values as 16-bit halves.
     pub half: bool,
 }
 
@@ -41,8 +42,11 @@ impl GridInfo {
 /// voxels of the grid) of the band over which density goes from 1 inside to 0 outside.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Request {
+    /// The float grid read as density (a fog volume's, or a level set's distances).
     pub density: String,
+    /// The vec3 grid read as colour, if any.
     pub color: Option<String>,
+    /// Width in voxels of a level set's band from density 1 to 0.
     pub band: f64,
 }
 

@@ -43,8 +43,9 @@ pub struct SparseVolume {
     pub density: Vec<f32>,
     /// Bricks of colour alike, when the volume has a colour grid.
     pub(crate) color: Option<Vec<[f32; 3]>>,
-    /// Index bounds (inclusive) of the voxels with non-zero density.
+    /// Lowest index corner (inclusive) of the voxels with non-zero density.
     pub lo: IVec3,
+    /// Highest index corner (inclusive) of the voxels with non-zero density.
     pub hi: IVec3,
     /// Leaves (and leaf tiles) holding density, before dilation.
     pub(crate) leaves: u64,
@@ -239,6 +240,7 @@ impl SparseVolume {
         h.finish()
     }
 
+    /// Bricks of density, brick 0 (the zeros) included.
     pub fn bricks(&self) -> u64 {
         (self.density.len() / BRICK_VALUES) as u64
     }

@@ -41,7 +41,9 @@ pub(crate) const CONTRIBUTION: super::Contribution = super::Contribution {
 /// Slice-vertex budget of one object: the storage-binding size every WebGPU adapter offers.
 pub(crate) const MAX_VERTEX_BYTES: u64 = 128 << 20;
 
+/// One AxisSlices object of a frame (Meyer & Neyret 1998): its parameters and prism order.
 pub struct AxisPlan {
+    /// The object's slicing parameters, as `choose_axis_slices.wgsl` reads them.
     pub params: AxisParams,
     /// The shell's prisms sorted back to front by centre distance (the draw order of texels).
     pub prisms: Vec<Prism>,

@@ -38,6 +38,7 @@ fn axis_of(n: Vec3, along: Vec3) -> Vec4 {
 }
 
 impl AxisFrame {
+    /// The frame of the prism with these bottom and top corners (camera-relative) and uvs.
     pub fn new(bottom: [Vec3; 3], top: [Vec3; 3], uv: [Vec2; 3]) -> Self {
         let mid = |i: usize| 0.5 * (bottom[i] + top[i]);
         let (e1, e2) = (mid(1) - mid(0), mid(2) - mid(0));
@@ -224,7 +225,9 @@ pub fn choose_axis(f: &AxisFrame, params: &AxisParams) -> AxisChoice {
 /// The opaque base surfaces' depth as `draw_base` leaves it in `base_depth`, with the frame's
 /// projection: what the occlusion culling reads.
 pub struct Occluders<'a> {
+    /// The frame's camera-relative world to clip transform.
     pub view_proj: glam::Mat4,
+    /// Size of the depth image in pixels (width, height).
     pub size: (u32, u32),
     /// Row-major, top row first: NDC depth of the nearest base surface, 1 where there is none.
     pub depth: &'a [f32],

@@ -44,6 +44,7 @@ impl MarchView {
 /// Shading switches (the kernel's overrides).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Shade {
+    /// Phong shading with the density gradient (`Phong`, `PhongShadows`).
     pub phong: bool,
     pub(crate) shadows: bool,
     /// Volumetric lighting by the Henyey-Greenstein phase function of this anisotropy g

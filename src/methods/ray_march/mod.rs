@@ -78,9 +78,13 @@ pub struct RayMarchPlan {
     pub(crate) hypertexture: String,
     /// The method as the scene (and the overrides) gave it: what the preview shows and steps.
     pub(crate) method: RayMarch,
+    /// The hypertexture's noises, transfer tables and mesh, as the kernels read them.
     pub packed: Packed,
+    /// The object's parameters (uniform `hyper`).
     pub params: HyperParams,
+    /// Shading switches.
     pub shade: Shade,
+    /// The ray step, world units.
     pub step: f64,
     pub(crate) shadow_step: f64,
     /// Dispatches of `ray_march.wgsl` per frame.
@@ -498,7 +502,9 @@ impl RayMarchPlan {
 /// What `probe_hypertexture.wgsl` returns: the transfer tables as `bake_transfer.wgsl` filled
 /// them, and four vectors per point (see the kernel).
 pub struct Probed {
+    /// The transfer tables.
     pub tables: Vec<f32>,
+    /// Four vectors per probed point.
     pub values: Vec<[f32; 4]>,
 }
 

@@ -65,6 +65,7 @@ pub(crate) struct PerPixel {
 
 /// One object as the tracer sees it (camera-relative f64 corners).
 pub struct TraceObject {
+    /// The prisms' corners, camera-relative.
     pub prisms: Vec<PrismCorners>,
     pub(crate) uvs: Vec<[DVec2; 3]>,
     pub(crate) volume: Volume,
@@ -78,7 +79,9 @@ pub struct TraceObject {
 /// The camera and light: a pixel's ray is `forward + sx right + sy up` (right and up scaled by the
 /// half extents of the image at unit distance), starting at the near plane.
 pub struct TraceView {
+    /// Image width in pixels.
     pub width: u32,
+    /// Image height in pixels.
     pub height: u32,
     pub(crate) forward: DVec3,
     pub(crate) right: DVec3,

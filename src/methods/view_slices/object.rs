@@ -8,6 +8,7 @@ use crate::methods::{texels, InputCx, MethodPlan, ObjectPlan, PartDecl, PlanCx};
 use crate::scene::{Compositor, Lighting, Lod, Method, ViewSlices, MAX_PLANES};
 use crate::types::{SliceParams, SliceVertex, VertexFrame};
 
+/// One ViewSlices object of a frame: its plane sweep in chunks, and what the renderer asks of it.
 pub struct ViewSlicesPlan {
     /// The whole sweep, and its chunks (consecutive planes with their own buffers).
     pub sweep: SliceParams,

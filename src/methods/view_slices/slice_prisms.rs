@@ -24,10 +24,12 @@ pub enum EdgeClass {
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Polygon {
     pub(crate) vertices: [SliceVertex; 5],
+    /// Vertices used, 0 (no intersection) or 3 to 5.
     pub len: usize,
 }
 
 impl Polygon {
+    /// The polygon's vertices.
     pub fn as_slice(&self) -> &[SliceVertex] {
         &self.vertices[..self.len]
     }

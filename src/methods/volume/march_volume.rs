@@ -9,10 +9,15 @@ use crate::vdb::SparseVolume;
 
 /// What the twin needs of the frame: the camera, the light (towards it, unit) and ambient term.
 pub struct TwinView {
+    /// The camera.
     pub camera: RayCamera,
+    /// The camera's unit forward direction.
     pub forward: DVec3,
+    /// Unit direction towards the light.
     pub light: DVec3,
+    /// Light kept without direct light, in [0, 1].
     pub ambient: f64,
+    /// Image size in pixels (width, height).
     pub size: (u32, u32),
 }
 

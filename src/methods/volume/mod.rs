@@ -44,6 +44,7 @@ pub(crate) const MAX_DISPATCHES: u32 = 20_000;
 pub struct VolumePlan {
     pub(crate) volume: String,
     pub(crate) grid: Arc<Grid>,
+    /// The object's parameters (uniform `volume_params`).
     pub params: VolumeParams,
     /// Reference: exact optical depth per voxel cell; else RayMarch's midpoint samples.
     pub(crate) exact: bool,
