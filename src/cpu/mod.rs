@@ -4,6 +4,7 @@ pub mod bake;
 pub mod bake_hypertexture;
 pub mod bake_mesh_grid;
 pub mod bake_mesh_texel;
+pub mod bake_point_grid;
 pub mod bake_splats;
 pub mod bake_transfer;
 pub mod hypertexture;

@@ -1,0 +1,66 @@
+//! CPU twin (f64) of `wgsl/bake/bake_point_grid.wgsl`: per grid sample the vector to the closest
+//! point of the union of a point set's kernel balls and the signed distance to it (positive
+//! inside), then the sum of the kernels `(1 - r^2/R^2)^3` over the saturation, by brute force
+//! over every point (ground truth: no BVH to get wrong).
+
+use glam::DVec3;
+
+use crate::mesh::points::PointSet;
+use crate::mesh::shape::GridSpec;
+
+/// The kernel `(1 - r^2/R^2)^3` inside R (Wyvill's soft-object falloff), 0 outside.
+pub fn kernel(r: f64, radius: f64) -> f64 {
+    let t = 1.0 - r * r / (radius * radius);
+    if t > 0.0 {
+        t * t * t
+    } else {
+        0.0
+    }
+}
+
+/// One sample: (vector to the closest ball surface point or, inside, outwards down the kernel
+/// sum's gradient as far as the deepest ball's depth; signed distance) and the kernel sum.
+pub fn sample(set: &PointSet, radius: f64, p: DVec3) -> ([f64; 4], f64) {
+    let mut best = f64::INFINITY;
+    let mut centre = p;
+    let mut sum = 0.0;
+    let mut gradient = DVec3::ZERO;
+    for (i, &c) in set.centres.iter().enumerate() {
+        let r = set.radius(i, radius);
+        let d = p - c;
+        if d.length() - r < best {
+            best = d.length() - r;
+            centre = c;
+        }
+        let t = 1.0 - d.dot(d) / (r * r);
+        if t > 0.0 {
+            sum += t * t * t;
+            gradient -= d * (6.0 * t * t / (r * r));
+        }
+    }
+    let mut out = (p - centre).normalize_or_zero();
+    if best < 0.0 && gradient.dot(gradient) > 1e-12 {
+        out = -gradient.normalize();
+    }
+    let v = out * -best;
+    ([v.x, v.y, v.z, -best], sum)
+}
+
+/// Every sample of the grid (x fastest, then y, then z) as (vector xyz, signed distance), then
+/// every sample's kernel sum over `saturation` (in x; y, z, w zero), as the kernel writes them.
+pub fn bake_point_grid(set: &PointSet, radius: f64, saturation: f64, spec: &GridSpec) -> Vec<[f64; 4]> {
+    let [nx, ny, nz] = spec.n;
+    let mut cells = Vec::with_capacity(2 * spec.samples() as usize);
+    let mut sums = Vec::with_capacity(spec.samples() as usize);
+    for k in 0..nz {
+        for j in 0..ny {
+            for i in 0..nx {
+                let (cell, sum) = sample(set, radius, spec.point(i, j, k));
+                cells.push(cell);
+                sums.push([sum / saturation, 0.0, 0.0, 0.0]);
+            }
+        }
+    }
+    cells.extend(sums);
+    cells
+}
