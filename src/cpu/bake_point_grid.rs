@@ -1,10 +1,12 @@
-//! CPU twin (f64) of `wgsl/bake/bake_point_grid.wgsl`: per grid sample the vector to the closest
-//! point of the union of a point set's kernel balls and the signed distance to it (positive
-//! inside), then the sum of the kernels `(1 - r^2/R^2)^3` over the saturation, by brute force
-//! over every point (ground truth: no BVH to get wrong).
+//! CPU twin (f64) of `wgsl/bake/bake_point_grid.wgsl`: per outside grid sample the vector to the
+//! closest point of the union of a point set's kernel balls and the distance to it, then per
+//! sample the sum of the kernels `(1 - r^2/R^2)^3` over the saturation, by brute force over
+//! every point (ground truth: no BVH to get wrong); [`bake_point_grid`] then floods the inside
+//! samples' closest boundary points as `flood_point_grid.wgsl` does.
 
 use glam::DVec3;
 
+use super::flood_point_grid::{flood_point_grid, flood_steps, NO_SEED};
 use crate::mesh::points::PointSet;
 use crate::mesh::shape::GridSpec;
 
@@ -18,13 +20,12 @@ pub fn kernel(r: f64, radius: f64) -> f64 {
     }
 }
 
-/// One sample: (vector to the closest ball surface point or, inside, outwards down the kernel
-/// sum's gradient as far as the deepest ball's depth; signed distance) and the kernel sum.
+/// One sample before flooding: outside, (vector to the closest ball's closest point, minus the
+/// distance); inside, (0, 0, 0, `NO_SEED`); and the kernel sum.
 pub fn sample(set: &PointSet, radius: f64, p: DVec3) -> ([f64; 4], f64) {
     let mut best = f64::INFINITY;
     let mut centre = p;
     let mut sum = 0.0;
-    let mut gradient = DVec3::ZERO;
     for (i, &c) in set.centres.iter().enumerate() {
         let r = set.radius(i, radius);
         let d = p - c;
@@ -32,17 +33,12 @@ pub fn sample(set: &PointSet, radius: f64, p: DVec3) -> ([f64; 4], f64) {
             best = d.length() - r;
             centre = c;
         }
-        let t = 1.0 - d.dot(d) / (r * r);
-        if t > 0.0 {
-            sum += t * t * t;
-            gradient -= d * (6.0 * t * t / (r * r));
-        }
+        sum += kernel(d.length(), r);
     }
-    let mut out = (p - centre).normalize_or_zero();
-    if best < 0.0 && gradient.dot(gradient) > 1e-12 {
-        out = -gradient.normalize();
+    if best < 0.0 {
+        return ([0.0, 0.0, 0.0, NO_SEED], sum);
     }
-    let v = out * -best;
+    let v = (centre - p).normalize_or_zero() * best;
     ([v.x, v.y, v.z, -best], sum)
 }
 
@@ -60,6 +56,9 @@ pub fn bake_point_grid(set: &PointSet, radius: f64, saturation: f64, spec: &Grid
                 sums.push([sum / saturation, 0.0, 0.0, 0.0]);
             }
         }
+    }
+    for step in flood_steps(spec.n[0]) {
+        cells = flood_point_grid(&cells, spec, step);
     }
     cells.extend(sums);
     cells

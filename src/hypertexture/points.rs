@@ -1,9 +1,14 @@
 //! Point-set objects of hypertextures (Gilet & Dischler 2009, section 5.1: a volumetric object
-//! defined by point samples, each with a radial kernel): baked by `bake_point_grid.wgsl` into a
-//! grid whose first block is a mesh grid's (vector to the closest surface point, signed
-//! distance, positive inside) for the union of the kernels' balls, and whose second block holds
-//! the kernel sum over the saturation, the object's density. A BVH over the kernels' boxes
-//! (`mesh::bvh::flat_bvh`) lets each sample visit only the kernels near it.
+//! defined by point samples, each with a radial kernel): baked into a grid whose first block is
+//! a mesh grid's (vector to the closest surface point, signed distance, positive inside) for the
+//! boundary of the union of the kernels' balls, and whose second block holds the kernel sum over
+//! the saturation, the object's density. `bake_point_grid.wgsl` finds the closest ball of each
+//! outside sample and the kernel sums through a BVH over the kernels' boxes
+//! (`mesh::bvh::flat_bvh`), so each sample visits only the kernels near it;
+//! `flood_point_grid.wgsl` then carries the outside samples' closest boundary points inwards by
+//! jump flooding (passes of halving steps), so that inside samples get about their closest
+//! boundary point: a field that turns smoothly, where the kernel sum's gradient deep inside a
+//! cloud points anywhere.
 
 use crate::error::Result;
 use crate::gpu::sources::Sources;
@@ -28,10 +33,11 @@ pub struct PointObject {
 }
 
 impl PointObject {
-    /// GPU bytes of the grid (two blocks of 16-byte samples), the kernels and their BVH.
+    /// GPU bytes of the grid (two blocks of 16-byte samples), the flooding's scratch block, the
+    /// kernels and their BVH.
     pub(crate) fn bytes(&self) -> u64 {
         let n = self.set.centres.len() as u64;
-        2 * self.spec.samples() * 16 + n * 16 + 2 * n * 32
+        3 * self.spec.samples() * 16 + n * 16 + 2 * n * 32
     }
 
     /// The bake cache's key.
@@ -94,12 +100,29 @@ pub fn bake(ctx: &GpuContext, object: &PointObject) -> Result<MeshGrid> {
     });
     b.insert("mesh_grid".into(), grid.clone());
     let mut encoder = ctx.device.create_command_encoder(&Default::default());
-    ComputeKernel::load(ctx, &Sources::project()?, "bake/bake_point_grid.wgsl")?.dispatch(
+    let root = Sources::project()?;
+    ComputeKernel::load(ctx, &root, "bake/bake_point_grid.wgsl")?.dispatch(
         ctx,
         &mut encoder,
         &inputs,
         object.spec.n,
     )?;
+    // The inside samples' closest boundary points, flooded between the grid and a scratch
+    // buffer; an even number of passes ends in the grid.
+    let mut flood = ComputeKernel::load(ctx, &root, "bake/flood_point_grid.wgsl")?;
+    let scratch =
+        crate::gpu::buffers::work_buffer(ctx, "flood_scratch", bytes / 2, wgpu::BufferUsages::empty());
+    for (pass, step) in crate::cpu::flood_point_grid::flood_steps(object.spec.n[0]).into_iter().enumerate() {
+        let mut params = params;
+        params.counts[3] = step;
+        let (from, to) = if pass % 2 == 0 { (&grid, &scratch) } else { (&scratch, &grid) };
+        let mut inputs = Inputs::default();
+        let b = &mut inputs.buffers;
+        b.insert("grid_params".into(), uniform(ctx, "grid_params", bytemuck::bytes_of(&params)));
+        b.insert("flood_from".into(), from.clone());
+        b.insert("flood_to".into(), to.clone());
+        flood.dispatch(ctx, &mut encoder, &inputs, object.spec.n)?;
+    }
     ctx.queue.submit([encoder.finish()]);
     ctx.take_errors()?;
     // The largest inside distance is a mesh's density scale: unused here, 1 for the readers.
