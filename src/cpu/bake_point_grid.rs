@@ -22,7 +22,7 @@ pub fn kernel(r: f64, radius: f64) -> f64 {
 
 /// One sample before flooding: outside, (vector to the closest ball's closest point, minus the
 /// distance); inside, (0, 0, 0, `NO_SEED`); and the kernel sum.
-pub fn sample(set: &PointSet, radius: f64, p: DVec3) -> ([f64; 4], f64) {
+pub(crate) fn sample(set: &PointSet, radius: f64, p: DVec3) -> ([f64; 4], f64) {
     let mut best = f64::INFINITY;
     let mut centre = p;
     let mut sum = 0.0;

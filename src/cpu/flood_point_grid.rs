@@ -5,12 +5,12 @@
 use crate::mesh::shape::GridSpec;
 
 /// Inside samples without a boundary point yet (mirrors `NO_SEED`).
-pub const NO_SEED: f64 = 3.0e38;
+pub(crate) const NO_SEED: f64 = 3.0e38;
 
 /// The steps of the passes (in samples) for `n` samples per axis: halving from the largest power
 /// of two below `n` to 1, then passes of 1 until their count is even (so the last pass writes
 /// the grid, not the scratch buffer; extra passes of 1 also mend jump flooding's rare misses).
-pub fn flood_steps(n: u32) -> Vec<u32> {
+pub(crate) fn flood_steps(n: u32) -> Vec<u32> {
     let mut steps = Vec::new();
     let mut k = (n.max(2) - 1).next_power_of_two() / 2;
     while k >= 1 {
@@ -25,7 +25,7 @@ pub fn flood_steps(n: u32) -> Vec<u32> {
 }
 
 /// One pass of step `step` from `from` (the first block of a point grid) into a new block.
-pub fn flood_point_grid(from: &[[f64; 4]], spec: &GridSpec, step: u32) -> Vec<[f64; 4]> {
+pub(crate) fn flood_point_grid(from: &[[f64; 4]], spec: &GridSpec, step: u32) -> Vec<[f64; 4]> {
     let [nx, ny, nz] = spec.n.map(|n| n as i64);
     let index = |i: i64, j: i64, k: i64| (i + nx * (j + ny * k)) as usize;
     let mut to = from.to_vec();

@@ -7,7 +7,7 @@ pub mod bake_mesh_texel;
 pub mod bake_point_grid;
 pub mod bake_splats;
 pub mod bake_transfer;
-pub mod flood_point_grid;
+pub(crate) mod flood_point_grid;
 pub mod hypertexture;
 pub mod mip_texel_volume;
 pub mod noise_simplex;

@@ -44,7 +44,7 @@ pub struct Packed {
     /// Mesh objects: the mesh and where its grid samples lie.
     pub mesh: Option<(std::sync::Arc<crate::mesh::shape::MeshShape>, crate::mesh::shape::GridSpec)>,
     /// Point-set objects: the points, their kernels and where their grid samples lie.
-    pub point_set: Option<points::PointObject>,
+    pub(crate) point_set: Option<points::PointObject>,
 }
 
 fn f4(v: DVec3, w: f64) -> [f32; 4] {
@@ -227,7 +227,7 @@ impl Packed {
 
     /// Bakes the object's grid: `bake_mesh_grid.wgsl` for a mesh, `bake_point_grid.wgsl` for a
     /// point set; `None` for the other objects.
-    pub fn bake_grid(&self, ctx: &crate::gpu::GpuContext) -> crate::Result<Option<mesh::MeshGrid>> {
+    pub(crate) fn bake_grid(&self, ctx: &crate::gpu::GpuContext) -> crate::Result<Option<mesh::MeshGrid>> {
         match (&self.mesh, &self.point_set) {
             (Some((shape, spec)), _) => mesh::bake(ctx, shape, spec).map(Some),
             (_, Some(p)) => points::bake(ctx, p).map(Some),

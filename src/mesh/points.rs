@@ -14,20 +14,20 @@ use crate::mesh::shape::GridSpec;
 
 /// Most points of one point set: its kernels (16 bytes each) and BVH (two 32-byte nodes per
 /// point) stay under 96 MiB, checked from the PLY header's count before anything is read.
-pub const MAX_POINTS: usize = 1 << 20;
+pub(crate) const MAX_POINTS: usize = 1 << 20;
 
 /// Most kernels overlapping at the densest place ([`PointSet::overlap`]): the grid bake visits
 /// each at every sample, within one invocation's loop budget.
-pub const MAX_OVERLAP: f64 = 4096.0;
+pub(crate) const MAX_OVERLAP: f64 = 4096.0;
 
 /// A point set in its node's frame: kernel centres and, when the file has a `radius` property,
 /// per-point factors of the scene's kernel radius.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PointSet {
     /// The points (kernel centres).
-    pub centres: Vec<DVec3>,
+    pub(crate) centres: Vec<DVec3>,
     /// Per point, the file's `radius` property (a factor of the scene's `radius`), if it has one.
-    pub radii: Option<Vec<f64>>,
+    pub(crate) radii: Option<Vec<f64>>,
     /// Of centres and radii: the bake cache's key.
     pub(crate) hash: u64,
 }
@@ -46,12 +46,12 @@ impl PointSet {
     }
 
     /// The kernel radius of point `i` for the scene's `radius`.
-    pub fn radius(&self, i: usize, radius: f64) -> f64 {
+    pub(crate) fn radius(&self, i: usize, radius: f64) -> f64 {
         self.radii.as_ref().map_or(radius, |r| r[i] * radius)
     }
 
     /// Where the kernels reach, (min, max), for the scene's `radius`.
-    pub fn bounds(&self, radius: f64) -> (DVec3, DVec3) {
+    pub(crate) fn bounds(&self, radius: f64) -> (DVec3, DVec3) {
         let mut lo = DVec3::INFINITY;
         let mut hi = DVec3::NEG_INFINITY;
         for (i, &p) in self.centres.iter().enumerate() {
@@ -74,7 +74,7 @@ impl PointSet {
     /// About how many kernels overlap at the densest place (points per cell of a 16^3 grid over
     /// the centres, times the largest kernel's volume over the cell's): the bake visits that
     /// many per sample.
-    pub fn overlap(&self, radius: f64) -> f64 {
+    pub(crate) fn overlap(&self, radius: f64) -> f64 {
         const CELLS: usize = 16;
         let mut lo = DVec3::INFINITY;
         let mut hi = DVec3::NEG_INFINITY;
@@ -95,7 +95,7 @@ impl PointSet {
 }
 
 /// Reads a point set: `.ply` as PLY, anything else as OBJ (its `v` lines).
-pub fn load(path: &Path) -> Result<PointSet> {
+pub(crate) fn load(path: &Path) -> Result<PointSet> {
     let bytes = crate::input::read(path, crate::input::Kind::Asset, "a point set (.ply or .obj)")?;
     let set = match path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() {
         Some("ply") => ply(path, &bytes)?,

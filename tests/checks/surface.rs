@@ -12,7 +12,7 @@ use std::path::Path;
 use crate::layers::rust_files;
 
 /// `pub` declarations (not `pub(crate)`) in the library, fields included.
-const PUB_DECLARATIONS: usize = 1258;
+const PUB_DECLARATIONS: usize = 1272;
 /// Of those, the ones without a `///` doc comment.
 const UNDOCUMENTED: usize = 352;
 
