@@ -450,9 +450,10 @@ pub struct HyperParams {
     /// ray, z the most one sample may cost (so a sample is begun only when it fits), w the
     /// longest adaptive stride in steps (0 or 1: off).
     pub budget: [u32; 4],
-    /// Mesh objects: xyz the lower corner of the baked grid (object space), w samples per axis.
+    /// Mesh and point-set objects: xyz the lower corner of the baked grid (object space), w
+    /// samples per axis.
     pub grid_min: [f32; 4],
-    /// Mesh objects: xyz the upper corner of the baked grid.
+    /// Mesh and point-set objects: xyz the upper corner of the baked grid.
     pub grid_max: [f32; 4],
     /// Density modulation (Perlin's functions): x bias, y gain (0.5: none).
     pub modulation: [f32; 4],
@@ -623,6 +624,7 @@ pub(crate) const OBJECT_ELLIPSOID: u32 = 1;
 pub(crate) const OBJECT_TORUS: u32 = 2;
 pub(crate) const OBJECT_BOX: u32 = 3;
 pub(crate) const OBJECT_MESH: u32 = 4;
+pub(crate) const OBJECT_POINTS: u32 = 5;
 /// `HyperParams::kinds[1]`.
 pub(crate) const FIELD_CLOSEST_SURFACE: u32 = 0;
 pub(crate) const FIELD_FROM_CENTRE: u32 = 1;

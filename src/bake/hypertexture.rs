@@ -76,8 +76,8 @@ impl HyperTexel {
         params: crate::types::BakeParams,
     ) -> Result<()> {
         use crate::gpu::buffers::{storage, uniform};
-        let grid = match &self.packed.mesh {
-            Some((shape, spec)) => mesh::bake(ctx, shape, spec)?,
+        let grid = match self.packed.bake_grid(ctx)? {
+            Some(grid) => grid,
             None => mesh::unused(ctx),
         };
         inputs.constants.extend(self.constants());
@@ -119,7 +119,7 @@ impl HyperTexel {
 impl std::fmt::Debug for HyperTexel {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         let p = &self.packed;
-        let mesh = p.mesh.as_ref().map(|(s, spec)| (s.hash, *spec));
+        let mesh = p.grid_key();
         write!(
             f,
             "HyperTexel({:?}, {:?}, {:?}, {:?}, mesh {:?})",

@@ -147,9 +147,7 @@ impl BakeRequest {
             BakeSource::Mesh(_) => vec!["bake/bake_mesh_grid.wgsl", "bake/bake_mesh_texel.wgsl"],
             BakeSource::Hypertexture(h) => {
                 let mut k = vec!["ray_march/bake_transfer.wgsl", "bake/bake_hypertexture.wgsl"];
-                if h.packed.mesh.is_some() {
-                    k.push("bake/bake_mesh_grid.wgsl");
-                }
+                k.extend(h.packed.grid_kernel());
                 k
             }
             BakeSource::Volume(_) => vec!["bake/bake_volume.wgsl"],
@@ -264,6 +262,9 @@ impl BakeRequest {
             BakeSource::Mesh(_) => "bake_mesh_grid.wgsl + bake_mesh_texel.wgsl",
             BakeSource::Hypertexture(ref h) if h.packed.mesh.is_some() => {
                 "bake_transfer.wgsl + bake_mesh_grid.wgsl + bake_hypertexture.wgsl"
+            }
+            BakeSource::Hypertexture(ref h) if h.packed.point_set.is_some() => {
+                "bake_transfer.wgsl + bake_point_grid.wgsl + bake_hypertexture.wgsl"
             }
             BakeSource::Hypertexture(_) => "bake_transfer.wgsl + bake_hypertexture.wgsl",
             BakeSource::Volume(_) => "bake/bake_volume.wgsl",

@@ -8,7 +8,8 @@ use super::bake_transfer::TRANSFER_SIZE;
 use super::noise_simplex::{simplex3, simplex3_tiled, simplex4};
 use crate::types::{HyperNoise, HyperParams};
 use crate::types::{
-    FIELD_CONSTANT, FIELD_FROM_CENTRE, FIELD_SWIRL, OBJECT_BOX, OBJECT_ELLIPSOID, OBJECT_MESH, OBJECT_TORUS,
+    FIELD_CONSTANT, FIELD_FROM_CENTRE, FIELD_SWIRL, OBJECT_BOX, OBJECT_ELLIPSOID, OBJECT_MESH, OBJECT_POINTS,
+    OBJECT_TORUS,
 };
 
 /// Vectors shorter than this have no direction (mirrors `TINY`).
@@ -23,7 +24,8 @@ pub struct Model<'a> {
     pub noises: &'a [HyperNoise],
     /// The sampled transfer tables.
     pub tables: &'a [f64],
-    /// Mesh objects: the baked grid's samples and its largest inside distance.
+    /// Mesh and point-set objects: the baked grid's samples (a point set's: then its densities)
+    /// and its largest inside distance.
     pub grid: Option<(&'a [[f32; 4]], f32)>,
 }
 
@@ -53,7 +55,13 @@ impl Model<'_> {
     /// The mesh grid at x (clamped to the grid), trilinear: vector to the closest surface point
     /// and signed distance (mirrors `mesh_sample`).
     pub(crate) fn mesh_sample(&self, x: DVec3) -> (DVec3, f64) {
-        let (cells, _) = self.grid.expect("a mesh object's grid");
+        self.grid_sample(x, 0)
+    }
+
+    /// The grid block starting at `base` at x, trilinear (mirrors `grid_sample`).
+    fn grid_sample(&self, x: DVec3, base: usize) -> (DVec3, f64) {
+        let (cells, _) = self.grid.expect("a mesh or point-set object's grid");
+        let cells = &cells[base..];
         let n = self.params.grid_min[3] as usize;
         let lo = v3(self.params.grid_min);
         let u = ((x - lo) / (v3(self.params.grid_max) - lo)).clamp(DVec3::ZERO, DVec3::ONE) * (n - 1) as f64;
@@ -77,6 +85,10 @@ impl Model<'_> {
             OBJECT_TORUS => 1.0 - DVec2::new(DVec2::new(x.x, x.y).length() - s.x, x.z).length() / s.y,
             OBJECT_BOX => 1.0 - (x.abs() / s).max_element(),
             OBJECT_MESH => self.mesh_sample(x).1 / self.grid.map_or(1.0, |g| g.1 as f64),
+            OBJECT_POINTS => {
+                let n = self.params.grid_min[3] as usize;
+                self.grid_sample(x, n * n * n).0.x
+            }
             _ => 1.0 - x.length() / s.x,
         };
         d.clamp(0.0, 1.0)
@@ -99,6 +111,15 @@ impl Model<'_> {
                 } else {
                     -self.mesh_sample(x).1 * 0.57735
                 }
+            }
+            OBJECT_POINTS => {
+                let (lo, hi) = (v3(self.params.grid_min), v3(self.params.grid_max));
+                let out = (lo - x).max(x - hi);
+                if out.cmpgt(DVec3::ZERO).any() {
+                    return out.max(DVec3::ZERO).length();
+                }
+                let cell = (hi.x - lo.x) / (self.params.grid_min[3] as f64 - 1.0);
+                -self.mesh_sample(x).1 - 2.0 * 3f64.sqrt() * cell
             }
             _ => x.length() - s.x,
         }
@@ -145,7 +166,7 @@ impl Model<'_> {
                 }
                 p
             }
-            OBJECT_MESH => {
+            OBJECT_MESH | OBJECT_POINTS => {
                 let c = x.clamp(v3(self.params.grid_min), v3(self.params.grid_max));
                 c + self.mesh_sample(c).0
             }

@@ -5,6 +5,7 @@
 //! tables of the colour transfer function).
 
 pub mod mesh;
+pub mod points;
 pub mod splats;
 
 use glam::DVec3;
@@ -17,7 +18,7 @@ use crate::types::{HyperNoise, HyperParams, TransferFunction, TransferPoint};
 
 pub(crate) use crate::types::{
     FIELD_CLOSEST_SURFACE, FIELD_CONSTANT, FIELD_FROM_CENTRE, FIELD_SWIRL, OBJECT_BOX, OBJECT_ELLIPSOID,
-    OBJECT_MESH, OBJECT_SPHERE, OBJECT_TORUS,
+    OBJECT_MESH, OBJECT_POINTS, OBJECT_SPHERE, OBJECT_TORUS,
 };
 
 /// The parts of `HyperParams` a hypertexture fixes (the camera, frame and march settings are
@@ -45,6 +46,8 @@ pub struct Packed {
     pub(crate) max_shift: f64,
     /// Mesh objects: the mesh and where its grid samples lie.
     pub mesh: Option<(std::sync::Arc<crate::mesh::shape::MeshShape>, crate::mesh::shape::GridSpec)>,
+    /// Point-set objects: the points, their kernels and where their grid samples lie.
+    pub(crate) point_set: Option<points::PointObject>,
 }
 
 fn f4(v: DVec3, w: f64) -> [f32; 4] {
@@ -58,6 +61,18 @@ pub(crate) fn pack(h: &Hypertexture) -> Packed {
         SoftObject::Torus { major, minor } => (OBJECT_TORUS, f4(DVec3::new(*major, *minor, 0.0), 0.0)),
         SoftObject::Box { size } => (OBJECT_BOX, f4(*size * 0.5, 0.0)),
         SoftObject::Mesh { .. } => (OBJECT_MESH, [0.0; 4]),
+        SoftObject::Points { .. } => (OBJECT_POINTS, [0.0; 4]),
+    };
+    let point_set = match &h.object.value {
+        SoftObject::Points { set: Some(set), radius, saturation, resolution, .. } => {
+            Some(points::PointObject {
+                set: set.clone(),
+                radius: *radius,
+                saturation: *saturation,
+                spec: set.grid(*radius, *resolution, h.max_shift()),
+            })
+        }
+        _ => None,
     };
     let mesh = match &h.object.value {
         SoftObject::Mesh { shape: Some(shape), resolution, .. } => {
@@ -79,6 +94,7 @@ pub(crate) fn pack(h: &Hypertexture) -> Packed {
         modulation: [h.bias as f32, h.gain as f32, 0.0, 0.0],
         max_shift: h.max_shift(),
         mesh,
+        point_set,
     };
     let base = match &h.field {
         Field::Perturbed { field, amount, frequency, magnitude, seed } => {
@@ -180,11 +196,46 @@ impl Packed {
             modulation: self.modulation,
             ..Default::default()
         };
-        if let Some((_, g)) = &self.mesh {
+        let grid = self.mesh.as_ref().map(|(_, g)| g).or(self.point_set.as_ref().map(|p| &p.spec));
+        if let Some(g) = grid {
             params.grid_min = [g.lo.x as f32, g.lo.y as f32, g.lo.z as f32, g.n[0] as f32];
             params.grid_max = [g.hi.x as f32, g.hi.y as f32, g.hi.z as f32, 0.0];
         }
         params
+    }
+
+    /// The cache key of the object's grid (mesh and point-set objects).
+    pub(crate) fn grid_key(&self) -> Option<u64> {
+        match (&self.mesh, &self.point_set) {
+            (Some((shape, spec)), _) => Some(crate::gpu::cache::key(&(shape.hash, spec))),
+            (_, Some(p)) => Some(p.key()),
+            _ => None,
+        }
+    }
+
+    /// The kernel that bakes the object's grid (mesh and point-set objects).
+    pub(crate) fn grid_kernel(&self) -> Option<&'static str> {
+        match (&self.mesh, &self.point_set) {
+            (Some(_), _) => Some("bake/bake_mesh_grid.wgsl"),
+            (_, Some(_)) => Some("bake/bake_point_grid.wgsl"),
+            _ => None,
+        }
+    }
+
+    /// GPU bytes of the object's grid and what its bake uploads.
+    pub(crate) fn grid_bytes(&self) -> u64 {
+        self.mesh.as_ref().map_or(0, |(_, g)| g.samples() * 16)
+            + self.point_set.as_ref().map_or(0, points::PointObject::bytes)
+    }
+
+    /// Bakes the object's grid: `bake_mesh_grid.wgsl` for a mesh, `bake_point_grid.wgsl` for a
+    /// point set; `None` for the other objects.
+    pub(crate) fn bake_grid(&self, ctx: &crate::gpu::GpuContext) -> crate::Result<Option<mesh::MeshGrid>> {
+        match (&self.mesh, &self.point_set) {
+            (Some((shape, spec)), _) => mesh::bake(ctx, shape, spec).map(Some),
+            (_, Some(p)) => points::bake(ctx, p).map(Some),
+            _ => Ok(None),
+        }
     }
 
     /// Values at evenly spaced x from 0 to 1, joined linearly.

@@ -6,6 +6,7 @@ pub mod generate;
 pub mod gltf;
 pub(crate) mod motion;
 pub mod obj;
+pub mod points;
 pub mod prism;
 pub mod shape;
 pub mod shell;

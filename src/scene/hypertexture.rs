@@ -8,6 +8,7 @@ use std::sync::Arc;
 use glam::{DMat4, DVec3};
 use serde::Deserialize;
 
+use crate::mesh::points::PointSet;
 use crate::mesh::shape::MeshShape;
 
 use super::values::{self as v, Mark};
@@ -96,6 +97,26 @@ pub enum SoftObject {
         #[serde(skip)]
         shape: Option<Arc<MeshShape>>,
     },
+    /// A point set (PLY or OBJ `v` lines, relative to the scene file; Gilet & Dischler 2009,
+    /// section 5.1), each point the centre of a kernel `(1 - r^2 / R^2)^3` of radius R: the
+    /// density is the sum of the kernels over `saturation`, clamped to 1, baked into a grid of
+    /// `resolution^3` samples.
+    Points {
+        /// The PLY (ASCII or binary little-endian: `x`, `y`, `z`, optional `radius`) or OBJ file.
+        path: Mark<String>,
+        /// The kernel radius R (node frame); a PLY `radius` property scales it per point.
+        #[serde(deserialize_with = "v::positive")]
+        radius: f64,
+        /// The kernel sum read as density 1 (the core): lower makes the object denser.
+        #[serde(default = "one", deserialize_with = "v::positive")]
+        saturation: f64,
+        /// Grid samples per axis (as a mesh object's).
+        #[serde(default = "default_grid", deserialize_with = "v::grid_resolution")]
+        resolution: u32,
+        /// Loaded and checked by `scene::load`.
+        #[serde(skip)]
+        set: Option<Arc<PointSet>>,
+    },
 }
 
 fn default_grid() -> u32 {
@@ -112,6 +133,9 @@ impl SoftObject {
             SoftObject::Box { size } => *size * 0.5,
             SoftObject::Mesh { shape, .. } => {
                 return shape.as_ref().map_or((DVec3::ZERO, DVec3::ZERO), |s| (s.lo, s.hi));
+            }
+            SoftObject::Points { set, radius, .. } => {
+                return set.as_ref().map_or((DVec3::ZERO, DVec3::ZERO), |s| s.bounds(*radius));
             }
         };
         (-h, h)

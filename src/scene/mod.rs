@@ -132,8 +132,14 @@ pub fn parse(source: &str, path: &Path) -> Result<Scene> {
         return Err(e);
     }
     for h in scene.hypertextures.values_mut() {
-        if let hypertexture::SoftObject::Mesh { path, shape, .. } = &mut h.object.value {
-            *shape = found.assets.shapes.get(&dir.join(&path.value)).cloned();
+        match &mut h.object.value {
+            hypertexture::SoftObject::Mesh { path, shape, .. } => {
+                *shape = found.assets.shapes.get(&dir.join(&path.value)).cloned();
+            }
+            hypertexture::SoftObject::Points { path, set, .. } => {
+                *set = found.assets.point_sets.get(&dir.join(&path.value)).cloned();
+            }
+            _ => {}
         }
         for noise in h.noises.value.iter_mut() {
             if let hypertexture::ShapeTransfer::Image { path, rows } = &mut noise.shape {

@@ -24,6 +24,8 @@ pub(crate) struct Assets {
     pub(crate) stacks: BTreeMap<PathBuf, Arc<SliceStack>>,
     /// Hypertexture mesh objects, welded and checked.
     pub(crate) shapes: BTreeMap<PathBuf, Arc<MeshShape>>,
+    /// Hypertexture point sets, read and checked.
+    pub(crate) point_sets: BTreeMap<PathBuf, Arc<crate::mesh::points::PointSet>>,
     /// Mesh texels' patterns by (path, filled): closed parts when filled, else one open part.
     pub(crate) texel_meshes: BTreeMap<(PathBuf, bool), Arc<MeshShape>>,
     /// Volumes read from their OpenVDB files, by name in `Scene::volumes`.
@@ -97,6 +99,41 @@ impl Checker<'_> {
                 self.f.assets.shapes.insert(full, Arc::new(shape));
             }
             Err(msg) => self.fail(path, msg),
+        }
+    }
+
+    /// A hypertexture's point set: read and checked, its kernels' overlap within budget.
+    fn points_object(&mut self, object: &Mark<super::hypertexture::SoftObject>) {
+        let super::hypertexture::SoftObject::Points { path, radius, .. } = &object.value else { return };
+        let full = self.f.assets.dir.join(&path.value);
+        let set = match self.f.assets.point_sets.get(&full) {
+            Some(s) => s.clone(),
+            None => {
+                if let Err(e) =
+                    crate::input::check(&full, crate::input::Kind::Asset, "a point set (.ply or .obj)")
+                {
+                    self.fail(path, e.to_string());
+                    return;
+                }
+                match crate::mesh::points::load(&full) {
+                    Ok(s) => {
+                        let s = Arc::new(s);
+                        self.f.assets.point_sets.insert(full, s.clone());
+                        s
+                    }
+                    Err(e) => return self.other(e),
+                }
+            }
+        };
+        let overlap = set.overlap(*radius);
+        if overlap > crate::mesh::points::MAX_OVERLAP {
+            let msg = format!(
+                "kernels of radius {radius} overlap about {overlap:.0} deep where the points of {} are densest: \
+                 at most {} are allowed (the bake visits each at every grid sample; expected a smaller radius)",
+                path.value,
+                crate::mesh::points::MAX_OVERLAP
+            );
+            self.fail(object, msg);
         }
     }
 
@@ -519,8 +556,14 @@ impl Checker<'_> {
         if let Some(Method::RayMarch(rm)) = ray_march.map(|m| &m.value) {
             // Mesh objects get their bounds from the mesh, loaded before the nodes are checked.
             let mut model = model.clone();
-            if let super::hypertexture::SoftObject::Mesh { path, shape, .. } = &mut model.object.value {
-                *shape = self.f.assets.shapes.get(&self.f.assets.dir.join(&path.value)).cloned();
+            match &mut model.object.value {
+                super::hypertexture::SoftObject::Mesh { path, shape, .. } => {
+                    *shape = self.f.assets.shapes.get(&self.f.assets.dir.join(&path.value)).cloned();
+                }
+                super::hypertexture::SoftObject::Points { path, set, .. } => {
+                    *set = self.f.assets.point_sets.get(&self.f.assets.dir.join(&path.value)).cloned();
+                }
+                _ => {}
             }
             let diagonal = super::hypertexture::diagonal(&model.world_corners(world));
             let samples = diagonal / rm.step();
@@ -600,6 +643,7 @@ pub(super) fn check(scene: &Scene, dir: &Path, source: &str, path: &Path) -> Fin
         if let super::hypertexture::SoftObject::Mesh { path, .. } = &h.object.value {
             c.mesh_object(path);
         }
+        c.points_object(&h.object);
         for noise in h.noises.iter() {
             if let super::hypertexture::ShapeTransfer::Image { path, .. } = &noise.shape {
                 c.shape_image(path);

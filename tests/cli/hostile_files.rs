@@ -152,3 +152,35 @@ fn invalid_utf8_is_reported_at_its_position() {
     let out = voltex_env(&["plan", s(&scene)], &[]);
     fails(&out, &[&format!("{}:{line}:{col}: expected UTF-8 text", scene.display())]);
 }
+
+/// Point sets of hypertexture `Points` objects (`voltex plan`): a FIFO refused without blocking,
+/// a binary PLY cut short at its byte, a header over the point budget at its line:col, a
+/// non-finite OBJ coordinate at its line:col; exit status 1, no panic.
+#[test]
+fn hostile_point_sets_are_refused_at_their_position() {
+    let dir = scratch_dir("voltex-hostile-points");
+    mkfifo(&dir.join("fifo.ply"));
+    let head = "ply\nformat binary_little_endian 1.0\nelement vertex 2\nproperty float x\nproperty float y\n\
+                property float z\nend_header\n";
+    let mut short = head.as_bytes().to_vec();
+    short.extend([0u8; 20]);
+    std::fs::write(dir.join("short.ply"), &short).unwrap();
+    std::fs::write(dir.join("huge.ply"), head.replace("vertex 2", "vertex 2000000")).unwrap();
+    std::fs::write(dir.join("inf.obj"), "v 0 0 0\nv 1 2 -inf\n").unwrap();
+    for (file, words) in [
+        ("fifo.ply", vec!["fifo.ply", "found a FIFO"]),
+        ("short.ply", vec!["short.ply: byte ", "expected 2 vertices of 12 bytes, found 1"]),
+        ("huge.ply", vec!["huge.ply:3:16: 2000000 points: at most 1048576 are allowed"]),
+        ("inf.obj", vec!["inf.obj:2:7: expected `v x y z` with finite numbers, found `-inf`"]),
+    ] {
+        let scene = dir.join("scene.ron");
+        let text = format!(
+            "Scene(output: (width: 8, height: 8), camera: (eye: (0, -3, 0), target: (0, 0, 0)), hypertextures: {{ \
+             \"h\": (object: Points(path: \"{file}\", radius: 0.1), noises: [(shape: Table([0.0, 1.0]), amplitude: \
+             0.1, frequency: 2.0)], color: Step(threshold: 0.3, color: (1, 1, 1))) }}, nodes: [(name: \"n\", \
+             hypertexture: \"h\", method: RayMarch(step: 0.05))])"
+        );
+        std::fs::write(&scene, text).unwrap();
+        fails(&voltex_env(&["plan", s(&scene)], &[]), &words);
+    }
+}

@@ -17,6 +17,7 @@ mod hard_cases;
 mod height_precision;
 mod hypertexture;
 mod hypertexture_mesh;
+mod hypertexture_points;
 mod hypertexture_segments;
 mod hypertexture_splatting;
 mod hypertexture_texel;

@@ -1,6 +1,6 @@
 // Soft objects (density 1 at the core falling to 0 on the boundary) and the vector fields of the
 // paper's Figure 8, in object space. Reads the kernel's `hyper: HyperParams` and, for mesh
-// objects, `mesh_grid` and `mesh_depth` (bake_mesh_grid.wgsl). CPU twin:
+// and point-set objects, `mesh_grid` and `mesh_depth` (bake_mesh_grid.wgsl, bake_point_grid.wgsl). CPU twin:
 // src/cpu/hypertexture.rs (same names).
 #include "shared/simplex.wgsl"
 
@@ -10,6 +10,7 @@ const OBJECT_ELLIPSOID: u32 = 1u;
 const OBJECT_TORUS: u32 = 2u;
 const OBJECT_BOX: u32 = 3u;
 const OBJECT_MESH: u32 = 4u;
+const OBJECT_POINTS: u32 = 5u;
 // HyperParams.kinds.y (twins: FIELD_*).
 const FIELD_CLOSEST_SURFACE: u32 = 0u;
 const FIELD_FROM_CENTRE: u32 = 1u;
@@ -23,28 +24,39 @@ fn unit_or_zero(v: vec3<f32>) -> vec3<f32> {
     return select(vec3<f32>(0.0), v / len, len > TINY);
 }
 
-fn mesh_cell(i: vec3<u32>, n: u32) -> vec4<f32> {
-    return mesh_grid[i.x + n * (i.y + n * i.z)];
+fn mesh_cell(i: vec3<u32>, n: u32, base: u32) -> vec4<f32> {
+    return mesh_grid[base + i.x + n * (i.y + n * i.z)];
 }
 
-// A mesh object's grid at x (clamped to the grid), trilinear: xyz the vector to the closest
-// surface point, w the signed distance (positive inside). No loops: no loop budget spent.
+// A mesh or point-set object's grid at x (clamped to the grid), trilinear: xyz the vector to
+// the closest surface point, w the signed distance (positive inside).
 fn mesh_sample(x: vec3<f32>) -> vec4<f32> {
+    return grid_sample(x, 0u);
+}
+
+// A point set's kernel sum over its saturation at x (the second block of its grid).
+fn points_density(x: vec3<f32>) -> f32 {
+    let n = u32(hyper.grid_min.w);
+    return grid_sample(x, n * n * n).x;
+}
+
+// The grid block starting at `base` at x, trilinear. No loops: no loop budget spent.
+fn grid_sample(x: vec3<f32>, base: u32) -> vec4<f32> {
     let n = u32(hyper.grid_min.w);
     let lo = hyper.grid_min.xyz;
     let u = clamp((x - lo) / (hyper.grid_max.xyz - lo), vec3<f32>(0.0), vec3<f32>(1.0)) * f32(n - 1u);
     let i = min(vec3<u32>(u), vec3<u32>(n - 2u));
     let f = u - vec3<f32>(i);
-    let x0 = mix(mesh_cell(i, n), mesh_cell(i + vec3<u32>(1u, 0u, 0u), n), f.x);
-    let x1 = mix(mesh_cell(i + vec3<u32>(0u, 1u, 0u), n), mesh_cell(i + vec3<u32>(1u, 1u, 0u), n), f.x);
-    let x2 = mix(mesh_cell(i + vec3<u32>(0u, 0u, 1u), n), mesh_cell(i + vec3<u32>(1u, 0u, 1u), n), f.x);
-    let x3 = mix(mesh_cell(i + vec3<u32>(0u, 1u, 1u), n), mesh_cell(i + vec3<u32>(1u, 1u, 1u), n), f.x);
+    let x0 = mix(mesh_cell(i, n, base), mesh_cell(i + vec3<u32>(1u, 0u, 0u), n, base), f.x);
+    let x1 = mix(mesh_cell(i + vec3<u32>(0u, 1u, 0u), n, base), mesh_cell(i + vec3<u32>(1u, 1u, 0u), n, base), f.x);
+    let x2 = mix(mesh_cell(i + vec3<u32>(0u, 0u, 1u), n, base), mesh_cell(i + vec3<u32>(1u, 0u, 1u), n, base), f.x);
+    let x3 = mix(mesh_cell(i + vec3<u32>(0u, 1u, 1u), n, base), mesh_cell(i + vec3<u32>(1u, 1u, 1u), n, base), f.x);
     return mix(mix(x0, x1, f.y), mix(x2, x3, f.y), f.z);
 }
 
 // O(x): sphere 1 - |x| / r; ellipsoid 1 - |x / radii|; torus (axis z) 1 - (distance to the core
 // circle) / minor; box 1 - max_i |x_i| / half_i; mesh: the inside distance over the largest
-// inside distance. Clamped to [0, 1].
+// inside distance; points: the kernel sum over the saturation. Clamped to [0, 1].
 fn object_density(x: vec3<f32>) -> f32 {
     let s = hyper.object;
     var d = 0.0;
@@ -62,6 +74,9 @@ fn object_density(x: vec3<f32>) -> f32 {
         case OBJECT_MESH: {
             d = mesh_sample(x).w / bitcast<f32>(mesh_depth[0]);
         }
+        case OBJECT_POINTS: {
+            d = points_density(x);
+        }
         default: {
             d = 1.0 - length(x) / s.x;
         }
@@ -72,7 +87,10 @@ fn object_density(x: vec3<f32>) -> f32 {
 // A lower bound of the distance from x to where the object's density is positive: exact for
 // the sphere, torus and box; for the ellipsoid (|x / radii| - 1) times its smallest radius; for a
 // mesh the distance to the grid's box outside it, and inside it the interpolated outside distance
-// over sqrt(3) (trilinear interpolation of samples of a distance rises at most that fast).
+// over sqrt(3) (trilinear interpolation of samples of a distance rises at most that fast); for a
+// point set the interpolated distance to its kernels' balls less two grid-cell diagonals (the
+// interpolated density is positive at most a diagonal beyond a sample inside a ball, and the
+// interpolated distance at most a diagonal above the distance to that sample).
 fn support_distance(x: vec3<f32>) -> f32 {
     let s = hyper.object;
     switch hyper.kinds.x {
@@ -92,6 +110,14 @@ fn support_distance(x: vec3<f32>) -> f32 {
                 return length(max(out, vec3<f32>(0.0)));
             }
             return -mesh_sample(x).w * 0.57735;
+        }
+        case OBJECT_POINTS: {
+            let out = max(hyper.grid_min.xyz - x, x - hyper.grid_max.xyz);
+            if (any(out > vec3<f32>(0.0))) {
+                return length(max(out, vec3<f32>(0.0)));
+            }
+            let cell = (hyper.grid_max.x - hyper.grid_min.x) / (hyper.grid_min.w - 1.0);
+            return -mesh_sample(x).w - 3.4641016 * cell;
         }
         default: {
             return length(x) - s.x;
@@ -137,7 +163,7 @@ fn closest_surface_point(x: vec3<f32>) -> vec3<f32> {
             }
             return p;
         }
-        case OBJECT_MESH: {
+        case OBJECT_MESH, OBJECT_POINTS: {
             let c = clamp(x, hyper.grid_min.xyz, hyper.grid_max.xyz);
             return c + mesh_sample(c).xyz;
         }

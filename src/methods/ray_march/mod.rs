@@ -330,7 +330,7 @@ impl RayMarchPlan {
             + self.packed.noises.len() * 32
             + self.packed.points.len() * 16
             + self.packed.functions.len() * (16 + 4 * TRANSFER_SIZE)) as u64
-            + self.packed.mesh.as_ref().map_or(0, |(_, g)| g.samples() * 16)
+            + self.packed.grid_bytes()
             + size.0 as u64 * size.1 as u64 * std::mem::size_of::<MarchState>() as u64
             + std::mem::size_of::<SegmentParams>() as u64
             + self.peel.as_ref().map_or(0, |(passes, lattice)| {
@@ -393,14 +393,15 @@ impl RayMarchPlan {
         splats::bake(ctx, &self.params, &self.segments, grid.unwrap_or(&unused))
     }
 
-    /// The mesh grid's cache key and a function that bakes it, for mesh objects.
+    /// The object grid's cache key, for mesh and point-set objects.
     pub(crate) fn mesh_grid_key(&self) -> Option<u64> {
-        self.packed.mesh.as_ref().map(|(shape, spec)| crate::gpu::cache::key(&(shape.hash, spec)))
+        self.packed.grid_key()
     }
 
-    /// Bakes the mesh grid of a mesh object (`bake_mesh_grid.wgsl`).
+    /// Bakes the grid of a mesh object (`bake_mesh_grid.wgsl`) or point-set object
+    /// (`bake_point_grid.wgsl`).
     pub fn bake_mesh_grid(&self, ctx: &GpuContext) -> Result<Option<MeshGrid>> {
-        self.packed.mesh.as_ref().map(|(shape, spec)| mesh::bake(ctx, shape, spec)).transpose()
+        self.packed.bake_grid(ctx)
     }
 
     /// The light volume's cache key: its grid and everything the density depends on (not the

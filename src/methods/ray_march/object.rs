@@ -72,7 +72,7 @@ impl MethodPlan for RayMarchPlan {
     }
 
     fn kernels(&self) -> Vec<&'static str> {
-        let grid = self.mesh_grid_key().map(|_| "bake/bake_mesh_grid.wgsl");
+        let grid = self.packed.grid_kernel();
         let splats = self.splat_key().map(|_| "ray_march/bake_splats.wgsl");
         grid.into_iter().chain(splats).collect()
     }
@@ -93,6 +93,14 @@ impl MethodPlan for RayMarchPlan {
                 "{name:<16} {x}x{y}x{z}  bake_mesh_grid.wgsl  mesh grid of {} triangles in {} part(s)",
                 shape.triangles.len(),
                 shape.parts.len(),
+            ));
+        }
+        if let Some(p) = &self.packed.point_set {
+            let [x, y, z] = p.spec.n;
+            lines.push(format!(
+                "{name:<16} {x}x{y}x{z}  bake_point_grid.wgsl  point grid of {} kernels of radius {}",
+                p.set.centres.len(),
+                p.radius,
             ));
         }
         if let Some(l) = &self.light {
@@ -146,7 +154,7 @@ impl MethodPlan for RayMarchPlan {
         let what = format!(
             "object {}: hypertexture parameters, transfer tables, per-pixel march state{}",
             object.object.name,
-            if self.packed.mesh.is_some() { ", mesh grid" } else { "" }
+            if self.packed.grid_key().is_some() { ", object grid" } else { "" }
         ) + if self.peel.is_some() { ", splat sets, per-pixel segment bounds" } else { "" }
             + if self.splatting.is_some() { ", splat sets, per-pixel depth slabs" } else { "" }
             + if self.light.is_some() { ", light volume" } else { "" };
