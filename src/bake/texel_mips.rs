@@ -11,7 +11,7 @@ pub fn mip_levels(res: [u32; 3]) -> u32 {
 }
 
 /// Voxels of a volume of `res` with its MIP levels (`mipmaps`) or level 0 alone.
-pub fn voxels(res: [u32; 3], mipmaps: bool) -> u64 {
+pub(crate) fn voxels(res: [u32; 3], mipmaps: bool) -> u64 {
     let levels = if mipmaps { mip_levels(res) } else { 1 };
     (0..levels).map(|l| res.iter().map(|&r| (r >> l).max(1) as u64).product::<u64>()).sum()
 }

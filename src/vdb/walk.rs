@@ -22,7 +22,7 @@ pub(crate) type Fault = String;
 
 /// The archive: its grids in file order (the format version is checked while reading).
 #[derive(Debug, Clone)]
-pub struct Archive {
+pub(crate) struct Archive {
     pub(crate) grids: Vec<GridHeader>,
 }
 
@@ -85,7 +85,7 @@ pub(crate) struct Splice {
 
 /// One grid's tree as walked: its transform, background and active root tiles.
 #[derive(Debug, Clone)]
-pub struct Topology {
+pub(crate) struct Topology {
     /// The map's name, e.g. `ScaleTranslateMap`.
     pub(crate) map: String,
     /// Index space to world space.

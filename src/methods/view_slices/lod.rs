@@ -8,10 +8,10 @@ use glam::DVec3;
 
 /// Planes per pixel of depth extent (or per texel voxel, when a voxel covers more than a
 /// pixel): two samples per pixel along the view axis.
-pub const PLANES_PER_SAMPLE: f64 = 2.0;
+pub(crate) const PLANES_PER_SAMPLE: f64 = 2.0;
 
 /// The fewest planes `lod: Auto` draws (unless `planes` is fewer).
-pub const MIN_LOD_PLANES: u32 = 8;
+pub(crate) const MIN_LOD_PLANES: u32 = 8;
 
 /// What `lod: Auto` chose for an object, with the sizes it chose from (`voltex plan`).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -24,9 +24,9 @@ pub struct LodChoice {
     /// voxel axis there (level 0).
     pub pixel: f64,
     /// The largest texel voxel axis (world units, level 0).
-    pub voxel_max: f64,
+    pub(crate) voxel_max: f64,
     /// The smallest texel voxel axis (world units, level 0).
-    pub voxel_min: f64,
+    pub(crate) voxel_min: f64,
 }
 
 /// World lengths of one voxel of a `res` texel along s, t and w over prism `p` (the bottom
@@ -55,7 +55,7 @@ fn voxel_sizes(shell: &Shell, p: &crate::types::Prism, res: [u32; 3]) -> Option<
 /// `focal` pixels: the coarsest texel MIP level (below `levels`) whose voxels cover at most a
 /// pixel at every prism's nearest depth, and [`PLANES_PER_SAMPLE`] planes per pixel, or per
 /// voxel where a voxel is larger, of the depth range, in `MIN_LOD_PLANES..=max_planes`.
-pub fn choose(
+pub(crate) fn choose(
     shell: &Shell,
     forward: [f32; 3],
     focal: f64,

@@ -20,7 +20,7 @@ pub struct ViewSlicesPlan {
     /// The rendered size the tiles were planned for.
     pub(crate) size: (u32, u32),
     /// The scene's plane count (`lod: Auto`: the most it may draw).
-    pub max_planes: u32,
+    pub(crate) max_planes: u32,
     /// What `lod: Auto` chose; `None` when off.
     pub lod: Option<LodChoice>,
 }
