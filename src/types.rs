@@ -347,7 +347,7 @@ pub struct AxisParams {
     pub criteria: [f32; 4],
     /// xyz: unit camera forward; w: 1 when the eye is inside a prism of the shell, else 0.
     pub forward: [f32; 4],
-    /// x: allowed directions (bit i for direction i); y: vertex capacity; z: back-face culling
+    /// x: allowed directions (bit i for direction i); y: vertex capacity; z: occlusion culling
     /// (0/1); w: empty-texel culling (0/1).
     pub flags: [u32; 4],
 }

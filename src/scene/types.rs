@@ -1021,8 +1021,7 @@ pub struct AxisSlices {
     pub blend: SliceBlend,
     /// Skip prisms hidden behind the opaque base surfaces: exact (every pixel a prism's corners
     /// can cover already holds a nearer base surface), so it never changes the image.
-    /// `occlusion_culling` is the field's former name.
-    #[serde(default, alias = "occlusion_culling")]
+    #[serde(default)]
     pub occlusion_culling: bool,
     /// Skip slices (and so texels) whose slice image is empty.
     #[serde(default = "yes")]

@@ -125,6 +125,14 @@ fn texel_shadow_and_lod_values() {
     assert_err("lod", &[(14, l)], "scene.ron", 14, 49, "`Auto`");
 }
 
+/// `back_face_culling`, AxisSlices' culling knob before exact occlusion culling replaced it
+/// (it changed images at silhouettes), is an unknown field whose error names the new one.
+#[test]
+fn former_culling_name_names_its_successor() {
+    let l = "            method: AxisSlices(back_face_culling: true),";
+    assert_err("former", &[(14, l)], "scene.ron", 14, 32, "`occlusion_culling`");
+}
+
 #[test]
 fn regress_supersample() {
     let l = "    output: (width: 64, height: 64), regress: (supersample: 9),";
