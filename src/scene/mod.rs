@@ -37,8 +37,8 @@ fn options() -> ron::Options {
 }
 
 impl Scene {
-    /// The files (meshes, images, hypertexture meshes) and slice-stack folders the scene refers to,
-    /// resolved.
+    /// The files (meshes, images, hypertexture meshes and point sets) and slice-stack folders the
+    /// scene refers to, resolved.
     pub(crate) fn asset_paths(&self) -> Vec<std::path::PathBuf> {
         let a = &self.assets;
         a.meshes
@@ -46,6 +46,7 @@ impl Scene {
             .chain(a.images.keys())
             .chain(a.stacks.keys())
             .chain(a.shapes.keys())
+            .chain(a.point_sets.keys())
             .chain(a.volume_files.iter())
             .cloned()
             .collect()

@@ -3,18 +3,8 @@
 #include "shared/bvh.wgsl"
 
 @group(0) @binding(0) var<uniform> grid_params: MeshGridParams;
-// The bytes of a `ReferenceNode` (methods::reference::flat_bvh) read with integer counts: a
-// count or index stored as f32 bits is a denormal, which software rasterisers may flush to zero.
-struct BvhNode {
-    lo: vec3<f32>,
-    // Triangles in the leaf (0: inner node).
-    count: u32,
-    hi: vec3<f32>,
-    // First triangle (leaf) or first child (inner; the second follows it).
-    first: u32,
-}
-
-// One BVH per closed part, concatenated (children and triangles indexed in the whole).
+// `BvhNode`s (shared/bvh.wgsl): one BVH per closed part, concatenated (children and triangles
+// indexed in the whole).
 @group(0) @binding(1) var<storage, read> mesh_nodes: array<BvhNode>;
 // Per part: x its root node.
 @group(0) @binding(5) var<storage, read> mesh_parts: array<vec4<u32>>;

@@ -5,17 +5,7 @@
 // lo, hi: the grid's corners (hi.w: 1 / saturation); counts: samples per axis, points, BVH
 // nodes; size: samples per axis.
 @group(0) @binding(0) var<uniform> grid_params: MeshGridParams;
-// The bytes of a `ReferenceNode` (mesh::bvh::flat_bvh) over the kernels' boxes, read with
-// integer counts (as bake_mesh_grid.wgsl does).
-struct BvhNode {
-    lo: vec3<f32>,
-    // Kernels in the leaf (0: inner node).
-    count: u32,
-    hi: vec3<f32>,
-    // First kernel (leaf) or first child (inner; the second follows it).
-    first: u32,
-}
-
+// `BvhNode`s (shared/bvh.wgsl) over the kernels' boxes.
 @group(0) @binding(1) var<storage, read> point_nodes: array<BvhNode>;
 // xyz the centre, w the radius, in the BVH's leaf order.
 @group(0) @binding(2) var<storage, read> point_kernels: array<vec4<f32>>;

@@ -1,5 +1,17 @@
-// The stack of a BVH walk (bake_mesh_grid.wgsl, trace_reference.wgsl): node indices, depth first.
-// Reads the kernel's `STACK_SIZE`; a full stack drops the children it cannot hold.
+// The stack of a BVH walk (bake_mesh_grid.wgsl, bake_point_grid.wgsl, trace_reference.wgsl): node
+// indices, depth first. Reads the kernel's `STACK_SIZE`; a full stack drops the children it cannot
+// hold.
+
+// The bytes of a `ReferenceNode` (mesh::bvh::flat_bvh) read with integer counts: a count or index
+// stored as f32 bits is a denormal, which software rasterisers may flush to zero.
+struct BvhNode {
+    lo: vec3<f32>,
+    // Primitives in the leaf (0: inner node).
+    count: u32,
+    hi: vec3<f32>,
+    // First primitive (leaf) or first child (inner; the second follows it).
+    first: u32,
+}
 
 struct BvhStack {
     nodes: array<u32, STACK_SIZE>,
