@@ -199,22 +199,10 @@ fn sphere_mesh_matches_the_soft_sphere() {
     assert!((depth - 1.0).abs() < 1e-3);
 }
 
-/// The ray marcher's side: density, field and colour at random points of a mesh hypertexture,
-/// the kernels (`probe_hypertexture.wgsl` on the baked grid) against the twin's trilinear sampling
-/// of the same grid; and whole images, kernel against twin, unshaded and with Phong.
-#[test]
-fn mesh_hypertexture_matches_twin() {
-    let dir = folder("march", &[("sphere.obj", &sphere_obj(1.0, 32, 16))]);
-    let object = "Mesh(path: \"sphere.obj\", resolution: 32)";
-    let scene = mesh_scene(&dir, object, NOISE, "RayMarch(step: 0.02)");
-    let bp = Blueprint::new(&scene, &sized(8, 8)).unwrap();
-    // `voltex plan` lists the bake.
-    let text = bp.describe();
-    assert!(
-        text.contains("32x32x32  bake_mesh_grid.wgsl  mesh grid of 960 triangles in 1 part(s)"),
-        "{text}"
-    );
-    let plan = plan_of(&bp);
+/// The ray marcher's kernels (`probe_hypertexture.wgsl` on the baked grid) against the twin's
+/// sampling of the same grid at 2048 random points of the object's bounds (from `seed`):
+/// object density, vector field and density within f32 rounding, and some points with density.
+pub(crate) fn probes_match_twin(plan: &RayMarchPlan, seed: u32, what: &str) {
     let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
     let grid = plan.bake_mesh_grid(&ctx).unwrap().unwrap();
     let (cells, depth) = mesh::read(&ctx, &grid).unwrap();
@@ -226,7 +214,7 @@ fn mesh_hypertexture_matches_twin() {
         grid: Some((&cells, depth)),
     };
     let (lo, hi) = plan.packed.bounds;
-    let mut seed = 11u32;
+    let mut seed = seed;
     let points: Vec<[f32; 4]> = (0..2048)
         .map(|_| {
             let mut next = || {
@@ -250,13 +238,30 @@ fn mesh_hypertexture_matches_twin() {
         positive += (density > 0.0) as usize;
     }
     eprintln!(
-        "mesh hypertexture probes vs twin: object density {:.2e}, field {:.2e}, density {:.2e} ({positive} of 2048 \
-         points with density)",
+        "{what} hypertexture probes vs twin: object density {:.2e}, field {:.2e}, density {:.2e} ({positive} of \
+         2048 points with density)",
         worst[0], worst[1], worst[2]
     );
     assert!(worst[0] < 1e-5 && worst[1] < 1e-5 && worst[2] < 1e-4, "{worst:?}");
     assert!(positive > 100);
-    drop(ctx);
+}
+
+/// The ray marcher's side: density, field and colour at random points of a mesh hypertexture,
+/// the kernels (`probe_hypertexture.wgsl` on the baked grid) against the twin's trilinear sampling
+/// of the same grid; and whole images, kernel against twin, unshaded and with Phong.
+#[test]
+fn mesh_hypertexture_matches_twin() {
+    let dir = folder("march", &[("sphere.obj", &sphere_obj(1.0, 32, 16))]);
+    let object = "Mesh(path: \"sphere.obj\", resolution: 32)";
+    let scene = mesh_scene(&dir, object, NOISE, "RayMarch(step: 0.02)");
+    let bp = Blueprint::new(&scene, &sized(8, 8)).unwrap();
+    // `voltex plan` lists the bake.
+    let text = bp.describe();
+    assert!(
+        text.contains("32x32x32  bake_mesh_grid.wgsl  mesh grid of 960 triangles in 1 part(s)"),
+        "{text}"
+    );
+    probes_match_twin(plan_of(&bp), 11, "mesh");
 
     for method in ["RayMarch(step: 0.02)", "RayMarch(step: 0.02, shading: Phong)"] {
         let scene = mesh_scene(&dir, object, NOISE, method);
@@ -272,7 +277,7 @@ fn mesh_hypertexture_matches_twin() {
 }
 
 /// The kernel's premultiplied layer of the RayMarch object and the twin's (on the kernel's grid).
-fn layer_and_twin(scene: &scene::Scene, opts: &RenderOptions) -> (Vec<[f64; 4]>, Vec<[f64; 4]>) {
+pub(crate) fn layer_and_twin(scene: &scene::Scene, opts: &RenderOptions) -> (Vec<[f64; 4]>, Vec<[f64; 4]>) {
     let bp = Blueprint::new(scene, opts).unwrap();
     let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
     let mut r = Renderer::new(&ctx, bp).unwrap();

@@ -4,6 +4,7 @@
 //! grid, images with and without splat segments, and bad point files reported at their position.
 
 use crate::common;
+use crate::hypertexture_mesh::{layer_and_twin, probes_match_twin};
 
 use common::{ctx, sized};
 use std::path::{Path, PathBuf};
@@ -11,13 +12,10 @@ use std::sync::Arc;
 
 use glam::DVec3;
 use voltex::cpu::bake_point_grid::{bake_point_grid, kernel};
-use voltex::cpu::bake_transfer::bake_transfer;
-use voltex::cpu::hypertexture::Model;
 use voltex::hypertexture::{mesh, points};
 use voltex::mesh::points::PointSet;
-use voltex::methods::ray_march::march::{ray_march, MarchView};
-use voltex::methods::ray_march::{probe, RayMarchPlan};
-use voltex::render::{Blueprint, Renderer};
+use voltex::methods::ray_march::RayMarchPlan;
+use voltex::render::Blueprint;
 use voltex::scene;
 
 /// Points scattered (a hash sequence) in a blob of radius 0.8 squashed along z.
@@ -226,51 +224,9 @@ fn points_hypertexture_matches_twin() {
         text.contains("32x32x32  bake_point_grid.wgsl  point grid of 400 kernels of radius 0.25"),
         "{text}"
     );
-    let plan = plan_of(&bp);
-    let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
-    let grid = plan.bake_mesh_grid(&ctx).unwrap().unwrap();
-    let (cells, depth) = mesh::read(&ctx, &grid).unwrap();
-    let tables = bake_transfer(&plan.packed.functions, &plan.packed.points);
-    let model = Model {
-        params: &plan.params,
-        noises: &plan.packed.noises,
-        tables: &tables,
-        grid: Some((&cells, depth)),
-    };
-    let (lo, hi) = plan.packed.bounds;
-    let mut seed = 5u32;
-    let points: Vec<[f32; 4]> = (0..2048)
-        .map(|_| {
-            let mut next = || {
-                seed = voltex::cpu::bake::pcg_hash(seed);
-                seed as f64 / 4294967296.0
-            };
-            let p = lo + (hi - lo) * DVec3::new(next(), next(), next());
-            [p.x as f32, p.y as f32, p.z as f32, 0.0]
-        })
-        .collect();
-    let gpu = probe(&ctx, plan, &points).unwrap();
-    let (mut worst, mut positive) = ([0.0f64; 3], 0);
-    for (i, p) in points.iter().enumerate() {
-        let x = DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64);
-        let v = model.vector_field(x);
-        let density = model.hyper_density(x);
-        let g = &gpu.values[4 * i..4 * i + 4];
-        worst[0] = worst[0].max((g[0][1] as f64 - model.object_density(x)).abs());
-        worst[1] = worst[1].max((0..3).map(|k| (g[1][k] as f64 - v[k]).abs()).fold(0.0, f64::max));
-        worst[2] = worst[2].max((g[2][0] as f64 - density).abs());
-        positive += (density > 0.0) as usize;
-    }
-    eprintln!(
-        "points hypertexture probes vs twin: object density {:.2e}, field {:.2e}, density {:.2e} ({positive} of 2048 \
-         with density)",
-        worst[0], worst[1], worst[2]
-    );
-    assert!(worst[0] < 1e-5 && worst[1] < 1e-5 && worst[2] < 1e-4, "{worst:?}");
-    assert!(positive > 100);
-    drop(ctx);
+    probes_match_twin(plan_of(&bp), 5, "points");
 
-    let (gpu, cpu) = layer_and_twin(&scene);
+    let (gpu, cpu) = layer_and_twin(&scene, &sized(32, 32));
     let (max, mean) = compare(&gpu, &cpu);
     let covered = cpu.iter().filter(|c| c[3] > 0.05).count();
     eprintln!("image kernel vs twin: max {max:.2e}, mean {mean:.2e}, {covered} covered pixels");
@@ -282,7 +238,7 @@ fn points_hypertexture_matches_twin() {
         [("DepthPeeling(passes: 4, splat_grid: 24)", 1e-6), ("Splatting(splat_grid: 24)", 0.1)]
     {
         let segmented = scene_at(&dir, object, &format!("RayMarch(step: 0.02, segments: {segments})"));
-        let (seg, _) = layer_and_twin(&segmented);
+        let (seg, _) = layer_and_twin(&segmented, &sized(32, 32));
         let (max, mean) = compare(&seg, &gpu);
         let holes = seg.iter().zip(&gpu).filter(|(s, b)| b[3] > 0.05 && s[3] < 0.5 * b[3]).count();
         eprintln!("{segments} vs Bounds: max {max:.2e}, mean {mean:.2e}, {holes} holes");
@@ -295,30 +251,6 @@ fn compare(a: &[[f64; 4]], b: &[[f64; 4]]) -> (f64, f64) {
         let d = (0..4).map(|k| (g[k] - c[k]).abs()).fold(0.0, f64::max);
         (m.max(d), s + d / a.len() as f64)
     })
-}
-
-/// The kernel's premultiplied layer of the RayMarch object and the twin's (on the kernel's grid).
-fn layer_and_twin(scene: &scene::Scene) -> (Vec<[f64; 4]>, Vec<[f64; 4]>) {
-    let bp = Blueprint::new(scene, &sized(32, 32)).unwrap();
-    let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
-    let mut r = Renderer::new(&ctx, bp).unwrap();
-    r.render(&ctx).unwrap();
-    let instance = r.blueprint.find_instance("RayMarch").unwrap();
-    let bytes = r.read_instance_buffer(&ctx, instance, "ray_march_state").unwrap();
-    let plan = plan_of(&r.blueprint);
-    let (cells, depth) = mesh::read(&ctx, &plan.bake_mesh_grid(&ctx).unwrap().unwrap()).unwrap();
-    drop(ctx);
-    let f = &r.blueprint.frame;
-    let gpu = common::lit_march_state(f, &bytes);
-    let tables = bake_transfer(&plan.packed.functions, &plan.packed.points);
-    let view = MarchView::of_frame(f, r.blueprint.size);
-    let model = Model {
-        params: &plan.params,
-        noises: &plan.packed.noises,
-        tables: &tables,
-        grid: Some((&cells, depth)),
-    };
-    (gpu, ray_march(&view, model, plan.shade))
 }
 
 /// Bad point files and budgets fail when the scene loads, at the file's position or the
