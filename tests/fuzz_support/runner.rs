@@ -56,19 +56,13 @@ pub fn case_secs() -> f64 {
     env("VOLTEX_FUZZ_CASE_SECS").unwrap_or(10.0)
 }
 
-/// CPU time of the calling thread, in seconds: the work of a case whatever the machine's load.
-pub fn thread_cpu() -> f64 {
+/// CPU time in seconds on `clock`: `CLOCK_THREAD_CPUTIME_ID` (the calling thread) or
+/// `CLOCK_PROCESS_CPUTIME_ID` (every thread, the driver's included). Either is the work of a
+/// case, whatever the machine's load.
+fn cpu_secs(clock: libc::clockid_t) -> f64 {
     let mut t = libc::timespec { tv_sec: 0, tv_nsec: 0 };
     // SAFETY: a valid timespec to fill.
-    unsafe { libc::clock_gettime(libc::CLOCK_THREAD_CPUTIME_ID, &mut t) };
-    t.tv_sec as f64 + t.tv_nsec as f64 * 1e-9
-}
-
-/// CPU time of the whole process (every thread, the driver's included), in seconds.
-pub fn process_cpu() -> f64 {
-    let mut t = libc::timespec { tv_sec: 0, tv_nsec: 0 };
-    // SAFETY: a valid timespec to fill.
-    unsafe { libc::clock_gettime(libc::CLOCK_PROCESS_CPUTIME_ID, &mut t) };
+    unsafe { libc::clock_gettime(clock, &mut t) };
     t.tv_sec as f64 + t.tv_nsec as f64 * 1e-9
 }
 
@@ -203,16 +197,16 @@ pub fn fuzz<S: Strategy>(
             w.case = Some((Instant::now(), input.clone()));
         }
         let guard = CaseGuard(&watch);
-        let (thread_start, process_start) = (thread_cpu(), process_cpu());
+        let clock = match bounds.rss {
+            // GPU targets: the driver works in threads of its own.
+            Some(_) => libc::CLOCK_PROCESS_CPUTIME_ID,
+            None => libc::CLOCK_THREAD_CPUTIME_ID,
+        };
+        let cpu_start = cpu_secs(clock);
         let heap_start = Tracked::begin_case();
         let outcome = test(value);
         let heap = Tracked::peak_since(heap_start);
-        // GPU targets: the driver works in threads of its own, so the process's CPU time; else
-        // the thread's. Neither is inflated by a loaded machine, as wall time is.
-        let secs = match bounds.rss {
-            Some(_) => process_cpu() - process_start,
-            None => thread_cpu() - thread_start,
-        };
+        let secs = cpu_secs(clock) - cpu_start;
         let grew = match bounds.rss {
             Some(_) => {
                 let w = watch.lock().unwrap();
