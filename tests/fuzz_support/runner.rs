@@ -132,10 +132,32 @@ fn shorten(mut s: String, max: usize) -> String {
     s
 }
 
-/// Runs `test` on `cases` inputs of `strategy` (`VOLTEX_FUZZ_CASES` overrides `default_cases`;
-/// `VOLTEX_FUZZ_SEED` picks the seed, default 0) within `bounds`; proptest shrinks a failure.
-/// Prints the inputs tried and accepted, the slowest input, the largest heap and resident
-/// memory of one input, and the target's wall time.
+/// Which inputs of a target a run tries: inputs `from..cases` of the stream `seed` generates.
+#[derive(Debug, Clone, Copy)]
+pub struct Campaign {
+    /// Inputs generated in all (`VOLTEX_FUZZ_CASES`, else the target's default).
+    pub cases: u32,
+    /// The random seed (`VOLTEX_FUZZ_SEED`, default 0, so CI is reproducible).
+    pub seed: u64,
+    /// Inputs generated but not run (`VOLTEX_FUZZ_FROM`, default 0): a resumed campaign. The
+    /// inputs are the same, since generating one does not depend on what a test did, so a long
+    /// campaign can run in pieces, or in shards on several machines, and still cover `0..cases`.
+    pub from: u64,
+}
+
+impl Campaign {
+    /// The campaign the environment asks for, `default_cases` inputs unless it says.
+    pub fn from_env(default_cases: u32) -> Self {
+        Self {
+            cases: env("VOLTEX_FUZZ_CASES").unwrap_or(default_cases),
+            seed: env("VOLTEX_FUZZ_SEED").unwrap_or(0),
+            from: env("VOLTEX_FUZZ_FROM").unwrap_or(0),
+        }
+    }
+}
+
+/// Runs `test` on the inputs of `strategy` the environment asks for (see [`Campaign`]), each
+/// within `bounds`; proptest shrinks a failure.
 pub fn fuzz<S: Strategy>(
     name: &str,
     default_cases: u32,
@@ -145,8 +167,21 @@ pub fn fuzz<S: Strategy>(
 ) where
     S::Value: std::fmt::Debug,
 {
-    let cases = env("VOLTEX_FUZZ_CASES").unwrap_or(default_cases);
-    let seed: u64 = env("VOLTEX_FUZZ_SEED").unwrap_or(0);
+    run_campaign(name, Campaign::from_env(default_cases), bounds, strategy, test);
+}
+
+/// Runs `test` on inputs `from..cases` of `strategy` within `bounds`. Prints the inputs tried
+/// and accepted, the slowest input, the largest heap and resident memory of one input, and the
+/// target's wall time.
+pub fn run_campaign<S: Strategy>(
+    name: &str,
+    Campaign { cases, seed, from }: Campaign,
+    bounds: Bounds,
+    strategy: S,
+    test: impl Fn(S::Value) -> Result<(), String>,
+) where
+    S::Value: std::fmt::Debug,
+{
     let config = ProptestConfig {
         cases,
         failure_persistence: None,
@@ -176,12 +211,15 @@ pub fn fuzz<S: Strategy>(
     let accepted_before = ACCEPTED.with(Cell::get);
     let result = runner.run(&strategy, |value| {
         tried.set(tried.get() + 1);
+        if tried.get() <= from {
+            return Ok(());
+        }
         // A long campaign's progress, once a minute (its figures if it is stopped).
         if last_report.get().elapsed() > Duration::from_secs(60) {
             last_report.set(Instant::now());
             eprintln!(
                 "fuzz {name}: {} inputs so far, {} accepted, {:.0} s; slowest input {:.2} s, largest heap {} MiB{}",
-                tried.get() - 1,
+                tried.get() - 1 - from,
                 ACCEPTED.with(Cell::get) - accepted_before,
                 start.elapsed().as_secs_f64(),
                 slowest.get(),
@@ -237,9 +275,9 @@ pub fn fuzz<S: Strategy>(
     watch.lock().unwrap().stop = true;
     dog.join().unwrap();
     eprintln!(
-        "fuzz {name}: {} inputs tried, {} accepted (seed {seed}, {cases} cases asked, {:.1} s; slowest input \
+        "fuzz {name}: {} inputs tried, {} accepted (seed {seed}, inputs {from}..{cases}, {:.1} s; slowest input \
          {:.2} s, largest heap {} MiB{})",
-        tried.get(),
+        tried.get().saturating_sub(from),
         ACCEPTED.with(Cell::get) - accepted_before,
         start.elapsed().as_secs_f64(),
         slowest.get(),

@@ -11,7 +11,8 @@
 //! input within the runner's bounds on time and memory (`fuzz_support::runner`).
 //!
 //! `VOLTEX_FUZZ_CASES=N` sets the inputs per target (default: a CI budget of about two minutes in
-//! all), `VOLTEX_FUZZ_SEED=N` the random seed (default fixed, so CI is reproducible). A failure is
+//! all), `VOLTEX_FUZZ_SEED=N` the random seed (default fixed, so CI is reproducible),
+//! `VOLTEX_FUZZ_FROM=K` resumes a campaign at input K. A failure is
 //! shrunk by proptest to a minimal input, printed; it then becomes a named test in
 //! `fuzz_regressions` below.
 
@@ -447,6 +448,27 @@ fn slice_classification() {
         true => accepted(),
         false => Ok(()),
     });
+}
+
+/// A campaign resumed at input K (`VOLTEX_FUZZ_FROM`) runs exactly the inputs K.. of the whole
+/// campaign, and none before them.
+#[test]
+fn a_resumed_campaign_runs_the_same_inputs() {
+    use fuzz_support::runner::{run_campaign, Campaign};
+    let strategy = (any::<u64>(), prop::collection::vec(any::<Mutation>(), 0..4));
+    let seen = std::cell::RefCell::new(Vec::new());
+    let run = |from| {
+        seen.borrow_mut().clear();
+        run_campaign("resume", Campaign { cases: 40, seed: 7, from }, SMALL, &strategy, |v| {
+            seen.borrow_mut().push(format!("{v:?}"));
+            Ok(())
+        });
+        seen.borrow().clone()
+    };
+    let whole = run(0);
+    assert_eq!(whole.len(), 40);
+    assert_eq!(run(25), whole[25..]);
+    assert!(run(40).is_empty());
 }
 
 /// Minimised failures found by the fuzz targets above, kept as named tests.
