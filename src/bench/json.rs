@@ -93,6 +93,10 @@ pub struct Limits {
     /// Premultiplied-over blended fragments per second into Rgba32Float, each with one trilinear
     /// 3D texture fetch.
     pub blend_fragments_per_s: f64,
+    /// Small triangles (32 pixels each) per second beyond their fragments' blending; `None` where
+    /// they cost under 5% of their draw. Absent from reports older than it.
+    #[serde(default)]
+    pub triangles_per_s: Option<f64>,
     /// Trilinear samples per second of an rgba8 3D texture in a compute kernel, marching along z.
     pub texture_samples_per_s: f64,
     /// 3D simplex noise evaluations per second (`bench_simplex.wgsl`).
@@ -255,9 +259,10 @@ pub fn markdown(reports: &[(String, Report)]) -> String {
         );
         if let Some(l) = &r.limits {
             out += &format!(
-                "Adapter limits measured in the run: blended fragments {:.0} M/s, trilinear texture samples {:.0} M/s, \
-                 simplex noise {:.0} M/s.\n\n",
+                "Adapter limits measured in the run: blended fragments {:.0} M/s, small triangles beyond their \
+                 fragments {}, trilinear texture samples {:.0} M/s, simplex noise {:.0} M/s.\n\n",
                 l.blend_fragments_per_s / 1e6,
+                super::limits::triangles(l),
                 l.texture_samples_per_s / 1e6,
                 l.noise_per_s / 1e6
             );

@@ -1,7 +1,8 @@
 //! `bench --limits`: the adapter's own rates, measured in the same run as the benchmark so that
 //! a method's speed can be read as a share of what the adapter can do at all: blended fill
 //! (`bench_blend.wgsl`: full-screen layers into Rgba32Float, premultiplied over, one trilinear
-//! fetch of an rgba8 3D texture per fragment, as ViewSlices draws), trilinear texture samples in a
+//! fetch of an rgba8 3D texture per fragment, as ViewSlices draws), the cost of small triangles
+//! beyond their fragments (`bench_triangles.wgsl`), trilinear texture samples in a
 //! compute kernel (`bench_texture.wgsl`) and 3D simplex noise (`bench_simplex.wgsl`). Each is the
 //! median wall time of 5 runs after one that compiles, over the work it did.
 
@@ -16,6 +17,9 @@ use crate::gpu::GpuContext;
 /// Target size and layers of the blend test; threads and samples of the texture test.
 const BLEND_SIZE: u32 = 512;
 const BLEND_LAYERS: u32 = 64;
+/// Pixels on a side of the triangle test's squares, and its layers.
+const TRIANGLE_CELL: u32 = 8;
+const TRIANGLE_LAYERS: u32 = 16;
 const TEXTURE_THREADS: u32 = 256;
 const TEXTURE_SAMPLES: u32 = 256;
 
@@ -85,32 +89,33 @@ fn module(ctx: &GpuContext, name: &str) -> Result<wgpu::ShaderModule> {
     })
 }
 
-/// Blended fragments per second (see the module's comment).
-pub(crate) fn blend_rate(ctx: &GpuContext) -> Result<f64> {
+/// Seconds to draw `kernel` (a vertex and fragment pair reading the volume) into a BLEND_SIZE
+/// square Rgba32Float target, blended premultiplied-over: `vertices` per instance.
+fn fill_seconds(
+    ctx: &GpuContext,
+    kernel: &str,
+    constants: &[(&str, f64)],
+    vertices: u32,
+    instances: u32,
+) -> Result<f64> {
     let (view, sampler) = volume(ctx);
-    let module = module(ctx, "bench/bench_blend.wgsl")?;
+    let module = module(ctx, kernel)?;
     let format = wgpu::TextureFormat::Rgba32Float;
-    let constants = [("layers", BLEND_LAYERS as f64)];
-    let pipeline = ctx.scoped("bench_blend", || {
+    let options = || wgpu::PipelineCompilationOptions { constants, ..Default::default() };
+    let pipeline = ctx.scoped(kernel, || {
         ctx.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("bench_blend"),
+            label: Some(kernel),
             layout: None,
             vertex: wgpu::VertexState {
                 module: &module,
                 entry_point: Some("vs_main"),
-                compilation_options: wgpu::PipelineCompilationOptions {
-                    constants: &constants,
-                    ..Default::default()
-                },
+                compilation_options: options(),
                 buffers: &[],
             },
             fragment: Some(wgpu::FragmentState {
                 module: &module,
                 entry_point: Some("fs_main"),
-                compilation_options: wgpu::PipelineCompilationOptions {
-                    constants: &constants,
-                    ..Default::default()
-                },
+                compilation_options: options(),
                 targets: &[Some(wgpu::ColorTargetState {
                     format,
                     blend: Some(wgpu::BlendState::PREMULTIPLIED_ALPHA_BLENDING),
@@ -125,7 +130,7 @@ pub(crate) fn blend_rate(ctx: &GpuContext) -> Result<f64> {
         })
     })?;
     let group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some("bench_blend"),
+        label: Some(kernel),
         layout: &pipeline.get_bind_group_layout(0),
         entries: &[
             wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&view) },
@@ -143,9 +148,9 @@ pub(crate) fn blend_rate(ctx: &GpuContext) -> Result<f64> {
         view_formats: &[],
     });
     let target = target.create_view(&Default::default());
-    let seconds = time(ctx, |encoder| {
+    time(ctx, |encoder| {
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("bench_blend"),
+            label: Some(kernel),
             color_attachments: &[Some(wgpu::RenderPassColorAttachment {
                 view: &target,
                 depth_slice: None,
@@ -159,9 +164,29 @@ pub(crate) fn blend_rate(ctx: &GpuContext) -> Result<f64> {
         });
         pass.set_pipeline(&pipeline);
         pass.set_bind_group(0, &group, &[]);
-        pass.draw(0..3, 0..BLEND_LAYERS);
-    })?;
+        pass.draw(0..vertices, 0..instances);
+    })
+}
+
+/// Blended fragments per second (see the module's comment).
+pub(crate) fn blend_rate(ctx: &GpuContext) -> Result<f64> {
+    let constants = [("layers", BLEND_LAYERS as f64)];
+    let seconds = fill_seconds(ctx, "bench/bench_blend.wgsl", &constants, 3, BLEND_LAYERS)?;
     Ok((BLEND_SIZE * BLEND_SIZE * BLEND_LAYERS) as f64 / seconds)
+}
+
+/// Triangles per second beyond their fragments' blending: layers of small triangles (two per
+/// TRIANGLE_CELL-pixel square, as large as ViewSlices' slice triangles at a few hundred pixels
+/// square) drawn as `bench_blend` draws, less the time `blend_rate` gives their fragments. `None`
+/// where the triangles cost under 5% of that draw (an adapter whose setup is nearly free).
+pub(crate) fn triangle_rate(ctx: &GpuContext, blend_rate: f64) -> Result<Option<f64>> {
+    let cells = BLEND_SIZE / TRIANGLE_CELL;
+    let constants = [("layers", TRIANGLE_LAYERS as f64), ("cells", cells as f64)];
+    let seconds =
+        fill_seconds(ctx, "bench/bench_triangles.wgsl", &constants, 6 * cells * cells, TRIANGLE_LAYERS)?;
+    let triangles = (2 * cells * cells * TRIANGLE_LAYERS) as f64;
+    let setup = seconds - (BLEND_SIZE * BLEND_SIZE * TRIANGLE_LAYERS) as f64 / blend_rate;
+    Ok((setup > 0.05 * seconds).then(|| triangles / setup))
 }
 
 /// Trilinear 3D texture samples per second in a compute kernel.
@@ -205,20 +230,35 @@ pub(crate) fn texture_rate(ctx: &GpuContext) -> Result<f64> {
     Ok((TEXTURE_THREADS * TEXTURE_THREADS * TEXTURE_SAMPLES) as f64 / seconds)
 }
 
-/// All three rates. Compute first: lavapipe's compute timing is only trusted before any render
+/// All the rates. Compute first: lavapipe's compute timing is only trusted before any render
 /// pass (wall clock here, but keep the habit).
 pub(crate) fn measure(ctx: &GpuContext) -> Result<Limits> {
     let texture_samples_per_s = texture_rate(ctx)?;
     let noise_per_s = super::hyper::noise_rate(ctx)?;
     let blend_fragments_per_s = blend_rate(ctx)?;
-    Ok(Limits { blend_fragments_per_s, texture_samples_per_s, noise_per_s })
+    let triangles_per_s = triangle_rate(ctx, blend_fragments_per_s)?;
+    Ok(Limits { blend_fragments_per_s, triangles_per_s, texture_samples_per_s, noise_per_s })
+}
+
+/// Seconds the adapter needs at least for `triangles` carrying `fragments`: their setup at the
+/// triangle rate (where it was measurable) and their fragments at the blend rate.
+pub(crate) fn bound_seconds(l: &Limits, triangles: f64, fragments: f64) -> f64 {
+    fragments / l.blend_fragments_per_s + l.triangles_per_s.map_or(0.0, |r| triangles / r)
+}
+
+/// The triangle rate as text: "M/s", or why there is none.
+pub(crate) fn triangles(l: &Limits) -> String {
+    l.triangles_per_s
+        .map_or("not measurable (under 5% of the draw)".into(), |r| format!("{:.2} M/s", r / 1e6))
 }
 
 pub(crate) fn describe(l: &Limits) -> String {
     format!(
         "adapter limits (same run, median of 5 after warm-up, wall clock): blended fragments into Rgba32Float with one \
-         3D texture fetch {:.0} M/s; trilinear 3D texture samples {:.0} M/s; 3D simplex noise {:.0} M/s",
+         3D texture fetch {:.0} M/s; small triangles beyond their fragments {}; trilinear 3D texture samples {:.0} M/s; \
+         3D simplex noise {:.0} M/s",
         l.blend_fragments_per_s / 1e6,
+        triangles(l),
         l.texture_samples_per_s / 1e6,
         l.noise_per_s / 1e6
     )

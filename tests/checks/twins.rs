@@ -110,6 +110,11 @@ const NO_TWIN: &[(&str, &str)] = &[
          3D texture fetch each, a fill rate; its output is never read",
     ),
     (
+        "bench_triangles",
+        "benchmark only (`voltex bench --limits` times it): layers of small triangles blended with \
+         one 3D texture fetch each, a per-triangle cost; its output is never read",
+    ),
+    (
         "bench_texture",
         "benchmark only (`voltex bench --limits` times it): sums trilinear 3D texture samples, a \
          sample rate; its output is never read",

@@ -104,6 +104,12 @@ fn bench_writes_json_rows_limits_cost_model_and_trace() {
     for rate in [limits.blend_fragments_per_s, limits.texture_samples_per_s, limits.noise_per_s] {
         assert!(rate.is_finite() && rate > 0.0);
     }
+    // None only where the adapter's triangles cost under 5% of their draw.
+    assert!(limits.triangles_per_s.is_none_or(|r| r.is_finite() && r > 0.0), "{limits:?}");
+    for row in &r.rows {
+        let bound = row.extra["frame_over_adapter_bound"];
+        assert!(bound.is_finite() && bound > 0.0 && bound <= row.extra["frame_over_blend_limit"], "{row:?}");
+    }
     assert_eq!(r.cost_models.len(), 1);
     assert!(r.cost_models[0].r2 <= 1.0 && r.cost_models[0].rows == 4);
 

@@ -22,9 +22,12 @@ fn options(compositor: Compositor) -> RenderOptions {
 }
 
 fn render(name: &str, opts: &RenderOptions) -> Image {
-    let scene = scene::load(&example(name)).unwrap();
+    render_scene(&scene::load(&example(name)).unwrap(), opts)
+}
+
+fn render_scene(scene: &scene::Scene, opts: &RenderOptions) -> Image {
     let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
-    let mut r = Renderer::new(&ctx, Blueprint::new(&scene, opts).unwrap()).unwrap();
+    let mut r = Renderer::new(&ctx, Blueprint::new(scene, opts).unwrap()).unwrap();
     r.render(&ctx).unwrap().image
 }
 
@@ -65,6 +68,34 @@ fn tiles_composite_the_raster_image() {
         eprintln!("{name}: FLIP against the Reference: raster {flip_raster:.4}, tiles {flip_tiles:.4}");
         assert!(flip_tiles <= flip_raster + 2e-3, "{name}: tiles {flip_tiles} against raster {flip_raster}");
     }
+}
+
+/// Per-pixel lighting interpolates each slice vertex's frame (from its prism) over the polygon:
+/// the rasteriser as a varying, the tiles from the triangle's barycentrics. On a torus of 2,304
+/// prisms, whose frames differ from prism to prism, both draw the same image.
+#[test]
+fn per_pixel_lighting_tiles_composite_the_raster_image() {
+    let text = std::fs::read_to_string(example("torus_egg.ron")).unwrap();
+    let lit = text
+        .replace("segments: (24, 12)", "segments: (48, 24)")
+        .replace("resolution: (128, 128, 128)", "resolution: (32, 32, 32)")
+        .replace("lighting: Baked", "lighting: PerPixel");
+    assert_eq!(lit.matches("(48, 24)").count() + lit.matches("PerPixel").count(), 2);
+    let scene = scene::parse(&lit, &example("torus_egg.ron")).unwrap();
+    let raster = render_scene(&scene, &options(Compositor::Raster));
+    let tiles = render_scene(&scene, &options(Compositor::Tiles));
+    let baked = render("torus_egg.ron", &options(Compositor::Raster));
+    let d = pixel_differences(&raster, &tiles);
+    let mean = d.iter().sum::<f64>() / d.len() as f64;
+    let max = d.iter().copied().fold(0.0, f64::max);
+    // How far apart two different lightings are, for scale.
+    let apart = pixel_differences(&raster, &baked).iter().sum::<f64>() / d.len() as f64;
+    eprintln!(
+        "per-pixel torus: raster against tiles mean {mean:.2e}, max {max:.2e}; against baked {apart:.2e}"
+    );
+    assert!(mean < 2e-4, "mean difference {mean}");
+    assert!(max < 0.01, "largest difference {max}");
+    assert!(apart > 20.0 * mean, "the lit image is too close to the baked one ({apart}) to tell");
 }
 
 /// Lists too small for the sweep: every overflowing segment is composited from all the
