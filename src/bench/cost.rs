@@ -115,7 +115,7 @@ pub(crate) fn fit_terms(points: &[Vec<f64>]) -> Option<(Vec<f64>, f64)> {
     let scales: Vec<f64> = (0..k)
         .map(|j| (points.iter().map(|p| (p[j] - means[j]).powi(2)).sum::<f64>() / n as f64).sqrt())
         .collect();
-    if scales.iter().any(|&s| !(s > 0.0)) {
+    if scales.iter().any(|&s| s.is_nan() || s <= 0.0) {
         return None;
     }
     let z = |p: &[f64], j: usize| (p[j] - means[j]) / scales[j];
@@ -134,11 +134,12 @@ pub(crate) fn fit_terms(points: &[Vec<f64>]) -> Option<(Vec<f64>, f64)> {
             return None;
         }
         m.swap(c, pivot);
-        for r in 0..k {
+        let pivot_row = m[c].clone();
+        for (r, row) in m.iter_mut().enumerate() {
             if r != c {
-                let f = m[r][c] / m[c][c];
-                for j in c..=k {
-                    m[r][j] -= f * m[c][j];
+                let f = row[c] / pivot_row[c];
+                for (x, p) in row.iter_mut().zip(&pivot_row).skip(c) {
+                    *x -= f * p;
                 }
             }
         }
