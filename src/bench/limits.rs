@@ -1,8 +1,8 @@
 //! `bench --limits`: the adapter's own rates, measured in the same run as the benchmark so that
 //! a method's speed can be read as a share of what the adapter can do at all: blended fill
-//! (`bench_blend.wgsl`: full-screen layers into Rgba32Float, premultiplied over, one trilinear
+//! (`bench_fill.wgsl`: full-screen layers into Rgba32Float, premultiplied over, one trilinear
 //! fetch of an rgba8 3D texture per fragment, as ViewSlices draws), the cost of small triangles
-//! beyond their fragments (`bench_triangles.wgsl`), trilinear texture samples in a
+//! beyond their fragments (the same kernel with each layer cut into small squares), trilinear texture samples in a
 //! compute kernel (`bench_texture.wgsl`) and 3D simplex noise (`bench_simplex.wgsl`). Each is the
 //! median wall time of 5 runs after one that compiles, over the work it did.
 
@@ -17,6 +17,8 @@ use crate::gpu::GpuContext;
 /// Target size and layers of the blend test; threads and samples of the texture test.
 const BLEND_SIZE: u32 = 512;
 const BLEND_LAYERS: u32 = 64;
+/// Both fill tests draw this kernel: full-screen layers, or layers cut into small squares.
+const FILL_KERNEL: &str = "bench/bench_fill.wgsl";
 /// Pixels on a side of the triangle test's squares, and its layers.
 const TRIANGLE_CELL: u32 = 8;
 const TRIANGLE_LAYERS: u32 = 16;
@@ -170,20 +172,19 @@ fn fill_seconds(
 
 /// Blended fragments per second (see the module's comment).
 pub(crate) fn blend_rate(ctx: &GpuContext) -> Result<f64> {
-    let constants = [("layers", BLEND_LAYERS as f64)];
-    let seconds = fill_seconds(ctx, "bench/bench_blend.wgsl", &constants, 3, BLEND_LAYERS)?;
+    let constants = [("layers", BLEND_LAYERS as f64), ("cells", 1.0)];
+    let seconds = fill_seconds(ctx, FILL_KERNEL, &constants, 6, BLEND_LAYERS)?;
     Ok((BLEND_SIZE * BLEND_SIZE * BLEND_LAYERS) as f64 / seconds)
 }
 
 /// Triangles per second beyond their fragments' blending: layers of small triangles (two per
 /// TRIANGLE_CELL-pixel square, as large as ViewSlices' slice triangles at a few hundred pixels
-/// square) drawn as `bench_blend` draws, less the time `blend_rate` gives their fragments. `None`
+/// square) drawn as the blend test draws, less the time `blend_rate` gives their fragments. `None`
 /// where the triangles cost under 5% of that draw (an adapter whose setup is nearly free).
 pub(crate) fn triangle_rate(ctx: &GpuContext, blend_rate: f64) -> Result<Option<f64>> {
     let cells = BLEND_SIZE / TRIANGLE_CELL;
     let constants = [("layers", TRIANGLE_LAYERS as f64), ("cells", cells as f64)];
-    let seconds =
-        fill_seconds(ctx, "bench/bench_triangles.wgsl", &constants, 6 * cells * cells, TRIANGLE_LAYERS)?;
+    let seconds = fill_seconds(ctx, FILL_KERNEL, &constants, 6 * cells * cells, TRIANGLE_LAYERS)?;
     let triangles = (2 * cells * cells * TRIANGLE_LAYERS) as f64;
     let setup = seconds - (BLEND_SIZE * BLEND_SIZE * TRIANGLE_LAYERS) as f64 / blend_rate;
     Ok((setup > 0.05 * seconds).then(|| triangles / setup))

@@ -105,14 +105,10 @@ const NO_TWIN: &[(&str, &str)] = &[
         "debug view: counts the slice polygons covering each pixel (additive white), no math",
     ),
     (
-        "bench_blend",
-        "benchmark only (`voltex bench --limits` times it): full-screen layers blended with one \
-         3D texture fetch each, a fill rate; its output is never read",
-    ),
-    (
-        "bench_triangles",
-        "benchmark only (`voltex bench --limits` times it): layers of small triangles blended with \
-         one 3D texture fetch each, a per-triangle cost; its output is never read",
+        "bench_fill",
+        "benchmark only (`voltex bench --limits` times it): layers of squares blended with one 3D \
+         texture fetch each, full-screen for a fill rate, small for a per-triangle cost; its output \
+         is never read",
     ),
     (
         "bench_texture",

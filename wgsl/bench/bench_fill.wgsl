@@ -1,4 +1,4 @@
-// Draws layers of small triangles (two per `cell`-pixel square) blended with one trilinear 3D texture fetch each, as bench_blend does: with it, the adapter's cost per triangle, for `voltex bench --limits`.
+// Draws layers of `cells` x `cells` squares (two triangles each) blended premultiplied-over, each fragment with one trilinear 3D texture fetch, for `voltex bench --limits`: one square a layer gives the adapter's blended fill rate, small squares its cost per triangle.
 
 @group(0) @binding(0) var bench_volume: texture_3d<f32>;
 @group(0) @binding(1) var bench_sampler: sampler;
