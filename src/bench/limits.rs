@@ -2,9 +2,10 @@
 //! a method's speed can be read as a share of what the adapter can do at all: blended fill
 //! (`bench_fill.wgsl`: full-screen layers into Rgba32Float, premultiplied over, one trilinear
 //! fetch of an rgba8 3D texture per fragment, as ViewSlices draws), the cost of small triangles
-//! beyond their fragments (the same kernel with each layer cut into small squares), trilinear texture samples in a
-//! compute kernel (`bench_texture.wgsl`) and 3D simplex noise (`bench_simplex.wgsl`). Each is the
-//! median wall time of 5 runs after one that compiles, over the work it did.
+//! beyond their fragments (the same kernel with each layer cut into small squares), trilinear
+//! texture samples in a compute kernel (`bench_texture.wgsl`) and 3D simplex noise
+//! (`bench_simplex.wgsl`). Each is the median wall time of 5 runs after one that compiles, over
+//! the work it did.
 
 use std::borrow::Cow;
 use std::time::Instant;
@@ -17,8 +18,6 @@ use crate::gpu::GpuContext;
 /// Target size and layers of the blend test; threads and samples of the texture test.
 const BLEND_SIZE: u32 = 512;
 const BLEND_LAYERS: u32 = 64;
-/// Both fill tests draw this kernel: full-screen layers, or layers cut into small squares.
-const FILL_KERNEL: &str = "bench/bench_fill.wgsl";
 /// Pixels on a side of the triangle test's squares, and its layers.
 const TRIANGLE_CELL: u32 = 8;
 const TRIANGLE_LAYERS: u32 = 16;
@@ -91,19 +90,15 @@ fn module(ctx: &GpuContext, name: &str) -> Result<wgpu::ShaderModule> {
     })
 }
 
-/// Seconds to draw `kernel` (a vertex and fragment pair reading the volume) into a BLEND_SIZE
-/// square Rgba32Float target, blended premultiplied-over: `vertices` per instance.
-fn fill_seconds(
-    ctx: &GpuContext,
-    kernel: &str,
-    constants: &[(&str, f64)],
-    vertices: u32,
-    instances: u32,
-) -> Result<f64> {
+/// Seconds to draw `instances` layers of `cells` x `cells` squares (`bench_fill.wgsl`) into a
+/// BLEND_SIZE square Rgba32Float target, blended premultiplied-over.
+fn fill_seconds(ctx: &GpuContext, cells: u32, instances: u32) -> Result<f64> {
+    let kernel = "bench/bench_fill.wgsl";
+    let constants = [("layers", instances as f64), ("cells", cells as f64)];
     let (view, sampler) = volume(ctx);
     let module = module(ctx, kernel)?;
     let format = wgpu::TextureFormat::Rgba32Float;
-    let options = || wgpu::PipelineCompilationOptions { constants, ..Default::default() };
+    let options = || wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() };
     let pipeline = ctx.scoped(kernel, || {
         ctx.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some(kernel),
@@ -166,25 +161,24 @@ fn fill_seconds(
         });
         pass.set_pipeline(&pipeline);
         pass.set_bind_group(0, &group, &[]);
-        pass.draw(0..vertices, 0..instances);
+        pass.draw(0..6 * cells * cells, 0..instances);
     })
 }
 
 /// Blended fragments per second (see the module's comment).
 pub(crate) fn blend_rate(ctx: &GpuContext) -> Result<f64> {
-    let constants = [("layers", BLEND_LAYERS as f64), ("cells", 1.0)];
-    let seconds = fill_seconds(ctx, FILL_KERNEL, &constants, 6, BLEND_LAYERS)?;
+    let seconds = fill_seconds(ctx, 1, BLEND_LAYERS)?;
     Ok((BLEND_SIZE * BLEND_SIZE * BLEND_LAYERS) as f64 / seconds)
 }
 
 /// Triangles per second beyond their fragments' blending: layers of small triangles (two per
-/// TRIANGLE_CELL-pixel square, as large as ViewSlices' slice triangles at a few hundred pixels
-/// square) drawn as the blend test draws, less the time `blend_rate` gives their fragments. `None`
-/// where the triangles cost under 5% of that draw (an adapter whose setup is nearly free).
+/// TRIANGLE_CELL-pixel square, 32 pixels each; ViewSlices' slice triangles on torus_egg average
+/// 22 to 360 pixels from 128x128 to 512x512) drawn as the blend test draws, less the time
+/// `blend_rate` gives their fragments. `None` where the triangles cost under 5% of that draw (an
+/// adapter whose setup is nearly free).
 pub(crate) fn triangle_rate(ctx: &GpuContext, blend_rate: f64) -> Result<Option<f64>> {
     let cells = BLEND_SIZE / TRIANGLE_CELL;
-    let constants = [("layers", TRIANGLE_LAYERS as f64), ("cells", cells as f64)];
-    let seconds = fill_seconds(ctx, FILL_KERNEL, &constants, 6 * cells * cells, TRIANGLE_LAYERS)?;
+    let seconds = fill_seconds(ctx, cells, TRIANGLE_LAYERS)?;
     let triangles = (2 * cells * cells * TRIANGLE_LAYERS) as f64;
     let setup = seconds - (BLEND_SIZE * BLEND_SIZE * TRIANGLE_LAYERS) as f64 / blend_rate;
     Ok((setup > 0.05 * seconds).then(|| triangles / setup))
