@@ -153,9 +153,9 @@ pub(crate) fn fit_terms(points: &[Vec<f64>]) -> Option<(Vec<f64>, f64)> {
     Some((std::iter::once(intercept).chain(slopes).collect(), r2))
 }
 
-/// One fit per (table, method, segments, compositor, trivial reject, work unit) over the rows that have work,
-/// with at least three rows; with a second term where every row has its measure and the rows
-/// tell the two apart.
+/// One fit per (table, method, segments, compositor, trivial reject, work unit) over the rows
+/// that have work, with at least three rows; with a second term where every row has its measure
+/// and the rows tell the two apart.
 pub fn fit(rows: &[Row]) -> Vec<Fit> {
     let key = |r: &Row| {
         (
