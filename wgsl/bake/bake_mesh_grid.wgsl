@@ -1,6 +1,7 @@
 // Bakes a mesh into a grid (hypertexture mesh objects, mesh texels): per sample the vector to the closest surface point and the signed distance (positive inside, by ray parity voted over three directions; no parity for shells) of the union of its closed parts, the largest inside distance, and for coloured meshes the colour at the closest point; CPU twin src/cpu/bake_mesh_grid.rs.
 #include "shared/types.wgsl"
 #include "shared/bvh.wgsl"
+#include "shared/grid_sample.wgsl"
 
 @group(0) @binding(0) var<uniform> grid_params: MeshGridParams;
 // `BvhNode`s (shared/bvh.wgsl): one BVH per closed part, concatenated (children and triangles
@@ -210,8 +211,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     if (any(id >= n)) {
         return;
     }
-    let lo = grid_params.lo.xyz;
-    let p = lo + (grid_params.hi.xyz - lo) * (vec3<f32>(id) / vec3<f32>(n - vec3<u32>(1u)));
+    let p = grid_sample_point(grid_params, id);
     let parity = grid_params.size.w != 0u;
     // The union of the parts: the largest signed distance of any part.
     var best = vec4<f32>(0.0, 0.0, 0.0, -3.4e38);

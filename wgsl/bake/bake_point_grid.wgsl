@@ -1,6 +1,7 @@
 // Bakes a point set (hypertexture Points objects) into a grid: per outside sample the vector to the closest point of the union of its kernels' balls and the signed distance to it (inside samples are left to flood_point_grid.wgsl), then per sample the sum of the kernels (1 - r^2/R^2)^3 over the saturation; CPU twin src/cpu/bake_point_grid.rs.
 #include "shared/types.wgsl"
 #include "shared/bvh.wgsl"
+#include "shared/grid_sample.wgsl"
 
 // lo, hi: the grid's corners (hi.w: 1 / saturation); counts: samples per axis, points, BVH
 // nodes; size: samples per axis.
@@ -28,8 +29,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     if (any(id >= n)) {
         return;
     }
-    let lo = grid_params.lo.xyz;
-    let p = lo + (grid_params.hi.xyz - lo) * (vec3<f32>(id) / vec3<f32>(n - vec3<u32>(1u)));
+    let p = grid_sample_point(grid_params, id);
     // The smallest |p - c| - R (negative inside a ball), its kernel's centre; the kernel sum. A
     // box farther than the best (or than 0 once inside) holds neither a closer ball nor a
     // kernel that reaches p.
