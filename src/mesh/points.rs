@@ -418,12 +418,15 @@ mod tests {
     use super::*;
 
     fn load_text(name: &str, text: &[u8]) -> Result<PointSet> {
-        let dir = std::env::temp_dir().join(format!("voltex-points-{}", std::process::id()));
+        // A file of its own per call: the tests run in parallel and reuse names.
+        static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+        let call = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        let dir = std::env::temp_dir().join(format!("voltex-points-{}-{call}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         let path = dir.join(name);
         std::fs::write(&path, text).unwrap();
         let r = load(&path);
-        std::fs::remove_file(&path).unwrap();
+        std::fs::remove_dir_all(&dir).unwrap();
         r
     }
 
