@@ -190,6 +190,7 @@ pub fn plan(
         };
         let bindings = reflect::bindings(&kernel, &decl.entry_points())
             .map_err(|e| graph.error_at(decl.name(), format!("pass `{}`: {e}", decl.name())))?;
+        check_fragment_outputs(graph, decl, &kernel)?;
         let (reads, writes) = accesses(decl, &bindings);
         candidates.push(PlannedPass { decl: decl.clone(), kernel, bindings, reads, writes, instances });
     }
@@ -254,6 +255,57 @@ pub fn plan(
         }
     }
     Ok(Plan { passes, textures, buffers, parameters, pruned, vocabulary: vocabulary.clone() })
+}
+
+/// A colour target's channels must all come from the fragment output at its location (wgpu
+/// refuses the pipeline otherwise, after the bakes): an Rgba target needs a `vec4<f32>`, an
+/// R32Float one any float output. A target the fragment does not write is left as the draw finds it.
+fn check_fragment_outputs(graph: &Graph, decl: &PassDecl, kernel: &Kernel) -> Result<()> {
+    let PassDecl::Raster { targets, fragment, .. } = decl else { return Ok(()) };
+    let module = &kernel.module;
+    let Some(ep) =
+        module.entry_points.iter().find(|e| e.stage == naga::ShaderStage::Fragment && e.name == *fragment)
+    else {
+        return Ok(());
+    };
+    let Some(result) = &ep.function.result else { return Ok(()) };
+    let mut outputs: Vec<(u32, naga::Handle<naga::Type>)> = Vec::new();
+    match (&result.binding, &module.types[result.ty].inner) {
+        (Some(naga::Binding::Location { location, .. }), _) => outputs.push((*location, result.ty)),
+        (None, naga::TypeInner::Struct { members, .. }) => {
+            for m in members {
+                if let Some(naga::Binding::Location { location, .. }) = m.binding {
+                    outputs.push((location, m.ty));
+                }
+            }
+        }
+        _ => {}
+    }
+    for (i, target) in targets.iter().enumerate() {
+        let Some(ResourceDecl::Texture { format, .. }) = graph.file.resources.get(&target.resource) else {
+            continue;
+        };
+        let Some(&(_, ty)) = outputs.iter().find(|(l, _)| *l as usize == i) else { continue };
+        let (channels, scalar) = match &module.types[ty].inner {
+            naga::TypeInner::Scalar(s) => (1, Some(*s)),
+            naga::TypeInner::Vector { size, scalar } => (*size as usize, Some(*scalar)),
+            _ => (0, None),
+        };
+        let needs = if *format == Format::R32Float { 1 } else { 4 };
+        if scalar.is_some_and(|s| s.kind == naga::ScalarKind::Float) && channels >= needs {
+            continue;
+        }
+        let msg = format!(
+            "pass `{}`: target `{}` is {format:?} ({needs} channel{}), but `{fragment}` writes @location({i}) as {}: \
+             the output must have at least the target's channels, as floats",
+            decl.name(),
+            target.resource,
+            if needs == 1 { "" } else { "s" },
+            wgsl_type(module, ty)
+        );
+        return Err(graph.error_in_pass(decl.name(), "targets", &target.resource, msg));
+    }
+    Ok(())
 }
 
 /// The byte size of every graph buffer for an output of `size`: an error at the expression for an

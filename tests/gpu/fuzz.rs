@@ -626,6 +626,41 @@ mod fuzz_regressions {
         assert!(Blueprint::new(&scene, &opts).is_ok());
     }
 
+    /// render_tiny, seed 28 (7 of 100,000 inputs): `base_depth`, which `draw_base` writes from an
+    /// `f32` fragment output, made an Rgba format: plan accepted, and making the pipeline failed
+    /// in wgpu ("Output format Rgba16Float is incompatible with the shader Float32") after the
+    /// bakes. Now a plan error at the pass's target. An Rgba output into R32Float is fine.
+    #[test]
+    fn a_target_with_more_channels_than_its_fragment_output_is_a_plan_error() {
+        let dir = std::env::temp_dir().join(format!("voltex-fuzz-channels-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let graph = dir.join("frame.ron");
+        let text = std::fs::read_to_string(root().join("graphs/frame.ron")).unwrap();
+        let scene = voltex::scene::load(&root().join("scenes/view_slices/sphere_balls.ron")).unwrap();
+        let opts = RenderOptions { size: Some((8, 8)), graph: Some(graph.clone()), ..Default::default() };
+        let from = "\"base_depth\": Texture(format: R32Float";
+        assert!(text.contains(from));
+        for format in ["Rgba16Float", "Rgba8Unorm"] {
+            std::fs::write(
+                &graph,
+                text.replacen(from, &format!("\"base_depth\": Texture(format: {format}"), 1),
+            )
+            .unwrap();
+            let e = Blueprint::new(&scene, &opts).err().expect("an error").to_string();
+            let at = text.find("targets: [(resource: \"hdr\"), (resource: \"base_depth\")]").unwrap();
+            let line = text[..at].matches('\n').count() + 1;
+            assert!(e.starts_with(&format!("{}:{line}:", graph.display())), "{e}");
+            assert!(e.contains(&format!("target `base_depth` is {format} (4 channels)")), "{e}");
+            assert!(e.contains("writes @location(1) as f32"), "{e}");
+        }
+        let from = "\"hdr\": Texture(format: Rgba32Float";
+        std::fs::write(&graph, text.replacen(from, "\"hdr\": Texture(format: R32Float", 1)).unwrap();
+        match Blueprint::new(&scene, &opts) {
+            Ok(_) => {}
+            Err(e) => assert!(!e.to_string().contains("channel"), "{e}"),
+        }
+    }
+
     fn surface(positions: Vec<DVec3>, triangles: Vec<[u32; 3]>) -> BaseSurface {
         BaseSurface {
             heights: vec![DVec3::ZERO; positions.len()],
