@@ -17,6 +17,12 @@ pub struct AxisBaked {
     pub occupancy: wgpu::Buffer,
 }
 
+impl crate::gpu::cache::GpuBytes for AxisBaked {
+    fn gpu_bytes(&self) -> u64 {
+        self.arrays.iter().map(|a| a.gpu_bytes()).sum::<u64>() + self.occupancy.gpu_bytes()
+    }
+}
+
 /// Image size of a direction's slices: s slices are (t, w) images, t slices (s, w), w slices (s, t).
 pub(crate) fn image_size(res: [u32; 3], direction: usize) -> [u32; 2] {
     match direction {

@@ -179,6 +179,12 @@ pub struct Baked {
     pub axis: Option<axis_slices::AxisBaked>,
 }
 
+impl crate::gpu::cache::GpuBytes for Baked {
+    fn gpu_bytes(&self) -> u64 {
+        self.volume.gpu_bytes() + self.normals.gpu_bytes() + self.axis.gpu_bytes()
+    }
+}
+
 impl BakeRequest {
     /// GPU memory of the bake of `texel`, by item (`voltex plan`).
     pub(crate) fn memory(&self, texel: &str) -> Vec<(String, u64)> {

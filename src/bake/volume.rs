@@ -25,6 +25,12 @@ pub(crate) struct Uploaded {
     pub(crate) color: wgpu::TextureView,
 }
 
+impl crate::gpu::cache::GpuBytes for Uploaded {
+    fn gpu_bytes(&self) -> u64 {
+        self.table.gpu_bytes() + self.density.texture().gpu_bytes() + self.color.texture().gpu_bytes()
+    }
+}
+
 impl Uploaded {
     /// Binds the table and atlases by their kernel names.
     pub(crate) fn bind(&self, inputs: &mut Inputs) {

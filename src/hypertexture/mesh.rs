@@ -29,6 +29,12 @@ pub struct MeshGrid {
     pub colors: Option<wgpu::Buffer>,
 }
 
+impl crate::gpu::cache::GpuBytes for MeshGrid {
+    fn gpu_bytes(&self) -> u64 {
+        self.grid.gpu_bytes() + self.depth.gpu_bytes() + self.colors.gpu_bytes()
+    }
+}
+
 /// Runs `bake_mesh_grid.wgsl` for `shape` over `spec`: one thread per sample, closest points
 /// and ray crossings found through a BVH per part (`mesh::bvh::flat_bvh`).
 pub fn bake(ctx: &GpuContext, shape: &MeshShape, spec: &GridSpec) -> Result<MeshGrid> {

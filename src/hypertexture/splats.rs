@@ -27,6 +27,12 @@ pub struct SplatSet {
     pub(crate) counts: [u32; 2],
 }
 
+impl crate::gpu::cache::GpuBytes for SplatSet {
+    fn gpu_bytes(&self) -> u64 {
+        self.surface.gpu_bytes() + self.interior.gpu_bytes()
+    }
+}
+
 /// Bytes of a splat set with `cells` lattice cells.
 pub(crate) fn bytes(cells: u32) -> u64 {
     2 * cells as u64 * std::mem::size_of::<Splat>() as u64 + 16

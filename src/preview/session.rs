@@ -35,6 +35,10 @@ pub(crate) struct Stages {
     pub(crate) build: f64,
 }
 
+/// Bakes an edit left unused that the preview keeps (beyond the frame's own memory), so that
+/// undoing the edit finds them instead of baking again.
+const STALE_BAKE_BYTES: u64 = 256 << 20;
+
 /// The preview's state without a window: the scene, its renderer and what the last rebuild
 /// found; rebuilt when a file it reads changes, keeping the last good state on an error.
 pub struct Session {
@@ -80,7 +84,7 @@ impl Session {
         let mut s = Session {
             scene_path: scene_path.to_path_buf(),
             options,
-            cache: GpuCache::default(),
+            cache: GpuCache::with_stale_bytes(STALE_BAKE_BYTES),
             scene: None,
             renderer: None,
             error: None,
@@ -147,7 +151,7 @@ impl Session {
     /// yet, rebuilds from the file. The current error, if any, stays.
     pub fn recover(&mut self, ctx: &GpuContext) -> Outcome {
         self.renderer = None;
-        self.cache = GpuCache::default();
+        self.cache = GpuCache::with_stale_bytes(STALE_BAKE_BYTES);
         let Some(scene) = self.scene.as_ref() else { return self.rebuild(ctx) };
         self.cache.begin();
         let built = self.blueprint(scene).and_then(|bp| Renderer::with_cache(ctx, bp, &mut self.cache));
