@@ -177,8 +177,8 @@ impl Kernel {
 /// any size, and drivers fail late (or crash) on huge per-invocation arrays.
 pub(crate) const MAX_PRIVATE_BYTES: u64 = 64 << 10;
 
-/// Checks naga accepts but a device may not: workgroup sizes and workgroup memory against
-/// WebGPU's default limits (what every adapter offers), and per-invocation arrays against
+/// Checks naga accepts but a device may not: workgroup sizes, workgroup memory and binding
+/// indices against WebGPU's default limits (what every adapter offers), and per-invocation arrays against
 /// [`MAX_PRIVATE_BYTES`], each at its WGSL position.
 fn check_limits(module: &naga::Module, ex: &Expanded) -> Result<()> {
     let limits = wgpu::Limits::default();
@@ -213,8 +213,22 @@ fn check_limits(module: &naga::Module, ex: &Expanded) -> Result<()> {
     }
     let mut workgroup = 0u64;
     for (h, g) in module.global_variables.iter() {
-        let Some(bytes) = size(g.ty) else { continue };
         let name = g.name.as_deref().unwrap_or("?");
+        if let Some(b) = &g.binding {
+            if b.group >= limits.max_bind_groups || b.binding >= limits.max_bindings_per_bind_group {
+                return Err(Error::at(
+                    at(module.global_variables.get_span(h)),
+                    format!(
+                        "`{name}` is at @group({}) @binding({}): groups go up to {} and bindings up to {}",
+                        b.group,
+                        b.binding,
+                        limits.max_bind_groups - 1,
+                        limits.max_bindings_per_bind_group - 1
+                    ),
+                ));
+            }
+        }
+        let Some(bytes) = size(g.ty) else { continue };
         match g.space {
             naga::AddressSpace::WorkGroup => {
                 workgroup += bytes;

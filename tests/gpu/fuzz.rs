@@ -600,6 +600,40 @@ mod fuzz_regressions {
         assert!(e.starts_with(&format!("{}:4:15: WGSL parse error", dir.join("k.wgsl").display())), "{e}");
     }
 
+    /// preview_reload, seed 30 (563 inputs in): a binding's `@group(0)` made `@group(4294967295)`
+    /// in `draw_slices.wgsl`. naga accepts any index; wgpu refused the module ("uses a group
+    /// index 4294967295 that exceeds the max_bind_groups limit of 8") with no line. Now an error
+    /// at the global in the kernel, for group and binding indices beyond WebGPU's limits.
+    #[test]
+    fn a_binding_index_beyond_the_limits_is_an_error_at_the_global() {
+        let dir = std::env::temp_dir().join(format!("voltex-fuzz-group-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let sources = voltex::gpu::sources::Sources::folder(&dir);
+        let kernel = |attrs: &str| {
+            format!(
+                "// k\n{attrs} var<storage, read_write> out: array<u32>;\n\
+                 @compute @workgroup_size(1) fn main() {{ out[0] = 1u; }}\n"
+            )
+        };
+        for (attrs, ok) in [
+            ("@group(3) @binding(999)", true),
+            ("@group(4294967295) @binding(0)", false),
+            ("@group(4) @binding(0)", false),
+            ("@group(0) @binding(1000)", false),
+        ] {
+            std::fs::write(dir.join("k.wgsl"), kernel(attrs)).unwrap();
+            match voltex::gpu::shader::load_from(&sources, "k.wgsl") {
+                Ok(_) => assert!(ok, "{attrs} was accepted"),
+                Err(e) => {
+                    let e = e.to_string();
+                    assert!(!ok, "{attrs}: {e}");
+                    assert!(e.starts_with(&format!("{}:2:", dir.join("k.wgsl").display())), "{e}");
+                    assert!(e.contains("`out` is at @group("), "{e}");
+                }
+            }
+        }
+    }
+
     /// render_tiny, seed 19: the graph texture `hdr` made `Fixed(1, 1)` beside the output-sized
     /// `depth`: plan accepted, and recording the frame failed in wgpu ("Attachments have
     /// differing sizes") with no position. Now a plan error at the pass's target.
