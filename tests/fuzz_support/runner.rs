@@ -4,9 +4,11 @@
 //! Time: an input over [`case_secs`] (10 s by default, `VOLTEX_FUZZ_CASE_SECS`) of its thread's
 //! CPU time fails the target when it returns; the GPU targets, whose work runs in the driver's
 //! threads, have three times the bound in the process's CPU time (all threads: software Vulkan's
-//! work, which a loaded machine or `nice` does not inflate as it does wall time). One still
-//! running after three times its bound in wall time is a hang: a watchdog thread prints the input
-//! and aborts the test binary (a blocked read cannot be interrupted).
+//! work, which a loaded machine or `nice` does not inflate as it does wall time). A watchdog
+//! thread prints the input and aborts the test binary (a blocked read cannot be interrupted) when
+//! a case is a hang: its clock made no progress (0.1 s of CPU) for three times its bound of wall
+//! time, or it has run three times its bound of CPU time. A case merely starved by a loaded
+//! machine (a campaign under `nice -n 19` beside a build) still progresses, and is waited for.
 //! Memory: the Rust heap a case has live at once (the counting allocator, per thread), and for
 //! the GPU targets the growth of the process's resident memory, sampled by the watchdog (the
 //! driver allocates outside Rust).
@@ -66,6 +68,14 @@ fn cpu_secs(clock: libc::clockid_t) -> f64 {
     t.tv_sec as f64 + t.tv_nsec as f64 * 1e-9
 }
 
+/// The CPU clock of the calling thread, which another thread can read.
+fn thread_clock() -> libc::clockid_t {
+    let mut id: libc::clockid_t = libc::CLOCK_THREAD_CPUTIME_ID;
+    // SAFETY: the calling thread's handle, and a clock id to fill.
+    unsafe { libc::pthread_getcpuclockid(libc::pthread_self(), &mut id) };
+    id
+}
+
 /// The process's resident memory in bytes (Linux; 0 elsewhere).
 pub fn rss() -> u64 {
     let statm = std::fs::read_to_string("/proc/self/statm").unwrap_or_default();
@@ -73,11 +83,25 @@ pub fn rss() -> u64 {
     pages * 4096
 }
 
+/// The running case, as the watchdog sees it.
+struct Case {
+    /// Its input (`Debug`, shortened).
+    input: String,
+    /// The CPU clock its time is measured on, and its reading at the start.
+    clock: libc::clockid_t,
+    cpu_start: f64,
+    /// When its clock last advanced by [`PROGRESS_SECS`], and the reading then.
+    progress: (Instant, f64),
+}
+
+/// CPU time a case must gain within its hang window to count as running (the watchdog's own
+/// sampling stays far below it; a case starved under `nice -n 19` still gets more).
+const PROGRESS_SECS: f64 = 0.1;
+
 /// What the watchdog knows of the running case.
 #[derive(Default)]
 struct Watch {
-    /// Start of the running case and its input (`Debug`, shortened).
-    case: Option<(Instant, String)>,
+    case: Option<Case>,
     rss_start: u64,
     rss_peak: u64,
     stop: bool,
@@ -92,13 +116,29 @@ impl Drop for CaseGuard<'_> {
     }
 }
 
+/// Whether a case whose clock reads `cpu` seconds at `now` is a hang, within a bound of `limit`
+/// seconds: its clock gained under [`PROGRESS_SECS`] in `3 limit` seconds of wall time since
+/// `progress` (updated here when it gained more), or it has run `3 limit` seconds of CPU time.
+pub fn hang_verdict(progress: &mut (Instant, f64), cpu: f64, now: Instant, limit: f64) -> Option<String> {
+    if cpu - progress.1 >= PROGRESS_SECS {
+        *progress = (now, cpu);
+    }
+    let window = 3.0 * limit;
+    if now.duration_since(progress.0).as_secs_f64() > window {
+        Some(format!("its CPU time stopped at {cpu:.1} s for {window:.0} s"))
+    } else if cpu > window {
+        Some(format!("it still runs after {cpu:.0} s of CPU time"))
+    } else {
+        None
+    }
+}
+
 fn watchdog(
     name: String,
     watch: Arc<Mutex<Watch>>,
     sample_rss: bool,
     limit: f64,
 ) -> std::thread::JoinHandle<()> {
-    let hang = Duration::from_secs_f64(3.0 * limit);
     std::thread::spawn(move || loop {
         std::thread::sleep(Duration::from_millis(if sample_rss { 20 } else { 200 }));
         let mut w = watch.lock().unwrap();
@@ -108,12 +148,10 @@ fn watchdog(
         if sample_rss && w.case.is_some() {
             w.rss_peak = w.rss_peak.max(rss());
         }
-        if let Some((start, input)) = &w.case {
-            if start.elapsed() > hang {
-                eprintln!(
-                    "fuzz {name}: an input still runs after {:.0} s (a hang; the bound is {limit} s), aborting: {input}",
-                    start.elapsed().as_secs_f64(),
-                );
+        if let Some(case) = &mut w.case {
+            let cpu = cpu_secs(case.clock) - case.cpu_start;
+            if let Some(why) = hang_verdict(&mut case.progress, cpu, Instant::now(), limit) {
+                eprintln!("fuzz {name}: a hang ({why}; the bound is {limit} s), aborting: {}", case.input);
                 std::process::abort();
             }
         }
@@ -228,19 +266,25 @@ pub fn run_campaign<S: Strategy>(
             );
         }
         let input = shorten(format!("{value:?}"), 2000);
-        {
-            let mut w = watch.lock().unwrap();
-            w.rss_start = if bounds.rss.is_some() { rss() } else { 0 };
-            w.rss_peak = w.rss_start;
-            w.case = Some((Instant::now(), input.clone()));
-        }
-        let guard = CaseGuard(&watch);
         let clock = match bounds.rss {
             // GPU targets: the driver works in threads of its own.
             Some(_) => libc::CLOCK_PROCESS_CPUTIME_ID,
             None => libc::CLOCK_THREAD_CPUTIME_ID,
         };
         let cpu_start = cpu_secs(clock);
+        {
+            let mut w = watch.lock().unwrap();
+            w.rss_start = if bounds.rss.is_some() { rss() } else { 0 };
+            w.rss_peak = w.rss_start;
+            // The watchdog reads this thread's clock by its id (its own "thread" clock is its own).
+            let watched = match bounds.rss {
+                Some(_) => clock,
+                None => thread_clock(),
+            };
+            let progress = (Instant::now(), 0.0);
+            w.case = Some(Case { input: input.clone(), clock: watched, cpu_start: cpu_secs(watched), progress });
+        }
+        let guard = CaseGuard(&watch);
         let heap_start = Tracked::begin_case();
         let outcome = test(value);
         let heap = Tracked::peak_since(heap_start);

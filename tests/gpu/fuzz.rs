@@ -450,6 +450,33 @@ fn slice_classification() {
     });
 }
 
+/// The watchdog's verdict: a case whose clock stopped (a blocked read) is a hang after three
+/// times its bound of wall time; one starved by a loaded machine, its clock creeping on, is not
+/// (counts, seed 19: a 2 s input aborted after 30 s of wall time beside a build); one that
+/// runs on past three times its bound of CPU time is.
+#[test]
+fn the_watchdog_tells_a_hang_from_a_starved_case() {
+    use fuzz_support::runner::hang_verdict;
+    use std::time::{Duration, Instant};
+    let t0 = Instant::now();
+    let at = |s: f64| t0 + Duration::from_secs_f64(s);
+    // Blocked: no CPU at all.
+    let mut progress = (t0, 0.0);
+    assert_eq!(hang_verdict(&mut progress, 0.0, at(29.0), 10.0), None);
+    let v = hang_verdict(&mut progress, 0.01, at(31.0), 10.0).expect("a hang");
+    assert!(v.contains("stopped"), "{v}");
+    // Starved: 0.4 s of CPU every 30 s (nice 19 beside two busy cores) for ten minutes.
+    let mut progress = (t0, 0.0);
+    for k in 1..=20 {
+        assert_eq!(hang_verdict(&mut progress, 0.4 * k as f64, at(30.0 * k as f64 - 1.0), 10.0), None);
+    }
+    // Busy past three times the bound.
+    let mut progress = (t0, 0.0);
+    assert_eq!(hang_verdict(&mut progress, 29.0, at(29.5), 10.0), None);
+    let v = hang_verdict(&mut progress, 31.0, at(31.5), 10.0).expect("over the bound");
+    assert!(v.contains("still runs"), "{v}");
+}
+
 /// A campaign resumed at input K (`VOLTEX_FUZZ_FROM`) runs exactly the inputs K.. of the whole
 /// campaign, and none before them.
 #[test]
