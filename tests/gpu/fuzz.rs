@@ -502,6 +502,18 @@ fn a_resumed_campaign_runs_the_same_inputs() {
 mod fuzz_regressions {
     use super::*;
 
+    /// A scratch copy of the default graph (its path and text; the test writes it), the scene
+    /// at `scene`, and options that plan the scene at 8x8 with the copy.
+    fn graph_copy(tag: &str, scene: &str) -> (PathBuf, String, voltex::scene::Scene, RenderOptions) {
+        let dir = std::env::temp_dir().join(format!("voltex-fuzz-{tag}-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let graph = dir.join("frame.ron");
+        let text = std::fs::read_to_string(root().join("graphs/frame.ron")).unwrap();
+        let scene = voltex::scene::load(&root().join(scene)).unwrap();
+        let opts = RenderOptions { size: Some((8, 8)), graph: Some(graph.clone()), ..Default::default() };
+        (graph, text, scene, opts)
+    }
+
     /// render_tiny, seed 19: a raster pass's target listed twice (`targets: [(resource: "hdr"),
     /// (resource: "hdr")]`): plan accepted, recording the frame failed in wgpu ("already attached
     /// to this render pass"). Now an error at the target in the graph file.
@@ -525,12 +537,7 @@ mod fuzz_regressions {
     /// resource, and graph textures are made inside an error scope.
     #[test]
     fn a_texture_format_its_kernel_cannot_bind_is_a_plan_error() {
-        let dir = std::env::temp_dir().join(format!("voltex-fuzz-format-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let graph = dir.join("frame.ron");
-        let text = std::fs::read_to_string(root().join("graphs/frame.ron")).unwrap();
-        let scene = voltex::scene::load(&root().join("scenes/reference/torus_egg.ron")).unwrap();
-        let opts = RenderOptions { size: Some((8, 8)), graph: Some(graph.clone()), ..Default::default() };
+        let (graph, text, scene, opts) = graph_copy("format", "scenes/reference/torus_egg.ron");
         let from = "\"reference_rgba\": Texture(format: Rgba32Float";
         for (format, words) in [
             ("Depth32Float", "binds it as a storage texture, which needs Rgba32Float"),
@@ -554,12 +561,7 @@ mod fuzz_regressions {
     /// position). Now both are plan errors at the output.
     #[test]
     fn an_output_that_cannot_be_read_back_is_a_plan_error() {
-        let dir = std::env::temp_dir().join(format!("voltex-fuzz-output-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let graph = dir.join("frame.ron");
-        let text = std::fs::read_to_string(root().join("graphs/frame.ron")).unwrap();
-        let scene = voltex::scene::load(&root().join("scenes/view_slices/flat_box.ron")).unwrap();
-        let opts = RenderOptions { size: Some((8, 8)), graph: Some(graph.clone()), ..Default::default() };
+        let (graph, text, scene, opts) = graph_copy("output", "scenes/view_slices/flat_box.ron");
         let text = text.replacen("outputs: [\"linear\"]", "outputs: [\"linear\", \"hdr\"]", 1);
         for (from, to, words) in [
             (
@@ -666,10 +668,7 @@ mod fuzz_regressions {
     /// differing sizes") with no position. Now a plan error at the pass's target.
     #[test]
     fn raster_targets_of_differing_sizes_are_a_plan_error() {
-        let dir = std::env::temp_dir().join(format!("voltex-fuzz-sizes-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let graph = dir.join("frame.ron");
-        let text = std::fs::read_to_string(root().join("graphs/frame.ron")).unwrap();
+        let (graph, text, scene, opts) = graph_copy("sizes", "scenes/view_slices/flat_box.ron");
         let from = "\"hdr\": Texture(format: Rgba32Float, size: Output";
         assert!(text.contains(from));
         std::fs::write(
@@ -677,8 +676,6 @@ mod fuzz_regressions {
             text.replacen(from, "\"hdr\": Texture(format: Rgba32Float, size: Fixed(1, 1)", 1),
         )
         .unwrap();
-        let scene = voltex::scene::load(&root().join("scenes/view_slices/flat_box.ron")).unwrap();
-        let opts = RenderOptions { size: Some((8, 8)), graph: Some(graph.clone()), ..Default::default() };
         let e = Blueprint::new(&scene, &opts).err().expect("an error").to_string();
         assert!(e.starts_with(&format!("{}:", graph.display())), "{e}");
         assert!(e.contains("target `depth` is 8x8 but target `hdr` is 1x1"), "{e}");
@@ -693,12 +690,7 @@ mod fuzz_regressions {
     /// bakes. Now a plan error at the pass's target. An Rgba output into R32Float is fine.
     #[test]
     fn a_target_with_more_channels_than_its_fragment_output_is_a_plan_error() {
-        let dir = std::env::temp_dir().join(format!("voltex-fuzz-channels-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let graph = dir.join("frame.ron");
-        let text = std::fs::read_to_string(root().join("graphs/frame.ron")).unwrap();
-        let scene = voltex::scene::load(&root().join("scenes/view_slices/sphere_balls.ron")).unwrap();
-        let opts = RenderOptions { size: Some((8, 8)), graph: Some(graph.clone()), ..Default::default() };
+        let (graph, text, scene, opts) = graph_copy("channels", "scenes/view_slices/sphere_balls.ron");
         let from = "\"base_depth\": Texture(format: R32Float";
         assert!(text.contains(from));
         for format in ["Rgba16Float", "Rgba8Unorm"] {
