@@ -1,12 +1,12 @@
 //! `voltex bench-hyper`: the set-up of the paper's Figure 11 on the current adapter: one
 //! hypertexture (three noises) on six objects (three soft primitives, the cube, teapot and bunny
-//! stand-in meshes of the Figure 11 scenes, whose grid bakes it also times, as the cumulus's point
-//! grid) covering most of the window, HQ and
-//! IE steps, no shading, Phong, and Phong with shadow rays, each with both segment strategies (the
-//! enlarged bounds and depth peeling). Per setting: the median wall time of a frame after
-//! warm-up, the density evaluations the frame made and those that ran the noises (counted by the
-//! kernel: points farther than the largest shift from the object skip them), and the share of the
-//! frame that those noise evaluations alone would take at the rate `bench_simplex.wgsl` measures
+//! stand-in meshes of the Figure 11 scenes, whose grid bakes it also times, as the cumulus's
+//! point grid) covering most of the window, HQ and IE steps, no shading, Phong, and Phong with
+//! shadow rays, each with both segment strategies (the enlarged bounds and depth peeling). Per
+//! setting: the median wall time of a frame after warm-up, the density evaluations the frame made
+//! and those that ran the noises (counted by the kernel: points farther than the largest shift
+//! from the object skip them), and the share of the frame that those noise evaluations alone
+//! would take at the rate `bench_simplex.wgsl` measures
 //! ("rate"), and the share measured directly ("A/B"): the same frame with the noises compiled out
 //! (override `noise_off`), timed in alternation, compared per density evaluation.
 //!

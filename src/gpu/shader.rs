@@ -178,8 +178,8 @@ impl Kernel {
 pub(crate) const MAX_PRIVATE_BYTES: u64 = 64 << 10;
 
 /// Checks naga accepts but a device may not: workgroup sizes, workgroup memory and binding
-/// indices against WebGPU's default limits (what every adapter offers), and per-invocation arrays against
-/// [`MAX_PRIVATE_BYTES`], each at its WGSL position.
+/// indices against WebGPU's default limits (what every adapter offers), and per-invocation
+/// arrays against [`MAX_PRIVATE_BYTES`], each at its WGSL position.
 fn check_limits(module: &naga::Module, ex: &Expanded) -> Result<()> {
     let limits = wgpu::Limits::default();
     let at = |span: naga::Span| {
