@@ -85,8 +85,9 @@ pub fn rss() -> u64 {
 
 /// The running case, as the watchdog sees it.
 struct Case {
-    /// Its input (`Debug`, shortened).
+    /// Its input (`Debug`, shortened), and its number in the campaign.
     input: String,
+    number: u64,
     /// The CPU clock its time is measured on, and its reading at the start.
     clock: libc::clockid_t,
     cpu_start: f64,
@@ -151,7 +152,12 @@ fn watchdog(
         if let Some(case) = &mut w.case {
             let cpu = cpu_secs(case.clock) - case.cpu_start;
             if let Some(why) = hang_verdict(&mut case.progress, cpu, Instant::now(), limit) {
-                eprintln!("fuzz {name}: a hang ({why}; the bound is {limit} s), aborting: {}", case.input);
+                let (n, input) = (case.number, &case.input);
+                eprintln!(
+                    "fuzz {name}: a hang ({why}; the bound is {limit} s) at input {n} (alone: VOLTEX_FUZZ_FROM={n} \
+                     VOLTEX_FUZZ_CASES={}), aborting: {input}",
+                    n + 1,
+                );
                 std::process::abort();
             }
         }
@@ -282,7 +288,13 @@ pub fn run_campaign<S: Strategy>(
                 None => thread_clock(),
             };
             let progress = (Instant::now(), 0.0);
-            w.case = Some(Case { input: input.clone(), clock: watched, cpu_start: cpu_secs(watched), progress });
+            w.case = Some(Case {
+                input: input.clone(),
+                number: tried.get() - 1,
+                clock: watched,
+                cpu_start: cpu_secs(watched),
+                progress,
+            });
         }
         let guard = CaseGuard(&watch);
         let heap_start = Tracked::begin_case();
