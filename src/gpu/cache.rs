@@ -115,7 +115,7 @@ pub(crate) fn key(parts: &impl std::fmt::Debug) -> u64 {
 impl GpuCache {
     /// A cache that keeps up to `bytes` of bakes a build left unused (newest first, for at most
     /// a few builds), beyond the frame's own memory: the preview's, where an edit is often undone.
-    pub fn with_stale_bytes(bytes: u64) -> Self {
+    pub(crate) fn with_stale_bytes(bytes: u64) -> Self {
         GpuCache { stale_bytes: bytes, ..Default::default() }
     }
 
