@@ -119,6 +119,11 @@ impl GpuCache {
         GpuCache { stale_bytes: bytes, ..Default::default() }
     }
 
+    /// Changes how many bytes of unused bakes `retain_used` keeps (see [`GpuCache::with_stale_bytes`]).
+    pub(crate) fn set_stale_bytes(&mut self, bytes: u64) {
+        self.stale_bytes = bytes;
+    }
+
     /// Starts a build: counts from zero and records which entries it uses.
     pub fn begin(&mut self) {
         self.stats = CacheStats::default();

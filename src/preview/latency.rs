@@ -146,6 +146,8 @@ pub fn measure(ctx: &GpuContext, scene: &Path, options: RenderOptions, repeat: u
     if let Some(e) = &session.error {
         return Err(Error::Invalid(e.clone()));
     }
+    // Each edit toggles between two values: timed as a rebake, not as the cache's undo.
+    session.keep_no_unused_bakes();
     frame(ctx, &mut session)?;
     let watcher = Watcher::new(&session.watch_dirs())?;
     let load =

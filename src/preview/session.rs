@@ -146,6 +146,12 @@ impl Session {
         Ok(Outcome::Rebuilt(self.cache.stats))
     }
 
+    /// Keeps no bake a rebuild left unused (the latency measurement: a value toggled back is
+    /// rebaked, as a new value would be, instead of found in the cache).
+    pub(crate) fn keep_no_unused_bakes(&mut self) {
+        self.cache.set_stale_bytes(0);
+    }
+
     /// After the device was lost: drops everything made on it and rebuilds the last good scene
     /// (not the file, which may be broken by now) on `ctx`, a new device. Without a good scene
     /// yet, rebuilds from the file. The current error, if any, stays.
