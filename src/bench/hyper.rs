@@ -258,27 +258,32 @@ pub fn run(args: &Args) -> Result<()> {
     result
 }
 
+/// The grid bake of `plan`'s mesh or point-set object, wall time with a readback in ms: the
+/// median of 3, after a first that compiles the kernels (also returned).
+fn grid_bake_ms(ctx: &GpuContext, plan: &RayMarchPlan) -> Result<(f64, f64)> {
+    let mut times = Vec::new();
+    for _ in 0..4 {
+        let t = Instant::now();
+        let grid = plan.bake_mesh_grid(ctx)?.expect("a mesh or point-set object");
+        crate::hypertexture::mesh::read(ctx, &grid)?;
+        times.push(t.elapsed().as_secs_f64() * 1e3);
+    }
+    Ok((median(times[1..].to_vec()), times[0]))
+}
+
 /// Times the point-set bake of `points_cumulus.ron` (its kernels through a BVH, then the
-/// jump flooding), as the mesh grid bakes are timed: wall, with a readback, median of 3.
+/// jump flooding), as the mesh grid bakes are timed.
 fn point_grid_bake(ctx: &GpuContext, size: (u32, u32)) -> Result<()> {
     let scene = crate::scene::load(&crate::project_root().join("scenes/hypertextures/points_cumulus.ron"))?;
     let bp = Blueprint::new(&scene, &RenderOptions { size: Some(size), ..Default::default() })?;
     let plan = bp.objects.iter().find_map(|o| o.method::<RayMarchPlan>()).expect("a RayMarch object");
     let points = plan.packed.point_set.as_ref().expect("a point-set object");
-    let mut times = Vec::new();
-    for _ in 0..4 {
-        let t = Instant::now();
-        let grid = plan.bake_mesh_grid(ctx)?.expect("a point grid");
-        crate::hypertexture::mesh::read(ctx, &grid)?;
-        times.push(t.elapsed().as_secs_f64() * 1e3);
-    }
+    let (ms, first) = grid_bake_ms(ctx, plan)?;
     println!(
-        "point grid bake, cumulus: {} kernels, {:?} samples: {:.1} ms (wall, with readback; median of 3 after one \
-         that compiles the kernels: {:.1} ms)",
+        "point grid bake, cumulus: {} kernels, {:?} samples: {ms:.1} ms (wall, with readback; median of 3 after one \
+         that compiles the kernels: {first:.1} ms)",
         points.set.centres.len(),
         points.spec.n,
-        median(times[1..].to_vec()),
-        times[0]
     );
     Ok(())
 }
@@ -313,22 +318,13 @@ fn tables(ctx: &GpuContext, args: &Args, report: &mut Report) -> Result<()> {
         let bp = Blueprint::new(&scene, &RenderOptions { size: Some(size), ..Default::default() })?;
         let plan = bp.objects.iter().find_map(|o| o.method::<RayMarchPlan>()).expect("a RayMarch object");
         let (shape, spec) = plan.packed.mesh.as_ref().expect("a mesh object");
-        let mut times = Vec::new();
-        // The first bake compiles the kernel.
-        for _ in 0..4 {
-            let t = Instant::now();
-            let grid = crate::hypertexture::mesh::bake(ctx, shape, spec)?;
-            crate::hypertexture::mesh::read(ctx, &grid)?;
-            times.push(t.elapsed().as_secs_f64() * 1e3);
-        }
+        let (ms, first) = grid_bake_ms(ctx, plan)?;
         println!(
-            "mesh grid bake, {name}: {} triangles in {} part(s), {:?} samples: {:.1} ms (wall, with readback; median of 3 \
-             after one that compiles the kernel: {:.1} ms)",
+            "mesh grid bake, {name}: {} triangles in {} part(s), {:?} samples: {ms:.1} ms (wall, with readback; median \
+             of 3 after one that compiles the kernel: {first:.1} ms)",
             shape.triangles.len(),
             shape.parts.len(),
             spec.n,
-            median(times[1..].to_vec()),
-            times[0]
         );
     }
     point_grid_bake(ctx, size)?;

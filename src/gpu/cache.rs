@@ -124,6 +124,11 @@ impl GpuCache {
         self.stale_bytes = bytes;
     }
 
+    /// Drops every entry (made on a device that was lost), keeping the settings.
+    pub(crate) fn clear(&mut self) {
+        self.entries.clear();
+    }
+
     /// Starts a build: counts from zero and records which entries it uses.
     pub fn begin(&mut self) {
         self.stats = CacheStats::default();

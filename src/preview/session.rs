@@ -157,7 +157,7 @@ impl Session {
     /// yet, rebuilds from the file. The current error, if any, stays.
     pub fn recover(&mut self, ctx: &GpuContext) -> Outcome {
         self.renderer = None;
-        self.cache = GpuCache::with_stale_bytes(STALE_BAKE_BYTES);
+        self.cache.clear();
         let Some(scene) = self.scene.as_ref() else { return self.rebuild(ctx) };
         self.cache.begin();
         let built = self.blueprint(scene).and_then(|bp| Renderer::with_cache(ctx, bp, &mut self.cache));

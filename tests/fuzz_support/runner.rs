@@ -275,26 +275,16 @@ pub fn run_campaign<S: Strategy>(
         let clock = match bounds.rss {
             // GPU targets: the driver works in threads of its own.
             Some(_) => libc::CLOCK_PROCESS_CPUTIME_ID,
-            None => libc::CLOCK_THREAD_CPUTIME_ID,
+            // This thread's clock by its id, which the watchdog can read too.
+            None => thread_clock(),
         };
         let cpu_start = cpu_secs(clock);
         {
             let mut w = watch.lock().unwrap();
             w.rss_start = if bounds.rss.is_some() { rss() } else { 0 };
             w.rss_peak = w.rss_start;
-            // The watchdog reads this thread's clock by its id (its own "thread" clock is its own).
-            let watched = match bounds.rss {
-                Some(_) => clock,
-                None => thread_clock(),
-            };
             let progress = (Instant::now(), 0.0);
-            w.case = Some(Case {
-                input: input.clone(),
-                number: tried.get() - 1,
-                clock: watched,
-                cpu_start: cpu_secs(watched),
-                progress,
-            });
+            w.case = Some(Case { input: input.clone(), number: tried.get() - 1, clock, cpu_start, progress });
         }
         let guard = CaseGuard(&watch);
         let heap_start = Tracked::begin_case();
