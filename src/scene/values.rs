@@ -9,6 +9,10 @@ use std::collections::BTreeMap;
 /// Largest magnitude of any number in a scene: beyond it, f32 kernels (and f32 fields such as
 /// texel shapes) overflow (the prism checks' `MAX_COORD`).
 pub(crate) const MAX_MAGNITUDE: f64 = crate::mesh::prism::MAX_COORD;
+/// Smallest magnitude of a non-zero number: below it, f32 kernels flush it to 0 (a denormal) or
+/// its square does, and a positive length divides by zero (`opacity_length: 1e-45` made NaN
+/// pixels).
+pub(crate) const MIN_MAGNITUDE: f64 = 1e-15;
 
 macro_rules! checked_f64 {
     ($name:ident, $ok:expr, $what:literal) => {
@@ -22,6 +26,15 @@ macro_rules! checked_f64 {
                     Err(D::Error::custom(format!(
                         concat!("expected ", $what, " within ±{:e}, found {:e}"),
                         MAX_MAGNITUDE, v
+                    )))
+                } else if v != 0.0 && v.abs() < MIN_MAGNITUDE {
+                    Err(D::Error::custom(format!(
+                        concat!(
+                            "expected ",
+                            $what,
+                            " of 0 or at least {:e} in magnitude (f32 on the GPU), found {:e}"
+                        ),
+                        MIN_MAGNITUDE, v
                     )))
                 } else if v.is_finite() && ok(v) {
                     Ok($name(v))

@@ -12,11 +12,16 @@
 //! Memory: the Rust heap a case has live at once (the counting allocator, per thread), and for
 //! the GPU targets the growth of the process's resident memory, sampled by the watchdog (the
 //! driver allocates outside Rust).
+//!
+//! Work that a mutated kernel decides (its draws and dispatches: an instance count of 16,384 where
+//! voltex writes 1) is the user's, not voltex's: a target runs it inside [`kernel_work`], whose
+//! CPU time the case's bound does not count. The watchdog still aborts a kernel that runs on for
+//! [`KERNEL_FACTOR`] times the bound (a software driver has no timeout to stop it).
 
 use super::Tracked;
 use proptest::prelude::*;
 use proptest::test_runner::{RngAlgorithm, TestCaseError, TestRng, TestRunner};
-use std::cell::Cell;
+use std::cell::{Cell, RefCell};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
@@ -93,6 +98,46 @@ struct Case {
     cpu_start: f64,
     /// When its clock last advanced by [`PROGRESS_SECS`], and the reading then.
     progress: (Instant, f64),
+    /// CPU time spent in [`kernel_work`], and the case's time when the open section began.
+    kernel: f64,
+    kernel_since: Option<f64>,
+}
+
+impl Case {
+    /// The case's CPU time so far, and how much of it was [`kernel_work`].
+    fn cpu(&self) -> (f64, f64) {
+        let cpu = cpu_secs(self.clock) - self.cpu_start;
+        (cpu, self.kernel + self.kernel_since.map_or(0.0, |since| cpu - since))
+    }
+}
+
+/// How many times its bound a case's [`kernel_work`] may run before the watchdog aborts.
+pub const KERNEL_FACTOR: f64 = 20.0;
+
+thread_local! {
+    /// The watch of the campaign running on this thread, for [`kernel_work`].
+    static RUNNING: RefCell<Option<Arc<Mutex<Watch>>>> = const { RefCell::new(None) };
+}
+
+/// Runs `work`, the GPU work of a kernel the input mutated, outside the case's time bound (not
+/// nested: the inner section's end ends it).
+pub fn kernel_work<T>(work: impl FnOnce() -> T) -> T {
+    let mark = |open: bool| {
+        let Some(watch) = RUNNING.with(|r| r.borrow().clone()) else { return };
+        let mut w = watch.lock().unwrap();
+        if let Some(case) = &mut w.case {
+            let cpu = case.cpu().0;
+            if open {
+                case.kernel_since = Some(cpu);
+            } else if let Some(since) = case.kernel_since.take() {
+                case.kernel += cpu - since;
+            }
+        }
+    };
+    mark(true);
+    let out = work();
+    mark(false);
+    out
 }
 
 /// CPU time a case must gain within its hang window to count as running (the watchdog's own
@@ -117,18 +162,26 @@ impl Drop for CaseGuard<'_> {
     }
 }
 
-/// Whether a case whose clock reads `cpu` seconds at `now` is a hang, within a bound of `limit`
-/// seconds: its clock gained under [`PROGRESS_SECS`] in `3 limit` seconds of wall time since
-/// `progress` (updated here when it gained more), or it has run `3 limit` seconds of CPU time.
-pub fn hang_verdict(progress: &mut (Instant, f64), cpu: f64, now: Instant, limit: f64) -> Option<String> {
+/// Whether a case whose clock reads `cpu` seconds at `now`, `kernel` of them in [`kernel_work`],
+/// is a hang, within a bound of `limit` seconds: its clock gained under [`PROGRESS_SECS`] in
+/// `3 limit` seconds of wall time since `progress` (updated here when it gained more), or it has
+/// run `3 limit` seconds of CPU time outside kernel work, or [`KERNEL_FACTOR`]` limit` in it.
+pub fn hang_verdict(
+    progress: &mut (Instant, f64),
+    (cpu, kernel): (f64, f64),
+    now: Instant,
+    limit: f64,
+) -> Option<String> {
     if cpu - progress.1 >= PROGRESS_SECS {
         *progress = (now, cpu);
     }
     let window = 3.0 * limit;
     if now.duration_since(progress.0).as_secs_f64() > window {
         Some(format!("its CPU time stopped at {cpu:.1} s for {window:.0} s"))
-    } else if cpu > window {
-        Some(format!("it still runs after {cpu:.0} s of CPU time"))
+    } else if cpu - kernel > window {
+        Some(format!("it still runs after {:.0} s of CPU time", cpu - kernel))
+    } else if kernel > KERNEL_FACTOR * limit {
+        Some(format!("a mutated kernel's own work still runs after {kernel:.0} s of CPU time"))
     } else {
         None
     }
@@ -150,7 +203,7 @@ fn watchdog(
             w.rss_peak = w.rss_peak.max(rss());
         }
         if let Some(case) = &mut w.case {
-            let cpu = cpu_secs(case.clock) - case.cpu_start;
+            let cpu = case.cpu();
             if let Some(why) = hang_verdict(&mut case.progress, cpu, Instant::now(), limit) {
                 let (n, input) = (case.number, &case.input);
                 eprintln!(
@@ -187,6 +240,8 @@ pub struct Campaign {
     /// inputs are the same, since generating one does not depend on what a test did, so a long
     /// campaign can run in pieces, or in shards on several machines, and still cover `0..cases`.
     pub from: u64,
+    /// An input's bound in seconds ([`case_secs`]; three times it for the GPU targets).
+    pub case_secs: f64,
 }
 
 impl Campaign {
@@ -196,6 +251,7 @@ impl Campaign {
             cases: env("VOLTEX_FUZZ_CASES").unwrap_or(default_cases),
             seed: env("VOLTEX_FUZZ_SEED").unwrap_or(0),
             from: env("VOLTEX_FUZZ_FROM").unwrap_or(0),
+            case_secs: case_secs(),
         }
     }
 }
@@ -219,7 +275,7 @@ pub fn fuzz<S: Strategy>(
 /// target's wall time.
 pub fn run_campaign<S: Strategy>(
     name: &str,
-    Campaign { cases, seed, from }: Campaign,
+    Campaign { cases, seed, from, case_secs }: Campaign,
     bounds: Bounds,
     strategy: S,
     test: impl Fn(S::Value) -> Result<(), String>,
@@ -246,10 +302,11 @@ pub fn run_campaign<S: Strategy>(
     };
     let watch = Arc::new(Mutex::new(Watch::default()));
     // GPU targets: three times the bound (software Vulkan's work counts from every thread).
-    let limit = if bounds.rss.is_some() { 3.0 * case_secs() } else { case_secs() };
+    let limit = if bounds.rss.is_some() { 3.0 * case_secs } else { case_secs };
     let dog = watchdog(name.to_string(), watch.clone(), bounds.rss.is_some(), limit);
-    let (tried, slowest, heap_peak, rss_peak) =
-        (Cell::new(0u64), Cell::new(0f64), Cell::new(0usize), Cell::new(0u64));
+    let outer = RUNNING.with(|r| r.replace(Some(watch.clone())));
+    let (tried, slowest, heap_peak, rss_peak, kernel_peak) =
+        (Cell::new(0u64), Cell::new(0f64), Cell::new(0usize), Cell::new(0u64), Cell::new(0f64));
     let start = Instant::now();
     let last_report = Cell::new(start);
     let accepted_before = ACCEPTED.with(Cell::get);
@@ -284,19 +341,20 @@ pub fn run_campaign<S: Strategy>(
             w.rss_start = if bounds.rss.is_some() { rss() } else { 0 };
             w.rss_peak = w.rss_start;
             let progress = (Instant::now(), 0.0);
-            w.case = Some(Case { input: input.clone(), number: tried.get() - 1, clock, cpu_start, progress });
+            let number = tried.get() - 1;
+            let (kernel, kernel_since) = (0.0, None);
+            w.case = Some(Case { input: input.clone(), number, clock, cpu_start, progress, kernel, kernel_since });
         }
         let guard = CaseGuard(&watch);
         let heap_start = Tracked::begin_case();
         let outcome = test(value);
         let heap = Tracked::peak_since(heap_start);
-        let secs = cpu_secs(clock) - cpu_start;
-        let grew = match bounds.rss {
-            Some(_) => {
-                let w = watch.lock().unwrap();
-                w.rss_peak.max(rss()).saturating_sub(w.rss_start)
-            }
-            None => 0,
+        let (secs, grew) = {
+            let w = watch.lock().unwrap();
+            let (cpu, kernel) = w.case.as_ref().map_or((0.0, 0.0), Case::cpu);
+            kernel_peak.set(kernel_peak.get().max(kernel));
+            let grew = if bounds.rss.is_some() { w.rss_peak.max(rss()).saturating_sub(w.rss_start) } else { 0 };
+            (cpu - kernel, grew)
         };
         drop(guard);
         slowest.set(slowest.get().max(secs));
@@ -318,17 +376,19 @@ pub fn run_campaign<S: Strategy>(
         }
         Ok(())
     });
+    RUNNING.with(|r| r.replace(outer));
     watch.lock().unwrap().stop = true;
     dog.join().unwrap();
     eprintln!(
         "fuzz {name}: {} inputs tried, {} accepted (seed {seed}, inputs {from}..{cases}, {:.1} s; slowest input \
-         {:.2} s, largest heap {} MiB{})",
+         {:.2} s, largest heap {} MiB{}; most kernel work {:.2} s)",
         tried.get().saturating_sub(from),
         ACCEPTED.with(Cell::get) - accepted_before,
         start.elapsed().as_secs_f64(),
         slowest.get(),
         heap_peak.get() >> 20,
         rss_text(rss_peak.get()),
+        kernel_peak.get(),
     );
     if let Err(e) = result {
         panic!("fuzz {name}: {e}");

@@ -462,19 +462,56 @@ fn the_watchdog_tells_a_hang_from_a_starved_case() {
     let at = |s: f64| t0 + Duration::from_secs_f64(s);
     // Blocked: no CPU at all.
     let mut progress = (t0, 0.0);
-    assert_eq!(hang_verdict(&mut progress, 0.0, at(29.0), 10.0), None);
-    let v = hang_verdict(&mut progress, 0.01, at(31.0), 10.0).expect("a hang");
+    assert_eq!(hang_verdict(&mut progress, (0.0, 0.0), at(29.0), 10.0), None);
+    let v = hang_verdict(&mut progress, (0.01, 0.0), at(31.0), 10.0).expect("a hang");
     assert!(v.contains("stopped"), "{v}");
     // Starved: 0.4 s of CPU every 30 s (nice 19 beside two busy cores) for ten minutes.
     let mut progress = (t0, 0.0);
     for k in 1..=20 {
-        assert_eq!(hang_verdict(&mut progress, 0.4 * k as f64, at(30.0 * k as f64 - 1.0), 10.0), None);
+        assert_eq!(hang_verdict(&mut progress, (0.4 * k as f64, 0.0), at(30.0 * k as f64 - 1.0), 10.0), None);
     }
     // Busy past three times the bound.
     let mut progress = (t0, 0.0);
-    assert_eq!(hang_verdict(&mut progress, 29.0, at(29.5), 10.0), None);
-    let v = hang_verdict(&mut progress, 31.0, at(31.5), 10.0).expect("over the bound");
+    assert_eq!(hang_verdict(&mut progress, (29.0, 0.0), at(29.5), 10.0), None);
+    let v = hang_verdict(&mut progress, (31.0, 0.0), at(31.5), 10.0).expect("over the bound");
     assert!(v.contains("still runs"), "{v}");
+    // A mutated kernel's work: 114 s of it is not the case's, 201 s of it is too long to wait.
+    let mut progress = (t0, 0.0);
+    assert_eq!(hang_verdict(&mut progress, (116.0, 114.0), at(117.0), 10.0), None);
+    let v = hang_verdict(&mut progress, (116.0, 10.0), at(117.0), 10.0).expect("over the bound");
+    assert!(v.contains("still runs after 106 s"), "{v}");
+    let v = hang_verdict(&mut progress, (203.0, 201.0), at(204.0), 10.0).expect("a kernel too long");
+    assert!(v.contains("kernel's own work"), "{v}");
+}
+
+/// The CPU time of a case inside `kernel_work` (a mutated kernel's draws) is not bounded as the
+/// case's: 1.2 s of it passes a bound of 1 s; 1.2 s outside it fails.
+#[test]
+fn a_mutated_kernels_work_is_not_the_cases_time() {
+    use fuzz_support::runner::{kernel_work, run_campaign, Campaign};
+    // 1.2 s of this thread's CPU time, whatever the machine's load.
+    let busy = || {
+        let cpu = || {
+            let mut t = libc::timespec { tv_sec: 0, tv_nsec: 0 };
+            // SAFETY: a valid timespec to fill.
+            unsafe { libc::clock_gettime(libc::CLOCK_THREAD_CPUTIME_ID, &mut t) };
+            t.tv_sec as f64 + t.tv_nsec as f64 * 1e-9
+        };
+        let start = cpu();
+        let mut x = 0u64;
+        while cpu() - start < 1.2 {
+            x = std::hint::black_box(x.wrapping_mul(31).wrapping_add(7));
+        }
+    };
+    // `Just`: a failure is not shrunk (run again and again).
+    let campaign = Campaign { cases: 1, seed: 1, from: 0, case_secs: 1.0 };
+    run_campaign("kernel_work", campaign, SMALL, Just(()), |()| Ok(kernel_work(busy)));
+    let outside = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        run_campaign("outside", campaign, SMALL, Just(()), |()| Ok(busy()))
+    }));
+    let why = outside.expect_err("1.2 s of the case's own time fails a bound of 1 s");
+    let why = why.downcast_ref::<String>().cloned().unwrap_or_default();
+    assert!(why.contains("over the bound of 1 s"), "{why}");
 }
 
 /// A campaign resumed at input K (`VOLTEX_FUZZ_FROM`) runs exactly the inputs K.. of the whole
@@ -486,10 +523,16 @@ fn a_resumed_campaign_runs_the_same_inputs() {
     let seen = std::cell::RefCell::new(Vec::new());
     let run = |from| {
         seen.borrow_mut().clear();
-        run_campaign("resume", Campaign { cases: 40, seed: 7, from }, SMALL, &strategy, |v| {
-            seen.borrow_mut().push(format!("{v:?}"));
-            Ok(())
-        });
+        run_campaign(
+            "resume",
+            Campaign { cases: 40, seed: 7, from, case_secs: 10.0 },
+            SMALL,
+            &strategy,
+            |v| {
+                seen.borrow_mut().push(format!("{v:?}"));
+                Ok(())
+            },
+        );
         seen.borrow().clone()
     };
     let whole = run(0);
@@ -754,6 +797,36 @@ mod fuzz_regressions {
         let text = std::fs::read_to_string(&path).unwrap().replacen("major: 0.28", "major: 1e39", 1);
         let e = voltex::scene::parse(&text, &path).unwrap_err().to_string();
         assert!(e.contains(":16:") && e.contains("within ±1e15, found 1e39"), "{e}");
+    }
+
+    /// preview_reload, seed 30 (13,799 inputs in): `opacity_length: 1e-45` in torus_egg, positive
+    /// in f64 and a denormal in f32, which the GPU flushes to 0: empty voxels became 0/0, NaN
+    /// pixels. Now a non-zero number under 1e-15 in magnitude is an error at its position, and
+    /// the smallest accepted length renders finite pixels.
+    #[test]
+    fn a_number_an_f32_kernel_flushes_to_zero_is_an_error() {
+        let path = root().join("scenes/reference/torus_egg.ron");
+        let base = std::fs::read_to_string(&path)
+            .unwrap()
+            .replace("resolution: (128, 128, 128)", "resolution: (16, 16, 16)");
+        let from = "opacity_length: 0.05";
+        assert!(base.contains(from));
+        for tiny in ["1e-45", "-1e-16", "9.9e-16"] {
+            let text = base.replacen(from, &format!("opacity_length: {tiny}"), 1);
+            let e = voltex::scene::parse(&text, &path).unwrap_err().to_string();
+            let line = text[..text.find("opacity_length").unwrap()].matches('\n').count() + 1;
+            assert!(e.starts_with(&format!("{}:{line}:", path.display())), "{e}");
+            assert!(e.contains("at least 1e-15 in magnitude"), "{e}");
+        }
+        let text = base.replacen(from, "opacity_length: 1e-15", 1);
+        let scene = voltex::scene::parse(&text, &path).unwrap();
+        let opts = RenderOptions { size: Some((16, 16)), ..Default::default() };
+        let ctx = crate::common::ctx().lock().unwrap_or_else(|e| e.into_inner());
+        let mut r = voltex::render::Renderer::new(&ctx, Blueprint::new(&scene, &opts).unwrap()).unwrap();
+        let image = r.render(&ctx).unwrap().image;
+        assert!(image.pixels.iter().flatten().all(|c| c.is_finite()));
+        // Opaque where the texel has matter: the frame is not the background alone.
+        assert!(image.pixels.iter().any(|p| p[0] > 0.1), "nothing drawn");
     }
 
     /// The same overflow one step later: objects and camera each within bounds, but too far
