@@ -505,9 +505,15 @@ fn a_mutated_kernels_work_is_not_the_cases_time() {
     };
     // `Just`: a failure is not shrunk (run again and again).
     let campaign = Campaign { cases: 1, seed: 1, from: 0, case_secs: 1.0 };
-    run_campaign("kernel_work", campaign, SMALL, Just(()), |()| Ok(kernel_work(busy)));
+    run_campaign("kernel_work", campaign, SMALL, Just(()), |()| {
+        kernel_work(busy);
+        Ok(())
+    });
     let outside = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        run_campaign("outside", campaign, SMALL, Just(()), |()| Ok(busy()))
+        run_campaign("outside", campaign, SMALL, Just(()), |()| {
+            busy();
+            Ok(())
+        })
     }));
     let why = outside.expect_err("1.2 s of the case's own time fails a bound of 1 s");
     let why = why.downcast_ref::<String>().cloned().unwrap_or_default();
