@@ -263,19 +263,20 @@ fn preview_reload() {
     put_back(&bases[0]);
     let session = RefCell::new(Session::open(&device(), &scene_path, opts));
     // The first frame of each base scene, to compare with after the good files are put back.
-    let firsts: RefCell<Vec<Option<Vec<[f32; 4]>>>> = RefCell::new(vec![None; bases.len()]);
+    let firsts: RefCell<Vec<Option<Vec<[u32; 4]>>>> = RefCell::new(vec![None; bases.len()]);
     let strategy = (any::<Index>(), prop::collection::vec(version(), 1..5));
     fuzz("preview_reload", 6, GPU, strategy, |(base, versions)| {
         let ctx = device();
         let s = &mut *session.borrow_mut();
         let b = base.index(bases.len());
+        // A frame's bits, so that a NaN pixel (a mutated kernel may draw one) equals itself.
         let frame = |s: &mut Session| match s.render(&ctx) {
-            Some(Ok(f)) => Ok(f.image.pixels),
+            Some(Ok(f)) => Ok(f.image.pixels.iter().map(|p| p.map(f32::to_bits)).collect::<Vec<_>>()),
             Some(Err(e)) => Err(format!("the last good renderer failed to render: {e}")),
             None => Err("no renderer".to_string()),
         };
         // The good files, and their frame.
-        let good = |s: &mut Session, firsts: &mut Vec<Option<Vec<[f32; 4]>>>| {
+        let good = |s: &mut Session, firsts: &mut Vec<Option<Vec<[u32; 4]>>>| {
             put_back(&bases[b]);
             if let Outcome::Failed(e) = s.rebuild(&ctx) {
                 return Err(format!("the good files failed to rebuild: {e}"));
@@ -324,7 +325,9 @@ fn preview_reload() {
                 Outcome::Rebuilt(_) => {
                     last = frame(s)?;
                     // Only a kernel of the user's may make NaN or infinite pixels.
-                    match last.iter().flatten().all(|c| c.is_finite()) || matches!(v, Version::Kernel(..)) {
+                    match last.iter().flatten().all(|&c| f32::from_bits(c).is_finite())
+                        || matches!(v, Version::Kernel(..))
+                    {
                         true => Ok(()),
                         false => Err("a rebuilt scene drew a NaN or infinite pixel".to_string()),
                     }
