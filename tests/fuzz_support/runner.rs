@@ -15,8 +15,9 @@
 //!
 //! Work that a mutated kernel decides (its draws and dispatches: an instance count of 16,384 where
 //! voltex writes 1) is the user's, not voltex's: a target runs it inside [`kernel_work`], whose
-//! CPU time the case's bound does not count. The watchdog still aborts a kernel that runs on for
-//! [`KERNEL_FACTOR`] times the bound (a software driver has no timeout to stop it).
+//! CPU time and resident growth the case's bounds do not count. The watchdog still aborts a
+//! kernel that runs on for [`KERNEL_FACTOR`] times the bound (a software driver has no timeout to
+//! stop it).
 
 use super::Tracked;
 use proptest::prelude::*;
@@ -114,6 +115,48 @@ impl Case {
 /// How many times its bound a case's [`kernel_work`] may run before the watchdog aborts.
 pub const KERNEL_FACTOR: f64 = 20.0;
 
+/// A case's growth of resident memory, less what its [`kernel_work`] grew (seed 30, input 81,215:
+/// an instance count of 16,384 made llvmpipe's draw grow it by 2.3 GiB). Fed readings in bytes.
+#[derive(Debug, Default, Clone, Copy)]
+pub struct Resident {
+    start: u64,
+    /// Net growth inside kernel work, and the reading when the open section began.
+    kernel: i64,
+    open: Option<u64>,
+    /// Highest reading outside kernel work, less `kernel`; largest growth inside a section.
+    peak: u64,
+    kernel_peak: u64,
+}
+
+impl Resident {
+    pub fn new(rss: u64) -> Self {
+        Self { start: rss, peak: rss, ..Self::default() }
+    }
+
+    pub fn sample(&mut self, rss: u64) {
+        match self.open {
+            Some(open) => self.kernel_peak = self.kernel_peak.max(rss.saturating_sub(open)),
+            None => self.peak = self.peak.max((rss as i64 - self.kernel).max(0) as u64),
+        }
+    }
+
+    /// A kernel section opens (`true`) or closes at reading `rss`.
+    pub fn kernel_work(&mut self, open: bool, rss: u64) {
+        if open {
+            self.sample(rss);
+            self.open = Some(rss);
+        } else if let Some(at) = self.open.take() {
+            self.kernel += rss as i64 - at as i64;
+            self.sample(rss);
+        }
+    }
+
+    /// The case's own growth: the bounded one.
+    pub fn growth(&self) -> u64 {
+        self.peak.saturating_sub(self.start)
+    }
+}
+
 thread_local! {
     /// The watch of the campaign running on this thread, for [`kernel_work`].
     static RUNNING: RefCell<Option<Arc<Mutex<Watch>>>> = const { RefCell::new(None) };
@@ -124,7 +167,7 @@ thread_local! {
 pub fn kernel_work<T>(work: impl FnOnce() -> T) -> T {
     let mark = |open: bool| {
         let Some(watch) = RUNNING.with(|r| r.borrow().clone()) else { return };
-        let mut w = watch.lock().unwrap();
+        let w = &mut *watch.lock().unwrap();
         if let Some(case) = &mut w.case {
             let cpu = case.cpu().0;
             if open {
@@ -132,6 +175,7 @@ pub fn kernel_work<T>(work: impl FnOnce() -> T) -> T {
             } else if let Some(since) = case.kernel_since.take() {
                 case.kernel += cpu - since;
             }
+            w.resident.kernel_work(open, rss());
         }
     };
     mark(true);
@@ -148,8 +192,8 @@ const PROGRESS_SECS: f64 = 0.1;
 #[derive(Default)]
 struct Watch {
     case: Option<Case>,
-    rss_start: u64,
-    rss_peak: u64,
+    /// The running case's resident memory (the GPU targets).
+    resident: Resident,
     stop: bool,
 }
 
@@ -200,7 +244,7 @@ fn watchdog(
             return;
         }
         if sample_rss && w.case.is_some() {
-            w.rss_peak = w.rss_peak.max(rss());
+            w.resident.sample(rss());
         }
         if let Some(case) = &mut w.case {
             let cpu = case.cpu();
@@ -305,8 +349,10 @@ pub fn run_campaign<S: Strategy>(
     let limit = if bounds.rss.is_some() { 3.0 * case_secs } else { case_secs };
     let dog = watchdog(name.to_string(), watch.clone(), bounds.rss.is_some(), limit);
     let outer = RUNNING.with(|r| r.replace(Some(watch.clone())));
-    let (tried, slowest, heap_peak, rss_peak, kernel_peak) =
-        (Cell::new(0u64), Cell::new(0f64), Cell::new(0usize), Cell::new(0u64), Cell::new(0f64));
+    let (tried, slowest, heap_peak, rss_peak) =
+        (Cell::new(0u64), Cell::new(0f64), Cell::new(0usize), Cell::new(0u64));
+    // The most CPU time and resident growth of one input's kernel work.
+    let kernel_peak = Cell::new((0f64, 0u64));
     let start = Instant::now();
     let last_report = Cell::new(start);
     let accepted_before = ACCEPTED.with(Cell::get);
@@ -338,8 +384,7 @@ pub fn run_campaign<S: Strategy>(
         let cpu_start = cpu_secs(clock);
         {
             let mut w = watch.lock().unwrap();
-            w.rss_start = if bounds.rss.is_some() { rss() } else { 0 };
-            w.rss_peak = w.rss_start;
+            w.resident = Resident::new(if bounds.rss.is_some() { rss() } else { 0 });
             let progress = (Instant::now(), 0.0);
             let number = tried.get() - 1;
             let (kernel, kernel_since) = (0.0, None);
@@ -352,9 +397,11 @@ pub fn run_campaign<S: Strategy>(
         let (secs, grew) = {
             let w = watch.lock().unwrap();
             let (cpu, kernel) = w.case.as_ref().map_or((0.0, 0.0), Case::cpu);
-            kernel_peak.set(kernel_peak.get().max(kernel));
-            let grew = if bounds.rss.is_some() { w.rss_peak.max(rss()).saturating_sub(w.rss_start) } else { 0 };
-            (cpu - kernel, grew)
+            let mut resident = w.resident;
+            resident.sample(rss());
+            let (most_cpu, most_rss) = kernel_peak.get();
+            kernel_peak.set((most_cpu.max(kernel), most_rss.max(resident.kernel_peak)));
+            (cpu - kernel, if bounds.rss.is_some() { resident.growth() } else { 0 })
         };
         drop(guard);
         slowest.set(slowest.get().max(secs));
@@ -381,14 +428,15 @@ pub fn run_campaign<S: Strategy>(
     dog.join().unwrap();
     eprintln!(
         "fuzz {name}: {} inputs tried, {} accepted (seed {seed}, inputs {from}..{cases}, {:.1} s; slowest input \
-         {:.2} s, largest heap {} MiB{}; most kernel work {:.2} s)",
+         {:.2} s, largest heap {} MiB{}; most kernel work {:.2} s, resident +{} MiB)",
         tried.get().saturating_sub(from),
         ACCEPTED.with(Cell::get) - accepted_before,
         start.elapsed().as_secs_f64(),
         slowest.get(),
         heap_peak.get() >> 20,
         rss_text(rss_peak.get()),
-        kernel_peak.get(),
+        kernel_peak.get().0,
+        kernel_peak.get().1 >> 20,
     );
     if let Err(e) = result {
         panic!("fuzz {name}: {e}");

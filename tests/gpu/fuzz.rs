@@ -520,6 +520,29 @@ fn a_mutated_kernels_work_is_not_the_cases_time() {
     assert!(why.contains("over the bound of 1 s"), "{why}");
 }
 
+/// The resident growth a mutated kernel's draw causes (llvmpipe grew 2.3 GiB for 16,384
+/// instances) is not the case's; growth before and after it is, also what stays resident.
+#[test]
+fn a_mutated_kernels_memory_is_not_the_cases() {
+    use fuzz_support::runner::Resident;
+    const MIB: u64 = 1 << 20;
+    let mut r = Resident::new(100 * MIB);
+    r.sample(150 * MIB);
+    r.kernel_work(true, 140 * MIB);
+    r.sample(2500 * MIB);
+    r.kernel_work(false, 2400 * MIB);
+    assert_eq!(r.growth(), 50 * MIB);
+    // The case's own after the kernel, on top of what the kernel left: 140 + 5, then 140 + 40.
+    r.sample(2405 * MIB);
+    assert_eq!(r.growth(), 50 * MIB);
+    r.sample(2440 * MIB);
+    assert_eq!(r.growth(), 80 * MIB);
+    // Without kernel work, every reading counts.
+    let mut r = Resident::new(100 * MIB);
+    r.sample(2500 * MIB);
+    assert_eq!(r.growth(), 2400 * MIB);
+}
+
 /// A campaign resumed at input K (`VOLTEX_FUZZ_FROM`) runs exactly the inputs K.. of the whole
 /// campaign, and none before them.
 #[test]
