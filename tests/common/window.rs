@@ -83,17 +83,33 @@ impl Preview {
 
     /// Waits (30 s at most) until `cond` holds for the last recorded frame; returns its number.
     pub fn until(&mut self, what: &str, cond: impl Fn(&Self, usize) -> bool) -> usize {
-        let deadline = Instant::now() + Duration::from_secs(30);
+        match self.within(30, what, cond) {
+            Ok(n) => n,
+            Err(n) => panic!("not within 30 s: {what}; last frame: {}", self.state(n)),
+        }
+    }
+
+    /// Waits `secs` at most until `cond` holds for the last recorded frame: its number, or the
+    /// last frame's number as the error.
+    pub fn within(
+        &mut self,
+        secs: u64,
+        what: &str,
+        cond: impl Fn(&Self, usize) -> bool,
+    ) -> Result<usize, usize> {
+        let deadline = Instant::now() + Duration::from_secs(secs);
         loop {
             let n = self.frames().saturating_sub(1);
             // A frame's PNG is renamed into place after its JSON: both are there.
             if self.frames() > 0 && cond(self, n) {
-                return n;
+                return Ok(n);
             }
             if let Ok(Some(status)) = self.child.try_wait() {
                 panic!("the preview exited ({status}) waiting for {what}");
             }
-            assert!(Instant::now() < deadline, "not within 30 s: {what}; last frame: {}", self.state(n));
+            if Instant::now() > deadline {
+                return Err(n);
+            }
             std::thread::sleep(Duration::from_millis(100));
         }
     }
