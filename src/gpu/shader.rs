@@ -129,6 +129,8 @@ fn load_expanded(name: &str, ex: Expanded) -> Result<Kernel> {
             format!("WGSL parse error: {}", first_line(&e.emit_to_string(&ex.text))),
         )
     })?;
+    // Before validation, whose set of locations took 512 MiB for `@location(4294967295)`.
+    check_locations(&module, &ex, &wgpu::Limits::default())?;
     let info = naga::valid::Validator::new(naga::valid::ValidationFlags::all(), capabilities())
         .validate(&module)
         .map_err(|e| {
@@ -263,6 +265,70 @@ fn check_limits(module: &naga::Module, ex: &Expanded) -> Result<()> {
                     format!("var `{name}` takes {bytes} bytes per invocation: at most {MAX_PRIVATE_BYTES} are allowed"),
                 ));
             }
+        }
+    }
+    Ok(())
+}
+
+/// Entry points' `@location`s against the limits of their stage and direction: naga accepts any
+/// (after a bit set of 512 MiB for `@location(4294967295)`), and wgpu's pipeline fails later.
+fn check_locations(module: &naga::Module, ex: &Expanded, limits: &wgpu::Limits) -> Result<()> {
+    fn collect(
+        module: &naga::Module,
+        ty: naga::Handle<naga::Type>,
+        b: Option<&naga::Binding>,
+        out: &mut Vec<u32>,
+    ) {
+        match (b, &module.types[ty].inner) {
+            (Some(naga::Binding::Location { location, .. }), _) => out.push(*location),
+            (None, naga::TypeInner::Struct { members, .. }) => {
+                members.iter().for_each(|m| collect(module, m.ty, m.binding.as_ref(), out))
+            }
+            _ => {}
+        }
+    }
+    for ep in module.entry_points.iter() {
+        let (inputs, outputs) = match ep.stage {
+            naga::ShaderStage::Vertex => {
+                (limits.max_vertex_attributes, limits.max_inter_stage_shader_variables)
+            }
+            naga::ShaderStage::Fragment => {
+                (limits.max_inter_stage_shader_variables, limits.max_color_attachments)
+            }
+            _ => continue,
+        };
+        let (mut ins, mut outs) = (Vec::new(), Vec::new());
+        for a in &ep.function.arguments {
+            collect(module, a.ty, a.binding.as_ref(), &mut ins);
+        }
+        if let Some(r) = &ep.function.result {
+            collect(module, r.ty, r.binding.as_ref(), &mut outs);
+        }
+        let over = |(list, max, what): (Vec<u32>, u32, &'static str)| {
+            list.into_iter().find(|&l| l >= max).map(|l| (l, max, what))
+        };
+        let bad = [(ins, inputs, "inputs"), (outs, outputs, "outputs")].into_iter().find_map(over);
+        if let Some((location, max, what)) = bad {
+            // naga keeps no span for the attribute: the `@location(..)` that says it, else the entry point.
+            let number = |a: &str| {
+                let n = a.trim().trim_end_matches(['u', 'i']);
+                n.strip_prefix("0x").map_or_else(|| n.parse().ok(), |h| u64::from_str_radix(h, 16).ok())
+            };
+            let attr = ex.text.match_indices("@location(").map(|(i, m)| i + m.len()).find(|&i| {
+                let arg = &ex.text[i..i + ex.text[i..].find(')').unwrap_or(0)];
+                number(arg) == Some(location as u64)
+            });
+            let at = attr.or_else(|| ex.text.find(&format!("fn {}(", ep.name))).unwrap_or(0);
+            let (line, col) = crate::error::line_col(&ex.text, at);
+            return Err(Error::at(
+                ex.locate(line as u32, col as u32),
+                format!(
+                    "entry point `{}`: @location({location}) among its {what}: {:?} {what} go up to @location({})",
+                    ep.name,
+                    ep.stage,
+                    max - 1
+                ),
+            ));
         }
     }
     Ok(())

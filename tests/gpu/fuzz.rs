@@ -735,6 +735,48 @@ mod fuzz_regressions {
         }
     }
 
+    /// preview_reload, seed 30 (input 59,947): `@location(2)` of a vertex output made
+    /// `@location(4294967295)` in `draw_slices.wgsl`. naga accepts it; wgpu's pipeline check
+    /// allocated 512 MiB before failing, at the pass rather than the line. Now an error at the
+    /// attribute, against the limits of each stage's inputs and outputs.
+    #[test]
+    fn a_location_beyond_the_limits_is_an_error_at_the_attribute() {
+        let dir = std::env::temp_dir().join(format!("voltex-fuzz-location-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let sources = voltex::gpu::sources::Sources::folder(&dir);
+        let kernel = |vin: &str, vout: &str, fout: &str| {
+            format!(
+                "// k
+struct V {{ @builtin(position) p: vec4<f32>, @location({vout}) c: vec4<f32> }}
+                 @vertex fn vs(@location({vin}) a: vec4<f32>) -> V {{ return V(a, a); }}
+                 @fragment fn fs(v: V) -> @location({fout}) vec4<f32> {{ return v.c; }}
+"
+            )
+        };
+        for (vin, vout, fout, line) in [
+            ("15", "15", "7", None),
+            ("16", "0", "0", Some(3)),
+            ("0", "4294967295", "0", Some(2)),
+            ("0", "0xffffffffu", "0", Some(2)),
+            ("0", "0", "8", Some(4)),
+        ] {
+            std::fs::write(dir.join("k.wgsl"), kernel(vin, vout, fout)).unwrap();
+            let heap = Tracked::begin_case();
+            let loaded = voltex::gpu::shader::load_from(&sources, "k.wgsl");
+            assert!(Tracked::peak_since(heap) < 64 << 20, "{vout}: {} MiB", Tracked::peak_since(heap) >> 20);
+            match (loaded, line) {
+                (Ok(_), None) => {}
+                (Ok(_), Some(_)) => panic!("{vin}, {vout}, {fout} was accepted"),
+                (Err(e), line) => {
+                    let e = e.to_string();
+                    let line = line.unwrap_or_else(|| panic!("{vin}, {vout}, {fout}: {e}"));
+                    assert!(e.starts_with(&format!("{}:{line}:", dir.join("k.wgsl").display())), "{e}");
+                    assert!(e.contains("@location(") && e.contains("go up to"), "{e}");
+                }
+            }
+        }
+    }
+
     /// render_tiny, seed 19: the graph texture `hdr` made `Fixed(1, 1)` beside the output-sized
     /// `depth`: plan accepted, and recording the frame failed in wgpu ("Attachments have
     /// differing sizes") with no position. Now a plan error at the pass's target.
