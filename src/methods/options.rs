@@ -90,8 +90,9 @@ pub const DEFAULT_PLANES: u32 = 400;
 
 impl RenderOptions {
     /// A volume object's method after the overrides. RayMarch and Reference both draw volumes:
-    /// `--method reference` switches a RayMarch volume to the exact Reference (lit per pixel,
-    /// with shadows, when it was shaded at all) with `--step`; otherwise as [`apply`](Self::apply).
+    /// `--method reference` switches a RayMarch volume to the exact Reference with `--step`,
+    /// keeping its shading (the truth of a look is that look, integrated exactly); otherwise as
+    /// [`apply`](Self::apply).
     pub(crate) fn apply_volume(&self, method: &Method) -> Method {
         match (self.method, method) {
             (Some(MethodKind::Reference), Method::RayMarch(rm)) => Method::Reference(Reference {
@@ -101,6 +102,7 @@ impl RenderOptions {
                 } else {
                     crate::scene::Lighting::PerPixel
                 },
+                volume_shading: Some(rm.shading),
             }),
             _ => self.apply(method),
         }
@@ -156,9 +158,11 @@ impl RenderOptions {
                 lod: self.lod.unwrap_or_default(),
             }),
             (MethodKind::Reference, Method::Reference(r)) => {
-                Method::Reference(Reference { step: self.step.or(r.step), lighting })
+                Method::Reference(Reference { step: self.step.or(r.step), lighting, ..*r })
             }
-            (MethodKind::Reference, _) => Method::Reference(Reference { step: self.step, lighting }),
+            (MethodKind::Reference, _) => {
+                Method::Reference(Reference { step: self.step, lighting, volume_shading: None })
+            }
             (MethodKind::AxisSlices, m) => {
                 let a = if let Method::AxisSlices(a) = m { *a } else { DEFAULT_AXIS_SLICES };
                 let (depth, pixels) = self.axis_criteria.unwrap_or((a.depth, a.pixels));

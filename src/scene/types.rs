@@ -947,6 +947,10 @@ pub struct Reference {
     pub step: Option<f64>,
     #[serde(default)]
     pub(crate) lighting: Lighting,
+    /// A `RayMarch` volume switched to the Reference (its truth, `--method reference`) keeps
+    /// its look: that object's shading. Not in scene files (`None`: `lighting` decides).
+    #[serde(skip)]
+    pub(crate) volume_shading: Option<Shading>,
 }
 
 /// View-aligned prism slicing (2002).

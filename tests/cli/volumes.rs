@@ -157,3 +157,26 @@ fn plan_checks_a_volume_against_the_budget() {
     assert_eq!(run.status.code(), Some(1), "{err}");
     assert!(err.contains("volume \"smoke\""), "{err}");
 }
+
+/// The truth of a RayMarch volume (`--method reference`, what `regress` renders) is the same
+/// look integrated exactly: its shading is kept (`level_set.ron` is Phong without shadows; a
+/// truth with shadows was FLIP 0.163 from it), and a Reference written in a scene is lit by
+/// its `lighting`.
+#[test]
+fn the_truth_of_a_volume_keeps_its_shading() {
+    let plan = |scene: &str, method: &[&str]| {
+        let scene = example(scene);
+        let mut args = vec!["plan", s(&scene)];
+        args.extend_from_slice(method);
+        ok(voltex(&args))
+    };
+    let method = |text: &str| text.lines().find(|l| l.contains("of volume")).unwrap_or("").to_string();
+    for (scene, shading) in
+        [("level_set.ron", "Phong"), ("smoke.ron", "PhongShadows"), ("absorbing_box.ron", "None")]
+    {
+        let own = method(&plan(scene, &[]));
+        let truth = method(&plan(scene, &["--method", "reference"]));
+        assert!(own.contains("RayMarch(step: ") && own.contains(&format!("shading: {shading},")), "{own}");
+        assert!(truth.contains("exact cells") && truth.contains(&format!("shading: {shading})")), "{truth}");
+    }
+}

@@ -122,7 +122,11 @@ impl MethodPlan for ReferencePlan {
     }
 
     fn scene_method(&self, object: &ObjectPlan) -> Option<Method> {
-        Some(Method::Reference(Reference { step: Some(self.step), lighting: lighting(object) }))
+        Some(Method::Reference(Reference {
+            step: Some(self.step),
+            lighting: lighting(object),
+            volume_shading: None,
+        }))
     }
 
     crate::any_plan!();

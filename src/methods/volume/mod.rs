@@ -64,6 +64,12 @@ pub(crate) fn voxel_length(node: &VolumeNode) -> f64 {
     crate::vdb::voxel_size(&(node.to_world * node.grid.index_to_world))
 }
 
+/// Whether a volume drawn with `shading` is Phong-shaded, and whether it casts shadows.
+fn lit(shading: crate::scene::Shading) -> (bool, bool) {
+    use crate::scene::Shading;
+    (shading != Shading::None, shading == Shading::PhongShadows)
+}
+
 /// Plans the march of `node` drawn with `method` (RayMarch or Reference) from `camera`.
 pub(crate) fn plan_volume(
     object: &str,
@@ -72,7 +78,7 @@ pub(crate) fn plan_volume(
     method: &Method,
     camera: &RayCamera,
 ) -> Result<VolumePlan> {
-    use crate::scene::{Lighting, Quality, Shading};
+    use crate::scene::{Lighting, Quality};
     let voxel = voxel_length(node);
     let (exact, step, shadow_step, phong, shadows) = match method {
         Method::RayMarch(rm) => {
@@ -80,12 +86,17 @@ pub(crate) fn plan_volume(
             let preset = if rm.quality == Quality::High { 0.25 } else { 1.0 };
             let step = rm.step.unwrap_or(preset * voxel);
             let shadow_step = rm.shadow_step.unwrap_or(2.0 * step);
-            (false, step, shadow_step, rm.shading != Shading::None, rm.shading == Shading::PhongShadows)
+            let (phong, shadows) = lit(rm.shading);
+            (false, step, shadow_step, phong, shadows)
         }
         Method::Reference(r) => {
             let step = r.step.unwrap_or(0.25 * voxel);
-            let lit = r.lighting == Lighting::PerPixel;
-            (true, step, step, lit, lit)
+            let (phong, shadows) = match r.volume_shading {
+                Some(shading) => lit(shading),
+                None if r.lighting == Lighting::PerPixel => (true, true),
+                None => (false, false),
+            };
+            (true, step, step, phong, shadows)
         }
         _ => {
             return Err(Error::Invalid(format!(
