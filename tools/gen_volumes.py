@@ -291,7 +291,45 @@ def paper2002():
     write(os.path.join(out, "fig12_car_park.vdb"), [fog("density", d, t, tolerance=1e-3, half=True), color("Cd", rgb, t)])
 
 
+def varied_density(x, y, z):
+    """The density of varied.vdb at world points (x, y, z) of the unit cube, in f64: six decades
+    in one grid. tests/gpu/volume_exact.rs computes the same formula in Rust (its f32 values
+    must equal the file's), so keep the two alike."""
+    # A dense ring (40 per unit, a soft edge of 3 voxels) around the z axis through the centre.
+    rad = np.sqrt((x - 0.5) ** 2 + (y - 0.5) ** 2)
+    ring = 40.0 * np.clip(0.5 - (np.sqrt((rad - 0.3) ** 2 + (z - 0.5) ** 2) - 0.09) * 128.0 / 3.0, 0.0, 1.0)
+    # A thin egg inside it, its density varying smoothly over three decades (1e-2 to 10).
+    e = np.sqrt(((x - 0.5) / 0.17) ** 2 + ((y - 0.5) / 0.17) ** 2 + ((z - 0.5) / 0.28) ** 2) - 1.0
+    egg = np.clip(-4.0 * e, 0.0, 1.0) * 10.0 ** (-2.0 + 3.0 * (0.5 + 0.5 * np.sin(9.0 * x + 2.0) * np.sin(7.0 * y) * np.cos(5.0 * z)))
+    # A hot core in the egg, up to 2000.
+    h = ((x - 0.5) ** 2 + (y - 0.5) ** 2 + (z - 0.7) ** 2) / 0.03 ** 2
+    core = 2000.0 * np.clip(1.0 - h, 0.0, 1.0)
+    # A faint haze (0.02 to 0.22) in a slab under the ring, edges mid-leaf.
+    slab = (z < 0.25) & (x > 0.1) & (x < 0.9) & (y > 0.1) & (y < 0.9)
+    haze = np.where(slab, 0.02 + 0.2 * (0.5 + 0.5 * np.sin(23.0 * x) * np.cos(19.0 * y)), 0.0)
+    return np.maximum(np.maximum(ring, egg), core) + haze
+
+
+def varied():
+    # The exactness check's volume (issue: optical depth on varied data, not a constant box):
+    # 128^3 voxels cell-centred on the unit cube (voxel 1/128), densities from 1e-5 to 2000, thin
+    # and dense parts, empty leaves, uniform leaves (tiles) inside the ring, full-precision floats.
+    n = 128
+    c = (np.arange(n) + 0.5) / n
+    x, y, z = np.meshgrid(c, c, c, indexing="ij")
+    d = varied_density(x, y, z).astype(np.float32)
+    g = fog("density", d, transform(1.0 / n, (0.5 / n,) * 3))
+    path = os.path.join(SCENES, "varied.vdb")
+    write(path, [g])
+    # OpenVDB reads back exactly the array it was given.
+    back = np.zeros_like(d)
+    vdb.read(path, "density").copyToArray(back, ijk=(0, 0, 0))
+    assert np.array_equal(back, d), "varied.vdb does not read back as written"
+    print(f"{path}: densities {d[d > 0].min():.3g} to {d.max():.4g}, {np.count_nonzero(d)} non-zero voxels")
+
+
 if __name__ == "__main__":
-    # Arguments name the sets to write (default all): examples, bad, paper2002.
-    for name in sys.argv[1:] or ["examples", "bad", "paper2002"]:
-        {"examples": examples, "bad": bad, "paper2002": paper2002}[name]()
+    # Arguments name the sets to write (default all): examples, varied, bad, paper2002.
+    sets = {"examples": examples, "varied": varied, "bad": bad, "paper2002": paper2002}
+    for name in sys.argv[1:] or list(sets):
+        sets[name]()

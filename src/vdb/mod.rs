@@ -23,17 +23,17 @@ use walk::{GridHeader, Topology, Value};
 /// One grid of a file, as `voltex import` and the errors list them.
 #[derive(Debug, Clone)]
 pub struct GridInfo {
-    pub(crate) name: String,
+    /// The grid's name in the file.
+    pub name: String,
     /// OpenVDB's value type name (`float`, `vec3s`, `int32`, ...).
-    pub(crate) value: String,
+    pub value: String,
     /// `level set`, `fog volume`, ... (empty when the file says nothing).
     pub(crate) class: String,
-    /// Whether the file stores the grid's values as 16-bit halves.
-    pub half: bool,
 }
 
 impl GridInfo {
-    pub(crate) fn is_level_set(&self) -> bool {
+    /// Whether the file says the grid is a level set (signed distances).
+    pub fn is_level_set(&self) -> bool {
         self.class == "level set"
     }
 }
@@ -55,14 +55,14 @@ fn read_file(path: &Path) -> Result<Arc<[u8]>> {
 }
 
 /// The grids of the file at `path`.
-pub(crate) fn grids(path: &Path) -> Result<Vec<GridInfo>> {
+pub fn grids(path: &Path) -> Result<Vec<GridInfo>> {
     let bytes = read_file(path)?;
     let archive = walk::archive(&bytes).map_err(|e| Error::file(path, e))?;
     Ok(archive.grids.iter().map(info).collect())
 }
 
 fn info(g: &GridHeader) -> GridInfo {
-    GridInfo { name: g.name.clone(), value: g.value_name().to_string(), class: g.class.clone(), half: g.half }
+    GridInfo { name: g.name.clone(), value: g.value_name().to_string(), class: g.class.clone() }
 }
 
 /// "`a` (float, level set), `b` (vec3s)": the grids for an error message.
@@ -88,7 +88,73 @@ pub fn load(path: &Path, request: &Request) -> Result<SparseVolume> {
 
 /// Reads `request` from the bytes of an OpenVDB file; `path` names it in errors.
 pub fn parse(bytes: Arc<[u8]>, path: &Path, request: &Request) -> Result<SparseVolume> {
-    let archive = walk::archive(&bytes).map_err(|e| Error::file(path, e))?;
+    let read = read_grids(&bytes, path, request)?;
+    let fail = |msg: String| Error::file(path, format!("grid `{}`: {msg}", read.name));
+    sparse::check_extent(&read.density).map_err(fail)?;
+    let built = SparseVolume::build(&read.density, read.color.as_ref(), read.to_world).map_err(fail)?;
+    built.ok_or_else(|| {
+        let what =
+            if read.level_set { "no voxel inside the level set" } else { "no active voxel with density" };
+        fail(format!("the grid is empty: {what}"))
+    })
+}
+
+/// The density grid of `request` in the file at `path` as read, before it is made sparse: its
+/// voxels' values (a level set's already turned into density) and its transform. For checks
+/// of the GPU's sparse copy that must not share its bricks and tables.
+pub fn voxels(path: &Path, request: &Request) -> Result<Voxels> {
+    let read = read_grids(&read_file(path)?, path, request)?;
+    Ok(Voxels { index_to_world: read.to_world, blocks: read.density })
+}
+
+/// A density grid's voxels by index (see [`voxels`]).
+pub struct Voxels {
+    /// Index space to world space (the file's transform).
+    pub index_to_world: DMat4,
+    blocks: Blocks<f32>,
+}
+
+impl Voxels {
+    /// The value of voxel `i` (0 where the grid holds none).
+    pub fn get(&self, i: glam::IVec3) -> f32 {
+        let leaf = i >> glam::IVec3::splat(3);
+        match self.blocks.get(&leaf) {
+            None => 0.0,
+            Some(tree::Block::Tile(v)) => *v,
+            Some(tree::Block::Voxels(v)) => {
+                let l = i - (leaf << glam::IVec3::splat(3));
+                v[(l.x * 64 + l.y * 8 + l.z) as usize]
+            }
+        }
+    }
+
+    /// Every value the grid holds (a tile's once per voxel it covers).
+    pub fn values(&self) -> impl Iterator<Item = f32> + '_ {
+        self.blocks.values().flat_map(|b| match b {
+            tree::Block::Tile(v) => vec![*v; 512],
+            tree::Block::Voxels(v) => v.to_vec(),
+        })
+    }
+
+    /// The lowest and highest voxel (inclusive) of the leaves and tiles that hold values.
+    pub fn bounds(&self) -> (glam::IVec3, glam::IVec3) {
+        let lo = self.blocks.keys().fold(glam::IVec3::MAX, |a, k| a.min(*k << 3));
+        let hi = self.blocks.keys().fold(glam::IVec3::MIN, |a, k| a.max((*k << 3) + 7));
+        (lo, hi)
+    }
+}
+
+/// A file's density (and colour) grids as read and checked, before they are made sparse.
+struct Read {
+    name: String,
+    level_set: bool,
+    to_world: DMat4,
+    density: Blocks<f32>,
+    color: Option<Blocks<[f32; 3]>>,
+}
+
+fn read_grids(bytes: &Arc<[u8]>, path: &Path, request: &Request) -> Result<Read> {
+    let archive = walk::archive(bytes).map_err(|e| Error::file(path, e))?;
     let fail = |grid: &str, msg: String| Error::file(path, format!("grid `{grid}`: {msg}"));
     let find = |name: &str, want: Value| -> Result<&GridHeader> {
         let all: Vec<GridInfo> = archive.grids.iter().map(info).collect();
@@ -114,10 +180,10 @@ pub fn parse(bytes: Arc<[u8]>, path: &Path, request: &Request) -> Result<SparseV
         Ok(g)
     };
     let dg = find(&request.density, Value::Float)?;
-    let dt = walk::topology(&bytes, dg).map_err(|e| fail(&dg.name, e))?;
+    let dt = walk::topology(bytes, dg).map_err(|e| fail(&dg.name, e))?;
     let to_world = check_transform(&dt).map_err(|e| fail(&dg.name, e))?;
     let level_set = dg.class == "level set";
-    let mut grid = read::<f32>(&bytes, &dt, dg).map_err(|e| fail(&dg.name, e))?;
+    let mut grid = read::<f32>(bytes, &dt, dg).map_err(|e| fail(&dg.name, e))?;
     let root_tiles = |t: &Topology, inside: bool| {
         t.root_tiles.iter().find(|(_, v, active)| *active || (inside && *v < 0.0)).map(|(o, _, _)| {
             format!(
@@ -159,7 +225,7 @@ pub fn parse(bytes: Arc<[u8]>, path: &Path, request: &Request) -> Result<SparseV
         None => None,
         Some(name) => {
             let cg = find(name, Value::Vec3)?;
-            let ct = walk::topology(&bytes, cg).map_err(|e| fail(name, e))?;
+            let ct = walk::topology(bytes, cg).map_err(|e| fail(name, e))?;
             if let Some(e) = root_tiles(&ct, false) {
                 return Err(fail(name, e));
             }
@@ -171,11 +237,11 @@ pub fn parse(bytes: Arc<[u8]>, path: &Path, request: &Request) -> Result<SparseV
                 return Err(fail(name, msg));
             }
             let blocks: Blocks<[f32; 3]> = if cg.half || cg.type_name.ends_with("_HalfFloat") {
-                let g = read::<[half::f16; 3]>(&bytes, &ct, cg).map_err(|e| fail(name, e))?;
+                let g = read::<[half::f16; 3]>(bytes, &ct, cg).map_err(|e| fail(name, e))?;
                 let b = tree::blocks(&g.tree, Keep::Active, |_| false).map_err(|e| fail(name, e))?;
                 tree::map(b, |v| v.map(half::f16::to_f32))
             } else {
-                let g = read::<[f32; 3]>(&bytes, &ct, cg).map_err(|e| fail(name, e))?;
+                let g = read::<[f32; 3]>(bytes, &ct, cg).map_err(|e| fail(name, e))?;
                 tree::blocks(&g.tree, Keep::Active, |_| false).map_err(|e| fail(name, e))?
             };
             if let Some((p, v)) = tree::find(&blocks, |c| c.iter().all(|x| x.is_finite())) {
@@ -185,12 +251,7 @@ pub fn parse(bytes: Arc<[u8]>, path: &Path, request: &Request) -> Result<SparseV
             Some(blocks)
         }
     };
-    sparse::check_extent(&density).map_err(|e| fail(&dg.name, e))?;
-    let built = SparseVolume::build(&density, color.as_ref(), to_world).map_err(|e| fail(&dg.name, e))?;
-    built.ok_or_else(|| {
-        let what = if level_set { "no voxel inside the level set" } else { "no active voxel with density" };
-        fail(&dg.name, format!("the grid is empty: {what}"))
-    })
+    Ok(Read { name: dg.name.clone(), level_set, to_world, density, color })
 }
 
 /// Reads grid `g` with vdb-rs, over the stream the walk patched, catching its panics.

@@ -32,3 +32,4 @@ mod texel_shadow;
 mod tile_compositor;
 mod view_slices_lod;
 mod volume;
+mod volume_exact;

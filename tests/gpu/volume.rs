@@ -4,7 +4,7 @@
 use crate::common;
 
 use common::ctx;
-use glam::{DMat4, DVec3};
+use glam::{DMat4, DVec3, IVec3};
 use voltex::methods::volume::march_volume::{march_volume, span, TwinView};
 use voltex::methods::volume::VolumePlan;
 use voltex::render::{Blueprint, Renderer};
@@ -24,36 +24,22 @@ fn box_scene(grid: &str, method: &str) -> scene::Scene {
     scene::parse(&text, &path).unwrap()
 }
 
-/// One trapezoid factor of the box's separable density along an index axis: 0 beyond the
-/// voxels' reach, `v(i)` at voxel centres i = 0..n-1, linear between (the trilinear
-/// interpolant of a separable grid is the product of its axes' linear interpolants).
-fn factor(x: f64, n: usize, v: &dyn Fn(usize) -> f64) -> f64 {
-    if x <= -1.0 || x >= n as f64 {
-        return 0.0;
-    }
-    let i = x.floor();
-    let f = x - i;
-    let at = |k: f64| if k < 0.0 || k > (n - 1) as f64 { 0.0 } else { v(k as usize) };
-    at(i) * (1.0 - f) + at(i + 1.0) * f
-}
-
-/// The exact optical depth along a ray through a separable box grid (index space o + dir t,
-/// t in world units): the density is a product of three piecewise-linear factors, so between
-/// the breakpoints (where a coordinate crosses a voxel centre) it is a cubic in t and Simpson's
-/// rule is exact.
-fn optical_depth(
+/// The exact optical depth (before `density_scale`) along the index-space ray o + dir t (t in
+/// world units) over [t0, t1], of the trilinear interpolant of the voxel values `at` (voxel i at
+/// index point i, OpenVDB's convention): cut wherever a coordinate crosses an integer, each
+/// piece lies in one cell, where the density is a cubic in t, so Simpson's rule is exact.
+pub(crate) fn optical_depth(
     o: DVec3,
     dir: DVec3,
     t0: f64,
     t1: f64,
-    n: usize,
-    v: &[&dyn Fn(usize) -> f64; 3],
-    scale: f64,
+    at: &(dyn Fn(IVec3) -> f64 + Sync),
 ) -> f64 {
     let mut cuts = vec![t0, t1];
     for a in 0..3 {
         if dir[a].abs() > 1e-300 {
-            for k in -1..=n as i64 {
+            let (u0, u1) = (o[a] + dir[a] * t0, o[a] + dir[a] * t1);
+            for k in u0.min(u1).ceil() as i64..=u0.max(u1).floor() as i64 {
                 let t = (k as f64 - o[a]) / dir[a];
                 if t > t0 && t < t1 {
                     cuts.push(t);
@@ -62,46 +48,89 @@ fn optical_depth(
         }
     }
     cuts.sort_by(f64::total_cmp);
-    let rho = |t: f64| {
-        let p = o + dir * t;
-        (0..3).map(|a| factor(p[a], n, v[a])).product::<f64>()
-    };
-    cuts.windows(2)
-        .map(|w| (w[1] - w[0]) / 6.0 * (rho(w[0]) + 4.0 * rho(0.5 * (w[0] + w[1])) + rho(w[1])))
-        .sum::<f64>()
-        * scale
+    let mut tau = 0.0;
+    for w in cuts.windows(2).filter(|w| w[1] > w[0]) {
+        let (a, b, m) = (w[0], w[1], 0.5 * (w[0] + w[1]));
+        let c = (o + dir * m).floor();
+        let corner = c.as_ivec3();
+        let k: [f64; 8] = std::array::from_fn(|n| {
+            let n = n as i32;
+            at(corner + IVec3::new(n & 1, n >> 1 & 1, n >> 2))
+        });
+        if k.iter().all(|v| *v == 0.0) {
+            continue;
+        }
+        let rho = |t: f64| {
+            let f = o + dir * t - c;
+            let x0 =
+                (k[0] * (1.0 - f.x) + k[1] * f.x) * (1.0 - f.y) + (k[2] * (1.0 - f.x) + k[3] * f.x) * f.y;
+            let x1 =
+                (k[4] * (1.0 - f.x) + k[5] * f.x) * (1.0 - f.y) + (k[6] * (1.0 - f.x) + k[7] * f.x) * f.y;
+            x0 * (1.0 - f.z) + x1 * f.z
+        };
+        tau += (b - a) / 6.0 * (rho(a) + 4.0 * rho(m) + rho(b));
+    }
+    tau
 }
 
-/// Per pixel: the analytic transmittance of the box scene's rays (background white, albedo 0).
-fn analytic(scene: &scene::Scene, size: u32, v: &[&dyn Fn(usize) -> f64; 3]) -> Vec<f64> {
+/// Per pixel (rows top to bottom): the exact transmittance of the rays of `scene`'s one volume
+/// object, whose voxels are `at` over `lo..=hi` (0 elsewhere) under `index_to_world`; as the
+/// march casts them (pixel centres, from the eye), in f64, on every core.
+pub(crate) fn exact_transmittance(
+    scene: &scene::Scene,
+    size: u32,
+    index_to_world: DMat4,
+    (lo, hi): (IVec3, IVec3),
+    at: &(dyn Fn(IVec3) -> f64 + Sync),
+) -> Vec<f64> {
     let bp = Blueprint::new(scene, &common::sized(size, size)).unwrap();
-    let plan = bp.objects[0].method::<VolumePlan>().unwrap();
+    let scale = bp.objects[0].method::<VolumePlan>().unwrap().params.medium[3] as f64;
     let node = bp.objects[0].object.volume.as_ref().unwrap();
     let view = twin_view(&bp);
-    let to_index =
-        (node.to_world * node.grid.index_to_world).inverse() * DMat4::from_translation(view.camera.eye);
-    let (lo, hi) = node.grid.index_bounds();
-    let mut out = Vec::new();
-    for py in 0..size {
-        for px in 0..size {
-            let sx = 2.0 * (px as f64 + 0.5) / size as f64 - 1.0;
-            let sy = 1.0 - 2.0 * (py as f64 + 0.5) / size as f64;
-            let d = (view.forward + view.camera.right * sx + view.camera.up * sy).normalize();
-            let o = to_index.transform_point3(DVec3::ZERO);
-            let dir = to_index.transform_vector3(d);
-            let (t0, t1) = span(o, dir, lo, hi);
-            let tau = if t1 > t0 {
-                optical_depth(o, dir, t0.max(0.0), t1, 16, v, plan.params.medium[3] as f64)
-            } else {
-                0.0
-            };
-            out.push((-tau).exp());
-        }
-    }
-    out
+    let to_index = (node.to_world * index_to_world).inverse() * DMat4::from_translation(view.camera.eye);
+    let o = to_index.transform_point3(DVec3::ZERO);
+    let (box_lo, box_hi) = ((lo - 1).as_dvec3(), (hi + 1).as_dvec3());
+    let row = |py: u32| -> Vec<f64> {
+        (0..size)
+            .map(|px| {
+                let sx = 2.0 * (px as f64 + 0.5) / size as f64 - 1.0;
+                let sy = 1.0 - 2.0 * (py as f64 + 0.5) / size as f64;
+                let d = (view.forward + view.camera.right * sx + view.camera.up * sy).normalize();
+                let dir = to_index.transform_vector3(d);
+                let (t0, t1) = span(o, dir, box_lo, box_hi);
+                let tau = if t1 > t0.max(0.0) { optical_depth(o, dir, t0.max(0.0), t1, at) } else { 0.0 };
+                (-scale * tau).exp()
+            })
+            .collect()
+    };
+    let threads = std::thread::available_parallelism().map_or(1, |n| n.get()) as u32;
+    std::thread::scope(|s| {
+        let parts: Vec<_> = (0..threads)
+            .map(|k| {
+                s.spawn(move || {
+                    (k..size).step_by(threads as usize).map(|py| (py, row(py))).collect::<Vec<_>>()
+                })
+            })
+            .collect();
+        let mut rows: Vec<(u32, Vec<f64>)> = parts.into_iter().flat_map(|p| p.join().unwrap()).collect();
+        rows.sort_by_key(|r| r.0);
+        rows.into_iter().flat_map(|r| r.1).collect()
+    })
 }
 
-fn twin_view(bp: &Blueprint) -> TwinView {
+/// The analytic transmittance of the box scene, whose 16^3 voxels are separable: v0(i) v1(j) v2(k).
+fn analytic(scene: &scene::Scene, size: u32, v: &[&(dyn Fn(usize) -> f64 + Sync); 3]) -> Vec<f64> {
+    let grid = scene.volume("box").unwrap();
+    let at = |i: IVec3| {
+        if i.cmplt(IVec3::ZERO).any() || i.cmpgt(IVec3::splat(15)).any() {
+            return 0.0;
+        }
+        (0..3).map(|a| v[a](i[a] as usize)).product::<f64>()
+    };
+    exact_transmittance(scene, size, grid.index_to_world, (IVec3::ZERO, IVec3::splat(15)), &at)
+}
+
+pub(crate) fn twin_view(bp: &Blueprint) -> TwinView {
     let f = &bp.frame;
     let v3 = |a: [f32; 4]| DVec3::new(a[0] as f64, a[1] as f64, a[2] as f64);
     let p = bp.objects[0].method::<VolumePlan>().unwrap();
@@ -121,7 +150,7 @@ fn twin_view(bp: &Blueprint) -> TwinView {
 }
 
 /// The rendered image's red channel (white background times the transmittance).
-fn render(scene: &scene::Scene, size: u32) -> Vec<f64> {
+pub(crate) fn render(scene: &scene::Scene, size: u32) -> Vec<f64> {
     let bp = Blueprint::new(scene, &common::sized(size, size)).unwrap();
     let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
     let mut r = Renderer::new(&ctx, bp).unwrap();
@@ -129,17 +158,17 @@ fn render(scene: &scene::Scene, size: u32) -> Vec<f64> {
     frame.image.pixels.iter().map(|p| p[0] as f64).collect()
 }
 
-fn rmse(a: &[f64], b: &[f64]) -> f64 {
+pub(crate) fn rmse(a: &[f64], b: &[f64]) -> f64 {
     (a.iter().zip(b).map(|(x, y)| (x - y).powi(2)).sum::<f64>() / a.len() as f64).sqrt()
 }
 
-fn max_error(a: &[f64], b: &[f64]) -> f64 {
+pub(crate) fn max_error(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max)
 }
 
-const ONE: &dyn Fn(usize) -> f64 = &|_| 1.0;
+const ONE: &(dyn Fn(usize) -> f64 + Sync) = &|_| 1.0;
 /// The `ramp` grid of box.vdb: 0.25 + 1.5 (i + 1/2) / 16 along i.
-const RAMP: &dyn Fn(usize) -> f64 = &|i| 0.25 + 1.5 * (i as f64 + 0.5) / 16.0;
+const RAMP: &(dyn Fn(usize) -> f64 + Sync) = &|i| 0.25 + 1.5 * (i as f64 + 0.5) / 16.0;
 
 #[test]
 fn absorbing_box_transmittance_is_analytic() {
