@@ -414,13 +414,8 @@ pub fn bake_volume(
 }
 
 /// Twin of `bake_implicit.wgsl`: the whole volume (rgba, normals with w = 0).
-pub fn bake_implicit(
-    params: &BakeParams,
-    shapes: &[ImplicitShape],
-    balls: &[[f32; 4]],
-    per_pixel: bool,
-) -> (Volume, Volume) {
-    bake_volume(params, |v| bake_implicit_voxel(params, shapes, balls, v, per_pixel))
+pub fn bake_implicit(params: &BakeParams, packed: &PackedShapes, per_pixel: bool) -> (Volume, Volume) {
+    bake_volume(params, |v| bake_implicit_voxel(params, &packed.shapes, &packed.balls, v, per_pixel))
 }
 
 /// Twin of `bake_heightfield.wgsl`: the whole volume (rgba, normals with w = 0).

@@ -112,7 +112,7 @@ fn union_takes_the_nearest_shape() {
 fn constant_fills_uniformly() {
     let packed = pack_shapes(&[(Shape::Constant, [0.5, 0.6, 0.7], 0.4)]);
     let params = bake_params([5, 4, 3], 1, [0.0, 0.0, 1.0], 0.3);
-    let (rgba, normals) = bake_implicit(&params, &packed.shapes, &packed.balls, false);
+    let (rgba, normals) = bake_implicit(&params, &packed, false);
     assert_eq!(rgba.texels.len(), 60);
     for (c, n) in rgba.texels.iter().zip(&normals.texels) {
         // N = (0,0,1) and the light along it: the albedo itself.

@@ -2,7 +2,9 @@
 //! the kernels without one are listed here with the reason. A kernel is a WGSL file under `wgsl/`
 //! (any depth, `wgsl/shared/` includes excluded) with an `@compute`, `@vertex` or `@fragment`
 //! entry point; its twin is a `pub fn <file stem>` anywhere under `src/` in a module whose `//!`
-//! doc calls it a twin. No GPU needed.
+//! doc calls it a twin. A twin must also be compared with its kernel: a GPU test (a file under
+//! `tests/gpu/`) calls it, or calls the twin function `COMPARED_THROUGH` names for it. No GPU
+//! needed.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
@@ -122,6 +124,30 @@ const NO_TWIN: &[(&str, &str)] = &[
     ),
 ];
 
+/// Kernels whose twin a GPU test reaches through another twin function, which the test calls:
+/// (kernel, that function, how). Kept true by the test below.
+const COMPARED_THROUGH: &[(&str, &str, &str)] = &[
+    (
+        "scan_plane_offsets",
+        "plane_draws",
+        "the per-plane draw arguments the scan writes, against the twin's scan of the twin's counts \
+         (tests/gpu/gpu_slicing.rs)",
+    ),
+    (
+        "flood_point_grid",
+        "bake_point_grid",
+        "the point grid's twin floods with it as the kernels do; the flooded grid is compared \
+         (tests/gpu/hypertexture_points.rs)",
+    ),
+    (
+        "composite_tiles",
+        "composite_tiles_frame",
+        "the twin over the lists a rendered frame's kernels filled (tests/gpu/tile_compositor.rs)",
+    ),
+    ("bake_hypertexture", "bake_hypertexture_voxel", "voxel by voxel (tests/gpu/hypertexture_texel.rs)"),
+    ("bake_height_image", "bake_height_image_voxel", "voxel by voxel (tests/gpu/axis_slices.rs)"),
+];
+
 fn root() -> &'static Path {
     Path::new(env!("CARGO_MANIFEST_DIR"))
 }
@@ -221,5 +247,48 @@ fn every_kernel_has_a_twin_of_its_name_or_a_listed_reason() {
             problems.push(format!("NO_TWIN lists {stem}, which is no kernel under wgsl/"));
         }
     }
+    assert!(problems.is_empty(), "{}", problems.join("\n"));
+}
+
+/// Whether `code` calls function `name` (`name(` not preceded by an identifier character, nor
+/// by `fn `).
+fn calls(code: &str, name: &str) -> bool {
+    let pattern = format!("{name}(");
+    code.match_indices(&pattern).any(|(at, _)| {
+        let before = &code[..at];
+        let prev = before.chars().next_back();
+        !prev.is_some_and(|c| c.is_alphanumeric() || c == '_') && !before.ends_with("fn ")
+    })
+}
+
+#[test]
+fn every_twin_is_compared_with_its_kernel_in_a_gpu_test() {
+    let mut paths = Vec::new();
+    files(&root().join("tests/gpu"), "rs", &mut paths);
+    let gpu_tests: Vec<String> = paths.iter().map(|p| code(&std::fs::read_to_string(p).unwrap())).collect();
+    let called = |name: &str| gpu_tests.iter().any(|c| calls(c, name));
+    let twins = twin_functions();
+    let through: BTreeMap<&str, &str> = COMPARED_THROUGH.iter().map(|(k, f, _)| (*k, *f)).collect();
+    let mut problems = Vec::new();
+    let mut compared = 0;
+    for stem in kernels().keys().filter(|k| twins.contains(*k)) {
+        let by = through.get(stem.as_str()).copied().unwrap_or(stem);
+        if called(by) {
+            compared += 1;
+        } else {
+            problems.push(format!(
+                "the twin of {stem} is compared in no GPU test: no file under tests/gpu/ calls `{by}(`"
+            ));
+        }
+        if through.contains_key(stem.as_str()) && called(stem) {
+            problems.push(format!("a GPU test calls `{stem}(` itself now: remove it from COMPARED_THROUGH"));
+        }
+    }
+    for kernel in through.keys() {
+        if !twins.contains(*kernel) {
+            problems.push(format!("COMPARED_THROUGH lists {kernel}, which has no twin"));
+        }
+    }
+    assert!(compared >= 25, "only {compared} twins found compared: is the scan broken?");
     assert!(problems.is_empty(), "{}", problems.join("\n"));
 }

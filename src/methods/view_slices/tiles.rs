@@ -338,6 +338,49 @@ pub fn composite_tiles(f: &TileFrame) -> Vec<[f32; 4]> {
     layer
 }
 
+/// The twin's layer of a `Tiles` object as a frame rendered it (baked lighting, one chunk):
+/// `read` returns a buffer of the object's graph instance as the kernels left it
+/// (`slice_vertices`, `plane_cursors`, `draw_args`, `tile_triangles`, `tile_cursors`,
+/// `tile_entries`), `texel` is its texel volume (resolution, rgba8 bytes of level 0, x fastest),
+/// `depth` the opaque surfaces' depth (row-major; `None`: all 1.0).
+pub fn composite_tiles_frame(
+    frame: &FrameParams,
+    plan: &super::ViewSlicesPlan,
+    opacity_length: f32,
+    read: impl Fn(&str) -> Vec<u8>,
+    texel: ([u32; 3], &[u8]),
+    depth: Option<&[f32]>,
+) -> Vec<[f32; 4]> {
+    fn pod<T: bytemuck::Pod>(bytes: Vec<u8>) -> Vec<T> {
+        let n = bytes.len() / std::mem::size_of::<T>() * std::mem::size_of::<T>();
+        bytemuck::pod_collect_to_vec(&bytes[..n])
+    }
+    let params = tile_params(plan.size, plan.sweep.plane_count, plan.tile_entries[0]);
+    let vertex_count = pod::<crate::types::DrawIndirect>(read("draw_args"))[0].vertex_count;
+    let vertices: Vec<SliceVertex> = pod(read("slice_vertices"));
+    let mut plane_ends: Vec<u32> = pod(read("plane_cursors"));
+    plane_ends.truncate(plan.sweep.plane_count as usize);
+    let ([w, h, d], bytes) = texel;
+    let volume = Volume {
+        resolution: [w, h, d],
+        texels: bytes.chunks_exact(4).map(|b| std::array::from_fn(|c| b[c] as f64 / 255.0)).collect(),
+    };
+    composite_tiles(&TileFrame {
+        frame,
+        params,
+        spacing: plan.sweep.spacing,
+        opacity_length,
+        vertices: &vertices[..(vertex_count as usize).min(vertices.len())],
+        plane_ends: &plane_ends,
+        vertex_count,
+        triangles: &pod::<TileTriangle>(read("tile_triangles")),
+        cursors: &pod::<u32>(read("tile_cursors")),
+        entries: &pod::<u32>(read("tile_entries")),
+        volume: &volume,
+        depth,
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
