@@ -489,8 +489,8 @@ pub struct MeshTexelParams {
     pub mode: [u32; 4],
 }
 
-/// One noise of a hypertexture: `t = T((1 + simplex(frequency (x + shift V))) / 2)`, combined
-/// into `k` by `k += amplitude t` or, with `blend`, `k = k (1 - t) + amplitude t`. In animated
+/// One noise of a hypertexture: `t = T((1 + simplex(frequency (x + shift V))) / 2)`, whose term
+/// `amplitude t` combines into `k` by `combine` (`scene::hypertexture::Operator`). In animated
 /// hypertextures the noise is 4D, its fourth coordinate `speed` times the frame's time.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
@@ -501,8 +501,8 @@ pub struct HyperNoise {
     pub frequency: f32,
     /// `r` in [0, 1]: where along `V` the noise is evaluated.
     pub shift: f32,
-    /// 1 combines by `Blend`, 0 by `Sum`.
-    pub blend: u32,
+    /// How the term combines into k: `OPERATOR_SUM`, `OPERATOR_BLEND` or `OPERATOR_MIX`.
+    pub combine: u32,
     /// Seed of the noise.
     pub seed: u32,
     /// Noise cycles per second along time (0: not animated).
@@ -512,8 +512,8 @@ pub struct HyperNoise {
     pub table: u32,
     /// Rows of the shape table from `table` (1: a 1D shape transfer function).
     pub rows: u32,
-    /// Per-axis factors of `frequency` (xyz; 1 unless periodic) that make each period a whole
-    /// number of noise tiles.
+    /// xyz: per-axis factors of `frequency` (1 unless periodic) that make each period a whole
+    /// number of noise tiles; w: Blend's unit, the largest amplitude of the hypertexture's noises.
     pub scale: [f32; 4],
     /// Periodic noise: `(a, b, c)` with periods of 3a, 3b, 3c noise cells along x, y, z (0: not
     /// periodic). See `simplex3_tiled` in `wgsl/shared/simplex.wgsl`.
@@ -630,6 +630,10 @@ pub(crate) const FIELD_CLOSEST_SURFACE: u32 = 0;
 pub(crate) const FIELD_FROM_CENTRE: u32 = 1;
 pub(crate) const FIELD_CONSTANT: u32 = 2;
 pub(crate) const FIELD_SWIRL: u32 = 3;
+/// `HyperNoise::operator` (mirrored in wgsl/shared/hypertexture.wgsl).
+pub(crate) const OPERATOR_SUM: u32 = 0;
+pub(crate) const OPERATOR_BLEND: u32 = 1;
+pub(crate) const OPERATOR_MIX: u32 = 2;
 
 /// One volume object (an OpenVDB grid) as `march_volume.wgsl` and `bake_volume.wgsl` see it;
 /// twin: `VolumeParams` in wgsl/shared/types.wgsl. Index space is the grid's (voxel (i, j, k)

@@ -6,7 +6,7 @@ use glam::{DVec2, DVec3, DVec4};
 
 use super::bake_transfer::TRANSFER_SIZE;
 use super::noise_simplex::{simplex3, simplex3_tiled, simplex4};
-use crate::types::{HyperNoise, HyperParams};
+use crate::types::{HyperNoise, HyperParams, OPERATOR_BLEND, OPERATOR_MIX};
 use crate::types::{
     FIELD_CONSTANT, FIELD_FROM_CENTRE, FIELD_SWIRL, OBJECT_BOX, OBJECT_ELLIPSOID, OBJECT_MESH, OBJECT_POINTS,
     OBJECT_TORUS,
@@ -232,8 +232,13 @@ impl Model<'_> {
                 simplex3_tiled(q, n.seed, n.tile.map(|t| t as i32)[..3].try_into().unwrap())
             };
             let t = self.shape_lookup(n, 0.5 + 0.5 * noise, density);
-            let a = n.amplitude as f64;
-            k = if n.blend != 0 { k * (1.0 - t) + a * t } else { k + a * t };
+            let term = n.amplitude as f64 * t;
+            let unit = n.scale[3] as f64;
+            k = match n.combine {
+                OPERATOR_BLEND => k * (1.0 - if unit > 0.0 { term / unit } else { 0.0 }) + term,
+                OPERATOR_MIX => k * (1.0 - t) + term,
+                _ => k + term,
+            };
         }
         k
     }

@@ -15,6 +15,7 @@ pub(crate) use crate::cpu::hypertexture::animated;
 use crate::scene::hypertexture::{ColorTransfer, Field, Operator, ShapeTransfer, SoftObject};
 use crate::scene::Hypertexture;
 use crate::types::{HyperNoise, HyperParams, TransferFunction, TransferPoint};
+use crate::types::{OPERATOR_BLEND, OPERATOR_MIX, OPERATOR_SUM};
 
 pub(crate) use crate::types::{
     FIELD_CLOSEST_SURFACE, FIELD_CONSTANT, FIELD_FROM_CENTRE, FIELD_SWIRL, OBJECT_BOX, OBJECT_ELLIPSOID,
@@ -121,17 +122,24 @@ pub(crate) fn pack(h: &Hypertexture) -> Packed {
         // Validation refuses a perturbed field inside another.
         Field::ClosestSurface | Field::Perturbed { .. } => {}
     }
+    // Blend's unit: the largest term a noise can add.
+    let unit = h.enabled_noises().map(|n| n.amplitude).fold(0.0, f64::max) as f32;
     for n in h.enabled_noises() {
         let table = p.functions.len() as u32;
         let rows = n.shape.rows().map_or(1, |r| r.len() as u32);
-        let (scale, tile) = n.tiling();
+        let (mut scale, tile) = n.tiling();
+        scale[3] = unit;
         p.noises.push(HyperNoise {
             scale,
             tile,
             amplitude: n.amplitude as f32,
             frequency: n.frequency as f32,
             shift: n.shift as f32,
-            blend: (n.operator == Operator::Blend) as u32,
+            combine: match n.operator {
+                Operator::Sum => OPERATOR_SUM,
+                Operator::Blend => OPERATOR_BLEND,
+                Operator::Mix => OPERATOR_MIX,
+            },
             seed: n.seed,
             speed: n.speed as f32,
             table,

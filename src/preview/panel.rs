@@ -117,7 +117,7 @@ const CHOICES: &[&[&str]] = &[
     &["Rays", "LightVolume(resolution: 64)"],
     &["IE", "HQ"],
     &["Baked", "PerPixel"],
-    &["Sum", "Blend"],
+    &["Sum", "Blend", "Mix"],
     &["Three", "Horizontal"],
     &["Binary", "Blended"],
     &["Texels", "Slices"],

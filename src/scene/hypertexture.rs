@@ -208,8 +208,8 @@ fn yes() -> bool {
     true
 }
 
-/// One noise of eq. 5: `t = T((1 + noise(frequency (x + shift V))) / 2)`, added to k as
-/// `amplitude t` (Sum) or blended over it, `k (1 - t) + amplitude t` (Blend).
+/// One noise of eq. 5: `t = T((1 + noise(frequency (x + shift V))) / 2)`, whose term
+/// `amplitude t` combines into k by its [`Operator`].
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Noise {
@@ -260,15 +260,20 @@ impl Noise {
     }
 }
 
-/// How a noise's term combines into the distortion factor k.
+/// How a noise's term `amplitude t` combines into the distortion factor k.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub enum Operator {
     /// `k += amplitude t` (the default).
     #[default]
     Sum,
-    /// `k = k (1 - t) + amplitude t`.
+    /// The paper's blending (Gilet & Dischler 2009, section 4.1): `v1 (1 - v2) + v2` with `v1`
+    /// the k so far and `v2 = amplitude t`, both in units of the largest amplitude `A` of the
+    /// hypertexture's noises (so `v2` lies in [0, 1]): `k = k (1 - amplitude t / A) + amplitude t`.
     Blend,
+    /// `k = k (1 - t) + amplitude t`: a lerp from k towards the amplitude by `t`, so where
+    /// `t = 1` the noise replaces what came before whatever its amplitude.
+    Mix,
 }
 
 /// A 1D shape transfer function on [0, 1] with values in [0, 1].
@@ -355,8 +360,8 @@ pub struct RampPoint(
 );
 
 impl Hypertexture {
-    /// The largest shift `k` can reach: the sum of the enabled noises' amplitudes (Blend never
-    /// exceeds it).
+    /// The largest shift `k` can reach: the sum of the enabled noises' amplitudes (Blend and Mix
+    /// never exceed it).
     pub(crate) fn max_shift(&self) -> f64 {
         self.enabled_noises().map(|n| n.amplitude).sum()
     }

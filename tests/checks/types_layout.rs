@@ -46,7 +46,7 @@ fn wgsl_structs_match_rust() {
         layout!(HyperParams; to_local, right, up, bounds_min, bounds_max, object, field, field_center, perturb, kinds, march, budget, grid_min, grid_max, modulation),
         layout!(MeshGridParams; lo, hi, counts),
         layout!(MeshTexelParams; color, extent, mode),
-        layout!(HyperNoise; amplitude, frequency, shift, blend, seed, speed, table, rows, scale, tile),
+        layout!(HyperNoise; amplitude, frequency, shift, combine, seed, speed, table, rows, scale, tile),
         layout!(TransferFunction; first, count, kind, _pad),
         layout!(TransferPoint; x, y, slope, _pad),
         layout!(MarchState; color, resume),

@@ -476,6 +476,63 @@ fn zero_amplitude_gives_the_undistorted_object() {
     assert!(inside > 200 && outside > 200);
 }
 
+/// Eq. 5's operators against the paper's formulas, with constant shape transfer functions (so
+/// `t_i` is known everywhere): Sum `k + a t`; Blend the paper's `v1 (1 - v2) + v2` with `v1` the
+/// k so far and `v2 = a t`, both over the largest amplitude A; Mix `k (1 - t) + a t`. Inside a
+/// soft unit sphere with the closest-surface field the density is `1 - (|x| - k)`, so kernel and
+/// twin give k at every point.
+#[test]
+fn operators_follow_the_papers_formulas() {
+    let (a, t) = ([0.2, 0.4, 0.1], [0.5, 0.75, 0.4]);
+    let big = 0.4;
+    let sum = a[0] * t[0];
+    let paper = |v1: f64, v2: f64| v1 * (1.0 - v2) + v2;
+    let blend = big * paper(sum / big, a[1] * t[1] / big);
+    let mix = blend * (1.0 - t[2]) + a[2] * t[2];
+    assert!((blend - 0.325).abs() < 1e-12 && (mix - 0.235).abs() < 1e-12, "{blend} {mix}");
+    for (operators, k) in
+        [(["Sum", "Sum", "Sum"], sum + a[1] * t[1] + a[2] * t[2]), (["Sum", "Blend", "Mix"], mix)]
+    {
+        let noise = |i: usize| {
+            format!(
+                "(shape: Table([{t}, {t}]), amplitude: {a}, frequency: 3.0, seed: {i}, operator: {op})",
+                t = t[i],
+                a = a[i],
+                op = operators[i]
+            )
+        };
+        let h = format!(
+            "(object: Sphere(radius: 1.0), noises: [{}, {}, {}], color: Step(threshold: 0.4, color: (1.0, 1.0, 1.0)), \
+             opacity_length: 0.01)",
+            noise(0),
+            noise(1),
+            noise(2)
+        );
+        let scene = one(&h, "RayMarch(step: 0.01)");
+        let bp = blueprint(&scene, &sized(16, 16));
+        let plan = plans(&bp)[0];
+        let mut rng = Rng(29);
+        let points: Vec<[f32; 4]> = (0..512)
+            .map(|_| {
+                let dir = rng.in_box(DVec3::splat(-1.0), DVec3::splat(1.0)).normalize();
+                point(dir * (0.5 + 0.45 * rng.next()), 0)
+            })
+            .collect();
+        let gpu = probe(&ctx().lock().unwrap_or_else(|e| e.into_inner()), plan, &points).unwrap();
+        let tables = twin_tables(plan);
+        let m = model(plan, &tables);
+        let mut worst: f64 = 0.0;
+        for (i, p) in points.iter().enumerate() {
+            let x = DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64);
+            let expected = 1.0 - (x.length() - k);
+            assert!((m.hyper_density(x) - expected).abs() < 1e-6, "{operators:?}: twin at {x}");
+            worst = worst.max((gpu.values[4 * i + 2][0] as f64 - expected).abs());
+        }
+        eprintln!("{operators:?}: k = {k}, kernel within {worst:.1e}");
+        assert!(worst < 1e-5, "{operators:?}: kernel off by {worst}");
+    }
+}
+
 /// The Henyey-Greenstein phase function: isotropic at g = 0, a density over the sphere of
 /// directions for every g (it integrates to 1), and its peak value; with g = 0 the phase shading
 /// keeps the albedo: the image equals the unshaded one.

@@ -6,8 +6,11 @@
 
 // O(x - k V/|V|) with k combining the noises in order from 0: noise i gives
 // t_i = T_i((1 + noise(f_i (x + r_i V))) / 2) (2D functions: T_i(.., O(x)), eq. 6) and then
-// k += a_i t_i (Sum) or k = k (1 - t_i) + a_i t_i (Blend); the noise is 4D when `animated`.
-// One loop iteration per noise.
+// k += a_i t_i (Sum), k = k (1 - a_i t_i / A) + a_i t_i (Blend: the paper's v1 (1 - v2) + v2 in
+// units of the largest amplitude A) or k = k (1 - t_i) + a_i t_i (Mix); the noise is 4D when
+// `animated`. One loop iteration per noise.
+const OPERATOR_BLEND: u32 = 1u;
+const OPERATOR_MIX: u32 = 2u;
 // Evaluations of `hyper_density` that ran the noises, for benchmarks (per invocation).
 var<private> noised_evaluations: u32;
 // Benchmarks only: every noise reads 0 (and is compiled out), to measure what noise costs.
@@ -38,10 +41,14 @@ fn hyper_density(x: vec3<f32>) -> f32 {
             value = simplex3_tiled(q, n.seed, vec3<i32>(n.tile.xyz));
         }
         let t = shape_lookup(n, 0.5 + 0.5 * value, density);
-        if (n.blend != 0u) {
-            k = k * (1.0 - t) + n.amplitude * t;
+        let term = n.amplitude * t;
+        if (n.combine == OPERATOR_BLEND) {
+            // The paper's v1 (1 - v2) + v2, in units of the largest amplitude (`scale.w`).
+            k = k * (1.0 - select(0.0, term / n.scale.w, n.scale.w > 0.0)) + term;
+        } else if (n.combine == OPERATOR_MIX) {
+            k = k * (1.0 - t) + term;
         } else {
-            k += n.amplitude * t;
+            k += term;
         }
     }
     return modulate(object_density(x - k * dir));

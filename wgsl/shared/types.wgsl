@@ -248,7 +248,7 @@ struct HyperNoise {
     amplitude: f32,
     frequency: f32,
     shift: f32,
-    blend: u32,
+    combine: u32,
     seed: u32,
     speed: f32,
     table: u32,
