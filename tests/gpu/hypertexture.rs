@@ -157,8 +157,9 @@ fn periodic_noise_repeats() {
     let bp = blueprint(&scene, &sized(8, 8));
     let plan = plans(&bp)[0];
     let noise = plan.packed.noises[0];
-    // frequency 2.5 x period 1.2 = 3 cells: one tile of 3 cells per axis, the frequency unchanged.
-    assert_eq!((noise.tile, noise.scale), ([1, 1, 1, 0], [1.0, 1.0, 1.0, 1.0]));
+    // frequency 2.5 x period 1.2 = 3 cells: one tile of 3 cells per axis, the frequency unchanged
+    // (scale.w is Blend's unit: the one noise's amplitude).
+    assert_eq!((noise.tile, noise.scale), ([1, 1, 1, 0], [1.0, 1.0, 1.0, noise.amplitude]));
     let tile = [2, 3, 5];
     let mut rng = Rng(11);
     let base: Vec<DVec3> = (0..1024).map(|_| rng.in_box(DVec3::splat(-20.0), DVec3::splat(20.0))).collect();
