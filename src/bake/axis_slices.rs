@@ -119,14 +119,15 @@ pub(crate) fn bake(
 }
 
 /// Records the MIP levels of every slice image of `baked` (level 0 baked), each from the one
-/// above by a 2x2 box of premultiplied colour (`mip_axis_slices.wgsl`).
+/// above by a 2x2 box of premultiplied colour (`mip_axis_slices.wgsl`); the w slices (the last
+/// array) repeat along both axes, the s and t slices along their first.
 pub(crate) fn mip(
     ctx: &GpuContext,
     kernel: &mut ComputeKernel,
     encoder: &mut wgpu::CommandEncoder,
     baked: &AxisBaked,
 ) -> Result<()> {
-    for array in &baked.arrays {
+    for (direction, array) in baked.arrays.iter().enumerate() {
         for level in 1..array.mip_level_count() {
             let view = |level: u32| {
                 array.create_view(&wgpu::TextureViewDescriptor {
@@ -139,6 +140,7 @@ pub(crate) fn mip(
             let mut inputs = Inputs::default();
             inputs.views.insert("finer".into(), view(level - 1));
             inputs.views.insert("coarser".into(), view(level));
+            inputs.constants.push(("wrap_rows".into(), (direction == 2) as u32 as f64));
             let (w, h) = ((array.width() >> level).max(1), (array.height() >> level).max(1));
             kernel.dispatch(ctx, encoder, &inputs, [w, h, array.depth_or_array_layers()])?;
         }

@@ -132,6 +132,17 @@ pub struct Overrides {
     /// (default: the scene's).
     #[arg(long, value_enum)]
     lod: Option<LodArg>,
+    /// MIP-mapped slice images of every AxisSlices object: `on` (each pixel filters the slices
+    /// over its footprint) or `off` (level 0) (default: the scene's `mipmaps`).
+    #[arg(long, value_enum)]
+    mipmaps: Option<Switch>,
+}
+
+/// An `on`/`off` value.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Switch {
+    On,
+    Off,
 }
 
 /// A `--lod` value.
@@ -230,6 +241,7 @@ impl Overrides {
             shadows: self.shadows.map(|s| s.0),
             compositor: self.compositor.map(Into::into),
             lod: self.lod.map(Into::into),
+            mipmaps: self.mipmaps.map(|m| m == Switch::On),
             ..Default::default()
         })
     }

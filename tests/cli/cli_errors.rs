@@ -538,3 +538,23 @@ fn closed_stdout_is_no_panic() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(!err.contains("panicked") && !err.contains("Broken pipe"), "{err}");
 }
+
+/// `--mipmaps on|off` switches the MIP-mapped slice images of every AxisSlices object (the
+/// scene's `mipmaps` otherwise), and anything else is a usage error.
+#[test]
+fn mipmaps_flag_switches_every_axis_slices_object() {
+    let scene = root().join("scenes/meyer_neyret/heightfield_plane.ron");
+    let scene = scene.to_str().unwrap();
+    for (args, expected) in [(&[][..], "mipmaps: true"), (&["--mipmaps", "off"][..], "mipmaps: false")] {
+        let mut all = vec!["plan", scene];
+        all.extend_from_slice(args);
+        let text = common::ok(common::voltex(&all));
+        assert!(text.contains(expected), "{args:?}: {text}");
+    }
+    let pear = root().join("scenes/meyer_neyret/pear.ron");
+    let text = common::ok(common::voltex(&["plan", pear.to_str().unwrap(), "--mipmaps", "on"]));
+    assert!(text.contains("mipmaps: true"), "{text}");
+    let out = common::voltex(&["plan", scene, "--mipmaps", "maybe"]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(stderr(&out).contains("possible values: on, off"), "{}", stderr(&out));
+}

@@ -50,19 +50,56 @@ struct SliceSample {
     corrected: f32,
 }
 
+// Samples of the footprint filter along its longer axis, at most.
+const MAX_FOOTPRINT_SAMPLES: u32 = 8u;
+
+// One trilinear sample of the slice image at `uv` and MIP level `level`.
+fn slice_at(in: VsOut, uv: vec2<f32>, level: f32) -> vec4<f32> {
+    if (in.direction == 2u) {
+        return textureSampleLevel(axis_slices_w, axis_sampler, uv, in.layer, level);
+    } else if (in.direction == 0u) {
+        return textureSampleLevel(axis_slices_s, axis_sampler_side, uv, in.layer, level);
+    }
+    return textureSampleLevel(axis_slices_t, axis_sampler_side, uv, in.layer, level);
+}
+
+// The slice image filtered over the pixel's footprint (`mipmaps: true`): up to
+// MAX_FOOTPRINT_SAMPLES trilinear samples spread along the footprint's longer axis (in texels),
+// at the level of the part each stands for (footprint assembly), so a slice seen at a grazing
+// angle is not blurred across. A trilinear sample at level l spans 2^(l+1) texels (the tent of
+// the bilinear filter on 2^l-texel texels), so the level is log2 of half the part's length: the
+// filter is as wide as the footprint. Explicit levels, not gradients: llvmpipe ignores the
+// gradients of an anisotropic sampler, so `textureSampleGrad` filtered alike at every distance.
+fn filtered_slice(in: VsOut) -> vec4<f32> {
+    var size: vec2<u32>;
+    if (in.direction == 2u) {
+        size = textureDimensions(axis_slices_w);
+    } else if (in.direction == 0u) {
+        size = textureDimensions(axis_slices_s);
+    } else {
+        size = textureDimensions(axis_slices_t);
+    }
+    let texels = vec2<f32>(size);
+    let dx = dpdx(in.uv);
+    let dy = dpdy(in.uv);
+    let lx = length(dx * texels);
+    let ly = length(dy * texels);
+    let major = select(dy, dx, lx >= ly);
+    let long = max(lx, ly);
+    let short = max(min(lx, ly), 1e-6);
+    let n = u32(clamp(ceil(long / short), 1.0, f32(MAX_FOOTPRINT_SAMPLES)));
+    let level = max(log2(0.5 * long / f32(n)), 0.0);
+    var sum = vec4<f32>(0.0);
+    for (var i = 0u; i < n; i++) {
+        sum += slice_at(in, in.uv + major * ((f32(i) + 0.5) / f32(n) - 0.5), level);
+    }
+    return sum / f32(n);
+}
+
 fn sample_slice(in: VsOut) -> SliceSample {
     var texel: vec4<f32>;
     if (mipmapped_slices) {
-        // Explicit gradients: the branch on the slice's direction is not uniform control flow.
-        let ddx = dpdx(in.uv);
-        let ddy = dpdy(in.uv);
-        if (in.direction == 2u) {
-            texel = textureSampleGrad(axis_slices_w, axis_sampler, in.uv, in.layer, ddx, ddy);
-        } else if (in.direction == 0u) {
-            texel = textureSampleGrad(axis_slices_s, axis_sampler_side, in.uv, in.layer, ddx, ddy);
-        } else {
-            texel = textureSampleGrad(axis_slices_t, axis_sampler_side, in.uv, in.layer, ddx, ddy);
-        }
+        texel = filtered_slice(in);
     } else if (in.direction == 2u) {
         texel = textureSampleLevel(axis_slices_w, axis_sampler, in.uv, in.layer, 0.0);
     } else if (in.direction == 0u) {

@@ -3,17 +3,22 @@
 @group(0) @binding(1) var coarser: texture_storage_2d_array<rgba16float, write>;
 
 // Premultiplied colour averages like coverage, so a minified slice keeps its mean opacity and
-// the colour it shows. An odd size repeats its last row or column (the texel past the edge).
+// the colour it shows. Filtering stays within the slice; at an odd size the texel past the edge
+// is the first one along an axis the texel repeats (s and t: both axes of a w slice, the first
+// of an s or t slice) and the last one along w, which does not repeat.
+override wrap_rows: bool = false;
+
 @compute @workgroup_size(8, 8, 1)
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let size = textureDimensions(coarser);
     if (id.x >= size.x || id.y >= size.y || id.z >= textureNumLayers(coarser)) {
         return;
     }
-    let last = textureDimensions(finer) - vec2<u32>(1u);
+    let fine = textureDimensions(finer);
     var sum = vec4<f32>(0.0);
     for (var k = 0u; k < 4u; k++) {
-        let p = min(2u * id.xy + vec2<u32>(k & 1u, k >> 1u), last);
+        let q = 2u * id.xy + vec2<u32>(k & 1u, k >> 1u);
+        let p = vec2<u32>(q.x % fine.x, select(min(q.y, fine.y - 1u), q.y % fine.y, wrap_rows));
         sum += textureLoad(finer, p, id.z, 0);
     }
     textureStore(coarser, id.xy, id.z, 0.25 * sum);

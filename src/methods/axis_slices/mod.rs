@@ -198,10 +198,10 @@ pub(crate) fn add_inputs(
         });
         inputs.views.insert(name.to_string(), view);
     }
-    // Trilinear and anisotropic between the MIP levels of `mipmaps: true`.
-    let (mipmap_filter, anisotropy_clamp) = match plan.method.mipmaps {
-        true => (wgpu::MipmapFilterMode::Linear, ANISOTROPY),
-        false => (wgpu::MipmapFilterMode::Nearest, 1),
+    // Trilinear between the MIP levels of `mipmaps: true` (the kernel picks each sample's level).
+    let mipmap_filter = match plan.method.mipmaps {
+        true => wgpu::MipmapFilterMode::Linear,
+        false => wgpu::MipmapFilterMode::Nearest,
     };
     let sampler = |label: &str, v: wgpu::AddressMode| {
         ctx.device.create_sampler(&wgpu::SamplerDescriptor {
@@ -211,7 +211,6 @@ pub(crate) fn add_inputs(
             mag_filter: wgpu::FilterMode::Linear,
             min_filter: wgpu::FilterMode::Linear,
             mipmap_filter,
-            anisotropy_clamp,
             ..Default::default()
         })
     };
@@ -224,10 +223,6 @@ pub(crate) fn add_inputs(
     inputs.constants.push(("grouped_slices".into(), plan.grouped as u32 as f64));
     inputs.constants.push(("mipmapped_slices".into(), plan.method.mipmaps as u32 as f64));
 }
-
-/// Samples the MIP levels take along a slice's stretched footprint (grazing views, side slices
-/// seen edge-on), so that the level follows its narrow side.
-const ANISOTROPY: u16 = 16;
 
 /// Reads back the per-prism choices and the drawn vertices after a frame (tests, `bench`).
 pub fn read_back(
