@@ -97,7 +97,10 @@ pub(crate) fn choose(
     let planes = (extent / spacing).ceil().min(max_planes as f64) as u32;
     LodChoice {
         planes: planes.max(MIN_LOD_PLANES).min(max_planes),
-        level: (need.floor().max(0.0) as u32).min(levels.saturating_sub(1)),
+        // A bilinear sample at level l spans 2^(l+1) voxels (the tent over two of its texels),
+        // so the filter is a pixel wide at l = need - 1: the nearest level to that (as a GPU's
+        // nearest-MIP choice rounds), not the coarsest whose voxel fits in a pixel.
+        level: ((need - 1.0).round().max(0.0) as u32).min(levels.saturating_sub(1)),
         pixel,
         voxel_max,
         voxel_min,
