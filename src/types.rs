@@ -47,10 +47,8 @@ pub struct SliceParams {
     pub prism_count: u32,
     /// Capacity of the slice-vertex buffer, in vertices.
     pub vertex_capacity: u32,
-    /// MIP level of the texel volume the slices sample (`lod: Auto`; 0: full resolution).
-    pub texel_level: f32,
     /// Padding to the WGSL layout (zero).
-    pub _pad: [u32; 2],
+    pub _pad: [u32; 3],
 }
 
 /// One vertex of a slice polygon, triangulated as a fan into a triangle list.

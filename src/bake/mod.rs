@@ -6,7 +6,7 @@
 pub mod axis_slices;
 pub mod hypertexture;
 pub mod shadow;
-pub mod texel_mips;
+pub mod texel_layers;
 pub mod volume;
 
 use crate::gpu::sources::Sources;
@@ -129,8 +129,9 @@ pub struct BakeRequest {
     pub axis_slices: bool,
     /// ... with their MIP levels (`AxisSlices(mipmaps: true)`).
     pub axis_mipmaps: bool,
-    /// The MIP levels of the volume (and normal volume) too (`ViewSlices(lod: Auto)`).
-    pub volume_mipmaps: bool,
+    /// The texel's layers too (`ViewSlices(lod: Auto)`): its w slices as f16 2D arrays whose
+    /// MIP levels filter s and t only (`texel_layers`), of the volume and of the normals.
+    pub layers: bool,
     /// Self-shadowing baked into the colour after the source's bake (`shadow_texel.wgsl`).
     pub shadow: Option<shadow::Shadow>,
 }
@@ -161,8 +162,8 @@ impl BakeRequest {
         if self.axis_slices && self.axis_mipmaps {
             k.push("axis_slices/mip_axis_slices.wgsl");
         }
-        if self.volume_mipmaps {
-            k.push(MIP_KERNEL);
+        if self.layers {
+            k.extend([texel_layers::COPY_KERNEL, texel_layers::MIP_KERNEL]);
         }
         k
     }
@@ -175,13 +176,17 @@ pub struct Baked {
     pub volume: wgpu::Texture,
     /// The normal volume (1x1x1 when `per_pixel` is off: the binding exists, nothing is stored).
     pub normals: wgpu::Texture,
+    /// The volume's and the normals' layers when the request asked for them (else 1x1, one
+    /// layer: the bindings exist, nothing is stored).
+    pub layers: [wgpu::Texture; 2],
     /// The slice images when the request asked for them.
     pub axis: Option<axis_slices::AxisBaked>,
 }
 
 impl crate::gpu::cache::GpuBytes for Baked {
     fn gpu_bytes(&self) -> u64 {
-        self.volume.gpu_bytes() + self.normals.gpu_bytes() + self.axis.gpu_bytes()
+        let layers: u64 = self.layers.iter().map(|l| l.gpu_bytes()).sum();
+        self.volume.gpu_bytes() + self.normals.gpu_bytes() + layers + self.axis.gpu_bytes()
     }
 }
 
@@ -190,11 +195,17 @@ impl BakeRequest {
     pub(crate) fn memory(&self, texel: &str) -> Vec<(String, u64)> {
         let [x, y, z] = self.resolution;
         let normals = if self.per_pixel { " + normals" } else { "" };
-        let mips = if self.volume_mipmaps { " with MIP levels" } else { "" };
         let mut out = vec![(
-            format!("texel {texel} {x}x{y}x{z} rgba8{normals}{mips}"),
-            bytes(self.resolution, self.per_pixel, self.volume_mipmaps),
+            format!("texel {texel} {x}x{y}x{z} rgba8{normals}"),
+            bytes(self.resolution, self.per_pixel),
         )];
+        if self.layers {
+            let copies = if self.per_pixel { 2 } else { 1 };
+            out.push((
+                format!("texel {texel} layers ({z} of {x}x{y}, s and t MIP levels){normals} rgba16f"),
+                copies * texel_layers::bytes(self.resolution),
+            ));
+        }
         if self.axis_slices {
             let mips = if self.axis_mipmaps { " with MIP levels" } else { "" };
             out.push((
@@ -209,11 +220,10 @@ impl BakeRequest {
     pub(crate) fn allocations(&self, texel: &str) -> Vec<Allocation> {
         let res = self.resolution;
         let voxels = res.iter().map(|&r| r as u64).product::<u64>();
-        let with_mips = texel_mips::voxels(res, self.volume_mipmaps);
         let driver = Driver::Texel(texel.to_string());
         let volume = |what: String, size| Allocation {
             what,
-            bytes: with_mips * 4,
+            bytes: voxels * 4,
             shape: Shape::Texture3d { size },
             driver: driver.clone(),
         };
@@ -223,6 +233,17 @@ impl BakeRequest {
         }
         if self.per_pixel {
             out.push(volume(format!("texel \"{texel}\"'s normal volume"), res));
+        }
+        if self.layers {
+            let names: &[&str] = if self.per_pixel { &["layers", "normal layers"] } else { &["layers"] };
+            for name in names {
+                out.push(Allocation {
+                    what: format!("texel \"{texel}\"'s {name}"),
+                    bytes: texel_layers::bytes(res),
+                    shape: Shape::Texture2d { size: [res[0], res[1]], layers: res[2] },
+                    driver: driver.clone(),
+                });
+            }
         }
         if let BakeSource::Volume(v) = &self.source {
             let size = volume::atlas_size(volume::slots(&v.grid));
@@ -277,8 +298,8 @@ impl BakeRequest {
         };
         let lighting = if self.per_pixel { "per-pixel (albedo + normals)" } else { "baked" };
         let mut s = format!("  {texel:<16} {x}x{y}x{z}  {kind}  lighting {lighting}\n");
-        if self.volume_mipmaps {
-            s += "  (and its MIP levels: mip_texel_volume.wgsl per level)\n";
+        if self.layers {
+            s += "  (and its layers: layer_texel_volume.wgsl, then mip_texel_layers.wgsl per s,t level)\n";
         }
         if let Some(sh) = &self.shadow {
             let [lx, ly, lz] = sh.toward_light.map(|c| c as f64);
@@ -303,15 +324,11 @@ impl BakeRequest {
     }
 }
 
-/// Bytes a bake allocates on the GPU (volume, plus normals at the same resolution; both with
-/// their MIP levels when `mipmaps`).
-pub(crate) fn bytes(res: [u32; 3], per_pixel: bool, mipmaps: bool) -> u64 {
-    let volume = texel_mips::voxels(res, mipmaps) * 4;
+/// Bytes a bake allocates on the GPU for its volume, plus normals at the same resolution.
+pub(crate) fn bytes(res: [u32; 3], per_pixel: bool) -> u64 {
+    let volume = res.iter().map(|&r| r as u64).product::<u64>() * 4;
     volume + if per_pixel { volume } else { 4 }
 }
-
-/// The kernel making a texel volume's MIP levels.
-const MIP_KERNEL: &str = "bake/mip_texel_volume.wgsl";
 
 /// Each kernel with the hash of its source, so that a baker kept across the preview's rebuilds
 /// reloads a kernel whose file (or include) changed.
@@ -328,9 +345,8 @@ pub struct Baker {
     axis: Slot,
     volume: Slot,
     axis_mip: Slot,
-    /// `mip_texel_volume` writing the volume's format, and writing normals (`rgba8snorm`).
-    volume_mip: Slot,
-    normals_mip: Slot,
+    layer_copy: Slot,
+    layer_mip: Slot,
     shadow: Slot,
     sources: Sources,
     /// `Rgba32Float` for [`Baker::full_precision`], else `Rgba8Unorm`.
@@ -350,8 +366,8 @@ impl Baker {
             axis: None,
             volume: None,
             axis_mip: None,
-            volume_mip: None,
-            normals_mip: None,
+            layer_copy: None,
+            layer_mip: None,
             shadow: None,
             sources: sources.clone(),
             format: wgpu::TextureFormat::Rgba8Unorm,
@@ -392,29 +408,6 @@ impl Baker {
         Ok(&mut slot.as_mut().unwrap().1)
     }
 
-    /// `mip_texel_volume` with its `coarser` declared in `format`.
-    fn mip_kernel<'a>(
-        slot: &'a mut Slot,
-        ctx: &GpuContext,
-        sources: &Sources,
-        format: wgpu::TextureFormat,
-    ) -> Result<&'a mut ComputeKernel> {
-        let hash = crate::gpu::shader::source_hash(sources, MIP_KERNEL)?;
-        if slot.as_ref().is_none_or(|(h, _)| *h != hash) {
-            let mut kernel = crate::gpu::shader::load_from(sources, MIP_KERNEL)?;
-            let storage = match format {
-                wgpu::TextureFormat::Rgba32Float => Some(naga::StorageFormat::Rgba32Float),
-                wgpu::TextureFormat::Rgba8Snorm => Some(naga::StorageFormat::Rgba8Snorm),
-                _ => None,
-            };
-            if let Some(storage) = storage {
-                kernel = kernel.with_storage_format("coarser", storage)?;
-            }
-            *slot = Some((hash, ComputeKernel::new(ctx, kernel)?));
-        }
-        Ok(&mut slot.as_mut().unwrap().1)
-    }
-
     /// Bakes `req` on the GPU: the source's kernel, then what the request asks for (shadows, MIP
     /// levels, slice images); a volume beyond the adapter's 3D texture limit is an error.
     pub fn bake(&mut self, ctx: &GpuContext, req: &BakeRequest) -> Result<Baked> {
@@ -425,16 +418,9 @@ impl Baker {
                 req.resolution
             )));
         }
-        let mips = |res| if req.volume_mipmaps { texel_mips::mip_levels(res) } else { 1 };
-        let volume = volume_texture(ctx, "texel volume", req.resolution, mips(req.resolution), self.format);
+        let volume = volume_texture(ctx, "texel volume", req.resolution, self.format);
         let normals_res = if req.per_pixel { req.resolution } else { [1, 1, 1] };
-        let normals = volume_texture(
-            ctx,
-            "texel normals",
-            normals_res,
-            mips(normals_res),
-            wgpu::TextureFormat::Rgba8Snorm,
-        );
+        let normals = volume_texture(ctx, "texel normals", normals_res, wgpu::TextureFormat::Rgba8Snorm);
         let params = crate::cpu::bake::bake_params(req.resolution, 0, req.light, req.ambient);
         let mut inputs = Inputs::default();
         inputs.constants.push(("per_pixel_lighting".into(), req.per_pixel as u32 as f64));
@@ -562,12 +548,18 @@ impl Baker {
             }
             None => volume,
         };
-        if req.volume_mipmaps {
-            for (slot, texture) in [(&mut self.volume_mip, &volume), (&mut self.normals_mip, &normals)] {
-                let kernel = Self::mip_kernel(slot, ctx, &root, texture.format())?;
-                texel_mips::record(ctx, kernel, &mut encoder, texture)?;
+        let layers = match req.layers {
+            true => {
+                let format = self.format;
+                let copy = Self::kernel(&mut self.layer_copy, ctx, &root, texel_layers::COPY_KERNEL, format)?;
+                let mip = Self::kernel(&mut self.layer_mip, ctx, &root, texel_layers::MIP_KERNEL, format)?;
+                let mut make = |t: &wgpu::Texture, label| {
+                    texel_layers::record(ctx, (&mut *copy, &mut *mip), &mut encoder, t, label)
+                };
+                [make(&volume, "texel layers")?, make(&normals, "texel normal layers")?]
             }
-        }
+            false => [0, 1].map(|_| texel_layers::texture(ctx, "no texel layers", [1, 1], 1, 1)),
+        };
         let axis = match req.axis_slices {
             true => {
                 let format = self.format;
@@ -591,7 +583,7 @@ impl Baker {
         };
         ctx.queue.submit([encoder.finish()]);
         ctx.take_errors()?;
-        Ok(Baked { volume, normals, axis })
+        Ok(Baked { volume, normals, layers, axis })
     }
 }
 
@@ -599,13 +591,12 @@ fn volume_texture(
     ctx: &GpuContext,
     label: &str,
     res: [u32; 3],
-    mip_level_count: u32,
     format: wgpu::TextureFormat,
 ) -> wgpu::Texture {
     ctx.device.create_texture(&wgpu::TextureDescriptor {
         label: Some(label),
         size: wgpu::Extent3d { width: res[0], height: res[1], depth_or_array_layers: res[2] },
-        mip_level_count,
+        mip_level_count: 1,
         sample_count: 1,
         dimension: wgpu::TextureDimension::D3,
         format,

@@ -48,8 +48,7 @@ pub(crate) fn apply(
 ) -> Result<wgpu::Texture> {
     let size = volume.size();
     let res = [size.width, size.height, size.depth_or_array_layers];
-    let shadowed =
-        super::volume_texture(ctx, "shadowed texel volume", res, volume.mip_level_count(), volume.format());
+    let shadowed = super::volume_texture(ctx, "shadowed texel volume", res, volume.format());
     let params = shadow.params(res);
     let mut inputs = Inputs::default();
     inputs.buffers.insert("shadow".into(), uniform(ctx, "shadow", bytemuck::bytes_of(&params)));

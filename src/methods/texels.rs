@@ -153,7 +153,7 @@ pub(crate) fn bake_index(
             ambient: light.ambient,
             axis_slices: false,
             axis_mipmaps: false,
-            volume_mipmaps: false,
+            layers: false,
             shadow: t.shadow.map(|sh| Shadow {
                 // The direction towards the light, like `light.direction`.
                 toward_light: sh.direction.map_or(light.direction, |d| (-d).as_vec3().to_array()),

@@ -159,7 +159,7 @@ pub fn plan(scene: &Scene, opts: &ExportOptions) -> Result<Vec<Export>> {
                     ambient: light.ambient,
                     axis_slices: false,
                     axis_mipmaps: false,
-                    volume_mipmaps: false,
+                    layers: false,
                     shadow: None,
                 },
                 opacity_length: h.opacity_length,

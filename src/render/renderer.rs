@@ -76,6 +76,8 @@ impl Renderer {
             address_mode_w: wgpu::AddressMode::ClampToEdge,
             mag_filter: wgpu::FilterMode::Linear,
             min_filter: wgpu::FilterMode::Linear,
+            // Between the MIP levels of texel layers (`lod: Auto`); level 0 alone elsewhere.
+            mipmap_filter: wgpu::MipmapFilterMode::Linear,
             ..Default::default()
         });
         // What plans bake for themselves (mesh grids, splat sets), per instance's plan.

@@ -118,6 +118,11 @@ const NO_TWIN: &[(&str, &str)] = &[
          sample rate; its output is never read",
     ),
     (
+        "layer_texel_volume",
+        "a copy of the volume into f16 layers, no arithmetic: level 0 of the layers equals the \
+         volume in tests/gpu/view_slices_lod.rs (`texel_layers_match_their_twin`)",
+    ),
+    (
         "present",
         "preview window only: shows an image already computed (filmic tonemap, sRGB, difference \
          heat map, overlay text); no headless output goes through it",

@@ -99,3 +99,24 @@ pub const TRANSFORMED_AND_INSIDE_VIEWS: [((&str, &str), &str); 2] = [
     (("(0.5, -4.0, 1.0)", "(0.0, 0.0, 0.0)"), "(rotate: (30.0, 10.0, 50.0), scale: (1.5, 0.6, 1.0))"),
     (("(0.0, -0.4, 0.2)", "(0.0, -2.0, 0.0)"), "()"),
 ];
+
+/// The f16 values of an `Rgba16Float` readback.
+pub fn f16s(bytes: &[u8]) -> Vec<f32> {
+    bytes
+        .chunks_exact(2)
+        .map(|b| {
+            let h = u16::from_le_bytes([b[0], b[1]]);
+            let (sign, exp, frac) = ((h >> 15) as i32, ((h >> 10) & 31) as i32, (h & 1023) as f32);
+            let v = match exp {
+                0 => frac * 2f32.powi(-24),
+                31 => f32::INFINITY,
+                _ => (1.0 + frac / 1024.0) * 2f32.powi(exp - 15),
+            };
+            if sign == 1 {
+                -v
+            } else {
+                v
+            }
+        })
+        .collect()
+}

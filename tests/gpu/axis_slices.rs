@@ -95,27 +95,6 @@ fn slice_counts_at_known_angles() {
     assert_eq!(layout::level_slices(64, c.level), expected.next_power_of_two());
 }
 
-/// The f16 values of an `Rgba16Float` readback.
-fn f16s(bytes: &[u8]) -> Vec<f32> {
-    bytes
-        .chunks_exact(2)
-        .map(|b| {
-            let h = u16::from_le_bytes([b[0], b[1]]);
-            let (sign, exp, frac) = ((h >> 15) as i32, ((h >> 10) & 31) as i32, (h & 1023) as f32);
-            let v = match exp {
-                0 => frac * 2f32.powi(-24),
-                31 => f32::INFINITY,
-                _ => (1.0 + frac / 1024.0) * 2f32.powi(exp - 15),
-            };
-            if sign == 1 {
-                -v
-            } else {
-                v
-            }
-        })
-        .collect()
-}
-
 #[test]
 fn slice_image_bake_matches_its_twin() {
     let res = [16, 12, 8];
@@ -131,7 +110,7 @@ fn slice_image_bake_matches_its_twin() {
         ambient: 0.3,
         axis_slices: true,
         axis_mipmaps: false,
-        volume_mipmaps: false,
+        layers: false,
         shadow: None,
     };
     let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
@@ -141,7 +120,7 @@ fn slice_image_bake_matches_its_twin() {
     let gpu: Vec<Vec<f32>> = axis
         .arrays
         .iter()
-        .map(|t| f16s(&voltex::bake::axis_slices::read_texture(&ctx, t, 8).unwrap()))
+        .map(|t| common::f16s(&voltex::bake::axis_slices::read_texture(&ctx, t, 8).unwrap()))
         .collect();
     let words: u64 = (0..3).map(|d| layout::array_layers(res[d]) as u64).sum();
     let occupancy: Vec<u32> =
@@ -181,7 +160,7 @@ fn slice_image_mips_match_their_twin() {
         ambient: 0.3,
         axis_slices: true,
         axis_mipmaps: true,
-        volume_mipmaps: false,
+        layers: false,
         shadow: None,
     };
     let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
@@ -193,7 +172,8 @@ fn slice_image_mips_match_their_twin() {
             voltex::bake::axis_slices::mip_levels([array.width(), array.height()])
         );
         for level in 1..array.mip_level_count() {
-            let read = |l| f16s(&voltex::bake::axis_slices::read_texture_level(&ctx, array, l, 8).unwrap());
+            let read =
+                |l| common::f16s(&voltex::bake::axis_slices::read_texture_level(&ctx, array, l, 8).unwrap());
             let (finer, coarser) = (read(level - 1), read(level));
             let (w, h) = ((array.width() >> (level - 1)).max(1), (array.height() >> (level - 1)).max(1));
             let per_layer = (w * h) as usize * 4;
@@ -239,7 +219,7 @@ fn height_image_bake_matches_its_twin() {
         ambient,
         axis_slices: false,
         axis_mipmaps: false,
-        volume_mipmaps: false,
+        layers: false,
         shadow: None,
     };
     let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());

@@ -195,8 +195,7 @@ fn explicit_planes(n: [f32; 3], ds: &[f32]) -> Vec<SliceParams> {
             plane_count: 1,
             prism_count: 1,
             vertex_capacity: 0,
-            texel_level: 0.0,
-            _pad: [0; 2],
+            _pad: [0; 3],
         })
         .collect()
 }

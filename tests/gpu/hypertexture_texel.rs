@@ -54,7 +54,7 @@ fn bake(ht: &HyperTexel, resolution: [u32; 3], per_pixel: bool) -> (Vec<u8>, Vec
         ambient: AMBIENT,
         axis_slices: false,
         axis_mipmaps: false,
-        volume_mipmaps: false,
+        layers: false,
         shadow: None,
     };
     let baked = Baker::new(&voltex::gpu::sources::Sources::project().unwrap()).bake(&ctx, &req).unwrap();

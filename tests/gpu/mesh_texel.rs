@@ -113,7 +113,7 @@ fn bake_res(source: BakeSource, resolution: [u32; 3], per_pixel: bool) -> (Vec<u
         ambient: AMBIENT,
         axis_slices: false,
         axis_mipmaps: false,
-        volume_mipmaps: false,
+        layers: false,
         shadow: None,
     };
     let t = std::time::Instant::now();

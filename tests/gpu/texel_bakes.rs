@@ -25,7 +25,7 @@ fn bake(
         ambient,
         axis_slices: false,
         axis_mipmaps: false,
-        volume_mipmaps: false,
+        layers: false,
         shadow: None,
     };
     let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());

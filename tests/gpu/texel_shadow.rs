@@ -145,7 +145,7 @@ fn a_column_shadows_its_neighbour_across_the_tile_edge() {
         ambient: 0.0,
         axis_slices: true,
         axis_mipmaps: false,
-        volume_mipmaps: false,
+        layers: false,
         shadow: Some(shadow),
     };
     let v = bake(&request, true);

@@ -6,7 +6,7 @@ use crate::common;
 
 use common::ctx;
 
-use voltex::bake::{texel_mips, BakeRequest, BakeSource, Baker};
+use voltex::bake::{texel_layers, BakeRequest, BakeSource, Baker};
 use voltex::cpu::bake::{pack_shapes, Shape};
 use voltex::io::Image;
 use voltex::methods::view_slices::lod::LodChoice;
@@ -35,11 +35,13 @@ fn render(scene: &scene::Scene, opts: &RenderOptions) -> Image {
     r.render(&ctx).unwrap().image
 }
 
-/// `mip_texel_volume.wgsl` against its twin: every level of the volume (rgba8unorm) and of the
-/// normal volume (rgba8snorm) from the GPU's own level above, odd sizes included (12 -> 6 -> 3
-/// -> 1 repeats the last voxel), within the 8-bit rounding of the mean.
+/// The texel's layers against their twins: level 0 of the volume's and the normals' layers
+/// equal the volumes (`layer_texel_volume.wgsl`, a copy into f16), and every MIP level of both
+/// (`mip_texel_layers.wgsl`) is `mip_texel_layers` of the GPU's own level above, odd sizes
+/// included (12 -> 6 -> 3 -> 1 wraps to the first texel), within f16 rounding; w is never
+/// filtered (every level keeps its 6 layers).
 #[test]
-fn texel_volume_mips_match_their_twin() {
+fn texel_layers_match_their_twin() {
     let res = [16, 12, 6];
     let shapes =
         pack_shapes(&[(Shape::Sphere { center: [0.4, 0.5, 0.4], radius: 0.35 }, [0.9, 0.3, 0.2], 0.7)]);
@@ -51,7 +53,7 @@ fn texel_volume_mips_match_their_twin() {
         ambient: 0.3,
         axis_slices: false,
         axis_mipmaps: false,
-        volume_mipmaps: true,
+        layers: true,
         shadow: None,
     };
     let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
@@ -59,28 +61,32 @@ fn texel_volume_mips_match_their_twin() {
     let unorm = |b: &[u8]| b.iter().map(|&v| v as f32 / 255.0).collect::<Vec<_>>();
     let snorm = |b: &[u8]| b.iter().map(|&v| (v as i8 as f32 / 127.0).max(-1.0)).collect::<Vec<_>>();
     let mut checked = 0;
-    for (texture, decode, step) in
-        [(&baked.volume, &unorm as &dyn Fn(&[u8]) -> Vec<f32>, 255.0), (&baked.normals, &snorm, 127.0)]
-    {
-        assert_eq!(texture.mip_level_count(), texel_mips::mip_levels(res));
-        for level in 1..texture.mip_level_count() {
-            let read =
-                |l| decode(&voltex::bake::axis_slices::read_texture_level(&ctx, texture, l, 4).unwrap());
+    for (volume, layers, decode) in [
+        (&baked.volume, &baked.layers[0], &unorm as &dyn Fn(&[u8]) -> Vec<f32>),
+        (&baked.normals, &baked.layers[1], &snorm),
+    ] {
+        assert_eq!(layers.mip_level_count(), texel_layers::mip_levels(res));
+        assert_eq!(layers.depth_or_array_layers(), res[2]);
+        let read =
+            |l| common::f16s(&voltex::bake::axis_slices::read_texture_level(&ctx, layers, l, 8).unwrap());
+        let source = decode(&voltex::bake::axis_slices::read_texture(&ctx, volume, 4).unwrap());
+        let level0 = read(0);
+        let copied = level0.iter().zip(&source).map(|(a, b)| (a - b).abs()).fold(0.0, f32::max);
+        assert!(copied <= 1e-3, "level 0 differs from the volume by {copied}");
+        for level in 1..layers.mip_level_count() {
             let (finer, coarser) = (read(level - 1), read(level));
-            let size = texture.size().mip_level_size(level - 1, wgpu::TextureDimension::D3);
+            let size = [(res[0] >> (level - 1)).max(1), (res[1] >> (level - 1)).max(1)];
             let fine: Vec<[f32; 4]> = finer.chunks_exact(4).map(|c| [c[0], c[1], c[2], c[3]]).collect();
-            let cpu = voltex::cpu::mip_texel_volume::mip_texel_volume(
-                &fine,
-                [size.width, size.height, size.depth_or_array_layers],
-            );
+            let cpu = voltex::cpu::mip_texel_layers::mip_texel_layers(&fine, size, res[2]);
             assert_eq!(cpu.len() * 4, coarser.len(), "level {level}");
+            // f16 keeps 11 bits: half an ulp of values up to 1.
             let worst =
                 coarser.iter().zip(cpu.iter().flatten()).map(|(g, c)| (g - c).abs()).fold(0.0, f32::max);
-            assert!(worst <= 0.51 / step, "level {level}: worst difference {worst}");
+            assert!(worst <= 5e-4, "level {level}: worst difference {worst}");
             checked += cpu.len();
         }
     }
-    assert!(checked > 200, "{checked} voxels checked");
+    assert!(checked > 200, "{checked} texels checked");
 }
 
 /// The plane count follows the distance: the nearest depth times the planes stays the same (a
@@ -106,9 +112,12 @@ fn lod_follows_the_distance() {
 }
 
 /// torus_egg three times as far, 64x64, against the Reference supersampled 2x2: `lod: Auto`
-/// draws 39 of 400 planes at texel level 4 (measured FLIP 0.0146, relative RMSE 0.090), closer
-/// than full detail (FLIP 0.0191, RMSE 0.122: the level filters what a pixel covers) and than
-/// the same 39 planes at level 0 (0.0288, 0.144).
+/// draws 39 of 400 planes, each fragment at its own level in s and t (measured FLIP 0.0176,
+/// relative RMSE 0.112), closer than full detail (FLIP 0.0191, RMSE 0.122: the level filters
+/// what a pixel covers) and than the same 39 planes at level 0 (0.0288, 0.144). (With one 3D
+/// level for the object, before 2026-11-28: 0.0146, 0.090. The egg is volumetric, and a 3D
+/// level also filters along w, which the layers leave unfiltered so that a height field keeps
+/// its profile: terrain's error fell from 0.0522 to 0.0497, see below.)
 #[test]
 fn far_lod_is_as_close_as_full_detail() {
     let (scene, opts) = torus_egg(3.0);
@@ -127,14 +136,14 @@ fn far_lod_is_as_close_as_full_detail() {
     };
     let (auto, full, same_planes) = (error(&auto), error(&full), error(&same_planes));
     eprintln!("lod {c:?}: FLIP, RMSE auto {auto:?}, full {full:?}, same planes at level 0 {same_planes:?}");
-    assert!(auto.0 <= 0.018 && auto.1 <= 0.10, "{auto:?}");
+    assert!(auto.0 <= 0.019 && auto.1 <= 0.115, "{auto:?}");
     assert!(auto.0 <= full.0 && auto.1 <= full.1, "{auto:?} {full:?}");
     assert!(auto.0 < same_planes.0 && auto.1 < same_planes.1, "{auto:?} {same_planes:?}");
 }
 
 /// terrain at 96x96 against the Reference averaging 4x4 samples a pixel (a pixel-area truth):
-/// `lod: Auto` draws fewer planes (281 of 400, texel level 1; measured FLIP 0.0522) and is no
-/// worse than full detail (0.0553). Against a one-sample Reference, which shares the slices'
+/// `lod: Auto` draws fewer planes (281 of 400, each fragment at its own level; measured FLIP
+/// 0.0497, and 0.0522 with one level for the object) and is no worse than full detail (0.0553). Against a one-sample Reference, which shares the slices'
 /// aliasing, any filtering looks worse (Auto 0.0433, Off 0.0145): the truth must be an area.
 #[test]
 fn auto_lod_on_terrain_is_no_worse_than_full_detail() {

@@ -256,7 +256,7 @@ fn volume_texel_bake_matches_twin() {
             ambient,
             axis_slices: false,
             axis_mipmaps: false,
-            volume_mipmaps: false,
+            layers: false,
             shadow: None,
         };
         let baked = Baker::new(&voltex::gpu::sources::Sources::project().unwrap()).bake(&ctx, &req).unwrap();

@@ -19,8 +19,7 @@ struct SliceParams {
     plane_count: u32,
     prism_count: u32,
     vertex_capacity: u32,
-    // MIP level of the texel volume the slices sample (0: full resolution).
-    texel_level: f32,
+    _pad0: u32,
     _pad1: u32,
     _pad2: u32,
 }

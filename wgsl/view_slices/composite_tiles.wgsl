@@ -29,6 +29,8 @@ override per_pixel_lighting: bool = false;
 @group(0) @binding(16) var depth: texture_depth_2d;
 @group(0) @binding(17) var<storage, read> tile_attributes: array<TileAttributes>;
 @group(0) @binding(18) var<storage, read_write> tile_layer: array<vec4<f32>>;
+@group(0) @binding(19) var volume_layers: texture_2d_array<f32>;
+@group(0) @binding(20) var normal_layers: texture_2d_array<f32>;
 
 // A pixel stops once less than this of what lies behind shows through (as the Reference does).
 const MIN_TRANSMITTANCE: f32 = 1e-4;
@@ -126,7 +128,9 @@ fn main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_id) l
                     f = tile_frame(t, bary);
                 }
             }
-            let c = slice_fragment(tile_attribute(tile_attributes[t], p), ray, exponent, f);
+            // A triangle's texel coordinates are affine in the pixel: its derivatives are exact.
+            let at = tile_attributes[t];
+            let c = slice_fragment(tile_attribute(at, p), texel_level(at.d_x.xyz, at.d_y.xyz), ray, exponent, f);
             rgb += transmittance * c.rgb;
             transmittance *= 1.0 - c.a;
         }

@@ -17,6 +17,8 @@ override per_pixel_lighting: bool = false;
 @group(0) @binding(9) var<storage, read> vertex_frames: array<VertexFrame>;
 // AOVs (fs_coverage, fs_depth): the nearest opaque hit per pixel.
 @group(0) @binding(10) var<storage, read_write> aov_opaque_depth: array<atomic<u32>>;
+@group(0) @binding(11) var volume_layers: texture_2d_array<f32>;
+@group(0) @binding(12) var normal_layers: texture_2d_array<f32>;
 
 #include "shared/aov_coverage.wgsl"
 #include "shared/aov_depth.wgsl"
@@ -49,7 +51,7 @@ fn vs_main(@builtin(vertex_index) index: u32) -> VsOut {
 
 // The texel's opacity over `opacity_length` (x) and over this pixel's ray between two planes (y).
 fn slice_alpha(in: VsOut) -> vec2<f32> {
-    let texel = textureSampleLevel(volume, volume_sampler, in.uvw, slice_params.texel_level);
+    let texel = texel_at(in.uvw, texel_level(dpdx(in.uvw), dpdy(in.uvw)));
     let step = slice_params.spacing / max(dot(normalize(in.rel), frame.forward.xyz), 1e-4);
     let a = clamp(texel.a, 0.0, 1.0);
     return vec2<f32>(a, 1.0 - pow(1.0 - min(a, 0.999999), step / object.opacity_length));
@@ -58,7 +60,8 @@ fn slice_alpha(in: VsOut) -> vec2<f32> {
 @fragment
 fn fs_main(in: VsOut) -> @location(0) vec4<f32> {
     let ray = normalize(in.rel);
-    return slice_fragment(in.uvw, ray, slice_exponent(ray, object.opacity_length), SliceFrame(in.n_s, in.n_t, in.n_w));
+    let level = texel_level(dpdx(in.uvw), dpdy(in.uvw));
+    return slice_fragment(in.uvw, level, ray, slice_exponent(ray, object.opacity_length), SliceFrame(in.n_s, in.n_t, in.n_w));
 }
 
 // Coverage AOV: the opacity fs_main draws with, into the object's slot.

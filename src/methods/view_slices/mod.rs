@@ -27,6 +27,8 @@ pub(crate) const CONTRIBUTION: super::Contribution = super::Contribution {
         "slice_vertices",
         "volume",
         "normals",
+        "volume_layers",
+        "normal_layers",
         "vertex_frames",
         "tile_params",
         "tile_triangles",
@@ -36,7 +38,7 @@ pub(crate) const CONTRIBUTION: super::Contribution = super::Contribution {
         "tile_layer",
     ],
     counts: &["prisms", "planes", "plane_blocks", "slice_triangles", "tiles_x", "tiles_y"],
-    texel_resources: &["volume", "normals"],
+    texel_resources: &["volume", "normals", "volume_layers", "normal_layers"],
     gather: None,
 };
 
@@ -55,8 +57,7 @@ pub fn sweep(shell: &Shell, forward: [f32; 3], planes: u32, near: f64) -> SliceP
         plane_count: planes,
         prism_count: shell.prisms.len() as u32,
         vertex_capacity: 0,
-        texel_level: 0.0,
-        _pad: [0; 2],
+        _pad: [0; 3],
     }
 }
 

@@ -2,6 +2,7 @@
 
 use super::lod::{self, LodChoice};
 use super::{add_inputs, check_budget, check_capacity, chunks, sweep, tile_buffers, tiles, SliceChunk};
+use crate::bake::texel_layers;
 use crate::error::{Error, Result};
 use crate::gpu::{buffers, Inputs};
 use crate::methods::{texels, InputCx, MethodPlan, ObjectPlan, PartDecl, PlanCx};
@@ -38,15 +39,14 @@ pub fn plan(cx: &mut PlanCx, object: &mut ObjectPlan, m: &ViewSlices) -> Result<
     let forward = cx.view.forward_f32();
     let lod = (m.lod == Lod::Auto).then(|| {
         let res = cx.bakes[bake].request.resolution;
-        let levels = crate::bake::texel_mips::mip_levels(res);
+        let levels = crate::bake::texel_layers::mip_levels(res);
         lod::choose(&object.shell, forward, cx.view.focal, cx.view.near, res, levels, planes)
     });
-    // The MIP levels are baked only when some object samples them.
-    if lod.is_some_and(|c| c.level > 0) {
-        cx.bakes[bake].request.volume_mipmaps = true;
+    // Each fragment samples the level of its own footprint from the texel's layers.
+    if lod.is_some() {
+        cx.bakes[bake].request.layers = true;
     }
-    let mut sweep = sweep(&object.shell, forward, lod.map_or(planes, |c| c.planes), cx.view.near);
-    sweep.texel_level = lod.map_or(0.0, |c| c.level as f32);
+    let sweep = sweep(&object.shell, forward, lod.map_or(planes, |c| c.planes), cx.view.near);
     let chunks = chunks(&object.shell, &sweep);
     check_budget(&chunks, &object.object.name, planes)?;
     object.frames = object.per_pixel.then(|| crate::mesh::shell::vertex_frames(&object.object.surface));
@@ -135,9 +135,13 @@ impl MethodPlan for ViewSlicesPlan {
         let frames = buffers::storage(cx.ctx, "vertex_frames", bytemuck::cast_slice(frames));
         inputs.buffers.insert("vertex_frames".into(), frames);
         if let Some(b) = object.bake {
-            inputs.views.insert("volume".into(), cx.baked[b].volume.create_view(&Default::default()));
-            inputs.views.insert("normals".into(), cx.baked[b].normals.create_view(&Default::default()));
+            let baked = &cx.baked[b];
+            inputs.views.insert("volume".into(), baked.volume.create_view(&Default::default()));
+            inputs.views.insert("normals".into(), baked.normals.create_view(&Default::default()));
+            inputs.views.insert("volume_layers".into(), texel_layers::array_view(&baked.layers[0]));
+            inputs.views.insert("normal_layers".into(), texel_layers::array_view(&baked.layers[1]));
         }
+        inputs.constants.push(("layered_texel".into(), self.lod.is_some() as u32 as f64));
     }
 
     fn summary(&self, object: &ObjectPlan) -> String {

@@ -437,8 +437,7 @@ fn flat_shell_cross_section_area_at_30_degrees() {
         plane_count: 1,
         prism_count: prisms.len() as u32,
         vertex_capacity: u32::MAX,
-        texel_level: 0.0,
-        _pad: [0; 2],
+        _pad: [0; 3],
     };
     let tris = &emit_slices(&v, &prisms, &params, true)[0];
     let total: f64 =
@@ -470,8 +469,7 @@ fn counts_scan_and_slices_agree_and_trivial_reject_changes_nothing() {
         plane_count: 64,
         prism_count: prisms.len() as u32,
         vertex_capacity: 1000,
-        texel_level: 0.0,
-        _pad: [0; 2],
+        _pad: [0; 3],
     };
     let slices = emit_slices(&v, &prisms, &params, true);
     assert_eq!(slices, emit_slices(&v, &prisms, &params, false));

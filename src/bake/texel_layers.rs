@@ -1,0 +1,87 @@
+//! A texel's layers (`ViewSlices(lod: Auto)`): its w slices as a 2D texture array whose MIP
+//! levels filter s and t only, so that each fragment can sample the level of its own footprint
+//! without blurring the height profile (a 3D MIP chain also halves w). Level 0 is the volume in
+//! f16 (`layer_texel_volume.wgsl`), each level the one above by a 2x2 box within its layer,
+//! wrapping as the texel repeats (`mip_texel_layers.wgsl`; twin `crate::cpu::mip_texel_layers`).
+
+use crate::error::Result;
+use crate::gpu::kernel::ComputeKernel;
+use crate::gpu::{GpuContext, Inputs};
+
+/// The kernel copying a volume into layers, and the one making their MIP levels.
+pub(crate) const COPY_KERNEL: &str = "bake/layer_texel_volume.wgsl";
+pub(crate) const MIP_KERNEL: &str = "bake/mip_texel_layers.wgsl";
+
+/// MIP levels of the layers of a texel of `res`: s and t halve down to 1x1, w stays.
+pub fn mip_levels(res: [u32; 3]) -> u32 {
+    32 - res[0].max(res[1]).max(1).leading_zeros()
+}
+
+/// Bytes of the layers of a texel of `res` (f16 RGBA, every level).
+pub(crate) fn bytes(res: [u32; 3]) -> u64 {
+    (0..mip_levels(res)).map(|l| (res[0] >> l).max(1) as u64 * (res[1] >> l).max(1) as u64 * 8).sum::<u64>()
+        * res[2] as u64
+}
+
+/// A 2D texture array of `layers` layers of `size`, `levels` MIP levels, f16 RGBA.
+pub(crate) fn texture(
+    ctx: &GpuContext,
+    label: &str,
+    size: [u32; 2],
+    layers: u32,
+    levels: u32,
+) -> wgpu::Texture {
+    ctx.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some(label),
+        size: wgpu::Extent3d { width: size[0], height: size[1], depth_or_array_layers: layers },
+        mip_level_count: levels,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: wgpu::TextureFormat::Rgba16Float,
+        usage: wgpu::TextureUsages::STORAGE_BINDING
+            | wgpu::TextureUsages::TEXTURE_BINDING
+            | wgpu::TextureUsages::COPY_SRC,
+        view_formats: &[],
+    })
+}
+
+/// A view of the whole array (every level), as the slicing kernels sample it.
+pub(crate) fn array_view(t: &wgpu::Texture) -> wgpu::TextureView {
+    t.create_view(&wgpu::TextureViewDescriptor {
+        dimension: Some(wgpu::TextureViewDimension::D2Array),
+        ..Default::default()
+    })
+}
+
+fn level_view(t: &wgpu::Texture, level: u32) -> wgpu::TextureView {
+    t.create_view(&wgpu::TextureViewDescriptor {
+        dimension: Some(wgpu::TextureViewDimension::D2Array),
+        base_mip_level: level,
+        mip_level_count: Some(1),
+        ..Default::default()
+    })
+}
+
+/// Records the layers of `volume` (level 0 baked) with every MIP level.
+pub(crate) fn record(
+    ctx: &GpuContext,
+    (copy, mip): (&mut ComputeKernel, &mut ComputeKernel),
+    encoder: &mut wgpu::CommandEncoder,
+    volume: &wgpu::Texture,
+    label: &str,
+) -> Result<wgpu::Texture> {
+    let res = [volume.width(), volume.height(), volume.depth_or_array_layers()];
+    let layers = texture(ctx, label, [res[0], res[1]], res[2], mip_levels(res));
+    let mut inputs = Inputs::default();
+    inputs.views.insert("source".into(), super::level_view(volume, 0));
+    inputs.views.insert("layers".into(), level_view(&layers, 0));
+    copy.dispatch(ctx, encoder, &inputs, res)?;
+    for level in 1..layers.mip_level_count() {
+        let mut inputs = Inputs::default();
+        inputs.views.insert("finer".into(), level_view(&layers, level - 1));
+        inputs.views.insert("coarser".into(), level_view(&layers, level));
+        let (w, h) = ((res[0] >> level).max(1), (res[1] >> level).max(1));
+        mip.dispatch(ctx, encoder, &inputs, [w, h, res[2]])?;
+    }
+    Ok(layers)
+}
