@@ -77,18 +77,9 @@ pub(crate) fn bake(
     encoder.clear_buffer(&occupancy, 0, None);
     let arrays = [0, 1, 2].map(|d| {
         let [w, h] = image_size(res, d);
-        ctx.device.create_texture(&wgpu::TextureDescriptor {
-            label: Some(["axis_slices_s", "axis_slices_t", "axis_slices_w"][d]),
-            size: wgpu::Extent3d { width: w, height: h, depth_or_array_layers: array_layers(res[d]) },
-            mip_level_count: if mipmaps { mip_levels([w, h]) } else { 1 },
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: wgpu::TextureFormat::Rgba16Float,
-            usage: wgpu::TextureUsages::STORAGE_BINDING
-                | wgpu::TextureUsages::TEXTURE_BINDING
-                | wgpu::TextureUsages::COPY_SRC,
-            view_formats: &[],
-        })
+        let label = ["axis_slices_s", "axis_slices_t", "axis_slices_w"][d];
+        let levels = if mipmaps { mip_levels([w, h]) } else { 1 };
+        super::texel_layers::texture(ctx, label, [w, h], array_layers(res[d]), levels)
     });
     let source = crate::bake::level_view(volume, 0);
     for (d, array) in arrays.iter().enumerate() {
@@ -119,7 +110,7 @@ pub(crate) fn bake(
 }
 
 /// Records the MIP levels of every slice image of `baked` (level 0 baked), each from the one
-/// above by a 2x2 box of premultiplied colour (`mip_axis_slices.wgsl`); the w slices (the last
+/// above by a 2x2 box of premultiplied colour (`mip_layers.wgsl`); the w slices (the last
 /// array) repeat along both axes, the s and t slices along their first.
 pub(crate) fn mip(
     ctx: &GpuContext,
@@ -128,22 +119,7 @@ pub(crate) fn mip(
     baked: &AxisBaked,
 ) -> Result<()> {
     for (direction, array) in baked.arrays.iter().enumerate() {
-        for level in 1..array.mip_level_count() {
-            let view = |level: u32| {
-                array.create_view(&wgpu::TextureViewDescriptor {
-                    dimension: Some(wgpu::TextureViewDimension::D2Array),
-                    base_mip_level: level,
-                    mip_level_count: Some(1),
-                    ..Default::default()
-                })
-            };
-            let mut inputs = Inputs::default();
-            inputs.views.insert("finer".into(), view(level - 1));
-            inputs.views.insert("coarser".into(), view(level));
-            inputs.constants.push(("wrap_rows".into(), (direction == 2) as u32 as f64));
-            let (w, h) = ((array.width() >> level).max(1), (array.height() >> level).max(1));
-            kernel.dispatch(ctx, encoder, &inputs, [w, h, array.depth_or_array_layers()])?;
-        }
+        super::texel_layers::record_mips(ctx, kernel, encoder, array, direction == 2)?;
     }
     Ok(())
 }

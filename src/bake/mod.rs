@@ -160,7 +160,7 @@ impl BakeRequest {
             k.push("axis_slices/bake_axis_slices.wgsl");
         }
         if self.axis_slices && self.axis_mipmaps {
-            k.push("axis_slices/mip_axis_slices.wgsl");
+            k.push(texel_layers::MIP_KERNEL);
         }
         if self.layers {
             k.extend([texel_layers::COPY_KERNEL, texel_layers::MIP_KERNEL]);
@@ -299,7 +299,7 @@ impl BakeRequest {
         let lighting = if self.per_pixel { "per-pixel (albedo + normals)" } else { "baked" };
         let mut s = format!("  {texel:<16} {x}x{y}x{z}  {kind}  lighting {lighting}\n");
         if self.layers {
-            s += "  (and its layers: layer_texel_volume.wgsl, then mip_texel_layers.wgsl per s,t level)\n";
+            s += "  (and its layers: layer_texel_volume.wgsl, then mip_layers.wgsl per s,t level)\n";
         }
         if let Some(sh) = &self.shadow {
             let [lx, ly, lz] = sh.toward_light.map(|c| c as f64);
@@ -317,7 +317,7 @@ impl BakeRequest {
         if self.axis_slices {
             s += "  (and its slice images: bake_axis_slices.wgsl per direction and level)\n";
             if self.axis_mipmaps {
-                s += "  (and their MIP levels: mip_axis_slices.wgsl per direction and MIP level)\n";
+                s += "  (and their MIP levels: mip_layers.wgsl per direction and MIP level)\n";
             }
         }
         s
@@ -344,8 +344,8 @@ pub struct Baker {
     transfer: Slot,
     axis: Slot,
     volume: Slot,
-    axis_mip: Slot,
     layer_copy: Slot,
+    /// `mip_layers`: the slice images' and the texel layers' MIP levels.
     layer_mip: Slot,
     shadow: Slot,
     sources: Sources,
@@ -365,7 +365,6 @@ impl Baker {
             transfer: None,
             axis: None,
             volume: None,
-            axis_mip: None,
             layer_copy: None,
             layer_mip: None,
             shadow: None,
@@ -568,13 +567,8 @@ impl Baker {
                 let baked =
                     axis_slices::bake(ctx, kernel, &mut encoder, &volume, req.resolution, req.axis_mipmaps)?;
                 if req.axis_mipmaps {
-                    let mip = Self::kernel(
-                        &mut self.axis_mip,
-                        ctx,
-                        &root,
-                        "axis_slices/mip_axis_slices.wgsl",
-                        format,
-                    )?;
+                    let mip =
+                        Self::kernel(&mut self.layer_mip, ctx, &root, texel_layers::MIP_KERNEL, format)?;
                     axis_slices::mip(ctx, mip, &mut encoder, &baked)?;
                 }
                 Some(baked)

@@ -2,7 +2,8 @@
 //! levels filter s and t only, so that each fragment can sample the level of its own footprint
 //! without blurring the height profile (a 3D MIP chain also halves w). Level 0 is the volume in
 //! f16 (`layer_texel_volume.wgsl`), each level the one above by a 2x2 box within its layer,
-//! wrapping as the texel repeats (`mip_texel_layers.wgsl`; twin `crate::cpu::mip_texel_layers`).
+//! wrapping as the texel repeats (`mip_layers.wgsl`, as AxisSlices' slice images; twin
+//! `crate::cpu::mip_layers`).
 
 use crate::error::Result;
 use crate::gpu::kernel::ComputeKernel;
@@ -10,7 +11,7 @@ use crate::gpu::{GpuContext, Inputs};
 
 /// The kernel copying a volume into layers, and the one making their MIP levels.
 pub(crate) const COPY_KERNEL: &str = "bake/layer_texel_volume.wgsl";
-pub(crate) const MIP_KERNEL: &str = "bake/mip_texel_layers.wgsl";
+pub(crate) const MIP_KERNEL: &str = "bake/mip_layers.wgsl";
 
 /// MIP levels of the layers of a texel of `res`: s and t halve down to 1x1, w stays.
 pub fn mip_levels(res: [u32; 3]) -> u32 {
@@ -23,7 +24,8 @@ pub(crate) fn bytes(res: [u32; 3]) -> u64 {
         * res[2] as u64
 }
 
-/// A 2D texture array of `layers` layers of `size`, `levels` MIP levels, f16 RGBA.
+/// A 2D texture array of `layers` layers of `size`, `levels` MIP levels, f16 RGBA (texel layers,
+/// AxisSlices' slice images).
 pub(crate) fn texture(
     ctx: &GpuContext,
     label: &str,
@@ -53,7 +55,8 @@ pub(crate) fn array_view(t: &wgpu::Texture) -> wgpu::TextureView {
     })
 }
 
-fn level_view(t: &wgpu::Texture, level: u32) -> wgpu::TextureView {
+/// A view of one MIP level of a 2D texture array.
+pub(crate) fn level_view(t: &wgpu::Texture, level: u32) -> wgpu::TextureView {
     t.create_view(&wgpu::TextureViewDescriptor {
         dimension: Some(wgpu::TextureViewDimension::D2Array),
         base_mip_level: level,
@@ -76,12 +79,26 @@ pub(crate) fn record(
     inputs.views.insert("source".into(), super::level_view(volume, 0));
     inputs.views.insert("layers".into(), level_view(&layers, 0));
     copy.dispatch(ctx, encoder, &inputs, res)?;
-    for level in 1..layers.mip_level_count() {
-        let mut inputs = Inputs::default();
-        inputs.views.insert("finer".into(), level_view(&layers, level - 1));
-        inputs.views.insert("coarser".into(), level_view(&layers, level));
-        let (w, h) = ((res[0] >> level).max(1), (res[1] >> level).max(1));
-        mip.dispatch(ctx, encoder, &inputs, [w, h, res[2]])?;
-    }
+    record_mips(ctx, mip, encoder, &layers, true)?;
     Ok(layers)
+}
+
+/// Records every MIP level of the 2D texture array `array` (level 0 made) with `mip_layers`,
+/// each from the one above; rows wrap with `wrap_rows` (columns always do).
+pub(crate) fn record_mips(
+    ctx: &GpuContext,
+    kernel: &mut ComputeKernel,
+    encoder: &mut wgpu::CommandEncoder,
+    array: &wgpu::Texture,
+    wrap_rows: bool,
+) -> Result<()> {
+    for level in 1..array.mip_level_count() {
+        let mut inputs = Inputs::default();
+        inputs.views.insert("finer".into(), level_view(array, level - 1));
+        inputs.views.insert("coarser".into(), level_view(array, level));
+        inputs.constants.push(("wrap_rows".into(), wrap_rows as u32 as f64));
+        let (w, h) = ((array.width() >> level).max(1), (array.height() >> level).max(1));
+        kernel.dispatch(ctx, encoder, &inputs, [w, h, array.depth_or_array_layers()])?;
+    }
+    Ok(())
 }

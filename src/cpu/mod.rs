@@ -9,7 +9,7 @@ pub mod bake_splats;
 pub mod bake_transfer;
 pub(crate) mod flood_point_grid;
 pub mod hypertexture;
-pub mod mip_texel_layers;
+pub mod mip_layers;
 pub mod noise_simplex;
 pub mod prism_map;
 pub mod shadow_texel;

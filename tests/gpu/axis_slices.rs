@@ -144,7 +144,7 @@ fn slice_image_bake_matches_its_twin() {
     assert!(coarsest_alpha > 0.0);
 }
 
-/// `mip_axis_slices.wgsl` against its twin: every MIP level of every direction's slice images
+/// `mip_layers.wgsl` against its twin (`voltex::cpu::mip_layers`): every MIP level of every direction's slice images
 /// (odd sizes included: past 3, a w slice wraps to its first row, an s or t slice repeats its
 /// last, the w row) from the GPU's own level above.
 #[test]
@@ -179,7 +179,7 @@ fn slice_image_mips_match_their_twin() {
             let per_layer = (w * h) as usize * 4;
             for (layer, fine) in finer.chunks_exact(per_layer).enumerate() {
                 let fine: Vec<[f32; 4]> = fine.chunks_exact(4).map(|c| [c[0], c[1], c[2], c[3]]).collect();
-                let cpu = twin::mip_axis_slices(&fine, w, h, direction == 2);
+                let cpu = voltex::cpu::mip_layers::mip_layers(&fine, [w, h], 1, direction == 2);
                 let gpu = &coarser[layer * cpu.len() * 4..][..cpu.len() * 4];
                 // f16 rounding of the mean (and of the level it came from): half an ulp near 1.
                 let worst =

@@ -37,7 +37,7 @@ fn render(scene: &scene::Scene, opts: &RenderOptions) -> Image {
 
 /// The texel's layers against their twins: level 0 of the volume's and the normals' layers
 /// equal the volumes (`layer_texel_volume.wgsl`, a copy into f16), and every MIP level of both
-/// (`mip_texel_layers.wgsl`) is `mip_texel_layers` of the GPU's own level above, odd sizes
+/// (`mip_layers.wgsl`) is `mip_layers` of the GPU's own level above, odd sizes
 /// included (12 -> 6 -> 3 -> 1 wraps to the first texel), within f16 rounding; w is never
 /// filtered (every level keeps its 6 layers).
 #[test]
@@ -77,7 +77,7 @@ fn texel_layers_match_their_twin() {
             let (finer, coarser) = (read(level - 1), read(level));
             let size = [(res[0] >> (level - 1)).max(1), (res[1] >> (level - 1)).max(1)];
             let fine: Vec<[f32; 4]> = finer.chunks_exact(4).map(|c| [c[0], c[1], c[2], c[3]]).collect();
-            let cpu = voltex::cpu::mip_texel_layers::mip_texel_layers(&fine, size, res[2]);
+            let cpu = voltex::cpu::mip_layers::mip_layers(&fine, size, res[2], true);
             assert_eq!(cpu.len() * 4, coarser.len(), "level {level}");
             // f16 keeps 11 bits: half an ulp of values up to 1.
             let worst =

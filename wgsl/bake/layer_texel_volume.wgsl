@@ -2,7 +2,7 @@
 @group(0) @binding(0) var source: texture_3d<f32>;
 @group(0) @binding(1) var layers: texture_storage_2d_array<rgba16float, write>;
 
-// The layers' MIP levels (mip_texel_layers.wgsl) then filter s and t only: a 3D MIP chain also
+// The layers' MIP levels (mip_layers.wgsl) then filter s and t only: a 3D MIP chain also
 // halves w and blurs the height profile.
 @compute @workgroup_size(4, 4, 4)
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {

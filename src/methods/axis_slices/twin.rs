@@ -1,5 +1,5 @@
 //! CPU twins of the axis-slicing kernels (`choose_axis_slices`, `emit_axis_slices`,
-//! `bake_axis_slices`, `mip_axis_slices` and `wgsl/shared/axis_slices.wgsl`), in f32 like the kernels so that the
+//! `bake_axis_slices` and `wgsl/shared/axis_slices.wgsl`), in f32 like the kernels so that the
 //! discrete decisions (direction, level) agree. Directions: 0 = s, 1 = t, 2 = w.
 
 use glam::{Vec2, Vec3, Vec4};
@@ -472,27 +472,4 @@ pub fn bake_axis_slices(volume: &[[u8; 4]], res: [u32; 3]) -> ([Vec<[f32; 4]>; 3
         }
     }
     (arrays, occupancy)
-}
-
-/// `mip_axis_slices.wgsl`: MIP level `l + 1` of a `w x h` slice image from level `l` (rows of
-/// premultiplied RGBA): the mean of the 2x2 texels it covers; past an odd size, the first
-/// column, and the first row with `wrap_rows` (w slices), else the last.
-pub fn mip_axis_slices(finer: &[[f32; 4]], w: u32, h: u32, wrap_rows: bool) -> Vec<[f32; 4]> {
-    let (cw, ch) = ((w / 2).max(1), (h / 2).max(1));
-    let mut out = Vec::with_capacity((cw * ch) as usize);
-    for y in 0..ch {
-        for x in 0..cw {
-            let mut sum = [0.0f32; 4];
-            for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
-                let (sx, sy) =
-                    ((2 * x + dx) % w, if wrap_rows { (2 * y + dy) % h } else { (2 * y + dy).min(h - 1) });
-                let p = finer[(sy * w + sx) as usize];
-                for c in 0..4 {
-                    sum[c] += p[c];
-                }
-            }
-            out.push(sum.map(|v| v * 0.25));
-        }
-    }
-    out
 }

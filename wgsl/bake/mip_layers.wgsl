@@ -1,11 +1,12 @@
-// Makes one MIP level of a direction's slice images from the level above: each texel the mean of the 2x2 premultiplied texels it covers.
+// Makes one MIP level of a 2D texture array (AxisSlices' slice images, a texel's layers) from the level above: each texel the mean of the 2x2 it covers within its layer.
 @group(0) @binding(0) var finer: texture_2d_array<f32>;
 @group(0) @binding(1) var coarser: texture_storage_2d_array<rgba16float, write>;
 
-// Premultiplied colour averages like coverage, so a minified slice keeps its mean opacity and
-// the colour it shows. Filtering stays within the slice; at an odd size the texel past the edge
-// is the first one along an axis the texel repeats (s and t: both axes of a w slice, the first
-// of an s or t slice) and the last one along w, which does not repeat.
+// Premultiplied colour averages like coverage, so a minified image keeps its mean opacity and
+// the colour it shows; normals average to the mean direction, renormalised where shaded.
+// Filtering stays within a layer. Past an odd size the texel beyond the edge is the first one
+// along an axis the texel repeats (columns: s or t; rows too with `wrap_rows`: a w slice's t, a
+// texel layer's t) and the last one along w, which does not repeat (an s or t slice's rows).
 override wrap_rows: bool = false;
 
 @compute @workgroup_size(8, 8, 1)
