@@ -13,7 +13,7 @@ use crate::gpu::sources::Sources;
 
 use crate::cpu::bake::PackedShapes;
 use crate::error::{Error, Result};
-use crate::gpu::budget::{Allocation, Driver, Shape};
+use crate::gpu::budget::{Allocation, AllocationKind, Driver};
 use crate::gpu::buffers::{storage, uniform};
 use crate::gpu::kernel::ComputeKernel;
 use crate::gpu::GpuContext;
@@ -224,7 +224,7 @@ impl BakeRequest {
         let volume = |what: String, size| Allocation {
             what,
             bytes: voxels * 4,
-            shape: Shape::Texture3d { size },
+            shape: AllocationKind::Texture3d { size },
             driver: driver.clone(),
         };
         let mut out = vec![volume(format!("texel \"{texel}\"'s volume"), res)];
@@ -240,7 +240,7 @@ impl BakeRequest {
                 out.push(Allocation {
                     what: format!("texel \"{texel}\"'s {name}"),
                     bytes: texel_layers::bytes(res),
-                    shape: Shape::Texture2d { size: [res[0], res[1]], layers: res[2] },
+                    shape: AllocationKind::Texture2d { size: [res[0], res[1]], layers: res[2] },
                     driver: driver.clone(),
                 });
             }
@@ -251,7 +251,7 @@ impl BakeRequest {
             out.push(Allocation {
                 what: format!("texel \"{texel}\"'s volume atlas ({} bricks)", v.grid.bricks()),
                 bytes: texels * if v.grid.color.is_some() { 12 } else { 4 },
-                shape: Shape::Texture3d { size },
+                shape: AllocationKind::Texture3d { size },
                 driver: driver.clone(),
             });
         }
@@ -259,7 +259,7 @@ impl BakeRequest {
             out.push(Allocation {
                 what: format!("texel \"{texel}\"'s mesh grid"),
                 bytes: voxels * 16,
-                shape: Shape::Buffer { storage: true },
+                shape: AllocationKind::Buffer { storage: true },
                 driver: driver.clone(),
             });
         }
@@ -270,7 +270,7 @@ impl BakeRequest {
                 out.push(Allocation {
                     what: format!("texel \"{texel}\"'s {} slice images", ["s", "t", "w"][d]),
                     bytes: axis_slices::image_bytes(size, self.axis_mipmaps) * layers as u64,
-                    shape: Shape::Texture2d { size, layers },
+                    shape: AllocationKind::Texture2d { size, layers },
                     driver: driver.clone(),
                 });
             }

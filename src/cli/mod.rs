@@ -135,12 +135,12 @@ pub struct Overrides {
     /// MIP-mapped slice images of every AxisSlices object: `on` (each pixel filters the slices
     /// over its footprint) or `off` (level 0) (default: the scene's `mipmaps`).
     #[arg(long, value_enum)]
-    mipmaps: Option<Switch>,
+    mipmaps: Option<OnOff>,
 }
 
 /// An `on`/`off` value.
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Switch {
+pub enum OnOff {
     On,
     Off,
 }
@@ -241,7 +241,7 @@ impl Overrides {
             shadows: self.shadows.map(|s| s.0),
             compositor: self.compositor.map(Into::into),
             lod: self.lod.map(Into::into),
-            mipmaps: self.mipmaps.map(|m| m == Switch::On),
+            mipmaps: self.mipmaps.map(|m| m == OnOff::On),
             ..Default::default()
         })
     }

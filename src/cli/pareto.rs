@@ -22,12 +22,12 @@ pub struct ParetoCmd {
     /// What errors are measured against: `reference`, `view-slices:PLANES` or
     /// `ray-march:STEP[:SHADOWS]` (SHADOWS as in --ray-shadows, e.g. ray-march:0.0005:rays).
     #[arg(long, default_value = "reference")]
-    truth: voltex::pareto::Truth,
+    truth: voltex::pareto::TruthSource,
     /// Methods to sweep (ray-march: the step of every hypertexture object).
     #[arg(long, value_enum, value_delimiter = ',', default_values = ["view-slices", "reference"])]
     methods: Vec<SweepArg>,
     /// ViewSlices plane counts (each with the trivial reject on and off).
-    #[arg(long, value_delimiter = ',', default_values_t = voltex::pareto::DEFAULT_PLANES)]
+    #[arg(long, value_delimiter = ',', default_values_t = voltex::pareto::SWEEP_PLANES)]
     planes: Vec<u32>,
     /// Also sweep ViewSlices with `lod: Auto` (planes and texel MIP level from the size on
     /// screen), each plane count its most planes.

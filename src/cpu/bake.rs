@@ -369,12 +369,12 @@ pub fn bake_height_image_voxel(
 
 /// A CPU RGBA volume, x fastest: texel (x,y,z) at `x + X * (y + Y * z)`.
 #[derive(Clone, Debug, PartialEq)]
-pub struct Volume {
+pub struct TexelVoxels {
     pub(crate) size: [u32; 3],
     pub(crate) texels: Vec<[f32; 4]>,
 }
 
-impl Volume {
+impl TexelVoxels {
     /// Index of voxel `v` in `texels`.
     pub fn index(&self, v: [u32; 3]) -> usize {
         (v[0] + self.size[0] * (v[1] + self.size[1] * v[2])) as usize
@@ -384,7 +384,7 @@ impl Volume {
         self.texels[self.index(v)]
     }
     /// Fills a volume of `size` from a per-voxel function.
-    pub fn from_fn(size: [u32; 3], mut f: impl FnMut([u32; 3]) -> [f32; 4]) -> Volume {
+    pub fn from_fn(size: [u32; 3], mut f: impl FnMut([u32; 3]) -> [f32; 4]) -> TexelVoxels {
         let mut texels = Vec::with_capacity((size[0] * size[1] * size[2]) as usize);
         for z in 0..size[2] {
             for y in 0..size[1] {
@@ -393,7 +393,7 @@ impl Volume {
                 }
             }
         }
-        Volume { size, texels }
+        TexelVoxels { size, texels }
     }
 }
 
@@ -402,24 +402,32 @@ impl Volume {
 pub fn bake_volume(
     params: &BakeParams,
     mut voxel: impl FnMut([u32; 3]) -> ([f32; 4], [f32; 3]),
-) -> (Volume, Volume) {
+) -> (TexelVoxels, TexelVoxels) {
     let size = xyz_u(params.resolution);
     let mut normals = Vec::new();
-    let rgba = Volume::from_fn(size, |v| {
+    let rgba = TexelVoxels::from_fn(size, |v| {
         let (c, n) = voxel(v);
         normals.push([n[0], n[1], n[2], 0.0]);
         c
     });
-    (rgba, Volume { size, texels: normals })
+    (rgba, TexelVoxels { size, texels: normals })
 }
 
 /// Twin of `bake_implicit.wgsl`: the whole volume (rgba, normals with w = 0).
-pub fn bake_implicit(params: &BakeParams, packed: &PackedShapes, per_pixel: bool) -> (Volume, Volume) {
+pub fn bake_implicit(
+    params: &BakeParams,
+    packed: &PackedShapes,
+    per_pixel: bool,
+) -> (TexelVoxels, TexelVoxels) {
     bake_volume(params, |v| bake_implicit_voxel(params, &packed.shapes, &packed.balls, v, per_pixel))
 }
 
 /// Twin of `bake_heightfield.wgsl`: the whole volume (rgba, normals with w = 0).
-pub fn bake_heightfield(params: &BakeParams, hf: &HeightfieldParams, per_pixel: bool) -> (Volume, Volume) {
+pub fn bake_heightfield(
+    params: &BakeParams,
+    hf: &HeightfieldParams,
+    per_pixel: bool,
+) -> (TexelVoxels, TexelVoxels) {
     bake_volume(params, |v| bake_heightfield_voxel(params, hf, v, per_pixel))
 }
 
@@ -429,7 +437,7 @@ pub fn bake_height_image(
     hi: &HeightImageParams,
     heights: &[f32],
     per_pixel: bool,
-) -> (Volume, Volume) {
+) -> (TexelVoxels, TexelVoxels) {
     bake_volume(params, |v| bake_height_image_voxel(params, hi, heights, v, per_pixel))
 }
 
@@ -441,7 +449,7 @@ fn xyz_u(v: [u32; 4]) -> [u32; 3] {
 
 /// A texel-space implicit shape, as the scene describes it.
 #[derive(Clone, Debug, PartialEq)]
-pub enum Shape {
+pub enum Primitive {
     /// A solid sphere.
     Sphere {
         /// Centre, texel space.
@@ -486,7 +494,7 @@ pub struct PackedShapes {
 }
 
 /// Packs a union of (shape, albedo rgb, opacity) into `ImplicitShape`s and the metaball buffer.
-pub fn pack_shapes(shapes: &[(Shape, V3, f32)]) -> PackedShapes {
+pub fn pack_shapes(shapes: &[(Primitive, V3, f32)]) -> PackedShapes {
     let mut packed = PackedShapes {
         shapes: Vec::with_capacity(shapes.len().max(1)),
         balls: Vec::new(),
@@ -497,30 +505,30 @@ pub fn pack_shapes(shapes: &[(Shape, V3, f32)]) -> PackedShapes {
             ImplicitShape { color: [albedo[0], albedo[1], albedo[2], *opacity], ..Default::default() };
         let c = |v: &V3| [v[0], v[1], v[2], 0.0];
         match shape {
-            Shape::Sphere { center, radius } => {
+            Primitive::Sphere { center, radius } => {
                 s.kind = SPHERE;
                 s.center = c(center);
                 s.params[0] = *radius;
             }
-            Shape::Torus { center, major, minor } => {
+            Primitive::Torus { center, major, minor } => {
                 s.kind = TORUS;
                 s.center = c(center);
                 s.params[0] = *major;
                 s.params[1] = *minor;
             }
-            Shape::Ellipsoid { center, radii } => {
+            Primitive::Ellipsoid { center, radii } => {
                 s.kind = ELLIPSOID;
                 s.center = c(center);
                 s.params = c(radii);
             }
-            Shape::Metaballs { balls, threshold } => {
+            Primitive::Metaballs { balls, threshold } => {
                 s.kind = METABALLS;
                 s.first_ball = packed.balls.len() as u32;
                 s.ball_count = balls.len() as u32;
                 s.params[0] = *threshold;
                 packed.balls.extend(balls.iter().map(|(p, r)| [p[0], p[1], p[2], *r]));
             }
-            Shape::Constant => s.kind = CONSTANT,
+            Primitive::Constant => s.kind = CONSTANT,
         }
         packed.shapes.push(s);
     }

@@ -4,7 +4,7 @@
 
 use glam::DVec3;
 
-use super::bake::{bake_volume, gradient_normal, shade_lambert, Volume};
+use super::bake::{bake_volume, gradient_normal, shade_lambert, TexelVoxels};
 use super::hypertexture::Model;
 use crate::types::BakeParams;
 
@@ -45,6 +45,6 @@ pub fn bake_hypertexture_voxel(
 }
 
 /// Twin of `bake_hypertexture.wgsl`: the whole volume (rgba, normals with w = 0).
-pub fn bake_hypertexture(params: &BakeParams, model: &Model, per_pixel: bool) -> (Volume, Volume) {
+pub fn bake_hypertexture(params: &BakeParams, model: &Model, per_pixel: bool) -> (TexelVoxels, TexelVoxels) {
     bake_volume(params, |v| bake_hypertexture_voxel(params, model, v, per_pixel))
 }

@@ -11,7 +11,7 @@ fn close(a: f32, b: f32, tol: f32) -> bool {
 /// A 16^3 volume with one sphere centred on voxel (8,8,8).
 fn sphere_scene(radius: f32, light: V3, ambient: f32) -> (BakeParams, PackedShapes) {
     let c = 8.5 / 16.0;
-    let packed = pack_shapes(&[(Shape::Sphere { center: [c, c, c], radius }, RED, 0.9)]);
+    let packed = pack_shapes(&[(Primitive::Sphere { center: [c, c, c], radius }, RED, 0.9)]);
     (bake_params([16; 3], packed.shape_count, light, ambient), packed)
 }
 
@@ -53,7 +53,7 @@ fn sphere_far_outside_is_empty_and_surface_half_covered() {
 fn sphere_wraps_across_the_s_seam() {
     // Sphere at s = 0.99, radius 0.05: voxel s = 0.01 (i = 0 of 50) is 0.02 away through the seam,
     // mirroring voxel s = 0.97 (i = 48) on the near side.
-    let packed = pack_shapes(&[(Shape::Sphere { center: [0.99, 0.51, 0.51], radius: 0.05 }, RED, 1.0)]);
+    let packed = pack_shapes(&[(Primitive::Sphere { center: [0.99, 0.51, 0.51], radius: 0.05 }, RED, 1.0)]);
     let params = bake_params([50; 3], 1, [0.0, 0.0, 1.0], 1.0);
     let (a, na) = bake_implicit_voxel(&params, &packed.shapes, &packed.balls, [0, 25, 25], false);
     let (b, nb) = bake_implicit_voxel(&params, &packed.shapes, &packed.balls, [48, 25, 25], false);
@@ -68,9 +68,9 @@ fn sphere_wraps_across_the_s_seam() {
 #[test]
 fn torus_ellipsoid_metaballs_distances() {
     let packed = pack_shapes(&[
-        (Shape::Torus { center: [0.5, 0.5, 0.5], major: 0.3, minor: 0.1 }, RED, 1.0),
-        (Shape::Ellipsoid { center: [0.5, 0.5, 0.5], radii: [0.2, 0.1, 0.05] }, RED, 1.0),
-        (Shape::Metaballs { balls: vec![([0.5, 0.5, 0.5], 0.2)], threshold: 0.5 }, RED, 1.0),
+        (Primitive::Torus { center: [0.5, 0.5, 0.5], major: 0.3, minor: 0.1 }, RED, 1.0),
+        (Primitive::Ellipsoid { center: [0.5, 0.5, 0.5], radii: [0.2, 0.1, 0.05] }, RED, 1.0),
+        (Primitive::Metaballs { balls: vec![([0.5, 0.5, 0.5], 0.2)], threshold: 0.5 }, RED, 1.0),
     ]);
     let [torus, ellipsoid, meta] = [0, 1, 2].map(|i| packed.shapes[i]);
     let balls = &packed.balls;
@@ -94,8 +94,8 @@ fn torus_ellipsoid_metaballs_distances() {
 fn union_takes_the_nearest_shape() {
     let blue = [0.1, 0.2, 0.9];
     let packed = pack_shapes(&[
-        (Shape::Sphere { center: [0.25, 0.5, 0.5], radius: 0.2 }, RED, 1.0),
-        (Shape::Sphere { center: [0.75, 0.5, 0.5], radius: 0.2 }, blue, 0.5),
+        (Primitive::Sphere { center: [0.25, 0.5, 0.5], radius: 0.2 }, RED, 1.0),
+        (Primitive::Sphere { center: [0.75, 0.5, 0.5], radius: 0.2 }, blue, 0.5),
     ]);
     let params = bake_params([16; 3], 2, [0.0, 0.0, 1.0], 1.0);
     let (a, _) = bake_implicit_voxel(&params, &packed.shapes, &packed.balls, [4, 8, 8], false);
@@ -110,7 +110,7 @@ fn union_takes_the_nearest_shape() {
 
 #[test]
 fn constant_fills_uniformly() {
-    let packed = pack_shapes(&[(Shape::Constant, [0.5, 0.6, 0.7], 0.4)]);
+    let packed = pack_shapes(&[(Primitive::Constant, [0.5, 0.6, 0.7], 0.4)]);
     let params = bake_params([5, 4, 3], 1, [0.0, 0.0, 1.0], 0.3);
     let (rgba, normals) = bake_implicit(&params, &packed, false);
     assert_eq!(rgba.texels.len(), 60);

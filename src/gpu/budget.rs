@@ -20,7 +20,7 @@ pub fn plan_limits() -> wgpu::Limits {
 
 /// What one allocation is, for the limit that applies to it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) enum Shape {
+pub(crate) enum AllocationKind {
     /// A buffer; `storage` when a kernel binds it whole (the binding-size limit applies).
     Buffer {
         storage: bool,
@@ -53,7 +53,7 @@ pub(crate) enum Driver {
 pub struct Allocation {
     pub(crate) what: String,
     pub(crate) bytes: u64,
-    pub(crate) shape: Shape,
+    pub(crate) shape: AllocationKind,
     pub(crate) driver: Driver,
 }
 
@@ -80,8 +80,10 @@ pub(crate) fn over_limit(a: &Allocation, limits: &wgpu::Limits) -> Option<String
         })
     };
     match a.shape {
-        Shape::Texture3d { size } => dims(&size, limits.max_texture_dimension_3d, "max_texture_dimension_3d"),
-        Shape::Texture2d { size, layers } => {
+        AllocationKind::Texture3d { size } => {
+            dims(&size, limits.max_texture_dimension_3d, "max_texture_dimension_3d")
+        }
+        AllocationKind::Texture2d { size, layers } => {
             dims(&size, limits.max_texture_dimension_2d, "max_texture_dimension_2d").or_else(|| {
                 (layers > limits.max_texture_array_layers).then(|| {
                     format!(
@@ -91,10 +93,10 @@ pub(crate) fn over_limit(a: &Allocation, limits: &wgpu::Limits) -> Option<String
                 })
             })
         }
-        Shape::Buffer { storage: true } => {
+        AllocationKind::Buffer { storage: true } => {
             bytes(limits.max_storage_buffer_binding_size, "max_storage_buffer_binding_size")
         }
-        Shape::Buffer { storage: false } => None,
+        AllocationKind::Buffer { storage: false } => None,
     }
     .or_else(|| bytes(limits.max_buffer_size, "max_buffer_size"))
 }

@@ -18,7 +18,7 @@ pub use plan::{BakePlan, InputCx, MethodPlan, ObjectPlan, PartDecl};
 
 use crate::error::Result;
 use crate::scene::{Method, Scene};
-use view::{Lighting, View};
+use view::{FrameLight, View};
 
 /// What a method brings to the render graph: the object filters its objects match (passes are
 /// instanced over them), and the per-object resources and counts its inputs provide (graph files
@@ -54,7 +54,7 @@ pub const REGISTRY: &[&Contribution] = &[
 pub struct PlanCx<'a> {
     pub(crate) scene: &'a Scene,
     pub(crate) view: &'a View,
-    pub(crate) light: &'a Lighting,
+    pub(crate) light: &'a FrameLight,
     /// The frame's time (animated texels are baked at it).
     pub(crate) time: f64,
     pub(crate) bakes: &'a mut Vec<BakePlan>,

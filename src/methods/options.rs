@@ -86,7 +86,7 @@ pub const DEFAULT_AXIS_SLICES: AxisSlices = AxisSlices {
 };
 
 /// Plane count when an object is switched to view slicing from a method without planes.
-pub const DEFAULT_PLANES: u32 = 400;
+pub const SWITCHED_PLANES: u32 = 400;
 
 impl RenderOptions {
     /// A volume object's method after the overrides. RayMarch and Reference both draw volumes:
@@ -151,7 +151,7 @@ impl RenderOptions {
                 lod: self.lod.unwrap_or(vs.lod),
             }),
             (MethodKind::ViewSlices, _) => Method::ViewSlices(ViewSlices {
-                planes: self.planes.unwrap_or(DEFAULT_PLANES),
+                planes: self.planes.unwrap_or(SWITCHED_PLANES),
                 trivial_reject: self.trivial_reject.unwrap_or(true),
                 lighting,
                 compositor: self.compositor.unwrap_or_default(),

@@ -4,10 +4,10 @@ use crate::bake::hypertexture::HyperTexel;
 use crate::bake::shadow::Shadow;
 use crate::bake::volume::VolumeTexel;
 use crate::bake::{BakeRequest, BakeSource, Heights, MeshTexel, StackTexels};
-use crate::cpu::bake::{pack_shapes, Shape as BakeShape};
+use crate::cpu::bake::{pack_shapes, Primitive};
 use crate::error::{Error, Result};
 use crate::methods::plan::BakePlan;
-use crate::methods::view::Lighting;
+use crate::methods::view::FrameLight;
 use crate::scene::{Scene, Shape, TexelSource};
 use crate::types::{HeightImageParams, HeightfieldParams};
 
@@ -17,7 +17,7 @@ pub(crate) fn bake_index(
     scene: &Scene,
     texel: &str,
     per_pixel: bool,
-    light: &Lighting,
+    light: &FrameLight,
     time: f64,
     bakes: &mut Vec<BakePlan>,
 ) -> Result<usize> {
@@ -138,7 +138,7 @@ pub(crate) fn bake_index(
             BakeSource::Volume(Box::new(VolumeTexel::new(grid, bounds, v.albedo, v.density_scale, length)))
         }
         TexelSource::Constant { color, opacity } => {
-            BakeSource::Implicit(pack_shapes(&[(BakeShape::Constant, *color, *opacity)]))
+            BakeSource::Implicit(pack_shapes(&[(Primitive::Constant, *color, *opacity)]))
         }
     };
     bakes.push(BakePlan {
@@ -172,19 +172,19 @@ fn rgb0(v: &[f32; 3]) -> [f32; 4] {
 }
 
 /// A scene shape as the bake kernels take it: (shape, albedo, opacity).
-fn bake_shape(s: &Shape) -> (BakeShape, [f32; 3], f32) {
+fn bake_shape(s: &Shape) -> (Primitive, [f32; 3], f32) {
     match s {
         Shape::Sphere { center, radius, color, opacity } => {
-            (BakeShape::Sphere { center: *center, radius: *radius }, *color, *opacity)
+            (Primitive::Sphere { center: *center, radius: *radius }, *color, *opacity)
         }
         Shape::Torus { center, major, minor, color, opacity } => {
-            (BakeShape::Torus { center: *center, major: *major, minor: *minor }, *color, *opacity)
+            (Primitive::Torus { center: *center, major: *major, minor: *minor }, *color, *opacity)
         }
         Shape::Ellipsoid { center, radii, color, opacity } => {
-            (BakeShape::Ellipsoid { center: *center, radii: *radii }, *color, *opacity)
+            (Primitive::Ellipsoid { center: *center, radii: *radii }, *color, *opacity)
         }
         Shape::Metaballs { balls, threshold, color, opacity } => (
-            BakeShape::Metaballs {
+            Primitive::Metaballs {
                 balls: balls.iter().map(|b| (b.center, b.radius)).collect(),
                 threshold: *threshold,
             },

@@ -84,7 +84,7 @@ impl View {
         self.forward.as_vec3().to_array()
     }
 
-    pub(crate) fn frame_params(&self, scene: &Scene, size: (u32, u32), light: &Lighting) -> FrameParams {
+    pub(crate) fn frame_params(&self, scene: &Scene, size: (u32, u32), light: &FrameLight) -> FrameParams {
         let view = view_matrix(self.forward, self.up);
         let proj = projection(self.fov_y.to_radians(), size.0 as f64 / size.1 as f64, self.near, self.far);
         let (f, l, c, b) = (self.forward_f32(), light.direction, light.color, scene.background);
@@ -100,13 +100,13 @@ impl View {
 }
 
 /// The scene's first light (towards the light, colour times intensity) and ambient term.
-pub struct Lighting {
+pub struct FrameLight {
     pub(crate) direction: [f32; 3],
     pub(crate) color: [f32; 3],
     pub(crate) ambient: f32,
 }
 
-impl Lighting {
+impl FrameLight {
     pub(crate) fn of(scene: &Scene) -> Self {
         let (direction, color) = match scene.lights.first() {
             Some(Light::Directional { direction, color, intensity }) => {

@@ -28,7 +28,7 @@ use crate::scene::{Scene, Segments, Shadows, MAX_PLANES};
 use report::Row;
 
 /// Default plane counts of the `ViewSlices` sweep.
-pub const DEFAULT_PLANES: [u32; 8] = [16, 32, 64, 128, 256, 512, 1024, 2048];
+pub const SWEEP_PLANES: [u32; 8] = [16, 32, 64, 128, 256, 512, 1024, 2048];
 /// Default ray steps of the `Reference` sweep, as multiples of its default step.
 /// (2x, half the truth's cost, would double the sweep's time; pass it with `--steps` if wanted.)
 pub const DEFAULT_STEP_FACTORS: [f64; 4] = [4.0, 8.0, 16.0, 32.0];
@@ -49,7 +49,7 @@ pub enum Sweep {
 
 /// What errors are measured against.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Truth {
+pub enum TruthSource {
     /// Every textured object ray cast by `Reference` with its default step.
     Reference,
     /// Every textured object sliced by `ViewSlices` with this many planes (a converged slicing).
@@ -60,14 +60,14 @@ pub enum Truth {
     RayMarch(f64, Option<Option<Shadows>>),
 }
 
-impl FromStr for Truth {
+impl FromStr for TruthSource {
     type Err = String;
     fn from_str(s: &str) -> std::result::Result<Self, String> {
         const EXPECTED: &str =
             "expected `reference`, `view-slices:PLANES` or `ray-march:STEP[:SHADOWS]`, e.g. \
              view-slices:4096, ray-march:0.0005 or ray-march:0.0005:rays";
         if s == "reference" {
-            return Ok(Truth::Reference);
+            return Ok(TruthSource::Reference);
         }
         if let Some(rest) = s.strip_prefix("ray-march:") {
             let (step, shadows) = match rest.split_once(':') {
@@ -75,39 +75,39 @@ impl FromStr for Truth {
                 None => (rest, None),
             };
             return match step.parse::<f64>() {
-                Ok(v) if v.is_finite() && v > 0.0 => Ok(Truth::RayMarch(v, shadows)),
+                Ok(v) if v.is_finite() && v > 0.0 => Ok(TruthSource::RayMarch(v, shadows)),
                 _ => Err(format!("`{step}`: expected a positive step in world units")),
             };
         }
         let n = s.strip_prefix("view-slices:").ok_or(EXPECTED)?;
         match n.parse::<u32>() {
-            Ok(n) if (1..=MAX_PLANES).contains(&n) => Ok(Truth::ViewSlices(n)),
+            Ok(n) if (1..=MAX_PLANES).contains(&n) => Ok(TruthSource::ViewSlices(n)),
             _ => Err(format!("`{n}`: expected a plane count in 1..={MAX_PLANES}")),
         }
     }
 }
 
-impl fmt::Display for Truth {
+impl fmt::Display for TruthSource {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            Truth::Reference => write!(f, "Reference, default step"),
-            Truth::ViewSlices(n) => write!(f, "ViewSlices, {n} planes"),
-            Truth::RayMarch(step, None) => write!(f, "RayMarch, step {step}"),
-            Truth::RayMarch(step, Some(s)) => {
+            TruthSource::Reference => write!(f, "Reference, default step"),
+            TruthSource::ViewSlices(n) => write!(f, "ViewSlices, {n} planes"),
+            TruthSource::RayMarch(step, None) => write!(f, "RayMarch, step {step}"),
+            TruthSource::RayMarch(step, Some(s)) => {
                 write!(f, "RayMarch, step {step}, shadows {}", shadows_name(*s))
             }
         }
     }
 }
 
-impl Truth {
+impl TruthSource {
     fn options(self, size: (u32, u32)) -> RenderOptions {
         let size = Some(size);
         match self {
-            Truth::Reference => {
+            TruthSource::Reference => {
                 RenderOptions { size, method: Some(MethodKind::Reference), ..Default::default() }
             }
-            Truth::ViewSlices(n) => RenderOptions {
+            TruthSource::ViewSlices(n) => RenderOptions {
                 size,
                 method: Some(MethodKind::ViewSlices),
                 planes: Some(n),
@@ -115,7 +115,7 @@ impl Truth {
                 lod: Some(crate::scene::Lod::Off),
                 ..Default::default()
             },
-            Truth::RayMarch(step, shadows) => RenderOptions {
+            TruthSource::RayMarch(step, shadows) => RenderOptions {
                 size,
                 method: Some(MethodKind::Reference),
                 step: Some(step),
@@ -138,7 +138,7 @@ pub struct Args {
     /// Output folder (default `out/pareto/<scene stem>`), created if missing.
     pub out: Option<PathBuf>,
     /// What the error is measured against.
-    pub truth: Truth,
+    pub truth: TruthSource,
     /// Methods to sweep.
     pub methods: Vec<Sweep>,
     /// `ViewSlices` plane counts (each with the trivial reject on and off).
@@ -451,7 +451,7 @@ fn measure_setting(scene: &Scene, args: &Args, s: &Setting, bp: Blueprint, truth
 /// on what cannot be measured. The truth must plan; a setting that does not is skipped.
 fn plan(scene: &Scene, args: &Args) -> Result<Planned> {
     Blueprint::new(scene, &args.truth.options(args.size)).map_err(|e| {
-        let hint = if args.truth == Truth::Reference { "; try --truth view-slices:4096" } else { "" };
+        let hint = if args.truth == TruthSource::Reference { "; try --truth view-slices:4096" } else { "" };
         Error::Invalid(format!("the truth ({}) cannot be rendered: {e}{hint}", args.truth))
     })?;
     let (all, mut notes) = sweep(scene, args)?;

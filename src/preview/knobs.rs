@@ -4,7 +4,7 @@
 
 use super::scene_text::{self as st, format_number, Edit, Step};
 use crate::error::{Error, Result};
-use crate::render::DEFAULT_PLANES;
+use crate::render::SWITCHED_PLANES;
 use crate::scene::{Method, Shading, MAX_PLANES};
 
 /// The edit of `path` made by `change`, a sequence of edits on the whole text inside `path`.
@@ -66,7 +66,7 @@ pub(crate) fn next_method(src: &str, node: &[Step], m: &Method) -> Result<Edit> 
             Method::ViewSlices(_) => "AxisSlices()".to_string(),
             Method::AxisSlices(_) => "Reference()".to_string(),
             Method::Reference(r) => {
-                format!("ViewSlices(planes: {DEFAULT_PLANES}, lighting: {})", lighting(r.lighting))
+                format!("ViewSlices(planes: {SWITCHED_PLANES}, lighting: {})", lighting(r.lighting))
             }
             #[allow(unreachable_patterns)]
             other => return Err(Error::Invalid(format!("no key switches {other:?}"))),

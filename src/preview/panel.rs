@@ -43,7 +43,7 @@ pub(crate) struct Object {
 }
 
 /// What the panel shows.
-pub(crate) struct View<'a> {
+pub(crate) struct PanelView<'a> {
     pub(crate) src: &'a str,
     pub(crate) tree: Option<&'a Value>,
     pub(crate) scene: Option<&'a Scene>,
@@ -149,7 +149,7 @@ fn type_key<'a>(v: &'a Value, path: &[Step], src: &'a str) -> Option<&'a str> {
 }
 
 /// Draws the panel; returns what the user did.
-pub(crate) fn show(root: &mut egui::Ui, view: &View) -> (Vec<Action>, Vec<(String, egui::Rect)>) {
+pub(crate) fn show(root: &mut egui::Ui, view: &PanelView) -> (Vec<Action>, Vec<(String, egui::Rect)>) {
     let mut cx = Cx {
         src: view.src,
         scene: view.scene,
@@ -163,7 +163,7 @@ pub(crate) fn show(root: &mut egui::Ui, view: &View) -> (Vec<Action>, Vec<(Strin
     (cx.actions, cx.rects)
 }
 
-fn contents(ui: &mut egui::Ui, cx: &mut Cx, view: &View) {
+fn contents(ui: &mut egui::Ui, cx: &mut Cx, view: &PanelView) {
     for (i, line) in view.lines.iter().enumerate() {
         if i == 0 {
             ui.label(RichText::new(line).strong());

@@ -28,7 +28,7 @@ pub enum Kind {
         /// The struct's name (`None` for `(..)`).
         name: Option<String>,
         /// Its fields, in order.
-        fields: Vec<Field>,
+        fields: Vec<ParenField>,
     },
     /// `[..]`: a list.
     List(Vec<Value>),
@@ -38,7 +38,7 @@ pub enum Kind {
 
 /// A field of a `Paren` value.
 #[derive(Debug, Clone, PartialEq)]
-pub struct Field {
+pub struct ParenField {
     /// The field's name (`None` in a tuple).
     pub(crate) name: Option<String>,
     pub(crate) value: Value,
@@ -354,11 +354,11 @@ impl Parser<'_> {
                     p.i += 1;
                     p.skip();
                     let field = p.src[id].trim_start_matches("r#").to_string();
-                    return Ok(Field { name: Some(field), value: p.value()? });
+                    return Ok(ParenField { name: Some(field), value: p.value()? });
                 }
             }
             p.i = at;
-            Ok(Field { name: None, value: p.value()? })
+            Ok(ParenField { name: None, value: p.value()? })
         })?;
         Ok(Kind::Paren { name, fields })
     }
@@ -527,7 +527,7 @@ pub fn add_field(src: &str, path: &[Step], name: &str, value: &str) -> Result<Ed
 }
 
 /// Where a named field's name starts (its value's span starts after `name:`).
-fn field_start(src: &str, f: &Field) -> usize {
+fn field_start(src: &str, f: &ParenField) -> usize {
     let Some(name) = &f.name else { return f.value.span.start };
     src[..f.value.span.start].rfind(name.as_str()).unwrap_or(f.value.span.start)
 }

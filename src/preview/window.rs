@@ -423,7 +423,7 @@ impl State {
         let objects = self.objects(tree.as_ref(), &src);
         let lines = self.info_lines();
         let editor = self.editor.as_ref();
-        let view = panel::View {
+        let view = panel::PanelView {
             src: &src,
             tree: tree.as_ref(),
             scene: self.session.scene(),

@@ -6,7 +6,7 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
 use super::record::Found;
-use super::shards::{read_json, Manifest, Plan, STATE_DIR};
+use super::shards::{read_json, Manifest, ShardPlan, STATE_DIR};
 use super::Shard;
 use crate::Result;
 
@@ -133,7 +133,7 @@ fn or_unknown(host: &str) -> &str {
 type Manifests = BTreeMap<Shard, (PathBuf, Manifest)>;
 
 /// Plans (by shard count) and shard manifests in every `.voltex/` folder under `out`.
-fn state(out: &Path) -> (BTreeMap<usize, Plan>, Manifests) {
+fn state(out: &Path) -> (BTreeMap<usize, ShardPlan>, Manifests) {
     let mut plans = BTreeMap::new();
     let mut manifests = BTreeMap::new();
     let mut dirs = vec![out.to_path_buf()];
@@ -155,13 +155,13 @@ fn state(out: &Path) -> (BTreeMap<usize, Plan>, Manifests) {
     (plans, manifests)
 }
 
-fn read_state(dir: &Path, plans: &mut BTreeMap<usize, Plan>, manifests: &mut Manifests) {
+fn read_state(dir: &Path, plans: &mut BTreeMap<usize, ShardPlan>, manifests: &mut Manifests) {
     let Ok(entries) = std::fs::read_dir(dir) else { return };
     for e in entries.flatten() {
         let path = e.path();
         let name = e.file_name().to_string_lossy().into_owned();
         if name.starts_with("plan-") && name.ends_with(".json") {
-            if let Ok(p) = read_json::<Plan>(&path) {
+            if let Ok(p) = read_json::<ShardPlan>(&path) {
                 plans.insert(p.count, p);
             }
         } else if name.starts_with("shard-") && name.ends_with(".json") {

@@ -153,7 +153,7 @@ fn estimate(entry: &SceneEntry, size: Option<(u32, u32)>) -> f64 {
 
 /// A plan: which shard (0-based) each scene goes to, and each shard's predicted load.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct Plan {
+pub struct ShardPlan {
     pub(crate) suite: String,
     pub(crate) count: usize,
     pub(crate) scenes: Vec<Planned>,
@@ -167,7 +167,7 @@ pub(crate) struct Planned {
     pub(crate) cost: Cost,
 }
 
-impl Plan {
+impl ShardPlan {
     /// Longest processing time first: scenes by falling cost (ties by path) each to the shard
     /// with the least load so far (ties to the lowest index). Loads are summed in whole
     /// microseconds so that every machine computes the same plan.
@@ -182,7 +182,7 @@ impl Plan {
             shard[i] = k;
             heap.push(Reverse((load + micros[i], k)));
         }
-        Plan {
+        ShardPlan {
             suite: suite_id(scenes),
             count,
             scenes: scenes
@@ -256,8 +256,8 @@ impl Plan {
     }
 
     /// The plan for `count` shards stored in `out` if it is for exactly these scenes.
-    pub(crate) fn stored(out: &Path, scenes: &[SceneEntry], count: usize) -> Option<Plan> {
-        let plan: Plan = read_json(&Self::path(out, count)).ok()?;
+    pub(crate) fn stored(out: &Path, scenes: &[SceneEntry], count: usize) -> Option<ShardPlan> {
+        let plan: ShardPlan = read_json(&Self::path(out, count)).ok()?;
         let same = plan.count == count
             && plan.scenes.len() == scenes.len()
             && plan
@@ -278,12 +278,12 @@ pub(crate) fn plan_for(
     scenes: &[SceneEntry],
     count: usize,
     size: Option<(u32, u32)>,
-) -> Result<Plan> {
-    if let Some(plan) = Plan::stored(out, scenes, count) {
+) -> Result<ShardPlan> {
+    if let Some(plan) = ShardPlan::stored(out, scenes, count) {
         return Ok(plan);
     }
     let plan = fresh_plan(out, scenes, count, size);
-    let path = Plan::path(out, count);
+    let path = ShardPlan::path(out, count);
     if path.exists() {
         // A plan for another scene list: replaced.
         plan.write(out)?;
@@ -299,7 +299,7 @@ pub(crate) fn plan_for(
     match linked {
         Ok(()) => Ok(plan),
         Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {
-            Ok(Plan::stored(out, scenes, count).unwrap_or(plan))
+            Ok(ShardPlan::stored(out, scenes, count).unwrap_or(plan))
         }
         // No hard links on this file system: the last writer wins.
         Err(_) => plan.write(out).map(|()| plan),
@@ -307,15 +307,20 @@ pub(crate) fn plan_for(
 }
 
 /// A plan from the costs under `out` now, not stored.
-pub(crate) fn fresh_plan(out: &Path, scenes: &[SceneEntry], count: usize, size: Option<(u32, u32)>) -> Plan {
+pub(crate) fn fresh_plan(
+    out: &Path,
+    scenes: &[SceneEntry],
+    count: usize,
+    size: Option<(u32, u32)>,
+) -> ShardPlan {
     let costs: Vec<Cost> = scenes.iter().map(|s| cost(out, s, size)).collect();
-    Plan::new(scenes, &costs, count)
+    ShardPlan::new(scenes, &costs, count)
 }
 
 /// Before a farm submission: DIR's scenes planned on `count` shards from the costs under `out`
 /// (created), the plan stored for the shards to follow, and the shard manifests of earlier runs
 /// removed, so that the merge judges this submission's shards only.
-pub fn prepare(dir: &Path, out: &Path, count: usize, size: Option<(u32, u32)>) -> Result<Plan> {
+pub fn prepare(dir: &Path, out: &Path, count: usize, size: Option<(u32, u32)>) -> Result<ShardPlan> {
     let all = super::find(dir)?;
     if all.is_empty() {
         return Err(Error::file(dir, "no scene files (*.ron) in this folder"));
@@ -427,15 +432,15 @@ mod tests {
         let scenes = entries(6);
         let costs: Vec<Cost> =
             [7.0, 5.0, 4.0, 3.0, 3.0, 2.0].iter().map(|&ms| Cost { ms, measured: true }).collect();
-        let plan = Plan::new(&scenes, &costs, 2);
+        let plan = ShardPlan::new(&scenes, &costs, 2);
         // 7 -> 1, 5 -> 2, 4 -> 2 (9), 3 -> 1 (10), 3 -> 2 (12), 2 -> 1 (12).
         assert_eq!(plan.scenes.iter().map(|p| p.shard).collect::<Vec<_>>(), [1, 2, 2, 1, 2, 1]);
         assert_eq!(plan.loads(), [12.0, 12.0]);
-        assert_eq!(plan, Plan::new(&scenes, &costs, 2));
+        assert_eq!(plan, ShardPlan::new(&scenes, &costs, 2));
         let take = plan.take(Shard { index: 1, count: 2 }, scenes.clone());
         assert_eq!(take.iter().map(|s| s.rel.as_str()).collect::<Vec<_>>(), ["s0.ron", "s3.ron", "s5.ron"]);
         // Equal costs deal the scenes out in order, as the modulo shards did.
-        let equal = Plan::new(&scenes, &[Cost { ms: 1.0, measured: false }; 6], 4);
+        let equal = ShardPlan::new(&scenes, &[Cost { ms: 1.0, measured: false }; 6], 4);
         assert_eq!(equal.scenes.iter().map(|p| p.shard).collect::<Vec<_>>(), [1, 2, 3, 4, 1, 2]);
         assert_ne!(suite_id(&scenes), suite_id(&scenes[1..]));
     }

@@ -3,7 +3,7 @@
 //! wgpu's default limits, `Renderer` against the adapter's, before anything is allocated.
 
 use crate::error::{Error, FileLoc, Result};
-use crate::gpu::budget::{self, Allocation, Driver, Failure, Shape};
+use crate::gpu::budget::{self, Allocation, AllocationKind, Driver, Failure};
 use crate::graph::{ResourceDecl, TextureSize};
 use crate::render::Blueprint;
 use crate::scene::Scene;
@@ -104,7 +104,7 @@ impl Blueprint {
             out.push(Allocation {
                 what: format!("graph texture `{name}` ({w}x{h} {format:?})"),
                 bytes: w as u64 * h as u64 * format.bytes_per_pixel(),
-                shape: Shape::Texture2d { size: [w, h], layers: 1 },
+                shape: AllocationKind::Texture2d { size: [w, h], layers: 1 },
                 driver,
             });
         }
@@ -112,14 +112,14 @@ impl Blueprint {
             out.push(Allocation {
                 what: format!("graph buffer `{name}`"),
                 bytes: b.bytes,
-                shape: Shape::Buffer { storage: true },
+                shape: AllocationKind::Buffer { storage: true },
                 driver: Driver::Graph(name.clone()),
             });
         }
         out.push(Allocation {
             what: format!("the {}x{} image's readback buffer", self.size.0, self.size.1),
             bytes: self.readback_bytes(),
-            shape: Shape::Buffer { storage: false },
+            shape: AllocationKind::Buffer { storage: false },
             driver: Driver::Output,
         });
         for b in &self.bakes {

@@ -23,7 +23,7 @@ use crate::error::{Error, Result};
 use crate::gpu::GpuContext;
 use crate::io::vdb::{self, Grid, GridClass, GridData, Voxels};
 use crate::mesh::BaseSurface;
-use crate::methods::view::Lighting;
+use crate::methods::view::FrameLight;
 use crate::scene::{Scene, TexelSource};
 use crate::vdb::SparseVolume;
 
@@ -103,7 +103,7 @@ pub struct Export {
 pub fn plan(scene: &Scene, opts: &ExportOptions) -> Result<Vec<Export>> {
     let time = opts.time.unwrap_or(scene.time);
     let objects = scene.objects_at(time)?;
-    let light = Lighting::of(scene);
+    let light = FrameLight::of(scene);
     let mut out = Vec::new();
     for (name, texel) in &scene.texels {
         if matches!(texel.source, TexelSource::Sequence { .. }) {

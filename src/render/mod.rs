@@ -10,7 +10,7 @@ pub mod trace;
 
 pub(crate) use budget::Positions;
 
-pub use crate::methods::options::{MethodKind, RenderOptions, DEFAULT_AXIS_SLICES, DEFAULT_PLANES};
+pub use crate::methods::options::{MethodKind, RenderOptions, DEFAULT_AXIS_SLICES, SWITCHED_PLANES};
 pub use crate::methods::{BakePlan, ObjectPlan};
 pub use renderer::{bake_key, Frame, Renderer};
 
@@ -22,7 +22,7 @@ use crate::error::{Error, Result};
 use crate::gpu::sources::Sources;
 use crate::graph::plan::{self, ObjectInfo, Plan};
 use crate::graph::{Graph, Vocabulary};
-use crate::methods::view::{Lighting, View};
+use crate::methods::view::{FrameLight, View};
 use crate::methods::{MethodPlan, PlanCx, REGISTRY};
 use crate::scene::{Scene, SceneObject};
 use crate::types::FrameParams;
@@ -83,7 +83,7 @@ pub struct Blueprint {
 /// The bake of `texel` with the scene's first light baked in (what `voltex bake` writes out).
 pub fn baked_texel(scene: &Scene, texel: &str) -> Result<BakePlan> {
     let mut bakes = Vec::new();
-    crate::methods::texels::bake_index(scene, texel, false, &Lighting::of(scene), scene.time, &mut bakes)?;
+    crate::methods::texels::bake_index(scene, texel, false, &FrameLight::of(scene), scene.time, &mut bakes)?;
     Ok(bakes.remove(0))
 }
 
@@ -135,7 +135,7 @@ impl Blueprint {
         // Pixels per unit of tangent, for the slice-count criterion (at the rendered size).
         view.focal = 0.5 * size.1 as f64 / (0.5 * view.fov_y.to_radians()).tan();
         view.size = size;
-        let light = Lighting::of(scene);
+        let light = FrameLight::of(scene);
         let mut bakes: Vec<BakePlan> = Vec::new();
         let time = opts.time.unwrap_or(scene.time);
         let mut cx = PlanCx {

@@ -102,19 +102,19 @@ pub fn parse(bytes: Arc<[u8]>, path: &Path, request: &Request) -> Result<SparseV
 /// The density grid of `request` in the file at `path` as read, before it is made sparse: its
 /// voxels' values (a level set's already turned into density) and its transform. For checks
 /// of the GPU's sparse copy that must not share its bricks and tables.
-pub fn voxels(path: &Path, request: &Request) -> Result<Voxels> {
+pub fn voxels(path: &Path, request: &Request) -> Result<GridVoxels> {
     let read = read_grids(&read_file(path)?, path, request)?;
-    Ok(Voxels { index_to_world: read.to_world, blocks: read.density })
+    Ok(GridVoxels { index_to_world: read.to_world, blocks: read.density })
 }
 
 /// A density grid's voxels by index (see [`voxels`]).
-pub struct Voxels {
+pub struct GridVoxels {
     /// Index space to world space (the file's transform).
     pub index_to_world: DMat4,
     blocks: Blocks<f32>,
 }
 
-impl Voxels {
+impl GridVoxels {
     /// The value of voxel `i` (0 where the grid holds none).
     pub fn get(&self, i: glam::IVec3) -> f32 {
         let leaf = i >> glam::IVec3::splat(3);

@@ -14,7 +14,7 @@ use std::path::Path;
 use crate::layers::rust_files;
 
 /// `pub` declarations (not `pub(crate)`) in the library, fields included.
-/// (1274: `vdb::voxels`, `Voxels` and `vdb::grids` for tests/gpu/volume_exact.rs, which checks the
+/// (1274: `vdb::voxels`, `GridVoxels` and `vdb::grids` for tests/gpu/volume_exact.rs, which checks the
 /// GPU's sparse copy of every grid against the voxels as read; `tiles::composite_tiles_frame`
 /// for the compositor's twin test.)
 const PUB_DECLARATIONS: usize = 1274;

@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 use glam::{Vec2, Vec3};
 use voltex::bake::axis_slices as layout;
 use voltex::bake::{BakeRequest, BakeSource, Baker};
-use voltex::cpu::bake::{pack_shapes, Shape};
+use voltex::cpu::bake::{pack_shapes, Primitive};
 use voltex::io::Image;
 use voltex::methods::axis_slices::twin::{self, AxisFrame};
 use voltex::methods::axis_slices::AxisPlan;
@@ -99,8 +99,8 @@ fn slice_counts_at_known_angles() {
 fn slice_image_bake_matches_its_twin() {
     let res = [16, 12, 8];
     let shapes = pack_shapes(&[
-        (Shape::Sphere { center: [0.4, 0.5, 0.4], radius: 0.3 }, [0.9, 0.3, 0.2], 0.7),
-        (Shape::Ellipsoid { center: [0.8, 0.2, 0.6], radii: [0.2, 0.3, 0.15] }, [0.2, 0.8, 0.3], 1.0),
+        (Primitive::Sphere { center: [0.4, 0.5, 0.4], radius: 0.3 }, [0.9, 0.3, 0.2], 0.7),
+        (Primitive::Ellipsoid { center: [0.8, 0.2, 0.6], radii: [0.2, 0.3, 0.15] }, [0.2, 0.8, 0.3], 1.0),
     ]);
     let request = BakeRequest {
         resolution: res,
@@ -151,7 +151,7 @@ fn slice_image_bake_matches_its_twin() {
 fn slice_image_mips_match_their_twin() {
     let res = [16, 12, 8];
     let shapes =
-        pack_shapes(&[(Shape::Sphere { center: [0.4, 0.5, 0.4], radius: 0.35 }, [0.9, 0.3, 0.2], 0.7)]);
+        pack_shapes(&[(Primitive::Sphere { center: [0.4, 0.5, 0.4], radius: 0.35 }, [0.9, 0.3, 0.2], 0.7)]);
     let request = BakeRequest {
         resolution: res,
         source: BakeSource::Implicit(shapes),

@@ -13,7 +13,7 @@ use std::sync::Arc;
 use glam::DVec3;
 use voltex::bake::axis_slices::read_texture;
 use voltex::bake::{BakeRequest, BakeSource, Baker, MeshTexel};
-use voltex::cpu::bake::{bake_params, pack_shapes, Shape};
+use voltex::cpu::bake::{bake_params, pack_shapes, Primitive};
 use voltex::cpu::bake_mesh_texel::bake_mesh_texel;
 use voltex::hypertexture::mesh;
 use voltex::mesh::obj;
@@ -286,7 +286,7 @@ fn sphere_mesh_matches_the_implicit_sphere_without_holes() {
     let dir = folder("sphere", &[("sphere.obj", &sphere_obj(r, false))]);
     let shape = MeshShape::new(&load(&dir, "sphere.obj"), &dir.join("sphere.obj")).unwrap();
     let (mesh, _) = bake(BakeSource::Mesh(mesh_texel(shape, true, [N; 3])), false);
-    let sphere = Shape::Sphere { center: [0.5; 3], radius: r as f32 };
+    let sphere = Primitive::Sphere { center: [0.5; 3], radius: r as f32 };
     let (implicit, _) = bake(BakeSource::Implicit(pack_shapes(&[(sphere, COLOR, 1.0)])), false);
     let (worst, mean) = alpha_diff(&mesh, &implicit);
     eprintln!("sphere: alpha vs implicit: largest {worst}/255, mean {mean:.3}/255");
@@ -310,7 +310,7 @@ fn torus_mesh_keeps_its_hole_empty() {
     let dir = folder("torus", &[("torus.obj", &torus_obj(major, minor))]);
     let shape = MeshShape::new(&load(&dir, "torus.obj"), &dir.join("torus.obj")).unwrap();
     let (mesh, _) = bake(BakeSource::Mesh(mesh_texel(shape, true, [N; 3])), false);
-    let torus = Shape::Torus { center: [0.5; 3], major: major as f32, minor: minor as f32 };
+    let torus = Primitive::Torus { center: [0.5; 3], major: major as f32, minor: minor as f32 };
     let (implicit, _) = bake(BakeSource::Implicit(pack_shapes(&[(torus, COLOR, 1.0)])), false);
     let (worst, mean) = alpha_diff(&mesh, &implicit);
     eprintln!("torus: alpha vs implicit: largest {worst}/255, mean {mean:.3}/255");

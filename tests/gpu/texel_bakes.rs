@@ -7,7 +7,7 @@ use crate::common;
 use common::ctx;
 use voltex::bake::axis_slices::read_texture;
 use voltex::bake::{BakeRequest, BakeSource, Baker};
-use voltex::cpu::bake::{bake_heightfield, bake_implicit, bake_params, pack_shapes, Shape, Volume};
+use voltex::cpu::bake::{bake_heightfield, bake_implicit, bake_params, pack_shapes, Primitive, TexelVoxels};
 
 /// Bakes `source` on the GPU: the colour (rgba8unorm) and normal (rgba8snorm) volumes.
 fn bake(
@@ -37,7 +37,11 @@ fn bake(
 
 /// Compares the GPU's volumes with the twin's: (voxels off by more than one 8-bit step, the
 /// worst step, voxels with matter, the worst normal difference where there is matter).
-fn compare(res: [u32; 3], gpu: &(Vec<u8>, Vec<u8>), twin: &(Volume, Volume)) -> (u32, i32, u32, f32) {
+fn compare(
+    res: [u32; 3],
+    gpu: &(Vec<u8>, Vec<u8>),
+    twin: &(TexelVoxels, TexelVoxels),
+) -> (u32, i32, u32, f32) {
     let (mut off, mut worst, mut matter, mut worst_normal) = (0, 0, 0, 0.0f32);
     for z in 0..res[2] {
         for y in 0..res[1] {
@@ -71,11 +75,11 @@ fn compare(res: [u32; 3], gpu: &(Vec<u8>, Vec<u8>), twin: &(Volume, Volume)) -> 
 #[test]
 fn implicit_bake_matches_its_twin() {
     let shapes = [
-        (Shape::Sphere { center: [0.3, 0.35, 0.45], radius: 0.22 }, [0.9, 0.3, 0.2], 0.8),
-        (Shape::Torus { center: [0.65, 0.6, 0.4], major: 0.22, minor: 0.07 }, [0.2, 0.7, 0.3], 1.0),
-        (Shape::Ellipsoid { center: [0.7, 0.25, 0.6], radii: [0.15, 0.1, 0.3] }, [0.3, 0.4, 0.9], 0.5),
+        (Primitive::Sphere { center: [0.3, 0.35, 0.45], radius: 0.22 }, [0.9, 0.3, 0.2], 0.8),
+        (Primitive::Torus { center: [0.65, 0.6, 0.4], major: 0.22, minor: 0.07 }, [0.2, 0.7, 0.3], 1.0),
+        (Primitive::Ellipsoid { center: [0.7, 0.25, 0.6], radii: [0.15, 0.1, 0.3] }, [0.3, 0.4, 0.9], 0.5),
         (
-            Shape::Metaballs {
+            Primitive::Metaballs {
                 balls: vec![([0.25, 0.75, 0.3], 0.12), ([0.38, 0.8, 0.35], 0.1)],
                 threshold: 0.5,
             },

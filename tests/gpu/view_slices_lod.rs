@@ -7,7 +7,7 @@ use crate::common;
 use common::ctx;
 
 use voltex::bake::{texel_layers, BakeRequest, BakeSource, Baker};
-use voltex::cpu::bake::{pack_shapes, Shape};
+use voltex::cpu::bake::{pack_shapes, Primitive};
 use voltex::io::Image;
 use voltex::methods::view_slices::lod::LodChoice;
 use voltex::methods::view_slices::ViewSlicesPlan;
@@ -44,7 +44,7 @@ fn render(scene: &scene::Scene, opts: &RenderOptions) -> Image {
 fn texel_layers_match_their_twin() {
     let res = [16, 12, 6];
     let shapes =
-        pack_shapes(&[(Shape::Sphere { center: [0.4, 0.5, 0.4], radius: 0.35 }, [0.9, 0.3, 0.2], 0.7)]);
+        pack_shapes(&[(Primitive::Sphere { center: [0.4, 0.5, 0.4], radius: 0.35 }, [0.9, 0.3, 0.2], 0.7)]);
     let request = BakeRequest {
         resolution: res,
         source: BakeSource::Implicit(shapes),

@@ -140,7 +140,7 @@ fn find_vdb(dir: &std::path::Path, out: &mut Vec<std::path::PathBuf>) {
 fn absorbing_scene(
     file: &std::path::Path,
     grid: &voltex::vdb::GridInfo,
-    voxels: &voltex::vdb::Voxels,
+    voxels: &voltex::vdb::GridVoxels,
     lo: IVec3,
     hi: IVec3,
 ) -> String {

@@ -4,7 +4,7 @@ use std::any::Any;
 
 use super::{plan, RayMarchPlan};
 use crate::error::{Error, Result};
-use crate::gpu::budget::{Allocation, Driver, Shape};
+use crate::gpu::budget::{Allocation, AllocationKind, Driver};
 use crate::gpu::cache::GpuCache;
 use crate::gpu::{GpuContext, Inputs};
 use crate::hypertexture::mesh::MeshGrid;
@@ -144,7 +144,7 @@ impl MethodPlan for RayMarchPlan {
             .map(|(name, bytes)| Allocation {
                 what: format!("RayMarch buffer `{name}` at {}x{}", size.0, size.1),
                 bytes,
-                shape: Shape::Buffer { storage: true },
+                shape: AllocationKind::Buffer { storage: true },
                 driver: Driver::Output,
             })
             .collect()

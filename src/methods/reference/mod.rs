@@ -19,7 +19,7 @@ use crate::mesh::bvh::flat_bvh;
 use crate::mesh::shell;
 use crate::mesh::shell::Shell;
 use crate::mesh::BaseSurface;
-use crate::methods::reference::trace_reference::{PerPixel, TraceObject, TraceView, Volume};
+use crate::methods::reference::trace_reference::{DecodedTexel, PerPixel, TraceObject, TraceView};
 use crate::types::{
     FrameParams, ReferenceNode, ReferenceObject, ReferenceParams, ReferencePrism, ReferenceState,
     ShellVertex, VertexFrame,
@@ -353,7 +353,7 @@ pub(crate) fn twin_inputs(
                 }
             }
         }
-        Volume { resolution: [w, h, d], texels }
+        DecodedTexel { resolution: [w, h, d], texels }
     };
     let mut objects = Vec::new();
     for (o, entry) in members.iter().zip(&set.table) {

@@ -3,7 +3,7 @@
 
 use super::{build, default_step, twin_inputs, Member, ReferenceSet};
 use crate::error::Result;
-use crate::gpu::budget::{Allocation, Driver, Shape};
+use crate::gpu::budget::{Allocation, AllocationKind, Driver};
 use crate::gpu::Inputs;
 use crate::methods::reference::trace_reference::{TraceObject, TraceView};
 use crate::methods::view::View;
@@ -170,7 +170,7 @@ impl MethodPlan for ReferenceSet {
         vec![Allocation {
             what: format!("the Reference per-pixel state at {}x{}", size.0, size.1),
             bytes: size.0 as u64 * size.1 as u64 * std::mem::size_of::<crate::types::ReferenceState>() as u64,
-            shape: Shape::Buffer { storage: true },
+            shape: AllocationKind::Buffer { storage: true },
             driver: Driver::Output,
         }]
     }

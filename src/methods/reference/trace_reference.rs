@@ -19,12 +19,12 @@ pub(crate) const MIN_TRANSMITTANCE: f64 = 1e-4;
 pub(crate) const MAX_ALPHA: f64 = 0.999999;
 
 /// Level 0 of a baked volume, decoded: x fastest, then y, then z.
-pub(crate) struct Volume {
+pub(crate) struct DecodedTexel {
     pub(crate) resolution: [u32; 3],
     pub(crate) texels: Vec<[f64; 4]>,
 }
 
-impl Volume {
+impl DecodedTexel {
     /// Trilinear filtering as the volume sampler does it: texel centres at `(i + 0.5) / n`,
     /// repeating in s and t, clamped in w.
     pub(crate) fn sample(&self, uvw: DVec3) -> [f64; 4] {
@@ -59,7 +59,7 @@ impl Volume {
 /// Per-pixel (Phong) lighting inputs of an object: its normal volume and, per prism corner,
 /// `dP/ds` and `dP/dt` (the same vertex frames the slicing method interpolates).
 pub(crate) struct PerPixel {
-    pub(crate) normals: Volume,
+    pub(crate) normals: DecodedTexel,
     pub(crate) frames: Vec<[(DVec3, DVec3); 3]>,
 }
 
@@ -68,7 +68,7 @@ pub struct TraceObject {
     /// The prisms' corners, camera-relative.
     pub prisms: Vec<PrismCorners>,
     pub(crate) uvs: Vec<[DVec2; 3]>,
-    pub(crate) volume: Volume,
+    pub(crate) volume: DecodedTexel,
     pub(crate) per_pixel: Option<PerPixel>,
     pub(crate) opacity_length: f64,
     pub(crate) step: f64,

@@ -11,7 +11,7 @@
 //! pixel, exact on a view plane). A segment whose
 //! entries did not fit the lists is composited from every triangle of its planes.
 
-use crate::methods::reference::trace_reference::Volume;
+use crate::methods::reference::trace_reference::DecodedTexel;
 use crate::types::{FrameParams, SliceVertex, TileAttributes, TileParams, TileTriangle};
 
 /// Tile side in pixels (`TILE_SIZE` in `wgsl/shared/tiles.wgsl`).
@@ -250,7 +250,7 @@ pub struct TileFrame<'a> {
     /// Segment ends (after `fill_tiles`).
     pub(crate) cursors: &'a [u32],
     pub(crate) entries: &'a [u32],
-    pub(crate) volume: &'a Volume,
+    pub(crate) volume: &'a DecodedTexel,
     /// The depth buffer (row-major), `None` for all 1.0.
     pub(crate) depth: Option<&'a [f32]>,
 }
@@ -361,7 +361,7 @@ pub fn composite_tiles_frame(
     let mut plane_ends: Vec<u32> = pod(read("plane_cursors"));
     plane_ends.truncate(plan.sweep.plane_count as usize);
     let ([w, h, d], bytes) = texel;
-    let volume = Volume {
+    let volume = DecodedTexel {
         resolution: [w, h, d],
         texels: bytes.chunks_exact(4).map(|b| std::array::from_fn(|c| b[c] as f64 / 255.0)).collect(),
     };

@@ -5,7 +5,7 @@ use std::any::Any;
 use super::{plan_volume, VolumePlan};
 use crate::bake::volume::{atlas_size, slots, upload, Uploaded};
 use crate::error::{Error, Result};
-use crate::gpu::budget::{Allocation, Driver, Shape};
+use crate::gpu::budget::{Allocation, AllocationKind, Driver};
 use crate::gpu::cache::GpuCache;
 use crate::gpu::{GpuContext, Inputs};
 use crate::methods::{InputCx, MethodPlan, ObjectPlan, PartDecl, PlanCx};
@@ -101,7 +101,7 @@ impl MethodPlan for VolumePlan {
             Allocation {
                 what: format!("the brick table of volume \"{}\"", self.volume),
                 bytes: self.grid.table.len() as u64 * 4,
-                shape: Shape::Buffer { storage: true },
+                shape: AllocationKind::Buffer { storage: true },
                 driver: driver.clone(),
             },
             Allocation {
@@ -111,13 +111,13 @@ impl MethodPlan for VolumePlan {
                     self.grid.bricks()
                 ),
                 bytes: texels * 4,
-                shape: Shape::Texture3d { size: atlas },
+                shape: AllocationKind::Texture3d { size: atlas },
                 driver: driver.clone(),
             },
             Allocation {
                 what: format!("the volume march state at {}x{}", size.0, size.1),
                 bytes: VolumePlan::state_bytes(size),
-                shape: Shape::Buffer { storage: true },
+                shape: AllocationKind::Buffer { storage: true },
                 driver: Driver::Output,
             },
         ];
@@ -125,7 +125,7 @@ impl MethodPlan for VolumePlan {
             out.push(Allocation {
                 what: format!("the colour atlas of volume \"{}\"", self.volume),
                 bytes: texels * 8,
-                shape: Shape::Texture3d { size: atlas },
+                shape: AllocationKind::Texture3d { size: atlas },
                 driver,
             });
         }
