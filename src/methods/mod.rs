@@ -7,6 +7,7 @@ pub mod axis_slices;
 pub(crate) mod base_surface;
 pub mod options;
 pub mod plan;
+pub(crate) mod plugin;
 pub mod ray_march;
 pub mod reference;
 pub(crate) mod texels;

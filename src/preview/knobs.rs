@@ -1,11 +1,12 @@
 //! The preview's method keys as edits of the scene file: `M` switches the selected object's method
 //! (a hypertexture's shading), `+` and `-` step its quality knob. Each is one edit of the node's
-//! text (undone at once), made from the method the renderer draws with.
+//! text (undone at once), made from the method the renderer draws with; what each key does to a
+//! method is its plug-in's answer (`methods::plugin`).
 
 use super::scene_text::{self as st, format_number, Edit, Step};
 use crate::error::{Error, Result};
-use crate::render::SWITCHED_PLANES;
-use crate::scene::{Method, Shading, MAX_PLANES};
+use crate::methods::plugin::Next;
+use crate::scene::Method;
 
 /// The edit of `path` made by `change`, a sequence of edits on the whole text inside `path`.
 fn compound(src: &str, path: &[Step], change: impl FnOnce(String) -> Result<String>) -> Result<Edit> {
@@ -36,108 +37,54 @@ fn method_path(src: &str, node: &[Step], written: &str) -> Result<(String, Vec<S
     Ok((text, m))
 }
 
-fn variant(m: &Method) -> &'static str {
-    match m {
-        Method::ViewSlices(_) => "ViewSlices",
-        Method::AxisSlices(_) => "AxisSlices",
-        Method::Reference(_) => "Reference",
-        Method::RayMarch(_) => "RayMarch",
-        #[allow(unreachable_patterns)]
-        _ => "",
-    }
-}
-
-/// `M`: ViewSlices, AxisSlices, Reference in turn (lighting kept where both have it); a
-/// hypertexture's RayMarch cycles its shading: None, Phong, PhongShadows, HenyeyGreenstein.
+/// `M`: the method's plug-in says what comes next: ViewSlices, AxisSlices, Reference in turn
+/// (lighting kept where both have it); a hypertexture's RayMarch cycles its shading.
 pub(crate) fn next_method(src: &str, node: &[Step], m: &Method) -> Result<Edit> {
-    compound(src, node, |text| {
-        let lighting = |l: crate::scene::Lighting| format!("{l:?}");
-        let next = match m {
-            Method::RayMarch(h) => {
-                let shading = match h.shading {
-                    Shading::None => "Phong",
-                    Shading::Phong => "PhongShadows",
-                    Shading::PhongShadows => "HenyeyGreenstein(g: 0.5, shadows: true)",
-                    Shading::HenyeyGreenstein { .. } => "None",
-                };
-                let (text, mp) = method_path(&text, node, "RayMarch()")?;
-                return set_field(&text, &mp, "shading", shading);
-            }
-            Method::ViewSlices(_) => "AxisSlices()".to_string(),
-            Method::AxisSlices(_) => "Reference()".to_string(),
-            Method::Reference(r) => {
-                format!("ViewSlices(planes: {SWITCHED_PLANES}, lighting: {})", lighting(r.lighting))
-            }
-            #[allow(unreachable_patterns)]
-            other => return Err(Error::Invalid(format!("no key switches {other:?}"))),
-        };
-        let (text, mp) = method_path(&text, node, &next)?;
-        st::set(&text, &mp, &next)?.apply(&text)
+    let written = format!("{}()", m.plugin().name());
+    compound(src, node, |text| match m.plugin().next(m) {
+        Next::Knob(path, value) => {
+            let (text, mp) = method_path(&text, node, &written)?;
+            set_knob(&text, &mp, path, &value)
+        }
+        Next::Method(next) => {
+            let (text, mp) = method_path(&text, node, &next)?;
+            st::set(&text, &mp, &next)?.apply(&text)
+        }
     })
 }
 
-/// `+` (finer) and `-`: ViewSlices planes x2 or /2, a ray step /2 or x2 (an adaptive stride's
-/// `max_step` with it), AxisSlices' slice depth /2 or x2. `None` where the method has no knob
-/// to step (Reference at its default step).
+/// Writes the knob at `path` under the method at `mp` (the last field added when the file
+/// leaves it out; the ones above it must be written).
+fn set_knob(src: &str, mp: &[Step], path: &[&str], value: &str) -> Result<String> {
+    let (last, above) = path.split_last().expect("a knob's path names a field");
+    let mut at = mp.to_vec();
+    at.extend(above.iter().map(|f| Step::Field((*f).into())));
+    set_field(src, &at, last, value)
+}
+
+/// `+` (finer) and `-`: the knobs the method's plug-in steps (ViewSlices' planes, a ray step
+/// with an adaptive stride's `max_step`, AxisSlices' slice depth). `None` where the method has
+/// no knob to step (Reference at its default step).
 pub(crate) fn step_quality(src: &str, node: &[Step], m: &Method, finer: bool) -> Result<Option<Edit>> {
-    let scale = if finer { 0.5 } else { 2.0 };
-    let (field, value) = match m {
-        Method::ViewSlices(v) => {
-            let planes = if finer { (v.planes * 2).min(MAX_PLANES) } else { (v.planes / 2).max(1) };
-            ("planes", planes.to_string())
-        }
-        Method::Reference(r) => match r.step {
-            Some(s) => ("step", format_number(s * scale, "0.0")),
-            None => return Ok(None),
-        },
-        // Finer: see less deep inside contours (more slices).
-        Method::AxisSlices(a) => ("depth", format_number((a.depth * scale).clamp(1.0 / 64.0, 1024.0), "0.0")),
-        Method::RayMarch(h) => ("step", format_number(h.step() * scale, "0.0")),
-        #[allow(unreachable_patterns)]
-        _ => return Ok(None),
-    };
+    let edits = m.plugin().quality_step(m, finer);
+    if edits.is_empty() {
+        return Ok(None);
+    }
     compound(src, node, |text| {
-        let (text, mp) = method_path(&text, node, &format!("{}()", variant(m)))?;
-        let text = set_field(&text, &mp, field, &value)?;
-        // The adaptive stride's longest step scales with the step, so the stride stays on.
-        match m {
-            Method::RayMarch(h) => match h.adaptive {
-                Some(a) => {
-                    let mut ap = mp.clone();
-                    ap.push(Step::Field("adaptive".into()));
-                    set_field(&text, &ap, "max_step", &format_number(a.max_step * scale, "0.0"))
-                }
-                None => Ok(text),
-            },
-            _ => Ok(text),
+        let (mut text, mp) = method_path(&text, node, &format!("{}()", m.plugin().name()))?;
+        for e in &edits {
+            let value = format_number(e.value, if e.integer { "0" } else { "0.0" });
+            text = set_knob(&text, &mp, e.path, &value)?;
         }
+        Ok(text)
     })
     .map(Some)
 }
 
-/// The method `d` times coarser, for a frame drawn while a drag goes on: a `d`-th of the planes,
-/// a ray step (and shadow step, adaptive stride) `d` times longer, AxisSlices criteria `d` times
-/// looser. Reference at its default step stays as it is.
+/// The method `d` times coarser, for a frame drawn while a drag goes on (its plug-in's
+/// `coarser`: fewer planes, longer steps, looser criteria).
 pub(crate) fn coarser(m: &Method, d: f64) -> Method {
-    let mut m = m.clone();
-    match &mut m {
-        Method::ViewSlices(v) => v.planes = ((v.planes as f64 / d).round() as u32).max(1),
-        Method::RayMarch(h) => {
-            h.step = Some(h.step() * d);
-            h.shadow_step = h.shadow_step.map(|s| s * d);
-            if let Some(a) = &mut h.adaptive {
-                a.max_step *= d;
-            }
-        }
-        Method::AxisSlices(a) => {
-            a.depth = (a.depth * d).min(1024.0);
-            a.pixels *= d;
-        }
-        Method::Reference(r) => r.step = r.step.map(|s| s * d),
-        #[allow(unreachable_patterns)]
-        _ => {}
-    }
-    m
+    m.plugin().coarser(m, d)
 }
 
 /// Names and paths of the nodes of the text (`nodes[i]`, `nodes[i].children[j]`, ...).

@@ -3,6 +3,7 @@
 //! `emit_axis_slices` and `draw_axis_slices`. The slice images come from `bake::axis_slices`.
 
 mod object;
+pub(crate) mod plugin;
 pub mod twin;
 
 pub(crate) use object::plan;

@@ -10,6 +10,7 @@ pub mod light_volume;
 pub mod march;
 mod object;
 pub mod peel_segments;
+pub(crate) mod plugin;
 pub mod splat_segments;
 
 use glam::{DMat4, DVec3};

@@ -4,6 +4,7 @@
 //! as the sampler would, so all objects fit in one dispatch without binding arrays).
 
 mod object;
+pub(crate) mod plugin;
 pub mod trace_reference;
 
 pub use object::{frame_twin_inputs, plan, ReferencePlan};

@@ -3,6 +3,7 @@
 
 pub mod lod;
 mod object;
+pub(crate) mod plugin;
 pub mod slice_prisms;
 pub(crate) mod tile_buffers;
 pub mod tiles;
