@@ -251,14 +251,15 @@ fn save(
     Ok((sample, stats))
 }
 
-/// Step `i` of an orbit around the scene's target (the window's left drag): rebuilt, rendered.
+/// Step `i` of an orbit around the scene's target (the window's left drag): re-planned, rendered.
 fn orbit(ctx: &GpuContext, session: &mut Session, i: usize) -> Result<(Sample, CacheStats)> {
     let start = Instant::now();
     let mut cam = *session.scene().ok_or_else(|| Error::Invalid("no scene".into()))?.camera;
     let turn = DQuat::from_axis_angle(cam.up.normalize(), (2.0 * i as f64).to_radians());
     cam.eye = cam.target + turn * (cam.eye - cam.target);
     session.options.camera = Some(cam);
-    let stats = match session.rebuild(ctx) {
+    // As the window does: the last good scene planned again, no file read.
+    let stats = match session.replan(ctx) {
         Outcome::Rebuilt(stats) => stats,
         Outcome::Failed(e) => return Err(Error::Invalid(e)),
     };

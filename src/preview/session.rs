@@ -130,20 +130,26 @@ impl Session {
     }
 
     fn build(&mut self, ctx: &GpuContext, scene: Scene) -> Result<Outcome> {
+        let stats = self.make(ctx, &scene)?;
+        self.scene = Some(scene);
+        self.error = None;
+        self.logged = None;
+        Ok(Outcome::Rebuilt(stats))
+    }
+
+    /// Plans `scene` with the session's options and makes its renderer (the stages timed).
+    fn make(&mut self, ctx: &GpuContext, scene: &Scene) -> Result<CacheStats> {
         self.cache.begin();
         let t = Instant::now();
-        let bp = self.blueprint(&scene)?;
+        let bp = self.blueprint(scene)?;
         let plan = ms(t);
         let t = Instant::now();
         let renderer = Renderer::with_cache(ctx, bp, &mut self.cache)?;
         let made = ms(t);
         self.stages = Stages { parse: 0.0, plan, bake: renderer.bake_ms, build: made - renderer.bake_ms };
         self.cache.retain_used();
-        self.scene = Some(scene);
         self.renderer = Some(renderer);
-        self.error = None;
-        self.logged = None;
-        Ok(Outcome::Rebuilt(self.cache.stats))
+        Ok(self.cache.stats)
     }
 
     /// Keeps no bake a rebuild left unused (the latency measurement: a value toggled back is
@@ -158,15 +164,18 @@ impl Session {
     pub fn recover(&mut self, ctx: &GpuContext) -> Outcome {
         self.renderer = None;
         self.cache.clear();
-        let Some(scene) = self.scene.as_ref() else { return self.rebuild(ctx) };
-        self.cache.begin();
-        let built = self.blueprint(scene).and_then(|bp| Renderer::with_cache(ctx, bp, &mut self.cache));
-        match built {
-            Ok(renderer) => {
-                self.cache.retain_used();
-                self.renderer = Some(renderer);
-                Outcome::Rebuilt(self.cache.stats)
-            }
+        self.replan(ctx)
+    }
+
+    /// The view changed (camera, draft), not the files: plans the last good scene again
+    /// without reading anything (its assets are in it). Without a good scene yet, rebuilds from
+    /// the file. The current error, if any, stays.
+    pub fn replan(&mut self, ctx: &GpuContext) -> Outcome {
+        let Some(scene) = self.scene.take() else { return self.rebuild(ctx) };
+        let made = self.make(ctx, &scene);
+        self.scene = Some(scene);
+        match made {
+            Ok(stats) => Outcome::Rebuilt(stats),
             Err(e) => self.failed(e),
         }
     }

@@ -364,8 +364,9 @@ impl State {
 
     /// Renders the scene if something changed, runs the panel, then draws both.
     fn redraw(&mut self, args: &PreviewArgs) -> Result<()> {
+        // Only the view changed (a camera move, a draft refined): no file is read again.
         if std::mem::take(&mut self.stale) {
-            self.session.rebuild(&self.ctx);
+            self.session.replan(&self.ctx);
         }
         let fresh = self.dirty;
         if self.dirty {

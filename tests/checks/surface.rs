@@ -16,8 +16,9 @@ use crate::layers::rust_files;
 /// `pub` declarations (not `pub(crate)`) in the library, fields included.
 /// (1274: `vdb::voxels`, `GridVoxels` and `vdb::grids` for tests/gpu/volume_exact.rs, which checks the
 /// GPU's sparse copy of every grid against the voxels as read; `tiles::composite_tiles_frame`
-/// for the compositor's twin test.)
-const PUB_DECLARATIONS: usize = 1274;
+/// for the compositor's twin test; `Session::replan`, a camera move without a file read, for
+/// tests/cli/faults.rs.)
+const PUB_DECLARATIONS: usize = 1275;
 
 /// Whether the declaration on line `n` has a `///` doc above its attributes (one-line ones, or
 /// multi-line ones from `#[` to `)]`).

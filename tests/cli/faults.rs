@@ -319,3 +319,26 @@ fn building_a_renderer_on_a_lost_device_is_an_error() {
     let err = voltex::render::Renderer::new(&ctx, bp).err().expect("no renderer on a lost device");
     assert!(matches!(err, voltex::Error::DeviceLost(_)), "{err}");
 }
+
+/// A camera move re-plans the last good scene without reading a file: with the scene file gone
+/// (and so any asset it names unreadable), the view still moves and the frame changes; the
+/// file's next read is what reports its absence.
+#[test]
+fn a_camera_move_reads_no_file() {
+    let dir = temp("camera-move");
+    let scene = scenes(&dir, 1).remove(0);
+    let options = RenderOptions { size: Some((32, 32)), ..Default::default() };
+    let ctx = GpuContext::new().unwrap();
+    let mut session = Session::open(&ctx, &scene, options);
+    let before = session.render(&ctx).unwrap().unwrap().image;
+    let mut camera = *session.scene().unwrap().camera;
+    std::fs::remove_file(&scene).unwrap();
+    camera.eye = camera.target + (camera.eye - camera.target) * 1.5;
+    session.options.camera = Some(camera);
+    assert!(matches!(session.replan(&ctx), Outcome::Rebuilt(_)), "{:?}", session.error);
+    let after = session.render(&ctx).unwrap().unwrap().image;
+    assert!(after.same_size(&before) && after.pixels != before.pixels, "the view moved");
+    assert!(session.error.is_none());
+    assert!(matches!(session.rebuild(&ctx), Outcome::Failed(_)), "a rebuild reads the file");
+    let _ = std::fs::remove_dir_all(&dir);
+}
