@@ -15,13 +15,13 @@ pub(crate) const MIP_KERNEL: &str = "bake/mip_layers.wgsl";
 
 /// MIP levels of the layers of a texel of `res`: s and t halve down to 1x1, w stays.
 pub fn mip_levels(res: [u32; 3]) -> u32 {
-    32 - res[0].max(res[1]).max(1).leading_zeros()
+    super::axis_slices::mip_levels([res[0], res[1]])
 }
 
-/// Bytes of the layers of a texel of `res` (f16 RGBA, every level).
+/// Bytes of the layers of a texel of `res` (f16 RGBA, every level): one layer a w voxel, each
+/// as an AxisSlices w slice image with its MIP levels.
 pub(crate) fn bytes(res: [u32; 3]) -> u64 {
-    (0..mip_levels(res)).map(|l| (res[0] >> l).max(1) as u64 * (res[1] >> l).max(1) as u64 * 8).sum::<u64>()
-        * res[2] as u64
+    super::axis_slices::image_bytes([res[0], res[1]], true) * res[2] as u64
 }
 
 /// A 2D texture array of `layers` layers of `size`, `levels` MIP levels, f16 RGBA (texel layers,

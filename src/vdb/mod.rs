@@ -118,14 +118,7 @@ impl GridVoxels {
     /// The value of voxel `i` (0 where the grid holds none).
     pub fn get(&self, i: glam::IVec3) -> f32 {
         let leaf = i >> glam::IVec3::splat(3);
-        match self.blocks.get(&leaf) {
-            None => 0.0,
-            Some(tree::Block::Tile(v)) => *v,
-            Some(tree::Block::Voxels(v)) => {
-                let l = i - (leaf << glam::IVec3::splat(3));
-                v[(l.x * 64 + l.y * 8 + l.z) as usize]
-            }
-        }
+        sparse::value(self.blocks.get(&leaf), i - (leaf << glam::IVec3::splat(3)), 0.0)
     }
 
     /// Every value the grid holds (a tile's once per voxel it covers).

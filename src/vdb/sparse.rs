@@ -99,7 +99,7 @@ fn dilated(blocks: &Blocks<f32>) -> Vec<IVec3> {
 }
 
 /// The value of voxel `local` (0..8 per axis) of a block, or `empty` where there is none.
-fn value<T: Copy>(b: Option<&Block<T>>, local: IVec3, empty: T) -> T {
+pub(crate) fn value<T: Copy>(b: Option<&Block<T>>, local: IVec3, empty: T) -> T {
     match b {
         None => empty,
         Some(Block::Tile(v)) => *v,
