@@ -95,8 +95,8 @@ pub struct Overrides {
     graph: Option<PathBuf>,
     /// Render every textured object with this method (its lighting mode is kept); `reference`
     /// also switches RayMarch volume objects to the exact Reference.
-    #[arg(long, value_enum)]
-    method: Option<MethodArg>,
+    #[arg(long, value_parser = method_parser(true))]
+    method: Option<MethodKind>,
     /// Render N x N samples per pixel and average them (anti-aliasing; e.g. 2 or 4).
     #[arg(long)]
     supersample: Option<u32>,
@@ -185,19 +185,16 @@ pub fn parse_shadows(s: &str) -> std::result::Result<ShadowsArg, String> {
     voltex::methods::options::parse_shadows(s).map(ShadowsArg)
 }
 
-#[derive(clap::ValueEnum, Clone, Copy)]
-enum MethodArg {
-    ViewSlices,
-    Reference,
-    AxisSlices,
-}
-
-fn method_kind(m: MethodArg) -> MethodKind {
-    match m {
-        MethodArg::ViewSlices => MethodKind::ViewSlices,
-        MethodArg::Reference => MethodKind::Reference,
-        MethodArg::AxisSlices => MethodKind::AxisSlices,
-    }
+/// A method by its command-line name (`view-slices`), among the registered ones (those that
+/// draw texels where `switchable`).
+pub fn method_parser(switchable: bool) -> impl clap::builder::TypedValueParser<Value = MethodKind> {
+    let names: Vec<&'static str> = MethodKind::all()
+        .filter(|k| !switchable || k.switchable())
+        .map(|k| &*Box::leak(k.cli_name().into_boxed_str()))
+        .collect();
+    use clap::builder::TypedValueParser;
+    clap::builder::PossibleValuesParser::new(names)
+        .map(|s: String| MethodKind::from_cli(&s).expect("a listed name"))
 }
 
 impl Overrides {
@@ -231,7 +228,7 @@ impl Overrides {
             graph: self.graph.clone(),
             planes: self.planes,
             trivial_reject: self.no_trivial_reject.then_some(false),
-            method: self.method.map(method_kind),
+            method: self.method,
             step: self.step,
             supersample: self.supersample,
             time: self.time,

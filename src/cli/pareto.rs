@@ -23,24 +23,25 @@ pub struct ParetoCmd {
     /// `ray-march:STEP[:SHADOWS]` (SHADOWS as in --ray-shadows, e.g. ray-march:0.0005:rays).
     #[arg(long, default_value = "reference")]
     truth: voltex::pareto::TruthSource,
-    /// Methods to sweep (ray-march: the step of every hypertexture object).
-    #[arg(long, value_enum, value_delimiter = ',', default_values = ["view-slices", "reference"])]
-    methods: Vec<SweepArg>,
+    /// Methods to sweep (ray-march: the step of every hypertexture object; default: those
+    /// each method's plug-in sweeps by default, view-slices and reference).
+    #[arg(long, value_delimiter = ',', value_parser = super::method_parser(false))]
+    methods: Vec<MethodKind>,
     /// ViewSlices plane counts (each with the trivial reject on and off).
-    #[arg(long, value_delimiter = ',', default_values_t = voltex::pareto::SWEEP_PLANES)]
+    #[arg(long, value_delimiter = ',', default_values_t = voltex::methods::sweep::SWEEP_PLANES)]
     planes: Vec<u32>,
     /// Also sweep ViewSlices with `lod: Auto` (planes and texel MIP level from the size on
     /// screen), each plane count its most planes.
     #[arg(long)]
     lod: bool,
     /// Reference ray steps, as multiples of the default step.
-    #[arg(long, value_delimiter = ',', default_values_t = voltex::pareto::DEFAULT_STEP_FACTORS)]
+    #[arg(long, value_delimiter = ',', default_values_t = voltex::methods::sweep::DEFAULT_STEP_FACTORS)]
     steps: Vec<f64>,
     /// AxisSlices criteria: d (voxels) = p (pixels) = each value.
-    #[arg(long, value_delimiter = ',', default_values_t = voltex::pareto::DEFAULT_CRITERIA)]
+    #[arg(long, value_delimiter = ',', default_values_t = voltex::methods::sweep::DEFAULT_CRITERIA)]
     criteria: Vec<f64>,
     /// RayMarch steps (world units).
-    #[arg(long, value_delimiter = ',', default_values_t = voltex::pareto::DEFAULT_RAY_STEPS)]
+    #[arg(long, value_delimiter = ',', default_values_t = voltex::methods::sweep::DEFAULT_RAY_STEPS)]
     ray_steps: Vec<f64>,
     /// RayMarch segment strategies, each swept over every step: bounds, depth-peeling (4 passes),
     /// splatting (16 slabs).
@@ -72,25 +73,6 @@ fn parse_adaptive(s: &str) -> std::result::Result<(f64, f64), String> {
     }
 }
 
-/// The methods `pareto` sweeps: those of `--method`, and the hypertextures' ray marching.
-#[derive(clap::ValueEnum, Clone, Copy)]
-enum SweepArg {
-    ViewSlices,
-    Reference,
-    AxisSlices,
-    RayMarch,
-}
-
-fn sweep(m: SweepArg) -> voltex::pareto::Sweep {
-    use voltex::pareto::Sweep;
-    match m {
-        SweepArg::ViewSlices => Sweep::Method(MethodKind::ViewSlices),
-        SweepArg::Reference => Sweep::Method(MethodKind::Reference),
-        SweepArg::AxisSlices => Sweep::Method(MethodKind::AxisSlices),
-        SweepArg::RayMarch => Sweep::RayMarch,
-    }
-}
-
 /// RayMarch segment strategies `pareto` sweeps (with their default passes, slabs and grid).
 #[derive(clap::ValueEnum, Clone, Copy)]
 enum SegmentsArg {
@@ -116,19 +98,25 @@ fn segments(s: SegmentsArg) -> voltex::scene::Segments {
 pub fn run(p: ParetoCmd) -> Result<()> {
     voltex::pareto::run(&voltex::pareto::Args {
         scene: p.scene,
-        size: p.size,
         frames: p.frames,
         out: p.out,
         truth: p.truth,
-        methods: p.methods.into_iter().map(sweep).collect(),
-        planes: p.planes,
-        lod: p.lod,
-        steps: p.steps,
-        criteria: p.criteria,
-        ray_steps: p.ray_steps,
-        ray_segments: p.ray_segments.into_iter().map(segments).collect(),
-        ray_adaptive: p.ray_adaptive,
-        ray_shadows: p.ray_shadows.into_iter().map(|s| s.0).collect(),
+        methods: if p.methods.is_empty() {
+            MethodKind::all().filter(|k| k.swept_by_default()).collect()
+        } else {
+            p.methods
+        },
+        sweep: voltex::methods::sweep::SweepValues {
+            size: p.size,
+            planes: p.planes,
+            lod: p.lod,
+            steps: p.steps,
+            criteria: p.criteria,
+            ray_steps: p.ray_steps,
+            ray_segments: p.ray_segments.into_iter().map(segments).collect(),
+            ray_adaptive: p.ray_adaptive,
+            ray_shadows: p.ray_shadows.into_iter().map(|s| s.0).collect(),
+        },
         peers: p.peers,
     })
 }

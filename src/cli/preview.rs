@@ -42,7 +42,9 @@ pub struct PreviewArgs {
 #[derive(clap::ValueEnum, Clone, Copy)]
 enum ViewArg {
     Image,
-    Reference,
+    /// The ground truth's image.
+    #[value(name = "reference")]
+    Truth,
     Difference,
 }
 
@@ -61,7 +63,7 @@ pub fn run(args: PreviewArgs) -> Result<()> {
     }
     let mode = match view {
         ViewArg::Image => Mode::Image,
-        ViewArg::Reference => Mode::Reference,
+        ViewArg::Truth => Mode::Truth,
         ViewArg::Difference => Mode::Difference,
     };
     let options = overrides.options()?;

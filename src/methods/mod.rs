@@ -3,17 +3,26 @@
 //! declares what it brings to the render graph ([`Contribution`]), plans objects into a
 //! [`MethodPlan`], and is registered once, in [`REGISTRY`] and `plan_method`.
 
-pub mod axis_slices;
 pub(crate) mod base_surface;
+pub(crate) mod knobs;
 pub mod options;
 pub mod plan;
 pub(crate) mod plugin;
-pub mod ray_march;
-pub mod reference;
+pub mod sweep;
 pub(crate) mod texels;
 pub mod view;
-pub mod view_slices;
 pub mod volume;
+
+macro_rules! method_modules {
+    ($($(#[doc = $doc:literal])* $(#[cfg($cfg:meta)])? $name:ident $folder:ident $(in $path:literal)?,)*) => {
+        $($(#[cfg($cfg)])? $(#[path = $path])? pub mod $folder;)*
+
+        /// Every method's graph contribution, the base surface's first and volumes' last.
+        pub const REGISTRY: &[&Contribution] =
+            &[&base_surface::CONTRIBUTION, $($(#[cfg($cfg)])? &$folder::CONTRIBUTION,)* &volume::CONTRIBUTION];
+    };
+}
+knobs::for_each_method!(method_modules);
 
 pub use plan::{BakePlan, InputCx, MethodPlan, ObjectPlan, PartDecl};
 
@@ -41,16 +50,6 @@ pub struct Contribution {
 /// Builds a frame-wide plan from the frame's objects, bakes and view (see [`Contribution::gather`]).
 pub(crate) type Gather = fn(&mut [ObjectPlan], &[BakePlan], &View) -> Option<Box<dyn MethodPlan>>;
 
-/// Every method, registered once.
-pub const REGISTRY: &[&Contribution] = &[
-    &base_surface::CONTRIBUTION,
-    &view_slices::CONTRIBUTION,
-    &axis_slices::CONTRIBUTION,
-    &reference::CONTRIBUTION,
-    &ray_march::CONTRIBUTION,
-    &volume::CONTRIBUTION,
-];
-
 /// What planning an object may read, and the frame's bakes it adds to.
 pub struct PlanCx<'a> {
     pub(crate) scene: &'a Scene,
@@ -69,12 +68,7 @@ pub(crate) fn plan_method(cx: &mut PlanCx, object: &mut ObjectPlan, method: &Met
     if object.object.volume.is_some() {
         return volume::plan(cx, object, method);
     }
-    match method {
-        Method::ViewSlices(m) => view_slices::plan(cx, object, m),
-        Method::AxisSlices(m) => axis_slices::plan(cx, object, m),
-        Method::Reference(m) => reference::plan(cx, object, m),
-        Method::RayMarch(m) => ray_march::plan_object(cx, object, m),
-    }
+    method.plugin().plan(cx, object)
 }
 
 /// The frame-wide plans of methods that gather their objects (see [`Contribution::gather`]).

@@ -3,7 +3,8 @@
 
 use std::path::PathBuf;
 
-use crate::scene::{AxisSlices, Camera, Method, RayMarch, Reference, Shading, Shadows, ViewSlices};
+use super::plugin::MethodKind;
+use crate::scene::{Camera, Method, Shadows};
 
 /// Overrides of what the scene file says, from the command line or tests.
 #[derive(Debug, Clone, Default)]
@@ -61,115 +62,28 @@ pub struct RenderOptions {
     pub shadows: Option<Option<crate::scene::Shadows>>,
 }
 
-/// A method without its knobs, to switch every object to it (`--method`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum MethodKind {
-    /// View-aligned prism slicing.
-    ViewSlices,
-    /// Exact ray casting (the ground truth).
-    Reference,
-    /// Axis-aligned slice stacks.
-    AxisSlices,
-}
-
-/// Axis slicing's knobs when an object is switched to it from another method.
-pub const DEFAULT_AXIS_SLICES: AxisSlices = AxisSlices {
-    depth: 1.0,
-    pixels: 1.0,
-    max_angle: 80.0,
-    directions: crate::scene::SliceDirections::Three,
-    blend: crate::scene::SliceBlend::Binary,
-    occlusion_culling: false,
-    empty_culling: true,
-    draw_order: crate::scene::DrawOrder::Texels,
-    mipmaps: false,
-};
-
-/// Plane count when an object is switched to view slicing from a method without planes.
-pub const SWITCHED_PLANES: u32 = 400;
-
 impl RenderOptions {
-    /// A volume object's method after the overrides. RayMarch and Reference both draw volumes:
-    /// `--method reference` switches a RayMarch volume to the exact Reference with `--step`,
-    /// keeping its shading (the truth of a look is that look, integrated exactly); otherwise as
-    /// [`apply`](Self::apply).
+    /// A volume object's method after the overrides: a switch (`--method`) to a method that
+    /// takes volumes from the object's (the Reference: the truth of a RayMarch volume is that
+    /// look, integrated exactly) makes that; otherwise as [`apply`](Self::apply).
     pub(crate) fn apply_volume(&self, method: &Method) -> Method {
-        match (self.method, method) {
-            (Some(MethodKind::Reference), Method::RayMarch(rm)) => Method::Reference(Reference {
-                step: self.step,
-                lighting: if rm.shading == Shading::None {
-                    crate::scene::Lighting::Baked
-                } else {
-                    crate::scene::Lighting::PerPixel
-                },
-                volume_shading: Some(rm.shading),
-            }),
-            _ => self.apply(method),
-        }
+        let switched = self.method.and_then(|k| k.defaults().plugin().volume_from(method, self));
+        switched.unwrap_or_else(|| self.apply(method))
     }
 
-    /// An object's method after the overrides: switched to `method` if given, knobs replaced.
+    /// An object's method after the overrides: switched to `method` if given (between methods
+    /// that draw texels; a new method starts from its defaults), then its plug-in applies the
+    /// knob overrides.
     pub(crate) fn apply(&self, method: &Method) -> Method {
-        if let Method::RayMarch(rm) = method {
-            // Hypertextures have no texel for other methods: only the step changes.
-            let adaptive = match self.max_step {
-                Some(m) => m.map(|max_step| crate::scene::Adaptive { max_step }),
-                None => rm.adaptive,
-            };
-            let step = self.step.or(rm.step);
-            let step = self.step_scale.map_or(step, |k| Some(k * step.unwrap_or(rm.step())));
-            let (shading, shadows) = match self.shadows {
-                None => (rm.shading, rm.shadows),
-                Some(None) => (Shading::Phong, Shadows::Rays),
-                Some(Some(s)) => (Shading::PhongShadows, s),
-            };
-            return Method::RayMarch(RayMarch {
-                step,
-                segments: self.segments.unwrap_or(rm.segments),
-                adaptive,
-                shading,
-                shadows,
-                ..*rm
-            });
-        }
         let lighting = method.lighting();
-        // A method the switch does not know keeps its knobs unless switched.
-        let Some(kind) = self.method.or(match method {
-            Method::ViewSlices(_) => Some(MethodKind::ViewSlices),
-            Method::Reference(_) => Some(MethodKind::Reference),
-            Method::AxisSlices(_) => Some(MethodKind::AxisSlices),
-            _ => None,
-        }) else {
-            return method.clone();
-        };
-        match (kind, method) {
-            (MethodKind::ViewSlices, Method::ViewSlices(vs)) => Method::ViewSlices(ViewSlices {
-                planes: self.planes.unwrap_or(vs.planes),
-                trivial_reject: self.trivial_reject.unwrap_or(vs.trivial_reject),
-                lighting,
-                compositor: self.compositor.unwrap_or(vs.compositor),
-                lod: self.lod.unwrap_or(vs.lod),
-            }),
-            (MethodKind::ViewSlices, _) => Method::ViewSlices(ViewSlices {
-                planes: self.planes.unwrap_or(SWITCHED_PLANES),
-                trivial_reject: self.trivial_reject.unwrap_or(true),
-                lighting,
-                compositor: self.compositor.unwrap_or_default(),
-                lod: self.lod.unwrap_or_default(),
-            }),
-            (MethodKind::Reference, Method::Reference(r)) => {
-                Method::Reference(Reference { step: self.step.or(r.step), lighting, ..*r })
-            }
-            (MethodKind::Reference, _) => {
-                Method::Reference(Reference { step: self.step, lighting, volume_shading: None })
-            }
-            (MethodKind::AxisSlices, m) => {
-                let a = if let Method::AxisSlices(a) = m { *a } else { DEFAULT_AXIS_SLICES };
-                let (depth, pixels) = self.axis_criteria.unwrap_or((a.depth, a.pixels));
-                let occlusion_culling = self.occlusion_culling.unwrap_or(a.occlusion_culling);
-                let mipmaps = self.mipmaps.unwrap_or(a.mipmaps);
-                Method::AxisSlices(AxisSlices { depth, pixels, occlusion_culling, mipmaps, ..a })
-            }
+        let switch = self.method.filter(|k| {
+            *k != method.kind()
+                && k.switchable()
+                && method.knobs().draws() == crate::methods::knobs::Draws::Texels
+        });
+        match switch {
+            Some(k) => k.defaults().plugin().with_options(self, lighting),
+            None => method.plugin().with_options(self, lighting),
         }
     }
 }
@@ -177,7 +91,7 @@ impl RenderOptions {
 /// Parses `--shadows` values: `none` (Phong without shadows), `rays` (shadow rays) or
 /// `volume:N` (a light volume of resolution N).
 pub fn parse_shadows(s: &str) -> std::result::Result<Option<Shadows>, String> {
-    use crate::scene::MAX_LIGHT_RESOLUTION;
+    use crate::methods::ray_march::knobs::MAX_LIGHT_RESOLUTION;
     match s {
         "none" => Ok(None),
         "rays" => Ok(Some(Shadows::Rays)),

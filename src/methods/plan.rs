@@ -101,6 +101,11 @@ pub trait MethodPlan: Any + Send {
         None
     }
 
+    /// The ray step this plan marches, where a truth's sweep scales it (`pareto`).
+    fn ray_step(&self) -> Option<f64> {
+        None
+    }
+
     /// The objects a frame-wide plan draws (see `Contribution::gather`); its instance is the
     /// first one's.
     fn members(&self) -> &[usize] {

@@ -19,110 +19,55 @@ use std::str::FromStr;
 use crate::error::{Error, Result};
 use crate::gpu::GpuContext;
 use crate::io::{atomic, Image};
-use crate::methods::options::shadows_name;
-use crate::methods::reference::ReferencePlan;
-use crate::methods::volume::VolumePlan;
+use crate::methods::sweep::{unique, SweepScene, SweepValues};
 use crate::progress::{Progress, Verbosity};
 use crate::render::{Blueprint, MethodKind, RenderOptions};
-use crate::scene::{Scene, Segments, Shadows, MAX_PLANES};
+use crate::scene::Scene;
 use report::Row;
 
-/// Default plane counts of the `ViewSlices` sweep.
-pub const SWEEP_PLANES: [u32; 8] = [16, 32, 64, 128, 256, 512, 1024, 2048];
-/// Default ray steps of the `Reference` sweep, as multiples of its default step.
-/// (2x, half the truth's cost, would double the sweep's time; pass it with `--steps` if wanted.)
-pub const DEFAULT_STEP_FACTORS: [f64; 4] = [4.0, 8.0, 16.0, 32.0];
-/// Default `AxisSlices` criteria swept: `d = p` = each value (smaller: more slices).
-pub const DEFAULT_CRITERIA: [f64; 6] = [0.25, 0.5, 1.0, 2.0, 4.0, 8.0];
-/// Default `RayMarch` steps swept (world units): the paper's HQ (0.002) and IE (0.015) among them.
-pub const DEFAULT_RAY_STEPS: [f64; 5] = [0.002, 0.004, 0.008, 0.015, 0.03];
-
-/// A method whose knobs the sweep varies: the three texel methods switch every textured object
-/// to themselves; `RayMarch` varies the step of every hypertexture object.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Sweep {
-    /// One of the texel methods (`ViewSlices`, `AxisSlices`, `Reference`).
-    Method(MethodKind),
-    /// The RayMarch step of every hypertexture object.
-    RayMarch,
-}
-
-/// What errors are measured against.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum TruthSource {
-    /// Every textured object ray cast by `Reference` with its default step.
-    Reference,
-    /// Every textured object sliced by `ViewSlices` with this many planes (a converged slicing).
-    ViewSlices(u32),
-    /// Every hypertexture ray-marched (and every textured object ray cast by `Reference`) with
-    /// this step in world units: a converged march; with `Some(shadows)` every hypertexture
-    /// shaded with them (`ray-march:STEP:rays`: shadow rays).
-    RayMarch(f64, Option<Option<Shadows>>),
+/// What errors are measured against: a method that can be a truth, with its argument
+/// (`reference`, `view-slices:4096`, `ray-march:0.0005:rays`; each method's plug-in says).
+#[derive(Debug, Clone, PartialEq)]
+pub struct TruthSource {
+    kind: MethodKind,
+    arg: Option<String>,
+    label: String,
 }
 
 impl FromStr for TruthSource {
     type Err = String;
     fn from_str(s: &str) -> std::result::Result<Self, String> {
-        const EXPECTED: &str =
-            "expected `reference`, `view-slices:PLANES` or `ray-march:STEP[:SHADOWS]`, e.g. \
-             view-slices:4096, ray-march:0.0005 or ray-march:0.0005:rays";
-        if s == "reference" {
-            return Ok(TruthSource::Reference);
-        }
-        if let Some(rest) = s.strip_prefix("ray-march:") {
-            let (step, shadows) = match rest.split_once(':') {
-                Some((step, shadows)) => (step, Some(crate::methods::options::parse_shadows(shadows)?)),
-                None => (rest, None),
-            };
-            return match step.parse::<f64>() {
-                Ok(v) if v.is_finite() && v > 0.0 => Ok(TruthSource::RayMarch(v, shadows)),
-                _ => Err(format!("`{step}`: expected a positive step in world units")),
-            };
-        }
-        let n = s.strip_prefix("view-slices:").ok_or(EXPECTED)?;
-        match n.parse::<u32>() {
-            Ok(n) if (1..=MAX_PLANES).contains(&n) => Ok(TruthSource::ViewSlices(n)),
-            _ => Err(format!("`{n}`: expected a plane count in 1..={MAX_PLANES}")),
-        }
+        let forms: Vec<&str> = MethodKind::all().filter_map(|k| k.defaults().plugin().truth_form()).collect();
+        let (name, arg) = match s.split_once(':') {
+            Some((n, a)) => (n, Some(a)),
+            None => (s, None),
+        };
+        let kind = MethodKind::from_cli(name)
+            .ok()
+            .filter(|k| k.defaults().plugin().truth_form().is_some())
+            .ok_or_else(|| format!("`{s}`: expected {}", forms.join(", ")))?;
+        let (_, label) = kind.defaults().plugin().truth(arg, (1, 1))?;
+        Ok(TruthSource { kind, arg: arg.map(str::to_string), label })
     }
 }
 
 impl fmt::Display for TruthSource {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            TruthSource::Reference => write!(f, "Reference, default step"),
-            TruthSource::ViewSlices(n) => write!(f, "ViewSlices, {n} planes"),
-            TruthSource::RayMarch(step, None) => write!(f, "RayMarch, step {step}"),
-            TruthSource::RayMarch(step, Some(s)) => {
-                write!(f, "RayMarch, step {step}, shadows {}", shadows_name(*s))
-            }
-        }
+        f.write_str(&self.label)
     }
 }
 
 impl TruthSource {
-    fn options(self, size: (u32, u32)) -> RenderOptions {
-        let size = Some(size);
-        match self {
-            TruthSource::Reference => {
-                RenderOptions { size, method: Some(MethodKind::Reference), ..Default::default() }
-            }
-            TruthSource::ViewSlices(n) => RenderOptions {
-                size,
-                method: Some(MethodKind::ViewSlices),
-                planes: Some(n),
-                trivial_reject: Some(true),
-                lod: Some(crate::scene::Lod::Off),
-                ..Default::default()
-            },
-            TruthSource::RayMarch(step, shadows) => RenderOptions {
-                size,
-                method: Some(MethodKind::Reference),
-                step: Some(step),
-                shadows,
-                ..Default::default()
-            },
-        }
+    /// The truth's default: the ground-truth method at its defaults.
+    pub(crate) fn ground_truth() -> TruthSource {
+        let kind = MethodKind::truth();
+        let (_, label) = kind.defaults().plugin().truth(None, (1, 1)).expect("the truth takes no argument");
+        TruthSource { kind, arg: None, label }
+    }
+
+    fn options(&self, size: (u32, u32)) -> RenderOptions {
+        let plugin = self.kind.defaults();
+        plugin.plugin().truth(self.arg.as_deref(), size).expect("checked when parsed").0
     }
 }
 
@@ -131,8 +76,6 @@ impl TruthSource {
 pub struct Args {
     /// The scene file to sweep.
     pub scene: PathBuf,
-    /// Render size in pixels (width, height).
-    pub size: (u32, u32),
     /// Timed frames per setting (after warm-up); medians are reported.
     pub frames: usize,
     /// Output folder (default `out/pareto/<scene stem>`), created if missing.
@@ -140,24 +83,9 @@ pub struct Args {
     /// What the error is measured against.
     pub truth: TruthSource,
     /// Methods to sweep.
-    pub methods: Vec<Sweep>,
-    /// `ViewSlices` plane counts (each with the trivial reject on and off).
-    pub planes: Vec<u32>,
-    /// `ViewSlices` with `lod: Auto` too, each plane count its most planes (trivial reject on).
-    pub lod: bool,
-    /// `Reference` steps as multiples of the default step.
-    pub steps: Vec<f64>,
-    /// `AxisSlices` criteria, `d = p` (voxels and pixels).
-    pub criteria: Vec<f64>,
-    /// `RayMarch` steps (world units).
-    pub ray_steps: Vec<f64>,
-    /// `RayMarch` segment strategies, each swept over every step.
-    pub ray_segments: Vec<Segments>,
-    /// `RayMarch` with an adaptive stride: `(step, max_step)` pairs (world units).
-    pub ray_adaptive: Vec<(f64, f64)>,
-    /// `RayMarch` shadows, each swept over every step (`None`: Phong without shadows); empty:
-    /// each object's own.
-    pub ray_shadows: Vec<Option<Shadows>>,
+    pub methods: Vec<MethodKind>,
+    /// The values swept (the render size among them).
+    pub sweep: SweepValues,
     /// CSV files of other renderers' rows (`peers`), shown beside voltex's.
     pub peers: Vec<PathBuf>,
 }
@@ -175,25 +103,27 @@ pub(crate) struct Setting {
 
 impl Args {
     fn check(&self) -> Result<()> {
-        if let Some(&p) = self.planes.iter().find(|&&p| p == 0 || p > MAX_PLANES) {
-            return Err(Error::Invalid(format!("--planes {p}: expected plane counts in 1..={MAX_PLANES}")));
+        let v = &self.sweep;
+        let max_planes = crate::scene::MAX_PLANES;
+        if let Some(&p) = v.planes.iter().find(|&&p| p == 0 || p > max_planes) {
+            return Err(Error::Invalid(format!("--planes {p}: expected plane counts in 1..={max_planes}")));
         }
-        if let Some(&f) = self.steps.iter().find(|&&f| !(f.is_finite() && f > 0.0)) {
+        if let Some(&f) = v.steps.iter().find(|&&f| !(f.is_finite() && f > 0.0)) {
             return Err(Error::Invalid(format!(
                 "--steps {f}: expected positive multiples of the default step"
             )));
         }
-        if let Some(&s) = self.ray_steps.iter().find(|&&s| !(s.is_finite() && s > 0.0)) {
+        if let Some(&s) = v.ray_steps.iter().find(|&&s| !(s.is_finite() && s > 0.0)) {
             return Err(Error::Invalid(format!("--ray-steps {s}: expected positive steps in world units")));
         }
         if let Some(&(s, m)) =
-            self.ray_adaptive.iter().find(|&&(s, m)| !(s.is_finite() && s > 0.0 && m.is_finite() && m >= s))
+            v.ray_adaptive.iter().find(|&&(s, m)| !(s.is_finite() && s > 0.0 && m.is_finite() && m >= s))
         {
             return Err(Error::Invalid(format!(
                 "--ray-adaptive {s}:{m}: expected STEP:MAX_STEP, positive world units with MAX_STEP >= STEP"
             )));
         }
-        if let Some(&c) = self.criteria.iter().find(|&&c| !(c > 0.0 && c <= 1024.0)) {
+        if let Some(&c) = v.criteria.iter().find(|&&c| !(c > 0.0 && c <= 1024.0)) {
             return Err(Error::Invalid(format!("--criteria {c}: expected values in (0, 1024]")));
         }
         if self.frames == 0 {
@@ -209,170 +139,35 @@ impl Args {
     }
 }
 
-/// `ViewSlices`: each plane count with the trivial reject on and off (a speed knob only), at
-/// full detail; with `lod`, also `lod: Auto` under each count.
-pub(crate) fn view_slices(args: &Args) -> Vec<Setting> {
-    let mut v = Vec::new();
-    for planes in unique(args.planes.iter().copied()) {
-        for reject in [true, false] {
-            v.push(Setting {
-                method: "ViewSlices",
-                knobs: format!("planes={planes} reject={}", if reject { "on" } else { "off" }),
-                tag: if reject { planes.to_string() } else { format!("{planes} no-reject") },
-                options: RenderOptions {
-                    size: Some(args.size),
-                    method: Some(MethodKind::ViewSlices),
-                    planes: Some(planes),
-                    trivial_reject: Some(reject),
-                    lod: Some(crate::scene::Lod::Off),
-                    ..Default::default()
-                },
-            });
-        }
-        if args.lod {
-            v.push(Setting {
-                method: "ViewSlices",
-                knobs: format!("planes={planes} reject=on lod=auto"),
-                tag: format!("{planes} lod"),
-                options: RenderOptions {
-                    size: Some(args.size),
-                    method: Some(MethodKind::ViewSlices),
-                    planes: Some(planes),
-                    trivial_reject: Some(true),
-                    lod: Some(crate::scene::Lod::Auto),
-                    ..Default::default()
-                },
-            });
-        }
-    }
-    v
-}
-
-/// `AxisSlices`: both criteria `d` (voxels) and `p` (pixels) set to each value; each object keeps
-/// its other knobs (directions, blend, culling), or the defaults when it used another method.
-pub(crate) fn axis_slices(args: &Args) -> Vec<Setting> {
-    let mut criteria = args.criteria.clone();
-    criteria.sort_by(f64::total_cmp);
-    criteria.dedup();
-    criteria
-        .into_iter()
-        .map(|c| Setting {
-            method: "AxisSlices",
-            knobs: format!("d=p={c}"),
-            tag: format!("{c}"),
-            options: RenderOptions {
-                size: Some(args.size),
-                method: Some(MethodKind::AxisSlices),
-                axis_criteria: Some((c, c)),
-                ..Default::default()
-            },
-        })
-        .collect()
-}
-
-/// `Reference`: the ray step as multiples of `default_step` (one step for all objects).
-pub(crate) fn reference(args: &Args, default_step: f64) -> Vec<Setting> {
-    unique(args.steps.iter().copied())
-        .into_iter()
-        .map(|f| Setting {
-            method: "Reference",
-            knobs: format!("step={f}x"),
-            tag: format!("{f}x"),
-            options: RenderOptions {
-                size: Some(args.size),
-                method: Some(MethodKind::Reference),
-                step: Some(f * default_step),
-                ..Default::default()
-            },
-        })
-        .collect()
-}
-
-/// `RayMarch`: every hypertexture object marched with each segment strategy and each shadow
-/// option, at each fixed step and then with each adaptive stride (textured objects keep their
-/// methods).
-pub(crate) fn ray_march(args: &Args) -> Vec<Setting> {
-    let mut steps = unique(args.ray_steps.iter().copied());
-    steps.sort_by(f64::total_cmp);
-    let mut pairs = args.ray_adaptive.clone();
-    pairs.dedup();
-    // No shadow options: each object's own shading.
-    let shadows: Vec<Option<Option<Shadows>>> = if args.ray_shadows.is_empty() {
-        vec![None]
-    } else {
-        unique(args.ray_shadows.iter().copied()).into_iter().map(Some).collect()
-    };
-    let mut v = Vec::new();
-    for (segments, shadows) in unique(args.ray_segments.iter().copied())
-        .into_iter()
-        .flat_map(|g| shadows.iter().map(move |s| (g, *s)))
-    {
-        let (name, short) = match segments {
-            Segments::Bounds => ("Bounds".to_string(), ""),
-            Segments::DepthPeeling { passes, .. } => (format!("DepthPeeling({passes})"), " peel"),
-            Segments::Splatting { slabs, .. } => (format!("Splatting({slabs})"), " splat"),
-        };
-        let fixed = steps.iter().map(|&step| (step, None));
-        let adaptive = pairs.iter().map(|&(step, max_step)| (step, Some(max_step)));
-        for (step, max_step) in fixed.chain(adaptive) {
-            let (knob, tag) = match max_step {
-                None => (String::new(), String::new()),
-                Some(m) => (format!(" max_step={m}"), format!("<{m}")),
-            };
-            let (shadow_knob, shadow_tag) = match shadows {
-                None => (String::new(), String::new()),
-                Some(s) => (format!(" shadows={}", shadows_name(s)), format!(" {}", shadows_name(s))),
-            };
-            v.push(Setting {
-                method: "RayMarch",
-                knobs: format!("step={step}{knob} segments={name}{shadow_knob}"),
-                tag: format!("{step}{tag}{short}{shadow_tag}"),
-                options: RenderOptions {
-                    size: Some(args.size),
-                    step: Some(step),
-                    max_step: Some(max_step),
-                    segments: Some(segments),
-                    shadows,
-                    ..Default::default()
-                },
-            });
-        }
-    }
-    v
-}
-
-/// Every setting of the methods asked for, with notes on what cannot be swept.
+/// Every setting of the methods asked for (each method's plug-in sweeps its knobs), with notes
+/// on what cannot be swept.
 pub(crate) fn sweep(scene: &Scene, args: &Args) -> Result<(Vec<Setting>, Vec<String>)> {
+    let facts = SweepScene {
+        has_hypertextures: !(scene.hypertextures.is_empty() && scene.volumes.is_empty()),
+        truth_step: truth_step(scene, args.sweep.size).map_err(|e| e.to_string()),
+    };
     let mut settings = Vec::new();
     let mut notes = Vec::new();
-    for &m in &args.methods {
-        match m {
-            Sweep::Method(MethodKind::ViewSlices) => settings.extend(view_slices(args)),
-            Sweep::Method(MethodKind::Reference) => match reference_default_step(scene, args.size) {
-                Ok(Some(step)) => settings.extend(reference(args, step)),
-                Ok(None) => notes.push("Reference: not measured: no textured object".into()),
-                Err(e) => notes.push(format!("Reference: not measured: {e}")),
-            },
-            Sweep::Method(MethodKind::AxisSlices) => settings.extend(axis_slices(args)),
-            Sweep::RayMarch if scene.hypertextures.is_empty() && scene.volumes.is_empty() => {
-                notes.push("RayMarch: not measured: no hypertexture and no volume".into())
-            }
-            Sweep::RayMarch => settings.extend(ray_march(args)),
+    for kind in unique(args.methods.iter().copied()) {
+        match kind.defaults().plugin().sweep(&args.sweep, &facts) {
+            Ok(points) => settings.extend(points.into_iter().map(|p| Setting {
+                method: kind.name(),
+                knobs: p.knobs,
+                tag: p.tag,
+                options: p.options,
+            })),
+            Err(why) => notes.push(format!("{kind}: not measured: {why}")),
         }
     }
     Ok((settings, notes))
 }
 
-/// The `Reference` method's default step for the scene: the smallest of its textured objects'
-/// default steps (half the smallest voxel extent, see `methods::reference::default_step`) and
-/// its volume objects' (a quarter voxel; the exact cells need no step, their shadow rays do).
-pub(crate) fn reference_default_step(scene: &Scene, size: (u32, u32)) -> Result<Option<f64>> {
-    let opts = RenderOptions { size: Some(size), method: Some(MethodKind::Reference), ..Default::default() };
+/// The ground truth's default ray step for the scene: the smallest of its objects' (see
+/// `MethodPlan::ray_step`; `None` when no object has one).
+pub(crate) fn truth_step(scene: &Scene, size: (u32, u32)) -> Result<Option<f64>> {
+    let opts = RenderOptions { size: Some(size), method: Some(MethodKind::truth()), ..Default::default() };
     let bp = Blueprint::new(scene, &opts)?;
-    let textured = bp.objects.iter().filter_map(|o| Some(o.method::<ReferencePlan>()?.step));
-    let volumes =
-        bp.objects.iter().filter_map(|o| o.method::<VolumePlan>().filter(|p| p.exact).map(|p| p.step));
-    Ok(textured.chain(volumes).min_by(f64::total_cmp))
+    Ok(bp.objects.iter().flat_map(|o| o.methods.iter().filter_map(|m| m.ray_step())).min_by(f64::total_cmp))
 }
 
 /// Runs `voltex pareto`: renders each setting of the swept methods, times it, measures its
@@ -392,7 +187,7 @@ pub fn run(args: &Args) -> Result<()> {
     let load = report::load_average();
     let ctx = GpuContext::new()?;
     eprintln!("truth: {}", args.truth);
-    let truth = measure::image(&ctx, Blueprint::new(&scene, &args.truth.options(args.size))?)?;
+    let truth = measure::image(&ctx, Blueprint::new(&scene, &args.truth.options(args.sweep.size))?)?;
     let mut rows = Vec::new();
     let mut progress = Progress::new(n, Verbosity::Normal);
     for (s, bp) in settings.into_iter().zip(blueprints) {
@@ -423,8 +218,8 @@ pub fn run(args: &Args) -> Result<()> {
     let title = format!(
         "{}: time against error ({}x{}, truth: {})",
         args.scene.file_stem().unwrap_or_default().to_string_lossy(),
-        args.size.0,
-        args.size.1,
+        args.sweep.size.0,
+        args.sweep.size.1,
         args.truth
     );
     atomic::write_bytes(
@@ -450,8 +245,12 @@ fn measure_setting(scene: &Scene, args: &Args, s: &Setting, bp: Blueprint, truth
 /// The settings to measure, each with its blueprint (CPU only: planning fails early), and notes
 /// on what cannot be measured. The truth must plan; a setting that does not is skipped.
 fn plan(scene: &Scene, args: &Args) -> Result<Planned> {
-    Blueprint::new(scene, &args.truth.options(args.size)).map_err(|e| {
-        let hint = if args.truth == TruthSource::Reference { "; try --truth view-slices:4096" } else { "" };
+    Blueprint::new(scene, &args.truth.options(args.sweep.size)).map_err(|e| {
+        let hint = if args.truth == TruthSource::ground_truth() {
+            "; try a converged method as the truth (--truth)"
+        } else {
+            ""
+        };
         Error::Invalid(format!("the truth ({}) cannot be rendered: {e}{hint}", args.truth))
     })?;
     let (all, mut notes) = sweep(scene, args)?;
@@ -494,14 +293,4 @@ fn note(notes: &mut Vec<String>, s: &Setting, e: &Error) -> Option<String> {
     }
     notes.push(line.clone());
     Some(format!("{line} ({})", s.knobs))
-}
-
-fn unique<T: PartialEq>(items: impl Iterator<Item = T>) -> Vec<T> {
-    let mut v = Vec::new();
-    for x in items {
-        if !v.contains(&x) {
-            v.push(x);
-        }
-    }
-    v
 }

@@ -200,7 +200,13 @@ pub(super) fn print_report(
     notes: &[String],
     load: Option<f64>,
 ) {
-    println!("pareto: {} at {}x{}, truth: {}", args.scene.display(), args.size.0, args.size.1, args.truth);
+    println!(
+        "pareto: {} at {}x{}, truth: {}",
+        args.scene.display(),
+        args.sweep.size.0,
+        args.sweep.size.1,
+        args.truth
+    );
     println!("adapter: {}", ctx.adapter_line());
     if ctx.has_timestamps() {
         println!(

@@ -5,7 +5,6 @@
 
 use super::scene_text::{self as st, format_number, Edit, Step};
 use crate::error::{Error, Result};
-use crate::methods::plugin::Next;
 use crate::scene::Method;
 
 /// The edit of `path` made by `change`, a sequence of edits on the whole text inside `path`.
@@ -40,13 +39,14 @@ fn method_path(src: &str, node: &[Step], written: &str) -> Result<(String, Vec<S
 /// `M`: the method's plug-in says what comes next: ViewSlices, AxisSlices, Reference in turn
 /// (lighting kept where both have it); a hypertexture's RayMarch cycles its shading.
 pub(crate) fn next_method(src: &str, node: &[Step], m: &Method) -> Result<Edit> {
-    let written = format!("{}()", m.plugin().name());
-    compound(src, node, |text| match m.plugin().next(m) {
-        Next::Knob(path, value) => {
+    let written = format!("{}()", m.kind());
+    compound(src, node, |text| match m.plugin().next_mode() {
+        Some((path, value)) => {
             let (text, mp) = method_path(&text, node, &written)?;
             set_knob(&text, &mp, path, &value)
         }
-        Next::Method(next) => {
+        None => {
+            let next = crate::methods::plugin::short_text(&crate::methods::plugin::next_method(m));
             let (text, mp) = method_path(&text, node, &next)?;
             st::set(&text, &mp, &next)?.apply(&text)
         }
@@ -66,12 +66,12 @@ fn set_knob(src: &str, mp: &[Step], path: &[&str], value: &str) -> Result<String
 /// with an adaptive stride's `max_step`, AxisSlices' slice depth). `None` where the method has
 /// no knob to step (Reference at its default step).
 pub(crate) fn step_quality(src: &str, node: &[Step], m: &Method, finer: bool) -> Result<Option<Edit>> {
-    let edits = m.plugin().quality_step(m, finer);
+    let edits = m.plugin().quality_step(finer);
     if edits.is_empty() {
         return Ok(None);
     }
     compound(src, node, |text| {
-        let (mut text, mp) = method_path(&text, node, &format!("{}()", m.plugin().name()))?;
+        let (mut text, mp) = method_path(&text, node, &format!("{}()", m.kind()))?;
         for e in &edits {
             let value = format_number(e.value, if e.integer { "0" } else { "0.0" });
             text = set_knob(&text, &mp, e.path, &value)?;
@@ -84,7 +84,7 @@ pub(crate) fn step_quality(src: &str, node: &[Step], m: &Method, finer: bool) ->
 /// The method `d` times coarser, for a frame drawn while a drag goes on (its plug-in's
 /// `coarser`: fewer planes, longer steps, looser criteria).
 pub(crate) fn coarser(m: &Method, d: f64) -> Method {
-    m.plugin().coarser(m, d)
+    m.plugin().coarser(d)
 }
 
 /// Names and paths of the nodes of the text (`nodes[i]`, `nodes[i].children[j]`, ...).

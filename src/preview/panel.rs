@@ -12,6 +12,7 @@ use egui::{Color32, RichText};
 
 use super::present::Mode;
 use super::scene_text::{self as st, format_number, Kind, Step, Value};
+use crate::methods::plugin::panel_knobs;
 use crate::scene::Scene;
 
 /// Width of the panel in points.
@@ -71,35 +72,9 @@ pub(crate) struct Cx<'a> {
 }
 
 /// Defaults of fields a file may leave out, by the struct's variant name (unnamed structs: the
-/// name [`type_key`] gives them). Shown greyed; editing one writes it into the file.
-pub(crate) const KNOBS: &[(&str, &[(&str, &str)])] = &[
-    ("ViewSlices", &[("planes", "64"), ("trivial_reject", "true"), ("lighting", "Baked")]),
-    ("Reference", &[("step", "0.01"), ("lighting", "Baked")]),
-    (
-        "RayMarch",
-        &[
-            ("quality", "IE"),
-            ("step", "0.015"),
-            ("shading", "None"),
-            ("shadow_step", "0.03"),
-            ("shadows", "Rays"),
-            ("segments", "Bounds"),
-            ("adaptive", "(max_step: 0.06)"),
-        ],
-    ),
-    (
-        "AxisSlices",
-        &[
-            ("depth", "1.0"),
-            ("pixels", "1.0"),
-            ("max_angle", "80.0"),
-            ("directions", "Three"),
-            ("blend", "Binary"),
-            ("occlusion_culling", "false"),
-            ("empty_culling", "true"),
-            ("draw_order", "Texels"),
-        ],
-    ),
+/// name [`type_key`] gives them). Shown greyed; editing one writes it into the file. Methods'
+/// knobs come from their plug-ins ([`defaults_of`]).
+const KNOBS: &[(&str, &[(&str, &str)])] = &[
     ("DepthPeeling", &[("passes", "4"), ("splat_grid", "32")]),
     ("Splatting", &[("slabs", "16"), ("splat_grid", "32")]),
     ("Noise", &[("shift", "0.0"), ("operator", "Sum"), ("seed", "0"), ("speed", "0.0")]),
@@ -112,7 +87,6 @@ pub(crate) const KNOBS: &[(&str, &[(&str, &str)])] = &[
 
 /// Variants that replace one another, as written when chosen (all fields given or defaulted).
 const CHOICES: &[&[&str]] = &[
-    &["ViewSlices(planes: 64)", "AxisSlices()", "Reference()"],
     &["None", "Phong", "PhongShadows", "HenyeyGreenstein(g: 0.5, shadows: true)"],
     &["Rays", "LightVolume(resolution: 64)"],
     &["IE", "HQ"],
@@ -130,6 +104,20 @@ const CHOICES: &[&[&str]] = &[
         "Perturbed(field: ClosestSurface, frequency: 4.0)",
     ],
 ];
+
+/// The defaults shown for the struct `key`: a method's from its plug-in, else [`KNOBS`]'.
+pub(crate) fn defaults_of(key: &str) -> Option<Vec<(&'static str, &'static str)>> {
+    if let Some(m) = panel_knobs().iter().find(|m| m.name == key) {
+        return Some(m.defaults.clone());
+    }
+    KNOBS.iter().find(|(n, _)| *n == key).map(|(_, d)| d.to_vec())
+}
+
+/// The methods an object may be switched between, as written when chosen.
+fn method_choices() -> &'static [&'static str] {
+    static CHOSEN: std::sync::OnceLock<Vec<&'static str>> = std::sync::OnceLock::new();
+    CHOSEN.get_or_init(|| panel_knobs().iter().filter_map(|m| m.chosen).collect())
+}
 
 fn variant(choice: &str) -> &str {
     choice.split('(').next().unwrap_or(choice)
@@ -173,7 +161,7 @@ fn contents(ui: &mut egui::Ui, cx: &mut Cx, view: &PanelView) {
     }
     ui.horizontal(|ui| {
         for (mode, label) in
-            [(Mode::Image, "1 image"), (Mode::Reference, "2 reference"), (Mode::Difference, "3 difference")]
+            [(Mode::Image, "1 image"), (Mode::Truth, "2 reference"), (Mode::Difference, "3 difference")]
         {
             if ui.selectable_label(view.mode == mode, label).clicked() {
                 cx.actions.push(Action::Mode(mode));
@@ -419,14 +407,14 @@ fn structure(ui: &mut egui::Ui, cx: &mut Cx, v: &Value, path: &[Step]) {
             None => field(ui, cx, &format!("{i}"), &f.value, &[path, &[Step::Index(i)]].concat()),
         }
     }
-    let Some(defaults) = key.and_then(|k| KNOBS.iter().find(|(n, _)| *n == k)) else { return };
-    for (name, default) in defaults.1 {
+    let Some(defaults) = key.and_then(defaults_of) else { return };
+    for (name, default) in defaults {
         if fields.iter().any(|f| f.name.as_deref() == Some(name)) {
             continue;
         }
         let p = [path, &[Step::Field(name.to_string())]].concat();
         ui.horizontal(|ui| {
-            ui.label(RichText::new(*name).weak());
+            ui.label(RichText::new(name).weak());
             let refused = refused_here(cx, &p).is_some();
             if let Some(new) = default_widget(ui, &mut cx.rects, default, refused, &p) {
                 push_edit(cx, st::add_field(src, path, name, &new), false);
@@ -458,7 +446,8 @@ fn default_widget(
 
 /// The variants that can replace `name`'s.
 fn group(name: &str) -> Option<&'static [&'static str]> {
-    CHOICES.iter().copied().find(|g| g.iter().any(|c| variant(c) == variant(name)))
+    let methods = std::iter::once(method_choices());
+    methods.chain(CHOICES.iter().copied()).find(|g| g.iter().any(|c| variant(c) == variant(name)))
 }
 
 /// A combo box of `group` showing `current`: the choice picked, if another.
@@ -481,10 +470,11 @@ fn choice(ui: &mut egui::Ui, cx: &mut Cx, v: &Value, path: &[Step]) {
     let Some(current) = v.name(src) else { return };
     let Some(group) = group(current) else { return };
     if let Some(c) = combo(ui, group, current, path) {
-        // Keep the lighting when switching between textured methods.
+        // Keep the lighting when switching between textured methods that have it.
         let lighting = v.child(&Step::Field("lighting".into()), src).map(|l| l.text(src).to_string());
+        let lit = defaults_of(variant(c)).is_some_and(|d| d.iter().any(|(n, _)| *n == "lighting"));
         let text = match (lighting, c.find('(')) {
-            (Some(l), Some(open)) if c != "Bounds" => {
+            (Some(l), Some(open)) if lit => {
                 let inner = &c[open + 1..c.len() - 1];
                 let sep = if inner.is_empty() { "" } else { ", " };
                 format!("{}({inner}{sep}lighting: {l})", variant(c))

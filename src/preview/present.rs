@@ -29,8 +29,8 @@ struct PresentParams {
 pub enum Mode {
     /// The render.
     Image = 0,
-    /// The same frame with every textured object drawn by the exact `Reference` method.
-    Reference = 1,
+    /// The same frame drawn by the ground truth (the exact Reference method): the "reference" view.
+    Truth = 1,
     /// The difference between the render and the reference.
     Difference = 2,
 }

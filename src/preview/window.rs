@@ -392,7 +392,7 @@ impl State {
                     options.size = Some(size);
                     options.supersample = None;
                 }
-                options.method = Some(MethodKind::Reference);
+                options.method = Some(MethodKind::truth());
                 options.object_methods.clear();
                 let mut r =
                     Session::open_with(&self.ctx, &self.session.scene_path, options, self.unsaved_text());
@@ -645,7 +645,7 @@ impl State {
     fn info_lines(&self) -> Vec<String> {
         let mode = match self.mode {
             Mode::Image => "image",
-            Mode::Reference => "reference",
+            Mode::Truth => "reference",
             Mode::Difference => "difference to the reference",
         };
         let mut lines = vec![format!("{}  [{mode}]", self.session.scene_path.display())];
@@ -823,7 +823,7 @@ impl State {
                 self.dirty = true;
             }
             "1" => self.set_mode(Mode::Image),
-            "2" => self.set_mode(Mode::Reference),
+            "2" => self.set_mode(Mode::Truth),
             "3" => self.set_mode(Mode::Difference),
             "s" | "S" => self.status = self.screenshot().unwrap_or_else(|e| format!("error: {e}")),
             _ => {}
@@ -833,7 +833,7 @@ impl State {
     /// Writes the shown image (the reference in the reference view) as EXR and PNG under out/.
     fn screenshot(&mut self) -> Result<String> {
         let session = match (self.mode, &self.reference) {
-            (Mode::Reference, Some(r)) => r,
+            (Mode::Truth, Some(r)) => r,
             _ => &self.session,
         };
         let Some(r) = session.renderer() else { return Err(Error::Invalid("nothing rendered yet".into())) };
@@ -855,30 +855,7 @@ impl State {
 }
 
 fn describe(m: &Method) -> String {
-    match m {
-        Method::RayMarch(h) => {
-            let adaptive = h.adaptive.map_or(String::new(), |a| format!(", max_step: {:.5}", a.max_step));
-            format!(
-                "RayMarch(step: {:.5}{adaptive}, shading: {:?}, segments: {:?})",
-                h.step(),
-                h.shading,
-                h.segments
-            )
-        }
-        Method::AxisSlices(a) => {
-            format!("AxisSlices(depth: {}, pixels: {}, {:?})", a.depth, a.pixels, a.directions)
-        }
-        Method::ViewSlices(v) => format!("ViewSlices(planes: {}, lighting: {:?})", v.planes, v.lighting),
-        Method::Reference(r) => {
-            format!(
-                "Reference(step: {}, lighting: {:?})",
-                r.step.map_or("default".into(), |s| format!("{s:.5}")),
-                r.lighting
-            )
-        }
-        #[allow(unreachable_patterns)]
-        other => format!("{other:?}"),
-    }
+    m.plugin().describe()
 }
 
 /// Turns the eye around the target: horizontal drags about `up`, vertical ones about the

@@ -184,7 +184,7 @@ fn truth(ctx: &GpuContext, scene: &scene::Scene, size: (u32, u32)) -> Result<Opt
     let opts = RenderOptions {
         size: Some(size),
         supersample: Some(scene.regress.supersample),
-        method: Some(MethodKind::Reference),
+        method: Some(MethodKind::truth()),
         step_scale: Some(t.step_scale),
         segments: Some(scene::Segments::Bounds),
         max_step: Some(None),

@@ -122,16 +122,14 @@ pub(crate) struct Cost {
     pub(crate) measured: bool,
 }
 
-/// Estimated milliseconds per 1000 pixels of each method on software Vulkan: medians of the
-/// example scenes' wall times (`regress scenes/ --jobs 2` on two busy cores, less the fixed
-/// cost), by the costliest method a scene names. A scene takes the highest rate of the methods
-/// its file names.
-const PER_KPIXEL_MS: [(&str, f64); 4] =
-    [("AxisSlices", 90.0), ("RayMarch", 75.0), ("ViewSlices", 45.0), ("Reference", 15.0)];
+/// Fixed milliseconds of a scene (start, bake, read-back) besides its methods' per-pixel cost
+/// (each method's plug-in estimates its own rate: `MethodPlugin::kpixel_ms`).
 const FIXED_MS: f64 = 150.0;
+/// Milliseconds per 1000 pixels of a scene whose methods cost less (or that has none).
+const MIN_KPIXEL_MS: f64 = 15.0;
 
 /// A scene's cost: its record's wall time under `out`, else an estimate from its render size
-/// and the costliest method its file names (a scene that does not load costs [`FIXED_MS`]).
+/// and the costliest method its nodes use (a scene that does not load costs [`FIXED_MS`]).
 pub(crate) fn cost(out: &Path, entry: &SceneEntry, size: Option<(u32, u32)>) -> Cost {
     if let Ok(r) = Record::read(&out.join(&entry.folder).join(RECORD_FILE)) {
         if r.wall_ms.is_finite() && r.wall_ms > 0.0 {
@@ -146,7 +144,7 @@ fn estimate(entry: &SceneEntry, size: Option<(u32, u32)>) -> f64 {
     let Ok(scene) = crate::scene::parse(&text, &entry.path) else { return FIXED_MS };
     let (w, h) =
         size.or(scene.regress.size.map(|[w, h]| (w, h))).unwrap_or((scene.output.width, scene.output.height));
-    let rate = PER_KPIXEL_MS.iter().filter(|(m, _)| text.contains(m)).map(|(_, r)| *r).fold(15.0, f64::max);
+    let rate = scene.methods().iter().map(|m| m.plugin().kpixel_ms()).fold(MIN_KPIXEL_MS, f64::max);
     let samples = f64::from(scene.regress.supersample.pow(2));
     FIXED_MS + rate * f64::from(w) * f64::from(h) * samples / 1000.0
 }

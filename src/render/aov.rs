@@ -120,7 +120,7 @@ pub(crate) fn check_groups(
         if members.len() > 1 {
             let names: Vec<&str> = members.iter().map(|&i| objects[i].object.name.as_str()).collect();
             return Err(Error::Invalid(format!(
-                "AOV `{}` is per object, but objects {names:?} are drawn together in one layer (the Reference method casts all its objects' rays at once): ask for it with one such object at most",
+                "AOV `{}` is per object, but objects {names:?} are drawn together in one layer (their method casts all its objects' rays at once): ask for it with one such object at most",
                 aov.name
             )));
         }

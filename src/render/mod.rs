@@ -10,7 +10,8 @@ pub mod trace;
 
 pub(crate) use budget::Positions;
 
-pub use crate::methods::options::{MethodKind, RenderOptions, DEFAULT_AXIS_SLICES, SWITCHED_PLANES};
+pub use crate::methods::options::RenderOptions;
+pub use crate::methods::plugin::MethodKind;
 pub use crate::methods::{BakePlan, ObjectPlan};
 pub use renderer::{bake_key, Frame, Renderer};
 

@@ -1,6 +1,7 @@
 //! The node tree flattened into world-space objects with their base surfaces.
 
-use super::types::{HeightScale, Method, Node, Scene, Surface, TexelSource};
+use super::types::{HeightScale, Node, Scene, Surface, TexelSource};
+use super::Method;
 use crate::error::{Error, FileLoc, Result};
 use crate::mesh::prism::{self, PrismReport};
 use crate::mesh::{generate, motion, BaseSurface, Mesh};
@@ -92,7 +93,7 @@ impl Scene {
             });
         } else if let Some(h) = &n.hypertexture {
             // Without a method, a hypertexture node is ray-marched with the defaults.
-            let method = n.method.as_ref().map_or(Method::RayMarch(Default::default()), |m| m.value.clone());
+            let method = n.method.as_ref().map_or_else(Method::for_densities, |m| m.value.clone());
             out.push(SceneObject {
                 name: n.name.clone(),
                 surface: Default::default(),
@@ -105,7 +106,7 @@ impl Scene {
             });
         } else if let Some(v) = &n.volume {
             // Without a method, a volume node is ray-marched with the defaults.
-            let method = n.method.as_ref().map_or(Method::RayMarch(Default::default()), |m| m.value.clone());
+            let method = n.method.as_ref().map_or_else(Method::for_densities, |m| m.value.clone());
             let grid = self.assets.volumes.get(&v.value).cloned().ok_or_else(|| {
                 Error::Invalid(format!("object \"{}\": volume \"{}\" was not loaded", n.name, v.value))
             })?;

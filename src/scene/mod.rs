@@ -5,8 +5,6 @@
 //! scene run after a first parse and are positioned by a second parse that fails at the
 //! offending value (`Mark`). Files the scene refers to (OBJ, PNG) are loaded by [`load`].
 
-/// Most planes one ViewSlices object may use (the scan kernel and the dispatch height allow it).
-pub const MAX_PLANES: u32 = 16384;
 /// Most samples per pixel axis of a supersampled render (`--supersample`, `regress.supersample`).
 pub const MAX_SUPERSAMPLE: u32 = 8;
 
@@ -17,19 +15,28 @@ mod image;
 pub mod import;
 mod types;
 mod validate;
-mod values;
+pub(crate) mod values;
 
 pub use budget::{MAX_NODES, MAX_SHAPE_VOXELS, MAX_TRIANGLES};
 pub(crate) use flatten::{HyperNode, SceneObject, VolumeNode};
 pub(crate) use hypertexture::Hypertexture;
 pub use image::HeightImage;
 pub use types::*;
+// The methods' knobs live in their folders (scene layer, see `methods::knobs`).
+pub use crate::methods::axis_slices::knobs::{AxisSlices, DrawOrder, SliceBlend, SliceDirections};
+pub use crate::methods::knobs::{Method, METHOD_NAMES};
+pub use crate::methods::ray_march::knobs::{
+    Adaptive, Quality, RayMarch, Segments, Shadows, DEFAULT_PEEL_PASSES, DEFAULT_SPLAT_GRID,
+    DEFAULT_SPLAT_SLABS,
+};
+pub use crate::methods::reference::knobs::Reference;
+pub use crate::methods::view_slices::knobs::{Compositor, Lod, ViewSlices, MAX_PLANES};
 
 use crate::error::{Error, FileLoc, Result};
 use std::collections::BTreeMap;
 use std::path::Path;
 
-fn options() -> ron::Options {
+pub(crate) fn options() -> ron::Options {
     use ron::extensions::Extensions;
     // Method variants wrap a struct: `ViewSlices(planes: 400)` rather than `ViewSlices((planes: 400))`.
     ron::Options::default()
@@ -37,6 +44,25 @@ fn options() -> ron::Options {
 }
 
 impl Scene {
+    /// The methods the scene's nodes are drawn with (a density node without one: its default).
+    pub(crate) fn methods(&self) -> Vec<Method> {
+        fn walk(nodes: &[Node], out: &mut Vec<Method>) {
+            for n in nodes {
+                match &n.method {
+                    Some(m) => out.push(m.value.clone()),
+                    None if n.hypertexture.is_some() || n.volume.is_some() => {
+                        out.push(Method::for_densities())
+                    }
+                    None => {}
+                }
+                walk(&n.children, out);
+            }
+        }
+        let mut out = Vec::new();
+        walk(&self.nodes, &mut out);
+        out
+    }
+
     /// The files (meshes, images, hypertexture meshes and point sets) and slice-stack folders the
     /// scene refers to, resolved.
     pub(crate) fn asset_paths(&self) -> Vec<std::path::PathBuf> {

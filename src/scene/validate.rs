@@ -2,15 +2,14 @@
 //! of the files the scene refers to (OBJ meshes, height images).
 
 use super::image::HeightImage;
-use super::types::{
-    DrawOrder, HeightScale, MeshBounds, Method, Node, Scene, Shading, Shadows, SliceBlend, Surface, Texel,
-    TexelSource,
-};
+use super::types::{HeightScale, MeshBounds, Node, Scene, Surface, Texel, TexelSource};
 use super::values::Mark;
+use super::Method;
 use crate::error::Error;
 use crate::io::stack::{self, SliceStack};
 use crate::mesh::shape::MeshShape;
 use crate::mesh::Mesh;
+use crate::methods::knobs::Draws;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -231,7 +230,7 @@ impl Checker<'_> {
             if (given / own - 1.0).abs() > 1e-4 {
                 let msg = format!(
                     "texel \"{texel}\": an opacity_length of {given} makes the baked hypertexture \"{}\" {} opaque \
-                     than RayMarch draws it (its opacity_length is {own}; leave the texel's out to take it)",
+                     than its hypertexture nodes draw it (its opacity_length is {own}; leave the texel's out to take it)",
                     name.value,
                     if given < own { "more" } else { "less" }
                 );
@@ -389,18 +388,10 @@ impl Checker<'_> {
             return self.fail(v, msg);
         }
         if let Some(m) = &n.method {
-            match &m.value {
-                Method::RayMarch(rm)
-                    if rm.segments != crate::scene::Segments::Bounds || rm.adaptive.is_some() =>
-                {
-                    let msg =
-                        "a volume node's RayMarch takes `step`, `quality`, `shading` and `shadow_step`: its \
-                               brick table skips empty space (no `segments` or `adaptive`)"
-                            .into();
-                    self.fail(m, msg)
-                }
-                Method::RayMarch(_) | Method::Reference(_) => {}
-                _ => self.fail(m, "a volume node is drawn with RayMarch(...) or Reference(...)".into()),
+            match m.value.knobs().volumes() {
+                Some(Ok(())) => {}
+                Some(Err(msg)) => self.fail(m, msg),
+                None => self.fail(m, format!("a volume node is drawn with {}", Method::volume_methods())),
             }
         }
     }
@@ -448,18 +439,14 @@ impl Checker<'_> {
         if n.volume.is_none() {
             self.hypertexture_node(n, &world);
         }
-        if let Some(m) =
-            n.method.as_ref().filter(|m| !matches!(m.value, Method::RayMarch(_)) && n.volume.is_none())
-        {
-            if let Method::AxisSlices(a) = &m.value {
-                if a.draw_order == DrawOrder::Slices && a.blend == SliceBlend::Blended {
-                    self.fail(m, format!(
-                        "node \"{}\": `draw_order: Slices` needs `blend: Binary` (blended slices must stay back to front \
-                         within each texel)",
-                        n.name
-                    ));
-                }
+        if let Some(m) = &n.method {
+            if let Err(msg) = m.value.knobs().check() {
+                self.fail(m, format!("node \"{}\": {msg}", n.name));
             }
+        }
+        if let Some(m) =
+            n.method.as_ref().filter(|m| m.value.knobs().draws() == Draws::Texels && n.volume.is_none())
+        {
             if n.texel.is_none() {
                 self.fail(m, format!("node \"{}\" has a method: expected a `texel`", n.name));
             } else if n.surface.is_none() {
@@ -522,14 +509,18 @@ impl Checker<'_> {
         }
     }
 
-    /// A hypertexture node draws a known hypertexture with `RayMarch` and nothing else; a step
-    /// that would need more than `MAX_SAMPLES_PER_RAY` samples across the bounds is refused.
+    /// A hypertexture node draws a known hypertexture with a method that draws densities and
+    /// nothing else; a step that would need more than `MAX_SAMPLES_PER_RAY` samples across the
+    /// bounds is refused.
     fn hypertexture_node(&mut self, n: &Node, world: &glam::DMat4) {
-        let ray_march = n.method.as_ref().filter(|m| matches!(m.value, Method::RayMarch(_)));
+        let densities = n.method.as_ref().filter(|m| m.value.knobs().draws() == Draws::Densities);
         let Some(h) = &n.hypertexture else {
-            if let Some(m) = ray_march {
-                let msg =
-                    format!("node \"{}\" is drawn with RayMarch: expected `hypertexture: \"name\"`", n.name);
+            if let Some(m) = densities {
+                let msg = format!(
+                    "node \"{}\" is drawn with {}: expected `hypertexture: \"name\"`",
+                    n.name,
+                    m.value.name()
+                );
                 self.fail(m, msg);
             }
             return;
@@ -539,8 +530,11 @@ impl Checker<'_> {
             self.fail(h, msg);
             return;
         }
-        if let Some(m) = n.method.as_ref().filter(|_| ray_march.is_none()) {
-            self.fail(m, "a hypertexture node is drawn with RayMarch(...): expected RayMarch".into());
+        if let Some(m) = n.method.as_ref().filter(|_| densities.is_none()) {
+            let expected = Method::for_densities().name();
+            let msg =
+                format!("a hypertexture node is drawn with {}(...): expected {expected}", m.value.name());
+            self.fail(m, msg);
             return;
         }
         let Some(model) = self.scene.hypertextures.get(&h.value) else {
@@ -553,46 +547,30 @@ impl Checker<'_> {
             self.fail(h, format!("unknown hypertexture \"{}\": {expected}", h.value));
             return;
         };
-        if let Some(Method::RayMarch(rm)) = ray_march.map(|m| &m.value) {
-            // Mesh objects get their bounds from the mesh, loaded before the nodes are checked.
-            let mut model = model.clone();
-            match &mut model.object.value {
-                super::hypertexture::SoftObject::Mesh { path, shape, .. } => {
-                    *shape = self.f.assets.shapes.get(&self.f.assets.dir.join(&path.value)).cloned();
-                }
-                super::hypertexture::SoftObject::Points { path, set, .. } => {
-                    *set = self.f.assets.point_sets.get(&self.f.assets.dir.join(&path.value)).cloned();
-                }
-                _ => {}
+        let Some((m, step)) = densities.and_then(|m| Some((m, m.value.knobs().density_step()?))) else {
+            return;
+        };
+        // Mesh objects get their bounds from the mesh, loaded before the nodes are checked.
+        let mut model = model.clone();
+        match &mut model.object.value {
+            super::hypertexture::SoftObject::Mesh { path, shape, .. } => {
+                *shape = self.f.assets.shapes.get(&self.f.assets.dir.join(&path.value)).cloned();
             }
-            let diagonal = super::hypertexture::diagonal(&model.world_corners(world));
-            let samples = diagonal / rm.step();
-            if samples > MAX_SAMPLES_PER_RAY {
-                let msg = format!(
-                    "a step of {} takes {samples:.3e} samples across the bounds of \"{}\" (diagonal {diagonal:.4}): \
-                     expected a step of at least {:.3e}",
-                    rm.step(),
-                    h.value,
-                    diagonal / MAX_SAMPLES_PER_RAY
-                );
-                self.fail(ray_march.unwrap(), msg);
+            super::hypertexture::SoftObject::Points { path, set, .. } => {
+                *set = self.f.assets.point_sets.get(&self.f.assets.dir.join(&path.value)).cloned();
             }
-            if let Some(a) = rm.adaptive.filter(|a| a.max_step < rm.step()) {
-                let msg = format!(
-                    "RayMarch(adaptive: (max_step: {})) is below the step {}: expected a max_step of at least the step",
-                    a.max_step,
-                    rm.step()
-                );
-                self.fail(ray_march.unwrap(), msg);
-            }
-            if rm.shadows != Shadows::Rays && rm.shading != Shading::PhongShadows {
-                let msg = format!(
-                    "RayMarch(shadows: LightVolume(..)) with shading: {:?}: expected shading: PhongShadows (the \
-                     light volume replaces its shadow rays)",
-                    rm.shading
-                );
-                self.fail(ray_march.unwrap(), msg);
-            }
+            _ => {}
+        }
+        let diagonal = super::hypertexture::diagonal(&model.world_corners(world));
+        let samples = diagonal / step;
+        if samples > MAX_SAMPLES_PER_RAY {
+            let msg = format!(
+                "a step of {step} takes {samples:.3e} samples across the bounds of \"{}\" (diagonal {diagonal:.4}): \
+                 expected a step of at least {:.3e}",
+                h.value,
+                diagonal / MAX_SAMPLES_PER_RAY
+            );
+            self.fail(m, msg);
         }
     }
 }

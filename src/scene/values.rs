@@ -14,12 +14,16 @@ pub(crate) const MAX_MAGNITUDE: f64 = crate::mesh::prism::MAX_COORD;
 /// pixels).
 pub(crate) const MIN_MAGNITUDE: f64 = 1e-15;
 
+/// A newtype `$name` whose `Deserialize` refuses values outside `$ok` (and beyond what f32
+/// kernels hold), with ron's position; method knobs (`methods/<m>/knobs.rs`) define theirs too.
 macro_rules! checked_f64 {
     ($name:ident, $ok:expr, $what:literal) => {
         #[derive(Clone, Copy)]
         struct $name(f64);
-        impl<'de> Deserialize<'de> for $name {
-            fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        impl<'de> serde::Deserialize<'de> for $name {
+            fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+                use serde::de::Error as _;
+                use $crate::scene::values::{MAX_MAGNITUDE, MIN_MAGNITUDE};
                 let v = f64::deserialize(d)?;
                 let ok: fn(f64) -> bool = $ok;
                 if v.is_finite() && v.abs() > MAX_MAGNITUDE {
@@ -45,6 +49,7 @@ macro_rules! checked_f64 {
         }
     };
 }
+pub(crate) use checked_f64;
 
 checked_f64!(Finite, |_| true, "a finite number");
 checked_f64!(Positive, |v| v > 0.0, "a positive finite number");
@@ -55,18 +60,17 @@ checked_f64!(Anisotropy, |v| v > -1.0 && v < 1.0, "an anisotropy g in (-1, 1)");
 checked_f64!(NonZero, |v| v != 0.0, "a finite non-zero number");
 checked_f64!(Jitter, |v| (0.0..0.5).contains(&v), "a jitter in [0, 0.5) (fraction of a cell)");
 checked_f64!(Distortion, |v| (0.0..0.9).contains(&v), "a distortion in [0, 0.9)");
-checked_f64!(SliceDepth, |v| v > 0.0 && v <= 1024.0, "a depth in (0, 1024] voxels");
-checked_f64!(SlicePixels, |v| v > 0.0 && v <= 1024.0, "a slice distance in (0, 1024] pixels");
-checked_f64!(MaxAngle, |v| v > 0.0 && v < 90.0, "a view angle in (0, 90) degrees");
 checked_f64!(FieldOfView, |v| v > 0.0 && v < 180.0, "a field of view in (0, 180) degrees");
 checked_f64!(ShadowBias, |v| (0.0..=8.0).contains(&v), "a shadow bias in [0, 8] voxels");
 
+/// A newtype `$name` whose `Deserialize` refuses values outside `$lo..=$hi`.
 macro_rules! checked_u32 {
     ($name:ident, $lo:expr, $hi:expr, $what:literal) => {
         #[derive(Clone, Copy)]
         struct $name(u32);
-        impl<'de> Deserialize<'de> for $name {
-            fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        impl<'de> serde::Deserialize<'de> for $name {
+            fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+                use serde::de::Error as _;
                 let v = u32::deserialize(d)?;
                 if ($lo..=$hi).contains(&v) {
                     Ok($name(v))
@@ -80,9 +84,9 @@ macro_rules! checked_u32 {
         }
     };
 }
+pub(crate) use checked_u32;
 
 checked_u32!(OutputSize, 1, 16384, "an output size");
-checked_u32!(PlaneCount, 1, super::MAX_PLANES, "a plane count");
 checked_u32!(Resolution, 1, 1024, "a resolution");
 checked_u32!(Octaves, 1, 8, "an octave count");
 checked_u32!(Supersample, 1, super::MAX_SUPERSAMPLE, "samples per pixel axis");
@@ -90,20 +94,6 @@ checked_u32!(Frequency, 1, 1024, "a frequency (lattice cells per tile)");
 checked_u32!(Cells, 1, 4096, "a cell count");
 checked_u32!(Around, 3, 4096, "a segment count");
 checked_u32!(PoleToPole, 2, 4096, "a segment count");
-checked_u32!(PeelPasses, 1, super::types::MAX_PEEL_PASSES, "a depth-peeling pass count");
-checked_u32!(
-    SplatGrid,
-    4,
-    super::types::MAX_SPLAT_GRID,
-    "a splat lattice size (cells along the longest axis)"
-);
-checked_u32!(
-    LightResolution,
-    4,
-    super::types::MAX_LIGHT_RESOLUTION,
-    "a light volume resolution (samples along the longest axis)"
-);
-checked_u32!(SplatSlabs, 1, super::types::MAX_SPLAT_SLABS, "a depth slab count");
 checked_u32!(
     GridResolution,
     4,
@@ -114,12 +104,13 @@ checked_u32!(
 // `deserialize_with` adapters: public types stay plain (f64, DVec3, [f32; 3], u32).
 macro_rules! adapter {
     ($fn:ident, $ty:ty, $via:ty, $map:expr) => {
-        pub(super) fn $fn<'de, D: Deserializer<'de>>(d: D) -> Result<$ty, D::Error> {
+        pub(crate) fn $fn<'de, D: serde::Deserializer<'de>>(d: D) -> Result<$ty, D::Error> {
             let map: fn($via) -> $ty = $map;
-            <$via>::deserialize(d).map(map)
+            <$via as serde::Deserialize>::deserialize(d).map(map)
         }
     };
 }
+pub(crate) use adapter;
 
 adapter!(positive, f64, Positive, |v| v.0);
 adapter!(finite, f64, Finite, |v| v.0);
@@ -138,9 +129,6 @@ adapter!(anisotropy, f64, Anisotropy, |v| v.0);
 adapter!(jitter, f64, Jitter, |v| v.0);
 adapter!(distortion, f64, Distortion, |v| v.0);
 adapter!(fov, f64, FieldOfView, |v| v.0);
-adapter!(slice_depth, f64, SliceDepth, |v| v.0);
-adapter!(slice_pixels, f64, SlicePixels, |v| v.0);
-adapter!(max_angle, f64, MaxAngle, |v| v.0);
 adapter!(finite_f32, f32, Finite, |v| v.0 as f32);
 adapter!(positive_f32, f32, Positive, |v| v.0 as f32);
 adapter!(opt_positive_f32, Option<f32>, Option<Positive>, |v| v.map(|x| x.0 as f32));
@@ -157,15 +145,10 @@ adapter!(light_color, [f32; 3], [NonNegative; 3], |v| v.map(|x| x.0 as f32));
 adapter!(opt_color, Option<[f32; 3]>, Option<[Unit; 3]>, |v| v.map(|c| c.map(|x| x.0 as f32)));
 adapter!(output_size, u32, OutputSize, |v| v.0);
 adapter!(opt_size2, Option<[u32; 2]>, Option<[OutputSize; 2]>, |v| v.map(|s| s.map(|x| x.0)));
-adapter!(planes, u32, PlaneCount, |v| v.0);
 adapter!(resolution, [u32; 3], [Resolution; 3], |v| v.map(|x| x.0));
 adapter!(octaves, u32, Octaves, |v| v.0);
 adapter!(supersample, u32, Supersample, |v| v.0);
 adapter!(grid_resolution, u32, GridResolution, |v| v.0);
-adapter!(peel_passes, u32, PeelPasses, |v| v.0);
-adapter!(splat_grid, u32, SplatGrid, |v| v.0);
-adapter!(light_resolution, u32, LightResolution, |v| v.0);
-adapter!(splat_slabs, u32, SplatSlabs, |v| v.0);
 adapter!(frequency, u32, Frequency, |v| v.0);
 adapter!(cells, [u32; 2], [Cells; 2], |v| v.map(|x| x.0));
 adapter!(sphere_segments, [u32; 2], (Around, PoleToPole), |v| [v.0 .0, v.1 .0]);

@@ -78,7 +78,8 @@ fn per_object_aovs_have_limits() {
     assert!(e.contains("AOV `coverage` holds 6 objects") && e.contains("this scene has 7"), "{e}");
     assert!(Blueprint::new(&scene(7, ""), &aovs(&["depth", "transmittance"])).is_ok());
     // The Reference method draws all its objects in one instance: one layer for all.
-    let reference = RenderOptions { method: Some(MethodKind::Reference), ..aovs(&["coverage"]) };
+    let reference =
+        RenderOptions { method: Some(MethodKind::named("Reference").unwrap()), ..aovs(&["coverage"]) };
     let e = error(&scene(2, ""), reference.clone());
     assert!(e.contains("drawn together in one layer") && e.contains(r#"["p0", "p1"]"#), "{e}");
     assert!(Blueprint::new(&scene(1, ""), &reference).is_ok());

@@ -14,7 +14,8 @@ const LAYERS: &[&[&str]] = &[
     &["input"],
     // Device, shader sources, reflection, caches; file formats; meshes, shells, BVHs; OpenVDB grids.
     &["gpu", "io", "mesh", "vdb"],
-    // Render graphs; image metrics; scene files (no GPU).
+    // Render graphs; image metrics; scene files (no GPU), with the methods' knobs (see
+    // `module_of`).
     &["graph", "metrics", "scene"],
     // CPU twins shared by several methods.
     &["cpu"],
@@ -47,21 +48,48 @@ pub(crate) fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
     }
 }
 
-/// Top-level modules a source text names through `crate::`.
+/// The layered module a path below `crate::` belongs to: its first segment, except that a
+/// method's knobs (`methods::knobs`, `methods::<method>::knobs`: the registration and the
+/// scene-file types of each method) belong to `scene`, whose files they are.
+fn module_of(path: &str) -> String {
+    let segments: Vec<&str> = path
+        .split("::")
+        .map(|s| s.trim())
+        .map(|s| s.split(|c: char| !(c.is_ascii_alphanumeric() || c == '_' || c == '$')).next().unwrap_or(""))
+        .collect();
+    let knobs = segments.first() == Some(&"methods")
+        && (segments.get(1) == Some(&"knobs") || segments.get(2) == Some(&"knobs"));
+    if knobs {
+        "scene".into()
+    } else {
+        segments.first().copied().unwrap_or("").to_string()
+    }
+}
+
+/// Layered modules a source text names through `crate::`.
 fn imports(text: &str) -> Vec<String> {
     let mut out = Vec::new();
     for (at, _) in text.match_indices("crate::") {
         let rest = &text[at + "crate::".len()..];
-        let names: Vec<&str> = if let Some(group) = rest.strip_prefix('{') {
-            // `crate::{a::b, c}`: the first segment of each item at depth 0.
+        let names: Vec<String> = if let Some(group) = rest.strip_prefix('{') {
+            // `crate::{a::b, c}`: each item at depth 0.
             let end = group.find('}').unwrap_or(group.len());
-            group[..end].split(',').map(|item| item.trim().split("::").next().unwrap_or("")).collect()
+            group[..end].split(',').map(module_of).collect()
         } else {
-            vec![rest.split(|c: char| !(c.is_ascii_alphanumeric() || c == '_')).next().unwrap_or("")]
+            let end = rest.find(|c: char| !(c.is_ascii_alphanumeric() || c == '_' || c == ':' || c == '$'));
+            vec![module_of(&rest[..end.unwrap_or(rest.len())])]
         };
-        out.extend(names.into_iter().filter(|n| !n.is_empty()).map(str::to_string));
+        out.extend(names.into_iter().filter(|n| !n.is_empty()));
     }
     out
+}
+
+/// A method's knobs file: `methods/knobs.rs` or `methods/<method>/knobs.rs` (scene layer).
+fn is_knobs_file(rel: &Path) -> bool {
+    let parts: Vec<String> = rel.components().map(|c| c.as_os_str().to_string_lossy().into_owned()).collect();
+    parts.first().map(String::as_str) == Some("methods")
+        && parts.last().map(String::as_str) == Some("knobs.rs")
+        && parts.len() <= 3
 }
 
 #[test]
@@ -84,10 +112,15 @@ fn modules_import_only_lower_layers() {
     for file in &files {
         let rel = file.strip_prefix(&src).unwrap();
         let first = rel.components().next().unwrap().as_os_str().to_string_lossy();
-        let module = first.trim_end_matches(".rs");
+        let module = if is_knobs_file(rel) { "scene" } else { first.trim_end_matches(".rs") };
         // The binary (main.rs, cli/) sits above the library.
         let Some(own) = layer_of(module) else { continue };
         let text = std::fs::read_to_string(file).unwrap();
+        if is_knobs_file(rel) && text.contains("super::") {
+            // Only `crate::` paths are scanned: a knobs file reaching its method by `super::`
+            // would hide an upward import.
+            wrong.entry("scene -> super::".into()).or_default().push(rel.display().to_string());
+        }
         for target in imports(&text) {
             let Some(layer) = layer_of(&target) else { continue };
             if target == module {
@@ -109,6 +142,10 @@ fn the_scan_sees_grouped_and_nested_imports() {
     let text =
         "use crate::gpu::{GpuContext, Inputs};\nuse crate::{Error, io::png};\nlet x = crate::render::f();";
     assert_eq!(imports(text), ["gpu", "Error", "io", "render"]);
+    let knobs = "use crate::methods::view_slices::knobs::ViewSlices;\nuse crate::{methods::knobs::Method, methods::plan};";
+    assert_eq!(imports(knobs), ["scene", "scene", "methods"]);
+    assert!(is_knobs_file(Path::new("methods/view_slices/knobs.rs")));
+    assert!(!is_knobs_file(Path::new("methods/view_slices/deep/knobs.rs")));
 }
 
 /// The graph core and the renderer reach methods only through `methods::REGISTRY` and the

@@ -8,6 +8,7 @@ mod docs;
 mod graph_errors;
 mod io_metrics;
 mod layers;
+mod method_names;
 mod names;
 mod scene_errors;
 mod strict;

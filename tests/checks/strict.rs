@@ -59,7 +59,16 @@ fn frame_graph() -> String {
 fn every_file_type_denies_unknown_fields() {
     let mut missing = Vec::new();
     let mut seen = 0;
-    for rel in ["src/scene/types.rs", "src/scene/hypertexture.rs", "src/graph/mod.rs"] {
+    let knobs =
+        std::fs::read_dir(root().join("src/methods")).unwrap().map(|e| e.unwrap().path().join("knobs.rs"));
+    let knobs: Vec<String> = knobs
+        .filter(|p| p.exists())
+        .map(|p| p.strip_prefix(root()).unwrap().display().to_string())
+        .chain(["src/methods/knobs.rs".to_string()])
+        .collect();
+    assert!(knobs.len() >= 5, "the methods' knobs files moved: {knobs:?}");
+    let files = ["src/scene/types.rs", "src/scene/hypertexture.rs", "src/graph/mod.rs"].map(String::from);
+    for rel in files.iter().chain(&knobs) {
         let text = std::fs::read_to_string(root().join(rel)).unwrap();
         let lines: Vec<&str> = text.lines().collect();
         for (i, l) in lines.iter().enumerate() {

@@ -18,7 +18,10 @@ use crate::layers::rust_files;
 /// GPU's sparse copy of every grid against the voxels as read; `tiles::composite_tiles_frame`
 /// for the compositor's twin test; `Session::replan`, a camera move without a file read, for
 /// tests/cli/faults.rs.)
-const PUB_DECLARATIONS: usize = 1275;
+/// (1285: the method plug-ins: `MethodKind` with the command-line names of the registered
+/// methods for `--method` and `pareto --methods`, `methods::sweep::SweepValues` for `pareto`'s
+/// flags, and `scene`'s re-exports of each method's knobs from its folder.)
+const PUB_DECLARATIONS: usize = 1285;
 
 /// Whether the declaration on line `n` has a `///` doc above its attributes (one-line ones, or
 /// multi-line ones from `#[` to `)]`).

@@ -12,6 +12,7 @@ mod faults;
 mod hostile_files;
 mod install;
 mod maxima;
+mod method_plugin;
 mod preview_input;
 mod preview_latency;
 mod preview_window;

@@ -123,7 +123,7 @@ fn keys_and_a_curve_drag_edit_the_scene_file() {
     // 2, 3, 1: the reference, the difference, the image.
     let image = pixels(&p, n);
     p.after(key("2"));
-    p.until("reference view", |p, n| p.state(n)["mode"] == "Reference");
+    p.until("reference view", |p, n| p.state(n)["mode"] == "Truth");
     p.after(key("3"));
     let n = p.until("difference view", |p, n| p.state(n)["mode"] == "Difference");
     assert!(changed(&image, &pixels(&p, n)) > 1000, "the difference view looks like the image");

@@ -104,12 +104,14 @@ fn transmittance_coverage_and_depth_of_a_slab_beside_a_floor() {
 #[test]
 fn depth_of_an_opaque_slab_by_slicing_and_by_the_reference() {
     let scene = scene(0.9);
-    for (method, within) in
-        [(None, 1.2 / 96.0), (Some(MethodKind::Reference), 0.01), (Some(MethodKind::AxisSlices), 3.0 / 16.0)]
-    {
+    for (method, within) in [
+        (None, 1.2 / 96.0),
+        (Some(MethodKind::named("Reference").unwrap()), 0.01),
+        (Some(MethodKind::named("AxisSlices").unwrap()), 3.0 / 16.0),
+    ] {
         let opts = RenderOptions {
             method,
-            step: (method == Some(MethodKind::Reference)).then_some(0.005),
+            step: (method == Some(MethodKind::named("Reference").unwrap())).then_some(0.005),
             aovs: Some(vec!["depth".into()]),
             ..Default::default()
         };

@@ -336,7 +336,7 @@ fn render_culled(path: &Path, culling: bool) -> (Image, usize, usize) {
     let scene = scene::load(path).unwrap();
     let opts = RenderOptions {
         size: Some((64, 64)),
-        method: Some(MethodKind::AxisSlices),
+        method: Some(MethodKind::named("AxisSlices").unwrap()),
         occlusion_culling: Some(culling),
         ..Default::default()
     };
@@ -412,7 +412,7 @@ fn blended_fog_box_keeps_its_brightness_at_every_level() {
     // reference's brightness whatever level the criteria pick.
     let reference = render(
         &FOG_BOX.replace("DEPTH", "1.0"),
-        &RenderOptions { method: Some(MethodKind::Reference), ..Default::default() },
+        &RenderOptions { method: Some(MethodKind::named("Reference").unwrap()), ..Default::default() },
     );
     let sum = |img: &Image| (0..img.len()).map(|i| img.pixels[i][0] as f64).sum::<f64>();
     for depth in ["0.25", "2.0", "8.0"] {
@@ -482,7 +482,9 @@ fn mipmaps_lower_the_error_of_minified_slices() {
         mipmaps,
         ..Default::default()
     };
-    let truth = |n: u32| render(&text, &RenderOptions { method: Some(MethodKind::Reference), ..at(n, None) });
+    let truth = |n: u32| {
+        render(&text, &RenderOptions { method: Some(MethodKind::named("Reference").unwrap()), ..at(n, None) })
+    };
     let (area, regress) = (truth(8), truth(4));
     for blend in ["Binary", "Blended"] {
         let flip = |n: u32, mipmaps: bool, truth: &Image| {
@@ -510,7 +512,10 @@ fn three_directions_bound_the_error_at_grazing_views() {
     );
     assert_ne!(grazing, source, "the pear scene's camera line");
     let size = RenderOptions { size: Some((64, 64)), ..Default::default() };
-    let reference = render(&grazing, &RenderOptions { method: Some(MethodKind::Reference), ..size.clone() });
+    let reference = render(
+        &grazing,
+        &RenderOptions { method: Some(MethodKind::named("Reference").unwrap()), ..size.clone() },
+    );
     let three = render(&grazing, &size);
     let horizontal =
         render(&grazing.replace("max_angle: 80.0", "max_angle: 80.0, directions: Horizontal"), &size);
@@ -657,7 +662,10 @@ fn pear_errors(elevation: f64) -> (f64, f64) {
     );
     let scene = source.replace("camera: (eye: (0.0, -2.3, 1.9), target: (0.0, 0.0, 0.45)", &camera);
     let size = RenderOptions { size: Some((64, 64)), ..Default::default() };
-    let reference = render(&scene, &RenderOptions { method: Some(MethodKind::Reference), ..size.clone() });
+    let reference = render(
+        &scene,
+        &RenderOptions { method: Some(MethodKind::named("Reference").unwrap()), ..size.clone() },
+    );
     let flip = |s: &str| voltex::metrics::flip(&render(s, &size), &reference).unwrap().mean;
     (flip(&scene), flip(&scene.replace("max_angle: 80.0", "max_angle: 80.0, directions: Horizontal")))
 }
@@ -776,7 +784,7 @@ fn inside_fog(z: f32) -> String {
 fn eye_inside_the_shell_sees_the_analytic_transmittance() {
     let axis = "AxisSlices(blend: Blended)";
     let camera_inside = voltex::project_root().join("scenes/hard_cases/camera_inside.ron");
-    let opts = RenderOptions { method: Some(MethodKind::AxisSlices), ..Default::default() };
+    let opts = RenderOptions { method: Some(MethodKind::named("AxisSlices").unwrap()), ..Default::default() };
     assert!(gpu_and_twin(&camera_inside, &opts) > 0);
     let scene = scene::load(&camera_inside).unwrap();
     let bp = Blueprint::new(&scene, &opts).unwrap();
@@ -787,7 +795,7 @@ fn eye_inside_the_shell_sees_the_analytic_transmittance() {
         let img = render(&source.replace("METHOD", axis), &RenderOptions::default());
         let reference = render(
             &source.replace("METHOD", axis),
-            &RenderOptions { method: Some(MethodKind::Reference), ..Default::default() },
+            &RenderOptions { method: Some(MethodKind::named("Reference").unwrap()), ..Default::default() },
         );
         // The four centre pixels: rays within 0.5 degrees of the axis.
         let centre = |img: &Image| {

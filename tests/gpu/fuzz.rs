@@ -669,8 +669,10 @@ mod fuzz_regressions {
         let text = std::fs::read_to_string(&path).unwrap();
         let text = text.replacen("resolution: (8, 8, 8)", "resolution: (577, 64, 1024)", 1);
         let scene = voltex::scene::parse(&text, &path).unwrap();
-        let opts =
-            RenderOptions { method: Some(voltex::render::MethodKind::Reference), ..Default::default() };
+        let opts = RenderOptions {
+            method: Some(voltex::render::MethodKind::named("Reference").unwrap()),
+            ..Default::default()
+        };
         let limits = voltex::gpu::budget::plan_limits();
         let e =
             Blueprint::new(&scene, &opts).and_then(|bp| bp.check_limits(&limits, "x")).expect_err("an error");

@@ -17,7 +17,7 @@ use voltex::cpu::hypertexture::Model;
 use voltex::io::Image;
 use voltex::methods::ray_march::march::{ray_march, MarchView};
 use voltex::methods::ray_march::RayMarchPlan;
-use voltex::render::{Blueprint, MethodKind, RenderOptions, Renderer, DEFAULT_AXIS_SLICES};
+use voltex::render::{Blueprint, MethodKind, RenderOptions, Renderer};
 use voltex::scene::{self, AxisSlices, Method, SliceBlend};
 use voltex::types::MarchState;
 
@@ -49,23 +49,23 @@ fn render(name: &str, source: &str, draw: Draw) -> Image {
     let mut opts = RenderOptions::default();
     match draw {
         Draw::View => {
-            opts.method = Some(MethodKind::ViewSlices);
+            opts.method = Some(MethodKind::named("ViewSlices").unwrap());
             if !source.contains("ViewSlices(") {
                 opts.planes = Some(64);
             }
         }
         Draw::Planes(n) => {
-            opts.method = Some(MethodKind::ViewSlices);
+            opts.method = Some(MethodKind::named("ViewSlices").unwrap());
             opts.planes = Some(n);
         }
-        Draw::Reference => opts.method = Some(MethodKind::Reference),
+        Draw::Reference => opts.method = Some(MethodKind::named("Reference").unwrap()),
         Draw::Axis if !source.contains("AxisSlices(") => {
-            let blended = AxisSlices { blend: SliceBlend::Blended, ..DEFAULT_AXIS_SLICES };
+            let blended = AxisSlices { blend: SliceBlend::Blended, ..Default::default() };
             opts.object_methods =
                 scene.nodes.iter().map(|n| (n.name.clone(), Method::AxisSlices(blended))).collect();
-            opts.method = Some(MethodKind::AxisSlices);
+            opts.method = Some(MethodKind::named("AxisSlices").unwrap());
         }
-        Draw::Axis => opts.method = Some(MethodKind::AxisSlices),
+        Draw::Axis => opts.method = Some(MethodKind::named("AxisSlices").unwrap()),
     }
     let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
     let mut r = Renderer::new(&ctx, Blueprint::new(&scene, &opts).unwrap()).unwrap();

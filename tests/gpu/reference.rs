@@ -16,7 +16,11 @@ use voltex::render::{Blueprint, MethodKind, RenderOptions, Renderer};
 use voltex::scene;
 
 fn reference(size: u32) -> RenderOptions {
-    RenderOptions { size: Some((size, size)), method: Some(MethodKind::Reference), ..Default::default() }
+    RenderOptions {
+        size: Some((size, size)),
+        method: Some(MethodKind::named("Reference").unwrap()),
+        ..Default::default()
+    }
 }
 
 fn example(name: &str) -> PathBuf {

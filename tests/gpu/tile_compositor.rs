@@ -53,7 +53,10 @@ fn tiles_composite_the_raster_image() {
         let tiles = render(name, &options(Compositor::Tiles));
         let truth = render(
             name,
-            &RenderOptions { method: Some(MethodKind::Reference), ..options(Compositor::Raster) },
+            &RenderOptions {
+                method: Some(MethodKind::named("Reference").unwrap()),
+                ..options(Compositor::Raster)
+            },
         );
         let d = pixel_differences(&raster, &tiles);
         let mean = d.iter().sum::<f64>() / d.len() as f64;

@@ -125,7 +125,11 @@ fn far_lod_is_as_close_as_full_detail() {
     assert!(c.level >= 3 && c.planes < 60, "{c:?}");
     let truth = render(
         &scene,
-        &RenderOptions { method: Some(MethodKind::Reference), supersample: Some(2), ..opts.clone() },
+        &RenderOptions {
+            method: Some(MethodKind::named("Reference").unwrap()),
+            supersample: Some(2),
+            ..opts.clone()
+        },
     );
     let auto = render(&scene, &RenderOptions { lod: Some(Lod::Auto), ..opts.clone() });
     let full = render(&scene, &opts);
@@ -151,7 +155,11 @@ fn auto_lod_on_terrain_is_no_worse_than_full_detail() {
     let opts = RenderOptions { size: Some((96, 96)), ..Default::default() };
     let truth = render(
         &scene,
-        &RenderOptions { method: Some(MethodKind::Reference), supersample: Some(4), ..opts.clone() },
+        &RenderOptions {
+            method: Some(MethodKind::named("Reference").unwrap()),
+            supersample: Some(4),
+            ..opts.clone()
+        },
     );
     let auto_opts = RenderOptions { lod: Some(Lod::Auto), ..opts.clone() };
     let bp = Blueprint::new(&scene, &auto_opts).unwrap();

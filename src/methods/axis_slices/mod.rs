@@ -2,6 +2,7 @@
 //! the prisms sorted back to front and the buffers of `choose_axis_slices`, `scan_axis_slices`,
 //! `emit_axis_slices` and `draw_axis_slices`. The slice images come from `bake::axis_slices`.
 
+pub(crate) mod knobs;
 mod object;
 pub(crate) mod plugin;
 pub mod twin;

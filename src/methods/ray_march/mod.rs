@@ -6,6 +6,7 @@
 //! or with EWA-style splatting the work blocks of `splat_segments.wgsl` and the per-pixel depth
 //! slabs `resolve_splats.wgsl` composites.
 
+pub(crate) mod knobs;
 pub mod light_volume;
 pub mod march;
 mod object;

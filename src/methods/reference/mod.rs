@@ -3,6 +3,7 @@
 //! and level 0 of their baked volumes packed into one storage buffer (the kernel filters by hand,
 //! as the sampler would, so all objects fit in one dispatch without binding arrays).
 
+pub(crate) mod knobs;
 mod object;
 pub(crate) mod plugin;
 pub mod trace_reference;

@@ -98,6 +98,10 @@ fn lighting(object: &ObjectPlan) -> Lighting {
 }
 
 impl MethodPlan for ReferencePlan {
+    fn ray_step(&self) -> Option<f64> {
+        Some(self.step)
+    }
+
     fn parts(&self) -> Vec<PartDecl> {
         Vec::new()
     }

@@ -28,6 +28,11 @@ pub fn plan(cx: &mut PlanCx, object: &mut ObjectPlan, method: &Method) -> Result
 }
 
 impl MethodPlan for VolumePlan {
+    /// The exact cells need no step; their shadow rays do (a quarter voxel).
+    fn ray_step(&self) -> Option<f64> {
+        self.exact.then_some(self.step)
+    }
+
     fn parts(&self) -> Vec<PartDecl> {
         vec![PartDecl { filters: vec!["Volume"], order: 0 }]
     }

@@ -407,9 +407,9 @@ fn counts() {
         std::fs::write(objs.join(format!("faces{faces}.obj")), grid_obj(*faces as usize)).unwrap();
     }
     let methods = prop::option::of(prop::sample::select(vec![
-        MethodKind::ViewSlices,
-        MethodKind::AxisSlices,
-        MethodKind::Reference,
+        MethodKind::named("ViewSlices").unwrap(),
+        MethodKind::named("AxisSlices").unwrap(),
+        MethodKind::named("Reference").unwrap(),
     ]));
     fuzz("counts", 40, LARGE, (count(), methods), |(c, method)| {
         let (path, text) = count_scene(&c, &objs);
