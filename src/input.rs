@@ -144,6 +144,13 @@ impl<R: Read> Read for Bounded<R> {
 /// Opens `path` after [`check`]: non-blocking (a file swapped for a FIFO after the check cannot
 /// hang the open) and checked again on the open handle.
 pub(crate) fn open(path: &Path, kind: Kind, role: &str) -> Result<Bounded<std::fs::File>> {
+    let start = std::time::Instant::now();
+    let opened = open_checked(path, kind, role);
+    crate::work::file_opened(start);
+    opened
+}
+
+fn open_checked(path: &Path, kind: Kind, role: &str) -> Result<Bounded<std::fs::File>> {
     check(path, kind, role)?;
     let mut options = std::fs::OpenOptions::new();
     options.read(true);
@@ -167,8 +174,11 @@ pub(crate) fn open(path: &Path, kind: Kind, role: &str) -> Result<Bounded<std::f
 /// The bytes of `path` (see [`open`]).
 pub(crate) fn read(path: &Path, kind: Kind, role: &str) -> Result<Vec<u8>> {
     let mut reader = open(path, kind, role)?;
+    let start = std::time::Instant::now();
     let mut out = Vec::new();
-    reader.read_to_end(&mut out).map_err(|e| Error::file(path, format!("cannot read {role}: {e}")))?;
+    let read = reader.read_to_end(&mut out);
+    crate::work::file_read(start);
+    read.map_err(|e| Error::file(path, format!("cannot read {role}: {e}")))?;
     Ok(out)
 }
 

@@ -28,6 +28,7 @@ pub mod render;
 pub mod scene;
 pub mod types;
 pub mod vdb;
+pub(crate) mod work;
 
 pub use error::{Error, FileLoc, Result};
 

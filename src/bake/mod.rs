@@ -392,9 +392,10 @@ impl Baker {
         name: &str,
         format: wgpu::TextureFormat,
     ) -> Result<&'a mut ComputeKernel> {
-        let hash = crate::gpu::shader::source_hash(sources, name)?;
+        let shared = crate::gpu::shader::load_shared(sources, name)?;
+        let hash = shared.source_hash;
         if slot.as_ref().is_none_or(|(h, _)| *h != hash) {
-            let mut kernel = crate::gpu::shader::load_from(sources, name)?;
+            let mut kernel = (*shared).clone();
             let writes_volume = crate::gpu::reflect::bindings(&kernel, &["main"])?.iter().any(|b| {
                 b.name == "volume"
                     && matches!(b.kind, crate::gpu::reflect::BindingKind::StorageTexture { .. })

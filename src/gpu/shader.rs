@@ -2,7 +2,9 @@
 //! then naga parsing and validation, so every shader error names `file:line:col` before any
 //! pipeline is made.
 
+use std::collections::HashMap;
 use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex};
 
 use crate::error::{Error, FileLoc, Result};
 use crate::gpu::sources::{Source, Sources};
@@ -10,6 +12,7 @@ use crate::gpu::sources::{Source, Sources};
 /// A validated WGSL kernel: the naga module (handed to wgpu as IR, parsed once), its validation
 /// info (used for reflection), and every file it was assembled from (on disk, or
 /// `<embedded>/wgsl/...`).
+#[derive(Clone)]
 pub struct Kernel {
     /// Path relative to the WGSL root, e.g. `view_slices/emit_slices.wgsl`.
     pub(crate) name: String,
@@ -23,13 +26,17 @@ pub struct Kernel {
 }
 
 /// Expanded source plus, for each expanded line, the file and line it came from.
+#[derive(Default)]
 struct Expanded {
     text: String,
     origin: Vec<(usize, usize)>, // (index into files, 1-based line)
     files: Vec<PathBuf>,
+    /// The shaders looked up (the kernel and its includes, relative to the WGSL root).
+    rels: Vec<String>,
 }
 
 fn expand(sources: &Sources, rel: &str, out: &mut Expanded, from: Option<FileLoc>) -> Result<()> {
+    out.rels.push(rel.to_string());
     let found = sources.shader(rel).map_err(|e| match &from {
         Some(loc) => Error::at(loc.clone(), format!("cannot include {rel}: {e}")),
         None => e,
@@ -97,17 +104,48 @@ pub fn load(root: &Path, rel: &str) -> Result<Kernel> {
 
 /// Loads, expands and validates the shader `rel` and its includes, each looked up in `sources`.
 pub fn load_from(sources: &Sources, rel: &str) -> Result<Kernel> {
-    let mut ex = Expanded { text: String::new(), origin: Vec::new(), files: Vec::new() };
+    let mut ex = Expanded::default();
     expand(sources, rel, &mut ex, None)?;
     load_expanded(rel, ex)
 }
 
-/// The hash of the expanded source of `rel` ([`Kernel::source_hash`] of the kernel it loads),
-/// without parsing it: cheap enough for every rebuild to ask whether a kernel changed.
-pub(crate) fn source_hash(sources: &Sources, rel: &str) -> Result<u64> {
-    let mut ex = Expanded { text: String::new(), origin: Vec::new(), files: Vec::new() };
+/// A kernel loaded before, with what its lookups found on disk (see [`load_shared`]).
+struct Loaded {
+    rels: Vec<String>,
+    found: Vec<(PathBuf, Option<(std::time::SystemTime, u64)>)>,
+    kernel: Arc<Kernel>,
+}
+
+type KernelCache = HashMap<(Sources, String), Loaded>;
+
+/// Like [`load_from`], shared: a kernel loaded before in this process is handed out again while
+/// every lookup its expansion made finds the same files with the same modification times and
+/// lengths (a `stat` each, no read), so planning an unchanged scene again reads and validates
+/// no WGSL. An edited file, or a new one that now shadows another, loads it anew.
+pub(crate) fn load_shared(sources: &Sources, rel: &str) -> Result<Arc<Kernel>> {
+    static KERNELS: Mutex<Option<KernelCache>> = Mutex::new(None);
+    let key = (sources.clone(), rel.to_string());
+    let found = |rels: &[String]| rels.iter().flat_map(|r| sources.probe(r)).collect::<Vec<_>>();
+    if let Some(l) = KERNELS.lock().unwrap().get_or_insert_with(HashMap::new).get(&key) {
+        if found(&l.rels) == l.found {
+            return Ok(l.kernel.clone());
+        }
+    }
+    let mut ex = Expanded::default();
     expand(sources, rel, &mut ex, None)?;
-    Ok(crate::gpu::cache::key(&ex.text))
+    let rels = ex.rels.clone();
+    // Stamped before validation: an edit made meanwhile is seen by the next load.
+    let stamp = found(&rels);
+    let kernel = Arc::new(load_expanded(rel, ex)?);
+    let loaded = Loaded { rels, found: stamp, kernel: kernel.clone() };
+    KERNELS.lock().unwrap().get_or_insert_with(HashMap::new).insert(key, loaded);
+    Ok(kernel)
+}
+
+/// The hash of the expanded source of `rel` ([`Kernel::source_hash`] of the kernel it loads):
+/// cheap enough for every rebuild to ask whether a kernel changed (see [`load_shared`]).
+pub(crate) fn source_hash(sources: &Sources, rel: &str) -> Result<u64> {
+    Ok(load_shared(sources, rel)?.source_hash)
 }
 
 /// Validates WGSL given as text (tests and tools); `path` is only used in messages.
@@ -116,11 +154,19 @@ pub fn load_str(path: &Path, source: &str) -> Result<Kernel> {
         text: source.to_string(),
         origin: (1..=source.lines().count()).map(|l| (0, l)).collect(),
         files: vec![path.to_path_buf()],
+        rels: Vec::new(),
     };
     load_expanded(&path.display().to_string(), ex)
 }
 
 fn load_expanded(name: &str, ex: Expanded) -> Result<Kernel> {
+    let start = std::time::Instant::now();
+    let kernel = validate(name, ex);
+    crate::work::shader_validated(start);
+    kernel
+}
+
+fn validate(name: &str, ex: Expanded) -> Result<Kernel> {
     let module = naga::front::wgsl::parse_str(&ex.text).map_err(|e| {
         let loc = e.location(&ex.text);
         let (line, col) = loc.map(|l| (l.line_number, l.line_position)).unwrap_or((1, 1));

@@ -38,12 +38,10 @@ pub(crate) struct Source {
     /// The file on disk, or `<embedded>/wgsl/...` for an embedded one (for messages).
     pub(crate) path: PathBuf,
     pub(crate) text: String,
-    /// False for an embedded file (nothing to watch for changes).
-    pub(crate) on_disk: bool,
 }
 
 /// The places shaders and graphs are looked up in, in order (see the module documentation).
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq, Eq, Hash)]
 pub struct Sources {
     /// Folders searched for shaders, in order.
     dirs: Vec<PathBuf>,
@@ -100,10 +98,39 @@ impl Sources {
             // rather than a silent fall-through to the embedded copy.
             if std::fs::symlink_metadata(&path).is_ok() {
                 let text = crate::input::read_text(&path, "a WGSL file")?;
-                return Ok(Some(Source { path, text, on_disk: true }));
+                return Ok(Some(Source { path, text }));
             }
         }
         Ok(self.embedded_file("wgsl", rel))
+    }
+
+    /// What looking up the shader `rel` finds on disk, one `stat` per folder tried: each path
+    /// tried with its modification time and length if something is there (the last one tried
+    /// is the one found, or none is and the embedded copy is used).
+    pub(crate) fn probe(&self, rel: &str) -> Vec<(PathBuf, Option<(std::time::SystemTime, u64)>)> {
+        let mut out = Vec::new();
+        for dir in &self.dirs {
+            let path = dir.join(rel);
+            let meta = std::fs::symlink_metadata(&path).ok();
+            let found = meta.map(|m| (m.modified().unwrap_or(std::time::UNIX_EPOCH), m.len()));
+            out.push((path, found));
+            if found.is_some() {
+                break;
+            }
+        }
+        out
+    }
+
+    /// Whether the shader `rel` exists in a place (one `stat` per folder, no read).
+    pub(crate) fn has_shader(&self, rel: &str) -> bool {
+        self.probe(rel).last().is_some_and(|(_, f)| f.is_some())
+            || (self.embedded && normalized(rel).is_some_and(|r| embedded(&format!("wgsl/{r}")).is_some()))
+    }
+
+    /// The project tree's file of the graph `name`, when it is on disk (else the embedded copy
+    /// is used).
+    pub(crate) fn graph_path(&self, name: &str) -> Option<PathBuf> {
+        self.graphs.as_ref().map(|g| g.join(name)).filter(|p| p.exists())
     }
 
     /// The graph `name` of the project (e.g. `frame.ron`): the file in the project tree's
@@ -111,7 +138,7 @@ impl Sources {
     pub(crate) fn graph(&self, name: &str) -> Result<Option<Source>> {
         if let Some(path) = self.graphs.as_ref().map(|g| g.join(name)).filter(|p| p.exists()) {
             let text = crate::input::read_text(&path, "a graph file")?;
-            return Ok(Some(Source { path, text, on_disk: true }));
+            return Ok(Some(Source { path, text }));
         }
         Ok(self.embedded_file("graphs", name))
     }
@@ -122,7 +149,7 @@ impl Sources {
         }
         let key = normalized(rel).map(|r| format!("{folder}/{r}"))?;
         let text = embedded(&key)?;
-        Some(Source { path: Path::new(EMBEDDED_PREFIX).join(&key), text: text.to_string(), on_disk: false })
+        Some(Source { path: Path::new(EMBEDDED_PREFIX).join(&key), text: text.to_string() })
     }
 
     /// The folders on disk that shaders are looked up in and that exist (what the preview
@@ -213,10 +240,10 @@ mod tests {
         let tint = s.shader("tint.wgsl").unwrap().unwrap();
         assert_eq!((tint.path, tint.text.as_str()), (graph_dir.join("tint.wgsl"), "// beside\n"));
         let c = s.shader("composite.wgsl").unwrap().unwrap();
-        assert_eq!((c.path, c.on_disk), (wgsl.join("composite.wgsl"), true));
+        assert_eq!(c.path, wgsl.join("composite.wgsl"));
         let t = s.shader("./shared/types.wgsl").unwrap().unwrap();
         assert_eq!(t.path, Path::new("<embedded>/wgsl/shared/types.wgsl"));
-        assert!(!t.on_disk && t.text == embedded("wgsl/shared/types.wgsl").unwrap());
+        assert!(t.path.starts_with(EMBEDDED_PREFIX) && t.text == embedded("wgsl/shared/types.wgsl").unwrap());
         assert!(s.shader("nothere.wgsl").unwrap().is_none());
         assert!(s.shader("../wgsl/shared/types.wgsl").unwrap().is_none());
         assert!(Sources::folder(&wgsl).shader("shared/types.wgsl").unwrap().is_none());

@@ -177,13 +177,13 @@ pub fn plan(
         let kernel = match kernels.get(decl.shader()) {
             Some(k) => k.clone(),
             None => {
-                if sources.shader(decl.shader())?.is_none() {
+                if !sources.has_shader(decl.shader()) {
                     return Err(graph.error_at(
                         decl.shader(),
                         format!("shader `{}` not found in {}", decl.shader(), sources.describe()),
                     ));
                 }
-                let k = Arc::new(shader::load_from(sources, decl.shader())?);
+                let k = shader::load_shared(sources, decl.shader())?;
                 kernels.insert(decl.shader().to_string(), k.clone());
                 k
             }

@@ -38,11 +38,18 @@ pub(crate) struct Sample {
     /// The output read back (the window presents it instead).
     pub(crate) readback: f64,
     pub(crate) total: f64,
+    /// Files opened (scene, assets, graph, WGSL) and the time spent reading them (ms), within
+    /// the stages above.
+    pub(crate) files: f64,
+    pub(crate) io: f64,
+    /// Shaders parsed and validated and the time it took (ms), within the stages above.
+    pub(crate) shaders: f64,
+    pub(crate) validate: f64,
 }
 
 /// The stages of a [`Sample`] in order, with their values.
 impl Sample {
-    pub(crate) fn stages(&self) -> [(&'static str, f64); 9] {
+    pub(crate) fn stages(&self) -> [(&'static str, f64); 13] {
         [
             ("write", self.write),
             ("watch", self.watch),
@@ -53,6 +60,10 @@ impl Sample {
             ("render", self.render),
             ("readback", self.readback),
             ("total", self.total),
+            ("files", self.files),
+            ("io", self.io),
+            ("shaders", self.shaders),
+            ("validate", self.validate),
         ]
     }
 
@@ -73,6 +84,10 @@ impl Sample {
             render: m(|s| s.render),
             readback: m(|s| s.readback),
             total: m(|s| s.total),
+            files: m(|s| s.files),
+            io: m(|s| s.io),
+            shaders: m(|s| s.shaders),
+            validate: m(|s| s.validate),
         }
     }
 }
@@ -247,6 +262,7 @@ fn save(
         render,
         readback,
         total: ms(start),
+        ..worked(s.work)
     };
     Ok((sample, stats))
 }
@@ -266,9 +282,19 @@ fn orbit(ctx: &GpuContext, session: &mut Session, i: usize) -> Result<(Sample, C
     let (render, readback) = frame(ctx, session)?;
     let s = session.stages;
     let (parse, plan, bake, build) = (s.parse, s.plan, s.bake, s.build);
-    let sample =
-        Sample { parse, plan, bake, build, render, readback, total: ms(start), ..Default::default() };
+    let sample = Sample { parse, plan, bake, build, render, readback, total: ms(start), ..worked(s.work) };
     Ok((sample, stats))
+}
+
+/// A sample with only the work counters of a rebuild set.
+fn worked(w: crate::work::Work) -> Sample {
+    Sample {
+        files: w.files as f64,
+        io: w.io_ms,
+        shaders: w.shaders as f64,
+        validate: w.validate_ms,
+        ..Default::default()
+    }
 }
 
 /// Renders a frame and reads it back: the times of both (ms).

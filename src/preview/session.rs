@@ -33,6 +33,8 @@ pub(crate) struct Stages {
     pub(crate) bake: f64,
     /// The rest of the renderer: buffers, pipelines not found in the cache.
     pub(crate) build: f64,
+    /// Files read and shaders validated over all of the above.
+    pub(crate) work: crate::work::Work,
 }
 
 /// Bakes an edit left unused that the preview keeps (beyond the frame's own memory), so that
@@ -100,6 +102,7 @@ impl Session {
 
     /// Reloads the scene, graph and kernels and makes a renderer, reusing whatever is unchanged.
     pub fn rebuild(&mut self, ctx: &GpuContext) -> Outcome {
+        let work = crate::work::Work::now();
         let t = Instant::now();
         let scene = match &self.text {
             Some(text) => scene::parse(text, &self.scene_path),
@@ -109,6 +112,7 @@ impl Session {
         match scene.and_then(|scene| self.build(ctx, scene)) {
             Ok(stats) => {
                 self.stages.parse = parse;
+                self.stages.work = crate::work::Work::since(work);
                 stats
             }
             Err(e) => self.failed(e),
@@ -146,7 +150,9 @@ impl Session {
         let t = Instant::now();
         let renderer = Renderer::with_cache(ctx, bp, &mut self.cache)?;
         let made = ms(t);
-        self.stages = Stages { parse: 0.0, plan, bake: renderer.bake_ms, build: made - renderer.bake_ms };
+        let work = self.stages.work;
+        self.stages =
+            Stages { parse: 0.0, plan, bake: renderer.bake_ms, build: made - renderer.bake_ms, work };
         self.cache.retain_used();
         self.renderer = Some(renderer);
         Ok(self.cache.stats)
@@ -172,7 +178,9 @@ impl Session {
     /// the file. The current error, if any, stays.
     pub fn replan(&mut self, ctx: &GpuContext) -> Outcome {
         let Some(scene) = self.scene.take() else { return self.rebuild(ctx) };
+        let work = crate::work::Work::now();
         let made = self.make(ctx, &scene);
+        self.stages.work = crate::work::Work::since(work);
         self.scene = Some(scene);
         match made {
             Ok(stats) => Outcome::Rebuilt(stats),

@@ -98,18 +98,37 @@ pub(crate) fn shader_sources(graph: Option<&Path>) -> Result<Sources> {
     let project = Sources::project()?;
     Ok(match graph {
         Some(path) => project.beside(path),
-        None => match project.graph(DEFAULT_GRAPH)? {
-            Some(g) if g.on_disk => project.beside(&g.path),
-            _ => project,
+        None => match project.graph_path(DEFAULT_GRAPH) {
+            Some(path) => project.beside(&path),
+            None => project,
         },
     })
 }
 
 /// The graph a render uses, `graph` (`--graph`) or else the project's `graphs/frame.ron` (the
-/// file when present, else the embedded copy), and where its shaders are looked up.
+/// file when present, else the embedded copy), and where its shaders are looked up. Loaded once
+/// per process while the graph file keeps its modification time and length (a `stat`, no read):
+/// planning an unchanged scene again opens no graph file.
 pub(crate) fn load_graph(graph: Option<&Path>) -> Result<(Graph, Sources)> {
+    type Stamp = Option<(std::time::SystemTime, u64)>;
+    type Loaded = (Option<PathBuf>, Stamp, Graph, Sources);
+    static GRAPHS: std::sync::Mutex<Vec<Loaded>> = std::sync::Mutex::new(Vec::new());
+    let file = match graph {
+        Some(path) => Some(path.to_path_buf()),
+        None => Sources::project()?.graph_path(DEFAULT_GRAPH),
+    };
+    let stamp = |f: &Option<PathBuf>| -> Stamp {
+        let m = std::fs::symlink_metadata(f.as_ref()?).ok()?;
+        Some((m.modified().unwrap_or(std::time::UNIX_EPOCH), m.len()))
+    };
+    let key = graph.map(Path::to_path_buf);
+    let now = stamp(&file);
+    let mut cache = GRAPHS.lock().unwrap();
+    if let Some((_, _, g, s)) = cache.iter().find(|(k, st, ..)| *k == key && *st == now && now.is_some()) {
+        return Ok((g.clone(), s.clone()));
+    }
     let sources = shader_sources(graph)?;
-    let graph = match graph {
+    let loaded = match graph {
         Some(path) => Graph::load(path)?,
         None => {
             let g = Sources::project()?.graph(DEFAULT_GRAPH)?.ok_or_else(|| {
@@ -118,7 +137,9 @@ pub(crate) fn load_graph(graph: Option<&Path>) -> Result<(Graph, Sources)> {
             Graph::parse(&g.path, g.text)?
         }
     };
-    Ok((graph, sources))
+    cache.retain(|(k, ..)| *k != key);
+    cache.push((key, now, loaded.clone(), sources.clone()));
+    Ok((loaded, sources))
 }
 
 impl Blueprint {
@@ -261,7 +282,7 @@ fn check_kernels(bakes: &[BakePlan], objects: &[ObjectPlan], groups: &[Box<dyn M
     kernels.dedup();
     let sources = Sources::project()?;
     for k in kernels {
-        crate::gpu::shader::load_from(&sources, k)?;
+        crate::gpu::shader::load_shared(&sources, k)?;
     }
     Ok(())
 }

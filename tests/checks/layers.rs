@@ -8,8 +8,8 @@ use std::path::{Path, PathBuf};
 
 /// Lowest first. Modules of one layer may not import each other.
 const LAYERS: &[&[&str]] = &[
-    // Errors, fault injection, the Pod structs shared with WGSL, progress on stderr.
-    &["error", "fault", "progress", "types"],
+    // Errors, fault injection, the Pod structs shared with WGSL, progress on stderr, work counters.
+    &["error", "fault", "progress", "types", "work"],
     // Bounded reads of user files (every reader above uses them).
     &["input"],
     // Device, shader sources, reflection, caches; file formats; meshes, shells, BVHs; OpenVDB grids.

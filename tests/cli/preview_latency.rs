@@ -28,7 +28,10 @@ Scene(
 )
 "#;
 
-const STAGES: &[&str] = &["write", "watch", "parse", "plan", "bake", "build", "render", "readback", "total"];
+const STAGES: &[&str] = &[
+    "write", "watch", "parse", "plan", "bake", "build", "render", "readback", "total", "files", "io",
+    "shaders", "validate",
+];
 
 #[test]
 fn measure_latency_writes_every_stage_of_every_edit() {
@@ -69,10 +72,16 @@ fn measure_latency_writes_every_stage_of_every_edit() {
         // lighting is baked), are baked again; nothing compiles.
         assert_eq!(r["bakes"], u32::from(["texel", "light"].contains(&edit)), "{r}");
         assert_eq!((&r["modules"], &r["pipelines"]), (&0.into(), &0.into()), "{r}");
-        // The file edits went through the watcher.
+        // The file edits went through the watcher and read the scene file; a camera move in the
+        // window opens no file. No edit validates a shader again (none changed).
+        let count = |stage: &str| samples.iter().map(|s| s[stage].as_f64().unwrap()).fold(0.0, f64::max);
         if !["orbit", "drag"].contains(&edit) {
             assert!(samples.iter().all(|s| s["watch"].as_f64().unwrap() > 0.0), "{r}");
+            assert!(samples.iter().all(|s| s["files"].as_f64().unwrap() >= 1.0), "{r}");
+        } else {
+            assert_eq!(count("files"), 0.0, "a camera move opened a file: {r}");
         }
+        assert_eq!(count("shaders"), 0.0, "{edit} validated a shader again: {r}");
         assert!(out.contains(&format!("\n{edit} ")), "{edit} not in the table:\n{out}");
     }
     assert_eq!(std::fs::read_to_string(&scene).unwrap(), SCENE);
