@@ -20,9 +20,21 @@ fn rel(p: DVec3, eye: DVec3) -> [f32; 4] {
     [r.x as f32, r.y as f32, r.z as f32, 1.0]
 }
 
+/// Each prism's bounding sphere in world space (centre, radius): what a shell needs of its
+/// prisms that does not depend on the view, made once per surface (see `SceneObject::spheres`).
+pub fn prism_spheres(surface: &BaseSurface) -> Vec<(DVec3, f64)> {
+    (0..surface.triangles.len()).map(|t| prism::bounding_sphere(surface.prism(t))).collect()
+}
+
 impl Shell {
     /// The shell of `surface` with positions made relative to the camera at `eye` (in f64, then f32).
     pub fn new(surface: &BaseSurface, eye: DVec3) -> Self {
+        Self::with_spheres(surface, &prism_spheres(surface), eye)
+    }
+
+    /// [`Shell::new`] with the prisms' world-space bounding spheres given ([`prism_spheres`]):
+    /// a new view moves them to the camera, O(prisms) with no square root.
+    pub fn with_spheres(surface: &BaseSurface, spheres: &[(DVec3, f64)], eye: DVec3) -> Self {
         let vertices = surface
             .positions
             .iter()
@@ -33,9 +45,9 @@ impl Shell {
             .triangles
             .iter()
             .zip(&surface.corner_uvs)
-            .enumerate()
-            .map(|(t, (ids, uv))| {
-                let (centre, radius) = prism::bounding_sphere(surface.prism(t).map(|p| p - eye));
+            .zip(spheres)
+            .map(|((ids, uv), &(centre, radius))| {
+                let centre = centre - eye;
                 // Grown by a relative epsilon so that f32 rounding never rejects a touching plane.
                 let radius = radius * (1.0 + 1e-5) + 1e-6;
                 Prism {

@@ -10,7 +10,7 @@ use super::knobs;
 use crate::gpu::cache::{CacheStats, GpuCache};
 use crate::gpu::GpuContext;
 use crate::render::{shader_sources, Blueprint, Frame, RenderOptions, Renderer};
-use crate::scene::{self, Scene};
+use crate::scene::{self, Scene, SceneObject};
 use crate::Result;
 
 /// What a rebuild did.
@@ -64,6 +64,9 @@ pub struct Session {
     pub draft: u32,
     /// Wall time of the last full-quality frame (ms), for [`Session::draft_scale`].
     frame_ms: Option<f64>,
+    /// The last good scene's objects (flattened, prisms checked, surfaces shared) at the time
+    /// they were made for: a view change plans them again without flattening the scene.
+    objects: Option<(Option<f64>, Vec<SceneObject>)>,
 }
 
 /// What a draft frame may take to draw (ms): with a rebuild and the panel, a drag stays near the
@@ -95,6 +98,7 @@ impl Session {
             stages: Stages::default(),
             draft: 1,
             frame_ms: None,
+            objects: None,
         };
         s.rebuild(ctx);
         s
@@ -134,7 +138,7 @@ impl Session {
     }
 
     fn build(&mut self, ctx: &GpuContext, scene: Scene) -> Result<Outcome> {
-        let stats = self.make(ctx, &scene)?;
+        let stats = self.make(ctx, &scene, false)?;
         self.scene = Some(scene);
         self.error = None;
         self.logged = None;
@@ -142,10 +146,17 @@ impl Session {
     }
 
     /// Plans `scene` with the session's options and makes its renderer (the stages timed).
-    fn make(&mut self, ctx: &GpuContext, scene: &Scene) -> Result<CacheStats> {
+    /// `same_scene`: `scene` is the last good one, whose objects may be planned again.
+    fn make(&mut self, ctx: &GpuContext, scene: &Scene, same_scene: bool) -> Result<CacheStats> {
         self.cache.begin();
         let t = Instant::now();
-        let bp = self.blueprint(scene)?;
+        let kept = self.objects.as_ref().filter(|(time, _)| same_scene && *time == self.options.time);
+        let objects = match kept {
+            Some((_, objects)) => objects.clone(),
+            None => scene.objects_at(self.options.time.unwrap_or(scene.time))?,
+        };
+        let bp = self.blueprint(scene, objects)?;
+        let objects = bp.objects.iter().map(|o| o.object.clone()).collect();
         let plan = ms(t);
         let t = Instant::now();
         let renderer = Renderer::with_cache(ctx, bp, &mut self.cache)?;
@@ -155,6 +166,7 @@ impl Session {
             Stages { parse: 0.0, plan, bake: renderer.bake_ms, build: made - renderer.bake_ms, work };
         self.cache.retain_used();
         self.renderer = Some(renderer);
+        self.objects = Some((self.options.time, objects));
         Ok(self.cache.stats)
     }
 
@@ -179,7 +191,7 @@ impl Session {
     pub fn replan(&mut self, ctx: &GpuContext) -> Outcome {
         let Some(scene) = self.scene.take() else { return self.rebuild(ctx) };
         let work = crate::work::Work::now();
-        let made = self.make(ctx, &scene);
+        let made = self.make(ctx, &scene, true);
         self.stages.work = crate::work::Work::since(work);
         self.scene = Some(scene);
         match made {
@@ -224,11 +236,10 @@ impl Session {
     }
 
     /// The blueprint of `scene` with the session's options, at draft quality while drafting.
-    fn blueprint(&self, scene: &Scene) -> Result<Blueprint> {
+    fn blueprint(&self, scene: &Scene, objects: Vec<SceneObject>) -> Result<Blueprint> {
         if self.draft <= 1 {
-            return Blueprint::new(scene, &self.options);
+            return Blueprint::with_objects(scene, objects, &self.options);
         }
-        let objects = scene.objects_at(self.options.time.unwrap_or(scene.time))?;
         let mut options = self.options.clone();
         options.size = self.draft_size(scene);
         options.supersample = None;
@@ -241,7 +252,8 @@ impl Session {
             }
         }
         // A draft the planner refuses (a knob past a limit) is drawn at full quality.
-        Blueprint::with_objects(scene, objects, &options).or_else(|_| Blueprint::new(scene, &self.options))
+        Blueprint::with_objects(scene, objects.clone(), &options)
+            .or_else(|_| Blueprint::with_objects(scene, objects, &self.options))
     }
 
     /// The size frames are drawn at while drafting (`None` at full quality).

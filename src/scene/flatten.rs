@@ -15,7 +15,11 @@ pub struct SceneObject {
     pub name: String,
     /// The base surface, world space, with its height vectors (empty for hypertexture and volume
     /// nodes).
-    pub surface: BaseSurface,
+    /// Shared: re-planning the same scene from another view reuses it (see `Session::replan`).
+    pub surface: Arc<BaseSurface>,
+    /// The world-space bounding spheres of `surface`'s prisms, made by the first plan and
+    /// shared by the clones a later view plans (`mesh::shell::prism_spheres`).
+    pub(crate) spheres: Arc<std::sync::OnceLock<Vec<(glam::DVec3, f64)>>>,
     /// The texel it draws, by name in `Scene::texels`.
     pub texel: Option<String>,
     pub(crate) method: Option<Method>,
@@ -83,7 +87,8 @@ impl Scene {
             }
             out.push(SceneObject {
                 name: n.name.clone(),
-                surface,
+                surface: Arc::new(surface),
+                spheres: Default::default(),
                 texel: n.texel.as_ref().map(|t| self.texel_at(&t.value, time)),
                 method: n.method.as_ref().map(|m| m.value.clone()),
                 base_color: n.base_color,
@@ -97,6 +102,7 @@ impl Scene {
             out.push(SceneObject {
                 name: n.name.clone(),
                 surface: Default::default(),
+                spheres: Default::default(),
                 texel: None,
                 method: Some(method),
                 base_color: None,
@@ -113,6 +119,7 @@ impl Scene {
             out.push(SceneObject {
                 name: n.name.clone(),
                 surface: Default::default(),
+                spheres: Default::default(),
                 texel: None,
                 method: Some(method),
                 base_color: None,
