@@ -3,6 +3,11 @@
 //! `("wgsl/shared/types.wgsl", include_str!("/abs/.../wgsl/shared/types.wgsl"))` sorted by path.
 //! Hidden files and editor backups (`.x.swp`, `x~`) are left out. Cargo reruns this script when
 //! anything under either folder changes (a directory given to `rerun-if-changed` is scanned).
+//!
+//! It also writes `$OUT_DIR/bindings.rs` (`gpu::bindings`): for each folder of `wgsl/`, one
+//! constant per resource its kernels bind (a `var<uniform>`, `var<storage>` or handle global,
+//! their includes' too), e.g. `view_slices::SLICE_PARAMS = "slice_params"`. Rust code that binds
+//! a resource by one of these names no longer compiles when the WGSL stops declaring it.
 
 use std::path::{Path, PathBuf};
 
@@ -23,8 +28,77 @@ fn main() {
         out.push_str(&format!("    ({rel:?}, include_str!({abs:?})),\n"));
     }
     out.push_str("]\n");
-    let dest = PathBuf::from(std::env::var_os("OUT_DIR").expect("OUT_DIR")).join("embedded.rs");
+    let out_dir = PathBuf::from(std::env::var_os("OUT_DIR").expect("OUT_DIR"));
+    let dest = out_dir.join("embedded.rs");
     std::fs::write(&dest, out).unwrap_or_else(|e| panic!("cannot write {}: {e}", dest.display()));
+    let dest = out_dir.join("bindings.rs");
+    let bindings = bindings(&manifest.join("wgsl"), &files);
+    std::fs::write(&dest, bindings).unwrap_or_else(|e| panic!("cannot write {}: {e}", dest.display()));
+}
+
+/// The `bindings.rs` module text: per top-level folder of `wgsl/`, the resources its kernels bind.
+fn bindings(wgsl: &Path, files: &[(String, String)]) -> String {
+    let mut folders: std::collections::BTreeMap<String, std::collections::BTreeSet<String>> =
+        Default::default();
+    for (rel, _) in files {
+        let Some(rest) = rel.strip_prefix("wgsl/") else { continue };
+        let Some((folder, _)) = rest.split_once('/') else { continue };
+        if !rest.ends_with(".wgsl") || folder == "shared" {
+            continue;
+        }
+        let mut seen = Vec::new();
+        let globals = folders.entry(folder.to_string()).or_default();
+        globals_of(wgsl, rest, &mut seen, globals);
+    }
+    let mut out = String::from("// Made by build.rs from the WGSL under wgsl/: do not edit.\n");
+    for (folder, globals) in folders {
+        out.push_str(&format!(
+            "/// Resources bound by the kernels of `wgsl/{folder}/`.\npub mod {folder} {{\n"
+        ));
+        for g in globals {
+            out.push_str(&format!("    /// `{g}`.\n    pub const {}: &str = {g:?};\n", g.to_uppercase()));
+        }
+        out.push_str("}\n");
+    }
+    out
+}
+
+/// The bound globals of the shader `rel` (relative to `wgsl/`) and of its includes, into `out`.
+fn globals_of(wgsl: &Path, rel: &str, seen: &mut Vec<String>, out: &mut std::collections::BTreeSet<String>) {
+    if seen.iter().any(|s| s == rel) {
+        return;
+    }
+    seen.push(rel.to_string());
+    let Ok(text) = std::fs::read_to_string(wgsl.join(rel)) else { return };
+    for line in text.lines() {
+        if let Some(inc) = line.trim().strip_prefix("#include") {
+            globals_of(wgsl, inc.trim().trim_matches('"'), seen, out);
+            continue;
+        }
+        // `@group(g) @binding(b) var<space, access> name: type;` or `var name: type;` at the top.
+        let Some(at) = line.find("var") else { continue };
+        let before = &line[..at];
+        if !(before.is_empty() || before.trim_start().starts_with("@group")) {
+            continue;
+        }
+        let decl = &line[at + 3..];
+        let (space, name) = match decl.strip_prefix('<') {
+            Some(rest) => match rest.split_once('>') {
+                Some((space, name)) => (space.trim(), name),
+                None => continue,
+            },
+            None if decl.starts_with(' ') => ("", decl),
+            None => continue,
+        };
+        if space.starts_with("private") || space.starts_with("workgroup") {
+            continue;
+        }
+        let name: String =
+            name.trim_start().chars().take_while(|c| c.is_ascii_alphanumeric() || *c == '_').collect();
+        if !name.is_empty() {
+            out.insert(name);
+        }
+    }
 }
 
 /// Whether a file or folder name is left out of the embedded set (tests use the same rule).

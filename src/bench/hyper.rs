@@ -436,8 +436,8 @@ const SHADOWS: &[&str] = &["none", "rays", "volume:32", "volume:64", "volume:128
 /// is cached: a frame pays it only when the light or the density changes), and the error against
 /// shadow rays at the truth step and against shadow rays at the same step.
 pub(crate) fn shadows_table(ctx: &GpuContext, args: &Args, report: &mut Report) -> Result<()> {
-    use crate::methods::options::parse_shadows;
     use crate::methods::ray_march::light_volume;
+    use crate::scene::parse_shadows;
     println!(
         "\n| object | shadows | frame ms (wall) | x Phong | light volume bake ms | M density evals | FLIP vs truth | \
          FLIP vs rays |"

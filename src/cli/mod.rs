@@ -182,7 +182,7 @@ impl From<CompositorArg> for voltex::scene::Compositor {
 pub struct ShadowsArg(pub Option<voltex::scene::Shadows>);
 
 pub fn parse_shadows(s: &str) -> std::result::Result<ShadowsArg, String> {
-    voltex::methods::options::parse_shadows(s).map(ShadowsArg)
+    voltex::scene::parse_shadows(s).map(ShadowsArg)
 }
 
 /// A method by its command-line name (`view-slices`), among the registered ones (those that

@@ -1,5 +1,6 @@
 //! Device, shader lookup (embedded defaults and folders on disk), loading and validation, reflection, timestamps.
 
+pub mod bindings;
 pub mod budget;
 pub(crate) mod buffers;
 pub mod cache;

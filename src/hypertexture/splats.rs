@@ -38,10 +38,11 @@ pub(crate) fn bytes(cells: u32) -> u64 {
     2 * cells as u64 * std::mem::size_of::<Splat>() as u64 + 16
 }
 
-/// Runs `bake_splats.wgsl` for an object (`grid`: its mesh grid, or stand-ins) and reads back
-/// the splat counts.
+/// Runs `kernel` (the method's `bake_splats.wgsl`) for an object (`grid`: its mesh grid, or
+/// stand-ins) and reads back the splat counts.
 pub(crate) fn bake(
     ctx: &GpuContext,
+    kernel: &str,
     hyper: &HyperParams,
     segments: &SegmentParams,
     grid: &MeshGrid,
@@ -69,7 +70,7 @@ pub(crate) fn bake(
     b.insert("splat_counts".into(), storage(ctx, "splat_counts", &[0u8; 16]));
     let mut encoder = ctx.device.create_command_encoder(&Default::default());
     let l = segments.lattice;
-    ComputeKernel::load(ctx, &Sources::project()?, "ray_march/bake_splats.wgsl")?.dispatch(
+    ComputeKernel::load(ctx, &Sources::project()?, kernel)?.dispatch(
         ctx,
         &mut encoder,
         &inputs,

@@ -22,7 +22,7 @@ fn rel(p: DVec3, eye: DVec3) -> [f32; 4] {
 
 /// Each prism's bounding sphere in world space (centre, radius): what a shell needs of its
 /// prisms that does not depend on the view, made once per surface (see `SceneObject::spheres`).
-pub fn prism_spheres(surface: &BaseSurface) -> Vec<(DVec3, f64)> {
+pub(crate) fn prism_spheres(surface: &BaseSurface) -> Vec<(DVec3, f64)> {
     (0..surface.triangles.len()).map(|t| prism::bounding_sphere(surface.prism(t))).collect()
 }
 
@@ -34,7 +34,7 @@ impl Shell {
 
     /// [`Shell::new`] with the prisms' world-space bounding spheres given ([`prism_spheres`]):
     /// a new view moves them to the camera, O(prisms) with no square root.
-    pub fn with_spheres(surface: &BaseSurface, spheres: &[(DVec3, f64)], eye: DVec3) -> Self {
+    pub(crate) fn with_spheres(surface: &BaseSurface, spheres: &[(DVec3, f64)], eye: DVec3) -> Self {
         let vertices = surface
             .positions
             .iter()

@@ -4,7 +4,7 @@
 use std::path::PathBuf;
 
 use super::plugin::MethodKind;
-use crate::scene::{Camera, Method, Shadows};
+use crate::scene::{Camera, Method};
 
 /// Overrides of what the scene file says, from the command line or tests.
 #[derive(Debug, Clone, Default)]
@@ -85,32 +85,5 @@ impl RenderOptions {
             Some(k) => k.defaults().plugin().with_options(self, lighting),
             None => method.plugin().with_options(self, lighting),
         }
-    }
-}
-
-/// Parses `--shadows` values: `none` (Phong without shadows), `rays` (shadow rays) or
-/// `volume:N` (a light volume of resolution N).
-pub fn parse_shadows(s: &str) -> std::result::Result<Option<Shadows>, String> {
-    use crate::methods::ray_march::knobs::MAX_LIGHT_RESOLUTION;
-    match s {
-        "none" => Ok(None),
-        "rays" => Ok(Some(Shadows::Rays)),
-        _ => match s.strip_prefix("volume:").map(|n| n.parse::<u32>()) {
-            Some(Ok(resolution)) if (4..=MAX_LIGHT_RESOLUTION).contains(&resolution) => {
-                Ok(Some(Shadows::LightVolume { resolution }))
-            }
-            _ => Err(format!(
-                "`{s}`: expected `none`, `rays` or `volume:N` with a resolution N in 4..={MAX_LIGHT_RESOLUTION}"
-            )),
-        },
-    }
-}
-
-/// `--shadows` as written: `none`, `rays` or `volume:N`.
-pub(crate) fn shadows_name(s: Option<Shadows>) -> String {
-    match s {
-        None => "none".into(),
-        Some(Shadows::Rays) => "rays".into(),
-        Some(Shadows::LightVolume { resolution }) => format!("volume:{resolution}"),
     }
 }

@@ -106,6 +106,13 @@ pub trait MethodPlan: Any + Send {
         None
     }
 
+    /// Density evaluations of the frame just drawn (what an adaptive stride saves, whatever the
+    /// machine's load), from its instance's buffers (`read` reads one by name); `None` where the
+    /// method does not count them.
+    fn evaluations(&self, _read: &mut dyn FnMut(&str) -> Result<Vec<u8>>) -> Result<Option<f64>> {
+        Ok(None)
+    }
+
     /// The objects a frame-wide plan draws (see `Contribution::gather`); its instance is the
     /// first one's.
     fn members(&self) -> &[usize] {

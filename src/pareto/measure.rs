@@ -18,7 +18,6 @@ use crate::gpu::GpuContext;
 use crate::graph::PassDecl;
 use crate::io::Image;
 use crate::render::{Blueprint, Renderer};
-use crate::types::MarchState;
 
 /// Frames rendered and thrown away before the timed ones...
 pub(crate) const WARM_UP_FRAMES: usize = 2;
@@ -91,14 +90,13 @@ pub(crate) fn full_frames(ctx: &GpuContext, bp: Blueprint, frames: usize) -> Res
     Ok(Frames { image, raster, wall_ms, evaluations })
 }
 
-/// Density evaluations of the frame just rendered, over every RayMarch object (their
-/// `ray_march_state`): what an adaptive stride saves, independent of the machine's load.
+/// Density evaluations of the frame just rendered, over every object whose method counts them
+/// (`MethodPlan::evaluations`): what an adaptive stride saves, independent of the machine's load.
 fn evaluations(ctx: &GpuContext, r: &Renderer) -> Result<f64> {
     let mut sum = 0.0;
-    for (i, _) in r.blueprint.instances.iter().enumerate().filter(|(_, p)| p.filters.contains(&"RayMarch")) {
-        let states: Vec<MarchState> =
-            bytemuck::pod_collect_to_vec(&r.read_instance_buffer(ctx, i, "ray_march_state")?);
-        sum += states.iter().map(|s| s.resume[1] as f64).sum::<f64>();
+    for (i, instance) in r.blueprint.instances.iter().enumerate() {
+        let mut read = |name: &str| r.read_instance_buffer(ctx, i, name);
+        sum += r.blueprint.plan_of(instance).evaluations(&mut read)?.unwrap_or(0.0);
     }
     Ok(sum)
 }

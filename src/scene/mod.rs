@@ -26,7 +26,7 @@ pub use types::*;
 pub use crate::methods::axis_slices::knobs::{AxisSlices, DrawOrder, SliceBlend, SliceDirections};
 pub use crate::methods::knobs::{Method, METHOD_NAMES};
 pub use crate::methods::ray_march::knobs::{
-    Adaptive, Quality, RayMarch, Segments, Shadows, DEFAULT_PEEL_PASSES, DEFAULT_SPLAT_GRID,
+    parse_shadows, Adaptive, Quality, RayMarch, Segments, Shadows, DEFAULT_PEEL_PASSES, DEFAULT_SPLAT_GRID,
     DEFAULT_SPLAT_SLABS,
 };
 pub use crate::methods::reference::knobs::Reference;

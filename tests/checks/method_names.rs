@@ -21,10 +21,6 @@ const OUTSIDE: &[(&str, usize)] = &[
     // The hypertexture benchmarks (the paper's figures) sit above the methods.
     ("src/bench/hyper.rs", 19),
     ("src/bench/mod.rs", 4),
-    ("src/hypertexture/splats.rs", 1),
-    // `--shadows` is parsed for every RayMarch object.
-    ("src/methods/options.rs", 1),
-    ("src/pareto/measure.rs", 1),
     // Imported assets are written as scenes drawn with a method.
     ("src/scene/import.rs", 2),
     // The scene re-exports each method's knobs (scene-file types) from its folder.

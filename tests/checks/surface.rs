@@ -21,7 +21,9 @@ use crate::layers::rust_files;
 /// (1285: the method plug-ins: `MethodKind` with the command-line names of the registered
 /// methods for `--method` and `pareto --methods`, `methods::sweep::SweepValues` for `pareto`'s
 /// flags, and `scene`'s re-exports of each method's knobs from its folder.)
-const PUB_DECLARATIONS: usize = 1285;
+/// (1286: `gpu::bindings`, the WGSL resource names made by build.rs, public for the doctest
+/// that shows a misspelt one does not compile.)
+const PUB_DECLARATIONS: usize = 1286;
 
 /// Whether the declaration on line `n` has a `///` doc above its attributes (one-line ones, or
 /// multi-line ones from `#[` to `)]`).

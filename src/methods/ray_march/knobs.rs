@@ -219,3 +219,29 @@ impl crate::methods::knobs::MethodKnobs for RayMarch {
         Ok(())
     }
 }
+
+/// Parses `--shadows` values: `none` (Phong without shadows), `rays` (shadow rays) or
+/// `volume:N` (a light volume of resolution N).
+pub fn parse_shadows(s: &str) -> std::result::Result<Option<Shadows>, String> {
+    match s {
+        "none" => Ok(None),
+        "rays" => Ok(Some(Shadows::Rays)),
+        _ => match s.strip_prefix("volume:").map(|n| n.parse::<u32>()) {
+            Some(Ok(resolution)) if (4..=MAX_LIGHT_RESOLUTION).contains(&resolution) => {
+                Ok(Some(Shadows::LightVolume { resolution }))
+            }
+            _ => Err(format!(
+                "`{s}`: expected `none`, `rays` or `volume:N` with a resolution N in 4..={MAX_LIGHT_RESOLUTION}"
+            )),
+        },
+    }
+}
+
+/// `--shadows` as written: `none`, `rays` or `volume:N`.
+pub(crate) fn shadows_name(s: Option<Shadows>) -> String {
+    match s {
+        None => "none".into(),
+        Some(Shadows::Rays) => "rays".into(),
+        Some(Shadows::LightVolume { resolution }) => format!("volume:{resolution}"),
+    }
+}

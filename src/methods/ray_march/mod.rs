@@ -392,7 +392,7 @@ impl RayMarchPlan {
     /// Bakes the splat set of a depth-peeled or splatted object (`bake_splats.wgsl`); `grid`: its mesh grid.
     pub fn bake_splats(&self, ctx: &GpuContext, grid: Option<&MeshGrid>) -> Result<SplatSet> {
         let unused = mesh::unused(ctx);
-        splats::bake(ctx, &self.params, &self.segments, grid.unwrap_or(&unused))
+        splats::bake(ctx, "ray_march/bake_splats.wgsl", &self.params, &self.segments, grid.unwrap_or(&unused))
     }
 
     /// The object grid's cache key, for mesh and point-set objects.

@@ -33,6 +33,12 @@ pub(crate) fn plan_object(cx: &mut PlanCx, object: &mut ObjectPlan, m: &RayMarch
 type Prepared = (Option<MeshGrid>, Option<SplatSet>, Option<wgpu::Buffer>);
 
 impl MethodPlan for RayMarchPlan {
+    /// Each pixel's `ray_march_state` counts the samples its ray evaluated.
+    fn evaluations(&self, read: &mut dyn FnMut(&str) -> Result<Vec<u8>>) -> Result<Option<f64>> {
+        let states: Vec<crate::types::MarchState> = bytemuck::pod_collect_to_vec(&read("ray_march_state")?);
+        Ok(Some(states.iter().map(|s| s.resume[1] as f64).sum()))
+    }
+
     fn parts(&self) -> Vec<PartDecl> {
         let filters = match (&self.peel, &self.splatting) {
             (Some(_), _) => vec!["RayMarch", "RayMarchPeeling"],

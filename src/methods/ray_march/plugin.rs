@@ -6,7 +6,7 @@ use crate::methods::plan::ObjectPlan;
 use crate::methods::plugin::{KnobEdit, MethodPlugin};
 use crate::methods::{options::RenderOptions, PlanCx};
 use super::knobs::Segments;
-use crate::methods::options::shadows_name;
+use super::knobs::{parse_shadows, shadows_name};
 use crate::scene::{Lighting, Method, Shading};
 use crate::methods::sweep::{unique, SweepPoint, SweepScene, SweepValues};
 
@@ -142,7 +142,7 @@ impl MethodPlugin for RayMarch {
     fn truth(&self, arg: Option<&str>, size: (u32, u32)) -> std::result::Result<(RenderOptions, String), String> {
         let rest = arg.ok_or("expected a step: ray-march:STEP[:SHADOWS]")?;
         let (step, shadows) = match rest.split_once(':') {
-            Some((step, shadows)) => (step, Some(crate::methods::options::parse_shadows(shadows)?)),
+            Some((step, shadows)) => (step, Some(parse_shadows(shadows)?)),
             None => (rest, None),
         };
         let step = match step.parse::<f64>() {

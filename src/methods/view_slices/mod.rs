@@ -11,6 +11,7 @@ pub mod tiles;
 
 pub use object::{plan, ViewSlicesPlan};
 
+use crate::gpu::bindings::view_slices as B;
 use crate::error::{Error, Result};
 use crate::mesh::shell::Shell;
 use crate::types::{SliceParams, SliceVertex};
@@ -20,27 +21,27 @@ pub(crate) const CONTRIBUTION: super::Contribution = super::Contribution {
     method: "ViewSlices",
     filters: &["ViewSlices", "ViewSlicesRaster", "ViewSlicesTiles"],
     resources: &[
-        "slice_params",
-        "shell_vertices",
-        "prisms",
-        "plane_cursors",
-        "draw_args",
-        "plane_draws",
-        "slice_vertices",
-        "volume",
-        "normals",
-        "volume_layers",
-        "normal_layers",
-        "vertex_frames",
-        "tile_params",
-        "tile_triangles",
-        "tile_attributes",
-        "tile_cursors",
-        "tile_entries",
-        "tile_layer",
+        B::SLICE_PARAMS,
+        B::SHELL_VERTICES,
+        B::PRISMS,
+        B::PLANE_CURSORS,
+        B::DRAW_ARGS,
+        B::PLANE_DRAWS,
+        B::SLICE_VERTICES,
+        B::VOLUME,
+        B::NORMALS,
+        B::VOLUME_LAYERS,
+        B::NORMAL_LAYERS,
+        B::VERTEX_FRAMES,
+        B::TILE_PARAMS,
+        B::TILE_TRIANGLES,
+        B::TILE_ATTRIBUTES,
+        B::TILE_CURSORS,
+        B::TILE_ENTRIES,
+        B::TILE_LAYER,
     ],
     counts: &["prisms", "planes", "plane_blocks", "slice_triangles", "tiles_x", "tiles_y"],
-    texel_resources: &["volume", "normals", "volume_layers", "normal_layers"],
+    texel_resources: &[B::VOLUME, B::NORMALS, B::VOLUME_LAYERS, B::NORMAL_LAYERS],
     gather: None,
 };
 
@@ -202,22 +203,22 @@ pub fn add_inputs(
     use crate::gpu::buffers::{storage, uniform};
     let buffer = |label: &str, size: u64, extra| crate::gpu::buffers::work_buffer(ctx, label, size, extra);
     let b = &mut inputs.buffers;
-    b.insert("slice_params".into(), uniform(ctx, "slice_params", bytemuck::bytes_of(params)));
-    b.insert("shell_vertices".into(), storage(ctx, "shell_vertices", bytemuck::cast_slice(&shell.vertices)));
-    b.insert("prisms".into(), storage(ctx, "prisms", bytemuck::cast_slice(&shell.prisms)));
+    b.insert(B::SLICE_PARAMS.into(), uniform(ctx, "slice_params", bytemuck::bytes_of(params)));
+    b.insert(B::SHELL_VERTICES.into(), storage(ctx, "shell_vertices", bytemuck::cast_slice(&shell.vertices)));
+    b.insert(B::PRISMS.into(), storage(ctx, "prisms", bytemuck::cast_slice(&shell.prisms)));
     b.insert(
         "plane_cursors".into(),
         buffer("plane_cursors", params.plane_count as u64 * 4, wgpu::BufferUsages::empty()),
     );
-    b.insert("draw_args".into(), buffer("draw_args", 16, wgpu::BufferUsages::INDIRECT));
+    b.insert(B::DRAW_ARGS.into(), buffer("draw_args", 16, wgpu::BufferUsages::INDIRECT));
     let per_plane = params.plane_count as u64 * std::mem::size_of::<crate::types::DrawIndirect>() as u64;
-    b.insert("plane_draws".into(), buffer("plane_draws", per_plane, wgpu::BufferUsages::INDIRECT));
+    b.insert(B::PLANE_DRAWS.into(), buffer("plane_draws", per_plane, wgpu::BufferUsages::INDIRECT));
     inputs.plane_depths = (0..params.plane_count)
         .map(|k| params.first_plane as f64 - k as f64 * params.spacing as f64)
         .collect();
     let bytes = capacity * std::mem::size_of::<SliceVertex>() as u64;
-    b.insert("slice_vertices".into(), buffer("slice_vertices", bytes, wgpu::BufferUsages::empty()));
-    inputs.counts.insert("prisms".into(), shell.prisms.len() as u32);
+    b.insert(B::SLICE_VERTICES.into(), buffer("slice_vertices", bytes, wgpu::BufferUsages::empty()));
+    inputs.counts.insert(B::PRISMS.into(), shell.prisms.len() as u32);
     inputs.counts.insert("planes".into(), params.plane_count);
     inputs.counts.insert("plane_blocks".into(), params.plane_count.div_ceil(PLANES_PER_THREAD));
     inputs.constants.push(("planes_per_thread".into(), PLANES_PER_THREAD as f64));

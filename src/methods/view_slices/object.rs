@@ -1,5 +1,6 @@
 //! One ViewSlices object of a frame: its plane sweep in chunks, and what the renderer asks of it.
 
+use crate::gpu::bindings::view_slices as B;
 use super::lod::{self, LodChoice};
 use super::{add_inputs, check_budget, check_capacity, chunks, sweep, tile_buffers, tiles, SliceChunk};
 use crate::bake::texel_layers;
@@ -133,13 +134,13 @@ impl MethodPlan for ViewSlicesPlan {
         // Bound even when unlit per pixel (the binding exists in the kernel): one entry then.
         let frames = object.frames.as_deref().unwrap_or(&[VertexFrame { ds: [0.0; 4], dt: [0.0; 4] }]);
         let frames = buffers::storage(cx.ctx, "vertex_frames", bytemuck::cast_slice(frames));
-        inputs.buffers.insert("vertex_frames".into(), frames);
+        inputs.buffers.insert(B::VERTEX_FRAMES.into(), frames);
         if let Some(b) = object.bake {
             let baked = &cx.baked[b];
-            inputs.views.insert("volume".into(), baked.volume.create_view(&Default::default()));
-            inputs.views.insert("normals".into(), baked.normals.create_view(&Default::default()));
-            inputs.views.insert("volume_layers".into(), texel_layers::array_view(&baked.layers[0]));
-            inputs.views.insert("normal_layers".into(), texel_layers::array_view(&baked.layers[1]));
+            inputs.views.insert(B::VOLUME.into(), baked.volume.create_view(&Default::default()));
+            inputs.views.insert(B::NORMALS.into(), baked.normals.create_view(&Default::default()));
+            inputs.views.insert(B::VOLUME_LAYERS.into(), texel_layers::array_view(&baked.layers[0]));
+            inputs.views.insert(B::NORMAL_LAYERS.into(), texel_layers::array_view(&baked.layers[1]));
         }
         inputs.constants.push(("layered_texel".into(), self.lod.is_some() as u32 as f64));
     }

@@ -1,6 +1,7 @@
 //! Buffers and counts of the `Tiles` compositor for one chunk of a ViewSlices sweep (its kernels
 //! and their twins: [`super::tiles`]).
 
+use crate::gpu::bindings::view_slices as B;
 use super::tiles::{tile_params, MAX_TRIANGLES, TILE_SIZE};
 use crate::gpu::buffers::{uniform, work_buffer};
 use crate::mesh::shell::Shell;
@@ -84,7 +85,7 @@ pub(crate) fn add_inputs(
 ) {
     let params = tile_params(size, planes, entry_capacity);
     let b = &mut inputs.buffers;
-    b.insert("tile_params".into(), uniform(ctx, "tile_params", bytemuck::bytes_of(&params)));
+    b.insert(B::TILE_PARAMS.into(), uniform(ctx, "tile_params", bytemuck::bytes_of(&params)));
     for (name, bytes) in tile_bytes(&params, vertex_capacity) {
         b.insert(name.into(), work_buffer(ctx, name, bytes, wgpu::BufferUsages::empty()));
     }
