@@ -9,6 +9,7 @@ pub mod twin;
 
 pub(crate) use object::plan;
 
+use crate::gpu::bindings::axis_slices as B;
 use crate::bake::axis_slices::AxisBaked;
 use crate::error::{Error, Result};
 use crate::mesh::shell::Shell;
@@ -21,22 +22,22 @@ pub(crate) const CONTRIBUTION: super::Contribution = super::Contribution {
     method: "AxisSlices",
     filters: &["AxisSlices", "AxisSlicesBinary", "AxisSlicesBlended", "AxisSlicesBySlice"],
     resources: &[
-        "shell_vertices",
-        "prisms",
-        "axis_params",
-        "axis_occupancy",
-        "axis_choices",
-        "axis_draw_args",
-        "axis_vertices",
-        "axis_layer_counts",
-        "axis_slices_s",
-        "axis_slices_t",
-        "axis_slices_w",
-        "axis_sampler",
-        "axis_sampler_side",
+        B::SHELL_VERTICES,
+        B::PRISMS,
+        B::AXIS_PARAMS,
+        B::AXIS_OCCUPANCY,
+        B::AXIS_CHOICES,
+        B::AXIS_DRAW_ARGS,
+        B::AXIS_VERTICES,
+        B::AXIS_LAYER_COUNTS,
+        B::AXIS_SLICES_S,
+        B::AXIS_SLICES_T,
+        B::AXIS_SLICES_W,
+        B::AXIS_SAMPLER,
+        B::AXIS_SAMPLER_SIDE,
     ],
     counts: &["prisms", "axis_triangles"],
-    texel_resources: &["axis_slices_s", "axis_slices_t", "axis_slices_w"],
+    texel_resources: &[B::AXIS_SLICES_S, B::AXIS_SLICES_T, B::AXIS_SLICES_W],
     gather: None,
 };
 
@@ -168,16 +169,16 @@ pub(crate) fn add_inputs(
     use crate::gpu::buffers::{storage, uniform};
     let buffer = |label: &str, size: u64, extra| crate::gpu::buffers::work_buffer(ctx, label, size, extra);
     let b = &mut inputs.buffers;
-    b.insert("axis_params".into(), uniform(ctx, "axis_params", bytemuck::bytes_of(&plan.params)));
-    b.insert("shell_vertices".into(), storage(ctx, "shell_vertices", bytemuck::cast_slice(&shell.vertices)));
-    b.insert("prisms".into(), storage(ctx, "prisms", bytemuck::cast_slice(&plan.prisms)));
-    b.insert("axis_occupancy".into(), baked.occupancy.clone());
+    b.insert(B::AXIS_PARAMS.into(), uniform(ctx, "axis_params", bytemuck::bytes_of(&plan.params)));
+    b.insert(B::SHELL_VERTICES.into(), storage(ctx, "shell_vertices", bytemuck::cast_slice(&shell.vertices)));
+    b.insert(B::PRISMS.into(), storage(ctx, "prisms", bytemuck::cast_slice(&plan.prisms)));
+    b.insert(B::AXIS_OCCUPANCY.into(), baked.occupancy.clone());
     let choices = plan.prisms.len() as u64 * std::mem::size_of::<crate::types::AxisChoice>() as u64;
-    b.insert("axis_choices".into(), buffer("axis_choices", choices, wgpu::BufferUsages::empty()));
-    b.insert("axis_draw_args".into(), buffer("axis_draw_args", 16, wgpu::BufferUsages::INDIRECT));
+    b.insert(B::AXIS_CHOICES.into(), buffer("axis_choices", choices, wgpu::BufferUsages::empty()));
+    b.insert(B::AXIS_DRAW_ARGS.into(), buffer("axis_draw_args", 16, wgpu::BufferUsages::INDIRECT));
     let bytes = plan.capacity * std::mem::size_of::<AxisVertex>() as u64;
     let copies = if plan.grouped { 2 } else { 1 };
-    b.insert("axis_vertices".into(), buffer("axis_vertices", copies * bytes, wgpu::BufferUsages::empty()));
+    b.insert(B::AXIS_VERTICES.into(), buffer("axis_vertices", copies * bytes, wgpu::BufferUsages::empty()));
     // One counter per slice image (the stride: the most layers of any direction); a stand-in
     // when not grouped.
     let stride = plan.params.resolution[..3]
@@ -216,11 +217,11 @@ pub(crate) fn add_inputs(
             ..Default::default()
         })
     };
-    inputs.samplers.insert("axis_sampler".into(), sampler("axis_sampler", wgpu::AddressMode::Repeat));
+    inputs.samplers.insert(B::AXIS_SAMPLER.into(), sampler("axis_sampler", wgpu::AddressMode::Repeat));
     inputs
         .samplers
-        .insert("axis_sampler_side".into(), sampler("axis_sampler_side", wgpu::AddressMode::ClampToEdge));
-    inputs.counts.insert("prisms".into(), plan.prisms.len() as u32);
+        .insert(B::AXIS_SAMPLER_SIDE.into(), sampler("axis_sampler_side", wgpu::AddressMode::ClampToEdge));
+    inputs.counts.insert(B::PRISMS.into(), plan.prisms.len() as u32);
     inputs.constants.push(("blended_slices".into(), plan.blended as u32 as f64));
     inputs.constants.push(("grouped_slices".into(), plan.grouped as u32 as f64));
     inputs.constants.push(("mipmapped_slices".into(), plan.method.mipmaps as u32 as f64));

@@ -16,6 +16,7 @@
 //! does) would darken every lit surface by about half; in thin media every openness is near 1 and
 //! the lookup is plain trilinear.
 
+use crate::gpu::bindings::ray_march as B;
 use glam::{DMat4, DVec3};
 
 use crate::cpu::hypertexture::Model;
@@ -191,7 +192,7 @@ pub(crate) fn bake(
         usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
         mapped_at_creation: false,
     });
-    inputs.buffers.insert("light_volume".into(), volume.clone());
+    inputs.buffers.insert(B::LIGHT_VOLUME.into(), volume.clone());
     let mut encoder = ctx.device.create_command_encoder(&Default::default());
     let functions = plan.packed.functions.len() as u32;
     let tables = crate::cpu::bake_transfer::TRANSFER_SIZE as u32;

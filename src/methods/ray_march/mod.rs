@@ -14,6 +14,7 @@ pub mod peel_segments;
 pub(crate) mod plugin;
 pub mod splat_segments;
 
+use crate::gpu::bindings::ray_march as B;
 use glam::{DMat4, DVec3};
 
 use crate::cpu::bake_transfer::TRANSFER_SIZE;
@@ -33,22 +34,22 @@ pub(crate) const CONTRIBUTION: super::Contribution = super::Contribution {
     method: "RayMarch",
     filters: &["RayMarch", "RayMarchPeeling", "RayMarchSplatting"],
     resources: &[
-        "hyper",
-        "hyper_noises",
-        "transfer_points",
-        "transfer_functions",
-        "transfer_tables",
-        "ray_march_state",
-        "mesh_grid",
-        "mesh_depth",
-        "segments",
-        "segment_bounds",
-        "surface_splats",
-        "interior_splats",
-        "peel_tickets",
-        "splat_slabs",
-        "light_grid",
-        "light_volume",
+        B::HYPER,
+        B::HYPER_NOISES,
+        B::TRANSFER_POINTS,
+        B::TRANSFER_FUNCTIONS,
+        B::TRANSFER_TABLES,
+        B::RAY_MARCH_STATE,
+        B::MESH_GRID,
+        B::MESH_DEPTH,
+        B::SEGMENTS,
+        B::SEGMENT_BOUNDS,
+        B::SURFACE_SPLATS,
+        B::INTERIOR_SPLATS,
+        B::PEEL_TICKETS,
+        B::SPLAT_SLABS,
+        B::LIGHT_GRID,
+        B::LIGHT_VOLUME,
     ],
     counts: &[
         "ray_march_dispatches",
@@ -434,9 +435,9 @@ impl RayMarchPlan {
         let light_grid = self.light.unwrap_or_default();
         inputs
             .buffers
-            .insert("light_grid".into(), uniform(ctx, "light_grid", bytemuck::bytes_of(&light_grid)));
+            .insert(B::LIGHT_GRID.into(), uniform(ctx, "light_grid", bytemuck::bytes_of(&light_grid)));
         let light = light.cloned().unwrap_or_else(|| storage(ctx, "light_volume", &[0u8; 16]));
-        inputs.buffers.insert("light_volume".into(), light);
+        inputs.buffers.insert(B::LIGHT_VOLUME.into(), light);
         let grid = grid.cloned().unwrap_or_else(|| mesh::unused(ctx));
         // Segments: the splats and per-pixel boundaries (stand-ins without depth peeling).
         let mut segments = self.segments;
@@ -444,9 +445,9 @@ impl RayMarchPlan {
         if let (Some((passes, _)), Some(set)) = (&self.peel, splats) {
             segments.counts[0] = set.counts[0];
             segments.counts[1] = set.counts[1];
-            inputs.buffers.insert("surface_splats".into(), set.surface.clone());
-            inputs.buffers.insert("interior_splats".into(), set.interior.clone());
-            inputs.counts.insert("surface_splats".into(), set.counts[0]);
+            inputs.buffers.insert(B::SURFACE_SPLATS.into(), set.surface.clone());
+            inputs.buffers.insert(B::INTERIOR_SPLATS.into(), set.interior.clone());
+            inputs.counts.insert(B::SURFACE_SPLATS.into(), set.counts[0]);
             inputs.counts.insert("peel_phases".into(), 2 * passes);
             inputs.counts.insert("peel_blocks".into(), (size.0 * size.1).div_ceil(segments.counts[3].max(1)));
             bounds_bytes = Self::segment_bytes(size, *passes);
@@ -455,21 +456,21 @@ impl RayMarchPlan {
         if let (Some((slabs, _)), Some(set)) = (&self.splatting, splats) {
             segments.counts[0] = set.counts[0];
             segments.counts[1] = set.counts[1];
-            inputs.buffers.insert("interior_splats".into(), set.interior.clone());
-            inputs.counts.insert("interior_splats".into(), set.counts[1]);
+            inputs.buffers.insert(B::INTERIOR_SPLATS.into(), set.interior.clone());
+            inputs.counts.insert(B::INTERIOR_SPLATS.into(), set.counts[1]);
             let [_, pixels, pieces, _] = segments.splatting;
             inputs.counts.insert("splat_blocks".into(), splat_blocks(size, pixels, pieces));
             slabs_bytes = slab_bytes(size, *slabs);
         }
-        inputs.buffers.insert("segments".into(), uniform(ctx, "segments", bytemuck::bytes_of(&segments)));
-        inputs.buffers.insert("peel_tickets".into(), storage(ctx, "peel_tickets", &[0u8; 16]));
-        inputs.buffers.insert("mesh_grid".into(), grid.grid);
-        inputs.buffers.insert("mesh_depth".into(), grid.depth);
+        inputs.buffers.insert(B::SEGMENTS.into(), uniform(ctx, "segments", bytemuck::bytes_of(&segments)));
+        inputs.buffers.insert(B::PEEL_TICKETS.into(), storage(ctx, "peel_tickets", &[0u8; 16]));
+        inputs.buffers.insert(B::MESH_GRID.into(), grid.grid);
+        inputs.buffers.insert(B::MESH_DEPTH.into(), grid.depth);
         inputs.counts.insert("ray_march_dispatches".into(), self.dispatches);
-        inputs.counts.insert("transfer_functions".into(), self.packed.functions.len() as u32);
+        inputs.counts.insert(B::TRANSFER_FUNCTIONS.into(), self.packed.functions.len() as u32);
         inputs.constants.extend(self.constants());
         let b = &mut inputs.buffers;
-        b.insert("hyper".into(), uniform(ctx, "hyper", bytemuck::bytes_of(&self.params)));
+        b.insert(B::HYPER.into(), uniform(ctx, "hyper", bytemuck::bytes_of(&self.params)));
         b.insert(
             "hyper_noises".into(),
             storage(ctx, "hyper_noises", bytemuck::cast_slice(&self.packed.noises)),
@@ -521,9 +522,9 @@ pub fn probe(ctx: &GpuContext, plan: &RayMarchPlan, points: &[[f32; 4]]) -> Resu
     let grid = plan.bake_mesh_grid(ctx)?;
     plan.add_inputs(ctx, &mut inputs, (1, 1), grid.as_ref(), None, None);
     let b = &mut inputs.buffers;
-    b.insert("probe_points".into(), storage(ctx, "probe_points", bytemuck::cast_slice(points)));
+    b.insert(B::PROBE_POINTS.into(), storage(ctx, "probe_points", bytemuck::cast_slice(points)));
     let zeros = vec![0u8; points.len() * 64];
-    b.insert("probe_values".into(), storage(ctx, "probe_values", &zeros));
+    b.insert(B::PROBE_VALUES.into(), storage(ctx, "probe_values", &zeros));
     let mut encoder = ctx.device.create_command_encoder(&Default::default());
     let functions = plan.packed.functions.len() as u32;
     ComputeKernel::load(ctx, &root, "ray_march/bake_transfer.wgsl")?.dispatch(

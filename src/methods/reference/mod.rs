@@ -10,6 +10,7 @@ pub mod trace_reference;
 
 pub use object::{frame_twin_inputs, plan, ReferencePlan};
 
+use crate::gpu::bindings::reference as B;
 use glam::{DVec3, Vec3A};
 use obvhs::aabb::Aabb;
 
@@ -32,17 +33,17 @@ pub(crate) const CONTRIBUTION: super::Contribution = super::Contribution {
     method: "Reference",
     filters: &["Reference"],
     resources: &[
-        "reference_params",
-        "reference_nodes",
-        "reference_prisms",
-        "reference_objects",
-        "texel_atlas",
-        "normal_atlas",
-        "reference_state",
-        "vertex_frames",
+        B::REFERENCE_PARAMS,
+        B::REFERENCE_NODES,
+        B::REFERENCE_PRISMS,
+        B::REFERENCE_OBJECTS,
+        B::TEXEL_ATLAS,
+        B::NORMAL_ATLAS,
+        B::REFERENCE_STATE,
+        B::VERTEX_FRAMES,
     ],
     counts: &["reference_dispatches"],
-    texel_resources: &["texel_atlas"],
+    texel_resources: &[B::TEXEL_ATLAS],
     gather: Some(object::gather),
 };
 
@@ -249,7 +250,7 @@ impl ReferenceSet {
             usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        inputs.buffers.insert("reference_state".into(), state);
+        inputs.buffers.insert(B::REFERENCE_STATE.into(), state);
         use crate::gpu::buffers::{storage, uniform};
         let b = &mut inputs.buffers;
         b.insert(
@@ -257,7 +258,7 @@ impl ReferenceSet {
             uniform(ctx, "reference_params", bytemuck::bytes_of(&self.params)),
         );
         let nodes = if self.nodes.is_empty() { vec![ReferenceNode::default()] } else { self.nodes.clone() };
-        b.insert("reference_nodes".into(), storage(ctx, "reference_nodes", bytemuck::cast_slice(&nodes)));
+        b.insert(B::REFERENCE_NODES.into(), storage(ctx, "reference_nodes", bytemuck::cast_slice(&nodes)));
         b.insert(
             "reference_prisms".into(),
             storage(ctx, "reference_prisms", bytemuck::cast_slice(&self.prisms)),
@@ -270,7 +271,7 @@ impl ReferenceSet {
             "shell_vertices".into(),
             storage(ctx, "shell_vertices", bytemuck::cast_slice(&self.vertices)),
         );
-        b.insert("vertex_frames".into(), storage(ctx, "vertex_frames", bytemuck::cast_slice(&self.frames)));
+        b.insert(B::VERTEX_FRAMES.into(), storage(ctx, "vertex_frames", bytemuck::cast_slice(&self.frames)));
         for (name, words) in [("texel_atlas", self.atlas_words), ("normal_atlas", self.normal_words)] {
             let buffer = ctx.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(name),

@@ -9,6 +9,7 @@
 pub mod march_volume;
 mod object;
 
+use crate::gpu::bindings::volume as B;
 use std::sync::Arc;
 
 use glam::{DMat4, DVec3};
@@ -25,7 +26,7 @@ pub(crate) use object::plan;
 pub(crate) const CONTRIBUTION: super::Contribution = super::Contribution {
     method: "Volume",
     filters: &["Volume"],
-    resources: &["volume_params", "volume_table", "volume_density", "volume_color", "volume_state"],
+    resources: &[B::VOLUME_PARAMS, B::VOLUME_TABLE, B::VOLUME_DENSITY, B::VOLUME_COLOR, B::VOLUME_STATE],
     counts: &["volume_dispatches"],
     texel_resources: &[],
     gather: None,

@@ -1,5 +1,6 @@
 //! One volume object of a frame as the renderer sees it.
 
+use crate::gpu::bindings::volume as B;
 use std::any::Any;
 
 use super::{plan_volume, VolumePlan};
@@ -65,7 +66,7 @@ impl MethodPlan for VolumePlan {
             VolumePlan::state_bytes(cx.size),
             wgpu::BufferUsages::empty(),
         );
-        inputs.buffers.insert("volume_state".into(), state);
+        inputs.buffers.insert(B::VOLUME_STATE.into(), state);
         inputs.counts.insert("volume_dispatches".into(), self.dispatches);
         inputs.constants.extend(self.constants());
     }
