@@ -243,6 +243,47 @@ where
     d.deserialize_map(Unique(std::marker::PhantomData))
 }
 
+/// An asset loaded from the user file `path` by `load` (`key`: what else its result depends on),
+/// shared while something holds it: a scene parsed again (the preview's edits) finds the meshes,
+/// images and volumes the last good scene holds, with no read, while the file keeps its
+/// modification time and length. Only weak references are kept, so nothing stays loaded for
+/// the cache's sake; errors are not kept.
+pub(crate) fn shared<T: Send + Sync + 'static>(
+    path: &Path,
+    key: &str,
+    load: impl FnOnce() -> Result<T>,
+) -> Result<std::sync::Arc<T>> {
+    use std::any::{Any, TypeId};
+    use std::sync::{Arc, Mutex, Weak};
+    type Stamp = (std::time::SystemTime, u64);
+    type Entries =
+        std::collections::HashMap<(std::path::PathBuf, TypeId, String), (Stamp, Weak<dyn Any + Send + Sync>)>;
+    static ASSETS: Mutex<Option<Entries>> = Mutex::new(None);
+    // Stamped before the read: an edit made meanwhile is seen by the next load.
+    let stamp =
+        std::fs::metadata(path).ok().map(|m| (m.modified().unwrap_or(std::time::UNIX_EPOCH), m.len()));
+    let id = (path.to_path_buf(), TypeId::of::<T>(), key.to_string());
+    if let Some(stamp) = stamp {
+        let mut assets = ASSETS.lock().unwrap();
+        let assets = assets.get_or_insert_with(Default::default);
+        assets.retain(|_, (_, held)| held.strong_count() > 0);
+        let found = assets.get(&id).filter(|(s, _)| *s == stamp).and_then(|(_, held)| held.upgrade());
+        if let Some(asset) = found.and_then(|a| a.downcast::<T>().ok()) {
+            return Ok(asset);
+        }
+    }
+    let asset = Arc::new(load()?);
+    if let Some(stamp) = stamp {
+        let held: Arc<dyn Any + Send + Sync> = asset.clone();
+        ASSETS
+            .lock()
+            .unwrap()
+            .get_or_insert_with(Default::default)
+            .insert(id, (stamp, Arc::downgrade(&held)));
+    }
+    Ok(asset)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

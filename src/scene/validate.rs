@@ -73,9 +73,14 @@ impl Checker<'_> {
             self.fail(path, e.to_string());
             return None;
         }
-        match crate::mesh::load(&full) {
+        // A glTF file's buffers may live beside it: it is read anew each time.
+        let gltf = full.extension().is_some_and(|e| e.eq_ignore_ascii_case("gltf"));
+        let loaded = match gltf {
+            true => crate::mesh::load(&full).map(Arc::new),
+            false => crate::input::shared(&full, "", || crate::mesh::load(&full)),
+        };
+        match loaded {
             Ok(m) => {
-                let m = Arc::new(m);
                 self.f.assets.meshes.insert(full, m.clone());
                 Some(m)
             }
@@ -114,9 +119,8 @@ impl Checker<'_> {
                     self.fail(path, e.to_string());
                     return;
                 }
-                match crate::mesh::points::load(&full) {
+                match crate::input::shared(&full, "", || crate::mesh::points::load(&full)) {
                     Ok(s) => {
-                        let s = Arc::new(s);
                         self.f.assets.point_sets.insert(full, s.clone());
                         s
                     }
@@ -285,9 +289,8 @@ impl Checker<'_> {
             self.fail(path, e.to_string());
             return None;
         }
-        match HeightImage::load(&full) {
+        match crate::input::shared(&full, "", || HeightImage::load(&full)) {
             Ok(m) => {
-                let m = Arc::new(m);
                 self.f.assets.images.insert(full, m.clone());
                 Some(m)
             }
@@ -337,9 +340,9 @@ impl Checker<'_> {
             }
             let request =
                 crate::vdb::Request { density: v.grid.clone(), color: v.color.clone(), band: v.band };
-            match crate::vdb::load(&full, &request) {
+            match crate::input::shared(&full, &format!("{request:?}"), || crate::vdb::load(&full, &request)) {
                 Ok(grid) => {
-                    self.f.assets.volumes.insert(name.clone(), Arc::new(grid));
+                    self.f.assets.volumes.insert(name.clone(), grid);
                     self.f.assets.volume_files.push(full);
                 }
                 Err(e) => self.fail(&v.file, format!("volume \"{name}\": {e}")),
