@@ -286,6 +286,37 @@ pub(crate) fn shared<T: Send + Sync + 'static>(
 
 #[cfg(test)]
 mod tests {
+    /// A shared asset is loaded once while it is held and its file is unchanged; an edit, or
+    /// nothing holding it any more, loads it again.
+    #[test]
+    fn shared_assets_load_once_while_held_and_unchanged() {
+        let dir = std::env::temp_dir().join(format!("voltex-shared-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("a.txt");
+        std::fs::write(&path, "one").unwrap();
+        let loads = std::cell::Cell::new(0);
+        let load = || {
+            loads.set(loads.get() + 1);
+            read_text(&path, "a test file")
+        };
+        let a = shared(&path, "", load).unwrap();
+        let b = shared(&path, "", load).unwrap();
+        assert_eq!((a.as_str(), loads.get()), ("one", 1));
+        assert!(std::sync::Arc::ptr_eq(&a, &b));
+        // Another key is another asset.
+        shared(&path, "k", load).unwrap();
+        assert_eq!(loads.get(), 2);
+        // Edited (another length): loaded again.
+        std::fs::write(&path, "three").unwrap();
+        assert_eq!(shared(&path, "", load).unwrap().as_str(), "three");
+        assert_eq!(loads.get(), 3);
+        // Held by nothing: not kept.
+        drop((a, b));
+        shared(&path, "", load).unwrap();
+        assert_eq!(loads.get(), 4);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
     use super::*;
 
     #[test]
