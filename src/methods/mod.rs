@@ -4,7 +4,6 @@
 //! [`MethodPlan`], and is registered once, in [`REGISTRY`] and `plan_method`.
 
 pub(crate) mod base_surface;
-pub(crate) mod knobs;
 pub mod options;
 pub mod plan;
 pub(crate) mod plugin;
@@ -14,7 +13,7 @@ pub mod view;
 pub mod volume;
 
 macro_rules! method_modules {
-    ($($(#[doc = $doc:literal])* $(#[cfg($cfg:meta)])? $name:ident $folder:ident $(in $path:literal)?,)*) => {
+    ($($(#[doc = $doc:literal])* $(#[cfg($cfg:meta)])? $name:ident $folder:ident $knobs:literal $(in $path:literal)?,)*) => {
         $($(#[cfg($cfg)])? $(#[path = $path])? pub mod $folder;)*
 
         /// Every method's graph contribution, the base surface's first and volumes' last.
@@ -22,7 +21,7 @@ macro_rules! method_modules {
             &[&base_surface::CONTRIBUTION, $($(#[cfg($cfg)])? &$folder::CONTRIBUTION,)* &volume::CONTRIBUTION];
     };
 }
-knobs::for_each_method!(method_modules);
+crate::scene::methods::for_each_method!(method_modules);
 
 pub use plan::{BakePlan, InputCx, MethodPlan, ObjectPlan, PartDecl};
 

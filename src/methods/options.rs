@@ -79,7 +79,7 @@ impl RenderOptions {
         let switch = self.method.filter(|k| {
             *k != method.kind()
                 && k.switchable()
-                && method.knobs().draws() == crate::methods::knobs::Draws::Texels
+                && method.knobs().draws() == crate::scene::methods::Draws::Texels
         });
         match switch {
             Some(k) => k.defaults().plugin().with_options(self, lighting),

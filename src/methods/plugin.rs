@@ -1,13 +1,13 @@
 //! A method as a plug-in: everything voltex does with a scene method, answered by the method's
 //! own folder (`<method>/plugin.rs` implements [`MethodPlugin`] on its knobs struct) and found
-//! through [`Method::plugin`], made from the one registration list (`methods::knobs`).
+//! through [`Method::plugin`], made from the one registration list (`scene::methods`).
 
-use super::knobs::Draws;
 use super::options::RenderOptions;
 use super::plan::ObjectPlan;
 use super::sweep::{SweepPoint, SweepScene, SweepValues};
 use super::PlanCx;
 use crate::error::Result;
+use crate::scene::methods::Draws;
 use crate::scene::{Lighting, Method, METHOD_NAMES};
 
 /// What a method answers, on its knobs (`self`: the knobs an object is drawn with, or the
@@ -99,7 +99,7 @@ pub(crate) struct KnobEdit {
 }
 
 macro_rules! plugin_dispatch {
-    ($($(#[doc = $doc:literal])* $(#[cfg($cfg:meta)])? $name:ident $folder:ident $(in $path:literal)?,)*) => {
+    ($($(#[doc = $doc:literal])* $(#[cfg($cfg:meta)])? $name:ident $folder:ident $knobs:literal $(in $path:literal)?,)*) => {
         impl Method {
             /// The method's plug-in: its knobs struct.
             pub(crate) fn plugin(&self) -> &dyn MethodPlugin {
@@ -127,7 +127,7 @@ macro_rules! plugin_dispatch {
         }
     };
 }
-super::knobs::for_each_method!(plugin_dispatch);
+crate::scene::methods::for_each_method!(plugin_dispatch);
 
 /// A registered method without its knobs (`--method`, `pareto --methods`), by its scene-file
 /// name.

@@ -13,6 +13,7 @@ mod flatten;
 pub mod hypertexture;
 mod image;
 pub mod import;
+pub(crate) mod methods;
 mod types;
 mod validate;
 pub(crate) mod values;
@@ -22,15 +23,15 @@ pub(crate) use flatten::{HyperNode, SceneObject, VolumeNode};
 pub(crate) use hypertexture::Hypertexture;
 pub use image::HeightImage;
 pub use types::*;
-// The methods' knobs live in their folders (scene layer, see `methods::knobs`).
-pub use crate::methods::axis_slices::knobs::{AxisSlices, DrawOrder, SliceBlend, SliceDirections};
-pub use crate::methods::knobs::{Method, METHOD_NAMES};
-pub use crate::methods::ray_march::knobs::{
+// The methods' knobs, from their folders (see `methods`).
+pub use methods::axis_slices::{AxisSlices, DrawOrder, SliceBlend, SliceDirections};
+pub use methods::ray_march::{
     parse_shadows, Adaptive, Quality, RayMarch, Segments, Shadows, DEFAULT_PEEL_PASSES, DEFAULT_SPLAT_GRID,
     DEFAULT_SPLAT_SLABS,
 };
-pub use crate::methods::reference::knobs::Reference;
-pub use crate::methods::view_slices::knobs::{Compositor, Lod, ViewSlices, MAX_PLANES};
+pub use methods::reference::Reference;
+pub use methods::view_slices::{Compositor, Lod, ViewSlices, MAX_PLANES};
+pub use methods::{Method, METHOD_NAMES};
 
 use crate::error::{Error, FileLoc, Result};
 use std::collections::BTreeMap;

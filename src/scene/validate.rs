@@ -9,7 +9,7 @@ use crate::error::Error;
 use crate::io::stack::{self, SliceStack};
 use crate::mesh::shape::MeshShape;
 use crate::mesh::Mesh;
-use crate::methods::knobs::Draws;
+use crate::scene::methods::Draws;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;

@@ -14,8 +14,8 @@ const LAYERS: &[&[&str]] = &[
     &["input"],
     // Device, shader sources, reflection, caches; file formats; meshes, shells, BVHs; OpenVDB grids.
     &["gpu", "io", "mesh", "vdb"],
-    // Render graphs; image metrics; scene files (no GPU), with the methods' knobs (see
-    // `module_of`).
+    // Render graphs; image metrics; scene files (no GPU), with the methods' knobs files (see
+    // `is_knobs_file`).
     &["graph", "metrics", "scene"],
     // CPU twins shared by several methods.
     &["cpu"],
@@ -48,22 +48,10 @@ pub(crate) fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
     }
 }
 
-/// The layered module a path below `crate::` belongs to: its first segment, except that a
-/// method's knobs (`methods::knobs`, `methods::<method>::knobs`: the registration and the
-/// scene-file types of each method) belong to `scene`, whose files they are.
+/// The layered module a path below `crate::` belongs to: its first segment.
 fn module_of(path: &str) -> String {
-    let segments: Vec<&str> = path
-        .split("::")
-        .map(|s| s.trim())
-        .map(|s| s.split(|c: char| !(c.is_ascii_alphanumeric() || c == '_' || c == '$')).next().unwrap_or(""))
-        .collect();
-    let knobs = segments.first() == Some(&"methods")
-        && (segments.get(1) == Some(&"knobs") || segments.get(2) == Some(&"knobs"));
-    if knobs {
-        "scene".into()
-    } else {
-        segments.first().copied().unwrap_or("").to_string()
-    }
+    let first = path.trim().split("::").next().unwrap_or("");
+    first.split(|c: char| !(c.is_ascii_alphanumeric() || c == '_')).next().unwrap_or("").to_string()
 }
 
 /// Layered modules a source text names through `crate::`.
@@ -84,12 +72,13 @@ fn imports(text: &str) -> Vec<String> {
     out
 }
 
-/// A method's knobs file: `methods/knobs.rs` or `methods/<method>/knobs.rs` (scene layer).
+/// A method's knobs file, `methods/<method>/knobs.rs`: compiled in the scene layer
+/// (`scene::methods`, by `#[path]`), so it may import only what the scene layer may.
 fn is_knobs_file(rel: &Path) -> bool {
     let parts: Vec<String> = rel.components().map(|c| c.as_os_str().to_string_lossy().into_owned()).collect();
     parts.first().map(String::as_str) == Some("methods")
         && parts.last().map(String::as_str) == Some("knobs.rs")
-        && parts.len() <= 3
+        && parts.len() == 3
 }
 
 #[test]
@@ -142,8 +131,8 @@ fn the_scan_sees_grouped_and_nested_imports() {
     let text =
         "use crate::gpu::{GpuContext, Inputs};\nuse crate::{Error, io::png};\nlet x = crate::render::f();";
     assert_eq!(imports(text), ["gpu", "Error", "io", "render"]);
-    let knobs = "use crate::methods::view_slices::knobs::ViewSlices;\nuse crate::{methods::knobs::Method, methods::plan};";
-    assert_eq!(imports(knobs), ["scene", "scene", "methods"]);
+    let grouped = "use crate::{scene::methods::Draws, methods::plan};";
+    assert_eq!(imports(grouped), ["scene", "methods"]);
     assert!(is_knobs_file(Path::new("methods/view_slices/knobs.rs")));
     assert!(!is_knobs_file(Path::new("methods/view_slices/deep/knobs.rs")));
 }

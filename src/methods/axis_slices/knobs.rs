@@ -1,5 +1,5 @@
 //! AxisSlices' scene-file knobs: types, defaults and ranges (scene layer, see
-//! `methods::knobs`).
+//! `scene::methods`).
 
 use crate::scene::values::{adapter, checked_f64};
 use serde::{Deserialize, Serialize};
@@ -96,7 +96,7 @@ pub enum SliceBlend {
     Blended,
 }
 
-impl crate::methods::knobs::MethodKnobs for AxisSlices {
+impl crate::scene::methods::MethodKnobs for AxisSlices {
     fn check(&self) -> Result<(), String> {
         if self.draw_order == DrawOrder::Slices && self.blend == SliceBlend::Blended {
             return Err("`draw_order: Slices` needs `blend: Binary` (blended slices must stay back to front \

@@ -2,7 +2,8 @@
 //! the prisms sorted back to front and the buffers of `choose_axis_slices`, `scan_axis_slices`,
 //! `emit_axis_slices` and `draw_axis_slices`. The slice images come from `bake::axis_slices`.
 
-pub(crate) mod knobs;
+/// Its scene-file knobs (`knobs.rs`, compiled in the scene layer: `scene::methods`).
+pub(crate) use crate::scene::methods::axis_slices as knobs;
 mod object;
 pub(crate) mod plugin;
 pub mod twin;

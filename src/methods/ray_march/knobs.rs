@@ -1,7 +1,7 @@
-//! RayMarch's scene-file knobs: types, defaults and ranges (scene layer, see `methods::knobs`).
+//! RayMarch's scene-file knobs: types, defaults and ranges (scene layer, see `scene::methods`).
 
 use crate::scene::values::{adapter, checked_u32};
-use crate::methods::knobs::Draws;
+use crate::scene::methods::Draws;
 use crate::scene::Shading;
 use serde::{Deserialize, Serialize};
 
@@ -182,7 +182,7 @@ adapter!(splat_grid, u32, SplatGrid, |v| v.0);
 adapter!(light_resolution, u32, LightResolution, |v| v.0);
 adapter!(splat_slabs, u32, SplatSlabs, |v| v.0);
 
-impl crate::methods::knobs::MethodKnobs for RayMarch {
+impl crate::scene::methods::MethodKnobs for RayMarch {
     fn draws(&self) -> Draws {
         Draws::Densities
     }

@@ -6,7 +6,8 @@
 //! or with EWA-style splatting the work blocks of `splat_segments.wgsl` and the per-pixel depth
 //! slabs `resolve_splats.wgsl` composites.
 
-pub(crate) mod knobs;
+/// Its scene-file knobs (`knobs.rs`, compiled in the scene layer: `scene::methods`).
+pub(crate) use crate::scene::methods::ray_march as knobs;
 pub mod light_volume;
 pub mod march;
 mod object;

@@ -1,4 +1,4 @@
-//! The Reference's scene-file knobs (scene layer, see `methods::knobs`).
+//! The Reference's scene-file knobs (scene layer, see `scene::methods`).
 
 use crate::scene::{Lighting, Shading};
 use serde::{Deserialize, Serialize};
@@ -18,7 +18,7 @@ pub struct Reference {
     pub(crate) volume_shading: Option<Shading>,
 }
 
-impl crate::methods::knobs::MethodKnobs for Reference {
+impl crate::scene::methods::MethodKnobs for Reference {
     fn lighting(&self) -> Lighting {
         self.lighting
     }

@@ -3,7 +3,8 @@
 //! and level 0 of their baked volumes packed into one storage buffer (the kernel filters by hand,
 //! as the sampler would, so all objects fit in one dispatch without binding arrays).
 
-pub(crate) mod knobs;
+/// Its scene-file knobs (`knobs.rs`, compiled in the scene layer: `scene::methods`).
+pub(crate) use crate::scene::methods::reference as knobs;
 mod object;
 pub(crate) mod plugin;
 pub mod trace_reference;

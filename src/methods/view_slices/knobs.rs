@@ -1,5 +1,5 @@
-//! ViewSlices' scene-file knobs: types, defaults and ranges. Scene-file types, so this file sits
-//! in the scene layer (it imports nothing above it) although it lives in the method's folder.
+//! ViewSlices' scene-file knobs: types, defaults and ranges. Compiled in the scene layer
+//! (`scene::methods`): it imports nothing above it, although it lives in the method's folder.
 
 use crate::scene::Lighting;
 use crate::scene::values::{adapter, checked_u32};
@@ -66,7 +66,7 @@ pub enum Compositor {
     Tiles,
 }
 
-impl crate::methods::knobs::MethodKnobs for ViewSlices {
+impl crate::scene::methods::MethodKnobs for ViewSlices {
     fn lighting(&self) -> Lighting {
         self.lighting
     }

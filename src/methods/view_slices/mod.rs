@@ -1,7 +1,8 @@
 //! Host side of view-aligned prism slicing (2002 paper): the plane sweep of one object and the
 //! buffers its kernels (`count_slices`, `scan_plane_offsets`, `emit_slices`) and `draw_slices` use.
 
-pub(crate) mod knobs;
+/// Its scene-file knobs (`knobs.rs`, compiled in the scene layer: `scene::methods`).
+pub(crate) use crate::scene::methods::view_slices as knobs;
 pub mod lod;
 mod object;
 pub(crate) mod plugin;

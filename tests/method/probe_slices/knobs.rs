@@ -1,4 +1,4 @@
-//! ProbeSlices' scene-file knobs (scene layer, see `methods::knobs`).
+//! ProbeSlices' scene-file knobs (scene layer, see `scene::methods`).
 
 use serde::{Deserialize, Serialize};
 
@@ -7,7 +7,7 @@ use serde::{Deserialize, Serialize};
 #[serde(deny_unknown_fields)]
 pub struct ProbeSlices {
     /// Slicing planes across the object's depth range.
-    #[serde(deserialize_with = "crate::methods::view_slices::knobs::planes")]
+    #[serde(deserialize_with = "crate::scene::methods::view_slices::planes")]
     pub planes: u32,
 }
 
@@ -17,4 +17,4 @@ impl Default for ProbeSlices {
     }
 }
 
-impl crate::methods::knobs::MethodKnobs for ProbeSlices {}
+impl crate::scene::methods::MethodKnobs for ProbeSlices {}

@@ -5,7 +5,8 @@
 //! shard cost, panel knobs, command-line name) is its own. The tests below, compiled into the
 //! library's unit tests, check that it shows up everywhere with no edit outside this folder.
 
-pub(crate) mod knobs;
+/// Its scene-file knobs (`knobs.rs`, compiled in the scene layer: `scene::methods`).
+pub(crate) use crate::scene::methods::probe_slices as knobs;
 mod plan;
 mod plugin;
 

@@ -6,7 +6,7 @@ use crate::gpu::cache::GpuCache;
 use crate::gpu::{GpuContext, Inputs};
 use crate::gpu::budget::Allocation;
 use crate::methods::plan::{InputCx, MethodPlan, ObjectPlan, PartDecl};
-use crate::methods::view_slices::knobs::ViewSlices;
+use crate::scene::methods::view_slices::ViewSlices;
 use crate::methods::PlanCx;
 use crate::scene::Method;
 

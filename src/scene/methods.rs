@@ -1,31 +1,34 @@
 //! The registration of every scene method, and the scene-file enum made from it.
 //!
-//! A method's knobs are scene-file types, so this file and each `methods/<method>/knobs.rs` sit in
-//! the scene layer (they import nothing above it; `tests/checks/layers.rs` places them), although
-//! they live in the methods' folders. Everything else a method does is its plug-in
-//! (`methods::plugin`), dispatched from the same list.
+//! A method's knobs are scene-file types: each `src/methods/<method>/knobs.rs` is compiled here,
+//! as `scene::methods::<method>` (a `#[path]` made from the list), so the scene layer never
+//! imports the methods layer, although each method's knobs live in its folder (they import
+//! nothing above the scene layer; `tests/checks/layers.rs` keeps it so). Everything else a
+//! method does is its plug-in (`methods::plugin`), dispatched from the same list.
 
 use crate::scene::Lighting;
 use serde::{Deserialize, Serialize};
 
-/// The registration: each method's scene-file name and its folder (`src/methods/<folder>/`,
-/// `wgsl/<folder>/`; `in "path"` for a folder elsewhere), optionally under a `cfg`. The
-/// scene-file enum [`Method`], its dispatch to knobs and plug-ins, the method modules and their
-/// graph contributions are all made from this list (`$then!` receives it), so a new method is
-/// a folder and a line here.
+/// The registration: each method's scene-file name, its folder (`src/methods/<folder>/`,
+/// `wgsl/<folder>/`) and its knobs file (relative to `src/scene/`), optionally under a `cfg`
+/// (`in "path"`: a method folder elsewhere, relative to `src/methods/`). The scene-file enum
+/// [`Method`], its dispatch to knobs and plug-ins, the method modules and their graph
+/// contributions are all made from this list (`$then!` receives it), so a new method is a
+/// folder and a line here.
 macro_rules! for_each_method {
     ($then:ident) => {
         $then! {
             /// View-aligned prism slicing (2002).
-            ViewSlices view_slices,
+            ViewSlices view_slices "../methods/view_slices/knobs.rs",
             /// Axis-aligned slice stacks (Meyer & Neyret 1998).
-            AxisSlices axis_slices,
+            AxisSlices axis_slices "../methods/axis_slices/knobs.rs",
             /// Exact ray casting through the prisms: the ground truth.
-            Reference reference,
+            Reference reference "../methods/reference/knobs.rs",
             /// Ray marching of a hypertexture or volume (Gilet & Dischler 2009).
-            RayMarch ray_march,
+            RayMarch ray_march "../methods/ray_march/knobs.rs",
             /// A method registered by the tests alone (the worked example of adding one).
-            #[cfg(feature = "test-method")] ProbeSlices probe_slices in "../../tests/method/probe_slices/mod.rs",
+            #[cfg(feature = "test-method")]
+            ProbeSlices probe_slices "../../tests/method/probe_slices/knobs.rs" in "../../tests/method/probe_slices/mod.rs",
         }
     };
 }
@@ -69,12 +72,14 @@ pub(crate) enum Draws {
 }
 
 macro_rules! scene_enum {
-    ($($(#[doc = $doc:literal])* $(#[cfg($cfg:meta)])? $name:ident $folder:ident $(in $path:literal)?,)*) => {
+    ($($(#[doc = $doc:literal])* $(#[cfg($cfg:meta)])? $name:ident $folder:ident $knobs:literal $(in $path:literal)?,)*) => {
+        $($(#[cfg($cfg)])? #[path = $knobs] pub(crate) mod $folder;)*
+
         /// How a node's texel is rendered: one variant per registered method, each with its knobs.
         #[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
         #[serde(deny_unknown_fields)]
         pub enum Method {
-            $($(#[doc = $doc])* $(#[cfg($cfg)])? $name(crate::methods::$folder::knobs::$name),)*
+            $($(#[doc = $doc])* $(#[cfg($cfg)])? $name($folder::$name),)*
         }
 
         impl Method {
