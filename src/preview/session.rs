@@ -33,7 +33,8 @@ pub(crate) struct Stages {
     pub(crate) bake: f64,
     /// The rest of the renderer: buffers, pipelines not found in the cache.
     pub(crate) build: f64,
-    /// Files read and shaders validated over all of the above.
+    /// Files read and shaders validated over all of the above (set by `rebuild` and `replan`,
+    /// which see the whole step).
     pub(crate) work: crate::work::Work,
 }
 
@@ -161,9 +162,9 @@ impl Session {
         let t = Instant::now();
         let renderer = Renderer::with_cache(ctx, bp, &mut self.cache)?;
         let made = ms(t);
-        let work = self.stages.work;
-        self.stages =
-            Stages { parse: 0.0, plan, bake: renderer.bake_ms, build: made - renderer.bake_ms, work };
+        // The callers add what they read before (the scene file) to the work: see `Stages::work`.
+        let (bake, build) = (renderer.bake_ms, made - renderer.bake_ms);
+        self.stages = Stages { parse: 0.0, plan, bake, build, work: Default::default() };
         self.cache.retain_used();
         self.renderer = Some(renderer);
         self.objects = Some((self.options.time, objects));
