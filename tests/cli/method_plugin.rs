@@ -27,3 +27,27 @@ fn pareto_sweeps_the_test_method() {
     assert_eq!(rows.len(), 2, "{csv}");
     std::fs::remove_dir_all(&out).unwrap();
 }
+
+/// Names the registry does not know are refused before any work, saying what is expected.
+#[test]
+fn unknown_method_and_truth_names_are_refused_with_the_known_ones() {
+    let out = voltex(&["plan", &scene(), "--method", "ray-march"]);
+    let err = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert!(!out.status.success() && err.contains("view-slices") && err.contains("reference"), "{err}");
+    for (truth, words) in [
+        (
+            "axis-slices",
+            &["`axis-slices`: expected", "reference", "view-slices:PLANES", "ray-march:STEP"][..],
+        ),
+        ("view-slices:0", &["`0`: expected a plane count in 1..="][..]),
+        ("reference:2", &["the Reference takes no argument"][..]),
+        ("ray-march:-1", &["`-1`: expected a positive step"][..]),
+    ] {
+        let out = voltex(&["pareto", &scene(), "--truth", truth, "--frames", "1"]);
+        let err = String::from_utf8_lossy(&out.stderr).into_owned();
+        assert!(!out.status.success(), "{truth}: {err}");
+        for w in words {
+            assert!(err.contains(w), "{truth}: expected {w:?} in {err}");
+        }
+    }
+}
