@@ -20,10 +20,74 @@ fn rel(p: DVec3, eye: DVec3) -> [f32; 4] {
     [r.x as f32, r.y as f32, r.z as f32, 1.0]
 }
 
-/// Each prism's bounding sphere in world space (centre, radius): what a shell needs of its
-/// prisms that does not depend on the view, made once per surface (see `SceneObject::spheres`).
+/// Each prism's bounding sphere in world space (centre, radius).
 pub(crate) fn prism_spheres(surface: &BaseSurface) -> Vec<(DVec3, f64)> {
     (0..surface.triangles.len()).map(|t| prism::bounding_sphere(surface.prism(t))).collect()
+}
+
+/// Shell vertices per corner box of [`PreparedShell`]: a view scans the corners of the few boxes
+/// that may hold the farthest one.
+const BOX_VERTICES: usize = 256;
+
+/// What planning a shell needs of its surface that does not depend on the view, made once per
+/// surface and shared by every view of it (see `SceneObject::prepared`), so that a camera move
+/// costs O(prisms) of plain copying and no square root or cross product.
+#[derive(Debug, Default)]
+pub(crate) struct PreparedShell {
+    /// Each prism's world-space bounding sphere ([`prism_spheres`]).
+    pub(crate) spheres: Vec<(DVec3, f64)>,
+    /// Boxes (min, max) around the bottoms and tops of each run of [`BOX_VERTICES`] vertices.
+    boxes: Vec<(DVec3, DVec3)>,
+    /// Per-vertex frames for per-pixel lighting ([`vertex_frames`]), made when first asked.
+    frames: std::sync::OnceLock<Vec<VertexFrame>>,
+}
+
+impl PreparedShell {
+    pub(crate) fn new(surface: &BaseSurface) -> Self {
+        let corners = surface.positions.iter().zip(&surface.heights).map(|(&p, &h)| (p, p + h));
+        let boxes = corners
+            .collect::<Vec<_>>()
+            .chunks(BOX_VERTICES)
+            .map(|run| {
+                run.iter().fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &(b, t)| {
+                    (lo.min(b).min(t), hi.max(b).max(t))
+                })
+            })
+            .collect();
+        Self { spheres: prism_spheres(surface), boxes, frames: Default::default() }
+    }
+
+    /// The per-vertex frames of `surface` (the one this was prepared from).
+    pub(crate) fn frames(&self, surface: &BaseSurface) -> &[VertexFrame] {
+        self.frames.get_or_init(|| vertex_frames(surface))
+    }
+
+    /// The largest `(c - eye) . forward` over the bottom and top corners `c` of `surface`'s
+    /// vertices (the one this was prepared from), `None` without vertices: exactly the value a scan
+    /// of every corner gives, found by scanning only the boxes whose bound may exceed it.
+    pub(crate) fn farthest(&self, surface: &BaseSurface, eye: DVec3, forward: DVec3) -> Option<f64> {
+        // A box's bound, widened far beyond its rounding error so that no box holding the
+        // farthest corner is skipped.
+        let bound = |(lo, hi): &(DVec3, DVec3)| {
+            let (centre, half) = (0.5 * (*lo + *hi) - eye, 0.5 * (*hi - *lo));
+            let b = centre.dot(forward) + half.dot(forward.abs());
+            b + 1e-9 * (centre.abs().element_sum() + half.element_sum())
+        };
+        let mut order: Vec<(f64, usize)> = self.boxes.iter().map(bound).zip(0..).collect();
+        order.sort_unstable_by(|a, b| b.0.total_cmp(&a.0));
+        let mut far: Option<f64> = None;
+        for (b, k) in order {
+            if far.is_some_and(|f| b < f) {
+                break;
+            }
+            let run = k * BOX_VERTICES..((k + 1) * BOX_VERTICES).min(surface.positions.len());
+            for (&p, &h) in surface.positions[run.clone()].iter().zip(&surface.heights[run]) {
+                let d = (p - eye).dot(forward).max((p + h - eye).dot(forward));
+                far = Some(far.map_or(d, |f| f.max(d)));
+            }
+        }
+        far
+    }
 }
 
 impl Shell {
@@ -35,44 +99,37 @@ impl Shell {
     /// [`Shell::new`] with the prisms' world-space bounding spheres given ([`prism_spheres`]):
     /// a new view moves them to the camera, O(prisms) with no square root.
     pub(crate) fn with_spheres(surface: &BaseSurface, spheres: &[(DVec3, f64)], eye: DVec3) -> Self {
-        let vertices = surface
-            .positions
-            .iter()
-            .zip(&surface.heights)
+        let vertices = (surface.positions.iter().zip(&surface.heights))
             .map(|(&p, &h)| ShellVertex { bottom: rel(p, eye), top: rel(p + h, eye) })
             .collect();
-        let prisms = surface
-            .triangles
-            .iter()
-            .zip(&surface.corner_uvs)
-            .zip(spheres)
-            .map(|((ids, uv), &(centre, radius))| {
-                let centre = centre - eye;
-                // Grown by a relative epsilon so that f32 rounding never rejects a touching plane.
-                let radius = radius * (1.0 + 1e-5) + 1e-6;
-                Prism {
-                    vertices: [ids[0], ids[1], ids[2], 0],
-                    uv01: [uv[0].x as f32, uv[0].y as f32, uv[1].x as f32, uv[1].y as f32],
-                    uv2: [uv[2].x as f32, uv[2].y as f32, 0.0, 0.0],
-                    sphere: [centre.x as f32, centre.y as f32, centre.z as f32, radius as f32],
-                }
-            })
-            .collect();
-        Self { vertices, prisms }
+        let prisms = (0..surface.triangles.len()).map(|t| {
+            let (ids, uv, (centre, radius)) = (surface.triangles[t], surface.corner_uvs[t], spheres[t]);
+            let centre = centre - eye;
+            // Grown by a relative epsilon so that f32 rounding never rejects a touching plane.
+            let radius = radius * (1.0 + 1e-5) + 1e-6;
+            Prism {
+                vertices: [ids[0], ids[1], ids[2], 0],
+                uv01: [uv[0].x as f32, uv[0].y as f32, uv[1].x as f32, uv[1].y as f32],
+                uv2: [uv[2].x as f32, uv[2].y as f32, 0.0, 0.0],
+                sphere: [centre.x as f32, centre.y as f32, centre.z as f32, radius as f32],
+            }
+        });
+        Self { vertices, prisms: prisms.collect() }
     }
 
     /// Range of `dot(n, x)` over all corners.
     pub(crate) fn depth_range(&self, n: [f32; 3]) -> (f64, f64) {
-        let mut lo = f64::INFINITY;
-        let mut hi = f64::NEG_INFINITY;
-        for v in &self.vertices {
-            for p in [v.bottom, v.top] {
-                let d = n[0] as f64 * p[0] as f64 + n[1] as f64 * p[1] as f64 + n[2] as f64 * p[2] as f64;
-                lo = lo.min(d);
-                hi = hi.max(d);
-            }
+        let depth =
+            |p: [f32; 4]| n[0] as f64 * p[0] as f64 + n[1] as f64 * p[1] as f64 + n[2] as f64 * p[2] as f64;
+        // Four lanes of vertices, so that the comparisons do not wait on each other (min and max
+        // are exact: the order does not change the result).
+        let (mut lo, mut hi) = ([f64::INFINITY; 4], [f64::NEG_INFINITY; 4]);
+        for (i, v) in self.vertices.iter().enumerate() {
+            let (b, t) = (depth(v.bottom), depth(v.top));
+            lo[i % 4] = lo[i % 4].min(b.min(t));
+            hi[i % 4] = hi[i % 4].max(b.max(t));
         }
-        (lo, hi)
+        (lo.into_iter().fold(f64::INFINITY, f64::min), hi.into_iter().fold(f64::NEG_INFINITY, f64::max))
     }
 }
 
@@ -131,7 +188,7 @@ pub(crate) fn vertex_frames(surface: &BaseSurface) -> Vec<VertexFrame> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use glam::DVec2;
 
@@ -160,5 +217,47 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// A jittered plane with varied height vectors, bent into a bowl.
+    pub(crate) fn bumpy(cells: u32) -> BaseSurface {
+        let mut s =
+            crate::mesh::generate::plane([3.0, 2.0], [cells, cells], 0.3, 7).to_base(0.4, None, DVec2::ONE);
+        for (i, (p, h)) in s.positions.iter_mut().zip(&mut s.heights).enumerate() {
+            p.z = 0.3 * (p.x * p.x - p.y) + 0.01 * (i % 7) as f64;
+            *h *= 0.5 + 0.1 * (i % 11) as f64;
+            h.x += 0.05 * ((i % 5) as f64 - 2.0);
+        }
+        s
+    }
+
+    /// The farthest corner found through the boxes is the one a scan of every corner finds, bit
+    /// for bit, from eyes all around and inside the shell (and none without vertices).
+    #[test]
+    fn the_farthest_corner_is_exactly_a_full_scans() {
+        let surface = bumpy(40);
+        let prepared = PreparedShell::new(&surface);
+        let mut views = 0;
+        for (i, eye) in [DVec3::new(0.0, -4.0, 3.0), DVec3::new(5.0, 1.0, -0.5), DVec3::new(1.4, 0.9, 0.2)]
+            .into_iter()
+            .enumerate()
+        {
+            for k in 0..24 {
+                let a = k as f64 * 0.7 + i as f64;
+                let forward = DVec3::new(a.cos(), a.sin(), 0.3 * (2.0 * a).sin()).normalize();
+                let scan = surface
+                    .positions
+                    .iter()
+                    .zip(&surface.heights)
+                    .map(|(&p, &h)| (p - eye).dot(forward).max((p + h - eye).dot(forward)))
+                    .fold(f64::NEG_INFINITY, f64::max);
+                let found = prepared.farthest(&surface, eye, forward).unwrap();
+                assert_eq!(found.to_bits(), scan.to_bits(), "eye {eye}, forward {forward}");
+                views += 1;
+            }
+        }
+        assert_eq!(views, 72);
+        let empty = BaseSurface::default();
+        assert_eq!(PreparedShell::new(&empty).farthest(&empty, DVec3::ZERO, DVec3::X), None);
     }
 }

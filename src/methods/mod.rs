@@ -87,8 +87,7 @@ pub(crate) fn plan_object(
     opts: &options::RenderOptions,
 ) -> Result<ObjectPlan> {
     let eye = cx.view.eye;
-    let spheres = object.spheres.get_or_init(|| crate::mesh::shell::prism_spheres(&object.surface));
-    let shell = crate::mesh::shell::Shell::with_spheres(&object.surface, spheres, eye);
+    let shell = crate::mesh::shell::Shell::with_spheres(&object.surface, &object.prepared().spheres, eye);
     // Kernels take camera-relative f32 corners and square their distances.
     let limit = crate::mesh::prism::MAX_COORD as f32;
     let in_range = |c: &[f32; 4]| c[..3].iter().all(|x| x.abs() <= limit);

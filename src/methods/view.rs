@@ -47,8 +47,9 @@ impl View {
         }
         let mut far: f64 = 1e-3;
         for o in objects {
-            for (&p, &h) in o.surface.positions.iter().zip(&o.surface.heights) {
-                far = far.max((p - cam.eye).dot(forward)).max((p + h - cam.eye).dot(forward));
+            if !o.surface.positions.is_empty() {
+                // Only the corner boxes that may hold the farthest corner are scanned.
+                far = far.max(o.prepared().farthest(&o.surface, cam.eye, forward).unwrap_or(far));
             }
             let hyper = o.hypertexture.as_ref().and_then(|n| Some((n, scene.hypertextures.get(&n.name)?)));
             if let Some((node, h)) = hyper {

@@ -17,9 +17,9 @@ pub struct SceneObject {
     /// nodes).
     /// Shared: re-planning the same scene from another view reuses it (see `Session::replan`).
     pub surface: Arc<BaseSurface>,
-    /// The world-space bounding spheres of `surface`'s prisms, made by the first plan and
-    /// shared by the clones a later view plans (`mesh::shell::prism_spheres`).
-    pub(crate) spheres: Arc<std::sync::OnceLock<Vec<(glam::DVec3, f64)>>>,
+    /// What planning needs of `surface` that does not depend on the view, made by the first
+    /// plan and shared by the clones a later view plans (see [`SceneObject::prepared`]).
+    prepared: Arc<std::sync::OnceLock<crate::mesh::shell::PreparedShell>>,
     /// The texel it draws, by name in `Scene::texels`.
     pub texel: Option<String>,
     pub(crate) method: Option<Method>,
@@ -46,6 +46,14 @@ impl VolumeNode {
     /// World-space corners of the box outside which the density is 0.
     pub(crate) fn corners(&self) -> [glam::DVec3; 8] {
         self.grid.world_corners(&self.to_world)
+    }
+}
+
+impl SceneObject {
+    /// What planning needs of the surface that does not depend on the view: made on the first
+    /// call, then shared by this object's clones (each view's plan clones the scene's objects).
+    pub(crate) fn prepared(&self) -> &crate::mesh::shell::PreparedShell {
+        self.prepared.get_or_init(|| crate::mesh::shell::PreparedShell::new(&self.surface))
     }
 }
 
@@ -88,7 +96,7 @@ impl Scene {
             out.push(SceneObject {
                 name: n.name.clone(),
                 surface: Arc::new(surface),
-                spheres: Default::default(),
+                prepared: Default::default(),
                 texel: n.texel.as_ref().map(|t| self.texel_at(&t.value, time)),
                 method: n.method.as_ref().map(|m| m.value.clone()),
                 base_color: n.base_color,
@@ -102,7 +110,7 @@ impl Scene {
             out.push(SceneObject {
                 name: n.name.clone(),
                 surface: Default::default(),
-                spheres: Default::default(),
+                prepared: Default::default(),
                 texel: None,
                 method: Some(method),
                 base_color: None,
@@ -119,7 +127,7 @@ impl Scene {
             out.push(SceneObject {
                 name: n.name.clone(),
                 surface: Default::default(),
-                spheres: Default::default(),
+                prepared: Default::default(),
                 texel: None,
                 method: Some(method),
                 base_color: None,

@@ -95,11 +95,10 @@ fn work_bound(s: &BaseSurface, step: f64) -> f64 {
 }
 
 /// Half the smallest world extent of a voxel over the object (height along w; `dP/ds`, `dP/dt`
-/// lengths along s and t), averaged over its vertices.
-pub(crate) fn default_step(s: &BaseSurface, resolution: [u32; 3]) -> f64 {
+/// lengths along s and t, from its vertex frames), averaged over its vertices.
+pub(crate) fn default_step(s: &BaseSurface, frames: &[VertexFrame], resolution: [u32; 3]) -> f64 {
     let n = s.heights.len().max(1) as f64;
     let h = s.heights.iter().map(|h| h.length()).sum::<f64>() / n;
-    let frames = shell::vertex_frames(s);
     let mean = |f: &dyn Fn(&VertexFrame) -> [f32; 4]| {
         let v: Vec<f64> = frames
             .iter()

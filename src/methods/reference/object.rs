@@ -22,12 +22,13 @@ pub struct ReferencePlan {
 /// Plans `object`'s bake, lighting and step.
 pub fn plan(cx: &mut PlanCx, object: &mut ObjectPlan, m: &Reference) -> Result<()> {
     object.per_pixel = m.lighting == Lighting::PerPixel;
-    object.frames = object.per_pixel.then(|| crate::mesh::shell::vertex_frames(&object.object.surface));
+    let surface = &object.object.surface;
+    let frames = object.object.prepared().frames(surface);
+    object.frames = object.per_pixel.then(|| frames.to_vec());
     let texel = object.object.texel.clone().unwrap_or_default();
     let bake = texels::bake_index(cx.scene, &texel, object.per_pixel, cx.light, cx.time, cx.bakes)?;
     object.bake = Some(bake);
-    let step =
-        m.step.unwrap_or_else(|| default_step(&object.object.surface, cx.bakes[bake].request.resolution));
+    let step = m.step.unwrap_or_else(|| default_step(surface, frames, cx.bakes[bake].request.resolution));
     object.methods.push(Box::new(ReferencePlan { step, dispatches: 0 }));
     Ok(())
 }

@@ -86,49 +86,78 @@ pub struct SliceChunk {
 /// pentagon is 3 triangles) on every plane its depth range crosses. Allocating this, not
 /// planes x prisms x 9, keeps memory proportional to what is drawn.
 pub(crate) fn plane_bounds(shell: &Shell, params: &SliceParams) -> Vec<u64> {
-    // Difference array: +9 where a prism's plane range starts, -9 after it ends.
-    let mut diff = vec![0i64; params.plane_count as usize + 1];
-    for p in &shell.prisms {
-        if let Some((k_min, k_max)) = prism_planes(shell, p, params) {
-            diff[k_min as usize] += 9;
-            diff[k_max as usize + 1] -= 9;
+    // Difference array: +9 where a prism's plane range starts, -9 after it ends; in four lanes,
+    // so that neighbouring prisms (mostly on the same planes) do not wait on each other's sums.
+    let mut diff = vec![[0i64; 4]; params.plane_count as usize + 1];
+    let planes = PrismPlanes::new(shell, params);
+    for (i, p) in shell.prisms.iter().enumerate() {
+        if let Some((k_min, k_max)) = planes.of(p) {
+            diff[k_min as usize][i % 4] += 9;
+            diff[k_max as usize + 1][i % 4] -= 9;
         }
     }
     let mut running = 0i64;
     diff[..params.plane_count as usize]
         .iter()
         .map(|d| {
-            running += d;
+            running += d.iter().sum::<i64>();
             running as u64
         })
         .collect()
 }
 
-/// The planes `[k_min, k_max]` of a sweep (or chunk) whose depth range the prism's corners span,
-/// widened by one plane for f32 rounding; `None` when there is none.
-pub(crate) fn prism_planes(
-    shell: &Shell,
-    p: &crate::types::Prism,
-    params: &SliceParams,
-) -> Option<(u32, u32)> {
-    let n = params.plane_normal.map(|x| x as f64);
-    let spacing = params.spacing as f64;
-    let first = params.first_plane as f64;
-    let last = params.plane_count as i64 - 1;
-    let mut lo = f64::INFINITY;
-    let mut hi = f64::NEG_INFINITY;
-    for &v in &p.vertices[..3] {
-        let sv = &shell.vertices[v as usize];
-        for c in [sv.bottom, sv.top] {
-            let d = n[0] * c[0] as f64 + n[1] * c[1] as f64 + n[2] * c[2] as f64;
-            lo = lo.min(d);
-            hi = hi.max(d);
-        }
+/// The planes of a sweep (or chunk) each prism's corners span: per prism `[k_min, k_max]`,
+/// the planes k with `lo <= first - k * spacing <= hi` over its six corners' depths, widened by
+/// one plane for f32 rounding.
+///
+/// Made per vertex, then combined per prism: `floor((first - d) / spacing)` never rises as the
+/// depth `d` grows (each operation rounds monotonically), so a prism's bound is the least (or
+/// greatest) of its vertices' and equals the bound of its corners' depth range exactly, at a
+/// sixth of the dot products (a camera move plans every prism of a million-triangle shell).
+pub(crate) struct PrismPlanes {
+    /// Per shell vertex: `floor((first - hi) / spacing)` and `ceil((first - lo) / spacing)` of
+    /// its bottom's and top's depths.
+    vertices: Vec<(i64, i64)>,
+    last: i64,
+}
+
+impl PrismPlanes {
+    pub(crate) fn new(shell: &Shell, params: &SliceParams) -> Self {
+        let n = params.plane_normal.map(|x| x as f64);
+        let spacing = params.spacing as f64;
+        let first = params.first_plane as f64;
+        let depth = |c: [f32; 4]| n[0] * c[0] as f64 + n[1] * c[1] as f64 + n[2] * c[2] as f64;
+        // `x.floor() as i64` and `x.ceil() as i64` (saturating, NaN to 0) without the calls to
+        // libm that the baseline x86-64 target makes of `floor` and `ceil`.
+        let floor = |x: f64| {
+            let i = x as i64;
+            if i as f64 > x { i.saturating_sub(1) } else { i }
+        };
+        let ceil = |x: f64| {
+            let i = x as i64;
+            if (i as f64) < x { i.saturating_add(1) } else { i }
+        };
+        let vertices = shell
+            .vertices
+            .iter()
+            .map(|v| {
+                let (b, t) = (depth(v.bottom), depth(v.top));
+                let (lo, hi) = (b.min(t), b.max(t));
+                (floor((first - hi) / spacing), ceil((first - lo) / spacing))
+            })
+            .collect();
+        Self { vertices, last: params.plane_count as i64 - 1 }
     }
-    // Planes k with lo <= first - k*spacing <= hi.
-    let k_min = (((first - hi) / spacing).floor() as i64 - 1).max(0);
-    let k_max = (((first - lo) / spacing).ceil() as i64 + 1).min(last);
-    (k_max >= k_min).then_some((k_min as u32, k_max as u32))
+
+    /// The planes `[k_min, k_max]` prism `p` (of the shell this was made for) spans; `None` when
+    /// there is none.
+    pub(crate) fn of(&self, p: &crate::types::Prism) -> Option<(u32, u32)> {
+        let v = |i: usize| self.vertices[p.vertices[i] as usize];
+        let (a, b, c) = (v(0), v(1), v(2));
+        let k_min = a.0.min(b.0).min(c.0).saturating_sub(1).max(0);
+        let k_max = a.1.max(b.1).max(c.1).saturating_add(1).min(self.last);
+        (k_max >= k_min).then_some((k_min as u32, k_max as u32))
+    }
 }
 
 /// Total slice-vertex capacity of a sweep (see `plane_bounds`).
@@ -254,3 +283,49 @@ pub fn read_back(
         })
         .collect())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A prism's planes by their definition: the depth range of its six corners.
+    fn by_corners(shell: &Shell, p: &crate::types::Prism, params: &SliceParams) -> Option<(u32, u32)> {
+        let n = params.plane_normal.map(|x| x as f64);
+        let (spacing, first) = (params.spacing as f64, params.first_plane as f64);
+        let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+        for &v in &p.vertices[..3] {
+            let sv = &shell.vertices[v as usize];
+            for c in [sv.bottom, sv.top] {
+                let d = n[0] * c[0] as f64 + n[1] * c[1] as f64 + n[2] * c[2] as f64;
+                (lo, hi) = (lo.min(d), hi.max(d));
+            }
+        }
+        let k_min = (((first - hi) / spacing).floor() as i64 - 1).max(0);
+        let k_max = (((first - lo) / spacing).ceil() as i64 + 1).min(params.plane_count as i64 - 1);
+        (k_max >= k_min).then_some((k_min as u32, k_max as u32))
+    }
+
+    /// Per-vertex plane ranges combined per prism equal the corners' ranges exactly, for sweeps
+    /// from several views with few and many planes (chunks too: a later first plane).
+    #[test]
+    fn prism_planes_from_vertices_equal_the_corners_ranges() {
+        let surface = crate::mesh::shell::tests::bumpy(30);
+        let mut spanned = 0usize;
+        for (k, eye) in [glam::DVec3::new(0.5, -4.0, 3.0), glam::DVec3::new(4.0, 2.0, 1.0)].into_iter().enumerate() {
+            let shell = Shell::new(&surface, eye);
+            let forward = (-eye).normalize().as_vec3().to_array();
+            for planes in [1, 7, 64, 1000] {
+                let mut params = sweep(&shell, forward, planes, 1e-3);
+                params.first_plane -= k as f32 * 3.0 * params.spacing;
+                let fast = PrismPlanes::new(&shell, &params);
+                for p in &shell.prisms {
+                    let range = fast.of(p);
+                    assert_eq!(range, by_corners(&shell, p, &params), "{planes} planes, prism {p:?}");
+                    spanned += range.is_some() as usize;
+                }
+            }
+        }
+        assert!(spanned > 10_000, "{spanned}");
+    }
+}
+

@@ -50,7 +50,7 @@ pub fn plan(cx: &mut PlanCx, object: &mut ObjectPlan, m: &ViewSlices) -> Result<
     let sweep = sweep(&object.shell, forward, lod.map_or(planes, |c| c.planes), cx.view.near);
     let chunks = chunks(&object.shell, &sweep);
     check_budget(&chunks, &object.object.name, planes)?;
-    object.frames = object.per_pixel.then(|| crate::mesh::shell::vertex_frames(&object.object.surface));
+    object.frames = object.per_pixel.then(|| object.object.prepared().frames(&object.object.surface).to_vec());
     let tile_entries = match m.compositor {
         Compositor::Raster => Vec::new(),
         Compositor::Tiles => {

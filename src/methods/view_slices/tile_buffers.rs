@@ -24,8 +24,9 @@ pub(crate) fn entry_bound(
     let tiles = |n: u32| n.div_ceil(TILE_SIZE) as i64;
     let all = (tiles(size.0) * tiles(size.1)) as u64;
     let mut total = 0u64;
+    let planes = super::PrismPlanes::new(shell, params);
     for p in &shell.prisms {
-        let Some((k_min, k_max)) = super::prism_planes(shell, p, params) else { continue };
+        let Some((k_min, k_max)) = planes.of(p) else { continue };
         let (mut lo, mut hi) = (glam::Vec2::splat(f32::INFINITY), glam::Vec2::splat(f32::NEG_INFINITY));
         let mut behind = false;
         for &v in &p.vertices[..3] {
