@@ -78,7 +78,7 @@ pub fn run(args: BakeArgs) -> Result<()> {
         let start = std::time::Instant::now();
         progress.started(&plan.texel);
         let baked = baker.bake(&ctx, &plan.request)?;
-        let bytes = voltex::bake::axis_slices::read_texture(&ctx, &baked.volume, 16)?;
+        let bytes = voltex::gpu::readback::read_texture(&ctx, &baked.volume, 16)?;
         let volume: Vec<[f32; 4]> = bytemuck::pod_collect_to_vec(&bytes);
         let dir = out.join(&plan.texel);
         let manifest = Manifest {

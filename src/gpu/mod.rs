@@ -7,6 +7,7 @@ pub mod cache;
 pub(crate) mod context;
 pub(crate) mod inputs;
 pub(crate) mod kernel;
+pub mod readback;
 pub(crate) mod reflect;
 pub mod shader;
 pub mod sources;

@@ -266,7 +266,7 @@ pub fn bake(ctx: &GpuContext, baker: &mut Baker, e: &Export) -> Result<Vec<[f32;
         return Err(Error::Invalid("export needs a full-precision baker".into()));
     }
     let baked = baker.bake(ctx, request)?;
-    let bytes = crate::bake::axis_slices::read_texture(ctx, &baked.volume, 16)?;
+    let bytes = crate::gpu::readback::read_texture(ctx, &baked.volume, 16)?;
     Ok(bytemuck::pod_collect_to_vec(&bytes))
 }
 

@@ -84,7 +84,7 @@ Scene(
             uv_tiling: ({tiles:.0}, {tiles:.0}),
             texel: "grain",
             base_color: (0.35, 0.3, 0.28),
-            method: ViewSlices(planes: 256),
+            method: {method},
         ),
     ],
 )
@@ -98,6 +98,7 @@ Scene(
         height = num(height),
         mesh = ron_string(mesh_path),
         up = if gltf { "glTF" } else { "An OBJ export" },
+        method = crate::scene::Method::imported(false),
     ))
 }
 
@@ -180,7 +181,7 @@ Scene(
         ),
     }},
     nodes: [
-        (name: "{name}", volume: "{name}", method: RayMarch(shading: PhongShadows)),
+        (name: "{name}", volume: "{name}", method: {method}),
     ],
 )
 "#,
@@ -188,6 +189,7 @@ Scene(
         grids = names.join(", "),
         grid = density.name,
         grid_string = ron_string(&density.name),
+        method = crate::scene::Method::imported(true),
         lo = v(lo),
         hi = v(hi),
         eye = v(eye),

@@ -60,6 +60,13 @@ pub(crate) trait MethodKnobs {
     fn check(&self) -> Result<(), String> {
         Ok(())
     }
+
+    /// The method as `voltex import` writes it into a new scene (scene-file text) for what it
+    /// draws: a texel on an imported mesh, or an imported volume ([`MethodKnobs::volumes`]).
+    /// The first registered method that answers is written.
+    fn imported(&self) -> Option<&'static str> {
+        None
+    }
 }
 
 /// What a method draws (see [`MethodKnobs::draws`]).
@@ -74,6 +81,8 @@ pub(crate) enum Draws {
 macro_rules! scene_enum {
     ($($(#[doc = $doc:literal])* $(#[cfg($cfg:meta)])? $name:ident $folder:ident $knobs:literal $(in $path:literal)?,)*) => {
         $($(#[cfg($cfg)])? #[path = $knobs] pub(crate) mod $folder;)*
+        // Each method's knob types are the scene's (`scene::ViewSlices`, ...).
+        $($(#[cfg($cfg)])? pub use $folder::*;)*
 
         /// How a node's texel is rendered: one variant per registered method, each with its knobs.
         #[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
@@ -123,6 +132,17 @@ impl Method {
     pub(crate) fn for_densities() -> Method {
         let mut all = Method::every_default().into_iter();
         all.find(|m| m.knobs().draws() == Draws::Densities).expect("a registered method draws densities")
+    }
+
+    /// What `voltex import` writes for an imported mesh's texel (`volume: false`) or an imported
+    /// volume (see [`MethodKnobs::imported`]).
+    pub(crate) fn imported(volume: bool) -> &'static str {
+        let draws = |m: &Method| match volume {
+            true => m.knobs().volumes().is_some(),
+            false => m.knobs().draws() == Draws::Texels,
+        };
+        let mut all = Method::every_default().into_iter().filter(draws);
+        all.find_map(|m| m.knobs().imported()).expect("a registered method is imported")
     }
 
     /// The methods that draw volume nodes, as a user would write them (`RayMarch(...)`).

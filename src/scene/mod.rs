@@ -23,15 +23,8 @@ pub(crate) use flatten::{HyperNode, SceneObject, VolumeNode};
 pub(crate) use hypertexture::Hypertexture;
 pub use image::HeightImage;
 pub use types::*;
-// The methods' knobs, from their folders (see `methods`).
-pub use methods::axis_slices::{AxisSlices, DrawOrder, SliceBlend, SliceDirections};
-pub use methods::ray_march::{
-    parse_shadows, Adaptive, Quality, RayMarch, Segments, Shadows, DEFAULT_PEEL_PASSES, DEFAULT_SPLAT_GRID,
-    DEFAULT_SPLAT_SLABS,
-};
-pub use methods::reference::Reference;
-pub use methods::view_slices::{Compositor, Lod, ViewSlices, MAX_PLANES};
-pub use methods::{Method, METHOD_NAMES};
+// The registered methods, each with its knob types (from its folder: see `methods`).
+pub use methods::*;
 
 use crate::error::{Error, FileLoc, Result};
 use std::collections::BTreeMap;

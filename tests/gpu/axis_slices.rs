@@ -115,12 +115,12 @@ fn slice_image_bake_matches_its_twin() {
     };
     let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
     let baked = Baker::new(&voltex::gpu::sources::Sources::project().unwrap()).bake(&ctx, &request).unwrap();
-    let volume = voltex::bake::axis_slices::read_texture(&ctx, &baked.volume, 4).unwrap();
+    let volume = voltex::gpu::readback::read_texture(&ctx, &baked.volume, 4).unwrap();
     let axis = baked.axis.unwrap();
     let gpu: Vec<Vec<f32>> = axis
         .arrays
         .iter()
-        .map(|t| common::f16s(&voltex::bake::axis_slices::read_texture(&ctx, t, 8).unwrap()))
+        .map(|t| common::f16s(&voltex::gpu::readback::read_texture(&ctx, t, 8).unwrap()))
         .collect();
     let words: u64 = (0..3).map(|d| layout::array_layers(res[d]) as u64).sum();
     let occupancy: Vec<u32> =
@@ -173,7 +173,7 @@ fn slice_image_mips_match_their_twin() {
         );
         for level in 1..array.mip_level_count() {
             let read =
-                |l| common::f16s(&voltex::bake::axis_slices::read_texture_level(&ctx, array, l, 8).unwrap());
+                |l| common::f16s(&voltex::gpu::readback::read_texture_level(&ctx, array, l, 8).unwrap());
             let (finer, coarser) = (read(level - 1), read(level));
             let (w, h) = ((array.width() >> (level - 1)).max(1), (array.height() >> (level - 1)).max(1));
             let per_layer = (w * h) as usize * 4;
@@ -224,7 +224,7 @@ fn height_image_bake_matches_its_twin() {
     };
     let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
     let baked = Baker::new(&voltex::gpu::sources::Sources::project().unwrap()).bake(&ctx, &request).unwrap();
-    let gpu = voltex::bake::axis_slices::read_texture(&ctx, &baked.volume, 4).unwrap();
+    let gpu = voltex::gpu::readback::read_texture(&ctx, &baked.volume, 4).unwrap();
     drop(ctx);
     let params = voltex::cpu::bake::bake_params(res, 0, light, ambient);
     let (mut off, mut worst, mut filled) = (0, 0, 0);

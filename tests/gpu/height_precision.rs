@@ -8,8 +8,8 @@ use crate::common;
 
 use common::ctx;
 
-use voltex::bake::axis_slices::read_texture;
 use voltex::bake::Baker;
+use voltex::gpu::readback::read_texture;
 use voltex::gpu::sources::Sources;
 
 const N: u32 = 32; // voxels per axis

@@ -8,13 +8,13 @@ use crate::common;
 use common::ctx;
 use std::path::Path;
 
-use voltex::bake::axis_slices::read_texture;
 use voltex::bake::hypertexture::HyperTexel;
 use voltex::bake::{BakeRequest, BakeSource, Baker};
 use voltex::cpu::bake::bake_params;
 use voltex::cpu::bake_hypertexture::bake_hypertexture_voxel;
 use voltex::cpu::bake_transfer::bake_transfer;
 use voltex::cpu::hypertexture::Model;
+use voltex::gpu::readback::read_texture;
 use voltex::render::{Blueprint, RenderOptions, Renderer};
 use voltex::scene;
 

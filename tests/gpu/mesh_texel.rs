@@ -11,10 +11,10 @@ use std::process::Command;
 use std::sync::Arc;
 
 use glam::DVec3;
-use voltex::bake::axis_slices::read_texture;
 use voltex::bake::{BakeRequest, BakeSource, Baker, MeshTexel};
 use voltex::cpu::bake::{bake_params, pack_shapes, Primitive};
 use voltex::cpu::bake_mesh_texel::bake_mesh_texel;
+use voltex::gpu::readback::read_texture;
 use voltex::hypertexture::mesh;
 use voltex::mesh::obj;
 use voltex::mesh::shape::MeshShape;

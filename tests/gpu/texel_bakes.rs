@@ -5,9 +5,9 @@
 use crate::common;
 
 use common::ctx;
-use voltex::bake::axis_slices::read_texture;
 use voltex::bake::{BakeRequest, BakeSource, Baker};
 use voltex::cpu::bake::{bake_heightfield, bake_implicit, bake_params, pack_shapes, Primitive, TexelVoxels};
+use voltex::gpu::readback::read_texture;
 
 /// Bakes `source` on the GPU: the colour (rgba8unorm) and normal (rgba8snorm) volumes.
 fn bake(

@@ -6,10 +6,10 @@ use crate::common;
 
 use common::{ctx, ok, root, s, voltex};
 
-use voltex::bake::axis_slices::read_texture;
 use voltex::bake::shadow::Shadow;
 use voltex::bake::{BakeRequest, BakeSource, Baker, StackTexels};
 use voltex::cpu::shadow_texel::{shadow_params, shadow_texel};
+use voltex::gpu::readback::read_texture;
 use voltex::gpu::sources::Sources;
 
 fn temp(name: &str) -> std::path::PathBuf {

@@ -179,7 +179,8 @@ fn binning_matches_its_twin() {
 /// barycentrics per fragment and trilinear weights in f64: close pixel by pixel, unbiased.
 #[test]
 fn compositing_matches_its_twin() {
-    use voltex::bake::{axis_slices::read_texture, Baker};
+    use voltex::bake::Baker;
+    use voltex::gpu::readback::read_texture;
     for (name, opaque) in [("torus_egg.ron", false), ("sphere_balls.ron", true)] {
         let text =
             std::fs::read_to_string(example(name)).unwrap().replace("lighting: PerPixel", "lighting: Baked");

@@ -67,9 +67,8 @@ fn texel_layers_match_their_twin() {
     ] {
         assert_eq!(layers.mip_level_count(), texel_layers::mip_levels(res));
         assert_eq!(layers.depth_or_array_layers(), res[2]);
-        let read =
-            |l| common::f16s(&voltex::bake::axis_slices::read_texture_level(&ctx, layers, l, 8).unwrap());
-        let source = decode(&voltex::bake::axis_slices::read_texture(&ctx, volume, 4).unwrap());
+        let read = |l| common::f16s(&voltex::gpu::readback::read_texture_level(&ctx, layers, l, 8).unwrap());
+        let source = decode(&voltex::gpu::readback::read_texture(&ctx, volume, 4).unwrap());
         let level0 = read(0);
         let copied = level0.iter().zip(&source).map(|(a, b)| (a - b).abs()).fold(0.0, f32::max);
         assert!(copied <= 1e-3, "level 0 differs from the volume by {copied}");

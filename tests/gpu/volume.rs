@@ -236,9 +236,9 @@ fn kernel_matches_twin() {
 /// both lightings: within the 8-bit rounding, and normals alike where there is matter.
 #[test]
 fn volume_texel_bake_matches_twin() {
-    use voltex::bake::axis_slices::read_texture;
     use voltex::bake::volume::{bake_volume, VolumeTexel};
     use voltex::bake::{BakeRequest, BakeSource, Baker};
+    use voltex::gpu::readback::read_texture;
     let scene = scene::load(&scene_path("smoke_texel.ron")).unwrap();
     let v = &scene.volumes["smoke"];
     let grid = scene.volume("smoke").unwrap().clone();

@@ -187,6 +187,10 @@ impl crate::scene::methods::MethodKnobs for RayMarch {
         Draws::Densities
     }
 
+    fn imported(&self) -> Option<&'static str> {
+        Some("RayMarch(shading: PhongShadows)")
+    }
+
     fn volumes(&self) -> Option<Result<(), String>> {
         Some(if self.segments != Segments::Bounds || self.adaptive.is_some() {
             Err("a volume node's RayMarch takes `step`, `quality`, `shading` and `shadow_step`: its brick \

@@ -70,6 +70,10 @@ impl crate::scene::methods::MethodKnobs for ViewSlices {
     fn lighting(&self) -> Lighting {
         self.lighting
     }
+
+    fn imported(&self) -> Option<&'static str> {
+        Some("ViewSlices(planes: 256)")
+    }
 }
 
 impl Default for ViewSlices {
