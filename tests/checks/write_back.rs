@@ -92,6 +92,7 @@ fn write_back_keeps_every_comment_of_every_example_scene() {
                 Some("ViewSlices") => ("planes", "300"),
                 Some("RayMarch") | Some("Reference") => ("step", "0.0125"),
                 Some("AxisSlices") => ("depth", "0.5"),
+                Some("ShellMarch") => ("step", "0.5"),
                 other => panic!("{}: method {other:?}", path.display()),
             };
             let mut knob = method.clone();

@@ -341,6 +341,11 @@ fn expand_prism(index: u32) {
         }
     }
     let x = crossings(&shape);
+    // The ray starts inside only if the near point is in the corners' box.
+    let near = ray * t_near;
+    var lo = min(min(shape.bottom[0], shape.bottom[1]), min(shape.bottom[2], min(min(shape.top[0], shape.top[1]), shape.top[2])));
+    var hi = max(max(shape.bottom[0], shape.bottom[1]), max(shape.bottom[2], max(max(shape.top[0], shape.top[1]), shape.top[2])));
+    let may_start_inside = all(near >= lo) && all(near <= hi);
     var t0 = t_near;
     var c0 = vec4<f32>(0.0, 0.0, 0.0, -1.0);
     var at_near = true;
@@ -350,7 +355,10 @@ fn expand_prism(index: u32) {
             continue;
         }
         // Between consecutive crossings the ray is wholly inside or outside: test a third in.
-        let c3 = prism_inverse(ray * mix(t0, t1, 1.0 / 3.0), &shape);
+        var c3 = vec4<f32>(0.0, 0.0, 0.0, -1.0);
+        if (!at_near || may_start_inside) {
+            c3 = prism_inverse(ray * mix(t0, t1, 1.0 / 3.0), &shape);
+        }
         if (c3.w >= 0.0) {
             if (at_near) {
                 c0 = prism_inverse(ray * t0, &shape);
@@ -371,39 +379,58 @@ fn slab(inv: vec3<f32>, node: BvhNode) -> vec2<f32> {
     return vec2<f32>(max(max(lo.x, lo.y), lo.z), min(min(hi.x, hi.y), hi.z));
 }
 
-// Queues node n if the ray crosses its box where samples may still be taken.
+// Queues node n if the ray crosses its box where samples may still be taken (a binary heap on
+// where the ray enters the box).
 fn push_node(n: u32, inv: vec3<f32>) {
     let span = slab(inv, shell_nodes[n]);
-    if (span.x <= span.y && span.y >= t_resume && span.x < t_opaque) {
-        if (heap_count < HEAP_SIZE) {
-            heap_t[heap_count] = span.x;
-            heap_node[heap_count] = n;
-            heap_count += 1u;
-        } else {
-            dropped += 1u;
-        }
+    if (!(span.x <= span.y && span.y >= t_resume && span.x < t_opaque)) {
+        return;
     }
+    if (heap_count >= HEAP_SIZE) {
+        dropped += 1u;
+        return;
+    }
+    var i = heap_count;
+    heap_count += 1u;
+    while (i > 0u && heap_t[(i - 1u) / 2u] > span.x) {
+        heap_t[i] = heap_t[(i - 1u) / 2u];
+        heap_node[i] = heap_node[(i - 1u) / 2u];
+        i = (i - 1u) / 2u;
+    }
+    heap_t[i] = span.x;
+    heap_node[i] = n;
 }
 
-// The queued node the ray enters first.
-fn heap_front() -> u32 {
-    var best = 0u;
-    for (var i = 1u; i < heap_count; i++) {
-        if (heap_t[i] < heap_t[best]) {
-            best = i;
-        }
-    }
-    return best;
+// Where the ray enters the first queued box (FAR: none).
+fn heap_front() -> f32 {
+    return select(FAR, heap_t[0], heap_count > 0u);
 }
 
 // Visits the queued node the ray enters first: a leaf's prisms join, an inner node's children queue.
 fn visit(inv: vec3<f32>) {
     budget -= NODE_COST;
-    let i = heap_front();
-    let node = shell_nodes[heap_node[i]];
+    let node = shell_nodes[heap_node[0]];
     heap_count -= 1u;
-    heap_t[i] = heap_t[heap_count];
-    heap_node[i] = heap_node[heap_count];
+    let t = heap_t[heap_count];
+    let n = heap_node[heap_count];
+    var i = 0u;
+    loop {
+        var c = 2u * i + 1u;
+        if (c >= heap_count) {
+            break;
+        }
+        if (c + 1u < heap_count && heap_t[c + 1u] < heap_t[c]) {
+            c += 1u;
+        }
+        if (heap_t[c] >= t) {
+            break;
+        }
+        heap_t[i] = heap_t[c];
+        heap_node[i] = heap_node[c];
+        i = c;
+    }
+    heap_t[i] = t;
+    heap_node[i] = n;
     if (node.count > 0u) {
         for (var p = 0u; p < node.count; p++) {
             expand_prism(node.first + p);
@@ -446,17 +473,6 @@ fn empty_run(s: u32, c: vec4<f32>, dc: vec4<f32>, most: u32) -> u32 {
     return u32(clamp(run, 0.0, f32(most)));
 }
 
-// The first sample of interval s at or after t (from sample k on).
-fn first_at(s: u32, k: u32, t: f32) -> u32 {
-    var e = u32(clamp(ceil((t - iv_t0[s]) / iv_h[s] - 0.5), f32(k), f32(iv_n[s])));
-    while (e > k && sample_t(s, e - 1u) >= t) {
-        e -= 1u;
-    }
-    while (e < iv_n[s] && sample_t(s, e) < t) {
-        e += 1u;
-    }
-    return e;
-}
 
 struct Axis {
     i0: u32,
@@ -548,29 +564,54 @@ fn composite(s: u32, t: f32, c: vec4<f32>) {
 }
 
 // Samples of interval s before `limit` (its next one in any case: it is the nearest held), in
-// order, until the budget or the ray runs out.
+// order, until the budget or the ray runs out. The interval's state is kept in registers meanwhile
+// (dynamically indexed private arrays are slow on lavapipe).
 fn run(s: u32, limit: f32) {
+    let t0 = iv_t0[s];
+    let h = iv_h[s];
+    let n = iv_n[s];
+    let m = iv_pieces[s];
+    var k = iv_k[s];
+    var t = iv_next[s];
+    var exact = iv_exact[s];
+    var ta = iv_ta[s];
+    var tb = iv_tb[s];
+    var ca = iv_ca[s];
+    var cb = iv_cb[s];
     var first = true;
-    while ((first || iv_next[s] < limit) && budget > 0 && transmittance >= min_transmittance) {
+    while ((first || t < limit) && budget > 0 && transmittance >= min_transmittance) {
         first = false;
-        let t = iv_next[s];
-        while (t >= iv_tb[s] && iv_piece[s] + 1u < iv_pieces[s]) {
-            set_piece(s, iv_piece[s] + 1u, vec4<f32>(0.0));
+        if (t >= tb && iv_piece[s] + 1u < m) {
+            while (t >= iv_tb[s] && iv_piece[s] + 1u < m) {
+                set_piece(s, iv_piece[s] + 1u, vec4<f32>(0.0));
+            }
+            exact = iv_exact[s];
+            ta = iv_ta[s];
+            tb = iv_tb[s];
+            ca = iv_ca[s];
+            cb = iv_cb[s];
         }
         budget -= 1;
         var c: vec4<f32>;
         var dc = vec4<f32>(0.0);
         var most = 1u;
-        if (iv_exact[s]) {
+        if (exact) {
             var shape = load_shape(iv_prism[s]);
             c = prism_inverse(ray * t, &shape);
             budget -= EXACT_COST;
         } else {
-            let span = iv_tb[s] - iv_ta[s];
-            c = mix(iv_ca[s], iv_cb[s], (t - iv_ta[s]) / span);
-            dc = (iv_cb[s] - iv_ca[s]) * (iv_h[s] / span);
-            let last = iv_piece[s] + 1u >= iv_pieces[s];
-            most = first_at(s, iv_k[s], select(min(iv_tb[s], limit), limit, last)) - iv_k[s];
+            c = mix(ca, cb, (t - ta) / (tb - ta));
+            dc = (cb - ca) * (h / (tb - ta));
+            // Skips stay in this piece and before `limit`: the first sample at or after either.
+            let bound = select(min(tb, limit), limit, iv_piece[s] + 1u >= m);
+            var e = u32(clamp(ceil((bound - t0) / h - 0.5), f32(k), f32(n)));
+            while (e > k && t0 + (f32(e - 1u) + 0.5) * h >= bound) {
+                e -= 1u;
+            }
+            while (e < n && t0 + (f32(e) + 0.5) * h < bound) {
+                e += 1u;
+            }
+            most = e - k;
         }
         var step = 1u;
         let jump = select(0u, empty_run(s, c, dc, most), skip_empty && c.w >= 0.0);
@@ -580,9 +621,11 @@ fn run(s: u32, limit: f32) {
         } else {
             composite(s, t, c);
         }
-        iv_k[s] += step;
-        iv_next[s] = select(FAR, sample_t(s, iv_k[s]), iv_k[s] < iv_n[s]);
+        k += step;
+        t = select(FAR, t0 + (f32(k) + 0.5) * h, k < n);
     }
+    iv_k[s] = k;
+    iv_next[s] = t;
 }
 
 // Composites every held sample before `end`, nearest first across intervals.
@@ -686,7 +729,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     var finished = false;
     loop {
-        let front = select(FAR, heap_t[heap_front()], heap_count > 0u);
+        let front = heap_front();
         let next = next_held();
         if (transmittance < min_transmittance || (front >= t_opaque && next >= t_opaque)) {
             finished = true;
@@ -702,8 +745,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
             march_to(min(front, t_opaque));
         }
     }
-    let front = select(FAR, heap_t[heap_front()], heap_count > 0u);
-    t_resume = max(t_resume, min(front, next_held()));
+    t_resume = max(t_resume, min(heap_front(), next_held()));
     shell_march_state[pixel] = ReferenceState(vec4<f32>(rgb, transmittance), vec4<f32>(t_resume, 1.0, select(0.0, 1.0, finished), 0.0));
     textureStore(shell_march_rgba, vec2<i32>(id.xy), vec4<f32>(rgb * frame.light_color.rgb, 1.0 - transmittance));
     if (taken > 0u) {

@@ -11,7 +11,7 @@ mod object;
 mod occupancy;
 pub(crate) mod plugin;
 
-pub use object::{frame_twin_inputs, ShellPlan, ShellSet};
+pub use object::{frame_twin_inputs, ShellSet};
 
 use crate::gpu::bindings::shell_march as B;
 

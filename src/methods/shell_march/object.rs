@@ -27,7 +27,7 @@ const PIECE_COST: f64 = 16.0;
 const MAX_DISPATCHES: u32 = 4096;
 
 /// One ShellMarch object: its knobs; it is drawn by the frame's [`ShellSet`].
-pub struct ShellPlan {
+pub(crate) struct ShellPlan {
     /// The knobs, lighting resolved.
     pub(crate) knobs: ShellMarch,
     /// Dispatches per frame of the set that marches it.
