@@ -26,6 +26,8 @@ macro_rules! for_each_method {
             Reference reference "../methods/reference/knobs.rs",
             /// Ray marching of a hypertexture or volume (Gilet & Dischler 2009).
             RayMarch ray_march "../methods/ray_march/knobs.rs",
+            /// Per-pixel ray casting through the shell, made for speed at a measured error.
+            ShellMarch shell_march "../methods/shell_march/knobs.rs",
             /// A method registered by the tests alone (the worked example of adding one).
             #[cfg(feature = "test-method")]
             ProbeSlices probe_slices "../../tests/method/probe_slices/knobs.rs" in "../../tests/method/probe_slices/mod.rs",

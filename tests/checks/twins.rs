@@ -81,6 +81,11 @@ const NO_TWIN: &[(&str, &str)] = &[
          checked by tests/gpu/reference.rs and the golden images",
     ),
     (
+        "composite_shell_march",
+        "raster: copies the march_shell layer (premultiplied-over blending by the pipeline); \
+         checked by tests/gpu/shell_march.rs and the golden images",
+    ),
+    (
         "blend_tiles",
         "raster: copies the layer composite_tiles made (premultiplied-over blending by the \
          pipeline); checked against the raster compositor's image in tests/gpu/tile_compositor.rs",

@@ -92,6 +92,7 @@ fn write_back_keeps_every_comment_of_every_example_scene() {
                 Some("ViewSlices") => ("planes", "300"),
                 Some("RayMarch") | Some("Reference") => ("step", "0.0125"),
                 Some("AxisSlices") => ("depth", "0.5"),
+                Some("ShellMarch") => ("step", "0.5"),
                 other => panic!("{}: method {other:?}", path.display()),
             };
             let mut knob = method.clone();
@@ -108,6 +109,7 @@ fn write_back_keeps_every_comment_of_every_example_scene() {
                 Some(Method::RayMarch(r)) => r.step == Some(0.0125),
                 Some(Method::Reference(r)) => r.step == Some(0.0125),
                 Some(Method::AxisSlices(a)) => a.depth == 0.5,
+                Some(Method::ShellMarch(s)) => s.step == 0.5,
                 _ => false,
             };
             assert!(ok, "{}: {} = {value} not read back: {got:?}", path.display(), st::show(&knob));

@@ -28,6 +28,7 @@ mod preview_draft;
 mod reference;
 mod regress;
 mod render_scenes;
+mod shell_march;
 mod texel_bakes;
 mod texel_shadow;
 mod tile_compositor;

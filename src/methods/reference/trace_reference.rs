@@ -205,7 +205,7 @@ fn sample(view: &TraceView, objects: &[TraceObject], active: &[&Segment], d: DVe
 
 /// Phong lighting exactly as `draw_slices.wgsl` does it, with the exact barycentrics.
 #[allow(clippy::too_many_arguments)]
-fn shade(
+pub(crate) fn shade(
     view: &TraceView,
     pp: &PerPixel,
     prism: usize,

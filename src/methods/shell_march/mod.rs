@@ -1,0 +1,38 @@
+//! Host side of `ShellMarch` (issue 31): a per-pixel compute ray caster through the shell, made
+//! for speed at a measured error. Its objects share the Reference's layout (one BVH over the
+//! prisms of every ShellMarch object, their shells concatenated, level 0 of their volumes in one
+//! storage buffer: `reference::build`), to which it adds, per prism, whether its map folds, and
+//! per object an occupancy pyramid of its texel (`occupancy.rs`) for empty-space skipping.
+
+/// Its scene-file knobs (`knobs.rs`, compiled in the scene layer: `scene::methods`).
+pub(crate) use crate::scene::methods::shell_march as knobs;
+pub mod march_shell;
+mod object;
+mod occupancy;
+pub(crate) mod plugin;
+
+pub use object::{frame_twin_inputs, ShellSet};
+
+use crate::gpu::bindings::shell_march as B;
+
+/// What ShellMarch brings to the render graph.
+pub(crate) const CONTRIBUTION: super::Contribution = super::Contribution {
+    method: "ShellMarch",
+    filters: &["ShellMarch"],
+    resources: &[
+        B::SHELL_PARAMS,
+        B::SHELL_NODES,
+        B::SHELL_PRISMS,
+        B::SHELL_OBJECTS,
+        B::SHELL_VERTICES,
+        B::VERTEX_FRAMES,
+        B::TEXEL_ATLAS,
+        B::NORMAL_ATLAS,
+        B::SHELL_OCCUPANCY,
+        B::SHELL_MARCH_STATE,
+        B::SHELL_MARCH_COUNTS,
+    ],
+    counts: &["shell_march_dispatches"],
+    texel_resources: &[B::TEXEL_ATLAS],
+    gather: Some(object::gather),
+};

@@ -1,0 +1,337 @@
+//! ShellMarch objects of a frame as the renderer sees them: each object's knobs
+//! ([`ShellPlan`]), and the one graph instance that marches them all ([`ShellSet`]).
+
+use glam::DVec3;
+
+use super::knobs::ShellMarch;
+use super::march_shell::{folds, ShellObject};
+use super::occupancy;
+use crate::cpu::prism_map::PrismCorners;
+use crate::error::{Error, Result};
+use crate::gpu::bindings::shell_march as B;
+use crate::gpu::budget::{Allocation, AllocationKind, Driver};
+use crate::gpu::buffers::{storage, uniform};
+use crate::gpu::Inputs;
+use crate::methods::reference::trace_reference::TraceView;
+use crate::methods::reference::{build, default_step, twin_inputs, Member, ReferenceSet};
+use crate::methods::view::View;
+use crate::methods::{texels, BakePlan, InputCx, MethodPlan, ObjectPlan, PartDecl, PlanCx};
+use crate::scene::{Lighting, Method};
+use crate::types::{FrameParams, ReferenceParams, ReferenceState};
+
+/// Mirrors `samples_per_dispatch` and the costs in march_shell.wgsl.
+const BUDGET: f64 = 2048.0;
+const PRISM_COST: f64 = 32.0;
+const PIECE_COST: f64 = 16.0;
+/// More dispatches than this means a scene far larger than its voxels.
+const MAX_DISPATCHES: u32 = 4096;
+
+/// One ShellMarch object: its knobs; it is drawn by the frame's [`ShellSet`].
+pub(crate) struct ShellPlan {
+    /// The knobs, lighting resolved.
+    pub(crate) knobs: ShellMarch,
+    /// Dispatches per frame of the set that marches it.
+    pub(crate) dispatches: u32,
+}
+
+/// Plans `object`'s bake and lighting.
+pub(crate) fn plan(cx: &mut PlanCx, object: &mut ObjectPlan, m: &ShellMarch) -> Result<()> {
+    object.per_pixel = m.lighting == Lighting::PerPixel;
+    object.frames = object.per_pixel.then(|| crate::mesh::shell::vertex_frames(&object.object.surface));
+    let texel = object.object.texel.clone().unwrap_or_default();
+    let bake = texels::bake_index(cx.scene, &texel, object.per_pixel, cx.light, cx.time, cx.bakes)?;
+    object.bake = Some(bake);
+    object.methods.push(Box::new(ShellPlan { knobs: *m, dispatches: 0 }));
+    Ok(())
+}
+
+/// Everything march_shell.wgsl reads, for all ShellMarch objects of a frame.
+pub struct ShellSet {
+    /// BVH, prisms (`uv2.z`: 1 where the map folds), shells, object table (`params`: opacity
+    /// length, step, tolerance; `atlas.w`: the occupancy offset) and atlases.
+    pub(crate) set: ReferenceSet,
+    /// Per object: its knobs.
+    pub(crate) knobs: Vec<ShellMarch>,
+    /// Words of the occupancy pyramids (at least 1).
+    pub(crate) occupancy_words: u64,
+}
+
+/// The frame's ShellMarch objects as the Reference's layout takes them.
+fn members<'a>(objects: &'a [ObjectPlan], bakes: &[BakePlan]) -> Vec<(Member<'a>, ShellMarch)> {
+    let member = |(index, o): (usize, &'a ObjectPlan)| {
+        let knobs = o.method::<ShellPlan>()?.knobs;
+        let bake = o.bake.unwrap_or(0);
+        let resolution = bakes[bake].request.resolution;
+        let member = Member {
+            index,
+            surface: &o.object.surface,
+            shell: &o.shell,
+            frames: o.frames.as_deref().filter(|_| o.per_pixel),
+            opaque: o.object.base_color.is_some(),
+            step: 2.0 * default_step(&o.object.surface, resolution) * knobs.step.min(1.0),
+            bake,
+            resolution,
+            opacity_length: bakes[bake].opacity_length,
+        };
+        Some((member, knobs))
+    };
+    objects.iter().enumerate().filter_map(member).collect()
+}
+
+/// A bound on the work (budget units) along any ray through the object: a ray meets a shell in a
+/// few stretches (four, for a torus seen edge-on), each no longer than its bounding diagonal.
+fn work_bound(m: &Member) -> f64 {
+    let s = m.surface;
+    let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+    for (p, h) in s.positions.iter().zip(&s.heights) {
+        for q in [*p, *p + *h] {
+            lo = lo.min(q);
+            hi = hi.max(q);
+        }
+    }
+    let edges: f64 =
+        s.triangles.iter().map(|t| (s.positions[t[1] as usize] - s.positions[t[0] as usize]).length()).sum();
+    let edge = (edges / s.triangles.len().max(1) as f64).max(1e-12);
+    let path = 4.0 * (hi - lo).length();
+    let intervals = 2.0 * path / edge + 8.0;
+    path / m.step + intervals * (PRISM_COST + 2.0 * PIECE_COST + 2.0)
+}
+
+/// The set of the frame's ShellMarch objects (see `Contribution::gather`).
+pub(super) fn gather(objects: &mut [ObjectPlan], bakes: &[BakePlan], view: &View) -> Option<Box<dyn MethodPlan>> {
+    let members = members(objects, bakes);
+    if members.is_empty() {
+        return None;
+    }
+    let camera = view.camera();
+    let (r, u) = (camera.right.as_vec3(), camera.up.as_vec3());
+    let params = ReferenceParams {
+        right: [r.x, r.y, r.z, view.near as f32],
+        up: [u.x, u.y, u.z, view.far as f32],
+        counts: [0; 4],
+    };
+    let (list, knobs): (Vec<Member>, Vec<ShellMarch>) = members.into_iter().unzip();
+    let mut set = build(&list, params);
+    let mut offset = 0u64;
+    for ((entry, k), m) in set.table.iter_mut().zip(&knobs).zip(&list) {
+        entry.params[1] = k.step as f32;
+        entry.params[2] = k.tolerance as f32;
+        entry.atlas[3] = offset as u32;
+        offset += occupancy::words(m.resolution);
+    }
+    let v3 = |a: [f32; 4]| DVec3::new(a[0] as f64, a[1] as f64, a[2] as f64);
+    for p in &mut set.prisms {
+        let ids = [p.vertices[0], p.vertices[1], p.vertices[2]];
+        let corners = PrismCorners {
+            bottom: ids.map(|v| v3(set.vertices[v as usize].bottom)),
+            top: ids.map(|v| v3(set.vertices[v as usize].top)),
+            ids,
+        };
+        p.uv2[2] = folds(&corners) as u32 as f32;
+    }
+    let work: f64 = list.iter().map(work_bound).sum();
+    // Twice the bound: each dispatch walks again to where the last one stopped.
+    set.dispatches = ((2.0 * work / BUDGET).ceil() + 1.0).min(u32::MAX as f64) as u32;
+    for o in objects.iter_mut().filter_map(|o| o.method_mut::<ShellPlan>()) {
+        o.dispatches = set.dispatches;
+    }
+    Some(Box::new(ShellSet { set, knobs, occupancy_words: offset.max(1) }))
+}
+
+impl ShellSet {
+    /// The kernel's override constants: the lowest cutoff of its objects; skipping unless one
+    /// turns it off.
+    fn constants(&self) -> Vec<(String, f64)> {
+        let cutoff = self.knobs.iter().map(|k| k.min_transmittance).fold(1.0, f64::min);
+        let skip = self.knobs.iter().all(|k| k.skip_empty);
+        vec![("min_transmittance".into(), cutoff), ("skip_empty".into(), skip as u32 as f64)]
+    }
+
+    /// Per-pixel state and counters, the tables, the atlases (copied from the bakes) and the
+    /// occupancy pyramids (made from the atlas, read back once).
+    fn add_inputs(&self, cx: &InputCx, inputs: &mut Inputs) -> Result<()> {
+        let (ctx, set) = (cx.ctx, &self.set);
+        inputs.counts.insert("shell_march_dispatches".into(), set.dispatches);
+        inputs.constants.extend(self.constants());
+        let pixels = cx.size.0 as u64 * cx.size.1 as u64;
+        let empty = |label: &str, bytes: u64, read: bool| {
+            let read = if read { wgpu::BufferUsages::COPY_SRC } else { wgpu::BufferUsages::empty() };
+            ctx.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: bytes,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST | read,
+                mapped_at_creation: false,
+            })
+        };
+        let state_bytes = pixels * std::mem::size_of::<ReferenceState>() as u64;
+        let b = &mut inputs.buffers;
+        b.insert(B::SHELL_MARCH_STATE.into(), empty("shell_march_state", state_bytes, true));
+        b.insert(B::SHELL_MARCH_COUNTS.into(), empty("shell_march_counts", 16, true));
+        b.insert(B::SHELL_PARAMS.into(), uniform(ctx, "shell_params", bytemuck::bytes_of(&set.params)));
+        let nodes = if set.nodes.is_empty() { vec![Default::default()] } else { set.nodes.clone() };
+        b.insert(B::SHELL_NODES.into(), storage(ctx, "shell_nodes", bytemuck::cast_slice(&nodes)));
+        b.insert(B::SHELL_PRISMS.into(), storage(ctx, "shell_prisms", bytemuck::cast_slice(&set.prisms)));
+        b.insert(B::SHELL_OBJECTS.into(), storage(ctx, "shell_objects", bytemuck::cast_slice(&set.table)));
+        b.insert(B::SHELL_VERTICES.into(), storage(ctx, "shell_vertices", bytemuck::cast_slice(&set.vertices)));
+        b.insert(B::VERTEX_FRAMES.into(), storage(ctx, "vertex_frames", bytemuck::cast_slice(&set.frames)));
+        for (name, words) in [(B::TEXEL_ATLAS, set.atlas_words), (B::NORMAL_ATLAS, set.normal_words)] {
+            b.insert(name.into(), empty(name, words * 4, true));
+        }
+        set.copy_volumes(ctx, inputs, cx.baked);
+        let atlas = ctx.read_buffer(&inputs.buffers[B::TEXEL_ATLAS], 0, set.atlas_words * 4)?;
+        let b = &mut inputs.buffers;
+        let mut pyramids = Vec::with_capacity(self.occupancy_words as usize);
+        for entry in &set.table {
+            let res = [entry.resolution[0], entry.resolution[1], entry.resolution[2]];
+            pyramids.extend(occupancy::pyramid(&occupancy::atlas_alpha(&atlas, res, entry.atlas[0], entry.atlas[1]), res));
+        }
+        pyramids.resize(self.occupancy_words as usize, 0);
+        b.insert(B::SHELL_OCCUPANCY.into(), storage(ctx, "shell_occupancy", bytemuck::cast_slice(&pyramids)));
+        Ok(())
+    }
+}
+
+/// Inputs of the f64 twin for a frame, from its objects, bakes and set and the atlases the kernel
+/// read.
+pub fn frame_twin_inputs(
+    objects: &[ObjectPlan],
+    bakes: &[BakePlan],
+    set: &ShellSet,
+    frame: (&FrameParams, (u32, u32), DVec3),
+    texel_atlas: &[u8],
+    normal_atlas: &[u8],
+) -> (TraceView, Vec<ShellObject>) {
+    let (list, knobs): (Vec<Member>, Vec<ShellMarch>) = members(objects, bakes).into_iter().unzip();
+    let (view, traced) = twin_inputs(&set.set, &list, frame, texel_atlas, normal_atlas);
+    let objects = traced
+        .into_iter()
+        .zip(knobs)
+        .map(|(trace, k)| ShellObject { trace, step: k.step, tolerance: k.tolerance })
+        .collect();
+    (view, objects)
+}
+
+fn lighting(object: &ObjectPlan) -> Lighting {
+    if object.per_pixel {
+        Lighting::PerPixel
+    } else {
+        Lighting::Baked
+    }
+}
+
+impl MethodPlan for ShellPlan {
+    fn parts(&self) -> Vec<PartDecl> {
+        Vec::new()
+    }
+
+    fn add_inputs(&self, _cx: &InputCx, _object: &ObjectPlan, _part: usize, _inputs: &mut Inputs) {}
+
+    fn summary(&self, object: &ObjectPlan) -> String {
+        let k = &self.knobs;
+        format!(
+            "ShellMarch step {} voxel(s), tolerance {} voxel(s), stop below {}, skipping {}, lighting {:?}, {} dispatch(es) per frame",
+            k.step,
+            k.tolerance,
+            k.min_transmittance,
+            if k.skip_empty { "on" } else { "off" },
+            lighting(object),
+            self.dispatches
+        )
+    }
+
+    fn metadata(&self, object: &ObjectPlan) -> String {
+        self.scene_method(object).map(|m| m.text()).unwrap_or_default()
+    }
+
+    fn memory(&self, _object: &ObjectPlan, _size: (u32, u32)) -> Vec<(String, u64)> {
+        Vec::new()
+    }
+
+    fn scene_method(&self, object: &ObjectPlan) -> Option<Method> {
+        Some(Method::ShellMarch(ShellMarch { lighting: lighting(object), ..self.knobs }))
+    }
+
+    crate::any_plan!();
+}
+
+impl MethodPlan for ShellSet {
+    fn parts(&self) -> Vec<PartDecl> {
+        vec![PartDecl { filters: vec!["ShellMarch"], order: 0 }]
+    }
+
+    fn distance(&self, _eye: DVec3) -> Option<f64> {
+        Some(0.0)
+    }
+
+    fn members(&self) -> &[usize] {
+        &self.set.objects
+    }
+
+    /// Samples composited (not those skipped) over the frame.
+    fn evaluations(&self, read: &mut dyn FnMut(&str) -> Result<Vec<u8>>) -> Result<Option<f64>> {
+        let counts: Vec<u32> = bytemuck::pod_collect_to_vec(&read(B::SHELL_MARCH_COUNTS)?);
+        Ok(counts.first().map(|&n| n as f64))
+    }
+
+    fn constants(&self) -> Vec<(String, f64)> {
+        ShellSet::constants(self)
+    }
+
+    fn check_limits(&self, _object: &ObjectPlan, limits: &wgpu::Limits) -> Result<()> {
+        if self.set.dispatches > MAX_DISPATCHES {
+            return Err(Error::Invalid(format!(
+                "ShellMarch: {} dispatches per frame (at most {MAX_DISPATCHES}): the objects are too large \
+                 for their voxels; use a larger `step`",
+                self.set.dispatches
+            )));
+        }
+        self.set.check_limits(limits.max_storage_buffer_binding_size)
+    }
+
+    fn add_inputs(&self, cx: &InputCx, _object: &ObjectPlan, _part: usize, inputs: &mut Inputs) {
+        // A failed read-back leaves the pyramid out: the plan's binding check then names it.
+        if let Err(e) = ShellSet::add_inputs(self, cx, inputs) {
+            eprintln!("ShellMarch: {e}");
+        }
+    }
+
+    fn summary(&self, _object: &ObjectPlan) -> String {
+        let folded = self.set.prisms.iter().filter(|p| p.uv2[2] != 0.0).count();
+        format!(
+            "ShellMarch set of {} object(s): {} prisms ({folded} folded, mapped exactly), {} dispatch(es) per frame",
+            self.set.objects.len(),
+            self.set.prisms.len(),
+            self.set.dispatches
+        )
+    }
+
+    fn metadata(&self, object: &ObjectPlan) -> String {
+        self.summary(object)
+    }
+
+    fn allocations(&self, _object: &ObjectPlan, size: (u32, u32)) -> Vec<Allocation> {
+        vec![Allocation {
+            what: format!("the ShellMarch per-pixel state at {}x{}", size.0, size.1),
+            bytes: size.0 as u64 * size.1 as u64 * std::mem::size_of::<ReferenceState>() as u64,
+            shape: AllocationKind::Buffer { storage: true },
+            driver: Driver::Output,
+        }]
+    }
+
+    fn memory(&self, _object: &ObjectPlan, size: (u32, u32)) -> Vec<(String, u64)> {
+        let s = &self.set;
+        vec![(
+            format!(
+                "shell march: BVH ({} nodes), {} prisms, shells, texel atlas{}, occupancy pyramids, per-pixel state",
+                s.nodes.len(),
+                s.prisms.len(),
+                if s.normal_words > 1 { " + normal atlas" } else { "" }
+            ),
+            (s.nodes.len() * 32 + s.prisms.len() * 48 + s.vertices.len() * 32 + s.frames.len() * 32) as u64
+                + (s.atlas_words + s.normal_words + self.occupancy_words) * 4
+                + size.0 as u64 * size.1 as u64 * 32,
+        )]
+    }
+
+    crate::any_plan!();
+}
