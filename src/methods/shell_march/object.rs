@@ -68,7 +68,9 @@ fn members<'a>(objects: &'a [ObjectPlan], bakes: &[BakePlan]) -> Vec<(Member<'a>
             shell: &o.shell,
             frames: o.frames.as_deref().filter(|_| o.per_pixel),
             opaque: o.object.base_color.is_some(),
-            step: 2.0 * default_step(&o.object.surface, resolution) * knobs.step.min(1.0),
+            step: 2.0
+                * default_step(&o.object.surface, o.object.prepared().frames(&o.object.surface), resolution)
+                * knobs.step.min(1.0),
             bake,
             resolution,
             opacity_length: bakes[bake].opacity_length,
