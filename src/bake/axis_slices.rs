@@ -7,6 +7,7 @@ use crate::gpu::kernel::ComputeKernel;
 use crate::gpu::GpuContext;
 use crate::gpu::Inputs;
 use crate::types::AxisBake;
+use super::texel_layers;
 
 /// A texel's AxisSlices slice images (Meyer & Neyret 1998), baked along s, t and w.
 #[derive(Clone)]
@@ -35,18 +36,7 @@ pub(crate) fn image_size(res: [u32; 3], direction: usize) -> [u32; 2] {
 /// Bytes of the slice arrays (f16 RGBA, with their MIP levels when `mipmaps`) and occupancy
 /// words of a texel.
 pub(crate) fn bytes(res: [u32; 3], mipmaps: bool) -> u64 {
-    (0..3).map(|d| (image_bytes(image_size(res, d), mipmaps) + 4) * array_layers(res[d]) as u64).sum()
-}
-
-/// Bytes of one f16 RGBA slice image of `size`, with its MIP levels when `mipmaps`.
-pub(crate) fn image_bytes(size: [u32; 2], mipmaps: bool) -> u64 {
-    let levels = if mipmaps { mip_levels(size) } else { 1 };
-    (0..levels).map(|l| (size[0] >> l).max(1) as u64 * (size[1] >> l).max(1) as u64 * 8).sum()
-}
-
-/// MIP levels of a slice image of `size`, down to 1x1.
-pub fn mip_levels(size: [u32; 2]) -> u32 {
-    32 - size[0].max(size[1]).max(1).leading_zeros()
+    (0..3).map(|d| (texel_layers::image_bytes(image_size(res, d), mipmaps) + 4) * array_layers(res[d]) as u64).sum()
 }
 
 /// Records the bake of every level of every direction from `volume` (level 0 is read).
@@ -78,7 +68,7 @@ pub(crate) fn bake(
     let arrays = [0, 1, 2].map(|d| {
         let [w, h] = image_size(res, d);
         let label = ["axis_slices_s", "axis_slices_t", "axis_slices_w"][d];
-        let levels = if mipmaps { mip_levels([w, h]) } else { 1 };
+        let levels = if mipmaps { texel_layers::image_levels([w, h]) } else { 1 };
         super::texel_layers::texture(ctx, label, [w, h], array_layers(res[d]), levels)
     });
     let source = crate::bake::level_view(volume, 0);

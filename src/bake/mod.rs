@@ -269,7 +269,7 @@ impl BakeRequest {
                 let layers = axis_slices::array_layers(res[d]);
                 out.push(Allocation {
                     what: format!("texel \"{texel}\"'s {} slice images", ["s", "t", "w"][d]),
-                    bytes: axis_slices::image_bytes(size, self.axis_mipmaps) * layers as u64,
+                    bytes: texel_layers::image_bytes(size, self.axis_mipmaps) * layers as u64,
                     shape: AllocationKind::Texture2d { size, layers },
                     driver: driver.clone(),
                 });

@@ -15,13 +15,23 @@ pub(crate) const MIP_KERNEL: &str = "bake/mip_layers.wgsl";
 
 /// MIP levels of the layers of a texel of `res`: s and t halve down to 1x1, w stays.
 pub fn mip_levels(res: [u32; 3]) -> u32 {
-    super::axis_slices::mip_levels([res[0], res[1]])
+    image_levels([res[0], res[1]])
 }
 
-/// Bytes of the layers of a texel of `res` (f16 RGBA, every level): one layer a w voxel, each
-/// as an AxisSlices w slice image with its MIP levels.
+/// Bytes of the layers of a texel of `res` (f16 RGBA, every level): one layer a w voxel.
 pub(crate) fn bytes(res: [u32; 3]) -> u64 {
-    super::axis_slices::image_bytes([res[0], res[1]], true) * res[2] as u64
+    image_bytes([res[0], res[1]], true) * res[2] as u64
+}
+
+/// MIP levels of a 2D image of `size` (a layer, a slice image), down to 1x1.
+pub fn image_levels(size: [u32; 2]) -> u32 {
+    32 - size[0].max(size[1]).max(1).leading_zeros()
+}
+
+/// Bytes of one f16 RGBA image of `size`, with its MIP levels when `mipmaps`.
+pub(crate) fn image_bytes(size: [u32; 2], mipmaps: bool) -> u64 {
+    let levels = if mipmaps { image_levels(size) } else { 1 };
+    (0..levels).map(|l| (size[0] >> l).max(1) as u64 * (size[1] >> l).max(1) as u64 * 8).sum()
 }
 
 /// A 2D texture array of `layers` layers of `size`, `levels` MIP levels, f16 RGBA (texel layers,

@@ -169,7 +169,7 @@ fn slice_image_mips_match_their_twin() {
     for (direction, array) in baked.axis.unwrap().arrays.iter().enumerate() {
         assert_eq!(
             array.mip_level_count(),
-            voltex::bake::axis_slices::mip_levels([array.width(), array.height()])
+            voltex::bake::texel_layers::image_levels([array.width(), array.height()])
         );
         for level in 1..array.mip_level_count() {
             let read =
