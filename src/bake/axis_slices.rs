@@ -2,12 +2,12 @@
 //! texture array holding every power-of-two level (finest first), each coarser slice combining
 //! `2^level` voxel slices, and one occupancy word per slice for empty-slice culling.
 
+use super::texel_layers;
 use crate::error::{Error, Result};
 use crate::gpu::kernel::ComputeKernel;
 use crate::gpu::GpuContext;
 use crate::gpu::Inputs;
 use crate::types::AxisBake;
-use super::texel_layers;
 
 /// A texel's AxisSlices slice images (Meyer & Neyret 1998), baked along s, t and w.
 #[derive(Clone)]
@@ -36,7 +36,9 @@ pub(crate) fn image_size(res: [u32; 3], direction: usize) -> [u32; 2] {
 /// Bytes of the slice arrays (f16 RGBA, with their MIP levels when `mipmaps`) and occupancy
 /// words of a texel.
 pub(crate) fn bytes(res: [u32; 3], mipmaps: bool) -> u64 {
-    (0..3).map(|d| (texel_layers::image_bytes(image_size(res, d), mipmaps) + 4) * array_layers(res[d]) as u64).sum()
+    (0..3)
+        .map(|d| (texel_layers::image_bytes(image_size(res, d), mipmaps) + 4) * array_layers(res[d]) as u64)
+        .sum()
 }
 
 /// Records the bake of every level of every direction from `volume` (level 0 is read).

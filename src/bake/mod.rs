@@ -147,7 +147,7 @@ impl BakeRequest {
             BakeSource::Stack(_) => vec![],
             BakeSource::Mesh(_) => vec!["bake/bake_mesh_grid.wgsl", "bake/bake_mesh_texel.wgsl"],
             BakeSource::Hypertexture(h) => {
-                let mut k = vec!["ray_march/bake_transfer.wgsl", "bake/bake_hypertexture.wgsl"];
+                let mut k = vec!["bake/bake_transfer.wgsl", "bake/bake_hypertexture.wgsl"];
                 k.extend(h.packed.grid_kernel());
                 k
             }
@@ -531,7 +531,7 @@ impl Baker {
             BakeSource::Hypertexture(ht) => {
                 let format = self.format;
                 let transfer =
-                    Self::kernel(&mut self.transfer, ctx, &root, "ray_march/bake_transfer.wgsl", format)?;
+                    Self::kernel(&mut self.transfer, ctx, &root, "bake/bake_transfer.wgsl", format)?;
                 let hyper = Self::kernel(&mut self.hyper, ctx, &root, "bake/bake_hypertexture.wgsl", format)?;
                 ht.bake(ctx, (transfer, hyper), &mut encoder, &mut inputs, params)?;
             }

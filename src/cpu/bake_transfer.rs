@@ -1,4 +1,4 @@
-//! CPU twin (f64) of `wgsl/ray_march/bake_transfer.wgsl`: transfer functions sampled into tables of
+//! CPU twin (f64) of `wgsl/bake/bake_transfer.wgsl`: transfer functions sampled into tables of
 //! `TRANSFER_SIZE` entries over [0, 1].
 
 use crate::types::{TransferFunction, TransferPoint};

@@ -147,6 +147,16 @@ impl GpuContext {
         )
     }
 
+    /// The adapter's name, type, backend and driver.
+    pub fn info(&self) -> &wgpu::AdapterInfo {
+        &self.info
+    }
+
+    /// The optional features the device was opened with (see `OPTIONAL_FEATURES`).
+    pub fn features(&self) -> wgpu::Features {
+        self.features
+    }
+
     pub(crate) fn has_timestamps(&self) -> bool {
         self.features
             .contains(wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS)

@@ -2,6 +2,7 @@
 // Each test binary uses only some helpers.
 #![allow(dead_code)]
 
+pub mod adapter;
 pub mod golden;
 pub mod window;
 

@@ -2,12 +2,15 @@
 //! floor under the right half, seen from straight above, give known transmittance, per-object
 //! coverage and depth; the EXR holds them as named channels with the metadata and camera
 //! attributes that say how the image was made.
+use crate::common::adapter::{gpu, Expectations};
+
+/// What these tests assume of the adapter: WebGPU's defaults.
+const ADAPTER: Expectations = Expectations::DEFAULTS;
 
 use crate::common;
 
 use std::path::Path;
 
-use common::ctx;
 use glam::DVec3;
 use voltex::render::{Blueprint, MethodKind, RenderOptions, Renderer};
 use voltex::scene::{self, Scene};
@@ -63,7 +66,7 @@ fn channel<'a>(frame: &'a voltex::render::Frame, name: &str) -> &'a [f32] {
 }
 
 fn render(scene: &Scene, opts: RenderOptions) -> (voltex::render::Frame, Renderer) {
-    let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
+    let ctx = crate::common::adapter::device(&ADAPTER);
     let mut r = Renderer::new(&ctx, Blueprint::new(scene, &opts).unwrap()).unwrap();
     let frame = r.render(&ctx).unwrap();
     (frame, r)
@@ -159,7 +162,7 @@ Scene(
 #[test]
 fn exr_channels_metadata_and_camera_round_trip() {
     let (frame, r) = render(&scene(0.3), RenderOptions { time: Some(1.25), ..Default::default() });
-    let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
+    let ctx = gpu!(ADAPTER);
     let meta = r.metadata(&ctx, &frame);
     drop(ctx);
     let path = common::scratch_dir("aov_exr").join("slab.exr");

@@ -2,10 +2,13 @@
 //! angles (CPU twin), the kernels against their twins on the same inputs, the slice-image bake
 //! against its twin, brightness independent of the level, the error against the reference at a
 //! grazing view with three directions and with horizontal slices only, and bad knobs.
+use crate::common::adapter::{gpu, Expectations};
+
+/// What these tests assume of the adapter: WebGPU's defaults.
+const ADAPTER: Expectations = Expectations::DEFAULTS;
 
 use crate::common;
 
-use common::ctx;
 use std::path::{Path, PathBuf};
 
 use glam::{Vec2, Vec3};
@@ -113,7 +116,7 @@ fn slice_image_bake_matches_its_twin() {
         layers: false,
         shadow: None,
     };
-    let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
+    let ctx = gpu!(ADAPTER);
     let baked = Baker::new(&voltex::gpu::sources::Sources::project().unwrap()).bake(&ctx, &request).unwrap();
     let volume = voltex::gpu::readback::read_texture(&ctx, &baked.volume, 4).unwrap();
     let axis = baked.axis.unwrap();
@@ -163,7 +166,7 @@ fn slice_image_mips_match_their_twin() {
         layers: false,
         shadow: None,
     };
-    let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
+    let ctx = gpu!(ADAPTER);
     let baked = Baker::new(&voltex::gpu::sources::Sources::project().unwrap()).bake(&ctx, &request).unwrap();
     let mut checked = 0;
     for (direction, array) in baked.axis.unwrap().arrays.iter().enumerate() {
@@ -222,7 +225,7 @@ fn height_image_bake_matches_its_twin() {
         layers: false,
         shadow: None,
     };
-    let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
+    let ctx = gpu!(ADAPTER);
     let baked = Baker::new(&voltex::gpu::sources::Sources::project().unwrap()).bake(&ctx, &request).unwrap();
     let gpu = voltex::gpu::readback::read_texture(&ctx, &baked.volume, 4).unwrap();
     drop(ctx);
@@ -247,7 +250,7 @@ fn height_image_bake_matches_its_twin() {
 fn gpu_and_twin(scene: &Path, opts: &RenderOptions) -> usize {
     let scene = scene::load(scene).unwrap();
     let bp = Blueprint::new(&scene, opts).unwrap();
-    let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
+    let ctx = gpu!(ADAPTER);
     let mut r = Renderer::new(&ctx, bp).unwrap();
     r.render(&ctx).unwrap();
     let mut checked = 0;
@@ -340,7 +343,7 @@ fn render_culled(path: &Path, culling: bool) -> (Image, usize, usize) {
         occlusion_culling: Some(culling),
         ..Default::default()
     };
-    let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
+    let ctx = crate::common::adapter::device(&ADAPTER);
     let mut r = Renderer::new(&ctx, Blueprint::new(&scene, &opts).unwrap()).unwrap();
     let image = r.render(&ctx).unwrap().image;
     let (mut prisms, mut culled) = (0, 0);
@@ -392,7 +395,7 @@ fn occlusion_culling_never_changes_the_image() {
 fn render(scene: &str, opts: &RenderOptions) -> Image {
     let scene = scene::parse(scene, Path::new("inline.ron")).unwrap();
     let bp = Blueprint::new(&scene, opts).unwrap();
-    let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
+    let ctx = crate::common::adapter::device(&ADAPTER);
     let mut r = Renderer::new(&ctx, bp).unwrap();
     r.render(&ctx).unwrap().image
 }
@@ -558,11 +561,11 @@ fn grouping_by_slice_image_draws_the_same_image() {
         let opts = RenderOptions { size: Some((64, 64)), ..Default::default() };
         let parse = |t: &str| scene::parse(t, &example("x.ron")).unwrap();
         let a = {
-            let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
+            let ctx = gpu!(ADAPTER);
             let mut r = Renderer::new(&ctx, Blueprint::new(&parse(&text), &opts).unwrap()).unwrap();
             r.render(&ctx).unwrap().image
         };
-        let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
+        let ctx = gpu!(ADAPTER);
         let mut r = Renderer::new(&ctx, Blueprint::new(&parse(&grouped(&text)), &opts).unwrap()).unwrap();
         let b = r.render(&ctx).unwrap().image;
         // The grouped half of the vertex buffer: every triangle once, slice images contiguous.
@@ -610,7 +613,7 @@ fn grouping_by_slice_image_draws_the_same_image() {
 #[test]
 #[ignore]
 fn draw_order_times() {
-    let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
+    let ctx = gpu!(ADAPTER);
     eprintln!("scene | triangles | draw ms by texel | draw ms by slice | group ms");
     for name in ["pear", "pears_on_sphere", "heightfield_plane", "heightfield_sphere", "pear_mesh", "bushes"]
     {
@@ -692,7 +695,7 @@ fn error_against_view_angle_stays_bounded_with_three_directions() {
 #[test]
 #[ignore]
 fn triangle_counts_and_times() {
-    let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
+    let ctx = gpu!(ADAPTER);
     eprintln!(
         "scene | prisms | finest | drawn: culling+LOD / no culling / no LOD | draw ms: same three | frame ms (wall): same three"
     );

@@ -1,10 +1,13 @@
 //! `voltex export` through the library: a constant texel on a plane (analytic density, colour
 //! and tile), a hypertexture node against the bake kernel's CPU twin at full precision (no 8-bit
 //! steps), and the written file read back by vdb-rs.
+use crate::common::adapter::{gpu, Expectations};
+
+/// What these tests assume of the adapter: WebGPU's defaults.
+const ADAPTER: Expectations = Expectations::DEFAULTS;
 
 use crate::common;
 
-use common::ctx;
 use std::path::Path;
 
 use glam::{DMat4, DVec3};
@@ -43,7 +46,7 @@ fn a_constant_texel_on_a_plane_exports_its_extinction_colour_and_tile() {
     let e = &exports[0];
     assert!(e.note.is_none(), "{:?}", e.note);
     let rgba = {
-        let ctx = ctx().lock().unwrap();
+        let ctx = gpu!(ADAPTER);
         export::bake(&ctx, &mut Baker::full_precision(&Sources::project().unwrap()), e).unwrap()
     };
     let grids = export::grids(e, &rgba);
@@ -108,7 +111,7 @@ fn a_hypertexture_node_exports_the_kernels_values_at_full_precision() {
     assert_eq!((e.name.as_str(), e.resolution()), ("cloud", [20, 20, 20]));
     let export::Source::Bake { request, .. } = &e.source else { panic!("a bake") };
     let rgba = {
-        let ctx = ctx().lock().unwrap();
+        let ctx = gpu!(ADAPTER);
         export::bake(&ctx, &mut Baker::full_precision(&Sources::project().unwrap()), e).unwrap()
     };
     let BakeSource::Hypertexture(ht) = &request.source else { panic!("a hypertexture bake") };
@@ -216,7 +219,7 @@ fn an_exported_volume_node_renders_like_the_original() {
 
 fn render(scene: &scene::Scene) -> Vec<[f32; 4]> {
     let bp = voltex::render::Blueprint::new(scene, &common::sized(40, 40)).unwrap();
-    let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
+    let ctx = gpu!(ADAPTER);
     let mut r = voltex::render::Renderer::new(&ctx, bp).unwrap();
     r.render(&ctx).unwrap().image.pixels
 }

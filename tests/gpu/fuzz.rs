@@ -15,6 +15,10 @@
 //! `VOLTEX_FUZZ_FROM=K` resumes a campaign at input K. A failure is
 //! shrunk by proptest to a minimal input, printed; it then becomes a named test in
 //! `fuzz_regressions` below.
+use crate::common::adapter::{gpu, Expectations};
+
+/// What these tests assume of the adapter: WebGPU's defaults.
+const ADAPTER: Expectations = Expectations::DEFAULTS;
 
 mod gpu_paths;
 mod graphs;
@@ -894,7 +898,7 @@ struct V {{ @builtin(position) p: vec4<f32>, @location({vout}) c: vec4<f32> }}
         let text = base.replacen(from, "opacity_length: 1e-15", 1);
         let scene = voltex::scene::parse(&text, &path).unwrap();
         let opts = RenderOptions { size: Some((16, 16)), ..Default::default() };
-        let ctx = crate::common::ctx().lock().unwrap_or_else(|e| e.into_inner());
+        let ctx = gpu!(ADAPTER);
         let mut r = voltex::render::Renderer::new(&ctx, Blueprint::new(&scene, &opts).unwrap()).unwrap();
         let image = r.render(&ctx).unwrap().image;
         assert!(image.pixels.iter().flatten().all(|c| c.is_finite()));

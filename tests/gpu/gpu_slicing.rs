@@ -1,12 +1,14 @@
 //! The view-slicing kernels (count, scan, emit) on software Vulkan against their CPU twin
 //! (`methods::view_slices::slice_prisms`), on random shells and planes and on the hard cases.
+use crate::common::adapter::{gpu, Expectations};
+
+/// What these tests assume of the adapter: WebGPU's defaults.
+const ADAPTER: Expectations = Expectations::DEFAULTS;
 
 use std::collections::BTreeMap;
-use std::sync::OnceLock;
 
 use glam::{DVec2, DVec3};
 use voltex::gpu::timing::Timer;
-use voltex::gpu::GpuContext;
 use voltex::gpu::Inputs;
 use voltex::graph::exec::Executor;
 use voltex::graph::plan::{self, ObjectInfo};
@@ -17,14 +19,10 @@ use voltex::methods::view_slices;
 use voltex::methods::view_slices::slice_prisms;
 use voltex::types::{SliceParams, SliceVertex};
 
-fn ctx() -> &'static GpuContext {
-    static CTX: OnceLock<GpuContext> = OnceLock::new();
-    CTX.get_or_init(|| GpuContext::new().expect("a GPU adapter (software Vulkan: mesa-vulkan-drivers)"))
-}
-
 /// Runs the slicing kernels through the `slices_only` graph and reads the polygons back.
 fn gpu_slices(shell: &Shell, params: &SliceParams, trivial_reject: bool) -> Vec<Vec<SliceVertex>> {
-    let ctx = ctx();
+    let guard = gpu!(ADAPTER);
+    let ctx = &*guard;
     let root = voltex::project_root();
     let graph = Graph::load(&root.join("graphs/slices_only.ron")).unwrap();
     let info = ObjectInfo { name: "shell".into(), filters: vec!["ViewSlices"], distance: 0.0, order: 0 };

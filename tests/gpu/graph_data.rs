@@ -3,6 +3,10 @@
 //! drawing it as bars over the output, tuned by two graph parameters, each a WGSL file beside the
 //! graph: rendered by the `voltex` binary and the library and checked against the CPU; picked up
 //! live by the preview's reload; and the errors of sizes and types at `file:line:col`.
+use crate::common::adapter::{gpu, Expectations};
+
+/// What these tests assume of the adapter: WebGPU's defaults.
+const ADAPTER: Expectations = Expectations::DEFAULTS;
 
 use crate::common;
 
@@ -178,7 +182,7 @@ fn histogram_buffer_and_overlay_from_the_graph_alone() {
 
     // The library: the histogram read back against one counted on the CPU from `hdr`, twice (the
     // buffer is zeroed each frame, not accumulated).
-    let ctx = common::ctx().lock().unwrap_or_else(|e| e.into_inner());
+    let ctx = gpu!(ADAPTER);
     let bp = Blueprint::new(&scene, &options(Some(&graph))).unwrap();
     assert_eq!(bp.plan.buffers["luminance_histogram"].bytes, 256);
     let mut r = Renderer::new(&ctx, bp).unwrap();
@@ -246,7 +250,7 @@ fn preview_picks_up_a_new_buffer_and_pass() {
     let dir = common::scratch_dir("voltex-graph-data-preview");
     let graph = dir.join("frame.ron");
     std::fs::write(&graph, frame_ron()).unwrap();
-    let ctx = common::ctx().lock().unwrap_or_else(|e| e.into_inner());
+    let ctx = gpu!(ADAPTER);
     let mut s = Session::open(&ctx, &scene_path(), options(Some(&graph)));
     assert!(s.error.is_none(), "{:?}", s.error);
     let plain = s.render(&ctx).unwrap().unwrap().image;

@@ -6,10 +6,11 @@
 //! failure (horizontal slices only at a grazing view) is asserted as a failure. Unit cases on
 //! the CPU twins (prism map inverse, ray intervals, slice polygons, axis choice) cover the
 //! degenerate prism geometries.
+use crate::common::adapter::{gpu, Expectations};
 
-use crate::common;
+/// What these tests assume of the adapter: WebGPU's defaults.
+const ADAPTER: Expectations = Expectations::DEFAULTS;
 
-use common::ctx;
 use std::path::PathBuf;
 
 use voltex::cpu::bake_transfer::bake_transfer;
@@ -67,7 +68,7 @@ fn render(name: &str, source: &str, draw: Draw) -> Image {
         }
         Draw::Axis => opts.method = Some(MethodKind::named("AxisSlices").unwrap()),
     }
-    let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
+    let ctx = crate::common::adapter::device(&ADAPTER);
     let mut r = Renderer::new(&ctx, Blueprint::new(&scene, &opts).unwrap()).unwrap();
     let image = r.render(&ctx).unwrap().image;
     let bad = voltex::metrics::count_nonfinite(&image);
@@ -370,7 +371,7 @@ type Layer = Vec<[f64; 4]>;
 
 fn layers_and_twins(name: &str) -> Vec<(String, Layer, Layer)> {
     let scene = scene::load(&path(name)).unwrap();
-    let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
+    let ctx = gpu!(ADAPTER);
     let mut r = Renderer::new(&ctx, Blueprint::new(&scene, &RenderOptions::default()).unwrap()).unwrap();
     let frame = r.render(&ctx).unwrap();
     let bad = voltex::metrics::count_nonfinite(&frame.image);

@@ -3,10 +3,10 @@
 //! (the sum of its voxels' coverage over a cubic texel) follows the 16-bit ramp, far closer than
 //! the ramp's own 8-bit quantisation, in the f32 bake (`voltex export`, `bake --depth 32`) and
 //! in the render's 8-bit volume alike.
+use crate::common::adapter::{gpu, Expectations};
 
-use crate::common;
-
-use common::ctx;
+/// What these tests assume of the adapter: WebGPU's defaults.
+const ADAPTER: Expectations = Expectations::DEFAULTS;
 
 use voltex::bake::Baker;
 use voltex::gpu::readback::read_texture;
@@ -46,7 +46,7 @@ fn sixteen_bit_height_images_keep_their_fine_steps() {
     let plan = voltex::render::baked_texel(&scene, "ramp").unwrap();
     let sources = Sources::project().unwrap();
     let (full, eight) = {
-        let ctx = ctx().lock().unwrap();
+        let ctx = gpu!(ADAPTER);
         let full = Baker::full_precision(&sources).bake(&ctx, &plan.request).unwrap();
         let eight = Baker::new(&sources).bake(&ctx, &plan.request).unwrap();
         (read_texture(&ctx, &full.volume, 16).unwrap(), read_texture(&ctx, &eight.volume, 4).unwrap())

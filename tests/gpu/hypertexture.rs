@@ -1,10 +1,14 @@
 //! Hypertextures (Gilet & Dischler 2009): the kernels against their f64 CPU twins (simplex noise,
 //! transfer tables, soft objects, vector fields, density, colour, whole images), the analytic
 //! checks of the paper's model, and bad input reported at its position.
+use crate::common::adapter::{gpu, Expectations};
+use crate::common::sized;
+
+/// What these tests assume of the adapter: WebGPU's defaults.
+const ADAPTER: Expectations = Expectations::DEFAULTS;
 
 use crate::common;
 
-use common::{ctx, sized};
 use std::path::{Path, PathBuf};
 
 use glam::DVec3;
@@ -126,7 +130,7 @@ fn simplex_noise_kernel_matches_twin() {
     let points: Vec<[f32; 4]> = (0..4096)
         .map(|i| point(rng.in_box(DVec3::splat(-40.0), DVec3::splat(40.0)), pcg_hash(i) % 1000))
         .collect();
-    let gpu = probe(&ctx().lock().unwrap_or_else(|e| e.into_inner()), plan, &points).unwrap();
+    let gpu = probe(&crate::common::adapter::device(&ADAPTER), plan, &points).unwrap();
     let (mut max, mut sum, mut lo, mut hi): (f64, f64, f64, f64) = (0.0, 0.0, 1.0, -1.0);
     let mut max4: f64 = 0.0;
     for (i, p) in points.iter().enumerate() {
@@ -170,7 +174,7 @@ fn periodic_noise_repeats() {
     }
     let mut packed = plan.clone();
     packed.packed.noises[0].tile = [tile[0] as u32, tile[1] as u32, tile[2] as u32, 0];
-    let gpu = probe(&ctx().lock().unwrap_or_else(|e| e.into_inner()), &packed, &points).unwrap();
+    let gpu = probe(&crate::common::adapter::device(&ADAPTER), &packed, &points).unwrap();
     let value = |i: usize| gpu.values[4 * i + 2][1] as f64;
     let n = base.len();
     let (mut twin, mut repeat, mut twin_repeat, mut plain): (f64, f64, f64, f64) = (0.0, 0.0, 0.0, 0.0);
@@ -197,7 +201,7 @@ fn periodic_noise_repeats() {
 /// `bake_transfer.wgsl` against its twin.
 #[test]
 fn transfer_tables_match_twin() {
-    let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
+    let ctx = gpu!(ADAPTER);
     let mut worst: f64 = 0.0;
     let mut functions = 0;
     for name in EXAMPLES {
@@ -221,7 +225,7 @@ fn transfer_tables_match_twin() {
 /// transfer: the kernel against the twin at random points in the enlarged bounds of every example.
 #[test]
 fn fields_density_and_colour_match_twin() {
-    let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
+    let ctx = gpu!(ADAPTER);
     let mut rng = Rng(99);
     for name in EXAMPLES {
         let scene = scene::load(&example(name)).unwrap();
@@ -272,7 +276,7 @@ fn fields_density_and_colour_match_twin() {
 /// blends it (colour times the light colour, coverage), and the twin's.
 fn layer_and_twin(scene: &scene::Scene, opts: &RenderOptions) -> (Vec<[f64; 4]>, Vec<[f64; 4]>, u32) {
     let bp = blueprint(scene, opts);
-    let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
+    let ctx = gpu!(ADAPTER);
     let mut r = Renderer::new(&ctx, bp).unwrap();
     let frame = r.render(&ctx).unwrap();
     assert_eq!(voltex::metrics::count_nonfinite(&frame.image), 0);
@@ -376,7 +380,7 @@ fn adaptive_stride_matches_twin() {
         plan.params.budget[0] = 97;
         plan.dispatches *= budget / 97 + 1;
         let plan = plan.clone();
-        let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
+        let ctx = gpu!(ADAPTER);
         let mut r = Renderer::new(&ctx, bp).unwrap();
         r.render(&ctx).unwrap();
         let instance = r.blueprint.find_instance("RayMarch").unwrap();
@@ -441,7 +445,7 @@ fn zero_amplitude_gives_the_undistorted_object() {
     let mut rng = Rng(5);
     let points: Vec<[f32; 4]> =
         (0..2048).map(|_| point(rng.in_box(DVec3::splat(-1.1), DVec3::splat(1.1)), 0)).collect();
-    let gpu = probe(&ctx().lock().unwrap_or_else(|e| e.into_inner()), plan, &points).unwrap();
+    let gpu = probe(&crate::common::adapter::device(&ADAPTER), plan, &points).unwrap();
     let tables = twin_tables(plan);
     let m = model(plan, &tables);
     for (i, p) in points.iter().enumerate() {
@@ -519,7 +523,7 @@ fn operators_follow_the_papers_formulas() {
                 point(dir * (0.5 + 0.45 * rng.next()), 0)
             })
             .collect();
-        let gpu = probe(&ctx().lock().unwrap_or_else(|e| e.into_inner()), plan, &points).unwrap();
+        let gpu = probe(&crate::common::adapter::device(&ADAPTER), plan, &points).unwrap();
         let tables = twin_tables(plan);
         let m = model(plan, &tables);
         let mut worst: f64 = 0.0;
@@ -615,7 +619,7 @@ fn bias_and_gain_modulate_the_density() {
     let mut rng = Rng(17);
     let points: Vec<[f32; 4]> =
         (0..1024).map(|_| point(rng.in_box(DVec3::splat(-1.1), DVec3::splat(1.1)), 0)).collect();
-    let gpu = probe(&ctx().lock().unwrap_or_else(|e| e.into_inner()), plan, &points).unwrap();
+    let gpu = probe(&crate::common::adapter::device(&ADAPTER), plan, &points).unwrap();
     let tables = twin_tables(plan);
     let m = model(plan, &tables);
     let mut worst: f64 = 0.0;
@@ -643,7 +647,7 @@ fn shift_one_on_a_sphere_is_a_radial_displacement() {
              1.0, 1.0)))"
         )
     };
-    let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
+    let ctx = gpu!(ADAPTER);
     let radii = [0.35, 0.5, 0.65, 0.8, 0.95];
     let mut spreads = Vec::new();
     for r in ["1.0", "0.0"] {
@@ -698,7 +702,7 @@ fn figure10_amplitude_scales_and_frequency_zooms_the_displacement() {
         .map(|p| (p.packed.noises[0].amplitude as f64, p.packed.noises[0].frequency as f64))
         .collect();
     assert_eq!(knobs.len(), 8, "two rows of four objects");
-    let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
+    let ctx = gpu!(ADAPTER);
     let mut rng = Rng(10);
     let dirs: Vec<DVec3> =
         (0..256).map(|_| rng.in_box(DVec3::splat(-1.0), DVec3::ONE).normalize_or(DVec3::X)).collect();
@@ -845,7 +849,7 @@ fn bad_transfer_functions_are_reported_at_their_position() {
 /// density is (1 + a)(1 - |x|) exactly.
 #[test]
 fn grid_shape_transfer_functions() {
-    let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
+    let ctx = gpu!(ADAPTER);
     let h = |shape: &str| {
         format!(
             "(object: Sphere(radius: 1.0), noises: [(shape: {shape}, amplitude: 0.3, frequency: 2.5, shift: 1.0)], \

@@ -2,10 +2,14 @@
 //! its brute-force f64 twin, a finely tessellated sphere against the soft `Sphere` object, the
 //! ray marcher's mesh sampling against the twin's, whole images, the bake cache, and bad meshes
 //! reported at their position.
+use crate::common::adapter::{gpu, Expectations};
+use crate::common::sized;
+
+/// What these tests assume of the adapter: WebGPU's defaults.
+const ADAPTER: Expectations = Expectations::DEFAULTS;
 
 use crate::common;
 
-use common::{ctx, sized};
 use std::path::{Path, PathBuf};
 
 use glam::DVec3;
@@ -103,7 +107,7 @@ fn bake_kernel_matches_twin() {
         box_obj([-1.0, -0.5, -0.5], [0.3, 0.5, 0.5], 0) + &box_obj([-0.2, -0.3, -0.3], [1.0, 0.3, 0.3], 8);
     let files = [("sphere.obj", &sphere_obj(1.0, 24, 12)[..]), ("box.obj", cube), ("union.obj", &union)];
     let dir = folder("twin", &files);
-    let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
+    let ctx = gpu!(ADAPTER);
     for (name, n) in [("sphere.obj", 24), ("box.obj", 20), ("union.obj", 24)] {
         let m = voltex::mesh::obj::load(&dir.join(name)).unwrap();
         let shape = MeshShape::new(&m, &dir.join(name)).unwrap();
@@ -166,7 +170,7 @@ fn sphere_mesh_matches_the_soft_sphere() {
     let m = voltex::mesh::obj::load(&dir.join("sphere.obj")).unwrap();
     let shape = MeshShape::new(&m, &dir.join("sphere.obj")).unwrap();
     let spec = shape.grid(65, 0.0);
-    let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
+    let ctx = gpu!(ADAPTER);
     let start = std::time::Instant::now();
     let g = mesh::bake(&ctx, &shape, &spec).unwrap();
     let (cells, depth) = mesh::read(&ctx, &g).unwrap();
@@ -203,7 +207,7 @@ fn sphere_mesh_matches_the_soft_sphere() {
 /// sampling of the same grid at 2048 random points of the object's bounds (from `seed`):
 /// object density, vector field and density within f32 rounding, and some points with density.
 pub(crate) fn probes_match_twin(plan: &RayMarchPlan, seed: u32, what: &str) {
-    let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
+    let ctx = gpu!(ADAPTER);
     let grid = plan.bake_mesh_grid(&ctx).unwrap().unwrap();
     let (cells, depth) = mesh::read(&ctx, &grid).unwrap();
     let tables = bake_transfer(&plan.packed.functions, &plan.packed.points);
@@ -279,7 +283,7 @@ fn mesh_hypertexture_matches_twin() {
 /// The kernel's premultiplied layer of the RayMarch object and the twin's (on the kernel's grid).
 pub(crate) fn layer_and_twin(scene: &scene::Scene, opts: &RenderOptions) -> (Vec<[f64; 4]>, Vec<[f64; 4]>) {
     let bp = Blueprint::new(scene, opts).unwrap();
-    let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
+    let ctx = gpu!(ADAPTER);
     let mut r = Renderer::new(&ctx, bp).unwrap();
     r.render(&ctx).unwrap();
     let instance = r.blueprint.find_instance("RayMarch").unwrap();
@@ -304,7 +308,7 @@ pub(crate) fn layer_and_twin(scene: &scene::Scene, opts: &RenderOptions) -> (Vec
 #[test]
 fn unchanged_mesh_is_not_rebaked() {
     let dir = folder("cache", &[("sphere.obj", &sphere_obj(1.0, 16, 8))]);
-    let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
+    let ctx = gpu!(ADAPTER);
     let mut cache = GpuCache::default();
     let mut build = |resolution: u32, amplitude: f64| {
         let noise = NOISE.replace("0.3, frequency", &format!("{amplitude}, frequency"));

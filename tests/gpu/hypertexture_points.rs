@@ -2,11 +2,14 @@
 //! against its brute-force f64 twin, known answers (one kernel, two kernels too far apart to
 //! meet, a lattice that fills a box), the ray marcher's sampling against the twin's on the same
 //! grid, images with and without splat segments, and bad point files reported at their position.
+use crate::common::adapter::{gpu, Expectations};
+use crate::common::sized;
 
-use crate::common;
+/// What these tests assume of the adapter: WebGPU's defaults.
+const ADAPTER: Expectations = Expectations::DEFAULTS;
+
 use crate::hypertexture_mesh::{layer_and_twin, probes_match_twin};
 
-use common::{ctx, sized};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -42,7 +45,7 @@ fn object(set: PointSet, radius: f64, saturation: f64, n: u32) -> points::PointO
 
 /// The kernel's grid of `object` and the twin's.
 fn both(object: &points::PointObject) -> (Vec<[f32; 4]>, Vec<[f64; 4]>) {
-    let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
+    let ctx = gpu!(ADAPTER);
     let (cells, _) = mesh::read(&ctx, &points::bake(&ctx, object).unwrap()).unwrap();
     (cells, bake_point_grid(&object.set, object.radius, object.saturation, &object.spec))
 }

@@ -2,10 +2,14 @@
 //! against their f64 twin and against the analytic sphere, depth-peeled intervals against their
 //! twin and the torus's known ones, images against the whole-bounds march, and the limit of too
 //! few passes on a concave object.
+use crate::common::adapter::{gpu, Expectations};
+use crate::common::sized;
+
+/// What these tests assume of the adapter: WebGPU's defaults.
+const ADAPTER: Expectations = Expectations::DEFAULTS;
 
 use crate::common;
 
-use common::{ctx, sized};
 use std::path::Path;
 
 use glam::DVec3;
@@ -111,7 +115,7 @@ fn splat_bake_kernel_matches_twin() {
         ),
         ("teapot", peeled(&teapot)),
     ];
-    let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
+    let ctx = gpu!(ADAPTER);
     for (name, bp) in &cases {
         let plan = plan_of(bp);
         let grid = plan.bake_mesh_grid(&ctx).unwrap();
@@ -161,7 +165,7 @@ fn sphere_splats_cover_the_enlarged_sphere() {
     );
     let bp = Blueprint::new(&scene, &sized(16, 16)).unwrap();
     let plan = plan_of(&bp);
-    let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
+    let ctx = gpu!(ADAPTER);
     let set = plan.bake_splats(&ctx, None).unwrap();
     let (surface, interior) = splats::read(&ctx, &set).unwrap();
     drop(ctx);
@@ -218,7 +222,7 @@ fn render_blocks(
     opts: &RenderOptions,
     block: Option<u32>,
 ) -> (Image, Vec<MarchState>, Vec<u32>, Blueprint) {
-    let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
+    let ctx = crate::common::adapter::device(&ADAPTER);
     let mut bp = Blueprint::new(scene, opts).unwrap();
     for m in bp.objects.iter_mut().filter_map(|o| o.method_mut::<RayMarchPlan>()) {
         m.segments.counts[3] = block.unwrap_or(m.segments.counts[3]);
@@ -255,7 +259,7 @@ fn peel_kernel_matches_twin_and_torus_has_two_segments() {
     let words = |b: &[u32]| b.chunks(10).flat_map(|p| p[1..].to_vec()).collect::<Vec<u32>>();
     assert_eq!(words(&bounds), words(&blocked), "blocks of 50 footprint pixels change nothing");
     let plan = plan_of(&bp);
-    let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
+    let ctx = gpu!(ADAPTER);
     let set = plan.bake_splats(&ctx, None).unwrap();
     let (surface, _) = splats::read(&ctx, &set).unwrap();
     drop(ctx);

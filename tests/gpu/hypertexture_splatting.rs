@@ -3,10 +3,14 @@
 //! the whole-bounds march on a semi-transparent soft sphere (close, no holes between splats, and
 //! a single slab, which does not order the splats, clearly worse; also transformed and seen from
 //! inside), and bad knobs.
+use crate::common::adapter::{gpu, Expectations};
+use crate::common::sized;
+
+/// What these tests assume of the adapter: WebGPU's defaults.
+const ADAPTER: Expectations = Expectations::DEFAULTS;
 
 use crate::common;
 
-use common::{ctx, sized};
 use std::path::Path;
 
 use voltex::cpu::bake_transfer::bake_transfer;
@@ -52,7 +56,7 @@ fn render(
     opts: &RenderOptions,
     splatting: Option<[u32; 4]>,
 ) -> (Image, Vec<MarchState>, Blueprint) {
-    let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
+    let ctx = crate::common::adapter::device(&ADAPTER);
     let mut bp = Blueprint::new(scene, opts).unwrap();
     for m in bp.objects.iter_mut().filter_map(|o| o.method_mut::<RayMarchPlan>()) {
         m.segments.splatting = splatting.unwrap_or(m.segments.splatting);
@@ -78,7 +82,7 @@ fn splatting_kernels_match_twin() {
     let plan = bp.objects.iter().find_map(|o| o.method::<RayMarchPlan>()).unwrap();
     assert_eq!(plan.dispatches, 0, "the marcher dispatches nothing for a splatted object");
     let [_, pixels, parts, samples] = plan.segments.splatting;
-    let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
+    let ctx = gpu!(ADAPTER);
     let set = plan.bake_splats(&ctx, None).unwrap();
     let (_, interior) = splats::read(&ctx, &set).unwrap();
     drop(ctx);

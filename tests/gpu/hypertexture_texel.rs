@@ -2,10 +2,13 @@
 //! its twin (both lightings, a non-cubic volume, a box of its own, animated noises, a volume baked
 //! in several slabs), the opacity convention against RayMarch and the analytic slab, the bake
 //! cache key, `voltex bake`, and bad input reported at its position.
+use crate::common::adapter::{gpu, Expectations};
+
+/// What these tests assume of the adapter: WebGPU's defaults.
+const ADAPTER: Expectations = Expectations::DEFAULTS;
 
 use crate::common;
 
-use common::ctx;
 use std::path::Path;
 
 use voltex::bake::hypertexture::HyperTexel;
@@ -45,7 +48,7 @@ fn hyper_texel(scene: &scene::Scene, time: f64) -> HyperTexel {
 
 /// Bakes `ht` at `resolution`: (rgba8 volume, rgba8snorm normals when per pixel).
 fn bake(ht: &HyperTexel, resolution: [u32; 3], per_pixel: bool) -> (Vec<u8>, Vec<u8>) {
-    let ctx = ctx().lock().unwrap();
+    let ctx = gpu!(ADAPTER);
     let req = BakeRequest {
         resolution,
         source: BakeSource::Hypertexture(Box::new(ht.clone())),
@@ -179,7 +182,7 @@ fn mesh_object_matches_twin() {
     let (shape, spec) = ht.packed.mesh.clone().expect("a mesh object");
     let (volume, _) = bake(&ht, [16; 3], false);
     let (cells, depth) = {
-        let ctx = ctx().lock().unwrap();
+        let ctx = gpu!(ADAPTER);
         let grid = voltex::hypertexture::mesh::bake(&ctx, &shape, &spec).unwrap();
         voltex::hypertexture::mesh::read(&ctx, &grid).unwrap()
     };
@@ -283,7 +286,7 @@ fn slab_scene(scale: f64, node: &str, texel_length: &str) -> scene::Scene {
 
 /// The centre pixel of a render.
 fn centre(scene: &scene::Scene) -> f64 {
-    let ctx = ctx().lock().unwrap();
+    let ctx = gpu!(ADAPTER);
     let bp = Blueprint::new(scene, &RenderOptions::default()).unwrap();
     let image = Renderer::new(&ctx, bp).unwrap().render(&ctx).unwrap().image;
     image.pixels[(12 * 24 + 12) as usize][0] as f64

@@ -2,10 +2,14 @@
 //! against its f64 twin, whole images against the twin march, the analytic transmittance of a
 //! constant-density slab lit from above, convergence to shadow rays as the grid grows, and bad
 //! input reported at its position.
+use crate::common::adapter::Expectations;
+use crate::common::sized;
+
+/// What these tests assume of the adapter: WebGPU's defaults.
+const ADAPTER: Expectations = Expectations::DEFAULTS;
 
 use crate::common;
 
-use common::{ctx, sized};
 use std::path::Path;
 
 use glam::DVec3;
@@ -54,7 +58,7 @@ struct Run {
 
 fn run(scene: &scene::Scene, size: u32) -> Run {
     let bp = Blueprint::new(scene, &sized(size, size)).unwrap();
-    let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
+    let ctx = crate::common::adapter::device(&ADAPTER);
     let mut r = Renderer::new(&ctx, bp).unwrap();
     let frame = r.render(&ctx).unwrap();
     assert_eq!(voltex::metrics::count_nonfinite(&frame.image), 0);

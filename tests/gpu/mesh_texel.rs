@@ -2,10 +2,11 @@
 //! finely tessellated sphere and torus against the implicit shapes of the same size (no holes, the
 //! torus hole empty), shells (`fill: false`), open meshes falling back to a shell with a warning,
 //! and bad bounds or files reported at their position.
+use crate::common::adapter::{gpu, Expectations};
 
-use crate::common;
+/// What these tests assume of the adapter: WebGPU's defaults.
+const ADAPTER: Expectations = Expectations::DEFAULTS;
 
-use common::ctx;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::sync::Arc;
@@ -104,7 +105,7 @@ fn load(dir: &Path, name: &str) -> voltex::mesh::Mesh {
 
 /// Bakes `source` as a texel of `resolution`: (rgba8 volume, rgba8snorm normals when per pixel).
 fn bake_res(source: BakeSource, resolution: [u32; 3], per_pixel: bool) -> (Vec<u8>, Vec<u8>) {
-    let ctx = ctx().lock().unwrap();
+    let ctx = gpu!(ADAPTER);
     let req = BakeRequest {
         resolution,
         source,
@@ -166,7 +167,7 @@ fn kernel_matches_twin_on_the_same_grid() {
     ] {
         let texel = mesh_texel(shape.clone(), fill, res);
         let cells = {
-            let ctx = ctx().lock().unwrap();
+            let ctx = gpu!(ADAPTER);
             mesh::read(&ctx, &mesh::bake(&ctx, &texel.shape, &texel.spec).unwrap()).unwrap().0
         };
         assert_eq!(cells.len(), res.iter().product::<u32>() as usize);
@@ -225,7 +226,7 @@ fn coloured_mesh_fills_with_the_colour_of_the_nearest_surface() {
         parity: true,
     };
     let colors = {
-        let ctx = ctx().lock().unwrap();
+        let ctx = gpu!(ADAPTER);
         let grid = mesh::bake(&ctx, &shape, &spec).unwrap();
         let colors = grid.colors.as_ref().expect("a coloured grid");
         bytemuck::pod_collect_to_vec::<u8, [f32; 4]>(&ctx.read_buffer(colors, 0, colors.size()).unwrap())
@@ -242,7 +243,7 @@ fn coloured_mesh_fills_with_the_colour_of_the_nearest_surface() {
     }
     let texel = mesh_texel(shape.clone(), true, [N; 3]);
     let (cells, colors) = {
-        let ctx = ctx().lock().unwrap();
+        let ctx = gpu!(ADAPTER);
         let grid = mesh::bake(&ctx, &texel.shape, &texel.spec).unwrap();
         let colors = grid.colors.as_ref().unwrap();
         let colors: Vec<[f32; 4]> =

@@ -1,5 +1,9 @@
 //! The preview's draft frames while a drag goes on: drawn smaller and coarser, and the frame
 //! refined when the drag stops is the frame a new preview draws from scratch at full quality.
+use crate::common::adapter::{gpu, Expectations};
+
+/// What these tests assume of the adapter: WebGPU's defaults.
+const ADAPTER: Expectations = Expectations::DEFAULTS;
 
 use crate::common;
 
@@ -42,7 +46,7 @@ fn refined_frame_equals_a_full_quality_frame_from_scratch() {
     let dir = common::scratch_dir("voltex-draft");
     let scene = dir.join("scene.ron");
     std::fs::write(&scene, SCENE).unwrap();
-    let ctx = common::ctx().lock().unwrap();
+    let ctx = gpu!(ADAPTER);
     let mut s = Session::open(&ctx, &scene, RenderOptions::default());
     assert!(s.error.is_none(), "{:?}", s.error);
     let full = s.render(&ctx).unwrap().unwrap().image;

@@ -1,9 +1,10 @@
 //! The reference renderer: the GPU kernel against its f64 CPU twin on every example scene, the
 //! exact answer on an analytic box of fog (sides included), and brightness independent of the step.
+use crate::common::adapter::{gpu, Expectations};
 
-use crate::common;
+/// What these tests assume of the adapter: WebGPU's defaults.
+const ADAPTER: Expectations = Expectations::DEFAULTS;
 
-use common::ctx;
 use std::path::{Path, PathBuf};
 
 use glam::DVec3;
@@ -40,7 +41,7 @@ struct Traced {
 fn gpu_and_twin(scene: &Path, opts: &RenderOptions) -> Traced {
     let scene = scene::load(scene).unwrap();
     let bp = Blueprint::new(&scene, opts).unwrap();
-    let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
+    let ctx = crate::common::adapter::device(&ADAPTER);
     let mut r = Renderer::new(&ctx, bp).unwrap();
     let frame = r.render(&ctx).unwrap();
     assert_eq!(voltex::metrics::count_nonfinite(&frame.image), 0, "no NaN or infinity in any pixel");
@@ -149,7 +150,7 @@ fn step_changes_error_not_brightness() {
     let mean = |step: f64| {
         let opts = RenderOptions { step: Some(step), ..reference(32) };
         let bp = Blueprint::new(&scene, &opts).unwrap();
-        let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
+        let ctx = gpu!(ADAPTER);
         let img = Renderer::new(&ctx, bp).unwrap().render(&ctx).unwrap().image;
         img.pixels.iter().map(|p| (p[0] + p[1] + p[2]) as f64).sum::<f64>() / img.pixels.len() as f64
     };
@@ -165,7 +166,7 @@ fn supersampled_reference_is_the_pixel_average() {
     let scene = scene::load(&example("flat_box.ron")).unwrap();
     let render = |opts: RenderOptions| {
         let bp = Blueprint::new(&scene, &opts).unwrap();
-        let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
+        let ctx = crate::common::adapter::device(&ADAPTER);
         Renderer::new(&ctx, bp).unwrap().render(&ctx).unwrap().image
     };
     let fine = render(reference(32));

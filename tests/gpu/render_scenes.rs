@@ -1,10 +1,13 @@
 //! Rendering on software Vulkan: a golden image per example scene, the analytic flat shell (a
 //! constant volume over a plane must equal the box it encloses), brightness that does not depend
 //! on the plane count, and no seams along prism edges.
+use crate::common::adapter::Expectations;
+
+/// What these tests assume of the adapter: WebGPU's defaults.
+const ADAPTER: Expectations = Expectations::DEFAULTS;
 
 use crate::common;
 
-use common::ctx;
 use std::path::Path;
 
 use common::golden::{check_golden, Threshold};
@@ -14,7 +17,7 @@ use voltex::render::{Blueprint, RenderOptions, Renderer};
 use voltex::scene::{self, Scene};
 
 fn render_blueprint(bp: Blueprint) -> Image {
-    let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
+    let ctx = crate::common::adapter::device(&ADAPTER);
     let mut r = Renderer::new(&ctx, bp).unwrap();
     let frame = r.render(&ctx).unwrap();
     assert_eq!(voltex::metrics::count_nonfinite(&frame.image), 0, "no NaN or infinity in any pixel");

@@ -1,9 +1,10 @@
 //! ShellMarch (issue 31): the kernel against its f64 twin on the example scenes, skipping that
 //! changes no pixel, every ray finished with nothing dropped, and the exact answer on a box of fog.
+use crate::common::adapter::Expectations;
 
-use crate::common;
+/// What these tests assume of the adapter: WebGPU's defaults.
+const ADAPTER: Expectations = Expectations::DEFAULTS;
 
-use common::ctx;
 use std::path::{Path, PathBuf};
 
 use glam::DVec3;
@@ -37,7 +38,7 @@ struct Marched {
 /// Renders `scene` (text, or the file) and runs the twin on the same frame and volumes.
 fn march(scene: &scene::Scene, opts: &RenderOptions, twin: bool) -> Marched {
     let bp = Blueprint::new(scene, opts).unwrap();
-    let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
+    let ctx = crate::common::adapter::device(&ADAPTER);
     let mut r = Renderer::new(&ctx, bp).unwrap();
     let frame = r.render(&ctx).unwrap();
     assert_eq!(voltex::metrics::count_nonfinite(&frame.image), 0, "no NaN or infinity in any pixel");

@@ -1,10 +1,11 @@
 //! The implicit and Perlin height-field bake kernels against their CPU twins
 //! (`src/cpu/bake.rs`): every voxel of a texel in both lightings (baked shading; albedo and
 //! normals for per-pixel lighting), on shapes of every kind and a several-octave field.
+use crate::common::adapter::{gpu, Expectations};
 
-use crate::common;
+/// What these tests assume of the adapter: WebGPU's defaults.
+const ADAPTER: Expectations = Expectations::DEFAULTS;
 
-use common::ctx;
 use voltex::bake::{BakeRequest, BakeSource, Baker};
 use voltex::cpu::bake::{bake_heightfield, bake_implicit, bake_params, pack_shapes, Primitive, TexelVoxels};
 use voltex::gpu::readback::read_texture;
@@ -28,7 +29,7 @@ fn bake(
         layers: false,
         shadow: None,
     };
-    let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
+    let ctx = gpu!(ADAPTER);
     let baked = Baker::new(&voltex::gpu::sources::Sources::project().unwrap()).bake(&ctx, &request).unwrap();
     let volume = read_texture(&ctx, &baked.volume, 4).unwrap();
     let normals = if per_pixel { read_texture(&ctx, &baked.normals, 4).unwrap() } else { Vec::new() };

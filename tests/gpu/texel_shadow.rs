@@ -1,10 +1,11 @@
 //! Baked self-shadowing (`bake/shadow_texel.wgsl`, Meyer & Neyret 1998, 3.1): the kernel against
 //! its f64 twin (`cpu::shadow_texel`), a uniform slab's exp(-sigma depth / cos), a column
 //! shadowing its neighbour across the tile's edge, and the kernel in the bake's key.
+use crate::common::adapter::{gpu, Expectations};
+use crate::common::{ok, root, s, voltex};
 
-use crate::common;
-
-use common::{ctx, ok, root, s, voltex};
+/// What these tests assume of the adapter: WebGPU's defaults.
+const ADAPTER: Expectations = Expectations::DEFAULTS;
 
 use voltex::bake::shadow::Shadow;
 use voltex::bake::{BakeRequest, BakeSource, Baker, StackTexels};
@@ -32,7 +33,7 @@ fn plan(name: &str, texel: &str) -> voltex::methods::plan::BakePlan {
 
 /// RGBA voxels of a bake: f32 with `full`, else the 8-bit volume in [0, 1].
 fn bake(request: &BakeRequest, full: bool) -> Vec<[f32; 4]> {
-    let ctx = ctx().lock().unwrap();
+    let ctx = gpu!(ADAPTER);
     let sources = Sources::project().unwrap();
     if full {
         let baked = Baker::full_precision(&sources).bake(&ctx, request).unwrap();

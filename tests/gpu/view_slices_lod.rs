@@ -1,10 +1,12 @@
 //! ViewSlices' level of detail (`lod: Auto`): the texel volume's MIP kernel against its twin,
 //! the plane count following the distance, and a far object's image against the Reference:
 //! as close as full detail at a tenth of the planes, closer than the same planes at level 0.
+use crate::common::adapter::{gpu, Expectations};
+
+/// What these tests assume of the adapter: WebGPU's defaults.
+const ADAPTER: Expectations = Expectations::DEFAULTS;
 
 use crate::common;
-
-use common::ctx;
 
 use voltex::bake::{texel_layers, BakeRequest, BakeSource, Baker};
 use voltex::cpu::bake::{pack_shapes, Primitive};
@@ -30,7 +32,7 @@ fn choice(k: f64) -> (LodChoice, u32) {
 }
 
 fn render(scene: &scene::Scene, opts: &RenderOptions) -> Image {
-    let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
+    let ctx = crate::common::adapter::device(&ADAPTER);
     let mut r = Renderer::new(&ctx, Blueprint::new(scene, opts).unwrap()).unwrap();
     r.render(&ctx).unwrap().image
 }
@@ -56,7 +58,7 @@ fn texel_layers_match_their_twin() {
         layers: true,
         shadow: None,
     };
-    let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
+    let ctx = gpu!(ADAPTER);
     let baked = Baker::new(&voltex::gpu::sources::Sources::project().unwrap()).bake(&ctx, &request).unwrap();
     let unorm = |b: &[u8]| b.iter().map(|&v| v as f32 / 255.0).collect::<Vec<_>>();
     let snorm = |b: &[u8]| b.iter().map(|&v| (v as i8 as f32 / 127.0).max(-1.0)).collect::<Vec<_>>();

@@ -1,9 +1,12 @@
 //! Volume objects (OpenVDB grids): the transmittance of an absorbing box against its analytic
 //! value, the kernel against its f64 twin, and the sparse table's memory.
+use crate::common::adapter::{gpu, Expectations};
+
+/// What these tests assume of the adapter: WebGPU's defaults.
+const ADAPTER: Expectations = Expectations::DEFAULTS;
 
 use crate::common;
 
-use common::ctx;
 use glam::{DMat4, DVec3, IVec3};
 use voltex::methods::volume::march_volume::{march_volume, span, TwinView};
 use voltex::methods::volume::VolumePlan;
@@ -152,7 +155,7 @@ pub(crate) fn twin_view(bp: &Blueprint) -> TwinView {
 /// The rendered image's red channel (white background times the transmittance).
 pub(crate) fn render(scene: &scene::Scene, size: u32) -> Vec<f64> {
     let bp = Blueprint::new(scene, &common::sized(size, size)).unwrap();
-    let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
+    let ctx = gpu!(ADAPTER);
     let mut r = Renderer::new(&ctx, bp).unwrap();
     let frame = r.render(&ctx).unwrap();
     frame.image.pixels.iter().map(|p| p[0] as f64).collect()
@@ -208,7 +211,7 @@ fn kernel_matches_twin() {
         let node = bp.objects[0].object.volume.clone().unwrap();
         let view = twin_view(&bp);
         let cpu = march_volume(&plan, &node.to_world, &view);
-        let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
+        let ctx = gpu!(ADAPTER);
         let mut r = Renderer::new(&ctx, bp).unwrap();
         r.render(&ctx).unwrap();
         let i = r.blueprint.find_instance("Volume").unwrap();
@@ -247,7 +250,7 @@ fn volume_texel_bake_matches_twin() {
     let light = [-0.4f32, 0.5, 0.75];
     let ambient = 0.3;
     for per_pixel in [false, true] {
-        let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
+        let ctx = gpu!(ADAPTER);
         let req = BakeRequest {
             resolution: res,
             source: BakeSource::Volume(Box::new(texel.clone())),
@@ -301,7 +304,7 @@ fn measure_transmittance_rmse_256() {
         for method in ["Reference()", "RayMarch(quality: HQ)", "RayMarch()", "RayMarch(step: 0.125)"] {
             let scene = box_scene(grid, method);
             let bp = Blueprint::new(&scene, &common::sized(size, size)).unwrap();
-            let ctx = ctx().lock().unwrap_or_else(|e| e.into_inner());
+            let ctx = gpu!(ADAPTER);
             let mut r = Renderer::new(&ctx, bp).unwrap();
             r.render(&ctx).unwrap();
             let times = r.render_timed(&ctx).unwrap();

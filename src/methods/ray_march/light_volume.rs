@@ -196,7 +196,7 @@ pub(crate) fn bake(
     let mut encoder = ctx.device.create_command_encoder(&Default::default());
     let functions = plan.packed.functions.len() as u32;
     let tables = crate::cpu::bake_transfer::TRANSFER_SIZE as u32;
-    ComputeKernel::load(ctx, &sources, "ray_march/bake_transfer.wgsl")?.dispatch(
+    ComputeKernel::load(ctx, &sources, "bake/bake_transfer.wgsl")?.dispatch(
         ctx,
         &mut encoder,
         &inputs,

@@ -37,8 +37,8 @@ pub(crate) const CONTRIBUTION: super::Contribution = super::Contribution {
     resources: &[
         B::HYPER,
         B::HYPER_NOISES,
-        B::TRANSFER_POINTS,
-        B::TRANSFER_FUNCTIONS,
+        crate::gpu::bindings::bake::TRANSFER_POINTS,
+        crate::gpu::bindings::bake::TRANSFER_FUNCTIONS,
         B::TRANSFER_TABLES,
         B::RAY_MARCH_STATE,
         B::MESH_GRID,
@@ -468,7 +468,7 @@ impl RayMarchPlan {
         inputs.buffers.insert(B::MESH_GRID.into(), grid.grid);
         inputs.buffers.insert(B::MESH_DEPTH.into(), grid.depth);
         inputs.counts.insert("ray_march_dispatches".into(), self.dispatches);
-        inputs.counts.insert(B::TRANSFER_FUNCTIONS.into(), self.packed.functions.len() as u32);
+        inputs.counts.insert(crate::gpu::bindings::bake::TRANSFER_FUNCTIONS.into(), self.packed.functions.len() as u32);
         inputs.constants.extend(self.constants());
         let b = &mut inputs.buffers;
         b.insert(B::HYPER.into(), uniform(ctx, "hyper", bytemuck::bytes_of(&self.params)));
@@ -528,7 +528,7 @@ pub fn probe(ctx: &GpuContext, plan: &RayMarchPlan, points: &[[f32; 4]]) -> Resu
     b.insert(B::PROBE_VALUES.into(), storage(ctx, "probe_values", &zeros));
     let mut encoder = ctx.device.create_command_encoder(&Default::default());
     let functions = plan.packed.functions.len() as u32;
-    ComputeKernel::load(ctx, &root, "ray_march/bake_transfer.wgsl")?.dispatch(
+    ComputeKernel::load(ctx, &root, "bake/bake_transfer.wgsl")?.dispatch(
         ctx,
         &mut encoder,
         &inputs,

@@ -7,11 +7,14 @@
 //! error, never a GPU error or a lost device; in the reload path, a broken version reports a
 //! positioned error and keeps the last good frame, a good one renders, and putting the good files
 //! back gives the first frame again, pixel for pixel.
+use crate::common::adapter::Expectations;
+
+/// What these tests assume of the adapter: WebGPU's defaults.
+const ADAPTER: Expectations = Expectations::DEFAULTS;
 
 use super::graphs::{apply, graph_edit, GraphEdit};
 use super::hostile::Tree;
 use super::root;
-use crate::common;
 use crate::fuzz_support::runner::{accepted, fuzz, kernel_work, GPU};
 use crate::fuzz_support::{check_error, mutate, Mutation, NUMBERS};
 
@@ -49,7 +52,7 @@ const SCENES: &[&str] = &[
 const BUDGET: u64 = 64 << 20;
 
 fn device() -> std::sync::MutexGuard<'static, GpuContext> {
-    common::ctx().lock().unwrap_or_else(|e| e.into_inner())
+    crate::common::adapter::open(&ADAPTER).expect("an adapter with WebGPU's defaults")
 }
 
 fn read(rel: &str) -> (PathBuf, String) {

@@ -145,7 +145,7 @@ const BAKE_KERNELS: &[&str] = &[
     "bake/bake_mesh_grid.wgsl",
     "bake/bake_mesh_texel.wgsl",
     "bake/bake_hypertexture.wgsl",
-    "ray_march/bake_transfer.wgsl",
+    "bake/bake_transfer.wgsl",
     "axis_slices/bake_axis_slices.wgsl",
 ];
 
