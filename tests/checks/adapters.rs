@@ -4,23 +4,12 @@
 //! And the matching itself: features, limits, deviations by adapter name and type.
 
 use crate::common::adapter::{Adapter, Deviation, Effect, Expectations, Limit};
-use std::path::{Path, PathBuf};
-
-fn files(dir: &Path, out: &mut Vec<PathBuf>) {
-    for entry in std::fs::read_dir(dir).unwrap() {
-        let path = entry.unwrap().path();
-        if path.is_dir() {
-            files(&path, out);
-        } else if path.extension().is_some_and(|e| e == "rs") {
-            out.push(path);
-        }
-    }
-}
+use std::path::PathBuf;
 
 #[test]
 fn every_gpu_test_module_declares_its_adapter() {
-    let mut all = Vec::new();
-    files(&PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/gpu"), &mut all);
+    let all =
+        crate::common::files_under(&PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/gpu"), &["rs"]);
     let mut opening = 0;
     let mut wrong = Vec::new();
     for file in &all {

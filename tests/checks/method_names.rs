@@ -6,7 +6,7 @@
 //! move, and a file that names a method anew, or more often, fails with the lines that do.
 
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use voltex::render::MethodKind;
 
@@ -22,17 +22,6 @@ const OUTSIDE: &[(&str, usize)] = &[
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
-
-fn files(dir: &Path, out: &mut Vec<PathBuf>) {
-    for entry in std::fs::read_dir(dir).unwrap() {
-        let path = entry.unwrap().path();
-        if path.is_dir() {
-            files(&path, out);
-        } else if path.extension().is_some_and(|e| e == "rs" || e == "wgsl") {
-            out.push(path);
-        }
-    }
 }
 
 /// The registered methods' scene-file names and folders.
@@ -72,9 +61,8 @@ fn count() -> BTreeMap<String, Vec<String>> {
         .map(|p| format!("src/methods/{}/", p.file_name().unwrap().to_string_lossy()))
         .collect();
     own.extend(methods.iter().map(|(_, f)| format!("wgsl/{f}/")));
-    let mut all = Vec::new();
-    files(&root().join("src"), &mut all);
-    files(&root().join("wgsl"), &mut all);
+    let mut all = crate::common::files_under(&root().join("src"), &["rs", "wgsl"]);
+    all.extend(crate::common::files_under(&root().join("wgsl"), &["rs", "wgsl"]));
     let mut out: BTreeMap<String, Vec<String>> = BTreeMap::new();
     for file in all {
         let rel = file.strip_prefix(root()).unwrap().display().to_string();
