@@ -3,7 +3,7 @@
 //! unless `ViewSlices(lod: Auto)` asks for its MIP levels), plus a normal volume when a
 //! per-pixel-lit object uses it. Only texels some object draws are baked, each (texel, lighting) pair once.
 
-pub mod axis_slices;
+pub mod derived;
 pub mod hypertexture;
 pub mod shadow;
 pub mod texel_layers;
@@ -125,10 +125,9 @@ pub struct BakeRequest {
     pub light: [f32; 3],
     /// Light a voxel keeps without direct light, in [0, 1].
     pub ambient: f32,
-    /// Also bake the slice images of axis-aligned slicing.
-    pub axis_slices: bool,
-    /// ... with their MIP levels (`AxisSlices(mipmaps: true)`).
-    pub axis_mipmaps: bool,
+    /// What the methods drawing it derive from the volume in the same bake (see
+    /// [`BakeRequest::derive`]).
+    pub derived: derived::Derivations,
     /// The texel's layers too (`ViewSlices(lod: Auto)`): its w slices as f16 2D arrays whose
     /// MIP levels filter s and t only (`texel_layers`), of the volume and of the normals.
     pub layers: bool,
@@ -156,12 +155,7 @@ impl BakeRequest {
         if self.shadow.is_some() {
             k.push(shadow::KERNEL);
         }
-        if self.axis_slices {
-            k.push("axis_slices/bake_axis_slices.wgsl");
-        }
-        if self.axis_slices && self.axis_mipmaps {
-            k.push(texel_layers::MIP_KERNEL);
-        }
+        k.extend(self.derived.0.iter().flat_map(|d| d.kernels()));
         if self.layers {
             k.extend([texel_layers::COPY_KERNEL, texel_layers::MIP_KERNEL]);
         }
@@ -179,18 +173,31 @@ pub struct Baked {
     /// The volume's and the normals' layers when the request asked for them (else 1x1, one
     /// layer: the bindings exist, nothing is stored).
     pub layers: [wgpu::Texture; 2],
-    /// The slice images when the request asked for them.
-    pub axis: Option<axis_slices::AxisBaked>,
+    /// What the request's methods derived from the volume (see [`BakeRequest::derive`]).
+    pub derived: derived::MadeProducts,
 }
 
 impl crate::gpu::cache::GpuBytes for Baked {
     fn gpu_bytes(&self) -> u64 {
         let layers: u64 = self.layers.iter().map(|l| l.gpu_bytes()).sum();
-        self.volume.gpu_bytes() + self.normals.gpu_bytes() + layers + self.axis.gpu_bytes()
+        self.volume.gpu_bytes() + self.normals.gpu_bytes() + layers + self.derived.gpu_bytes()
     }
 }
 
 impl BakeRequest {
+    /// Asks for the product `D` derived from the volume, made by `make` from the one already
+    /// asked for (another object drawing the same texel), which it replaces.
+    pub(crate) fn derive<D: derived::Derived>(&mut self, make: impl FnOnce(Option<&D>) -> D) {
+        let all = &mut self.derived.0;
+        let at = all.iter().position(|d| (d.as_ref() as &dyn std::any::Any).is::<D>());
+        let before = at.and_then(|i| (all[i].as_ref() as &dyn std::any::Any).downcast_ref::<D>());
+        let made: std::sync::Arc<dyn derived::Derived> = std::sync::Arc::new(make(before));
+        match at {
+            Some(i) => all[i] = made,
+            None => all.push(made),
+        }
+    }
+
     /// GPU memory of the bake of `texel`, by item (`voltex plan`).
     pub(crate) fn memory(&self, texel: &str) -> Vec<(String, u64)> {
         let [x, y, z] = self.resolution;
@@ -206,13 +213,7 @@ impl BakeRequest {
                 copies * texel_layers::bytes(self.resolution),
             ));
         }
-        if self.axis_slices {
-            let mips = if self.axis_mipmaps { " with MIP levels" } else { "" };
-            out.push((
-                format!("texel {texel} slice images (s, t, w; all levels{mips}) rgba16f"),
-                axis_slices::bytes(self.resolution, self.axis_mipmaps),
-            ));
-        }
+        out.extend(self.derived.0.iter().map(|d| d.memory(texel, self.resolution)));
         out
     }
 
@@ -263,18 +264,7 @@ impl BakeRequest {
                 driver: driver.clone(),
             });
         }
-        if self.axis_slices {
-            for d in 0..3 {
-                let size = axis_slices::image_size(res, d);
-                let layers = axis_slices::array_layers(res[d]);
-                out.push(Allocation {
-                    what: format!("texel \"{texel}\"'s {} slice images", ["s", "t", "w"][d]),
-                    bytes: texel_layers::image_bytes(size, self.axis_mipmaps) * layers as u64,
-                    shape: AllocationKind::Texture2d { size, layers },
-                    driver: driver.clone(),
-                });
-            }
-        }
+        out.extend(self.derived.0.iter().flat_map(|d| d.allocations(texel, res, &driver)));
         out
     }
 
@@ -314,12 +304,7 @@ impl BakeRequest {
                 sh.ambient
             );
         }
-        if self.axis_slices {
-            s += "  (and its slice images: bake_axis_slices.wgsl per direction and level)\n";
-            if self.axis_mipmaps {
-                s += "  (and their MIP levels: mip_layers.wgsl per direction and MIP level)\n";
-            }
-        }
+        s.extend(self.derived.0.iter().map(|d| d.describe()));
         s
     }
 }
@@ -342,7 +327,8 @@ pub struct Baker {
     mesh: Slot,
     hyper: Slot,
     transfer: Slot,
-    axis: Slot,
+    /// The kernels of derived products (see `derived::Kernels`).
+    derived: Vec<(&'static str, Slot)>,
     volume: Slot,
     layer_copy: Slot,
     /// `mip_layers`: the slice images' and the texel layers' MIP levels.
@@ -363,7 +349,7 @@ impl Baker {
             mesh: None,
             hyper: None,
             transfer: None,
-            axis: None,
+            derived: Vec::new(),
             volume: None,
             layer_copy: None,
             layer_mip: None,
@@ -560,25 +546,13 @@ impl Baker {
             }
             false => [0, 1].map(|_| texel_layers::texture(ctx, "no texel layers", [1, 1], 1, 1)),
         };
-        let axis = match req.axis_slices {
-            true => {
-                let format = self.format;
-                let kernel =
-                    Self::kernel(&mut self.axis, ctx, &root, "axis_slices/bake_axis_slices.wgsl", format)?;
-                let baked =
-                    axis_slices::bake(ctx, kernel, &mut encoder, &volume, req.resolution, req.axis_mipmaps)?;
-                if req.axis_mipmaps {
-                    let mip =
-                        Self::kernel(&mut self.layer_mip, ctx, &root, texel_layers::MIP_KERNEL, format)?;
-                    axis_slices::mip(ctx, mip, &mut encoder, &baked)?;
-                }
-                Some(baked)
-            }
-            false => None,
-        };
+        let mut kernels = derived::Kernels { slots: &mut self.derived, sources: &root, format: self.format };
+        let made = (req.derived.0.iter())
+            .map(|d| d.record(ctx, &mut kernels, &mut encoder, &volume, req.resolution))
+            .collect::<Result<Vec<_>>>()?;
         ctx.queue.submit([encoder.finish()]);
         ctx.take_errors()?;
-        Ok(Baked { volume, normals, layers, axis })
+        Ok(Baked { volume, normals, layers, derived: derived::MadeProducts(made) })
     }
 }
 

@@ -151,8 +151,7 @@ pub(crate) fn bake_index(
             // z-up base surface; PerPixel lighting is right everywhere.
             light: light.direction,
             ambient: light.ambient,
-            axis_slices: false,
-            axis_mipmaps: false,
+            derived: Default::default(),
             layers: false,
             shadow: t.shadow.map(|sh| Shadow {
                 // The direction towards the light, like `light.direction`.

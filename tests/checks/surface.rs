@@ -26,7 +26,10 @@ use crate::layers::rust_files;
 /// (1301: ShellMarch, issue 31: its knobs (the struct and four fields, read by the tests and
 /// the write-back check), its twin for the GPU test (`march_shell`, `folds`, `ShellObject` and
 /// its fields, `frame_twin_inputs`, `ShellSet`) and `gpu::bindings::shell_march`.)
-const PUB_DECLARATIONS: usize = 1301;
+/// (1304: the GPU tests' adapter expectations read `GpuContext::info` and `features`; tests
+/// bake a texel's derived products (`bake::derived::Derivations`, `MadeProducts::get`, AxisSlices'
+/// `slice_images`), which the bake layer no longer names.)
+const PUB_DECLARATIONS: usize = 1304;
 
 /// Whether the declaration on line `n` has a `///` doc above its attributes (one-line ones, or
 /// multi-line ones from `#[` to `)]`).

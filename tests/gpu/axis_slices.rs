@@ -12,10 +12,10 @@ use crate::common;
 use std::path::{Path, PathBuf};
 
 use glam::{Vec2, Vec3};
-use voltex::bake::axis_slices as layout;
 use voltex::bake::{BakeRequest, BakeSource, Baker};
 use voltex::cpu::bake::{pack_shapes, Primitive};
 use voltex::io::Image;
+use voltex::methods::axis_slices::slice_images as layout;
 use voltex::methods::axis_slices::twin::{self, AxisFrame};
 use voltex::methods::axis_slices::AxisPlan;
 use voltex::render::{Blueprint, MethodKind, RenderOptions, Renderer};
@@ -111,15 +111,14 @@ fn slice_image_bake_matches_its_twin() {
         per_pixel: false,
         light: [0.3, 0.4, 0.8],
         ambient: 0.3,
-        axis_slices: true,
-        axis_mipmaps: false,
+        derived: layout::slice_images(false),
         layers: false,
         shadow: None,
     };
     let ctx = gpu!(ADAPTER);
     let baked = Baker::new(&voltex::gpu::sources::Sources::project().unwrap()).bake(&ctx, &request).unwrap();
     let volume = voltex::gpu::readback::read_texture(&ctx, &baked.volume, 4).unwrap();
-    let axis = baked.axis.unwrap();
+    let axis = baked.derived.get::<layout::AxisBaked>().unwrap().clone();
     let gpu: Vec<Vec<f32>> = axis
         .arrays
         .iter()
@@ -161,15 +160,16 @@ fn slice_image_mips_match_their_twin() {
         per_pixel: false,
         light: [0.3, 0.4, 0.8],
         ambient: 0.3,
-        axis_slices: true,
-        axis_mipmaps: true,
+        derived: layout::slice_images(true),
         layers: false,
         shadow: None,
     };
     let ctx = gpu!(ADAPTER);
     let baked = Baker::new(&voltex::gpu::sources::Sources::project().unwrap()).bake(&ctx, &request).unwrap();
     let mut checked = 0;
-    for (direction, array) in baked.axis.unwrap().arrays.iter().enumerate() {
+    for (direction, array) in
+        baked.derived.get::<layout::AxisBaked>().unwrap().clone().arrays.iter().enumerate()
+    {
         assert_eq!(
             array.mip_level_count(),
             voltex::bake::texel_layers::image_levels([array.width(), array.height()])
@@ -220,8 +220,7 @@ fn height_image_bake_matches_its_twin() {
         per_pixel: false,
         light,
         ambient,
-        axis_slices: false,
-        axis_mipmaps: false,
+        derived: Default::default(),
         layers: false,
         shadow: None,
     };

@@ -436,8 +436,8 @@ fn hypertextures_vanishing_fields_far_noise_and_transfer_limits() {
 
 mod twins {
     use glam::{DVec3, Vec2, Vec3};
-    use voltex::bake::axis_slices::level_count;
     use voltex::cpu::prism_map::{inverse, ray_intervals, PrismCorners};
+    use voltex::methods::axis_slices::slice_images::level_count;
     use voltex::methods::axis_slices::twin::{choose_axis, AxisFrame};
     use voltex::methods::view_slices::slice_prisms::slice_prism;
     use voltex::types::{AxisParams, Prism, ShellVertex};

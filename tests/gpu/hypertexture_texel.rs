@@ -55,8 +55,7 @@ fn bake(ht: &HyperTexel, resolution: [u32; 3], per_pixel: bool) -> (Vec<u8>, Vec
         per_pixel,
         light: LIGHT,
         ambient: AMBIENT,
-        axis_slices: false,
-        axis_mipmaps: false,
+        derived: Default::default(),
         layers: false,
         shadow: None,
     };

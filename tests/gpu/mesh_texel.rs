@@ -112,8 +112,7 @@ fn bake_res(source: BakeSource, resolution: [u32; 3], per_pixel: bool) -> (Vec<u
         per_pixel,
         light: LIGHT,
         ambient: AMBIENT,
-        axis_slices: false,
-        axis_mipmaps: false,
+        derived: Default::default(),
         layers: false,
         shadow: None,
     };

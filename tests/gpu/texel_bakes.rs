@@ -24,8 +24,7 @@ fn bake(
         per_pixel,
         light,
         ambient,
-        axis_slices: false,
-        axis_mipmaps: false,
+        derived: Default::default(),
         layers: false,
         shadow: None,
     };

@@ -144,8 +144,7 @@ fn a_column_shadows_its_neighbour_across_the_tile_edge() {
         per_pixel: false,
         light: [0.0, 0.0, 1.0],
         ambient: 0.0,
-        axis_slices: true,
-        axis_mipmaps: false,
+        derived: voltex::methods::axis_slices::slice_images::slice_images(false),
         layers: false,
         shadow: Some(shadow),
     };

@@ -53,8 +53,7 @@ fn texel_layers_match_their_twin() {
         per_pixel: true,
         light: [0.3, 0.4, 0.8],
         ambient: 0.3,
-        axis_slices: false,
-        axis_mipmaps: false,
+        derived: Default::default(),
         layers: true,
         shadow: None,
     };

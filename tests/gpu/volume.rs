@@ -257,8 +257,7 @@ fn volume_texel_bake_matches_twin() {
             per_pixel,
             light,
             ambient,
-            axis_slices: false,
-            axis_mipmaps: false,
+            derived: Default::default(),
             layers: false,
             shadow: None,
         };

@@ -1,17 +1,18 @@
 //! Host side of Meyer & Neyret's axis-aligned slicing (1998): per object the slicing parameters,
 //! the prisms sorted back to front and the buffers of `choose_axis_slices`, `scan_axis_slices`,
-//! `emit_axis_slices` and `draw_axis_slices`. The slice images come from `bake::axis_slices`.
+//! `emit_axis_slices` and `draw_axis_slices`. The slice images are derived in the texel bake (`slice_images`).
 
 /// Its scene-file knobs (`knobs.rs`, compiled in the scene layer: `scene::methods`).
 pub(crate) use crate::scene::methods::axis_slices as knobs;
 mod object;
+pub mod slice_images;
 pub(crate) mod plugin;
 pub mod twin;
 
 pub(crate) use object::plan;
 
 use crate::gpu::bindings::axis_slices as B;
-use crate::bake::axis_slices::AxisBaked;
+use slice_images::AxisBaked;
 use crate::error::{Error, Result};
 use crate::mesh::shell::Shell;
 use crate::scene::{AxisSlices, DrawOrder, SliceBlend, SliceDirections};
@@ -184,7 +185,7 @@ pub(crate) fn add_inputs(
     // when not grouped.
     let stride = plan.params.resolution[..3]
         .iter()
-        .map(|&r| crate::bake::axis_slices::array_layers(r))
+        .map(|&r| slice_images::array_layers(r))
         .max()
         .unwrap_or(1);
     let counters = if plan.grouped { 3 * stride as u64 } else { 3 };

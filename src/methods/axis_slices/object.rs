@@ -1,5 +1,6 @@
 //! One AxisSlices object of a frame as the renderer sees it.
 
+use super::slice_images::SliceImages;
 use super::{add_inputs, AxisPlan};
 use crate::error::Result;
 use crate::gpu::Inputs;
@@ -10,8 +11,11 @@ use crate::scene::{AxisSlices, Method};
 pub fn plan(cx: &mut PlanCx, object: &mut ObjectPlan, m: &AxisSlices) -> Result<()> {
     let texel = object.object.texel.clone().unwrap_or_default();
     let bake = texels::bake_index(cx.scene, &texel, false, cx.light, cx.time, cx.bakes)?;
-    cx.bakes[bake].request.axis_slices = true;
-    cx.bakes[bake].request.axis_mipmaps |= m.mipmaps;
+    // Objects drawing the same texel share its slice images, with MIP levels if any asks.
+    let mipmaps = m.mipmaps;
+    cx.bakes[bake].request.derive(|before: Option<&SliceImages>| SliceImages {
+        mipmaps: mipmaps || before.is_some_and(|b| b.mipmaps),
+    });
     object.bake = Some(bake);
     let res = cx.bakes[bake].request.resolution;
     let (forward, focal) = (cx.view.forward_f32(), cx.view.focal);
@@ -32,7 +36,7 @@ impl MethodPlan for AxisPlan {
 
     fn add_inputs(&self, cx: &InputCx, object: &ObjectPlan, _part: usize, inputs: &mut Inputs) {
         let Some(b) = object.bake else { return };
-        if let Some(axis) = &cx.baked[b].axis {
+        if let Some(axis) = cx.baked[b].derived.get::<super::slice_images::AxisBaked>() {
             add_inputs(cx.ctx, inputs, &object.shell, self, axis);
         }
     }

@@ -4,7 +4,7 @@
 
 use glam::{Vec2, Vec3, Vec4};
 
-use crate::bake::axis_slices::{level_count, level_layer, level_slices, occupancy_base, slice_layer};
+use super::slice_images::{level_count, level_layer, level_slices, occupancy_base, slice_layer};
 
 use crate::types::{AxisChoice, AxisParams, AxisVertex};
 

@@ -2,12 +2,86 @@
 //! texture array holding every power-of-two level (finest first), each coarser slice combining
 //! `2^level` voxel slices, and one occupancy word per slice for empty-slice culling.
 
-use super::texel_layers;
+use std::sync::Arc;
+
+use crate::bake::derived::{Derived, Kernels, Made};
+use crate::bake::texel_layers;
 use crate::error::{Error, Result};
+use crate::gpu::budget::{Allocation, AllocationKind, Driver};
 use crate::gpu::kernel::ComputeKernel;
 use crate::gpu::GpuContext;
 use crate::gpu::Inputs;
 use crate::types::AxisBake;
+
+/// The kernel baking one level of one direction's slice images.
+const KERNEL: &str = "axis_slices/bake_axis_slices.wgsl";
+
+/// The slice images a texel's bake derives for AxisSlices (the bake layer's [`Derived`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct SliceImages {
+    /// With their MIP levels (`AxisSlices(mipmaps: true)` on any object drawing the texel).
+    pub(crate) mipmaps: bool,
+}
+
+/// A bake request's derivations with the slice images (tests bake them directly).
+pub fn slice_images(mipmaps: bool) -> crate::bake::derived::Derivations {
+    crate::bake::derived::Derivations(vec![Arc::new(SliceImages { mipmaps })])
+}
+
+impl Derived for SliceImages {
+    fn kernels(&self) -> Vec<&'static str> {
+        let mut k = vec![KERNEL];
+        if self.mipmaps {
+            k.push(texel_layers::MIP_KERNEL);
+        }
+        k
+    }
+
+    fn describe(&self) -> String {
+        let mut s = "  (and its slice images: bake_axis_slices.wgsl per direction and level)\n".to_string();
+        if self.mipmaps {
+            s += "  (and their MIP levels: mip_layers.wgsl per direction and MIP level)\n";
+        }
+        s
+    }
+
+    fn memory(&self, texel: &str, resolution: [u32; 3]) -> (String, u64) {
+        let mips = if self.mipmaps { " with MIP levels" } else { "" };
+        (
+            format!("texel {texel} slice images (s, t, w; all levels{mips}) rgba16f"),
+            bytes(resolution, self.mipmaps),
+        )
+    }
+
+    fn allocations(&self, texel: &str, res: [u32; 3], driver: &Driver) -> Vec<Allocation> {
+        (0..3)
+            .map(|d| {
+                let (size, layers) = (image_size(res, d), array_layers(res[d]));
+                Allocation {
+                    what: format!("texel \"{texel}\"'s {} slice images", ["s", "t", "w"][d]),
+                    bytes: texel_layers::image_bytes(size, self.mipmaps) * layers as u64,
+                    shape: AllocationKind::Texture2d { size, layers },
+                    driver: driver.clone(),
+                }
+            })
+            .collect()
+    }
+
+    fn record(
+        &self,
+        ctx: &GpuContext,
+        kernels: &mut Kernels,
+        encoder: &mut wgpu::CommandEncoder,
+        volume: &wgpu::Texture,
+        resolution: [u32; 3],
+    ) -> Result<Arc<dyn Made>> {
+        let baked = bake(ctx, kernels.get(ctx, KERNEL)?, encoder, volume, resolution, self.mipmaps)?;
+        if self.mipmaps {
+            mip(ctx, kernels.get(ctx, texel_layers::MIP_KERNEL)?, encoder, &baked)?;
+        }
+        Ok(Arc::new(baked))
+    }
+}
 
 /// A texel's AxisSlices slice images (Meyer & Neyret 1998), baked along s, t and w.
 #[derive(Clone)]
@@ -71,7 +145,7 @@ pub(crate) fn bake(
         let [w, h] = image_size(res, d);
         let label = ["axis_slices_s", "axis_slices_t", "axis_slices_w"][d];
         let levels = if mipmaps { texel_layers::image_levels([w, h]) } else { 1 };
-        super::texel_layers::texture(ctx, label, [w, h], array_layers(res[d]), levels)
+        texel_layers::texture(ctx, label, [w, h], array_layers(res[d]), levels)
     });
     let source = crate::bake::level_view(volume, 0);
     for (d, array) in arrays.iter().enumerate() {
@@ -111,7 +185,7 @@ pub(crate) fn mip(
     baked: &AxisBaked,
 ) -> Result<()> {
     for (direction, array) in baked.arrays.iter().enumerate() {
-        super::texel_layers::record_mips(ctx, kernel, encoder, array, direction == 2)?;
+        texel_layers::record_mips(ctx, kernel, encoder, array, direction == 2)?;
     }
     Ok(())
 }
