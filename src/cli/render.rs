@@ -13,8 +13,9 @@ use super::Overrides;
 #[derive(clap::Args)]
 pub struct RenderArgs {
     scene: PathBuf,
-    /// Output EXR (default: out/<scene name>.exr); the PNG goes beside it. With --frames, the
-    /// first frame's path: frame N is written as <stem>_NNNN.exr beside it.
+    /// Output EXR (default: out/<scene name>.exr); the PNG goes beside it. `x.png` writes x.exr
+    /// and x.png; a folder (existing, or ending in /) gets <scene name>.exr; missing folders are
+    /// made. With --frames, the first frame's path: frame N is written as <stem>_NNNN.exr beside it.
     #[arg(short, long)]
     output: Option<PathBuf>,
     /// Render frames A to B (inclusive) of an animation, at time N / fps for frame N.
@@ -120,19 +121,33 @@ fn render_frames(
     Ok(ctx)
 }
 
-/// The EXR path to write (default `out/<stem>.exr`), its folder checked writable before any GPU
-/// work (`out/` is created when missing).
+/// The EXR path to write (its PNG goes beside it), its folder made when missing and checked
+/// writable before any GPU work. `-o` may name the EXR, the PNG (`x.png`: both are written, as
+/// `x.exr` and `x.png`), or a folder (an existing one, or a path ending in `/`: the scene's name
+/// in it); without it, `out/<stem>.exr`.
 fn output_path(scene_path: &Path, output: Option<PathBuf>) -> Result<PathBuf> {
-    let exr_path = output.unwrap_or_else(|| {
-        let stem = scene_path.file_stem().unwrap_or_default();
-        PathBuf::from("out").join(stem).with_extension("exr")
-    });
+    let stem = scene_path.file_stem().unwrap_or_default();
+    let named = output.unwrap_or_else(|| PathBuf::from("out").join(stem).with_extension("exr"));
+    let folder = named.is_dir() || named.as_os_str().to_string_lossy().ends_with(std::path::MAIN_SEPARATOR);
+    let exr_path = match named.extension().and_then(|e| e.to_str()) {
+        _ if folder => named.join(stem).with_extension("exr"),
+        Some("exr" | "png") | None => named.with_extension("exr"),
+        Some(other) => {
+            return Err(voltex::Error::file(
+                &named,
+                format!(
+                    "cannot write a .{other} image: expected an output ending in .exr or .png, or a folder"
+                ),
+            ))
+        }
+    };
     let dir = match exr_path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
         _ => PathBuf::from("."),
     };
-    if !dir.exists() && dir == Path::new("out") {
-        std::fs::create_dir_all(&dir).map_err(|e| voltex::Error::file(&dir, e))?;
+    if !dir.exists() {
+        std::fs::create_dir_all(&dir)
+            .map_err(|e| voltex::Error::file(&dir, format!("cannot make the output folder: {e}")))?;
     }
     io::atomic::check_writable_dir(&dir)?;
     Ok(exr_path)

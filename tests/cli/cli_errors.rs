@@ -4,7 +4,7 @@
 
 use crate::common;
 
-use common::{entries, stderr};
+use common::{entries, s, stderr};
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -221,14 +221,18 @@ fn missing_scene_file() {
 
 // ---- command-line errors ----
 
+/// A missing output folder is made (issue 32: the tutorial's `-o out/my/balls.exr`); one that
+/// cannot be made (under a plain file) is an error naming it, before any work.
 #[test]
-fn missing_output_folder() {
+fn unmakeable_output_folder() {
     let dir = temp_dir("no_out_dir");
+    let file = dir.join("plain");
+    std::fs::write(&file, "x").unwrap();
     let scene = root().join("scenes/view_slices/flat_box.ron");
+    let target = file.join("sub/x.exr");
     let out =
-        voltex(&["render", scene.to_str().unwrap(), "-o", "/nonexistent/dir/x.exr", "--size", "64x64"], None);
-    assert_fails(&out, &dir, &["/nonexistent/dir", "does not exist"]);
-    assert!(!Path::new("/nonexistent/dir").exists());
+        voltex(&["render", scene.to_str().unwrap(), "-o", target.to_str().unwrap(), "--size", "64x64"], None);
+    assert_fails(&out, &dir, &[&file.join("sub").display().to_string(), "cannot make the output folder"]);
 }
 
 #[test]
@@ -557,4 +561,42 @@ fn mipmaps_flag_switches_every_axis_slices_object() {
     let out = common::voltex(&["plan", scene, "--mipmaps", "maybe"]);
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
     assert!(stderr(&out).contains("possible values: on, off"), "{}", stderr(&out));
+}
+
+/// Where `-o` puts a render (issue 32, items 2 and 6): into folders that do not exist yet (made),
+/// `x.png` as x.exr and x.png (the PNG no longer replaces the EXR under its name), a folder
+/// (existing, or ending in `/`) as the scene's name in it, and an unknown extension refused
+/// before any work.
+#[test]
+fn output_paths_make_folders_and_keep_both_images() {
+    let dir = temp_dir("output_paths");
+    let scene = dir.join("scene.ron");
+    std::fs::write(&scene, flat_box()).unwrap();
+    let render_to =
+        |o: &Path| voltex(&["render", s(&scene), "--size", "16x16", "-o", o.to_str().unwrap()], None);
+    let nested = dir.join("new/deeper/box.exr");
+    let out = render_to(&nested);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(
+        nested.exists() && nested.with_extension("png").exists(),
+        "{:?}",
+        entries(&dir.join("new/deeper"))
+    );
+    let png = dir.join("pictures/x.png");
+    let out = render_to(&png);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let said = String::from_utf8_lossy(&out.stdout).to_string();
+    assert!(said.contains("x.exr and ") && said.contains("x.png"), "{said}");
+    let (exr, _) = voltex::io::exr::read(&png.with_extension("exr")).unwrap();
+    assert_eq!((exr.width, exr.height), (16, 16));
+    for folder in [dir.join("pictures"), dir.join("more/")] {
+        let out = render_to(&folder);
+        assert!(out.status.success(), "{}", stderr(&out));
+        assert!(folder.join("scene.exr").exists(), "{:?}", entries(&folder));
+    }
+    let jpg = dir.join("y.jpg");
+    let out = render_to(&jpg);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(stderr(&out).contains("expected an output ending in .exr or .png"), "{}", stderr(&out));
+    assert!(!jpg.exists() && !jpg.with_extension("exr").exists());
 }
