@@ -20,7 +20,7 @@ fn is_volume(path: &Path) -> bool {
 }
 
 /// Scene text around the asset `asset`, which the scene names as `mesh_path` (relative to the
-/// scene file's folder, or absolute).
+/// scene file's folder: see [`mesh_path`]).
 pub fn scene_text(asset: &Path, mesh_path: &str) -> Result<String> {
     if is_volume(asset) {
         return volume_scene_text(asset, mesh_path);
@@ -214,10 +214,18 @@ fn ron_string(s: &str) -> String {
     format!("\"{}\"", s.replace('\\', "\\\\").replace('"', "\\\""))
 }
 
-/// The path by which a scene written to `scene` names `asset`: relative when the asset lies in
-/// the scene's folder or below, else absolute.
+/// The path by which a scene written to `scene` names `asset`: relative to the scene's folder
+/// (with `..` where the asset lies outside it), so that the pair moves together; absolute only
+/// when the two share no root (another drive).
 pub fn mesh_path(asset: &Path, scene: &Path) -> PathBuf {
+    use std::path::Component;
     let absolute = |p: &Path| std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf());
     let (asset, dir) = (absolute(asset), absolute(scene.parent().unwrap_or(Path::new(""))));
-    asset.strip_prefix(&dir).map(Path::to_path_buf).unwrap_or(asset)
+    let (a, d): (Vec<Component>, Vec<Component>) = (asset.components().collect(), dir.components().collect());
+    let shared = a.iter().zip(&d).take_while(|(x, y)| x == y).count();
+    if shared == 0 {
+        return asset;
+    }
+    let up = std::iter::repeat_n(Component::ParentDir, d.len() - shared);
+    up.chain(a[shared..].iter().copied()).collect()
 }
