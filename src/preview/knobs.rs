@@ -36,9 +36,14 @@ fn method_path(src: &str, node: &[Step], written: &str) -> Result<(String, Vec<S
     Ok((text, m))
 }
 
+/// The settings of the methods `M` switched away from, per node and method, so that cycling
+/// back finds them again (`ViewSlices(planes: 800, lighting: PerPixel)` stays so).
+pub(crate) type LeftMethods = std::collections::BTreeMap<(String, String), Method>;
+
 /// `M`: the method's plug-in says what comes next: ViewSlices, AxisSlices, Reference in turn
-/// (lighting kept where both have it); a hypertexture's RayMarch cycles its shading.
-pub(crate) fn next_method(src: &str, node: &[Step], m: &Method) -> Result<Edit> {
+/// (lighting kept where both have it, or the settings the node had in that method when `M` last
+/// left it, from `left`); a hypertexture's RayMarch cycles its shading.
+pub(crate) fn next_method(src: &str, node: &[Step], m: &Method, left: &mut LeftMethods) -> Result<Edit> {
     let written = format!("{}()", m.kind());
     compound(src, node, |text| match m.plugin().next_mode() {
         Some((path, value)) => {
@@ -46,7 +51,11 @@ pub(crate) fn next_method(src: &str, node: &[Step], m: &Method) -> Result<Edit> 
             set_knob(&text, &mp, path, &value)
         }
         None => {
-            let next = crate::methods::plugin::short_text(&crate::methods::plugin::next_method(m));
+            let key = |m: &Method| (st::show(node), m.kind().to_string());
+            left.insert(key(m), m.clone());
+            let next = crate::methods::plugin::next_method(m);
+            let next = left.get(&key(&next)).cloned().unwrap_or(next);
+            let next = crate::methods::plugin::short_text(&next);
             let (text, mp) = method_path(&text, node, &next)?;
             st::set(&text, &mp, &next)?.apply(&text)
         }
@@ -123,7 +132,8 @@ mod tests {
         });
         let e = step_quality(SRC, &node(0), &v, true).unwrap().unwrap();
         assert_eq!(e.apply(SRC).unwrap(), SRC.replace("planes: 24", "planes: 48"));
-        let e = next_method(SRC, &node(0), &v).unwrap();
+        let mut left = LeftMethods::new();
+        let e = next_method(SRC, &node(0), &v, &mut left).unwrap();
         assert_eq!(e.apply(SRC).unwrap(), SRC.replace("ViewSlices(planes: 24)", "AxisSlices()"));
         let h = Method::RayMarch(RayMarch {
             step: Some(0.01),
@@ -135,10 +145,33 @@ mod tests {
             e.apply(SRC).unwrap(),
             SRC.replace("step: 0.01, adaptive: (max_step: 0.04)", "step: 0.02, adaptive: (max_step: 0.08)")
         );
-        let e = next_method(SRC, &node(1), &h).unwrap();
+        let e = next_method(SRC, &node(1), &h, &mut left).unwrap();
         assert!(e.apply(SRC).unwrap().contains("adaptive: (max_step: 0.04), shading: Phong)"));
         // A node without a method in the file gets one.
         let e = step_quality(SRC, &node(2), &v, false).unwrap().unwrap();
         assert!(e.apply(SRC).unwrap().contains("(name: \"d\", method: ViewSlices(planes: 12)),"));
+    }
+
+    /// `M` around the cycle comes back to the settings it left (issue 32: they were thrown away).
+    #[test]
+    fn m_around_the_cycle_keeps_each_methods_settings() {
+        let src = "Scene(\n    nodes: [\n        (name: \"a\", method: ViewSlices(planes: 800, lighting: PerPixel)),\n    ],\n)\n";
+        let parse = |text: &str| -> Method {
+            let at = text.find("method: ").unwrap() + "method: ".len();
+            let end = text[at..].find("),\n").unwrap() + at;
+            ron::from_str(&format!("#![enable(implicit_some, unwrap_variant_newtypes)] {}", &text[at..end]))
+                .unwrap()
+        };
+        let mut left = LeftMethods::new();
+        let mut text = src.to_string();
+        let mut seen = Vec::new();
+        let cycle = crate::methods::plugin::MethodKind::all().filter(|k| k.switchable()).count();
+        for _ in 0..cycle {
+            let m = parse(&text);
+            text = next_method(&text, &node(0), &m, &mut left).unwrap().apply(&text).unwrap();
+            seen.push(crate::methods::plugin::short_text(&parse(&text)));
+        }
+        assert_eq!(text, src, "after {seen:?}");
+        assert_ne!(seen[0], seen[1]);
     }
 }

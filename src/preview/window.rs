@@ -85,6 +85,8 @@ struct State {
     /// The scene file, canonical, to tell its changes from those of other watched files.
     scene_file: PathBuf,
     home: Option<Camera>,
+    /// The methods `M` switched away from, per node (see `knobs::LeftMethods`).
+    left_methods: knobs::LeftMethods,
     selected: usize,
     mode: Mode,
     gpu_ms: Option<f64>,
@@ -309,6 +311,7 @@ impl State {
             watcher,
             editor,
             home,
+            left_methods: Default::default(),
             selected: 0,
             mode: args.mode,
             gpu_ms: None,
@@ -813,7 +816,11 @@ impl State {
                 }
                 self.home = Some(cam);
             }
-            "m" | "M" => self.node_edit(|src, node, m| knobs::next_method(src, node, m).map(Some)),
+            "m" | "M" => {
+                let mut left = std::mem::take(&mut self.left_methods);
+                self.node_edit(|src, node, m| knobs::next_method(src, node, m, &mut left).map(Some));
+                self.left_methods = left;
+            }
             "+" | "=" | "-" => {
                 let finer = c.as_str() != "-";
                 self.node_edit(|src, node, m| knobs::step_quality(src, node, m, finer));
