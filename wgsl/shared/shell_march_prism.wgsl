@@ -131,7 +131,8 @@ fn sample_t(s: u32, k: u32) -> f32 {
 
 // Makes piece j the current piece of interval s: its ends mapped exactly (the interval's own
 // ends from its crossings), the line between them checked unless it is the whole interval.
-fn set_piece(s: u32, j: u32, ca_known: vec4<f32>) {
+// `next`: piece j follows the current one, whose end (the same t, bit for bit) is its start.
+fn set_piece(s: u32, j: u32, ca_known: vec4<f32>, next: bool) {
     budget -= PIECE_COST;
     let m = iv_pieces[s];
     iv_piece[s] = j;
@@ -147,7 +148,9 @@ fn set_piece(s: u32, j: u32, ca_known: vec4<f32>) {
     let tb = select(t0 + (t1 - t0) * f32(j + 1u) / f32(m), t1, j + 1u == m);
     var shape = load_shape(iv_prism[s]);
     var ca = ca_known;
-    if (j > 0u) {
+    if (next) {
+        ca = iv_cb[s];
+    } else if (j > 0u) {
         ca = prism_inverse(ray * ta, &shape);
     }
     var cb = iv_c1[s];
@@ -219,14 +222,14 @@ fn add_interval(index: u32, t0: f32, t1: f32, c0: vec4<f32>, c1: vec4<f32>, c3: 
     if (pieces > 1u) {
         j = min(u32((iv_next[s] - t0) / (t1 - t0) * f32(pieces)), pieces - 1u);
     }
-    set_piece(s, j, c0);
+    set_piece(s, j, c0, false);
     // The piece a sample falls in is found by `t >= tb` as the march goes: agree with it.
     while (iv_next[s] >= iv_tb[s] && iv_piece[s] + 1u < pieces) {
-        set_piece(s, iv_piece[s] + 1u, c0);
+        set_piece(s, iv_piece[s] + 1u, c0, true);
     }
     while (j > 0u && iv_piece[s] == j && iv_next[s] < iv_ta[s]) {
         j -= 1u;
-        set_piece(s, j, c0);
+        set_piece(s, j, c0, false);
     }
 }
 

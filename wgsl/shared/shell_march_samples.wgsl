@@ -143,7 +143,7 @@ fn run(s: u32, limit: f32) {
         first = false;
         if (t >= tb && iv_piece[s] + 1u < m) {
             while (t >= iv_tb[s] && iv_piece[s] + 1u < m) {
-                set_piece(s, iv_piece[s] + 1u, vec4<f32>(0.0));
+                set_piece(s, iv_piece[s] + 1u, vec4<f32>(0.0), true);
             }
             exact = iv_exact[s];
             ta = iv_ta[s];
