@@ -334,11 +334,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_
             }
         }
     }
-    if (!inside || state.resume.z != 0.0) {
-        return;
-    }
-    shell_march_state[pixel] = ReferenceState(vec4<f32>(rgb, transmittance), vec4<f32>(t_resume, 1.0, select(0.0, 1.0, finished), 0.0));
-    textureStore(shell_march_rgba, vec2<i32>(id.xy), vec4<f32>(rgb * frame.light_color.rgb, 1.0 - transmittance));
+    // Invocation 0 counts the tile's dropped nodes even where its own pixel was done.
     if (taken > 0u) {
         atomicAdd(&shell_march_counts[0], taken);
     }
@@ -351,4 +347,9 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_
     if (exact_pieces > 0u) {
         atomicAdd(&shell_march_counts[3], exact_pieces);
     }
+    if (!inside || state.resume.z != 0.0) {
+        return;
+    }
+    shell_march_state[pixel] = ReferenceState(vec4<f32>(rgb, transmittance), vec4<f32>(t_resume, 1.0, select(0.0, 1.0, finished), 0.0));
+    textureStore(shell_march_rgba, vec2<i32>(id.xy), vec4<f32>(rgb * frame.light_color.rgb, 1.0 - transmittance));
 }
