@@ -113,6 +113,18 @@ fn kernel_matches_its_f64_twin() {
     assert!(exact > 0, "some piece is mapped exactly (a folded prism, or beyond the tolerance)");
 }
 
+/// The kernel walks the BVH once per 8x8 tile of pixels: an image whose sides are no multiple of
+/// 8 (tiles cut by its edge, with pixels that march nothing) still matches the twin, every ray
+/// finished, nothing dropped.
+#[test]
+fn partial_tiles_match_the_twin() {
+    let m = march(&load(&example("shell_march", "torus_egg.ron")), &shell_march(37), true);
+    let (max, mean) = differences(&m.gpu, &m.cpu);
+    eprintln!("37x37: GPU vs f64 twin: max {max:.2e}, mean {mean:.2e}");
+    assert!(mean < 2e-3 && max < 0.25, "max {max}, mean {mean}");
+    assert_eq!((m.unfinished, m.counts[2]), (0, 0), "unfinished rays, dropped intervals");
+}
+
 /// Empty-space skipping changes no pixel, bit for bit, and skips samples.
 #[test]
 fn skipping_changes_no_pixel() {

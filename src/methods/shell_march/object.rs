@@ -20,7 +20,7 @@ use crate::scene::{Lighting, Method};
 use crate::types::{FrameParams, ReferenceParams, ReferenceState};
 
 /// Mirrors `samples_per_dispatch` and the costs in march_shell.wgsl.
-const BUDGET: f64 = 2048.0;
+const BUDGET: f64 = 8192.0;
 const PRISM_COST: f64 = 32.0;
 const PIECE_COST: f64 = 16.0;
 /// More dispatches than this means a scene far larger than its voxels.

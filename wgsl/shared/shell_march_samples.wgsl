@@ -1,0 +1,247 @@
+// ShellMarch's samples (included by march_shell.wgsl): empty-space runs, trilinear filtering and
+// lighting as the Reference does them, and compositing the held intervals nearest first.
+
+// How many samples of interval s from map value c on are empty for certain (at most `most`):
+// along the line c + k dc, until it leaves the largest brick around c that holds no opacity.
+fn empty_run(s: u32, c: vec4<f32>, dc: vec4<f32>, most: u32) -> u32 {
+    let prism = shell_prisms[iv_prism[s]];
+    let object = shell_objects[prism.vertices.w];
+    let res = object.resolution.xyz;
+    let resf = vec3<f32>(res);
+    let st = c.x * prism.uv01.xy + c.y * prism.uv01.zw + c.z * prism.uv2.xy;
+    let x = vec3<f32>(fract(st), c.w) * resf;
+    let dx = vec3<f32>(dc.x * prism.uv01.xy + dc.y * prism.uv01.zw + dc.z * prism.uv2.xy, dc.w) * resf;
+    var run = 0.0;
+    var offset = object.atlas.w;
+    for (var level = 0u; level < 3u; level++) {
+        let size = 4u << (2u * level);
+        let dims = (res + vec3<u32>(size - 1u)) / size;
+        let brick = vec3<u32>(clamp(floor(x / f32(size)), vec3<f32>(0.0), vec3<f32>(dims - vec3<u32>(1u))));
+        if (shell_occupancy[offset + (brick.z * dims.y + brick.y) * dims.x + brick.x] != 0u) {
+            break;
+        }
+        // The brick and half a voxel around it (the occupancy covers the filter's reach from
+        // there); along w the first and last bricks reach on (sampling clamps there).
+        var lo = vec3<f32>(brick * size) - 0.5;
+        var hi = vec3<f32>(min((brick + 1u) * size, res)) + 0.5;
+        lo.z = select(lo.z, -FAR, brick.z == 0u);
+        hi.z = select(hi.z, FAR, brick.z + 1u == dims.z);
+        let exit = select(select((lo - x) / dx, (hi - x) / dx, dx > vec3<f32>(0.0)), vec3<f32>(FAR), dx == vec3<f32>(0.0));
+        run = floor(min(min(exit.x, exit.y), exit.z)) + 1.0;
+        offset += dims.x * dims.y * dims.z;
+    }
+    return u32(clamp(run, 0.0, f32(most)));
+}
+
+
+struct Axis {
+    i0: u32,
+    i1: u32,
+    f: f32,
+}
+
+fn axis(c: f32, n: u32, wrap: bool) -> Axis {
+    let x = c * f32(n) - 0.5;
+    let fl = floor(x);
+    let m = i32(n);
+    var i0 = i32(fl);
+    var i1 = i0 + 1;
+    if (wrap) {
+        i0 = ((i0 % m) + m) % m;
+        i1 = ((i1 % m) + m) % m;
+    } else {
+        i0 = clamp(i0, 0, m - 1);
+        i1 = clamp(i1, 0, m - 1);
+    }
+    return Axis(u32(i0), u32(i1), x - fl);
+}
+
+// Trilinear filtering as the volume sampler does it (the Reference's atlas): repeat in s and t,
+// clamp in w, level 0.
+fn sample_volume(object: ReferenceObject, uvw: vec3<f32>, normals: bool) -> vec4<f32> {
+    let ax = axis(fract(uvw.x), object.resolution.x, true);
+    let ay = axis(fract(uvw.y), object.resolution.y, true);
+    let az = axis(uvw.z, object.resolution.z, false);
+    let offset = select(object.atlas.x, object.atlas.z, normals);
+    var out = vec4<f32>(0.0);
+    for (var k = 0u; k < 8u; k++) {
+        let x = select(ax.i0, ax.i1, (k & 1u) != 0u);
+        let y = select(ay.i0, ay.i1, (k & 2u) != 0u);
+        let z = select(az.i0, az.i1, (k & 4u) != 0u);
+        let weight = select(1.0 - ax.f, ax.f, (k & 1u) != 0u) * select(1.0 - ay.f, ay.f, (k & 2u) != 0u)
+            * select(1.0 - az.f, az.f, (k & 4u) != 0u);
+        let at = offset + (z * object.resolution.y + y) * object.atlas.y + x;
+        if (normals) {
+            out += unpack4x8snorm(normal_atlas[at]) * weight;
+        } else {
+            out += unpack4x8unorm(texel_atlas[at]) * weight;
+        }
+    }
+    return out;
+}
+
+// Per-pixel lighting as the Reference does it (shared/shading.wgsl), at map value c.
+fn shade(index: u32, object: ReferenceObject, c: vec4<f32>, uvw: vec3<f32>, albedo: vec3<f32>) -> vec3<f32> {
+    let shape = load_shape(index);
+    let fa = vertex_frames[shape.ids[0]];
+    let fb = vertex_frames[shape.ids[1]];
+    let fc = vertex_frames[shape.ids[2]];
+    let ds = c.x * fa.ds.xyz + c.y * fb.ds.xyz + c.z * fc.ds.xyz;
+    let dt = c.x * fa.dt.xyz + c.y * fb.dt.xyz + c.z * fc.dt.xyz;
+    let dw = c.x * (shape.top[0] - shape.bottom[0]) + c.y * (shape.top[1] - shape.bottom[1]) + c.z * (shape.top[2] - shape.bottom[2]);
+    let sign_j = select(-1.0, 1.0, dot(ds, cross(dt, dw)) >= 0.0);
+    let tn = sample_volume(object, uvw, true).xyz;
+    var n = cross(dt, dw) * sign_j * tn.x + cross(dw, ds) * sign_j * tn.y + cross(ds, dt) * sign_j * tn.z;
+    n = select(-ray, normalize(n), dot(n, n) > 1e-20);
+    return shade_phong(albedo, n, frame.light_dir, -ray, PIXEL_SPECULAR, PIXEL_SHININESS);
+}
+
+// Composites one sample of interval s at ray distance t and map value c (w < 0: none).
+fn composite(s: u32, t: f32, c: vec4<f32>) {
+    taken += 1u;
+    if (c.w < 0.0) {
+        return;
+    }
+    let prism = shell_prisms[iv_prism[s]];
+    let object = shell_objects[prism.vertices.w];
+    let uvw = vec3<f32>(c.x * prism.uv01.xy + c.y * prism.uv01.zw + c.z * prism.uv2.xy, c.w);
+    let texel = sample_volume(object, uvw, false);
+    if (texel.a >= OPAQUE_ALPHA && !opaque_found) {
+        opaque_found = true;
+        record_opaque_depth(pixel, t * dot(ray, frame.forward.xyz));
+    }
+    let alpha = clamp(texel.a, 0.0, MAX_ALPHA);
+    if (alpha > 1e-6) {
+        var colour = texel.rgb / alpha;
+        if ((object.resolution.w & 1u) != 0u) {
+            colour = shade(iv_prism[s], object, c, uvw, colour);
+        }
+        // The step-corrected opacity: 1 - (1 - a)^(h / opacity_length).
+        let a = 1.0 - exp(log(1.0 - alpha) * iv_h[s] / object.params.x);
+        rgb += colour * a * transmittance;
+        transmittance *= 1.0 - a;
+    }
+}
+
+// Samples of interval s before `limit` (its next one in any case: it is the nearest held), in
+// order, until the budget or the ray runs out. The interval's state is kept in registers meanwhile
+// (dynamically indexed private arrays are slow on lavapipe).
+fn run(s: u32, limit: f32) {
+    let t0 = iv_t0[s];
+    let h = iv_h[s];
+    let n = iv_n[s];
+    let m = iv_pieces[s];
+    var k = iv_k[s];
+    var t = iv_next[s];
+    var exact = iv_exact[s];
+    var ta = iv_ta[s];
+    var tb = iv_tb[s];
+    var ca = iv_ca[s];
+    var cb = iv_cb[s];
+    var first = true;
+    while ((first || t < limit) && budget > 0 && transmittance >= min_transmittance) {
+        first = false;
+        if (t >= tb && iv_piece[s] + 1u < m) {
+            while (t >= iv_tb[s] && iv_piece[s] + 1u < m) {
+                set_piece(s, iv_piece[s] + 1u, vec4<f32>(0.0), true);
+            }
+            exact = iv_exact[s];
+            ta = iv_ta[s];
+            tb = iv_tb[s];
+            ca = iv_ca[s];
+            cb = iv_cb[s];
+        }
+        budget -= 1;
+        var c: vec4<f32>;
+        var dc = vec4<f32>(0.0);
+        var most = 1u;
+        if (exact) {
+            var shape = load_shape(iv_prism[s]);
+            c = prism_inverse(ray * t, &shape);
+            budget -= EXACT_COST;
+        } else {
+            c = mix(ca, cb, (t - ta) / (tb - ta));
+            dc = (cb - ca) * (h / (tb - ta));
+            // Skips stay in this piece and before `limit`: the first sample at or after either.
+            let bound = select(min(tb, limit), limit, iv_piece[s] + 1u >= m);
+            var e = u32(clamp(ceil((bound - t0) / h - 0.5), f32(k), f32(n)));
+            while (e > k && t0 + (f32(e - 1u) + 0.5) * h >= bound) {
+                e -= 1u;
+            }
+            while (e < n && t0 + (f32(e) + 0.5) * h < bound) {
+                e += 1u;
+            }
+            most = e - k;
+        }
+        var step = 1u;
+        let jump = select(0u, empty_run(s, c, dc, most), skip_empty && c.w >= 0.0);
+        if (jump > 0u) {
+            skipped += jump;
+            step = jump;
+        } else {
+            composite(s, t, c);
+        }
+        k += step;
+        t = select(FAR, t0 + (f32(k) + 0.5) * h, k < n);
+    }
+    iv_k[s] = k;
+    iv_next[s] = t;
+}
+
+// Composites every held sample before `end`, nearest first across intervals.
+fn march_to(end: f32) {
+    loop {
+        budget -= 1;
+        var best = MAX_ACTIVE;
+        var t_best = end;
+        var t_second = end;
+        var i = 0u;
+        while (i < held) {
+            let t = iv_next[i];
+            if (t >= FAR || t >= t_opaque) {
+                // Done: the last held interval takes its slot.
+                held -= 1u;
+                copy_interval(held, i);
+                continue;
+            }
+            if (t < t_best) {
+                t_second = t_best;
+                t_best = t;
+                best = i;
+            } else if (t < t_second) {
+                t_second = t;
+            }
+            i += 1u;
+        }
+        if (best == MAX_ACTIVE || budget <= 0 || transmittance < min_transmittance) {
+            return;
+        }
+        run(best, t_second);
+    }
+}
+
+fn copy_interval(src: u32, dst: u32) {
+    iv_prism[dst] = iv_prism[src];
+    iv_t0[dst] = iv_t0[src];
+    iv_t1[dst] = iv_t1[src];
+    iv_h[dst] = iv_h[src];
+    iv_n[dst] = iv_n[src];
+    iv_k[dst] = iv_k[src];
+    iv_next[dst] = iv_next[src];
+    iv_pieces[dst] = iv_pieces[src];
+    iv_piece[dst] = iv_piece[src];
+    iv_exact[dst] = iv_exact[src];
+    iv_ta[dst] = iv_ta[src];
+    iv_tb[dst] = iv_tb[src];
+    iv_ca[dst] = iv_ca[src];
+    iv_cb[dst] = iv_cb[src];
+    iv_c1[dst] = iv_c1[src];
+}
+
+fn next_held() -> f32 {
+    var t = FAR;
+    for (var i = 0u; i < held; i++) {
+        t = min(t, iv_next[i]);
+    }
+    return t;
+}
