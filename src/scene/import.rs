@@ -28,7 +28,11 @@ pub fn scene_text(asset: &Path, mesh_path: &str) -> Result<String> {
     let mesh = crate::mesh::load(asset)?;
     let gltf = !asset.extension().is_some_and(|e| e.eq_ignore_ascii_case("obj"));
     if mesh.uvs_missing {
-        return Err(Error::file(asset, "a primitive has no TEXCOORD_0: a base surface needs uvs"));
+        eprintln!(
+            "warning: {}: a primitive has no TEXCOORD_0: its corners take planar uvs from the mesh's x, y \
+             bounds",
+            asset.display()
+        );
     }
     // glTF is y-up (and so are most OBJ exports); voltex scenes are z-up.
     let rotate = DMat4::from_rotation_x(std::f64::consts::FRAC_PI_2);

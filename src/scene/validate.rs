@@ -475,13 +475,15 @@ impl Checker<'_> {
                 }
                 Surface::Obj { path } => {
                     mesh = self.mesh(path);
-                    // Texels tile by uv: a surface without them would be textured by accident.
+                    // Texels tile by uv: corners without them get planar uvs (as an OBJ without
+                    // `vt`), which the user should know of.
                     if mesh.as_ref().is_some_and(|m| m.uvs_missing) {
                         let msg = format!(
-                            "{} has a primitive without TEXCOORD_0: a base surface needs uvs",
+                            "{} has a primitive without TEXCOORD_0: its corners take planar uvs from the \
+                             mesh's x, y bounds (export uvs for a texture that follows the surface)",
                             path.value
                         );
-                        self.fail(path, msg);
+                        self.f.warnings.push((Some(path.seq), msg));
                     }
                 }
                 _ => {}

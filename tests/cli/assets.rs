@@ -69,8 +69,10 @@ fn broken_gltf_names_the_file_and_writes_nothing() {
     }
 }
 
+/// A glTF primitive without uvs takes planar ones, as an OBJ without `vt` does (issue 32: it was
+/// refused), with a warning at its path; `import` and the asset opened directly take it too.
 #[test]
-fn a_base_surface_without_uvs_is_an_error_at_its_path() {
+fn a_base_surface_without_uvs_gets_planar_uvs_and_a_warning_at_its_path() {
     let dir = scratch_dir("voltex-gltf-no-uvs");
     // The dome's glb with TEXCOORD_0 dropped from its primitive.
     let glb = std::fs::read(root().join("scenes/view_slices/meshes/dome.glb")).unwrap();
@@ -84,10 +86,16 @@ fn a_base_surface_without_uvs_is_an_error_at_its_path() {
     let text = dome("dome.glb").replace(s(&root().join("scenes/view_slices/meshes/dome.glb")), s(&mesh));
     let line = text.lines().position(|l| l.contains("no_uvs.glb")).unwrap() + 1;
     std::fs::write(&scene, text).unwrap();
-    let run = voltex(&["plan", s(&scene)]);
+    let run = voltex(&["render", s(&scene), "--size", "16x16", "-o", s(&dir.join("no_uvs.exr"))]);
     let err = stderr(&run);
-    assert_eq!(run.status.code(), Some(1), "{err}");
-    assert!(err.contains(&format!("no_uvs.ron:{line}:")) && err.contains("without TEXCOORD_0"), "{err}");
+    assert!(run.status.success(), "{err}");
+    assert!(err.contains(&format!("no_uvs.ron:{line}:")) && err.contains("planar uvs"), "{err}");
+    let (image, _) = voltex::io::exr::read(&dir.join("no_uvs.exr")).unwrap();
+    assert!(image.pixels.iter().any(|p| p[3] > 0.0), "nothing drawn");
+    let imported = dir.join("imported.ron");
+    let run = voltex(&["import", s(&mesh), "-o", s(&imported)]);
+    assert!(run.status.success() && stderr(&run).contains("planar uvs"), "{}", stderr(&run));
+    ok(voltex(&["plan", s(&imported)]));
 }
 
 /// `voltex render FILE.glb` opens the asset as the scene `voltex import` writes, so both render
