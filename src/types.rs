@@ -661,3 +661,18 @@ pub struct VolumeParams {
     /// sample; w: unused.
     pub budget: [u32; 4],
 }
+
+/// What `export/resample_world.wgsl` resamples: one dispatch's leaves of a textured object's world
+/// voxels. Mirrored as `WorldParams` in `wgsl/shared/types.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct WorldParams {
+    /// xyz: the index of the voxel whose centre the shell is relative to; w: sub-points per axis.
+    pub anchor: [i32; 4],
+    /// x: voxel size (world units); y: 1 / the texel's opacity length; z, w unused.
+    pub voxel: [f32; 4],
+    /// x: leaves in this dispatch; y, z, w unused.
+    pub counts: [u32; 4],
+    /// xyz: the texel's voxels per axis; w unused.
+    pub resolution: [u32; 4],
+}

@@ -5,6 +5,7 @@
 
 pub mod derived;
 pub mod hypertexture;
+pub(crate) mod occupancy;
 pub mod shadow;
 pub mod texel_layers;
 pub mod volume;

@@ -298,3 +298,14 @@ pub fn private_runtime_dir() {
         }
     }
 }
+
+/// `--frames A..B`: frame numbers with A <= B.
+pub(crate) fn parse_frames(s: &str) -> std::result::Result<(u32, u32), String> {
+    let bad = || "expected A..B, frame numbers with A <= B <= 99999, e.g. 0..47".to_string();
+    let (a, b) = s.split_once("..").ok_or_else(bad)?;
+    let (a, b): (u32, u32) = (a.trim().parse().map_err(|_| bad())?, b.trim().parse().map_err(|_| bad())?);
+    if a > b || b > 99_999 {
+        return Err(bad());
+    }
+    Ok((a, b))
+}

@@ -19,7 +19,7 @@ pub struct RenderArgs {
     #[arg(short, long)]
     output: Option<PathBuf>,
     /// Render frames A to B (inclusive) of an animation, at time N / fps for frame N.
-    #[arg(long, value_parser = parse_frames, conflicts_with = "time")]
+    #[arg(long, value_parser = super::parse_frames, conflicts_with = "time")]
     frames: Option<(u32, u32)>,
     /// Frames per second of --frames.
     #[arg(long, default_value_t = 24.0, requires = "frames")]
@@ -30,16 +30,6 @@ pub struct RenderArgs {
     trace: Option<PathBuf>,
     #[command(flatten)]
     overrides: Overrides,
-}
-
-fn parse_frames(s: &str) -> std::result::Result<(u32, u32), String> {
-    let bad = || "expected A..B, frame numbers with A <= B <= 99999, e.g. 0..47".to_string();
-    let (a, b) = s.split_once("..").ok_or_else(bad)?;
-    let (a, b): (u32, u32) = (a.trim().parse().map_err(|_| bad())?, b.trim().parse().map_err(|_| bad())?);
-    if a > b || b > 99_999 {
-        return Err(bad());
-    }
-    Ok((a, b))
 }
 
 pub fn run(args: RenderArgs) -> Result<()> {

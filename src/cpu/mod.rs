@@ -7,6 +7,7 @@ pub mod bake_mesh_texel;
 pub mod bake_point_grid;
 pub mod bake_splats;
 pub mod bake_transfer;
+pub(crate) mod decoded_texel;
 pub(crate) mod flood_point_grid;
 pub mod hypertexture;
 pub mod mip_layers;

@@ -75,6 +75,11 @@ pub fn stage(path: &Path, write: impl FnOnce(&Path) -> Result<()>) -> Result<Sta
 }
 
 impl Staged {
+    /// Size of the staged file in bytes.
+    pub fn bytes(&self) -> u64 {
+        std::fs::metadata(&self.tmp).map_or(0, |m| m.len())
+    }
+
     /// Renames the temporary file over the target.
     pub fn commit(mut self) -> Result<()> {
         let result = rename(&self.tmp, &self.path, &self.dir);

@@ -103,6 +103,24 @@ impl<T: Value> Voxels<T> {
         leaf.values[n] = value;
     }
 
+    /// Adds the leaf whose first voxel is `origin` (a multiple of 8): voxel `n` (OpenVDB's
+    /// order: x slowest, z fastest) is active with value `f(n)` where that is `Some`. A leaf
+    /// with no active voxel is not added.
+    pub(crate) fn insert_leaf(&mut self, origin: [i32; 3], mut f: impl FnMut(usize) -> Option<T>) {
+        let mut leaf = Leaf { mask: [0; LEAF_VOXELS / 64], values: vec![T::default(); LEAF_VOXELS] };
+        let mut any = false;
+        for n in 0..LEAF_VOXELS {
+            if let Some(v) = f(n) {
+                leaf.mask[n / 64] |= 1 << (n % 64);
+                leaf.values[n] = v;
+                any = true;
+            }
+        }
+        if any {
+            self.leaves.insert(origin, leaf);
+        }
+    }
+
     /// The value of voxel `ijk` when it is active.
     pub fn get(&self, ijk: [i32; 3]) -> Option<T> {
         let leaf = self.leaves.get(&origin(ijk, LEAF_DIM))?;

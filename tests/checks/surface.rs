@@ -29,7 +29,11 @@ use crate::layers::rust_files;
 /// (1304: the GPU tests' adapter expectations read `GpuContext::info` and `features`; tests
 /// bake a texel's derived products (`bake::derived::Derivations`, `MadeProducts::get`, AxisSlices'
 /// `slice_images`), which the bake layer no longer names.)
-const PUB_DECLARATIONS: usize = 1304;
+/// (1325: `export --world`, issue 33: `WorldOptions` and `WorldShell` for the command line and
+/// the GPU tests, its twin `resample_world` with the texel it samples (`world::texel`),
+/// `surface_obj` for `--with-mesh`, `WorldParams` for the layout check, `gpu::bindings::export`,
+/// `Staged::bytes` for the file sizes export prints.)
+const PUB_DECLARATIONS: usize = 1325;
 
 /// Whether the declaration on line `n` has a `///` doc above its attributes (one-line ones, or
 /// multi-line ones from `#[` to `)]`).

@@ -54,6 +54,7 @@ fn wgsl_structs_match_rust() {
         layout!(SegmentParams; from_local, lattice_min, lattice, surface, counts, splatting),
         layout!(Splat; center, normal),
         layout!(LightVolumeParams; origin, u, v, w, to_grid, counts),
+        layout!(WorldParams; anchor, voxel, counts, resolution),
     ];
     let mut seen = 0;
     for (_, ty) in kernel.module.types.iter() {

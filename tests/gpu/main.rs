@@ -10,6 +10,7 @@ mod aov;
 mod axis_slices;
 mod bake_stack;
 mod export;
+mod export_world;
 mod fuzz;
 mod gpu_slicing;
 mod graph_data;

@@ -313,3 +313,11 @@ struct VolumeParams {
     atlas: vec4<u32>,
     budget: vec4<u32>,
 }
+
+// What resample_world.wgsl resamples (twin: WorldParams in src/types.rs).
+struct WorldParams {
+    anchor: vec4<i32>,
+    voxel: vec4<f32>,
+    counts: vec4<u32>,
+    resolution: vec4<u32>,
+}

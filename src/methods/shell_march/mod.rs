@@ -8,7 +8,6 @@
 pub(crate) use crate::scene::methods::shell_march as knobs;
 pub mod march_shell;
 mod object;
-mod occupancy;
 pub(crate) mod plugin;
 
 pub use object::{frame_twin_inputs, ShellSet};

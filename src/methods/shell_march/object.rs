@@ -5,7 +5,7 @@ use glam::DVec3;
 
 use super::knobs::ShellMarch;
 use super::march_shell::{folds, ShellObject};
-use super::occupancy;
+use crate::bake::occupancy;
 use crate::cpu::prism_map::PrismCorners;
 use crate::error::{Error, Result};
 use crate::gpu::bindings::shell_march as B;

@@ -1,9 +1,9 @@
-//! The occupancy pyramid of a texel, for empty-space skipping (read by `march_shell.wgsl`'s
-//! `empty_run`): levels of bricks of 4, 16 and 64 voxels, x fastest, each brick holding the most
+//! The occupancy pyramid of a texel, for empty-space skipping (read by ShellMarch's kernel, and
+//! by the world export to leave out leaves only empty texel space reaches): levels of bricks of 4, 16 and 64 voxels, x fastest, each brick holding the most
 //! opacity (0 to 255) of the voxels within one voxel of it: a trilinear sample taken up to half a
 //! voxel outside the brick reads only those, so where a brick holds 0 such samples are exactly
-//! transparent and skipping them changes no pixel. Made on the CPU, once per renderer, from the
-//! texel atlas the kernel reads.
+//! transparent and skipping them changes no pixel. Made on the CPU from the texel the kernel
+//! reads.
 
 /// Brick edge in voxels, per level.
 pub(crate) const BRICKS: [u32; 3] = [4, 16, 64];
@@ -20,7 +20,13 @@ pub(crate) fn words(res: [u32; 3]) -> u64 {
 
 /// Along one axis of a grid of `shape` cells (x fastest): per brick of `size` cells, the most of
 /// its cells and of one beyond either side (repeating when `wrap`, else clamped).
-fn reduce_axis(values: &[u8], shape: [usize; 3], axis: usize, size: usize, wrap: bool) -> (Vec<u8>, [usize; 3]) {
+fn reduce_axis(
+    values: &[u8],
+    shape: [usize; 3],
+    axis: usize,
+    size: usize,
+    wrap: bool,
+) -> (Vec<u8>, [usize; 3]) {
     let n = shape[axis];
     let bricks = n.div_ceil(size);
     let mut out_shape = shape;
@@ -61,6 +67,12 @@ pub(crate) fn pyramid(alpha: &[u8], res: [u32; 3]) -> Vec<u32> {
     out
 }
 
+/// Level 0 opacity of a volume read back as f32 RGBA (x fastest): any opacity above 0 counts at
+/// least 1, so that no occupied voxel reads as empty.
+pub(crate) fn float_alpha(rgba: &[[f32; 4]]) -> Vec<u8> {
+    rgba.iter().map(|v| if v[3] > 0.0 { (v[3].min(1.0) * 255.0).round().max(1.0) as u8 } else { 0 }).collect()
+}
+
 /// Level 0 opacity of one object's volume from the atlas bytes (rgba8, rows `pitch` words apart,
 /// starting at word `offset`).
 pub(crate) fn atlas_alpha(bytes: &[u8], res: [u32; 3], offset: u32, pitch: u32) -> Vec<u8> {
@@ -93,7 +105,9 @@ mod tests {
         let at = |x: usize, y: usize, z: usize| p[(z * 2 + y) * 2 + x];
         // s: brick 0 holds it, brick 1 reaches it across the wrap (its cells 4..8 and 8 = 0).
         // t: voxel 4 is brick 1's first, within one voxel of brick 0's last (3). w: brick 1 only.
-        for (x, y, z, want) in [(0, 0, 1, 200), (1, 0, 1, 200), (0, 1, 1, 200), (1, 1, 1, 200), (0, 0, 0, 0), (1, 1, 0, 0)] {
+        for (x, y, z, want) in
+            [(0, 0, 1, 200), (1, 0, 1, 200), (0, 1, 1, 200), (1, 1, 1, 200), (0, 0, 0, 0), (1, 1, 0, 0)]
+        {
             assert_eq!(at(x, y, z), want, "brick ({x}, {y}, {z})");
         }
         // Levels 1 and 2: one brick each, holding it.

@@ -27,6 +27,11 @@ use crate::methods::view::FrameLight;
 use crate::scene::{Scene, TexelSource};
 use crate::vdb::SparseVolume;
 
+pub mod resample_world;
+pub mod world;
+
+pub use world::{WorldOptions, WorldShell};
+
 /// The transmittance of one voxel (its smallest world side) of opacity 1.
 pub(crate) const OPAQUE_TRANSMITTANCE: f64 = 1e-4;
 /// Most voxels one exported volume may have: its f32 RGBA read-back takes 16 bytes a voxel
@@ -46,6 +51,9 @@ pub struct ExportOptions {
     pub resolution: u32,
     /// How the voxel values are stored.
     pub compression: vdb::Compression,
+    /// Every textured object resampled into world voxels (`--world`), in place of one tile per
+    /// texel.
+    pub world: Option<WorldOptions>,
 }
 
 impl Default for ExportOptions {
@@ -55,6 +63,7 @@ impl Default for ExportOptions {
             time: None,
             resolution: DEFAULT_HYPER_RESOLUTION,
             compression: vdb::Compression::Zip,
+            world: None,
         }
     }
 }
@@ -80,6 +89,8 @@ pub enum Source {
         /// Linear RGB scaling the scattered light.
         albedo: [f32; 3],
     },
+    /// A textured object's look resampled into world voxels on the GPU (`--world`).
+    Shell(Box<WorldShell>),
 }
 
 /// One volume to write: its file stem, what it is, its voxels and where they lie.
@@ -105,7 +116,10 @@ pub fn plan(scene: &Scene, opts: &ExportOptions) -> Result<Vec<Export>> {
     let objects = scene.objects_at(time)?;
     let light = FrameLight::of(scene);
     let mut out = Vec::new();
-    for (name, texel) in &scene.texels {
+    if let Some(world) = opts.world {
+        out.extend(world_shells(scene, &objects, &light, time, world, &opts.only)?);
+    }
+    for (name, texel) in scene.texels.iter().filter(|_| opts.world.is_none()) {
         if matches!(texel.source, TexelSource::Sequence { .. }) {
             continue; // its frames are texels of their own
         }
@@ -187,6 +201,61 @@ pub fn plan(scene: &Scene, opts: &ExportOptions) -> Result<Vec<Export>> {
     select(scene, out, &opts.only)
 }
 
+/// Every object drawing a texel (those `only` names, when it names any), resampled in world
+/// space: one export per object, named after it.
+fn world_shells(
+    scene: &Scene,
+    objects: &[crate::scene::SceneObject],
+    light: &FrameLight,
+    time: f64,
+    world: WorldOptions,
+    only: &[String],
+) -> Result<Vec<Export>> {
+    let mut out = Vec::new();
+    for o in objects {
+        if o.hypertexture.is_some() || o.volume.is_some() {
+            continue;
+        }
+        let what = format!("object \"{}\"", o.name);
+        let Some(texel_name) = &o.texel else {
+            if only.contains(&o.name) {
+                return Err(Error::Invalid(format!(
+                    "{}: --only {:?}: {what} draws no texel, so it has no look to export (its base surface only)",
+                    scene.path.display(),
+                    o.name
+                )));
+            }
+            continue;
+        };
+        if !only.is_empty() && !only.contains(&o.name) {
+            continue;
+        }
+        let texel = &scene.texels[texel_name];
+        // Slice stacks hold what they were baked with; every other source bakes the unlit albedo.
+        let stack = matches!(texel.source, TexelSource::Slices { .. });
+        let mut bakes = Vec::new();
+        crate::methods::texels::bake_index(scene, texel_name, !stack, light, time, &mut bakes)?;
+        let request = bakes.remove(0).request;
+        let opacity_length = texel.opacity_length(&scene.hypertextures) as f64;
+        let at = |e: Error| Error::Invalid(format!("{}: {e}", scene.path.display()));
+        let shell =
+            WorldShell::new(&what, o.surface.clone(), request, opacity_length, world, MAX_EXPORT_VOXELS)
+                .map_err(at)?;
+        let note = stack.then(|| "a slice stack: Cd holds the colour it was baked with".to_string());
+        out.push(Export {
+            name: o.name.clone(),
+            what: format!(
+                "{what} (texel \"{texel_name}\", voxel {:.6}, {}^3 sub-points)",
+                shell.voxel, shell.samples
+            ),
+            index_to_world: shell.index_to_world(),
+            source: Source::Shell(Box::new(shell)),
+            note,
+        });
+    }
+    Ok(out)
+}
+
 /// Keeps the volumes `only` names (all when empty), and checks names and sizes.
 fn select(scene: &Scene, all: Vec<Export>, only: &[String]) -> Result<Vec<Export>> {
     let at = |msg: String| Error::Invalid(format!("{}: {msg}", scene.path.display()));
@@ -209,7 +278,8 @@ fn select(scene: &Scene, all: Vec<Export>, only: &[String]) -> Result<Vec<Export
             )));
         }
         file_name(&e.name).map_err(|m| at(format!("{}: {m}", e.what)))?;
-        // A volume object's grid is already in memory, as sparse as its file.
+        // A volume object's grid is already in memory, as sparse as its file; a world shell's
+        // leaves were counted as it was planned.
         let Source::Bake { request, .. } = &e.source else { continue };
         let [x, y, z] = request.resolution;
         let voxels = x as u64 * y as u64 * z as u64;
@@ -246,24 +316,28 @@ impl Export {
         match &self.source {
             Source::Bake { request, .. } => request.resolution,
             Source::Volume { grid, .. } => (grid.hi - grid.lo + 1).as_uvec3().to_array(),
+            Source::Shell(shell) => shell.extent(),
         }
     }
 
     /// A volume written from its grid needs no GPU.
     pub fn needs_gpu(&self) -> bool {
-        matches!(self.source, Source::Bake { .. })
+        !matches!(self.source, Source::Volume { .. })
     }
 }
 
 /// Bakes `e` with `baker` (a [`Baker::full_precision`]) and reads the volume back: premultiplied
-/// RGBA, x fastest, then y, then z.
+/// RGBA, x fastest, then y, then z. A world shell is resampled too: per leaf, 512 voxels of
+/// (extinction, colour) ([`world::resample`]).
 pub fn bake(ctx: &GpuContext, baker: &mut Baker, e: &Export) -> Result<Vec<[f32; 4]>> {
-    let Source::Bake { request, .. } = &e.source else {
-        return Err(Error::Invalid(format!("{} is not baked", e.what)));
-    };
     if baker.format() != wgpu::TextureFormat::Rgba32Float {
         return Err(Error::Invalid("export needs a full-precision baker".into()));
     }
+    let request = match &e.source {
+        Source::Bake { request, .. } => request,
+        Source::Shell(shell) => return world::resample(ctx, baker, shell),
+        Source::Volume { .. } => return Err(Error::Invalid(format!("{} is not baked", e.what))),
+    };
     let baked = baker.bake(ctx, request)?;
     let bytes = crate::gpu::readback::read_texture(ctx, &baked.volume, 16)?;
     Ok(bytemuck::pod_collect_to_vec(&bytes))
@@ -275,6 +349,7 @@ pub fn grids(e: &Export, rgba: &[[f32; 4]]) -> Vec<Grid> {
     let (density, colour) = match &e.source {
         Source::Bake { request, opacity_length } => baked_grids(request.resolution, *opacity_length, e, rgba),
         Source::Volume { grid, density_scale, albedo } => volume_grids(grid, *density_scale, *albedo),
+        Source::Shell(shell) => world::world_grids(shell, rgba),
     };
     vec![
         Grid {
