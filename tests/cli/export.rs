@@ -175,3 +175,79 @@ fn export_writes_volume_nodes_with_scaled_density_colour_and_world_transform() {
     assert_eq!(scale_translate(&cd_map), (s1, t1), "Cd shares the density's voxels");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// `--world` through the binary: one file per textured object named after its node, on a lattice
+/// of the voxel given, a numbered sequence with `--frames`, the base surface as OBJ with
+/// `--with-mesh`.
+#[test]
+fn world_export_writes_a_sequence_of_world_voxels_and_meshes() {
+    let dir = temp("world");
+    let scene = common::root().join("scenes/view_slices/flat_box.ron");
+    let out = dir.join("vdb");
+    let (s, o) = (scene.to_str().unwrap(), out.to_str().unwrap());
+    let run =
+        voltex(&["export", s, "--out", o, "--world", "--voxel", "0.1", "--frames", "1..2", "--with-mesh"]);
+    let text = common::ok(run);
+    assert!(text.contains("object \"box\"") && text.contains("voxel 0.100000"), "{text}");
+    assert_eq!(entries(&out), ["box.0001.obj", "box.0001.vdb", "box.0002.obj", "box.0002.vdb"]);
+    let file = std::fs::File::open(out.join("box.0002.vdb")).unwrap();
+    let mut r = vdb_rs::VdbReader::new(std::io::BufReader::new(file)).unwrap();
+    let grid = r.read_grid::<f32>("density").unwrap();
+    let (scale, translation) = scale_translate(&grid.transform);
+    assert!((scale - glam::DVec3::splat(0.1)).length() < 1e-12 && translation.length() < 1e-12);
+    // The 2 x 2 x 0.5 box of fog: ln 2 / 0.5 inside, less in the voxels its sides cut.
+    let sigma = 2f32.ln() / 0.5;
+    let voxels: Vec<([i32; 3], f32)> =
+        grid.iter().map(|(p, d, _)| ([p.x, p.y, p.z].map(|c| c.round() as i32), d)).collect();
+    assert!(
+        voxels.iter().all(|(_, d)| *d > 0.0 && *d <= sigma * (1.0 + 1e-5)),
+        "densities within (0, {sigma}]"
+    );
+    let inner = voxels.iter().filter(|(p, _)| p[0].abs() < 10 && p[1].abs() < 10 && (1..4).contains(&p[2]));
+    assert_eq!(inner.clone().count(), 19 * 19 * 3);
+    assert!(inner.into_iter().all(|(_, d)| (d / sigma - 1.0).abs() < 1e-5));
+    let obj = std::fs::read_to_string(out.join("box.0001.obj")).unwrap();
+    let count = |prefix: &str| obj.lines().filter(|l| l.starts_with(prefix)).count();
+    assert_eq!((count("v "), count("vt "), count("f ")), (25, 96, 32), "{obj}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// Bad `--world` input: a voxel too small for the budget (naming the voxels and the flag), an
+/// `--only` object with no texel, a scene with nothing to export, bad numbers, an output that is
+/// a file: status 1, a clear message, nothing written.
+#[test]
+fn bad_world_exports_fail_cleanly_and_write_nothing() {
+    let dir = temp("world-bad");
+    let out = dir.join("out");
+    let write = |name: &str, text: &str| {
+        let p = dir.join(name);
+        std::fs::write(&p, text).unwrap();
+        p.to_str().unwrap().to_string()
+    };
+    let scene = write("box.ron", &flat_box());
+    let o = out.to_str().unwrap();
+    let world = |extra: &[&str]| {
+        let mut args = vec!["export", scene.as_str(), "--out", o, "--world"];
+        args.extend_from_slice(extra);
+        voltex(&args)
+    };
+    fails(&world(&["--voxel", "0.0005"]), &["box.ron", "object \"box\"", "voxels or more", "--voxel"]);
+    fails(&world(&["--voxel", "0"]), &["--voxel 0", "positive"]);
+    fails(&world(&["--voxel", "NaN"]), &["--voxel NaN"]);
+    fails(&world(&["--samples", "9"]), &["--samples 9", "1 to 8"]);
+    let file = write("file.txt", "not a folder");
+    fails(&voltex(&["export", &scene, "--out", &file, "--world"]), &[&file, "not a folder"]);
+    // A base surface without a texel: nothing to export, and naming it says why.
+    let bare = flat_box().replace("texel: \"fog\",", "base_color: (0.5, 0.5, 0.5),");
+    let bare = write("bare.ron", &bare.replace("method: ViewSlices(planes: 256, lighting: Baked),", ""));
+    fails(&voltex(&["export", &bare, "--out", o, "--world"]), &["bare.ron", "no textured object"]);
+    fails(
+        &voltex(&["export", &bare, "--out", o, "--world", "--only", "box"]),
+        &["object \"box\" draws no texel"],
+    );
+    // --voxel means nothing without --world.
+    let run = voltex(&["export", &scene, "--out", o, "--voxel", "0.1"]);
+    assert!(!run.status.success() && stderr(&run).contains("--world"), "{}", stderr(&run));
+    assert!(!out.exists(), "the output folder was made: {:?}", entries(&out));
+    std::fs::remove_dir_all(&dir).unwrap();
+}

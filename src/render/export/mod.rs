@@ -157,9 +157,16 @@ pub fn plan(scene: &Scene, opts: &ExportOptions) -> Result<Vec<Export>> {
         })?;
         let (lo, hi) = crate::hypertexture::pack(h).bounds;
         let extent = hi - lo;
-        let resolution = extent
-            .to_array()
-            .map(|e| ((opts.resolution as f64 * e / extent.max_element()).round() as u32).max(1));
+        // `--world --voxel`: about that voxel along each axis of the node's box in world units.
+        let resolution = match opts.world.and_then(|w| w.voxel) {
+            Some(voxel) => std::array::from_fn(|a| {
+                let world = extent[a] * node.to_world.col(a).truncate().length();
+                ((world / voxel).round().clamp(1.0, u32::MAX as f64) as u32).max(1)
+            }),
+            None => extent
+                .to_array()
+                .map(|e| ((opts.resolution as f64 * e / extent.max_element()).round() as u32).max(1)),
+        };
         let texel = HyperTexel::new(h, Some((lo, hi)), resolution, time);
         out.push(Export {
             name: o.name.clone(),
@@ -198,7 +205,7 @@ pub fn plan(scene: &Scene, opts: &ExportOptions) -> Result<Vec<Export>> {
             note: None,
         });
     }
-    select(scene, out, &opts.only)
+    select(scene, out, &opts.only, opts.world.is_some())
 }
 
 /// Every object drawing a texel (those `only` names, when it names any), resampled in world
@@ -257,18 +264,30 @@ fn world_shells(
 }
 
 /// Keeps the volumes `only` names (all when empty), and checks names and sizes.
-fn select(scene: &Scene, all: Vec<Export>, only: &[String]) -> Result<Vec<Export>> {
+fn select(scene: &Scene, all: Vec<Export>, only: &[String], world: bool) -> Result<Vec<Export>> {
     let at = |msg: String| Error::Invalid(format!("{}: {msg}", scene.path.display()));
     if let Some(unknown) = only.iter().find(|n| !all.iter().any(|e| &e.name == *n)) {
         let names: Vec<&str> = all.iter().map(|e| e.name.as_str()).collect();
         return Err(at(format!(
-            "--only {unknown:?}: expected a texel, a hypertexture node or a volume node of the scene: {}",
+            "--only {unknown:?}: expected {} of the scene: {}",
+            if world {
+                "a textured object, a hypertexture node or a volume node"
+            } else {
+                "a texel, a hypertexture node or a volume node"
+            },
             if names.is_empty() { "it has none".to_string() } else { names.join(", ") }
         )));
     }
     let chosen: Vec<Export> = all.into_iter().filter(|e| only.is_empty() || only.contains(&e.name)).collect();
     if chosen.is_empty() {
-        return Err(at("the scene has no texel, hypertexture node or volume node to export".into()));
+        return Err(at(format!(
+            "the scene has no {} to export",
+            if world {
+                "textured object, hypertexture node or volume node"
+            } else {
+                "texel, hypertexture node or volume node"
+            }
+        )));
     }
     for (i, e) in chosen.iter().enumerate() {
         if let Some(other) = chosen[..i].iter().find(|o| o.name == e.name) {
@@ -288,7 +307,11 @@ fn select(scene: &Scene, all: Vec<Export>, only: &[String]) -> Result<Vec<Export
                 "{}: {x}x{y}x{z} = {voxels} voxels, more than the {MAX_EXPORT_VOXELS} one export may have \
                  (16 bytes a voxel are read back): lower its resolution{}",
                 e.what,
-                if matches!(request.source, BakeSource::Hypertexture(_)) { " (--resolution)" } else { "" }
+                if matches!(request.source, BakeSource::Hypertexture(_)) {
+                    " (--resolution, or --voxel with --world)"
+                } else {
+                    ""
+                }
             )));
         }
     }
