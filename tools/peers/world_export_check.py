@@ -42,10 +42,14 @@ import cycles_peer  # noqa: E402
 PEARS = os.path.join(common.ROOT, "scenes", "meyer_neyret", "pears_on_sphere.ron")
 FLAG = os.path.join(common.ROOT, "scenes", "meyer_neyret", "waving_flag.ron")
 IMAGE = os.path.join(common.ROOT, "docs", "src", "images", "export_world_cycles.png")
-# Bounds on the mean |T_cycles - T_voltex| over covered pixels, by export (measured: see the
-# report in docs/src/export.md). The exports dilate the pears a little (a trilinear fringe of
-# very dense voxels is opaque): the coarser the voxel, the larger the error.
-BOUND = {"default": 0.03, "0.02": 0.08}
+# Bounds on the mean |T_cycles - T_voltex| over covered pixels, by export and Cycles mode.
+# Measured (Blender 5.0.1, 128x128, 64 spp): 0.0184, 0.0262 with null scattering, 0.0538 at
+# --voxel 0.02. The error is at the silhouettes, where the exported pears look larger by about
+# 0.45 voxel at both voxel sizes (the table's dilation; no shift): most likely Cycles' trilinear
+# lookup, which spreads a very dense voxel, still opaque, over half the gap to an empty neighbour.
+# (A resampling that averages the extinction instead of the transmittance grew them by ~0.8 voxel:
+# 0.0857 at 0.02, which the bound 0.08 rejects.)
+BOUND = {("default", "ray march"): 0.03, ("default", "null scattering"): 0.035, ("0.02", "ray march"): 0.08}
 
 FAILED = []
 
@@ -153,14 +157,14 @@ def cycles_transmittance(bpy, view, vdb, voxel, out, size, spp, threads, ray_mar
         scene.cycles.volume_biased = True
         obj.data.render.step_size = voxel / 2  # world units (render.space is WORLD)
         scene.cycles.volume_max_steps = 16384  # never cut a ray short: the default 1024 might
-        setting = f"ray march, step {voxel / 2:.4g}"
+        mode = "ray march"
     else:
-        setting = "null scattering"
+        mode = "null scattering"
     exr = os.path.join(out, f"cycles_transmittance_{voxel:g}_{'march' if ray_march else 'null'}.exr")
     scene.render.filepath = exr
     start = time.perf_counter()
     bpy.ops.render.render(write_still=True)
-    return read_exr(exr, "R"), time.perf_counter() - start, setting
+    return read_exr(exr, "R"), time.perf_counter() - start, mode
 
 
 def cycles_lit(bpy, view, vdb, mesh, voxel, out, size, threads):
@@ -293,18 +297,21 @@ def main():
     # 2. Cycles against voltex's Reference.
     truth, truth_seconds = voltex_transmittance(out, args.size)
     covered = truth < 0.99
+    # The silhouette's length in pixels (|gradient| of a nearly binary image), to turn the summed
+    # difference into a mean dilation of the silhouette in pixels.
+    perimeter = np.hypot(*np.gradient(truth)).sum()
     rows = []
     for e in exports:
         view = common.load_view(os.path.join(e["dir"], "view.json"))
         for ray_march in (True, False) if e["label"] == "default" else (True,):
-            t, seconds, setting = cycles_transmittance(bpy, view, e["vdb"], e["voxel"], out, args.size, args.spp, args.threads, ray_march)
+            t, seconds, mode = cycles_transmittance(bpy, view, e["vdb"], e["voxel"], out, args.size, args.spp, args.threads, ray_march)
             diff = t - truth
-            rows.append(dict(e, setting=setting, seconds=seconds, t=t, cov_mean=np.abs(diff[covered]).mean(),
+            rows.append(dict(e, mode=mode, seconds=seconds, t=t, cov_mean=np.abs(diff[covered]).mean(),
                              cov_max=np.abs(diff[covered]).max(), all_mean=np.abs(diff).mean(), all_max=np.abs(diff).max(),
-                             signed=diff[covered].mean()))
+                             signed=diff[covered].mean(), dilation=-diff.sum() / perimeter))
     for r in rows:
-        check(r["cov_mean"] <= BOUND[r["label"]], f"Cycles ({r['setting']}) at voxel {r['label']}: mean |dT| over covered pixels "
-              f"{r['cov_mean']:.4f} <= {BOUND[r['label']]}")
+        bound = BOUND[(r["label"], r["mode"])]
+        check(r["cov_mean"] <= bound, f"Cycles ({r['mode']}) at voxel {r['label']}: mean |dT| over covered pixels {r['cov_mean']:.4f} <= {bound}")
 
     # 3. The sequence.
     check_sequence(bpy, vdb, out)
@@ -327,10 +334,13 @@ def main():
     print(f"\ntransmittance, {args.size}x{args.size}: voltex Reference --supersample 4 ({truth_seconds:.1f} s, "
           f"{covered.sum()} covered pixels of {covered.size}) against Cycles CPU {args.spp} spp, box filter 1 px, "
           f"{args.threads} threads, precision FULL")
-    print("export   Cycles                     seconds  covered: mean   max     signed  all: mean   max")
+    print("(ray march: volume_biased, step half a voxel; null scattering: Cycles 5.0's default; dilation: the\n"
+          " silhouette's mean growth, -sum(dT) / sum|grad T_voltex|, in pixels)")
+    print("export   Cycles           step     seconds  covered: mean   max     signed  all: mean   max     dilation px")
     for r in rows:
-        print(f"{r['label']:8} {r['setting']:26} {r['seconds']:7.1f}  {r['cov_mean']:12.4f} {r['cov_max']:7.4f} {r['signed']:+8.4f}"
-              f"  {r['all_mean']:9.4f} {r['all_max']:7.4f}")
+        step = f"{r['voxel'] / 2:.4g}" if r["mode"] == "ray march" else "-"
+        print(f"{r['label']:8} {r['mode']:16} {step:8} {r['seconds']:7.1f}  {r['cov_mean']:12.4f} {r['cov_max']:7.4f} {r['signed']:+8.4f}"
+              f"  {r['all_mean']:9.4f} {r['all_max']:7.4f} {r['dilation']:8.3f}")
     print(f"\nCycles lit picture: {lit_seconds:.1f} s; {os.path.relpath(IMAGE, common.ROOT)} {kib:.0f} KiB")
     print(f"{len(FAILED)} failed" if FAILED else "all checks passed")
     sys.exit(1 if FAILED else 0)

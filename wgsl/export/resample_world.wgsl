@@ -1,6 +1,6 @@
 // `voltex export --world`: a textured object's look resampled into world voxels. One workgroup per
-// 8^3 leaf the shell touches; each invocation fills one x-row of it. A voxel is the mean of n^3
-// sub-points spread over its cell (n from the footprint of a voxel in texel voxels): per
+// 8^3 leaf the shell touches; each invocation fills one x-row of it. A voxel lets through the mean
+// transmittance (across one voxel) of n^3 sub-points spread over its cell (n from the footprint of a voxel in texel voxels): per
 // sub-point the exact inverse prism map (shared/prism_map.wgsl) of every prism listed for the
 // leaf gives (s, t, w), and the texel is filtered trilinearly there. A sub-point takes the first
 // prism that holds it: one on a side two prisms share counts once. CPU twin:
@@ -19,13 +19,29 @@
 @group(0) @binding(4) var<storage, read> shell_prisms: array<Prism>;
 // The texel at full precision (rgba32float, premultiplied), read without a sampler.
 @group(0) @binding(5) var texel_volume: texture_3d<f32>;
-// Per voxel (leaf by leaf, 512 each in OpenVDB's x-major order): x the mean extinction per world
-// unit, yzw the extinction-weighted colour.
+// Per voxel (leaf by leaf, 512 each in OpenVDB's x-major order): x the extinction per world unit
+// (from the sub-points' mean transmittance across the voxel), yzw the opacity-weighted colour.
 @group(0) @binding(6) var<storage, read_write> world_voxels: array<vec4<f32>>;
 
 // As the Reference: opacity below 1 keeps the extinction finite; a fainter sample adds nothing.
 const MAX_ALPHA: f32 = 0.999999;
 const MIN_ALPHA: f32 = 1e-6;
+
+// 1 - exp(-y) for y >= 0, without the cancellation of small y (WGSL has no expm1).
+fn one_minus_exp(y: f32) -> f32 {
+    if (y < 1e-2) {
+        return y * (1.0 - y * (0.5 - y * (1.0 / 6.0 - y / 24.0)));
+    }
+    return 1.0 - exp(-y);
+}
+
+// -ln(1 - x) for x in [0, 1] (infinite at 1), without the cancellation of small x (no log1p).
+fn minus_log_one_minus(x: f32) -> f32 {
+    if (x < 1e-2) {
+        return x * (1.0 + x * (0.5 + x * (1.0 / 3.0 + x * 0.25)));
+    }
+    return -log(1.0 - x);
+}
 
 fn load_corners(index: u32) -> PrismShape {
     let ids = shell_prisms[index].vertices.xyz;
@@ -84,6 +100,7 @@ fn main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index
         let ijk = entry.xyz + vec3<i32>(x, i32(local >> 3u), i32(local & 7u));
         let centre = vec3<f32>(ijk - world_params.anchor.xyz) * voxel;
         var sigma = 0.0;
+        var covered = 0.0;
         var emitted = vec3<f32>(0.0);
         for (var q = 0; q < n * n * n; q++) {
             let sub = (vec3<f32>(vec3<i32>(q % n, (q / n) % n, q / (n * n))) + 0.5) / f32(n) - 0.5;
@@ -106,16 +123,24 @@ fn main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index
                 if (a > MIN_ALPHA) {
                     let s = -log(1.0 - a) * inv_length;
                     sigma += s;
-                    emitted += texel.xyz / a * s;
+                    let opacity = one_minus_exp(s * voxel);
+                    covered += opacity;
+                    emitted += texel.xyz / a * opacity;
                 }
                 break;
             }
         }
+        // The extinction whose transmittance across the voxel is the sub-points' mean (those
+        // without extinction let all the light through): a voxel half covered by an opaque
+        // pattern lets half the light through, as the pattern does; the mean extinction would
+        // make it opaque and grow dense silhouettes by up to a voxel. At most the mean
+        // extinction, which it equals where the sub-points agree.
         let count = f32(n * n * n);
+        let density = min(sigma / count, minus_log_one_minus(covered / count) / voxel);
         var colour = vec3<f32>(0.0);
-        if (sigma > 0.0) {
-            colour = emitted / sigma;
+        if (covered > 0.0) {
+            colour = emitted / covered;
         }
-        world_voxels[leaf * 512u + u32(x) * 64u + local] = vec4<f32>(sigma / count, colour);
+        world_voxels[leaf * 512u + u32(x) * 64u + local] = vec4<f32>(density, colour);
     }
 }

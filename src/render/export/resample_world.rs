@@ -3,7 +3,8 @@
 //! for the leaf maps it back to (s, t, w) by the exact inverse prism map
 //! (`cpu::prism_map::inverse`, the Reference's) and the texel is filtered trilinearly there; the
 //! first prism that holds it counts (a point on a side two prisms share counts once). The voxel
-//! holds the mean extinction and the extinction-weighted colour.
+//! holds the extinction whose transmittance across it is the sub-points' mean (at most their
+//! mean extinction) and the opacity-weighted colour.
 
 use glam::DVec3;
 
@@ -46,10 +47,9 @@ pub fn resample_world(shell: &WorldShell, texel: &[[f32; 4]]) -> Vec<[f64; 4]> {
         for m in 0..LEAF_VOXELS {
             let ijk = *leaf + glam::IVec3::new((m >> 6) as i32, ((m >> 3) & 7) as i32, (m & 7) as i32);
             let centre = (ijk - shell.anchor).as_dvec3() * shell.voxel;
-            let (mut sigma, mut emitted) = (0.0, DVec3::ZERO);
+            let (mut sigma, mut covered, mut emitted) = (0.0, 0.0, DVec3::ZERO);
             for q in 0..n * n * n {
-                let sub =
-                    (DVec3::new((q % n) as f64, (q / n % n) as f64, (q / (n * n)) as f64) + 0.5) / n as f64;
+                let sub = (DVec3::new((q % n) as f64, (q / n % n) as f64, (q / (n * n)) as f64) + 0.5) / n as f64;
                 let p = centre + (sub - 0.5) * shell.voxel;
                 for &t in list {
                     let Some((b, w)) = prism_map::inverse(p, &prisms[t as usize]) else { continue };
@@ -59,14 +59,18 @@ pub fn resample_world(shell: &WorldShell, texel: &[[f32; 4]]) -> Vec<[f64; 4]> {
                     let a = v[3].clamp(0.0, MAX_ALPHA);
                     if a > MIN_ALPHA {
                         let s_k = -(1.0 - a).ln() / shell.opacity_length;
+                        let opacity = -(-s_k * shell.voxel).exp_m1();
                         sigma += s_k;
-                        emitted += DVec3::new(v[0], v[1], v[2]) / a * s_k;
+                        covered += opacity;
+                        emitted += DVec3::new(v[0], v[1], v[2]) / a * opacity;
                     }
                     break;
                 }
             }
-            let colour = if sigma > 0.0 { emitted / sigma } else { DVec3::ZERO };
-            out.push([sigma / (n * n * n) as f64, colour.x, colour.y, colour.z]);
+            let count = (n * n * n) as f64;
+            let density = (sigma / count).min(-(-covered / count).ln_1p() / shell.voxel);
+            let colour = if covered > 0.0 { emitted / covered } else { DVec3::ZERO };
+            out.push([density, colour.x, colour.y, colour.z]);
         }
     }
     out
