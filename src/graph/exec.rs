@@ -346,7 +346,7 @@ impl Executor {
         let mut written: Vec<String> = Vec::new();
         for index in 0..plan.passes.len() {
             ctx.fault_at_pass();
-            self.record(ctx, plan, index, frame, objects, &mut encoder, timer, &mut written)
+            self.record(ctx, plan, index, frame, objects, &mut encoder, timer, &mut written, 0..u64::MAX)
                 .map_err(|e| self.at_pass(&plan.passes[index].decl, e))?;
         }
         timer.resolve(&mut encoder);
@@ -365,6 +365,66 @@ impl Executor {
         ctx.take_errors()
     }
 
+    /// Units of work of pass `index` (see [`Executor::step`]): a compute pass's dispatches over its
+    /// instances, 1 for a raster pass.
+    fn units(plan: &Plan, index: usize, frame: &Inputs, objects: &[Inputs]) -> u64 {
+        let pass = &plan.passes[index];
+        match &pass.decl {
+            PassDecl::Compute { repeat, .. } => {
+                instance_inputs(pass, frame, objects).iter().map(|i| count(repeat, i, frame) as u64).sum()
+            }
+            PassDecl::Raster { .. } => 1,
+        }
+    }
+
+    /// A frame to be rendered in steps ([`Executor::step`]): what is left of it.
+    pub fn begin_steps(plan: &Plan, frame: &Inputs, objects: &[Inputs]) -> Steps {
+        let total = (0..plan.passes.len()).map(|i| Self::units(plan, i, frame, objects).max(1)).sum();
+        Steps { pass: 0, unit: 0, done: 0, total, written: Vec::new() }
+    }
+
+    /// Records and submits the next `max_units` units of work of `steps`' frame (at least one),
+    /// splitting a repeated compute pass between its dispatches: the same dispatches in the same
+    /// order as [`Executor::run`], so the finished frame is the same bit for bit, but in submissions
+    /// short enough for other work (a window's frames) to run between them. Passes are not
+    /// timed. Returns whether the frame is finished.
+    pub fn step(
+        &mut self,
+        ctx: &GpuContext,
+        plan: &Plan,
+        frame: &Inputs,
+        objects: &[Inputs],
+        steps: &mut Steps,
+        max_units: u64,
+    ) -> Result<bool> {
+        let mut encoder =
+            ctx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame step") });
+        let mut timer = Timer::inert();
+        let mut budget = max_units.max(1);
+        while budget > 0 && steps.pass < plan.passes.len() {
+            let index = steps.pass;
+            let units = Self::units(plan, index, frame, objects).max(1);
+            let take = budget.min(units - steps.unit);
+            ctx.fault_at_pass();
+            let range = steps.unit..steps.unit + take;
+            let mut written = std::mem::take(&mut steps.written);
+            let recorded = self.record(ctx, plan, index, frame, objects, &mut encoder, &mut timer, &mut written, range);
+            steps.written = written;
+            recorded.map_err(|e| self.at_pass(&plan.passes[index].decl, e))?;
+            budget -= take;
+            steps.done += take;
+            steps.unit += take;
+            if steps.unit == units {
+                steps.pass += 1;
+                steps.unit = 0;
+            }
+        }
+        let commands = ctx.scoped("recording a frame step", || encoder.finish())?;
+        ctx.queue.submit([commands]);
+        ctx.take_errors()?;
+        Ok(steps.pass == plan.passes.len())
+    }
+
     #[allow(clippy::too_many_arguments)]
     fn record(
         &self,
@@ -376,21 +436,26 @@ impl Executor {
         encoder: &mut wgpu::CommandEncoder,
         timer: &mut Timer,
         written: &mut Vec<String>,
+        units: std::ops::Range<u64>,
     ) -> Result<()> {
         let pass = &plan.passes[index];
+        // A later part of a split pass: its clears were recorded with its first part.
+        let first_part = units.start == 0;
         let instances = instance_inputs(pass, frame, objects);
         let groups: Vec<Vec<wgpu::BindGroup>> = instances
             .iter()
             .map(|inst| self.bind_groups(ctx, pass, index, frame, inst))
             .collect::<Result<_>>()?;
-        self.clear_buffers(encoder, pass, written);
+        if first_part {
+            self.clear_buffers(encoder, pass, written);
+        }
         let pipeline_of = |inst: &Inputs| -> &Pipeline {
             // `prepare` made every pipeline, so the specialisation is known to succeed here.
             &self.pipelines[&(index, constants_key(&specialisation(pass, frame, inst).unwrap_or_default()))]
         };
         match &pass.decl {
             PassDecl::Compute { name, entry, clear, dispatch, repeat, .. } => {
-                for inst in &instances {
+                for inst in instances.iter().filter(|_| first_part) {
                     for b in clear {
                         let buf = self
                             .resolve(inst, frame, b)
@@ -400,7 +465,7 @@ impl Executor {
                 }
                 // Graph textures a compute pass touches before any pass wrote them this frame start
                 // from their clear value (e.g. the depth buffer when no base surface is drawn).
-                for b in &pass.bindings {
+                for b in pass.bindings.iter().filter(|_| first_part) {
                     if self.textures.contains_key(&b.name) && !written.contains(&b.name) {
                         written.push(b.name.clone());
                         if !matches!(b.kind, BindingKind::StorageTexture { .. }) {
@@ -413,7 +478,15 @@ impl Executor {
                     label: Some(name),
                     timestamp_writes: timer.compute(name),
                 });
+                // Units of work: each dispatch of each instance, in order; `units` picks some.
+                let mut unit = 0u64;
                 for (inst, bgs) in instances.iter().zip(&groups) {
+                    let repeats = count(repeat, inst, frame) as u64;
+                    let mine = units.start.max(unit)..units.end.min(unit + repeats);
+                    unit += repeats;
+                    if mine.is_empty() {
+                        continue;
+                    }
                     let Pipeline::Compute(p) = pipeline_of(inst) else { unreachable!("compute pass") };
                     let (counts, per_group) = match dispatch {
                         Dispatch::Threads(x, y, z) => ([x, y, z], false),
@@ -437,7 +510,7 @@ impl Executor {
                     for (i, bg) in bgs.iter().enumerate() {
                         cpass.set_bind_group(i as u32, bg, &[]);
                     }
-                    for _ in 0..count(repeat, inst, frame) {
+                    for _ in mine {
                         cpass.dispatch_workgroups(g[0], g[1], g[2]);
                     }
                 }
@@ -699,6 +772,23 @@ fn instance_inputs<'a>(pass: &PlannedPass, frame: &'a Inputs, objects: &'a [Inpu
 
 fn resolve_buffer<'a>(inst: &'a Inputs, frame: &'a Inputs, name: &str) -> Option<&'a wgpu::Buffer> {
     inst.buffers.get(name).or_else(|| frame.buffers.get(name))
+}
+
+/// What is left of a frame rendered in steps ([`Executor::step`]).
+#[derive(Debug, Clone)]
+pub struct Steps {
+    pass: usize,
+    unit: u64,
+    done: u64,
+    total: u64,
+    written: Vec<String>,
+}
+
+impl Steps {
+    /// Units of work done and in all (a compute pass counts one per dispatch).
+    pub fn progress(&self) -> (u64, u64) {
+        (self.done, self.total)
+    }
 }
 
 fn count(name: &str, inst: &Inputs, frame: &Inputs) -> u32 {

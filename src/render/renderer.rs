@@ -7,7 +7,7 @@ use crate::gpu::sources::Sources;
 use crate::gpu::timing::{Span, Timer};
 use crate::gpu::Inputs;
 use crate::gpu::{buffers, GpuContext};
-use crate::graph::exec::Executor;
+use crate::graph::exec::{Executor, Steps};
 use crate::io::Image;
 use crate::methods::InputCx;
 use crate::render::Blueprint;
@@ -133,6 +133,27 @@ impl Renderer {
         self.timer.reset();
         self.exec.run(ctx, &self.blueprint.plan, &self.frame, &self.objects, &mut self.timer)?;
         self.spans = self.timer.read_spans(ctx)?;
+        self.read_frame(ctx)
+    }
+
+    /// Starts a frame rendered in steps ([`Renderer::step`]) rather than in one submission.
+    pub fn begin_steps(&self) -> Steps {
+        Executor::begin_steps(&self.blueprint.plan, &self.frame, &self.objects)
+    }
+
+    /// Submits the next `max_units` units of work of `steps` (a compute pass counts one per
+    /// dispatch, so a Reference or RayMarch frame splits between its dispatches); returns
+    /// whether the frame is finished. The finished frame is the one [`Renderer::render`] makes,
+    /// bit for bit, read with [`Renderer::read_frame`]. A window renders a slow frame so and
+    /// draws itself between the steps; a new frame may start at any step (the old one is left).
+    pub fn step(&mut self, ctx: &GpuContext, steps: &mut Steps, max_units: u64) -> Result<bool> {
+        self.spans.clear();
+        self.exec.step(ctx, &self.blueprint.plan, &self.frame, &self.objects, steps, max_units)
+    }
+
+    /// Reads back the last frame rendered: the graph's first output and the AOVs (pass times of
+    /// a frame rendered by [`Renderer::render`]; none after steps).
+    pub fn read_frame(&mut self, ctx: &GpuContext) -> Result<Frame> {
         let pass_times = self.spans.iter().map(|s| (s.name.clone(), s.ms)).collect();
         let image = self.read_output(ctx)?.box_downsample(self.blueprint.supersample);
         let mut aovs = Vec::new();

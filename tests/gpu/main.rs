@@ -30,6 +30,7 @@ mod reference;
 mod regress;
 mod render_scenes;
 mod shell_march;
+mod stepped_frames;
 mod texel_bakes;
 mod texel_shadow;
 mod tile_compositor;
