@@ -34,11 +34,6 @@ impl Timer {
         Self { set: Some(set), resolve: Some(resolve), labels: Vec::new(), capacity }
     }
 
-    /// A timer that records nothing (frames rendered in steps, whose passes are split).
-    pub(crate) fn inert() -> Self {
-        Self { set: None, resolve: None, labels: Vec::new(), capacity: 0 }
-    }
-
     pub(crate) fn reset(&mut self) {
         self.labels.clear();
     }

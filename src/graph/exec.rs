@@ -386,8 +386,9 @@ impl Executor {
     /// Records and submits the next `max_units` units of work of `steps`' frame (at least one),
     /// splitting a repeated compute pass between its dispatches: the same dispatches in the same
     /// order as [`Executor::run`], so the finished frame is the same bit for bit, but in submissions
-    /// short enough for other work (a window's frames) to run between them. Passes are not
-    /// timed. Returns whether the frame is finished.
+    /// short enough for other work (a window's frames) to run between them. Each part of a pass
+    /// is timed on its own by `timer` (one made for [`Steps::progress`]'s total). Returns whether
+    /// the frame is finished.
     pub fn step(
         &mut self,
         ctx: &GpuContext,
@@ -396,10 +397,10 @@ impl Executor {
         objects: &[Inputs],
         steps: &mut Steps,
         max_units: u64,
+        timer: &mut Timer,
     ) -> Result<bool> {
         let mut encoder =
             ctx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame step") });
-        let mut timer = Timer::inert();
         let mut budget = max_units.max(1);
         while budget > 0 && steps.pass < plan.passes.len() {
             let index = steps.pass;
@@ -408,7 +409,7 @@ impl Executor {
             ctx.fault_at_pass();
             let range = steps.unit..steps.unit + take;
             let mut written = std::mem::take(&mut steps.written);
-            let recorded = self.record(ctx, plan, index, frame, objects, &mut encoder, &mut timer, &mut written, range);
+            let recorded = self.record(ctx, plan, index, frame, objects, &mut encoder, timer, &mut written, range);
             steps.written = written;
             recorded.map_err(|e| self.at_pass(&plan.passes[index].decl, e))?;
             budget -= take;
@@ -419,6 +420,7 @@ impl Executor {
                 steps.unit = 0;
             }
         }
+        timer.resolve(&mut encoder);
         let commands = ctx.scoped("recording a frame step", || encoder.finish())?;
         ctx.queue.submit([commands]);
         ctx.take_errors()?;

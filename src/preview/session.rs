@@ -9,6 +9,7 @@ use std::time::Instant;
 use super::knobs;
 use crate::gpu::cache::{CacheStats, GpuCache};
 use crate::gpu::GpuContext;
+use crate::graph::exec::Steps;
 use crate::render::{shader_sources, Blueprint, Frame, RenderOptions, Renderer};
 use crate::scene::{self, Scene, SceneObject};
 use crate::Result;
@@ -65,6 +66,8 @@ pub struct Session {
     pub draft: u32,
     /// Wall time of the last full-quality frame (ms), for [`Session::draft_scale`].
     frame_ms: Option<f64>,
+    /// Wall time of the steps of the frame in flight (ms).
+    step_ms: f64,
     /// The last good scene's objects (flattened, prisms checked, surfaces shared) at the time
     /// they were made for: a view change plans them again without flattening the scene.
     objects: Option<(Option<f64>, Vec<SceneObject>)>,
@@ -99,6 +102,7 @@ impl Session {
             stages: Stages::default(),
             draft: 1,
             frame_ms: None,
+            step_ms: 0.0,
             objects: None,
         };
         s.rebuild(ctx);
@@ -225,6 +229,30 @@ impl Session {
             self.frame_ms = Some(ms(t));
         }
         Some(times)
+    }
+
+    /// Starts the next frame in steps ([`Session::step`]); `None` without a renderer.
+    pub(crate) fn begin_steps(&mut self, ctx: &GpuContext) -> Option<Steps> {
+        self.step_ms = 0.0;
+        self.renderer.as_mut().map(|r| r.begin_steps(ctx))
+    }
+
+    /// Renders one unit of `steps`' frame (one dispatch or pass, waited for, so that the window's
+    /// own frames run between steps): the per-pass GPU times when the frame is finished. The
+    /// steps' wall time times full-quality frames for [`Session::draft_scale`].
+    pub(crate) fn step(&mut self, ctx: &GpuContext, steps: &mut Steps) -> Result<Option<Vec<(String, f64)>>> {
+        let Some(r) = self.renderer.as_mut() else { return Ok(Some(Vec::new())) };
+        let t = Instant::now();
+        let finished = r.step(ctx, steps, 1)?;
+        ctx.wait()?;
+        self.step_ms += ms(t);
+        if !finished {
+            return Ok(None);
+        }
+        if self.draft == 1 {
+            self.frame_ms = Some(self.step_ms);
+        }
+        Ok(Some(r.spans().iter().map(|s| (s.name.clone(), s.ms)).collect()))
     }
 
     /// The draft scale for a drag: 1 when a full-quality frame draws within [`DRAFT_FRAME_MS`],

@@ -22,6 +22,7 @@ use super::scene_text::{self as st, Step};
 use super::{camera_file, knobs, Session, Watcher};
 use crate::error::{Error, Result};
 use crate::gpu::GpuContext;
+use crate::graph::exec::Steps;
 use crate::io::Image;
 use crate::render::{MethodKind, RenderOptions};
 use crate::scene::{Camera, Method};
@@ -47,6 +48,9 @@ pub struct PreviewArgs {
 const NO_FILE: &str = "a mesh opened directly has no scene file to edit: `voltex import` writes one";
 /// Frames a preview trace keeps (the latest).
 const TRACE_FRAMES: usize = 100;
+/// How long (ms) one window frame renders the frame in flight before drawing itself: a slow
+/// frame renders in steps between window frames (see `State::run_steps`).
+const STEP_MS: f64 = 30.0;
 
 /// Runs `voltex preview`: opens the window and renders the scene, rebuilding when its files
 /// change, until the window closes.
@@ -92,6 +96,12 @@ struct State {
     gpu_ms: Option<f64>,
     /// The scene must be rendered again.
     dirty: bool,
+    /// The frame being rendered in steps, between which the window draws itself (`None` once
+    /// it is shown), and the reference's.
+    inflight: Option<Steps>,
+    reference_inflight: Option<Steps>,
+    /// The last finished frame, shown while the next one renders in steps.
+    shown: Option<wgpu::Texture>,
     /// The renderer must be rebuilt before the next frame (the camera moved, a drag ended).
     stale: bool,
     /// The next frame is recorded even if the image is unchanged (the user did something).
@@ -308,6 +318,9 @@ impl State {
             scene_file: std::fs::canonicalize(&args.scene).unwrap_or(args.scene.clone()),
             session,
             reference: None,
+            inflight: None,
+            reference_inflight: None,
+            shown: None,
             watcher,
             editor,
             home,
@@ -371,24 +384,9 @@ impl State {
         if std::mem::take(&mut self.stale) {
             self.session.replan(&self.ctx);
         }
-        let fresh = self.dirty;
-        if self.dirty {
-            self.dirty = false;
-            if let Some(times) = self.session.draw(&self.ctx) {
-                let times = times?;
-                self.gpu_ms = (!times.is_empty()).then(|| times.iter().map(|t| t.1).sum());
-                if let (Some(path), Some(r)) = (&args.trace, self.session.renderer()) {
-                    // Written after every frame, so the file holds the latest whatever ends the preview.
-                    self.trace.frames.push(r.spans().to_vec());
-                    let excess = self.trace.frames.len().saturating_sub(TRACE_FRAMES);
-                    self.trace.frames.drain(..excess);
-                    crate::render::trace::write(
-                        path,
-                        std::slice::from_ref(&self.trace),
-                        &self.ctx.adapter_line(),
-                    )?;
-                }
-            }
+        if std::mem::take(&mut self.dirty) {
+            // A new frame supersedes the one in flight.
+            self.inflight = self.session.begin_steps(&self.ctx);
             if self.mode != Mode::Image && self.reference.is_none() {
                 let mut options = self.session.options.clone();
                 if let Some(size) = self.session.scene().and_then(|s| self.session.draft_size(s)) {
@@ -399,18 +397,89 @@ impl State {
                 options.object_methods.clear();
                 let mut r =
                     Session::open_with(&self.ctx, &self.session.scene_path, options, self.unsaved_text());
-                if let Some(times) = r.draw(&self.ctx) {
-                    times?;
-                }
+                self.reference_inflight = r.begin_steps(&self.ctx);
                 self.reference = Some(r);
             }
         }
+        let fresh = self.run_steps(args)?;
         let actions = self.run_panel();
-        let image = self.session.renderer().and_then(|r| r.output_texture()).cloned();
-        let record = fresh || std::mem::take(&mut self.record_next);
+        let image = match self.inflight {
+            Some(_) => self.shown.clone(),
+            None => self.session.renderer().and_then(|r| r.output_texture()).cloned(),
+        };
+        // A recording shows finished frames only: what the user did is recorded once the frames
+        // it started are shown.
+        let settled = self.inflight.is_none() && self.reference_inflight.is_none();
+        if fresh && !settled {
+            self.record_next = true;
+        }
+        let record = settled && (fresh || std::mem::take(&mut self.record_next));
         self.present(image, record, args)?;
         self.act(actions);
         Ok(())
+    }
+
+    /// Renders the frames in flight, step by step, for at most [`STEP_MS`] of this window frame
+    /// (at least one step), so the window keeps drawing and taking input while a slow frame
+    /// renders; asks for another window frame while one is unfinished. Whether the image's
+    /// frame finished now.
+    fn run_steps(&mut self, args: &PreviewArgs) -> Result<bool> {
+        let until = Instant::now() + Duration::from_secs_f64(STEP_MS / 1e3);
+        let mut fresh = false;
+        while let Some(steps) = &mut self.inflight {
+            let Some(times) = self.session.step(&self.ctx, steps)? else {
+                if Instant::now() >= until {
+                    break;
+                }
+                continue;
+            };
+            self.inflight = None;
+            fresh = true;
+            self.gpu_ms = (!times.is_empty()).then(|| times.iter().map(|t| t.1).sum());
+            self.keep_shown();
+            if let (Some(path), Some(r)) = (&args.trace, self.session.renderer()) {
+                // Written after every frame, so the file holds the latest whatever ends the preview.
+                self.trace.frames.push(r.spans().to_vec());
+                let excess = self.trace.frames.len().saturating_sub(TRACE_FRAMES);
+                self.trace.frames.drain(..excess);
+                crate::render::trace::write(path, std::slice::from_ref(&self.trace), &self.ctx.adapter_line())?;
+            }
+        }
+        while let (Some(steps), Some(r)) = (&mut self.reference_inflight, &mut self.reference) {
+            if Instant::now() >= until && !fresh {
+                break;
+            }
+            if r.step(&self.ctx, steps)?.is_some() {
+                self.reference_inflight = None;
+                self.record_next = true;
+            }
+        }
+        if self.inflight.is_some() || self.reference_inflight.is_some() {
+            self.window.request_redraw();
+        }
+        Ok(fresh)
+    }
+
+    /// Copies the finished frame, to be shown while the next one renders in steps.
+    fn keep_shown(&mut self) {
+        let Some(out) = self.session.renderer().and_then(|r| r.output_texture()) else { return };
+        let fits = self.shown.as_ref().is_some_and(|t| t.size() == out.size() && t.format() == out.format());
+        if !fits {
+            self.shown = Some(self.ctx.device.create_texture(&wgpu::TextureDescriptor {
+                label: Some("shown frame"),
+                size: out.size(),
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: out.format(),
+                usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST | wgpu::TextureUsages::COPY_SRC,
+                view_formats: &[],
+            }));
+        }
+        let Some(shown) = &self.shown else { return };
+        let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
+        encoder.copy_texture_to_texture(out.as_image_copy(), shown.as_image_copy(), out.size());
+        self.ctx.queue.submit([encoder.finish()]);
     }
 
     /// Runs the panel's code for this frame: what the user did in it.
@@ -515,8 +584,10 @@ impl State {
     fn present(&mut self, image: Option<wgpu::Texture>, record: bool, args: &PreviewArgs) -> Result<()> {
         // Without the panel, a few lines of text over the image say what it would.
         let lines = if self.panel { Vec::new() } else { self.hidden_lines() };
-        let reference =
-            self.reference.as_ref().and_then(|r| r.renderer()).and_then(|r| r.output_texture()).cloned();
+        // The reference's views wait for its frame: until then the image is shown.
+        let reference = (self.reference_inflight.is_none())
+            .then(|| self.reference.as_ref().and_then(|r| r.renderer()).and_then(|r| r.output_texture()).cloned())
+            .flatten();
         let blank = || {
             self.ctx.device.create_texture(&wgpu::TextureDescriptor {
                 label: Some("blank"),
@@ -656,6 +727,13 @@ impl State {
         lines.push(format!("{gpu}  {}", self.ctx.info.name));
         if !self.status.is_empty() {
             lines.push(self.status.clone());
+        }
+        // A slow frame's progress, while the last finished one is shown.
+        for (what, steps) in [("frame", &self.inflight), ("reference", &self.reference_inflight)] {
+            if let Some((done, total)) = steps.as_ref().map(|s| s.progress()) {
+                let bar: String = (0..20).map(|i| if i * total < 20 * done { '#' } else { '.' }).collect();
+                lines.push(format!("rendering the {what} [{bar}] {}%", done * 100 / total.max(1)));
+            }
         }
         lines
     }

@@ -40,6 +40,8 @@ pub struct Renderer {
     frame: Inputs,
     objects: Vec<Inputs>,
     timer: Timer,
+    /// The timer of the frame rendered in steps (sized for its parts by `begin_steps`).
+    step_timer: Timer,
     readback: wgpu::Buffer,
     /// The passes of the last frame on the adapter's clock.
     spans: Vec<Span>,
@@ -121,7 +123,9 @@ impl Renderer {
             usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let mut r = Self { blueprint, exec, frame, objects, timer, readback, spans: Vec::new(), bake_ms };
+        let step_timer = Timer::new(ctx, 1);
+        let mut r =
+            Self { blueprint, exec, frame, objects, timer, step_timer, readback, spans: Vec::new(), bake_ms };
         // Pipelines now, so that a bad kernel fails before any frame.
         r.exec.prepare(ctx, &r.blueprint.plan, &r.frame, &r.objects, cache)?;
         ctx.wait()?;
@@ -137,8 +141,12 @@ impl Renderer {
     }
 
     /// Starts a frame rendered in steps ([`Renderer::step`]) rather than in one submission.
-    pub fn begin_steps(&self) -> Steps {
-        Executor::begin_steps(&self.blueprint.plan, &self.frame, &self.objects)
+    pub fn begin_steps(&mut self, ctx: &GpuContext) -> Steps {
+        let steps = Executor::begin_steps(&self.blueprint.plan, &self.frame, &self.objects);
+        // Every part of a split pass gets its timestamps.
+        let parts = steps.progress().1 + self.blueprint.plan.passes.len() as u64;
+        self.step_timer = Timer::new(ctx, parts.min(u32::MAX as u64 / 2) as u32);
+        steps
     }
 
     /// Submits the next `max_units` units of work of `steps` (a compute pass counts one per
@@ -147,12 +155,16 @@ impl Renderer {
     /// bit for bit, read with [`Renderer::read_frame`]. A window renders a slow frame so and
     /// draws itself between the steps; a new frame may start at any step (the old one is left).
     pub fn step(&mut self, ctx: &GpuContext, steps: &mut Steps, max_units: u64) -> Result<bool> {
-        self.spans.clear();
-        self.exec.step(ctx, &self.blueprint.plan, &self.frame, &self.objects, steps, max_units)
+        let plan = &self.blueprint.plan;
+        let finished = self.exec.step(ctx, plan, &self.frame, &self.objects, steps, max_units, &mut self.step_timer)?;
+        if finished {
+            self.spans = self.step_timer.read_spans(ctx)?;
+        }
+        Ok(finished)
     }
 
-    /// Reads back the last frame rendered: the graph's first output and the AOVs (pass times of
-    /// a frame rendered by [`Renderer::render`]; none after steps).
+    /// Reads back the last frame rendered: the graph's first output, the AOVs and the pass times
+    /// (per part of a pass split by [`Renderer::step`]).
     pub fn read_frame(&mut self, ctx: &GpuContext) -> Result<Frame> {
         let pass_times = self.spans.iter().map(|s| (s.name.clone(), s.ms)).collect();
         let image = self.read_output(ctx)?.box_downsample(self.blueprint.supersample);

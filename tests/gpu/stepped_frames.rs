@@ -40,7 +40,7 @@ fn a_frame_rendered_in_steps_is_the_blocking_frame_bit_for_bit() {
         let mut r = Renderer::new(&ctx, Blueprint::new(&scene, &opts).unwrap()).unwrap();
         let blocking = bits(&r.render(&ctx).unwrap());
         for units in [1, 3] {
-            let mut steps = r.begin_steps();
+            let mut steps = r.begin_steps(&ctx);
             let (mut submissions, mut finished) = (0, false);
             while !finished {
                 finished = r.step(&ctx, &mut steps, units).unwrap();
