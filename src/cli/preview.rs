@@ -34,8 +34,16 @@ pub struct PreviewArgs {
     /// With --measure-latency: timed saves per edit, after one warm-up.
     #[arg(long, default_value_t = 5, requires = "measure_latency", value_parser = clap::value_parser!(u32).range(1..=1000))]
     repeat: u32,
-    /// With --measure-latency: also write the measurements to this JSON file.
-    #[arg(long, requires = "measure_latency")]
+    /// Open the window, switch to the reference view (every object drawn by the exact
+    /// Reference) and time the window's frames while that frame renders, against the same frame
+    /// rendered blocking; print the measurements and close.
+    #[arg(long, conflicts_with = "measure_latency")]
+    measure_ui: bool,
+    /// With --measure-ui: switches to the reference view, each from the image view.
+    #[arg(long, default_value_t = 3, requires = "measure_ui", value_parser = clap::value_parser!(u32).range(1..=100))]
+    runs: u32,
+    /// With --measure-latency or --measure-ui: also write the measurements to this JSON file.
+    #[arg(long)]
     json: Option<PathBuf>,
 }
 
@@ -49,8 +57,22 @@ enum ViewArg {
 }
 
 pub fn run(args: PreviewArgs) -> Result<()> {
-    let PreviewArgs { scene, overrides, record, quit_after, view, trace, measure_latency, repeat, json } =
-        args;
+    let PreviewArgs {
+        scene,
+        overrides,
+        record,
+        quit_after,
+        view,
+        trace,
+        measure_latency,
+        repeat,
+        measure_ui,
+        runs,
+        json,
+    } = args;
+    if json.is_some() && !measure_latency && !measure_ui {
+        return Err(voltex::Error::Invalid("--json needs --measure-latency or --measure-ui".into()));
+    }
     if measure_latency {
         let ctx = voltex::gpu::GpuContext::new()?;
         let report = latency::measure(&ctx, &scene, overrides.options()?, repeat as usize)?;
@@ -72,5 +94,6 @@ pub fn run(args: PreviewArgs) -> Result<()> {
             t.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new(".")),
         )?;
     }
-    window::run(WindowArgs { scene, options, record, quit_after, mode, trace })
+    let measure_ui = measure_ui.then_some((runs, json));
+    window::run(WindowArgs { scene, options, record, quit_after, mode, trace, measure_ui })
 }

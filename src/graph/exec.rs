@@ -343,6 +343,10 @@ impl Executor {
     ) -> Result<()> {
         let mut encoder =
             ctx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
+        // Whole dispatches start at the first pixel (a frame in steps may have left a tile's).
+        if let Some(origin) = frame.buffers.get(STEP_ORIGIN) {
+            ctx.queue.write_buffer(origin, 0, &[0; 16]);
+        }
         let mut written: Vec<String> = Vec::new();
         for index in 0..plan.passes.len() {
             ctx.fault_at_pass();
@@ -370,15 +374,33 @@ impl Executor {
     fn units(plan: &Plan, index: usize, frame: &Inputs, objects: &[Inputs]) -> u64 {
         let pass = &plan.passes[index];
         match &pass.decl {
-            PassDecl::Compute { repeat, .. } => {
-                instance_inputs(pass, frame, objects).iter().map(|i| count(repeat, i, frame) as u64).sum()
-            }
+            PassDecl::Compute { repeat, .. } => instance_inputs(pass, frame, objects)
+                .iter()
+                .map(|i| count(repeat, i, frame) as u64 * tiles(pass, i, frame).map_or(1, |t| t.count()))
+                .sum(),
             PassDecl::Raster { .. } => 1,
         }
     }
 
+    /// For a tiled pass, the units left from `unit` to the end of its tile; `None` otherwise.
+    fn tile_left(plan: &Plan, index: usize, frame: &Inputs, objects: &[Inputs], unit: u64) -> Option<u64> {
+        let pass = &plan.passes[index];
+        let PassDecl::Compute { repeat, .. } = &pass.decl else { return None };
+        let mut first = 0u64;
+        for inst in instance_inputs(pass, frame, objects) {
+            let t = tiles(pass, inst, frame)?;
+            let repeats = count(repeat, inst, frame) as u64;
+            let units = repeats * t.count();
+            if unit < first + units {
+                return Some(repeats - (unit - first) % repeats.max(1));
+            }
+            first += units;
+        }
+        Some(1)
+    }
+
     /// A frame to be rendered in steps ([`Executor::step`]): what is left of it.
-    pub fn begin_steps(plan: &Plan, frame: &Inputs, objects: &[Inputs]) -> Steps {
+    pub(crate) fn begin_steps(plan: &Plan, frame: &Inputs, objects: &[Inputs]) -> Steps {
         let total = (0..plan.passes.len()).map(|i| Self::units(plan, i, frame, objects).max(1)).sum();
         Steps { pass: 0, unit: 0, done: 0, total, written: Vec::new() }
     }
@@ -389,7 +411,8 @@ impl Executor {
     /// short enough for other work (a window's frames) to run between them. Each part of a pass
     /// is timed on its own by `timer` (one made for [`Steps::progress`]'s total). Returns whether
     /// the frame is finished.
-    pub fn step(
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn step(
         &mut self,
         ctx: &GpuContext,
         plan: &Plan,
@@ -402,14 +425,24 @@ impl Executor {
         let mut encoder =
             ctx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame step") });
         let mut budget = max_units.max(1);
+        let mut recorded_any = false;
         while budget > 0 && steps.pass < plan.passes.len() {
             let index = steps.pass;
             let units = Self::units(plan, index, frame, objects).max(1);
-            let take = budget.min(units - steps.unit);
+            // A tiled pass's units set their tile's origin, which one submission holds one of:
+            // it takes the units of one tile (its dispatches).
+            let tile_left = Self::tile_left(plan, index, frame, objects, steps.unit);
+            if tile_left.is_some() && recorded_any {
+                break;
+            }
+            let tiled = tile_left.is_some();
+            let take = budget.min(tile_left.unwrap_or(units - steps.unit));
+            recorded_any = true;
             ctx.fault_at_pass();
             let range = steps.unit..steps.unit + take;
             let mut written = std::mem::take(&mut steps.written);
-            let recorded = self.record(ctx, plan, index, frame, objects, &mut encoder, timer, &mut written, range);
+            let recorded =
+                self.record(ctx, plan, index, frame, objects, &mut encoder, timer, &mut written, range);
             steps.written = written;
             recorded.map_err(|e| self.at_pass(&plan.passes[index].decl, e))?;
             budget -= take;
@@ -418,6 +451,9 @@ impl Executor {
             if steps.unit == units {
                 steps.pass += 1;
                 steps.unit = 0;
+            }
+            if tiled {
+                break;
             }
         }
         timer.resolve(&mut encoder);
@@ -480,11 +516,15 @@ impl Executor {
                     label: Some(name),
                     timestamp_writes: timer.compute(name),
                 });
-                // Units of work: each dispatch of each instance, in order; `units` picks some.
+                // Units of work: each dispatch of each instance, in order (of each tile, when a
+                // part of a tiled pass is recorded); `units` picks some.
+                let whole = units == (0..u64::MAX);
                 let mut unit = 0u64;
                 for (inst, bgs) in instances.iter().zip(&groups) {
-                    let repeats = count(repeat, inst, frame) as u64;
+                    let tiling = tiles(pass, inst, frame).filter(|_| !whole);
+                    let repeats = count(repeat, inst, frame) as u64 * tiling.map_or(1, |t| t.count());
                     let mine = units.start.max(unit)..units.end.min(unit + repeats);
+                    let first_unit = unit;
                     unit += repeats;
                     if mine.is_empty() {
                         continue;
@@ -512,8 +552,25 @@ impl Executor {
                     for (i, bg) in bgs.iter().enumerate() {
                         cpass.set_bind_group(i as u32, bg, &[]);
                     }
-                    for _ in mine {
-                        cpass.dispatch_workgroups(g[0], g[1], g[2]);
+                    for u in mine {
+                        match tiling {
+                            // One unit a submission (`step`): the tile's origin is written for it.
+                            Some(t) => {
+                                // Tile by tile, each tile's dispatches in turn.
+                                let (origin, groups) = t.tile((u - first_unit) / (repeats / t.count()), g);
+                                let buffer = frame
+                                    .buffers
+                                    .get(STEP_ORIGIN)
+                                    .ok_or_else(|| plan::unknown_resource(&self.graph, name, STEP_ORIGIN))?;
+                                ctx.queue.write_buffer(
+                                    buffer,
+                                    0,
+                                    bytemuck::cast_slice(&[origin[0], origin[1], 0, 0]),
+                                );
+                                cpass.dispatch_workgroups(groups[0], groups[1], groups[2]);
+                            }
+                            None => cpass.dispatch_workgroups(g[0], g[1], g[2]),
+                        }
                     }
                 }
             }
@@ -776,6 +833,14 @@ fn resolve_buffer<'a>(inst: &'a Inputs, frame: &'a Inputs, name: &str) -> Option
     inst.buffers.get(name).or_else(|| frame.buffers.get(name))
 }
 
+/// The frame resource (a uniform, xy the first pixel) through which a kernel learns where the
+/// tile it is dispatched over starts: a compute pass binding it is split into tiles of about
+/// [`TILE_PIXELS`] pixels when a frame renders in steps, one tile a submission.
+pub(crate) const STEP_ORIGIN: &str = "step_origin";
+/// Pixels of a tile of a split pass: about 60 ms of the exact Reference's first dispatch on
+/// llvmpipe (its later dispatches, going on with the longer rays, are cheaper).
+const TILE_PIXELS: u32 = 512;
+
 /// What is left of a frame rendered in steps ([`Executor::step`]).
 #[derive(Debug, Clone)]
 pub struct Steps {
@@ -791,6 +856,61 @@ impl Steps {
     pub fn progress(&self) -> (u64, u64) {
         (self.done, self.total)
     }
+}
+
+/// How a tiled pass (one binding [`STEP_ORIGIN`]) is cut when a frame renders in steps: tiles of
+/// whole workgroups, about [`TILE_PIXELS`] threads each.
+#[derive(Debug, Clone, Copy)]
+struct Tiling {
+    /// Workgroup size (x, y).
+    group: [u32; 2],
+    /// Workgroups per tile along x and y.
+    per_tile: [u32; 2],
+    /// Tiles along x and y.
+    tiles: [u32; 2],
+}
+
+impl Tiling {
+    fn count(&self) -> u64 {
+        self.tiles[0] as u64 * self.tiles[1] as u64
+    }
+
+    /// Tile `k` (row by row) of a dispatch of `groups` workgroups: its first thread (x, y) and
+    /// its workgroups.
+    fn tile(&self, k: u64, groups: [u32; 3]) -> ([u32; 2], [u32; 3]) {
+        let (tx, ty) = ((k % self.tiles[0] as u64) as u32, (k / self.tiles[0] as u64) as u32);
+        let first = [tx * self.per_tile[0], ty * self.per_tile[1]];
+        let n = [0, 1].map(|a| self.per_tile[a].min(groups[a] - first[a]));
+        ([first[0] * self.group[0], first[1] * self.group[1]], [n[0], n[1], groups[2]])
+    }
+}
+
+/// The tiling of a compute pass that binds [`STEP_ORIGIN`] for instance `inst`, else `None`.
+fn tiles(pass: &PlannedPass, inst: &Inputs, frame: &Inputs) -> Option<Tiling> {
+    let PassDecl::Compute { entry, dispatch, .. } = &pass.decl else { return None };
+    if !pass.bindings.iter().any(|b| b.name == STEP_ORIGIN) {
+        return None;
+    }
+    let wg = reflect::workgroup_size(&pass.kernel, entry).unwrap_or([1, 1, 1]);
+    let (counts, per_group) = match dispatch {
+        Dispatch::Threads(x, y, z) => ([x, y, z], false),
+        Dispatch::Groups(x, y, z) => ([x, y, z], true),
+    };
+    let groups: Vec<u32> = (0..2)
+        .map(|a| {
+            let n = count(counts[a], inst, frame);
+            if per_group {
+                n
+            } else {
+                n.div_ceil(wg[a].max(1))
+            }
+        })
+        .collect();
+    let group = [wg[0].max(1), wg[1].max(1)];
+    // Rows of one workgroup, as many workgroups along x as make about TILE_PIXELS threads.
+    let per_tile = [(TILE_PIXELS / (group[0] * group[1])).max(1).min(groups[0].max(1)), 1];
+    let tiles = [groups[0].div_ceil(per_tile[0]).max(1), groups[1].max(1)];
+    Some(Tiling { group, per_tile, tiles })
 }
 
 fn count(name: &str, inst: &Inputs, frame: &Inputs) -> u32 {

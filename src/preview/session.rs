@@ -66,8 +66,9 @@ pub struct Session {
     pub draft: u32,
     /// Wall time of the last full-quality frame (ms), for [`Session::draft_scale`].
     frame_ms: Option<f64>,
-    /// Wall time of the steps of the frame in flight (ms).
+    /// Wall time of the steps of the frame in flight (ms), and the units submitted a batch.
     step_ms: f64,
+    batch: u32,
     /// The last good scene's objects (flattened, prisms checked, surfaces shared) at the time
     /// they were made for: a view change plans them again without flattening the scene.
     objects: Option<(Option<f64>, Vec<SceneObject>)>,
@@ -103,6 +104,7 @@ impl Session {
             draft: 1,
             frame_ms: None,
             step_ms: 0.0,
+            batch: 1,
             objects: None,
         };
         s.rebuild(ctx);
@@ -234,18 +236,44 @@ impl Session {
     /// Starts the next frame in steps ([`Session::step`]); `None` without a renderer.
     pub(crate) fn begin_steps(&mut self, ctx: &GpuContext) -> Option<Steps> {
         self.step_ms = 0.0;
+        self.batch = 1;
         self.renderer.as_mut().map(|r| r.begin_steps(ctx))
     }
 
-    /// Renders one unit of `steps`' frame (one dispatch or pass, waited for, so that the window's
-    /// own frames run between steps): the per-pass GPU times when the frame is finished. The
-    /// steps' wall time times full-quality frames for [`Session::draft_scale`].
-    pub(crate) fn step(&mut self, ctx: &GpuContext, steps: &mut Steps) -> Result<Option<Vec<(String, f64)>>> {
+    /// Renders `steps`' frame on for about `budget_ms`: units submitted in batches, each batch
+    /// sized from the time the last units took and waited for, so that the window's own frames
+    /// run between batches. The per-pass GPU times when the frame is finished. The steps' wall
+    /// time times full-quality frames for [`Session::draft_scale`].
+    pub(crate) fn step(
+        &mut self,
+        ctx: &GpuContext,
+        steps: &mut Steps,
+        budget_ms: f64,
+    ) -> Result<Option<Vec<(String, f64)>>> {
         let Some(r) = self.renderer.as_mut() else { return Ok(Some(Vec::new())) };
-        let t = Instant::now();
-        let finished = r.step(ctx, steps, 1)?;
-        ctx.wait()?;
-        self.step_ms += ms(t);
+        let start = Instant::now();
+        let mut finished = false;
+        while !finished {
+            // A batch doubles while it takes under a quarter of the budget and halves past half
+            // of it: units differ (a tile of the Reference against a cheap pass), so it follows
+            // what the last one took rather than predicting.
+            let t = Instant::now();
+            let goal = steps.progress().0 + self.batch as u64;
+            while !finished && steps.progress().0 < goal {
+                finished = r.step(ctx, steps, goal - steps.progress().0)?;
+            }
+            ctx.wait()?;
+            let took = ms(t);
+            if took < budget_ms / 4.0 {
+                self.batch = (self.batch * 2).min(256);
+            } else if took > budget_ms / 2.0 {
+                self.batch = (self.batch / 2).max(1);
+            }
+            if ms(start) + took >= budget_ms {
+                break;
+            }
+        }
+        self.step_ms += ms(start);
         if !finished {
             return Ok(None);
         }
@@ -294,6 +322,10 @@ impl Session {
     /// The current renderer (none before the first good build).
     pub fn renderer(&self) -> Option<&Renderer> {
         self.renderer.as_ref()
+    }
+
+    pub(crate) fn renderer_mut(&mut self) -> Option<&mut Renderer> {
+        self.renderer.as_mut()
     }
 
     /// The current scene (none before the first good load).

@@ -42,6 +42,9 @@ pub struct PreviewArgs {
     pub mode: Mode,
     /// Keep the per-pass GPU times of the last frames rendered in this Chrome/Perfetto trace.
     pub trace: Option<PathBuf>,
+    /// `--measure-ui`: switch to the reference view this many times, timing the window's frames
+    /// while its frame renders, then print (and write to the file) the measurements and close.
+    pub measure_ui: Option<(u32, Option<PathBuf>)>,
 }
 
 /// Said when a key or the panel would edit a scene that has no file of its own.
@@ -120,6 +123,9 @@ struct State {
     started: Instant,
     /// `--trace`: the passes of the frames rendered so far (the last `TRACE_FRAMES`).
     trace: crate::render::trace::Track,
+    /// `--measure-ui`'s measurement, and whether it ended (the window closes).
+    measure: Option<super::measure_ui::UiMeasure>,
+    measured: bool,
 }
 
 impl ApplicationHandler for App {
@@ -213,7 +219,7 @@ impl ApplicationHandler for App {
 
     fn about_to_wait(&mut self, event_loop: &ActiveEventLoop) {
         let Some(s) = self.state.as_mut() else { return };
-        if self.args.quit_after.is_some_and(|t| s.started.elapsed().as_secs_f64() > t) {
+        if s.measured || self.args.quit_after.is_some_and(|t| s.started.elapsed().as_secs_f64() > t) {
             event_loop.exit();
             return;
         }
@@ -341,6 +347,11 @@ impl State {
             recorded: 0,
             started: Instant::now(),
             trace: crate::render::trace::Track { name: "preview".into(), frames: Vec::new() },
+            measure: args
+                .measure_ui
+                .clone()
+                .map(|(runs, json)| super::measure_ui::UiMeasure::new(runs as usize, json)),
+            measured: false,
         })
     }
 
@@ -395,8 +406,12 @@ impl State {
                 }
                 options.method = Some(MethodKind::truth());
                 options.object_methods.clear();
+                let built = Instant::now();
                 let mut r =
                     Session::open_with(&self.ctx, &self.session.scene_path, options, self.unsaved_text());
+                if let Some(m) = &mut self.measure {
+                    m.build_ms = built.elapsed().as_secs_f64() * 1e3;
+                }
                 self.reference_inflight = r.begin_steps(&self.ctx);
                 self.reference = Some(r);
             }
@@ -416,6 +431,25 @@ impl State {
         let record = settled && (fresh || std::mem::take(&mut self.record_next));
         self.present(image, record, args)?;
         self.act(actions);
+        self.measure_ui()
+    }
+
+    /// `--measure-ui`: after each window frame, what the measurement does next.
+    fn measure_ui(&mut self) -> Result<()> {
+        use super::measure_ui::Next;
+        let Some(m) = &mut self.measure else { return Ok(()) };
+        let settled = self.inflight.is_none() && self.reference_inflight.is_none();
+        let reference = self.reference.as_mut().and_then(|r| r.renderer_mut());
+        match m.presented(settled, reference, &self.ctx)? {
+            Next::Wait => {}
+            Next::Switch => self.set_mode(Mode::Truth),
+            Next::Back => {
+                self.reference = None;
+                self.set_mode(Mode::Image);
+            }
+            Next::Quit => self.measured = true,
+        }
+        self.window.request_redraw();
         Ok(())
     }
 
@@ -424,32 +458,31 @@ impl State {
     /// renders; asks for another window frame while one is unfinished. Whether the image's
     /// frame finished now.
     fn run_steps(&mut self, args: &PreviewArgs) -> Result<bool> {
-        let until = Instant::now() + Duration::from_secs_f64(STEP_MS / 1e3);
+        let start = Instant::now();
         let mut fresh = false;
-        while let Some(steps) = &mut self.inflight {
-            let Some(times) = self.session.step(&self.ctx, steps)? else {
-                if Instant::now() >= until {
-                    break;
+        if let Some(steps) = &mut self.inflight {
+            if let Some(times) = self.session.step(&self.ctx, steps, STEP_MS)? {
+                self.inflight = None;
+                fresh = true;
+                self.gpu_ms = (!times.is_empty()).then(|| times.iter().map(|t| t.1).sum());
+                self.keep_shown();
+                if let (Some(path), Some(r)) = (&args.trace, self.session.renderer()) {
+                    // Written after every frame, so the file holds the latest whatever ends the preview.
+                    self.trace.frames.push(r.spans().to_vec());
+                    let excess = self.trace.frames.len().saturating_sub(TRACE_FRAMES);
+                    self.trace.frames.drain(..excess);
+                    crate::render::trace::write(
+                        path,
+                        std::slice::from_ref(&self.trace),
+                        &self.ctx.adapter_line(),
+                    )?;
                 }
-                continue;
-            };
-            self.inflight = None;
-            fresh = true;
-            self.gpu_ms = (!times.is_empty()).then(|| times.iter().map(|t| t.1).sum());
-            self.keep_shown();
-            if let (Some(path), Some(r)) = (&args.trace, self.session.renderer()) {
-                // Written after every frame, so the file holds the latest whatever ends the preview.
-                self.trace.frames.push(r.spans().to_vec());
-                let excess = self.trace.frames.len().saturating_sub(TRACE_FRAMES);
-                self.trace.frames.drain(..excess);
-                crate::render::trace::write(path, std::slice::from_ref(&self.trace), &self.ctx.adapter_line())?;
             }
         }
-        while let (Some(steps), Some(r)) = (&mut self.reference_inflight, &mut self.reference) {
-            if Instant::now() >= until && !fresh {
-                break;
-            }
-            if r.step(&self.ctx, steps)?.is_some() {
+        // The reference gets what is left of the window frame, and at least a step.
+        if let (Some(steps), Some(r)) = (&mut self.reference_inflight, &mut self.reference) {
+            let left = (STEP_MS - start.elapsed().as_secs_f64() * 1e3).max(1.0);
+            if r.step(&self.ctx, steps, left)?.is_some() {
                 self.reference_inflight = None;
                 self.record_next = true;
             }
@@ -472,7 +505,9 @@ impl State {
                 sample_count: 1,
                 dimension: wgpu::TextureDimension::D2,
                 format: out.format(),
-                usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST | wgpu::TextureUsages::COPY_SRC,
+                usage: wgpu::TextureUsages::TEXTURE_BINDING
+                    | wgpu::TextureUsages::COPY_DST
+                    | wgpu::TextureUsages::COPY_SRC,
                 view_formats: &[],
             }));
         }
@@ -586,7 +621,9 @@ impl State {
         let lines = if self.panel { Vec::new() } else { self.hidden_lines() };
         // The reference's views wait for its frame: until then the image is shown.
         let reference = (self.reference_inflight.is_none())
-            .then(|| self.reference.as_ref().and_then(|r| r.renderer()).and_then(|r| r.output_texture()).cloned())
+            .then(|| {
+                self.reference.as_ref().and_then(|r| r.renderer()).and_then(|r| r.output_texture()).cloned()
+            })
             .flatten();
         let blank = || {
             self.ctx.device.create_texture(&wgpu::TextureDescriptor {

@@ -21,6 +21,7 @@ use glam::DVec3;
 
 use crate::error::{Error, Result};
 use crate::gpu::sources::Sources;
+use crate::graph::exec::STEP_ORIGIN;
 use crate::graph::plan::{self, ObjectInfo, Plan};
 use crate::graph::{Graph, Vocabulary};
 use crate::methods::view::{FrameLight, View};
@@ -288,7 +289,7 @@ fn check_kernels(bakes: &[BakePlan], objects: &[ObjectPlan], groups: &[Box<dyn M
 }
 
 /// Resources the renderer itself binds by name: per frame, and per instance of any method.
-pub(crate) const FRAME_RESOURCES: &[&str] = &["frame", "volume_sampler"];
+pub(crate) const FRAME_RESOURCES: &[&str] = &["frame", "volume_sampler", STEP_ORIGIN];
 pub(crate) const OBJECT_RESOURCES: &[&str] = &["object"];
 
 /// Every name the runtime offers graph files: the renderer's own and those the registered

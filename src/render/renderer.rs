@@ -7,7 +7,7 @@ use crate::gpu::sources::Sources;
 use crate::gpu::timing::{Span, Timer};
 use crate::gpu::Inputs;
 use crate::gpu::{buffers, GpuContext};
-use crate::graph::exec::{Executor, Steps};
+use crate::graph::exec::{Executor, Steps, STEP_ORIGIN};
 use crate::io::Image;
 use crate::methods::InputCx;
 use crate::render::Blueprint;
@@ -31,6 +31,9 @@ impl Frame {
         (!self.pass_times.is_empty()).then(|| self.pass_times.iter().map(|p| p.1).sum())
     }
 }
+
+/// Parts of passes a frame rendered in steps times: WebGPU's 4096 queries a query set, two each.
+const MAX_TIMED_PARTS: u64 = 2048;
 
 /// GPU resources of a blueprint, ready to render frames.
 pub struct Renderer {
@@ -97,6 +100,7 @@ impl Renderer {
         frame
             .buffers
             .insert("frame".into(), buffers::uniform(ctx, "frame", bytemuck::bytes_of(&blueprint.frame)));
+        frame.buffers.insert(STEP_ORIGIN.into(), buffers::uniform(ctx, STEP_ORIGIN, &[0; 16]));
         frame.samplers.insert("volume_sampler".into(), sampler);
         frame.counts.insert("width".into(), blueprint.size.0);
         frame.counts.insert("height".into(), blueprint.size.1);
@@ -143,9 +147,10 @@ impl Renderer {
     /// Starts a frame rendered in steps ([`Renderer::step`]) rather than in one submission.
     pub fn begin_steps(&mut self, ctx: &GpuContext) -> Steps {
         let steps = Executor::begin_steps(&self.blueprint.plan, &self.frame, &self.objects);
-        // Every part of a split pass gets its timestamps.
+        // Every part of a split pass gets its timestamps, up to the 4096 queries a set may hold
+        // (parts past it are not timed).
         let parts = steps.progress().1 + self.blueprint.plan.passes.len() as u64;
-        self.step_timer = Timer::new(ctx, parts.min(u32::MAX as u64 / 2) as u32);
+        self.step_timer = Timer::new(ctx, parts.min(MAX_TIMED_PARTS) as u32);
         steps
     }
 
@@ -156,7 +161,8 @@ impl Renderer {
     /// draws itself between the steps; a new frame may start at any step (the old one is left).
     pub fn step(&mut self, ctx: &GpuContext, steps: &mut Steps, max_units: u64) -> Result<bool> {
         let plan = &self.blueprint.plan;
-        let finished = self.exec.step(ctx, plan, &self.frame, &self.objects, steps, max_units, &mut self.step_timer)?;
+        let finished =
+            self.exec.step(ctx, plan, &self.frame, &self.objects, steps, max_units, &mut self.step_timer)?;
         if finished {
             self.spans = self.step_timer.read_spans(ctx)?;
         }

@@ -95,3 +95,42 @@ fn window_settles_after_one_save() {
     assert_eq!(settled, after_save, "still drawing 6 s after the save; stderr: {err}");
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// `--measure-ui` in the real window: it switches to the reference view (the exact Reference,
+/// rendered in steps between window frames), keeps presenting frames meanwhile, and the frame it
+/// finishes equals the same frame rendered blocking, bit for bit; the JSON holds the figures.
+/// (Durations are printed, never asserted.)
+#[test]
+fn measure_ui_renders_the_reference_in_steps_and_matches_the_blocking_frame() {
+    let dir = common::scratch_dir("voltex-measure-ui");
+    let scene = common::root().join("scenes/view_slices/torus_egg.ron");
+    let json = dir.join("ui.json");
+    let out = Command::new("xvfb-run")
+        .args(["-a", "-s", "-screen 0 1280x800x24"])
+        .args([
+            env!("CARGO_BIN_EXE_voltex"),
+            "preview",
+            scene.to_str().unwrap(),
+            "--size",
+            "96x72",
+            "--measure-ui",
+            "--runs",
+            "1",
+            "--json",
+        ])
+        .arg(&json)
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{text}\n{}", common::stderr(&out));
+    println!("{text}");
+    let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    assert_eq!(v["identical"], true, "{v}");
+    let run = &v["runs"][0];
+    assert_eq!(run["differing_values"], 0, "{v}");
+    assert!(run["presented"].as_u64().unwrap() >= 2, "the window went on presenting: {v}");
+    for key in ["ui_gap_max_ms", "ui_gap_p99_ms", "final_ms", "blocking_ms"] {
+        assert!(v[key].as_f64().is_some_and(|x| x > 0.0), "{key} in {v}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}

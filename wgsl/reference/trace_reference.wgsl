@@ -34,6 +34,9 @@ const DEPTH_SLACK: f32 = 2e-3;
 @group(0) @binding(11) var<storage, read_write> reference_state: array<ReferenceState>;
 // The depth AOV: the nearest opaque sample of each pixel (shared/aov_depth.wgsl).
 @group(0) @binding(12) var<storage, read_write> aov_opaque_depth: array<atomic<u32>>;
+// xy: the first pixel of this dispatch. A frame rendered in steps (the preview) dispatches tiles
+// of the image, each in its own submission; a whole frame dispatches every pixel from (0, 0).
+@group(0) @binding(13) var<uniform> step_origin: vec4<u32>;
 
 #include "shared/aov_depth.wgsl"
 
@@ -251,7 +254,8 @@ fn sample_point(d: vec3<f32>, t: f32, a: f32, b: f32) -> vec4<f32> {
 }
 
 @compute @workgroup_size(8, 8, 1)
-fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+fn main(@builtin(global_invocation_id) invocation: vec3<u32>) {
+    let id = invocation + vec3<u32>(step_origin.xy, 0u);
     let size = vec2<u32>(frame.viewport.xy);
     let pixel = id.y * size.x + id.x;
     var state = ReferenceState(vec4<f32>(0.0, 0.0, 0.0, 1.0), vec4<f32>(0.0));

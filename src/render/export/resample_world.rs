@@ -49,7 +49,8 @@ pub fn resample_world(shell: &WorldShell, texel: &[[f32; 4]]) -> Vec<[f64; 4]> {
             let centre = (ijk - shell.anchor).as_dvec3() * shell.voxel;
             let (mut sigma, mut covered, mut emitted) = (0.0, 0.0, DVec3::ZERO);
             for q in 0..n * n * n {
-                let sub = (DVec3::new((q % n) as f64, (q / n % n) as f64, (q / (n * n)) as f64) + 0.5) / n as f64;
+                let sub =
+                    (DVec3::new((q % n) as f64, (q / n % n) as f64, (q / (n * n)) as f64) + 0.5) / n as f64;
                 let p = centre + (sub - 0.5) * shell.voxel;
                 for &t in list {
                     let Some((b, w)) = prism_map::inverse(p, &prisms[t as usize]) else { continue };
