@@ -14,6 +14,9 @@ pub(crate) const OPTIONAL_FEATURES: wgpu::Features = wgpu::Features::TIMESTAMP_Q
     .union(wgpu::Features::FLOAT32_BLENDABLE);
 
 /// The wgpu device and queue voltex renders with, with its adapter's info, features and limits.
+/// A clone shares the device (the preview builds a session on another thread with one; wgpu's
+/// error scopes are per thread).
+#[derive(Clone)]
 pub struct GpuContext {
     /// The wgpu device.
     pub device: wgpu::Device,

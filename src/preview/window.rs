@@ -103,6 +103,8 @@ struct State {
     /// it is shown), and the reference's.
     inflight: Option<Steps>,
     reference_inflight: Option<Steps>,
+    /// The reference's session being built on another thread, and since when.
+    reference_build: Option<(std::thread::JoinHandle<Session>, Instant)>,
     /// The last finished frame, shown while the next one renders in steps.
     shown: Option<wgpu::Texture>,
     /// The renderer must be rebuilt before the next frame (the camera moved, a drag ended).
@@ -252,6 +254,7 @@ impl State {
                 self.session.recover(&ctx);
                 self.gui.reset(&ctx.device, self.config.format);
                 self.reference = None;
+                self.reference_build = None;
                 self.ctx = ctx;
                 self.presenter = presenter;
                 self.dirty = true;
@@ -326,6 +329,7 @@ impl State {
             reference: None,
             inflight: None,
             reference_inflight: None,
+            reference_build: None,
             shown: None,
             watcher,
             editor,
@@ -372,6 +376,7 @@ impl State {
             self.session.text = self.unsaved_text();
             self.session.rebuild(&self.ctx);
             self.reference = None;
+            self.reference_build = None;
             self.dirty = true;
             let _ = self.watcher.watch(&self.session.watch_dirs());
         }
@@ -398,7 +403,7 @@ impl State {
         if std::mem::take(&mut self.dirty) {
             // A new frame supersedes the one in flight.
             self.inflight = self.session.begin_steps(&self.ctx);
-            if self.mode != Mode::Image && self.reference.is_none() {
+            if self.mode != Mode::Image && self.reference.is_none() && self.reference_build.is_none() {
                 let mut options = self.session.options.clone();
                 if let Some(size) = self.session.scene().and_then(|s| self.session.draft_size(s)) {
                     options.size = Some(size);
@@ -406,15 +411,23 @@ impl State {
                 }
                 options.method = Some(MethodKind::truth());
                 options.object_methods.clear();
-                let built = Instant::now();
-                let mut r =
-                    Session::open_with(&self.ctx, &self.session.scene_path, options, self.unsaved_text());
-                if let Some(m) = &mut self.measure {
-                    m.build_ms = built.elapsed().as_secs_f64() * 1e3;
-                }
-                self.reference_inflight = r.begin_steps(&self.ctx);
-                self.reference = Some(r);
+                // Built on another thread (scene, bakes, pipelines: half a second of llvmpipe for
+                // torus_egg), so the window keeps drawing meanwhile.
+                let (ctx, path, text) =
+                    (self.ctx.clone(), self.session.scene_path.clone(), self.unsaved_text());
+                let build = std::thread::spawn(move || Session::open_with(&ctx, &path, options, text));
+                self.reference_build = Some((build, Instant::now()));
             }
+        }
+        if self.reference_build.as_ref().is_some_and(|(b, _)| b.is_finished()) {
+            let (build, started) = self.reference_build.take().expect("a build");
+            let mut r =
+                build.join().map_err(|_| Error::Invalid("building the reference view failed".into()))?;
+            if let Some(m) = &mut self.measure {
+                m.build_ms = started.elapsed().as_secs_f64() * 1e3;
+            }
+            self.reference_inflight = r.begin_steps(&self.ctx);
+            self.reference = Some(r);
         }
         let fresh = self.run_steps(args)?;
         let actions = self.run_panel();
@@ -424,7 +437,7 @@ impl State {
         };
         // A recording shows finished frames only: what the user did is recorded once the frames
         // it started are shown.
-        let settled = self.inflight.is_none() && self.reference_inflight.is_none();
+        let settled = self.settled();
         if fresh && !settled {
             self.record_next = true;
         }
@@ -437,14 +450,15 @@ impl State {
     /// `--measure-ui`: after each window frame, what the measurement does next.
     fn measure_ui(&mut self) -> Result<()> {
         use super::measure_ui::Next;
+        let settled = self.settled();
         let Some(m) = &mut self.measure else { return Ok(()) };
-        let settled = self.inflight.is_none() && self.reference_inflight.is_none();
         let reference = self.reference.as_mut().and_then(|r| r.renderer_mut());
         match m.presented(settled, reference, &self.ctx)? {
             Next::Wait => {}
             Next::Switch => self.set_mode(Mode::Truth),
             Next::Back => {
                 self.reference = None;
+                self.reference_build = None;
                 self.set_mode(Mode::Image);
             }
             Next::Quit => self.measured = true,
@@ -487,10 +501,15 @@ impl State {
                 self.record_next = true;
             }
         }
-        if self.inflight.is_some() || self.reference_inflight.is_some() {
+        if !self.settled() {
             self.window.request_redraw();
         }
         Ok(fresh)
+    }
+
+    /// No frame is rendering and no reference building: what is shown is the latest.
+    fn settled(&self) -> bool {
+        self.inflight.is_none() && self.reference_inflight.is_none() && self.reference_build.is_none()
     }
 
     /// Copies the finished frame, to be shown while the next one renders in steps.
@@ -612,6 +631,7 @@ impl State {
     fn edited(&mut self) {
         self.session.text = self.unsaved_text();
         self.reference = None;
+        self.reference_build = None;
         self.dirty = true;
         self.window.request_redraw();
     }
@@ -761,16 +781,23 @@ impl State {
         };
         let mut lines = vec![format!("{}  [{mode}]", self.session.scene_path.display())];
         let gpu = self.gpu_ms.map(|t| format!("{t:.2} ms GPU")).unwrap_or_else(|| "no GPU timestamps".into());
-        lines.push(format!("{gpu}  {}", self.ctx.info.name));
+        // While a slow frame renders (the last finished one shown), its progress takes the GPU
+        // line's place: the panel's layout stays put under the pointer.
+        let progress = [("frame", &self.inflight), ("reference", &self.reference_inflight)]
+            .into_iter()
+            .find_map(|(what, steps)| steps.as_ref().map(|s| (what, s.progress())));
+        lines.push(match progress {
+            Some((what, (done, total))) => {
+                let bar: String = (0..20).map(|i| if i * total < 20 * done { '#' } else { '.' }).collect();
+                format!("rendering the {what} [{bar}] {}%", done * 100 / total.max(1))
+            }
+            None if self.reference_build.is_some() => {
+                "building the reference (scene, bakes, pipelines)".into()
+            }
+            None => format!("{gpu}  {}", self.ctx.info.name),
+        });
         if !self.status.is_empty() {
             lines.push(self.status.clone());
-        }
-        // A slow frame's progress, while the last finished one is shown.
-        for (what, steps) in [("frame", &self.inflight), ("reference", &self.reference_inflight)] {
-            if let Some((done, total)) = steps.as_ref().map(|s| s.progress()) {
-                let bar: String = (0..20).map(|i| if i * total < 20 * done { '#' } else { '.' }).collect();
-                lines.push(format!("rendering the {what} [{bar}] {}%", done * 100 / total.max(1)));
-            }
         }
         lines
     }
@@ -840,6 +867,7 @@ impl State {
         // Rebuilt once before the next frame, however many moves come before it.
         self.stale = true;
         self.reference = None;
+        self.reference_build = None;
         self.dirty = true;
     }
 
@@ -849,6 +877,7 @@ impl State {
             self.session.draft = 1;
             self.stale = true;
             self.reference = None;
+            self.reference_build = None;
             self.dirty = true;
             self.window.request_redraw();
         }
@@ -903,6 +932,7 @@ impl State {
                 self.session.options.camera = None;
                 self.session.rebuild(&self.ctx);
                 self.reference = None;
+                self.reference_build = None;
                 self.dirty = true;
                 self.status = "camera reset to the scene's".into();
             }
