@@ -43,17 +43,7 @@ fn minus_log_one_minus(x: f32) -> f32 {
     return -log(1.0 - x);
 }
 
-fn load_corners(index: u32) -> PrismShape {
-    let ids = shell_prisms[index].vertices.xyz;
-    let a = shell_vertices[ids.x];
-    let b = shell_vertices[ids.y];
-    let c = shell_vertices[ids.z];
-    return PrismShape(
-        array<vec3<f32>, 3>(a.bottom.xyz, b.bottom.xyz, c.bottom.xyz),
-        array<vec3<f32>, 3>(a.top.xyz, b.top.xyz, c.top.xyz),
-        array<u32, 3>(ids.x, ids.y, ids.z),
-    );
-}
+#include "shared/shell_prism.wgsl"
 
 // Texel voxel i along an axis of n: repeating (s, t) or clamped (w).
 fn wrap_axis(i: i32, n: i32, repeat: bool) -> i32 {
@@ -112,7 +102,7 @@ fn main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index
                 if (dot(d, d) > prism.sphere.w * prism.sphere.w) {
                     continue;
                 }
-                var shape = load_corners(index);
+                var shape = load_shape(index);
                 let c = prism_inverse(p, &shape);
                 if (c.w < 0.0) {
                     continue;

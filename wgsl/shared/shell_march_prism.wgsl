@@ -2,17 +2,7 @@
 // ray and the held intervals): crossings of the prism's boundary with the exact map there, and
 // the intervals between them with their samples and interpolation pieces.
 
-fn load_shape(index: u32) -> PrismShape {
-    let ids = shell_prisms[index].vertices.xyz;
-    let a = shell_vertices[ids.x];
-    let b = shell_vertices[ids.y];
-    let c = shell_vertices[ids.z];
-    return PrismShape(
-        array<vec3<f32>, 3>(a.bottom.xyz, b.bottom.xyz, c.bottom.xyz),
-        array<vec3<f32>, 3>(a.top.xyz, b.top.xyz, c.top.xyz),
-        array<u32, 3>(ids.x, ids.y, ids.z),
-    );
-}
+#include "shared/shell_prism.wgsl"
 
 // This invocation's crossings of the current prism, sorted: ray distance and (b0, b1, b2, w), the
 // exact inverse map there. In workgroup memory (a slice per invocation) rather than a private
