@@ -16,7 +16,7 @@ pub struct BakeArgs {
     #[arg(long = "texel")]
     texels: Vec<String>,
     /// Output folder (default: out/bake/<scene name>).
-    #[arg(long)]
+    #[arg(short = 'o', long, visible_alias = "output")]
     out: Option<PathBuf>,
     /// Bits per channel: 8 or 16 (PNG slices), or 32 (float EXR slices).
     #[arg(long, default_value_t = 16, value_parser = parse_depth)]

@@ -16,7 +16,7 @@ pub struct ExportArgs {
     scene: PathBuf,
     /// Output folder (made if missing): one NAME.vdb per texel (per textured object with
     /// --world) and per node drawing a hypertexture or a volume.
-    #[arg(long)]
+    #[arg(short = 'o', long, visible_alias = "output")]
     out: PathBuf,
     /// Every textured object's look resampled into world-space voxels, one NAME.vdb per object
     /// (its node's name), where its shell puts it; in place of one tile per texel.

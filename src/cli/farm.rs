@@ -94,7 +94,7 @@ struct SubmitArgs {
     dir: PathBuf,
     /// Output folder (shared with the nodes): a folder per scene, index.html, junit.xml, and
     /// .voltex/ with the plan, shard manifests, job scripts and logs.
-    #[arg(long)]
+    #[arg(short = 'o', long, visible_alias = "output")]
     out: PathBuf,
     #[command(flatten)]
     pass: Pass,
@@ -129,7 +129,7 @@ struct ManifestArgs {
     /// Scene folder (checked here; inside the pods it is --suite-path).
     dir: PathBuf,
     /// Folder to write voltex-regress.yaml into.
-    #[arg(long)]
+    #[arg(short = 'o', long, visible_alias = "output")]
     out: PathBuf,
     #[command(flatten)]
     pass: Pass,

@@ -13,7 +13,7 @@ pub struct ImportArgs {
     /// An asset: a mesh (`.glb`, `.gltf` or `.obj`) or an OpenVDB file (`.vdb`).
     pub file: PathBuf,
     /// The scene file to write (default: FILE with the extension `.ron`).
-    #[arg(short, long)]
+    #[arg(short, long, visible_alias = "output")]
     pub out: Option<PathBuf>,
 }
 

@@ -17,7 +17,7 @@ pub struct ParetoCmd {
     #[arg(long, default_value_t = 5)]
     frames: usize,
     /// Output folder (default: out/pareto/<scene name>).
-    #[arg(long)]
+    #[arg(short = 'o', long, visible_alias = "output")]
     out: Option<PathBuf>,
     /// What errors are measured against: `reference`, `view-slices:PLANES` or
     /// `ray-march:STEP[:SHADOWS]` (SHADOWS as in --ray-shadows, e.g. ray-march:0.0005:rays).

@@ -16,7 +16,7 @@ pub struct RenderArgs {
     /// Output EXR (default: out/<scene name>.exr); the PNG goes beside it. `x.png` writes x.exr
     /// and x.png; a folder (existing, or ending in /) gets <scene name>.exr; missing folders are
     /// made. With --frames, the first frame's path: frame N is written as <stem>_NNNN.exr beside it.
-    #[arg(short, long)]
+    #[arg(short, long, visible_alias = "out")]
     output: Option<PathBuf>,
     /// Render frames A to B (inclusive) of an animation, at time N / fps for frame N.
     #[arg(long, value_parser = super::parse_frames, conflicts_with = "time")]

@@ -50,7 +50,7 @@ pub struct Args {
     #[arg(required_unless_present = "report_only")]
     pub(crate) dir: Option<PathBuf>,
     /// Output folder: a subfolder per scene and index.html.
-    #[arg(long, default_value = "out/regress")]
+    #[arg(short = 'o', long, visible_alias = "output", default_value = "out/regress")]
     pub out: PathBuf,
     /// Write `<stem>.ref.exr` for scenes that are new, regressed or whose reference has another
     /// size (passing ones are left untouched). Without it no reference is ever written.

@@ -600,3 +600,39 @@ fn output_paths_make_folders_and_keep_both_images() {
     assert!(stderr(&out).contains("expected an output ending in .exr or .png"), "{}", stderr(&out));
     assert!(!jpg.exists() && !jpg.with_extension("exr").exists());
 }
+
+/// One spelling for outputs (issue 32, item 7): every subcommand that writes files takes `-o`,
+/// `--out` and `--output` (render's and import's differed, export's, bake's, pareto's and
+/// regress's had no `-o`); and the short and the long forms do the same (an export with `-o`).
+#[test]
+fn every_output_takes_dash_o_out_and_output() {
+    let help = |args: &[&str]| {
+        let out = common::voltex(&[args, &["--help"]].concat());
+        String::from_utf8_lossy(&out.stdout).into_owned()
+    };
+    for args in [
+        &["render"][..],
+        &["import"],
+        &["export"],
+        &["bake"],
+        &["pareto"],
+        &["regress"],
+        &["farm", "submit"],
+        &["farm", "manifest"],
+    ] {
+        let text = help(args);
+        // The option's entry: its line and the description lines under it (clap's long help).
+        let at = text.find("  -o, --out").unwrap_or_else(|| panic!("{args:?}: no -o, --out...:\n{text}"));
+        let entry: String = text[at..].lines().take_while(|l| !l.trim_start().starts_with("--")).collect();
+        let entry = entry + text[at..].lines().next().unwrap_or("");
+        assert!(entry.contains("--output"), "{args:?}: -o, --out and --output:\n{entry}");
+    }
+    let dir = temp_dir("dash-o");
+    let scene = dir.join("box.ron");
+    std::fs::write(&scene, flat_box()).unwrap();
+    let out = dir.join("vdb");
+    let run = common::voltex(&["export", s(&scene), "-o", s(&out)]);
+    assert!(run.status.success(), "{}", stderr(&run));
+    assert_eq!(entries(&out), ["fog.vdb"]);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
