@@ -137,6 +137,23 @@ fn write_all(
     verbosity: Verbosity,
 ) -> Result<()> {
     voltex::io::atomic::check_writable_dir(out)?;
+    // What a world export may take, before any work: every voxel of the leaves its shell meets
+    // is read back (16 bytes each), and at most those are written (4 bytes of density and 12 of
+    // colour each, before compression); the voxel budget of `plan` bounds both.
+    if !matches!(verbosity, Verbosity::Quiet) {
+        for e in &plans[0].1 {
+            if let export::Source::Shell(shell) = &e.source {
+                let mib = (shell.voxels() * 16) as f64 / (1 << 20) as f64;
+                eprintln!(
+                    "{}: at most {} voxels in the leaves its shell meets: at most {mib:.0} MiB read back and \
+                     {mib:.0} MiB in the file before compression{}",
+                    e.what,
+                    shell.voxels(),
+                    if plans.len() > 1 { ", a frame" } else { "" }
+                );
+            }
+        }
+    }
     // Volume nodes are written from their grids: the GPU starts only for bakes.
     let mut gpu = None;
     if plans.iter().flat_map(|p| &p.1).any(|e| e.needs_gpu()) {

@@ -187,6 +187,9 @@ fn world_export_writes_a_sequence_of_world_voxels_and_meshes() {
     let (s, o) = (scene.to_str().unwrap(), out.to_str().unwrap());
     let run =
         voltex(&["export", s, "--out", o, "--world", "--voxel", "0.1", "--frames", "1..2", "--with-mesh"]);
+    // The estimate before any work: the voxels of the leaves the shell meets, and their bytes.
+    let err = stderr(&run);
+    assert!(err.contains("voxels in the leaves its shell meets") && err.contains("MiB read back"), "{err}");
     let text = common::ok(run);
     assert!(text.contains("object \"box\"") && text.contains("voxel 0.100000"), "{text}");
     assert_eq!(entries(&out), ["box.0001.obj", "box.0001.vdb", "box.0002.obj", "box.0002.vdb"]);
