@@ -46,6 +46,18 @@ impl BaseSurface {
         (b - a).cross(c - a)
     }
 
+    /// The shell's mean scale: world units per uv unit along s and t (the square root of world
+    /// area over uv area; not finite without uv area) and the mean height (along w).
+    pub(crate) fn mean_scale(&self) -> (f64, f64) {
+        let (mut world, mut uv) = (0.0, 0.0);
+        for (t, uvs) in self.corner_uvs.iter().enumerate() {
+            world += self.face_normal(t).length() / 2.0;
+            uv += (uvs[1] - uvs[0]).perp_dot(uvs[2] - uvs[0]).abs() / 2.0;
+        }
+        let height = self.heights.iter().map(|h| h.length()).sum::<f64>() / self.heights.len().max(1) as f64;
+        ((world / uv).sqrt(), height)
+    }
+
     /// The six corners of triangle `t`'s prism: `p_0..p_2` then `p_0 + h_0 .. p_2 + h_2`.
     pub(crate) fn prism(&self, t: usize) -> [DVec3; 6] {
         let [a, b, c] = self.triangles[t].map(|i| i as usize);

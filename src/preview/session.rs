@@ -269,7 +269,7 @@ impl Session {
             } else if took > budget_ms / 2.0 {
                 self.batch = (self.batch / 2).max(1);
             }
-            if ms(start) + took >= budget_ms {
+            if ms(start) >= budget_ms {
                 break;
             }
         }

@@ -485,15 +485,8 @@ pub(crate) fn texel_frame(surface: &BaseSurface, object: &str) -> (DMat4, Option
         }
     }
     // Mean scales: world area over uv area for s and t, the mean height for w.
-    let (mut world, mut uv, mut height) = (0.0, 0.0, 0.0);
-    for (t, uvs) in surface.corner_uvs.iter().enumerate() {
-        world += surface.face_normal(t).length() / 2.0;
-        uv += (uvs[1] - uvs[0]).perp_dot(uvs[2] - uvs[0]).abs() / 2.0;
-    }
-    for h in &surface.heights {
-        height += h.length() / surface.heights.len().max(1) as f64;
-    }
-    let st = if uv > 0.0 { (world / uv).sqrt() } else { 1.0 };
+    let (st, height) = surface.mean_scale();
+    let st = if st.is_finite() { st } else { 1.0 };
     let scale = DVec3::new(st, st, if height > 0.0 { height } else { st });
     let note = format!(
         "object \"{object}\"'s shell is curved: one tile at the world origin, {st:.4} x {st:.4} x {:.4} world units \

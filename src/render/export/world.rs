@@ -67,14 +67,7 @@ pub struct WorldShell {
 /// The mean world size of one texel voxel on `surface` along s, t and w: s and t from world area
 /// over uv area (tiling included), w from the mean height.
 pub(crate) fn texel_voxel_size(surface: &BaseSurface, resolution: [u32; 3]) -> Option<DVec3> {
-    let (mut world, mut uv) = (0.0, 0.0);
-    for (t, uvs) in surface.corner_uvs.iter().enumerate() {
-        world += surface.face_normal(t).length() / 2.0;
-        uv += (uvs[1] - uvs[0]).perp_dot(uvs[2] - uvs[0]).abs() / 2.0;
-    }
-    let height =
-        surface.heights.iter().map(|h| h.length()).sum::<f64>() / surface.heights.len().max(1) as f64;
-    let st = (world / uv).sqrt();
+    let (st, height) = surface.mean_scale();
     let size =
         DVec3::new(st / resolution[0] as f64, st / resolution[1] as f64, height / resolution[2] as f64);
     (size.is_finite() && size.min_element() > 0.0).then_some(size)
@@ -113,16 +106,12 @@ impl WorldShell {
             if count.x * count.y * count.z > max_voxels as i64 / LEAF_VOXELS as i64 {
                 return Err(too_many(what, (count.x * count.y * count.z) as u64 * 512, voxel, max_voxels));
             }
-            for x in first.x..=last.x {
-                for y in first.y..=last.y {
-                    for z in first.z..=last.z {
-                        lists.entry(IVec3::new(x, y, z) * LEAF).or_default().push(t as u32);
-                    }
-                }
-                if lists.len() as u64 * LEAF_VOXELS as u64 > max_voxels {
-                    let voxels = lists.len() as u64 * LEAF_VOXELS as u64;
-                    return Err(too_many(what, voxels, voxel, max_voxels));
-                }
+            for leaf in leaves_between(first, last) {
+                lists.entry(leaf).or_default().push(t as u32);
+            }
+            if lists.len() as u64 * LEAF_VOXELS as u64 > max_voxels {
+                let voxels = lists.len() as u64 * LEAF_VOXELS as u64;
+                return Err(too_many(what, voxels, voxel, max_voxels));
             }
         }
         let mut leaves: Vec<IVec3> = lists.keys().copied().collect();
@@ -235,13 +224,7 @@ impl WorldShell {
                     let lo = corners.iter().flatten().fold(DVec3::INFINITY, |a, &c| a.min(c));
                     let hi = corners.iter().flatten().fold(DVec3::NEG_INFINITY, |a, &c| a.max(c));
                     let (first, last) = leaf_range(lo, hi, self.voxel);
-                    for x in first.x..=last.x {
-                        for y in first.y..=last.y {
-                            for z in first.z..=last.z {
-                                keep.insert(IVec3::new(x, y, z) * LEAF);
-                            }
-                        }
-                    }
+                    keep.extend(leaves_between(first, last));
                 }
             }
         }
@@ -267,6 +250,13 @@ fn leaf_range(lo: DVec3, hi: DVec3, voxel: f64) -> (IVec3, IVec3) {
     let first = (lo / voxel - 0.5 - HAIR).ceil().as_ivec3();
     let last = (hi / voxel + 0.5 + HAIR).floor().as_ivec3();
     (first.div_euclid(IVec3::splat(LEAF)), last.div_euclid(IVec3::splat(LEAF)))
+}
+
+/// The first voxels of the leaves `first..=last` (in leaves).
+fn leaves_between(first: IVec3, last: IVec3) -> impl Iterator<Item = IVec3> {
+    (first.x..=last.x).flat_map(move |x| {
+        (first.y..=last.y).flat_map(move |y| (first.z..=last.z).map(move |z| IVec3::new(x, y, z) * LEAF))
+    })
 }
 
 fn too_many(what: &str, voxels: u64, voxel: f64, max: u64) -> Error {
