@@ -67,6 +67,48 @@ pub(crate) fn pyramid(alpha: &[u8], res: [u32; 3]) -> Vec<u32> {
     out
 }
 
+/// Per column of level-0 bricks (x fastest): the first and last occupied brick along w, or
+/// `None` where the column holds nothing. `pyramid`: a [`pyramid`] of a volume of `res`.
+pub(crate) fn columns(pyramid: &[u32], res: [u32; 3]) -> Vec<Option<(u32, u32)>> {
+    let [bx, by, bz] = dims(res, BRICKS[0]).map(|n| n as usize);
+    let mut out = vec![None; bx * by];
+    for z in 0..bz {
+        for (c, range) in out.iter_mut().enumerate() {
+            if pyramid[z * bx * by + c] != 0 {
+                let z = z as u32;
+                *range = Some(range.map_or((z, z), |(lo, _): (u32, u32)| (lo, z)));
+            }
+        }
+    }
+    out
+}
+
+/// The band of w (0 to 1) outside which every sample over the voxel box `lo..=hi` of s and t
+/// (voxel coordinates, repeating) is exactly transparent: whole level-0 bricks from the first
+/// occupied one to the last (each brick covers samples up to half a voxel beyond it, so the
+/// samples below and above read only empty bricks' voxels). `None`: all of them are.
+pub(crate) fn band(
+    columns: &[Option<(u32, u32)>],
+    res: [u32; 3],
+    lo: [f64; 2],
+    hi: [f64; 2],
+) -> Option<[f64; 2]> {
+    let size = BRICKS[0] as f64;
+    let [bx, by, _] = dims(res, BRICKS[0]).map(|n| n as i64);
+    let first = lo.map(|v| (v / size).floor() as i64);
+    let last = hi.map(|v| (v / size).floor() as i64);
+    let mut range: Option<(u32, u32)> = None;
+    for y in first[1]..=last[1].min(first[1] + by - 1) {
+        for x in first[0]..=last[0].min(first[0] + bx - 1) {
+            if let Some((a, b)) = columns[(y.rem_euclid(by) * bx + x.rem_euclid(bx)) as usize] {
+                range = Some(range.map_or((a, b), |(lo, hi)| (lo.min(a), hi.max(b))));
+            }
+        }
+    }
+    let depth = res[2] as f64;
+    range.map(|(a, b)| [a as f64 * size / depth, ((b + 1) as f64 * size).min(depth) / depth])
+}
+
 /// Level 0 opacity of a volume read back as f32 RGBA (x fastest): any opacity above 0 counts at
 /// least 1, so that no occupied voxel reads as empty.
 pub(crate) fn float_alpha(rgba: &[[f32; 4]]) -> Vec<u8> {
@@ -113,5 +155,29 @@ mod tests {
         // Levels 1 and 2: one brick each, holding it.
         assert_eq!(&p[8..], &[200, 200]);
         assert!(pyramid(&vec![0; 512], res).iter().all(|&v| v == 0));
+    }
+
+    /// The band over a box of s and t is the occupied bricks' w extent, found across the repeat.
+    #[test]
+    fn a_band_spans_the_occupied_bricks_over_a_box_of_s_and_t() {
+        let res = [16, 16, 16];
+        let mut alpha = vec![0u8; 16 * 16 * 16];
+        // Voxel (14, 2, 9): brick (3, 0, 2); its reach adds brick (3, 1, 2) and, across the
+        // wrap, none in s (15 is still brick 3).
+        alpha[(9 * 16 + 2) * 16 + 14] = 90;
+        let cols = columns(&pyramid(&alpha, res), res);
+        assert_eq!(cols[3], Some((2, 2)));
+        assert_eq!(band(&cols, res, [13.0, 0.0], [15.0, 3.0]), Some([0.5, 0.75]));
+        // The same bricks reached from the next repeat of s (x 16 + 13), and a box beside them.
+        assert_eq!(band(&cols, res, [29.0, 0.0], [30.0, 1.0]), Some([0.5, 0.75]));
+        assert_eq!(band(&cols, res, [0.0, 9.0], [7.0, 15.0]), None);
+        // Samples of the band's neighbours read only empty voxels (every sample's 8 voxels).
+        let sample_alpha = |z: f64| {
+            let z0 = (z * 16.0 - 0.5).floor().clamp(0.0, 15.0) as usize;
+            let z1 = (z0 + 1).min(15);
+            [z0, z1].iter().map(|&z| alpha[(z * 16 + 2) * 16 + 14]).max().unwrap()
+        };
+        assert!(sample_alpha(0.5 - 1e-9) == 0 && sample_alpha(0.75 + 1e-9) == 0);
+        assert!(sample_alpha(0.59) > 0);
     }
 }

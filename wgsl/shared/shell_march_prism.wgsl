@@ -69,16 +69,25 @@ fn patch_crossings(i: u32, j: u32, p: ptr<function, PrismShape>) {
     }
 }
 
-// Every crossing of the ray with the prism's boundary, sorted, with the map's value there.
-fn crossings(p: ptr<function, PrismShape>) {
-    crossing_count = 0u;
-    let bottom = triangle_hit((*p).bottom[0], (*p).bottom[1], (*p).bottom[2]);
-    if (bottom.x >= 0.0) {
-        add_crossing(bottom.x, vec4<f32>(1.0 - bottom.y - bottom.z, bottom.y, bottom.z, 0.0));
+// The crossing of the ray with the prism's flat section at height w (its bottom at 0, its top at 1).
+fn section_crossing(p: ptr<function, PrismShape>, w: f32) {
+    let hit = triangle_hit(mix((*p).bottom[0], (*p).top[0], w), mix((*p).bottom[1], (*p).top[1], w), mix((*p).bottom[2], (*p).top[2], w));
+    if (hit.x >= 0.0) {
+        add_crossing(hit.x, vec4<f32>(1.0 - hit.y - hit.z, hit.y, hit.z, w));
     }
-    let top = triangle_hit((*p).top[0], (*p).top[1], (*p).top[2]);
-    if (top.x >= 0.0) {
-        add_crossing(top.x, vec4<f32>(1.0 - top.y - top.z, top.y, top.z, 1.0));
+}
+
+// Every crossing of the ray with the prism's boundary and with the sections bounding its band
+// (where they are inside it), sorted, with the map's value there.
+fn crossings(p: ptr<function, PrismShape>, band: vec2<f32>) {
+    crossing_count = 0u;
+    section_crossing(p, 0.0);
+    section_crossing(p, 1.0);
+    if (band.x > 0.0) {
+        section_crossing(p, band.x);
+    }
+    if (band.y < 1.0) {
+        section_crossing(p, band.y);
     }
     for (var e = 0u; e < 3u; e++) {
         var i = e;
@@ -236,7 +245,11 @@ fn expand_prism(index: u32) {
             t_opaque = min(t_opaque, tb);
         }
     }
-    crossings(&shape);
+    let band = shell_bands[index];
+    if (band.x > band.y) {
+        return;
+    }
+    crossings(&shape, band);
     let base = slot * MAX_CROSSINGS;
     // The ray starts inside only if the near point is in the corners' box.
     let near = ray * t_near;
@@ -256,7 +269,8 @@ fn expand_prism(index: u32) {
         if (!at_near || may_start_inside) {
             c3 = prism_inverse(ray * mix(t0, t1, 1.0 / 3.0), &shape);
         }
-        if (c3.w >= 0.0) {
+        // Between consecutive crossings the ray is also wholly below, in or above the band.
+        if (c3.w >= band.x && c3.w <= band.y) {
             if (at_near) {
                 c0 = prism_inverse(ray * t0, &shape);
             }

@@ -25,6 +25,8 @@ pub struct ShellObject {
     pub step: f64,
     /// Interpolation tolerance in voxels.
     pub tolerance: f64,
+    /// Per prism: the band of w outside which its texel is transparent ([1, 0]: all of it).
+    pub bands: Vec<[f64; 2]>,
 }
 
 /// Where the ray crosses a prism's boundary, and the map's value there: (b0, b1, b2, w).
@@ -68,14 +70,23 @@ fn triangle_hit(d: DVec3, a: DVec3, b: DVec3, c: DVec3) -> Option<(f64, f64, f64
     (det != 0.0 && u >= 0.0 && v >= 0.0 && u + v <= 1.0).then(|| (e2.dot(q) / det, u, v))
 }
 
-/// Twin of `crossings`: every crossing of the ray with the prism's boundary, sorted.
-pub(crate) fn crossings(d: DVec3, p: &PrismCorners) -> Vec<Crossing> {
+/// Twin of `crossings`: every crossing of the ray with the prism's boundary and with the
+/// sections bounding its band, sorted.
+pub(crate) fn crossings(d: DVec3, p: &PrismCorners, band: [f64; 2]) -> Vec<Crossing> {
     let mut out = Vec::new();
-    if let Some((t, u, v)) = triangle_hit(d, p.bottom[0], p.bottom[1], p.bottom[2]) {
-        out.push((t, [1.0 - u - v, u, v, 0.0]));
+    let mut section = |w: f64| {
+        let q = [0, 1, 2].map(|i| p.bottom[i].lerp(p.top[i], w));
+        if let Some((t, u, v)) = triangle_hit(d, q[0], q[1], q[2]) {
+            out.push((t, [1.0 - u - v, u, v, w]));
+        }
+    };
+    section(0.0);
+    section(1.0);
+    if band[0] > 0.0 {
+        section(band[0]);
     }
-    if let Some((t, u, v)) = triangle_hit(d, p.top[0], p.top[1], p.top[2]) {
-        out.push((t, [1.0 - u - v, u, v, 1.0]));
+    if band[1] < 1.0 {
+        section(band[1]);
     }
     for e in 0..3 {
         let (mut i, mut j) = (e, (e + 1) % 3);
@@ -202,14 +213,18 @@ fn interval(d: DVec3, o: &ShellObject, k: usize, (t0, t1): (f64, f64), c0: Optio
 
 /// Twin of `expand_prism`: the intervals of ray `d` inside prism k after `t_near`.
 pub(crate) fn intervals(d: DVec3, o: &ShellObject, k: usize, t_near: f64) -> Vec<Interval> {
-    let p = &o.trace.prisms[k];
+    let (p, band) = (&o.trace.prisms[k], o.bands[k]);
     let mut out = Vec::new();
+    if band[0] > band[1] {
+        return out;
+    }
     let (mut t0, mut c0, mut at_near) = (t_near, None, true);
-    for (t1, c1) in crossings(d, p) {
+    for (t1, c1) in crossings(d, p, band) {
         if t1 <= t0 {
             continue;
         }
-        if let Some(c3) = exact(d * (t0 + (t1 - t0) / 3.0), p) {
+        let c3 = exact(d * (t0 + (t1 - t0) / 3.0), p).filter(|c| c[3] >= band[0] && c[3] <= band[1]);
+        if let Some(c3) = c3 {
             if at_near {
                 c0 = exact(d * t0, p);
             }

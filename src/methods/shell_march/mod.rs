@@ -1,14 +1,16 @@
 //! Host side of `ShellMarch` (issue 31): a per-pixel compute ray caster through the shell, made
-//! for speed at a measured error. Its objects share the Reference's layout (one BVH over the
-//! prisms of every ShellMarch object, their shells concatenated, level 0 of their volumes in one
-//! storage buffer: `reference::build`), to which it adds, per prism, whether its map folds, and
-//! per object an occupancy pyramid of its texel (`occupancy.rs`) for empty-space skipping.
+//! for speed at a measured error. Its objects share the Reference's layout (the prisms of every
+//! ShellMarch object, their shells concatenated, level 0 of their volumes in one storage buffer:
+//! `reference::build`), to which it adds, per prism, whether its map folds, per object an
+//! occupancy pyramid of its texel (`bake::occupancy`) for empty-space skipping, and per frame the
+//! prisms binned into screen tiles (`tiles.rs`).
 
 /// Its scene-file knobs (`knobs.rs`, compiled in the scene layer: `scene::methods`).
 pub(crate) use crate::scene::methods::shell_march as knobs;
 pub mod march_shell;
 mod object;
 pub(crate) mod plugin;
+mod tiles;
 
 pub use object::{frame_twin_inputs, ShellSet};
 
@@ -20,7 +22,10 @@ pub(crate) const CONTRIBUTION: super::Contribution = super::Contribution {
     filters: &["ShellMarch"],
     resources: &[
         B::SHELL_PARAMS,
-        B::SHELL_NODES,
+        B::SHELL_TILES,
+        B::SHELL_TILE_PRISMS,
+        B::SHELL_BOUNDS,
+        B::SHELL_BANDS,
         B::SHELL_PRISMS,
         B::SHELL_OBJECTS,
         B::SHELL_VERTICES,

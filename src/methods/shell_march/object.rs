@@ -1,10 +1,11 @@
 //! ShellMarch objects of a frame as the renderer sees them: each object's knobs
 //! ([`ShellPlan`]), and the one graph instance that marches them all ([`ShellSet`]).
 
-use glam::DVec3;
+use glam::{DVec2, DVec3};
 
 use super::knobs::ShellMarch;
 use super::march_shell::{folds, ShellObject};
+use super::tiles;
 use crate::bake::occupancy;
 use crate::cpu::prism_map::PrismCorners;
 use crate::error::{Error, Result};
@@ -14,10 +15,10 @@ use crate::gpu::buffers::{storage, uniform};
 use crate::gpu::Inputs;
 use crate::methods::reference::trace_reference::TraceView;
 use crate::methods::reference::{build, default_step, twin_inputs, Member, ReferenceSet};
-use crate::methods::view::View;
+use crate::methods::view::{RayCamera, View};
 use crate::methods::{texels, BakePlan, InputCx, MethodPlan, ObjectPlan, PartDecl, PlanCx};
 use crate::scene::{Lighting, Method};
-use crate::types::{FrameParams, ReferenceParams, ReferenceState};
+use crate::types::{FrameParams, ReferenceObject, ReferenceParams, ReferenceState};
 
 /// Mirrors `samples_per_dispatch` and the costs in march_shell.wgsl.
 const BUDGET: f64 = 8192.0;
@@ -54,6 +55,9 @@ pub struct ShellSet {
     pub(crate) knobs: Vec<ShellMarch>,
     /// Words of the occupancy pyramids (at least 1).
     pub(crate) occupancy_words: u64,
+    /// The camera and image size the prisms are binned for (`tiles::bin`).
+    pub(crate) camera: RayCamera,
+    pub(crate) size: (u32, u32),
 }
 
 /// The frame's ShellMarch objects as the Reference's layout takes them.
@@ -137,7 +141,7 @@ pub(super) fn gather(objects: &mut [ObjectPlan], bakes: &[BakePlan], view: &View
     for o in objects.iter_mut().filter_map(|o| o.method_mut::<ShellPlan>()) {
         o.dispatches = set.dispatches;
     }
-    Some(Box::new(ShellSet { set, knobs, occupancy_words: offset.max(1) }))
+    Some(Box::new(ShellSet { set, knobs, occupancy_words: offset.max(1), camera, size: view.size }))
 }
 
 impl ShellSet {
@@ -170,8 +174,6 @@ impl ShellSet {
         b.insert(B::SHELL_MARCH_STATE.into(), empty("shell_march_state", state_bytes, true));
         b.insert(B::SHELL_MARCH_COUNTS.into(), empty("shell_march_counts", 16, true));
         b.insert(B::SHELL_PARAMS.into(), uniform(ctx, "shell_params", bytemuck::bytes_of(&set.params)));
-        let nodes = if set.nodes.is_empty() { vec![Default::default()] } else { set.nodes.clone() };
-        b.insert(B::SHELL_NODES.into(), storage(ctx, "shell_nodes", bytemuck::cast_slice(&nodes)));
         b.insert(B::SHELL_PRISMS.into(), storage(ctx, "shell_prisms", bytemuck::cast_slice(&set.prisms)));
         b.insert(B::SHELL_OBJECTS.into(), storage(ctx, "shell_objects", bytemuck::cast_slice(&set.table)));
         b.insert(B::SHELL_VERTICES.into(), storage(ctx, "shell_vertices", bytemuck::cast_slice(&set.vertices)));
@@ -183,12 +185,37 @@ impl ShellSet {
         let atlas = ctx.read_buffer(&inputs.buffers[B::TEXEL_ATLAS], 0, set.atlas_words * 4)?;
         let b = &mut inputs.buffers;
         let mut pyramids = Vec::with_capacity(self.occupancy_words as usize);
+        let mut columns = Vec::with_capacity(set.table.len());
         for entry in &set.table {
-            let res = [entry.resolution[0], entry.resolution[1], entry.resolution[2]];
-            pyramids.extend(occupancy::pyramid(&occupancy::atlas_alpha(&atlas, res, entry.atlas[0], entry.atlas[1]), res));
+            let (pyramid, cols) = occupancy_of(&atlas, entry);
+            pyramids.extend(pyramid);
+            columns.push(cols);
         }
         pyramids.resize(self.occupancy_words as usize, 0);
         b.insert(B::SHELL_OCCUPANCY.into(), storage(ctx, "shell_occupancy", bytemuck::cast_slice(&pyramids)));
+        let uv = |a: [f32; 4], i: usize| DVec2::new(a[i] as f64, a[i + 1] as f64);
+        let bands: Vec<[f32; 2]> = set
+            .prisms
+            .iter()
+            .map(|p| {
+                let o = p.vertices[3] as usize;
+                let band = prism_band(&columns[o], &set.table[o], [uv(p.uv01, 0), uv(p.uv01, 2), uv(p.uv2, 0)]);
+                band.map(|w| w as f32)
+            })
+            .collect();
+        // Prisms whose texel is transparent are left out of the lists, but for their opaque bases.
+        let listed: Vec<bool> = (set.prisms.iter().zip(&bands))
+            .map(|(p, band)| band[0] <= band[1] || set.table[p.vertices[3] as usize].resolution[3] & 2 != 0)
+            .collect();
+        let t = tiles::bin(&set.prisms, &set.vertices, &listed, &self.camera, self.size);
+        // Bindings exist even where nothing is listed.
+        let entries = if t.entries.is_empty() { &[0][..] } else { &t.entries };
+        let bounds = if t.bounds.is_empty() { &[[0.0; 4]][..] } else { &t.bounds };
+        let bands = if bands.is_empty() { &[[1.0, 0.0]][..] } else { &bands };
+        b.insert(B::SHELL_TILES.into(), storage(ctx, "shell_tiles", bytemuck::cast_slice(&t.tiles)));
+        b.insert(B::SHELL_TILE_PRISMS.into(), storage(ctx, "shell_tile_prisms", bytemuck::cast_slice(entries)));
+        b.insert(B::SHELL_BOUNDS.into(), storage(ctx, "shell_bounds", bytemuck::cast_slice(bounds)));
+        b.insert(B::SHELL_BANDS.into(), storage(ctx, "shell_bands", bytemuck::cast_slice(bands)));
         Ok(())
     }
 }
@@ -205,12 +232,33 @@ pub fn frame_twin_inputs(
 ) -> (TraceView, Vec<ShellObject>) {
     let (list, knobs): (Vec<Member>, Vec<ShellMarch>) = members(objects, bakes).into_iter().unzip();
     let (view, traced) = twin_inputs(&set.set, &list, frame, texel_atlas, normal_atlas);
-    let objects = traced
-        .into_iter()
-        .zip(knobs)
-        .map(|(trace, k)| ShellObject { trace, step: k.step, tolerance: k.tolerance })
+    let objects = (traced.into_iter().zip(knobs).zip(&set.set.table))
+        .map(|((trace, k), entry)| {
+            let columns = occupancy_of(texel_atlas, entry).1;
+            let bands = trace.uvs.iter().map(|uv| prism_band(&columns, entry, *uv)).collect();
+            ShellObject { trace, step: k.step, tolerance: k.tolerance, bands }
+        })
         .collect();
     (view, objects)
+}
+
+/// An object's occupancy pyramid from the texel atlas the kernel reads, and the w extents of
+/// its level-0 columns.
+fn occupancy_of(atlas: &[u8], entry: &ReferenceObject) -> (Vec<u32>, Vec<Option<(u32, u32)>>) {
+    let res = [entry.resolution[0], entry.resolution[1], entry.resolution[2]];
+    let pyramid = occupancy::pyramid(&occupancy::atlas_alpha(atlas, res, entry.atlas[0], entry.atlas[1]), res);
+    let columns = occupancy::columns(&pyramid, res);
+    (pyramid, columns)
+}
+
+/// The band of w of a prism with corner uvs `uv` (its texel repeating) outside which its samples
+/// are transparent, [1, 0] where all are: over the box of its uvs, which holds every sample's s
+/// and t (barycentrics are interpolated or mapped inside the prism).
+fn prism_band(columns: &[Option<(u32, u32)>], entry: &ReferenceObject, uv: [DVec2; 3]) -> [f64; 2] {
+    let scale = DVec2::new(entry.resolution[0] as f64, entry.resolution[1] as f64);
+    let (lo, hi) = (uv[0].min(uv[1]).min(uv[2]) * scale, uv[0].max(uv[1]).max(uv[2]) * scale);
+    let res = [entry.resolution[0], entry.resolution[1], entry.resolution[2]];
+    occupancy::band(columns, res, lo.to_array(), hi.to_array()).unwrap_or([1.0, 0.0])
 }
 
 fn lighting(object: &ObjectPlan) -> Lighting {

@@ -33,7 +33,7 @@ fn object(p: PrismCorners, tolerance: f64) -> ShellObject {
         step: 0.01,
         opaque_base: false,
     };
-    ShellObject { trace, step: 1.0, tolerance }
+    ShellObject { trace, step: 1.0, tolerance, bands: vec![[0.0, 1.0]] }
 }
 
 /// Base triangle in front of a camera at the origin looking down +y.
@@ -88,7 +88,7 @@ fn neighbours_cross_their_shared_side_at_identical_points() {
         .collect();
     let through = rays(&left, &mut rng, 200).into_iter().chain(rays(&right, &mut rng, 200));
     for d in on_side.into_iter().chain(through) {
-        let (l, r) = (crossings(d, &left), crossings(d, &right));
+        let (l, r) = (crossings(d, &left, [0.0, 1.0]), crossings(d, &right, [0.0, 1.0]));
         // Crossings of the shared side: corner 0 of left has no weight, corner 2 of right none.
         let on_left: Vec<&Crossing> = l.iter().filter(|c| c.1[0] == 0.0 && c.1[3] > 0.0 && c.1[3] < 1.0).collect();
         let on_right: Vec<&Crossing> = r.iter().filter(|c| c.1[2] == 0.0 && c.1[3] > 0.0 && c.1[3] < 1.0).collect();
