@@ -123,6 +123,21 @@ fn composite(s: u32, t: f32, c: vec4<f32>) {
     }
 }
 
+// The index of the first sample of interval s at or after `bound` (its samples from k on).
+fn first_at(s: u32, k: u32, bound: f32) -> u32 {
+    let t0 = iv_t0[s];
+    let h = iv_h[s];
+    let n = iv_n[s];
+    var e = u32(clamp(ceil((bound - t0) / h - 0.5), f32(k), f32(n)));
+    while (e > k && t0 + (f32(e - 1u) + 0.5) * h >= bound) {
+        e -= 1u;
+    }
+    while (e < n && t0 + (f32(e) + 0.5) * h < bound) {
+        e += 1u;
+    }
+    return e;
+}
+
 // Samples of interval s before `limit` (its next one in any case: it is the nearest held), in
 // order, until the budget or the ray runs out. The interval's state is kept in registers meanwhile
 // (dynamically indexed private arrays are slow on lavapipe).
@@ -138,6 +153,9 @@ fn run(s: u32, limit: f32) {
     var tb = iv_tb[s];
     var ca = iv_ca[s];
     var cb = iv_cb[s];
+    // Skips stay in the current piece and before `limit`: they end at the first sample at or
+    // after either (found again when the piece changes).
+    var end = first_at(s, k, select(min(tb, limit), limit, iv_piece[s] + 1u >= m));
     var first = true;
     while ((first || t < limit) && budget > 0 && transmittance >= min_transmittance) {
         first = false;
@@ -150,6 +168,7 @@ fn run(s: u32, limit: f32) {
             tb = iv_tb[s];
             ca = iv_ca[s];
             cb = iv_cb[s];
+            end = first_at(s, k, select(min(tb, limit), limit, iv_piece[s] + 1u >= m));
         }
         budget -= 1;
         var c: vec4<f32>;
@@ -162,16 +181,7 @@ fn run(s: u32, limit: f32) {
         } else {
             c = mix(ca, cb, (t - ta) / (tb - ta));
             dc = (cb - ca) * (h / (tb - ta));
-            // Skips stay in this piece and before `limit`: the first sample at or after either.
-            let bound = select(min(tb, limit), limit, iv_piece[s] + 1u >= m);
-            var e = u32(clamp(ceil((bound - t0) / h - 0.5), f32(k), f32(n)));
-            while (e > k && t0 + (f32(e - 1u) + 0.5) * h >= bound) {
-                e -= 1u;
-            }
-            while (e < n && t0 + (f32(e) + 0.5) * h < bound) {
-                e += 1u;
-            }
-            most = e - k;
+            most = end - k;
         }
         var step = 1u;
         let jump = select(0u, empty_run(s, c, dc, most), skip_empty && c.w >= 0.0);
