@@ -14,10 +14,13 @@
 use std::time::Instant;
 
 use crate::error::Result;
+use crate::gpu::cache::GpuCache;
 use crate::gpu::GpuContext;
 use crate::graph::PassDecl;
 use crate::io::Image;
+use crate::methods::options::RenderOptions;
 use crate::render::{Blueprint, Renderer};
+use crate::scene::Scene;
 
 /// Frames rendered and thrown away before the timed ones...
 pub(crate) const WARM_UP_FRAMES: usize = 2;
@@ -99,6 +102,37 @@ fn evaluations(ctx: &GpuContext, r: &Renderer) -> Result<f64> {
         sum += r.blueprint.plan_of(instance).evaluations(&mut read)?.unwrap_or(0.0);
     }
     Ok(sum)
+}
+
+/// Degrees the camera turns between the frames of an orbit (the preview's measured orbit).
+pub(crate) const ORBIT_DEGREES: f64 = 2.0;
+
+/// Orbit time: the median wall ms of `frames` frames (after warm-up) whose camera turned since
+/// the last, each planned again, its GPU inputs made again with the bakes kept (as the preview
+/// does while the camera is dragged), rendered and waited for: what a preview orbit costs,
+/// CPU planning and uploads included.
+pub(crate) fn orbit_ms(
+    ctx: &GpuContext,
+    scene: &Scene,
+    options: &RenderOptions,
+    frames: usize,
+) -> Result<f64> {
+    let mut cache = GpuCache::default();
+    let camera = options.camera.unwrap_or(*scene.camera);
+    let mut times = Vec::new();
+    for i in 0..WARM_UP_FRAMES + frames.max(1) {
+        let t = Instant::now();
+        let opts =
+            RenderOptions { camera: Some(camera.orbited(ORBIT_DEGREES * i as f64)), ..options.clone() };
+        cache.begin();
+        let mut r = Renderer::with_cache(ctx, Blueprint::new(scene, &opts)?, &mut cache)?;
+        cache.retain_used();
+        r.render_timed(ctx)?;
+        if i >= WARM_UP_FRAMES {
+            times.push(t.elapsed().as_secs_f64() * 1e3);
+        }
+    }
+    Ok(median(times))
 }
 
 /// Just the image (the truth).

@@ -239,7 +239,8 @@ fn measure_setting(scene: &Scene, args: &Args, s: &Setting, bp: Blueprint, truth
     let ctx = GpuContext::new()?;
     let compute = measure::compute_passes(&ctx, bp, args.frames)?;
     let frames = measure::full_frames(&ctx, Blueprint::new(scene, &s.options)?, args.frames)?;
-    Row::new(s.clone(), compute, frames, truth)
+    let orbit = measure::orbit_ms(&ctx, scene, &s.options, args.frames)?;
+    Row::new(s.clone(), compute, frames, orbit, truth)
 }
 
 /// The settings to measure, each with its blueprint (CPU only: planning fails early), and notes

@@ -14,6 +14,8 @@ pub(super) struct Row {
     wall_ms: f64,
     /// Wall ms of the compute-only frame (phase 1), to check its timestamps against.
     compute_wall_ms: f64,
+    /// Median wall ms of a frame while the camera orbits (`measure::orbit_ms`).
+    orbit_ms: f64,
     flip: f64,
     rel_rmse: f64,
     /// Density evaluations of RayMarch objects per frame.
@@ -27,6 +29,7 @@ impl Row {
         setting: Setting,
         compute: measure::ComputeOnly,
         frames: measure::Frames,
+        orbit_ms: f64,
         truth: &Image,
     ) -> Result<Self> {
         let passes = compute
@@ -40,6 +43,7 @@ impl Row {
             wall_ms: frames.wall_ms,
             evaluations: frames.evaluations,
             compute_wall_ms: compute.wall_ms,
+            orbit_ms,
             flip: crate::metrics::flip(&frames.image, truth)?.mean,
             rel_rmse: crate::metrics::relative_rmse(&frames.image, truth)?,
             setting,
@@ -95,14 +99,14 @@ fn num(v: Option<f64>) -> String {
 pub(super) fn csv(rows: &[Row]) -> String {
     let mut s = String::from(
         "method,knobs,planes,trivial_reject,step,gpu_ms,compute_ms,raster_ms,wall_ms,compute_wall_ms,\
-         flip,rel_rmse,evaluations,method_front,overall_front,passes\n",
+         orbit_ms,flip,rel_rmse,evaluations,method_front,overall_front,passes\n",
     );
     for r in rows {
         let o = &r.setting.options;
         let sum = |compute: bool| r.passes.iter().filter(|p| p.compute == compute).map(|p| p.ms).sum::<f64>();
         let passes: Vec<String> = r.passes.iter().map(|p| format!("{}={:.4}", p.name, p.ms)).collect();
         s.push_str(&format!(
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
             r.setting.method,
             r.setting.knobs,
             o.planes.map(|p| p.to_string()).unwrap_or_default(),
@@ -113,6 +117,7 @@ pub(super) fn csv(rows: &[Row]) -> String {
             num(Some(sum(false))),
             num(Some(r.wall_ms)),
             num(Some(r.compute_wall_ms)),
+            num(Some(r.orbit_ms)),
             num(Some(r.flip)),
             num(Some(r.rel_rmse)),
             r.evaluations,
@@ -211,14 +216,23 @@ pub(super) fn print_report(
     if ctx.has_timestamps() {
         println!(
             "GPU ms: per frame, the sum of each pass's median over {} frames after warm-up ({} frames, \
-             1 when a frame takes over {} ms; compute passes timed alone, see README); wall ms: submit to idle",
+             1 when a frame takes over {} ms; compute passes timed alone, see README); wall ms: submit to idle; \
+             orbit ms: median wall ms of {} frames whose camera turns {} degrees a frame, planned, uploaded, \
+             rendered and waited for",
             args.frames,
             measure::WARM_UP_FRAMES,
-            measure::LONG_FRAME_MS
+            measure::LONG_FRAME_MS,
+            args.frames,
+            measure::ORBIT_DEGREES
         );
         println!("{}", timing_check(rows));
     } else {
-        println!("no GPU timestamps on this adapter: times are wall clock (submit to idle)");
+        println!(
+            "no GPU timestamps on this adapter: times are wall clock (submit to idle); orbit ms: median wall ms \
+             of {} frames whose camera turns {} degrees a frame, planned, uploaded, rendered and waited for",
+            args.frames,
+            measure::ORBIT_DEGREES
+        );
     }
     let cores = std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1);
     if let (Some(a), Some(b)) = (load, load_average()) {
@@ -231,16 +245,17 @@ pub(super) fn print_report(
         let mut ids = ids;
         ids.sort_by(|&a, &b| rows[a].time().total_cmp(&rows[b].time()));
         println!("\n{title}");
-        println!("| method | knobs | GPU ms | wall ms | FLIP | rel RMSE | density evaluations |");
-        println!("|---|---|---|---|---|---|---|");
+        println!("| method | knobs | GPU ms | wall ms | orbit ms | FLIP | rel RMSE | density evaluations |");
+        println!("|---|---|---|---|---|---|---|---|");
         for i in ids {
             let r = &rows[i];
             println!(
-                "| {} | {} | {:.2} | {:.2} | {:.4} | {:.4} | {:.3e} |",
+                "| {} | {} | {:.2} | {:.2} | {:.2} | {:.4} | {:.4} | {:.3e} |",
                 r.setting.method,
                 r.setting.knobs,
                 r.gpu_ms(),
                 r.wall_ms,
+                r.orbit_ms,
                 r.flip,
                 r.rel_rmse,
                 r.evaluations

@@ -270,10 +270,8 @@ fn save(
 /// Step `i` of an orbit around the scene's target (the window's left drag): re-planned, rendered.
 fn orbit(ctx: &GpuContext, session: &mut Session, i: usize) -> Result<(Sample, CacheStats)> {
     let start = Instant::now();
-    let mut cam = *session.scene().ok_or_else(|| Error::Invalid("no scene".into()))?.camera;
-    let turn = DQuat::from_axis_angle(cam.up.normalize(), (2.0 * i as f64).to_radians());
-    cam.eye = cam.target + turn * (cam.eye - cam.target);
-    session.options.camera = Some(cam);
+    let cam = *session.scene().ok_or_else(|| Error::Invalid("no scene".into()))?.camera;
+    session.options.camera = Some(cam.orbited(2.0 * i as f64));
     // As the window does: the last good scene planned again, no file read.
     let stats = match session.replan(ctx) {
         Outcome::Rebuilt(stats) => stats,
