@@ -21,7 +21,7 @@ use std::time::Instant;
 use crate::error::Result;
 use crate::gpu::GpuContext;
 use crate::io::Image;
-use crate::pareto::measure::timed;
+use crate::pareto::measure::{orbit_ms, timed};
 use crate::render::{Blueprint, RenderOptions, Renderer};
 use crate::scene::{Compositor, Scene};
 
@@ -45,6 +45,8 @@ struct Row {
     /// Median GPU ms of the raster passes of a full frame.
     raster: Vec<(String, f64)>,
     wall_ms: f64,
+    /// Median wall ms of a frame while the camera orbits (planning and uploads included).
+    orbit_ms: f64,
     cpu_ms: f64,
     /// Fragments the slices cover: their projected area in pixels, summed.
     fragments: f64,
@@ -170,6 +172,7 @@ pub fn run(args: &Args) -> Result<()> {
         row.raster =
             passes.into_iter().filter(|p| draw.contains(&p.0.as_str()) || p.0 == "composite").collect();
         row.wall_ms = wall;
+        row.orbit_ms = orbit_ms(&ctx, &scenes[s.scene], &options(s, None), frames)?;
     }
 
     println!("adapter: {}", ctx.adapter_line());
@@ -178,16 +181,16 @@ pub fn run(args: &Args) -> Result<()> {
         "error: relative RMSE and mean FLIP against the same scene sliced with {reference_planes} planes"
     );
     println!(
-        "| scene | planes | reject | compositor | count | scan | emit | slicing | draw | Mfrag | Mfrag/s | composite | frame (wall) | fps | CPU twin | rel RMSE | FLIP |"
+        "| scene | planes | reject | compositor | count | scan | emit | slicing | draw | Mfrag | Mfrag/s | composite | frame (wall) | fps | orbit | CPU twin | rel RMSE | FLIP |"
     );
-    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
     for (s, row) in settings.iter().zip(&rows) {
         let get = |v: &[(String, f64)], p: &str| v.iter().find(|x| x.0 == p).map(|x| x.1).unwrap_or(f64::NAN);
         let slicing: f64 = row.slicing.iter().map(|p| p.1).sum();
         let name = Path::new(&paths[s.scene]).file_stem().unwrap_or_default().to_string_lossy().to_string();
         let draw = draw_ms(row, s.compositor);
         println!(
-            "| {name} | {} | {} | {:?} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.1} | {:.0} | {:.3} | {:.1} | {:.2} | {:.1} | {:.4} | {:.4} |",
+            "| {name} | {} | {} | {:?} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.1} | {:.0} | {:.3} | {:.1} | {:.2} | {:.1} | {:.1} | {:.4} | {:.4} |",
             s.planes,
             if s.reject { "on" } else { "off" },
             s.compositor,
@@ -201,6 +204,7 @@ pub fn run(args: &Args) -> Result<()> {
             get(&row.raster, "composite"),
             row.wall_ms,
             1000.0 / row.wall_ms,
+            row.orbit_ms,
             row.cpu_ms,
             row.rel_rmse,
             row.flip,
@@ -214,7 +218,10 @@ pub fn run(args: &Args) -> Result<()> {
         "draw = draw_slices (Raster) or bin + scan + fill + composite + blend of the tiles (Tiles; on lavapipe \
          compute timestamps go wrong once a render pass has run: compare frame (wall))"
     );
-    println!("frame (wall) = submit to idle of a whole frame; CPU twin = the same slicing on one CPU core");
+    println!(
+        "frame (wall) = submit to idle of a whole frame; orbit = the median wall time of a frame whose camera \
+         turned (planned, uploaded, rendered, waited for); CPU twin = the same slicing on one CPU core"
+    );
     let truth = format!("ViewSlices, {reference_planes} planes");
     for (s, row) in settings.iter().zip(&rows) {
         let name = Path::new(&paths[s.scene]).file_stem().unwrap_or_default().to_string_lossy().to_string();
@@ -226,6 +233,7 @@ pub fn run(args: &Args) -> Result<()> {
         }
         extra.insert("fragments".into(), row.fragments);
         extra.insert("cpu_twin_ms".into(), row.cpu_ms);
+        extra.insert("orbit_ms".into(), row.orbit_ms);
         let draw = draw_ms(row, s.compositor);
         extra.insert("draw_ms".into(), draw);
         if let Some(l) = &report.limits {
