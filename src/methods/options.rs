@@ -60,9 +60,17 @@ pub struct RenderOptions {
     /// Shadows of every RayMarch object (`--shadows`, the Pareto sweep): `Some(None)` is Phong
     /// without shadows, `Some(Some(s))` `PhongShadows` with `s`.
     pub shadows: Option<Option<crate::scene::Shadows>>,
+    /// Knobs by name for every object of the switched-to (or own) method whose plug-in knows
+    /// the name, e.g. `("tolerance", 1.0)` (a sweep's point); unknown names are ignored.
+    pub knobs: Vec<(&'static str, f64)>,
 }
 
 impl RenderOptions {
+    /// The value given for knob `name` (see `knobs`).
+    pub(crate) fn knob(&self, name: &str) -> Option<f64> {
+        self.knobs.iter().rev().find(|(k, _)| *k == name).map(|(_, v)| *v)
+    }
+
     /// A volume object's method after the overrides: a switch (`--method`) to a method that
     /// takes volumes from the object's (the Reference: the truth of a RayMarch volume is that
     /// look, integrated exactly) makes that; otherwise as [`apply`](Self::apply).
