@@ -61,6 +61,13 @@ pub struct ParetoCmd {
     /// the tables and the chart.
     #[arg(long, num_args = 1..)]
     peers: Vec<PathBuf>,
+    /// Render the truth with N x N samples per pixel, averaged: each pixel the mean over its
+    /// area (the truth of methods that filter by the pixel's footprint).
+    #[arg(long, default_value_t = 1)]
+    supersample: u32,
+    /// Render every swept setting with N x N samples per pixel, averaged.
+    #[arg(long, default_value_t = 1)]
+    supersample_methods: u32,
 }
 
 fn parse_adaptive(s: &str) -> std::result::Result<(f64, f64), String> {
@@ -118,5 +125,7 @@ pub fn run(p: ParetoCmd) -> Result<()> {
             ray_shadows: p.ray_shadows.into_iter().map(|s| s.0).collect(),
         },
         peers: p.peers,
+        supersample: p.supersample,
+        supersample_methods: p.supersample_methods,
     })
 }

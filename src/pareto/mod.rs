@@ -71,6 +71,9 @@ impl TruthSource {
     }
 }
 
+/// Most samples per pixel side of `--supersample` and `--supersample-methods`.
+pub const MAX_SUPERSAMPLE: u32 = 8;
+
 /// The command's arguments.
 #[derive(Debug, Clone)]
 pub struct Args {
@@ -88,6 +91,11 @@ pub struct Args {
     pub sweep: SweepValues,
     /// CSV files of other renderers' rows (`peers`), shown beside voltex's.
     pub peers: Vec<PathBuf>,
+    /// Samples per pixel side of the truth (`--supersample`): each pixel the mean over its area,
+    /// the truth of methods that filter by the pixel's footprint.
+    pub supersample: u32,
+    /// Samples per pixel side of every swept setting (`--supersample-methods`).
+    pub supersample_methods: u32,
 }
 
 /// One point of the sweep.
@@ -129,7 +137,30 @@ impl Args {
         if self.frames == 0 {
             return Err(Error::Invalid("--frames 0: expected at least one timed frame".into()));
         }
+        for (flag, n) in
+            [("--supersample", self.supersample), ("--supersample-methods", self.supersample_methods)]
+        {
+            if !(1..=MAX_SUPERSAMPLE).contains(&n) {
+                return Err(Error::Invalid(format!(
+                    "{flag} {n}: expected 1 to {MAX_SUPERSAMPLE} samples per pixel side"
+                )));
+            }
+        }
         Ok(())
+    }
+
+    /// The truth as reports name it: `reference`, `reference, 4x4 samples per pixel`.
+    pub(crate) fn truth_label(&self) -> String {
+        match self.supersample {
+            1 => self.truth.to_string(),
+            n => format!("{}, {n}x{n} samples per pixel", self.truth),
+        }
+    }
+
+    /// The truth's options: its method's, supersampled as asked.
+    fn truth_options(&self) -> RenderOptions {
+        let n = (self.supersample > 1).then_some(self.supersample);
+        RenderOptions { supersample: n, ..self.truth.options(self.sweep.size) }
     }
 
     pub(crate) fn out_dir(&self) -> PathBuf {
@@ -154,7 +185,10 @@ pub(crate) fn sweep(scene: &Scene, args: &Args) -> Result<(Vec<Setting>, Vec<Str
                 method: kind.name(),
                 knobs: p.knobs,
                 tag: p.tag,
-                options: p.options,
+                options: RenderOptions {
+                    supersample: (args.supersample_methods > 1).then_some(args.supersample_methods),
+                    ..p.options
+                },
             })),
             Err(why) => notes.push(format!("{kind}: not measured: {why}")),
         }
@@ -186,8 +220,8 @@ pub fn run(args: &Args) -> Result<()> {
     let n = settings.len();
     let load = report::load_average();
     let ctx = GpuContext::new()?;
-    eprintln!("truth: {}", args.truth);
-    let truth = measure::image(&ctx, Blueprint::new(&scene, &args.truth.options(args.sweep.size))?)?;
+    eprintln!("truth: {}", args.truth_label());
+    let truth = measure::image(&ctx, Blueprint::new(&scene, &args.truth_options())?)?;
     let mut rows = Vec::new();
     let mut progress = Progress::new(n, Verbosity::Normal);
     for (s, bp) in settings.into_iter().zip(blueprints) {
@@ -220,7 +254,7 @@ pub fn run(args: &Args) -> Result<()> {
         args.scene.file_stem().unwrap_or_default().to_string_lossy(),
         args.sweep.size.0,
         args.sweep.size.1,
-        args.truth
+        args.truth_label()
     );
     atomic::write_bytes(
         &svg_path,
@@ -246,7 +280,7 @@ fn measure_setting(scene: &Scene, args: &Args, s: &Setting, bp: Blueprint, truth
 /// The settings to measure, each with its blueprint (CPU only: planning fails early), and notes
 /// on what cannot be measured. The truth must plan; a setting that does not is skipped.
 fn plan(scene: &Scene, args: &Args) -> Result<Planned> {
-    Blueprint::new(scene, &args.truth.options(args.sweep.size)).map_err(|e| {
+    Blueprint::new(scene, &args.truth_options()).map_err(|e| {
         let hint = if args.truth == TruthSource::ground_truth() {
             "; try a converged method as the truth (--truth)"
         } else {

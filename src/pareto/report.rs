@@ -210,8 +210,12 @@ pub(super) fn print_report(
         args.scene.display(),
         args.sweep.size.0,
         args.sweep.size.1,
-        args.truth
+        args.truth_label()
     );
+    if args.supersample_methods > 1 {
+        let n = args.supersample_methods;
+        println!("every setting rendered with {n}x{n} samples per pixel, averaged");
+    }
     println!("adapter: {}", ctx.adapter_line());
     if ctx.has_timestamps() {
         println!(

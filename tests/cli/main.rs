@@ -13,6 +13,7 @@ mod hostile_files;
 mod install;
 mod maxima;
 mod method_plugin;
+mod pareto;
 mod preview_input;
 mod preview_latency;
 mod preview_window;

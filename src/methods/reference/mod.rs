@@ -149,7 +149,9 @@ impl Member<'_> {
     }
 }
 
-pub(crate) fn build(members: &[Member], params: ReferenceParams) -> ReferenceSet {
+/// The layout of `members` for the kernels; with `bvh`, a BVH over the prisms (in its leaf order),
+/// else the prisms in the members' order and no nodes.
+pub(crate) fn build(members: &[Member], params: ReferenceParams, bvh: bool) -> ReferenceSet {
     let mut set = ReferenceSet {
         objects: members.iter().map(|m| m.index).collect(),
         params,
@@ -175,15 +177,17 @@ pub(crate) fn build(members: &[Member], params: ReferenceParams) -> ReferenceSet
         }
         for p in &o.shell.prisms {
             let ids = [p.vertices[0], p.vertices[1], p.vertices[2]];
-            let corners = ids.iter().flat_map(|&v| {
-                let sv = &o.shell.vertices[v as usize];
-                [Vec3A::from_slice(&sv.bottom[..3]), Vec3A::from_slice(&sv.top[..3])]
-            });
-            let pts: Vec<Vec3A> = corners.collect();
-            let b = Aabb::from_points(&pts);
-            // Grown by a relative epsilon so that f32 rounding in the slab test never loses a prism.
-            let pad = Vec3A::splat(1e-5 * (b.max - b.min).max_element() + 1e-7);
-            boxes.push(Aabb::new(b.min - pad, b.max + pad));
+            if bvh {
+                let corners = ids.iter().flat_map(|&v| {
+                    let sv = &o.shell.vertices[v as usize];
+                    [Vec3A::from_slice(&sv.bottom[..3]), Vec3A::from_slice(&sv.top[..3])]
+                });
+                let pts: Vec<Vec3A> = corners.collect();
+                let b = Aabb::from_points(&pts);
+                // Grown by a relative epsilon so that f32 rounding in the slab test never loses a prism.
+                let pad = Vec3A::splat(1e-5 * (b.max - b.min).max_element() + 1e-7);
+                boxes.push(Aabb::new(b.min - pad, b.max + pad));
+            }
             prisms.push(ReferencePrism {
                 vertices: [ids[0] + first, ids[1] + first, ids[2] + first, k as u32],
                 uv01: p.uv01,
@@ -205,7 +209,9 @@ pub(crate) fn build(members: &[Member], params: ReferenceParams) -> ReferenceSet
             set.normal_words += words;
         }
     }
-    if !prisms.is_empty() {
+    if !bvh {
+        set.prisms = prisms;
+    } else if !prisms.is_empty() {
         let (nodes, order) = flat_bvh(&boxes);
         // Prisms in leaf order, so leaves index them directly.
         set.prisms = order.iter().map(|&i| prisms[i as usize]).collect();

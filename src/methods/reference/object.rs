@@ -70,7 +70,7 @@ pub(super) fn gather(
         up: [u.x, u.y, u.z, view.far as f32],
         counts: [0; 4],
     };
-    let set = build(&members, params);
+    let set = build(&members, params, true);
     for o in objects.iter_mut().filter_map(|o| o.method_mut::<ReferencePlan>()) {
         o.dispatches = set.dispatches;
     }

@@ -5,7 +5,7 @@ use glam::{DVec2, DVec3};
 
 use super::knobs::ShellMarch;
 use super::march_shell::{folds, ShellObject};
-use super::tiles;
+use super::tiles::{self, TileLists};
 use crate::bake::occupancy;
 use crate::cpu::prism_map::PrismCorners;
 use crate::error::{Error, Result};
@@ -15,7 +15,7 @@ use crate::gpu::buffers::{storage, uniform};
 use crate::gpu::Inputs;
 use crate::methods::reference::trace_reference::TraceView;
 use crate::methods::reference::{build, default_step, twin_inputs, Member, ReferenceSet};
-use crate::methods::view::{RayCamera, View};
+use crate::methods::view::View;
 use crate::methods::{texels, BakePlan, InputCx, MethodPlan, ObjectPlan, PartDecl, PlanCx};
 use crate::scene::{Lighting, Method};
 use crate::types::{FrameParams, ReferenceObject, ReferenceParams, ReferenceState};
@@ -55,9 +55,9 @@ pub struct ShellSet {
     pub(crate) knobs: Vec<ShellMarch>,
     /// Words of the occupancy pyramids (at least 1).
     pub(crate) occupancy_words: u64,
-    /// The camera and image size the prisms are binned for (`tiles::bin`).
-    pub(crate) camera: RayCamera,
-    pub(crate) size: (u32, u32),
+    /// Every prism binned into the image's tiles (`tiles::bin`); those whose texel is
+    /// transparent over their uvs leave the lists once the atlas is known (`add_inputs`).
+    pub(crate) tiles: TileLists,
 }
 
 /// The frame's ShellMarch objects as the Reference's layout takes them.
@@ -117,7 +117,8 @@ pub(super) fn gather(objects: &mut [ObjectPlan], bakes: &[BakePlan], view: &View
         counts: [0; 4],
     };
     let (list, knobs): (Vec<Member>, Vec<ShellMarch>) = members.into_iter().unzip();
-    let mut set = build(&list, params);
+    // No BVH: the kernel walks screen tiles' lists (`tiles.rs`).
+    let mut set = build(&list, params, false);
     let mut offset = 0u64;
     for ((entry, k), m) in set.table.iter_mut().zip(&knobs).zip(&list) {
         entry.params[1] = k.step as f32;
@@ -141,7 +142,8 @@ pub(super) fn gather(objects: &mut [ObjectPlan], bakes: &[BakePlan], view: &View
     for o in objects.iter_mut().filter_map(|o| o.method_mut::<ShellPlan>()) {
         o.dispatches = set.dispatches;
     }
-    Some(Box::new(ShellSet { set, knobs, occupancy_words: offset.max(1), camera, size: view.size }))
+    let tiles = tiles::bin(&set.prisms, &set.vertices, &camera, view.size);
+    Some(Box::new(ShellSet { set, knobs, occupancy_words: offset.max(1), tiles }))
 }
 
 impl ShellSet {
@@ -207,7 +209,7 @@ impl ShellSet {
         let listed: Vec<bool> = (set.prisms.iter().zip(&bands))
             .map(|(p, band)| band[0] <= band[1] || set.table[p.vertices[3] as usize].resolution[3] & 2 != 0)
             .collect();
-        let t = tiles::bin(&set.prisms, &set.vertices, &listed, &self.camera, self.size);
+        let t = self.tiles.only(&listed);
         // Bindings exist even where nothing is listed.
         let entries = if t.entries.is_empty() { &[0][..] } else { &t.entries };
         let bounds = if t.bounds.is_empty() { &[[0.0; 4]][..] } else { &t.bounds };
@@ -372,12 +374,14 @@ impl MethodPlan for ShellSet {
         let s = &self.set;
         vec![(
             format!(
-                "shell march: BVH ({} nodes), {} prisms, shells, texel atlas{}, occupancy pyramids, per-pixel state",
-                s.nodes.len(),
+                "shell march: {} prisms with bounds and bands, {} tile list entries at most, shells, texel atlas{}, \
+                 occupancy pyramids, per-pixel state",
                 s.prisms.len(),
+                self.tiles.entries.len(),
                 if s.normal_words > 1 { " + normal atlas" } else { "" }
             ),
-            (s.nodes.len() * 32 + s.prisms.len() * 48 + s.vertices.len() * 32 + s.frames.len() * 32) as u64
+            (s.prisms.len() * (48 + 32 + 8) + s.vertices.len() * 32 + s.frames.len() * 32) as u64
+                + (self.tiles.tiles.len() * 8 + self.tiles.entries.len() * 4) as u64
                 + (s.atlas_words + s.normal_words + self.occupancy_words) * 4
                 + size.0 as u64 * size.1 as u64 * 32,
         )]

@@ -28,15 +28,24 @@ pub(crate) struct TileLists {
     pub(crate) bounds: Vec<[f32; 4]>,
 }
 
-/// Bins the `listed` of `prisms` (corners in `vertices`, camera-relative) into the tiles of a
-/// `size` image seen by `camera`; bounds are given for all.
-pub(crate) fn bin(
-    prisms: &[ReferencePrism],
-    vertices: &[ShellVertex],
-    listed: &[bool],
-    camera: &RayCamera,
-    size: (u32, u32),
-) -> TileLists {
+impl TileLists {
+    /// The lists with only the prisms `listed` (order kept).
+    pub(crate) fn only(&self, listed: &[bool]) -> TileLists {
+        let mut out = TileLists { tiles: Vec::with_capacity(self.tiles.len()), entries: Vec::new(), bounds: self.bounds.clone() };
+        for &[first, count] in &self.tiles {
+            let start = out.entries.len() as u32;
+            let entries = &self.entries[first as usize..(first + count) as usize];
+            out.entries.extend(entries.iter().filter(|&&p| listed[p as usize]));
+            let kept = out.entries.len() as u32 - start;
+            out.tiles.push([if kept > 0 { start } else { 0 }, kept]);
+        }
+        out
+    }
+}
+
+/// Bins `prisms` (corners in `vertices`, camera-relative) into the tiles of a `size` image seen
+/// by `camera`.
+pub(crate) fn bin(prisms: &[ReferencePrism], vertices: &[ShellVertex], camera: &RayCamera, size: (u32, u32)) -> TileLists {
     let tiles = (size.0.div_ceil(TILE), size.1.div_ceil(TILE));
     let forward = camera.right.cross(camera.up).normalize() * -1.0;
     let v3 = |a: [f32; 4]| DVec3::new(a[0] as f64, a[1] as f64, a[2] as f64);
@@ -58,9 +67,6 @@ pub(crate) fn bin(
         let far = lo.abs().max(hi.abs()).length();
         bounds.push([lo.x as f32, lo.y as f32, lo.z as f32, near as f32]);
         bounds.push([hi.x as f32, hi.y as f32, hi.z as f32, far as f32]);
-        if !listed[index] {
-            continue;
-        }
         let Some((x0, x1, y0, y1)) = screen_box(&corners, camera, forward, size) else {
             continue;
         };
@@ -143,7 +149,7 @@ mod tests {
         let mut vertices = small(5.0, 0.0);
         vertices.extend(small(2.0, 0.0));
         vertices.extend(small(3.0, 0.9));
-        let lists = bin(&[prism(0), prism(3), prism(6)], &vertices, &[true; 3], &camera(), (64, 64));
+        let lists = bin(&[prism(0), prism(3), prism(6)], &vertices, &camera(), (64, 64));
         assert_eq!(lists.tiles.len(), 64);
         // Screen centre: pixels 31-32; the first two prisms fall in tiles (3..=4, 3..=4).
         let centre = lists.tiles[3 * 8 + 3];
@@ -153,6 +159,11 @@ mod tests {
         let edge = lists.tiles[3 * 8 + 7];
         assert_eq!(&lists.entries[edge[0] as usize..(edge[0] + edge[1]) as usize], [2]);
         assert!(lists.bounds[2][3] < lists.bounds[0][3] && lists.bounds[1][3] > lists.bounds[0][3]);
+        // Leaving the nearest out keeps the others in order.
+        let kept = lists.only(&[true, false, true]);
+        let centre = kept.tiles[3 * 8 + 3];
+        assert_eq!(&kept.entries[centre[0] as usize..(centre[0] + centre[1]) as usize], [0]);
+        assert_eq!(kept.tiles[3 * 8 + 7][1], 1);
     }
 
     #[test]
@@ -160,11 +171,11 @@ mod tests {
         let through = [DVec3::new(0.0, 0.0, 1.0), DVec3::new(0.1, 0.0, -1.0), DVec3::new(0.0, 0.1, -1.0)]
             .map(|p| vertex(p, p - DVec3::Z * 0.1))
             .to_vec();
-        let lists = bin(&[prism(0)], &through, &[true], &camera(), (20, 12));
+        let lists = bin(&[prism(0)], &through, &camera(), (20, 12));
         assert_eq!(lists.tiles.len(), 6);
         assert!(lists.tiles.iter().all(|t| t[1] == 1));
         let off = small(2.0, 3.0);
-        let lists = bin(&[prism(0)], &off, &[true], &camera(), (20, 12));
+        let lists = bin(&[prism(0)], &off, &camera(), (20, 12));
         assert!(lists.entries.is_empty());
     }
 }
