@@ -125,7 +125,7 @@ mod tests {
 
     fn vertex(p: DVec3, top: DVec3) -> ShellVertex {
         let f = |v: DVec3| [v.x as f32, v.y as f32, v.z as f32, 0.0];
-        ShellVertex { bottom: f(p), top: f(top), ..Default::default() }
+        ShellVertex { bottom: f(p), top: f(top) }
     }
 
     fn camera() -> RayCamera {
