@@ -1,11 +1,10 @@
 // ShellMarch's samples (included by march_shell.wgsl): empty-space runs, trilinear filtering and
 // lighting as the Reference does them, and compositing the held intervals nearest first.
 
-// How many samples of interval s from map value c on are empty for certain (at most `most`):
-// along the line c + k dc, until it leaves the largest brick around c that holds no opacity.
-fn empty_run(s: u32, c: vec4<f32>, dc: vec4<f32>, most: u32) -> u32 {
-    let prism = shell_prisms[iv_prism[s]];
-    let object = shell_objects[prism.vertices.w];
+// How many samples of an interval in `prism` (of `object`) from map value c on are empty for
+// certain (at most `most`): along the line c + k dc, until it leaves the largest brick around c
+// that holds no opacity.
+fn empty_run(prism: ReferencePrism, object: ReferenceObject, c: vec4<f32>, dc: vec4<f32>, most: u32) -> u32 {
     let res = object.resolution.xyz;
     let resf = vec3<f32>(res);
     let st = c.x * prism.uv01.xy + c.y * prism.uv01.zw + c.z * prism.uv2.xy;
@@ -14,8 +13,10 @@ fn empty_run(s: u32, c: vec4<f32>, dc: vec4<f32>, most: u32) -> u32 {
     var run = 0.0;
     var offset = object.atlas.w;
     for (var level = 0u; level < 3u; level++) {
-        let size = 4u << (2u * level);
-        let dims = (res + vec3<u32>(size - 1u)) / size;
+        // Bricks of 4, 16, 64 voxels: shifts, as vector integer division is slow on llvmpipe.
+        let shift = 2u + 2u * level;
+        let size = 1u << shift;
+        let dims = (res + vec3<u32>(size - 1u)) >> vec3<u32>(shift);
         let brick = vec3<u32>(clamp(floor(x / f32(size)), vec3<f32>(0.0), vec3<f32>(dims - vec3<u32>(1u))));
         if (shell_occupancy[offset + (brick.z * dims.y + brick.y) * dims.x + brick.x] != 0u) {
             break;
@@ -40,6 +41,8 @@ struct Axis {
     f: f32,
 }
 
+// c in [0, 1] (s and t after `fract`, w clamped): the voxels either side are in [-1, n], so
+// wrapping needs no modulo (a vector modulo is slow on llvmpipe).
 fn axis(c: f32, n: u32, wrap: bool) -> Axis {
     let x = c * f32(n) - 0.5;
     let fl = floor(x);
@@ -47,8 +50,8 @@ fn axis(c: f32, n: u32, wrap: bool) -> Axis {
     var i0 = i32(fl);
     var i1 = i0 + 1;
     if (wrap) {
-        i0 = ((i0 % m) + m) % m;
-        i1 = ((i1 % m) + m) % m;
+        i0 = select(i0, i0 + m, i0 < 0);
+        i1 = select(i1, i1 - m, i1 >= m);
     } else {
         i0 = clamp(i0, 0, m - 1);
         i1 = clamp(i1, 0, m - 1);
@@ -96,14 +99,13 @@ fn shade(index: u32, object: ReferenceObject, c: vec4<f32>, uvw: vec3<f32>, albe
     return shade_phong(albedo, n, frame.light_dir, -ray, PIXEL_SPECULAR, PIXEL_SHININESS);
 }
 
-// Composites one sample of interval s at ray distance t and map value c (w < 0: none).
-fn composite(s: u32, t: f32, c: vec4<f32>) {
+// Composites one sample, h apart from the next, of an interval in prism `index` (`prism`, of
+// `object`) at ray distance t and map value c (w < 0: none).
+fn composite(index: u32, prism: ReferencePrism, object: ReferenceObject, h: f32, t: f32, c: vec4<f32>) {
     taken += 1u;
     if (c.w < 0.0) {
         return;
     }
-    let prism = shell_prisms[iv_prism[s]];
-    let object = shell_objects[prism.vertices.w];
     let uvw = vec3<f32>(c.x * prism.uv01.xy + c.y * prism.uv01.zw + c.z * prism.uv2.xy, c.w);
     let texel = sample_volume(object, uvw, false);
     if (texel.a >= OPAQUE_ALPHA && !opaque_found) {
@@ -114,10 +116,10 @@ fn composite(s: u32, t: f32, c: vec4<f32>) {
     if (alpha > 1e-6) {
         var colour = texel.rgb / alpha;
         if ((object.resolution.w & 1u) != 0u) {
-            colour = shade(iv_prism[s], object, c, uvw, colour);
+            colour = shade(index, object, c, uvw, colour);
         }
         // The step-corrected opacity: 1 - (1 - a)^(h / opacity_length).
-        let a = 1.0 - exp(log(1.0 - alpha) * iv_h[s] / object.params.x);
+        let a = 1.0 - exp(log(1.0 - alpha) * h / object.params.x);
         rgb += colour * a * transmittance;
         transmittance *= 1.0 - a;
     }
@@ -139,13 +141,18 @@ fn first_at(s: u32, k: u32, bound: f32) -> u32 {
 }
 
 // Samples of interval s before `limit` (its next one in any case: it is the nearest held), in
-// order, until the budget or the ray runs out. The interval's state is kept in registers meanwhile
-// (dynamically indexed private arrays are slow on lavapipe).
+// order, until the budget or the ray runs out. The interval's state is kept in registers meanwhile:
+// on llvmpipe every read of a dynamically indexed private array is a chain of selects over all of
+// its entries, so the loop reads none but where a piece ends.
 fn run(s: u32, limit: f32) {
+    let index = iv_prism[s];
+    let prism = shell_prisms[index];
+    let object = shell_objects[prism.vertices.w];
     let t0 = iv_t0[s];
     let h = iv_h[s];
     let n = iv_n[s];
     let m = iv_pieces[s];
+    var piece = iv_piece[s];
     var k = iv_k[s];
     var t = iv_next[s];
     var exact = iv_exact[s];
@@ -155,27 +162,28 @@ fn run(s: u32, limit: f32) {
     var cb = iv_cb[s];
     // Skips stay in the current piece and before `limit`: they end at the first sample at or
     // after either (found again when the piece changes).
-    var end = first_at(s, k, select(min(tb, limit), limit, iv_piece[s] + 1u >= m));
+    var end = first_at(s, k, select(min(tb, limit), limit, piece + 1u >= m));
     var first = true;
     while ((first || t < limit) && budget > 0 && transmittance >= min_transmittance) {
         first = false;
-        if (t >= tb && iv_piece[s] + 1u < m) {
+        if (t >= tb && piece + 1u < m) {
             while (t >= iv_tb[s] && iv_piece[s] + 1u < m) {
                 set_piece(s, iv_piece[s] + 1u, vec4<f32>(0.0), true);
             }
+            piece = iv_piece[s];
             exact = iv_exact[s];
             ta = iv_ta[s];
             tb = iv_tb[s];
             ca = iv_ca[s];
             cb = iv_cb[s];
-            end = first_at(s, k, select(min(tb, limit), limit, iv_piece[s] + 1u >= m));
+            end = first_at(s, k, select(min(tb, limit), limit, piece + 1u >= m));
         }
         budget -= 1;
         var c: vec4<f32>;
         var dc = vec4<f32>(0.0);
         var most = 1u;
         if (exact) {
-            var shape = load_shape(iv_prism[s]);
+            var shape = load_shape(index);
             c = prism_inverse(ray * t, &shape);
             budget -= EXACT_COST;
         } else {
@@ -184,12 +192,12 @@ fn run(s: u32, limit: f32) {
             most = end - k;
         }
         var step = 1u;
-        let jump = select(0u, empty_run(s, c, dc, most), skip_empty && c.w >= 0.0);
+        let jump = select(0u, empty_run(prism, object, c, dc, most), skip_empty && c.w >= 0.0);
         if (jump > 0u) {
             skipped += jump;
             step = jump;
         } else {
-            composite(s, t, c);
+            composite(index, prism, object, h, t, c);
         }
         k += step;
         t = select(FAR, t0 + (f32(k) + 0.5) * h, k < n);

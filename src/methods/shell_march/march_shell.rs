@@ -6,7 +6,10 @@
 //! which (b, w) is interpolated, each checked against the exact map at two interior points
 //! (exact where that misses the tolerance, or where the prism's map folds); then every sample
 //! of every interval composited in depth order until the transmittance falls below the cutoff.
-//! Empty-space skipping changes no pixel, so the twin samples everything.
+//! Empty-space skipping changes no pixel, so the twin samples everything. The kernel finds the
+//! exact map at a piece's check points by a few Newton steps from the line's own value
+//! (`prism_near`, falling back to mapping the piece exactly where they do not settle); the twin
+//! takes the f64 exact inverse there: the same map, to the kernel's rounding.
 
 use glam::{DVec2, DVec3};
 
