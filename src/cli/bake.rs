@@ -11,6 +11,8 @@ use voltex::{io, scene, Error, Result};
 
 #[derive(clap::Args)]
 pub struct BakeArgs {
+    /// A scene file (.ron), or an asset opened as `voltex import` writes it: a mesh (.glb,
+    /// .gltf, .obj) or an OpenVDB file (.vdb).
     scene: PathBuf,
     /// Texels to bake (default: every texel of the scene).
     #[arg(long = "texel")]

@@ -13,6 +13,8 @@ use voltex::{scene, Error, Result};
 
 #[derive(clap::Args)]
 pub struct ExportArgs {
+    /// A scene file (.ron), or an asset opened as `voltex import` writes it: a mesh (.glb,
+    /// .gltf, .obj) or an OpenVDB file (.vdb).
     scene: PathBuf,
     /// Output folder (made if missing): one NAME.vdb per texel (per textured object with
     /// --world) and per node drawing a hypertexture or a volume.

@@ -57,7 +57,7 @@ pub enum Command {
     /// framed by a camera, editable.
     Import(import::ImportArgs),
     /// Open a window showing the scene, redrawn whenever the scene, its files, a graph or a kernel
-    /// changes (keys and mouse: see the overlay and the README).
+    /// changes (keys and mouse: see the overlay and docs/src/preview.md).
     Preview(preview::PreviewArgs),
     /// Render every scene under a folder and compare it with its reference image (<stem>.ref.exr).
     Regress(voltex::regress::Args),

@@ -10,6 +10,8 @@ use super::parse_size;
 /// `voltex pareto`'s arguments (see `voltex::pareto::Args`).
 #[derive(clap::Args)]
 pub struct ParetoCmd {
+    /// A scene file (.ron), or an asset opened as `voltex import` writes it: a mesh (.glb,
+    /// .gltf, .obj) or an OpenVDB file (.vdb).
     scene: PathBuf,
     #[arg(long, value_parser = parse_size, default_value = "256x256")]
     size: (u32, u32),

@@ -9,6 +9,8 @@ use super::Overrides;
 
 #[derive(clap::Args)]
 pub struct PlanArgs {
+    /// A scene file (.ron), or an asset opened as `voltex import` writes it: a mesh (.glb,
+    /// .gltf, .obj) or an OpenVDB file (.vdb).
     scene: PathBuf,
     #[command(flatten)]
     overrides: Overrides,
@@ -16,6 +18,10 @@ pub struct PlanArgs {
     /// adapter is assumed to offer.
     #[arg(long)]
     adapter: bool,
+    /// List every pruned pass (by default the passes of methods and object kinds the scene does
+    /// not use are only counted).
+    #[arg(short, long)]
+    verbose: bool,
 }
 
 pub fn run(args: PlanArgs) -> Result<()> {
@@ -31,6 +37,6 @@ pub fn run(args: PlanArgs) -> Result<()> {
             "the limit `voltex plan` assumes; --adapter checks this machine's",
         )?;
     }
-    print!("{}", bp.describe());
+    print!("{}", bp.describe(args.verbose));
     Ok(())
 }

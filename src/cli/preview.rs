@@ -11,6 +11,8 @@ use super::Overrides;
 
 #[derive(clap::Args)]
 pub struct PreviewArgs {
+    /// A scene file (.ron), or an asset opened as `voltex import` writes it: a mesh (.glb,
+    /// .gltf, .obj) or an OpenVDB file (.vdb).
     scene: PathBuf,
     #[command(flatten)]
     overrides: Overrides,

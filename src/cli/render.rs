@@ -12,6 +12,8 @@ use super::Overrides;
 
 #[derive(clap::Args)]
 pub struct RenderArgs {
+    /// A scene file (.ron), or an asset opened as `voltex import` writes it: a mesh (.glb,
+    /// .gltf, .obj) or an OpenVDB file (.vdb).
     scene: PathBuf,
     /// Output EXR (default: out/<scene name>.exr); the PNG goes beside it. `x.png` writes x.exr
     /// and x.png; a folder (existing, or ending in /) gets <scene name>.exr; missing folders are

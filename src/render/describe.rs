@@ -49,7 +49,7 @@ impl Blueprint {
     }
 
     /// The text of `voltex plan`.
-    pub fn describe(&self) -> String {
+    pub fn describe(&self, verbose: bool) -> String {
         let mut s = format!(
             "scene {}\noutput {}x{}\n\nbakes:\n",
             self.scene_path.display(),
@@ -101,8 +101,25 @@ impl Blueprint {
         );
         if !self.plan.pruned.is_empty() {
             s += "\npruned:\n";
-            for p in &self.plan.pruned {
-                s += &format!("  {p}\n");
+            if verbose {
+                for p in &self.plan.pruned {
+                    s += &format!("  {p}\n");
+                }
+            } else {
+                // A pass or resource per line is dozens of lines for a one-object scene: counted
+                // by reason unless `verbose`.
+                let mut reasons: Vec<(String, usize)> = Vec::new();
+                for p in &self.plan.pruned {
+                    let reason = pruned_reason(p);
+                    match reasons.iter_mut().find(|r| r.0 == reason) {
+                        Some(r) => r.1 += 1,
+                        None => reasons.push((reason, 1)),
+                    }
+                }
+                for (reason, n) in reasons {
+                    s += &format!("  {n} {reason}\n");
+                }
+                s += "  (--verbose lists them)\n";
             }
         }
         s += "\nGPU memory:\n";
@@ -166,4 +183,18 @@ impl Blueprint {
             .collect::<Vec<_>>()
             .join(" ")
     }
+}
+
+/// What a line of `Plan::pruned` says, without the name: `passes: no object matches ...` for a
+/// method's passes (whatever the method), else its kind and reason.
+fn pruned_reason(line: &str) -> String {
+    let (kind, reason) = match line.split_once(' ') {
+        Some((kind, rest)) => (kind, rest.split_once(": ").map_or(rest, |r| r.1)),
+        None => ("", line),
+    };
+    if reason.starts_with("no object matches") {
+        return "pass(es) of methods and object kinds this scene does not use".into();
+    }
+    let kinds = if kind == "pass" { "pass(es)".to_string() } else { format!("{kind}(s)") };
+    format!("{kinds}: {reason}")
 }

@@ -9,6 +9,7 @@ mod cli_errors;
 mod export;
 mod farm;
 mod faults;
+mod first_hour;
 mod hostile_files;
 mod install;
 mod maxima;

@@ -260,7 +260,7 @@ fn mesh_hypertexture_matches_twin() {
     let scene = mesh_scene(&dir, object, NOISE, "RayMarch(step: 0.02)");
     let bp = Blueprint::new(&scene, &sized(8, 8)).unwrap();
     // `voltex plan` lists the bake.
-    let text = bp.describe();
+    let text = bp.describe(true);
     assert!(
         text.contains("32x32x32  bake_mesh_grid.wgsl  mesh grid of 960 triangles in 1 part(s)"),
         "{text}"

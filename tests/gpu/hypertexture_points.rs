@@ -222,7 +222,7 @@ fn points_hypertexture_matches_twin() {
     let object = "Points(path: \"blob.ply\", radius: 0.25, saturation: 3.0, resolution: 32)";
     let scene = scene_at(&dir, object, "RayMarch(step: 0.02)");
     let bp = Blueprint::new(&scene, &sized(8, 8)).unwrap();
-    let text = bp.describe();
+    let text = bp.describe(true);
     assert!(
         text.contains("32x32x32  bake_point_grid.wgsl  point grid of 400 kernels of radius 0.25"),
         "{text}"
