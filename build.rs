@@ -1,5 +1,6 @@
-//! Embeds every file under `wgsl/` and `graphs/` in the library (`gpu::sources`), so an installed
-//! or copied binary renders without the source tree: `$OUT_DIR/embedded.rs` is a table of
+//! Embeds every file under `wgsl/` and `graphs/`, and the presets' scene files
+//! (`scenes/presets/*.ron`, for `voltex import --preset`), in the library (`gpu::sources`), so an
+//! installed or copied binary renders without the source tree: `$OUT_DIR/embedded.rs` is a table of
 //! `("wgsl/shared/types.wgsl", include_str!("/abs/.../wgsl/shared/types.wgsl"))` sorted by path.
 //! Hidden files and editor backups (`.x.swp`, `x~`) are left out. Cargo reruns this script when
 //! anything under either folder changes (a directory given to `rerun-if-changed` is scanned).
@@ -11,16 +12,20 @@
 
 use std::path::{Path, PathBuf};
 
-const FOLDERS: &[&str] = &["wgsl", "graphs"];
+/// Folders embedded, with the extension their files must have (any where `None`).
+const FOLDERS: &[(&str, Option<&str>)] = &[("wgsl", None), ("graphs", None), ("scenes/presets", Some("ron"))];
 
 fn main() {
     let manifest = PathBuf::from(std::env::var_os("CARGO_MANIFEST_DIR").expect("CARGO_MANIFEST_DIR"));
     println!("cargo:rerun-if-changed=build.rs");
     let mut files = Vec::new();
-    for folder in FOLDERS {
+    for (folder, ext) in FOLDERS {
         let dir = manifest.join(folder);
         println!("cargo:rerun-if-changed={}", dir.display());
-        collect(&dir, folder, &mut files);
+        let mut found = Vec::new();
+        collect(&dir, folder, &mut found);
+        files
+            .extend(found.into_iter().filter(|(rel, _)| ext.is_none_or(|e| rel.ends_with(&format!(".{e}")))));
     }
     files.sort();
     let mut out = String::from("&[\n");

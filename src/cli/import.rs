@@ -15,6 +15,10 @@ pub struct ImportArgs {
     /// The scene file to write (default: FILE with the extension `.ron`).
     #[arg(short, long, visible_alias = "output")]
     pub out: Option<PathBuf>,
+    /// The look a mesh gets, from the presets built in (scenes/presets/NAME.ron shows each on a
+    /// sphere): grain (the default), moss, grass, fur, pears, cobbles, cloud.
+    #[arg(long, value_name = "NAME")]
+    pub preset: Option<String>,
 }
 
 pub fn run(args: ImportArgs) -> Result<()> {
@@ -26,7 +30,7 @@ pub fn run(args: ImportArgs) -> Result<()> {
     }
     let out = args.out.unwrap_or_else(|| args.file.with_extension("ron"));
     let mesh = import::mesh_path(&args.file, &out);
-    let text = import::scene_text(&args.file, &mesh.to_string_lossy())?;
+    let text = import::scene_text(&args.file, &mesh.to_string_lossy(), args.preset.as_deref())?;
     // What `render` would read back must parse: check before writing.
     voltex::scene::parse(&text, &out)?;
     voltex::io::atomic::write_bytes(&out, text.as_bytes())?;

@@ -72,7 +72,7 @@ impl TruthSource {
 }
 
 /// Most samples per pixel side of `--supersample` and `--supersample-methods`.
-pub const MAX_SUPERSAMPLE: u32 = 8;
+pub(crate) const MAX_SUPERSAMPLE: u32 = 8;
 
 /// The command's arguments.
 #[derive(Debug, Clone)]

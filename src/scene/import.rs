@@ -19,12 +19,83 @@ fn is_volume(path: &Path) -> bool {
     path.extension().is_some_and(|e| e.eq_ignore_ascii_case("vdb"))
 }
 
+/// The preset a mesh gets without `--preset`.
+pub(crate) const DEFAULT_PRESET: &str = "grain";
+
+/// The presets `voltex import --preset` puts on a mesh: the scene files under `scenes/presets/`
+/// (built into the binary), by name, sorted.
+pub(crate) fn presets() -> Vec<&'static str> {
+    let names = crate::gpu::sources::embedded_files().iter();
+    names.filter_map(|(p, _)| p.strip_prefix("scenes/presets/")?.strip_suffix(".ron")).collect()
+}
+
+/// A preset's look, from its scene file: the text of its `texels` entries and its node's
+/// texel, height, uv tiles, base colour and method, for a sphere of radius 1.
+struct Look {
+    name: String,
+    /// What it is: the first comment line's text after the name.
+    what: String,
+    /// The lines inside the file's `texels: { ... }`.
+    texels: String,
+    texel: String,
+    height: f64,
+    /// The edge of a uv tile (the sphere's area over its tile count, square rooted).
+    tile: f64,
+    base_color: String,
+    method: String,
+}
+
+/// The preset `name` (see [`presets`]), or an error listing them.
+fn look(name: &str) -> Result<Look> {
+    let rel = format!("scenes/presets/{name}.ron");
+    let Some(text) = crate::gpu::sources::embedded(&rel) else {
+        return Err(Error::Invalid(format!("no preset `{name}`: expected one of {}", presets().join(", "))));
+    };
+    let path = PathBuf::from(crate::gpu::sources::EMBEDDED_PREFIX).join(&rel);
+    let scene = crate::scene::parse(text, &path)?;
+    let node = scene.nodes.first().ok_or_else(|| Error::file(&path, "a preset has a node"))?;
+    // The node's fields as written (comments and formatting kept), by their line.
+    let field = |key: &str| -> Result<String> {
+        let at = text.lines().find_map(|l| l.trim().strip_prefix(&format!("{key}: "))?.strip_suffix(','));
+        at.map(str::to_string)
+            .ok_or_else(|| Error::file(&path, format!("a preset's node writes `{key}` on a line")))
+    };
+    let start = text
+        .find("\n    texels: {\n")
+        .ok_or_else(|| Error::file(&path, "expected `texels: {` at the top"))?;
+    let body = &text[start + "\n    texels: {\n".len()..];
+    let end = body.find("\n    },\n").ok_or_else(|| Error::file(&path, "expected `}` closing `texels`"))?;
+    let (u, v) = (node.uv_tiling[0].max(1e-6), node.uv_tiling[1].max(1e-6));
+    Ok(Look {
+        name: name.to_string(),
+        what: text
+            .lines()
+            .next()
+            .and_then(|l| l.split_once("): "))
+            .map_or(String::new(), |w| w.1.to_string()),
+        texels: body[..end].to_string(),
+        texel: node.texel.as_ref().map(|t| t.to_string()).unwrap_or_default(),
+        height: node.height.length,
+        tile: (4.0 * std::f64::consts::PI / (u * v)).sqrt(),
+        base_color: field("base_color")?,
+        method: field("method")?,
+    })
+}
+
 /// Scene text around the asset `asset`, which the scene names as `mesh_path` (relative to the
-/// scene file's folder: see [`mesh_path`]).
-pub fn scene_text(asset: &Path, mesh_path: &str) -> Result<String> {
+/// scene file's folder: see [`mesh_path`]); a mesh gets the look of `preset` (default
+/// [`DEFAULT_PRESET`]).
+pub fn scene_text(asset: &Path, mesh_path: &str, preset: Option<&str>) -> Result<String> {
     if is_volume(asset) {
-        return volume_scene_text(asset, mesh_path);
+        return match preset {
+            Some(p) => Err(Error::Invalid(format!(
+                "{}: --preset {p} puts a look on a mesh; an OpenVDB file is drawn as a volume",
+                asset.display()
+            ))),
+            None => volume_scene_text(asset, mesh_path),
+        };
     }
+    let look = look(preset.unwrap_or(DEFAULT_PRESET))?;
     let mesh = crate::mesh::load(asset)?;
     let gltf = !asset.extension().is_some_and(|e| e.eq_ignore_ascii_case("obj"));
     if mesh.uvs_missing {
@@ -42,15 +113,29 @@ pub fn scene_text(asset: &Path, mesh_path: &str) -> Result<String> {
     });
     let centre = 0.5 * (lo + hi);
     let radius = (0.5 * (hi - lo).length()).max(1e-6);
-    let height = 0.04 * 2.0 * radius;
-    // Uv tiles about four heights wide, over the surface's extent.
+    // The preset's height and tile size, shown on a sphere of radius 1, scaled to the mesh's
+    // bounding radius; the tiles over the surface's extent. The height is halved until the
+    // mesh's prisms are valid: a mesh more curved than the sphere may not take it.
+    let mut height = look.height * radius;
+    let mut halved = 0;
+    while halved < 8 && !crate::mesh::prism::check(&mesh.to_base(height, None, glam::DVec2::ONE)).is_ok() {
+        height *= 0.5;
+        halved += 1;
+    }
+    let height_note = match halved {
+        0 => String::new(),
+        n => format!(
+            "            // The preset's height ({} x the mesh's radius) twists prisms at this mesh's curvature: halved {n} time(s).\n",
+            num(look.height)
+        ),
+    };
     let area: f64 = (0..mesh.triangles.len())
         .map(|t| {
             let [a, b, c] = mesh.triangles[t].map(|i| mesh.positions[i as usize]);
             0.5 * (b - a).cross(c - a).length()
         })
         .sum();
-    let tiles = (area.sqrt() / (4.0 * height)).round().clamp(1.0, 64.0);
+    let tiles = (area.sqrt() / (look.tile * radius)).round().clamp(1.0, 64.0);
     let fov: f64 = 40.0;
     let distance = 1.15 * radius / (0.5 * fov.to_radians()).sin();
     let eye = centre + DVec3::new(0.55, -1.0, 0.6).normalize() * distance;
@@ -58,7 +143,8 @@ pub fn scene_text(asset: &Path, mesh_path: &str) -> Result<String> {
     let v = |p: DVec3| format!("({}, {}, {})", num(p.x), num(p.y), num(p.z));
     Ok(format!(
         r#"// Written by `voltex import` around {file} ({triangles} triangles after welding).
-// Edit freely: the mesh is a base surface under the texel "grain", drawn with ViewSlices.
+// Edit freely: the mesh is a base surface under the texel "{texel}" of the preset "{preset}"
+// ({what}), drawn with the preset's method; scenes/presets/{preset}.ron shows it on a sphere.
 #![enable(implicit_some)]
 Scene(
     output: (width: 512, height: 512),
@@ -69,14 +155,7 @@ Scene(
     ambient: 0.25,
     lights: [Directional(direction: (-0.4, 0.55, -0.75), intensity: 1.0)],
     texels: {{
-        // The default texel: grains of sand, one per uv tile.
-        "grain": (
-            resolution: (32, 32, 32),
-            opacity_length: 0.05,
-            source: Implicit(shapes: [
-                Sphere(center: (0.5, 0.5, 0.35), radius: 0.3, color: (0.85, 0.7, 0.45), opacity: 1.0),
-            ]),
-        ),
+{texels}
     }},
     nodes: [
         (
@@ -84,10 +163,10 @@ Scene(
             // {up} is y-up; voltex scenes are z-up.
             transform: (rotate: (90.0, 0.0, 0.0)),
             surface: Obj(path: {mesh}),
-            height: (length: {height}),
+{height_note}            height: (length: {height}),
             uv_tiling: ({tiles:.0}, {tiles:.0}),
-            texel: "grain",
-            base_color: (0.35, 0.3, 0.28),
+            texel: "{texel}",
+            base_color: {base_color},
             method: {method},
         ),
     ],
@@ -102,7 +181,12 @@ Scene(
         height = num(height),
         mesh = ron_string(mesh_path),
         up = if gltf { "glTF" } else { "An OBJ export" },
-        method = crate::scene::Method::imported(false),
+        texels = look.texels,
+        texel = look.texel,
+        preset = look.name,
+        what = look.what.trim_end_matches('.'),
+        base_color = look.base_color,
+        method = look.method,
     ))
 }
 

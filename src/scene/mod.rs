@@ -128,7 +128,7 @@ impl Scene {
 pub fn load(path: &Path) -> Result<Scene> {
     if import::is_asset(path) {
         let name = path.file_name().and_then(|n| n.to_str()).unwrap_or_default();
-        return parse(&import::scene_text(path, name)?, path);
+        return parse(&import::scene_text(path, name, None)?, path);
     }
     let source = crate::input::read_text(path, "a scene file")?;
     parse(&source, path)

@@ -155,7 +155,7 @@ pub struct Camera {
 impl Camera {
     /// The camera turned by `degrees` about its up axis through its target: one step of an
     /// orbit (the preview's left drag; `pareto`'s and `bench`'s orbit times).
-    pub fn orbited(&self, degrees: f64) -> Camera {
+    pub(crate) fn orbited(&self, degrees: f64) -> Camera {
         let turn = DQuat::from_axis_angle(self.up.normalize(), degrees.to_radians());
         Camera { eye: self.target + turn * (self.eye - self.target), ..*self }
     }

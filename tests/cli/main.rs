@@ -15,6 +15,7 @@ mod install;
 mod maxima;
 mod method_plugin;
 mod pareto;
+mod presets;
 mod preview_input;
 mod preview_latency;
 mod preview_window;

@@ -29,7 +29,7 @@ pub struct ShellObject {
     /// Interpolation tolerance in voxels.
     pub tolerance: f64,
     /// Per prism: the band of w outside which its texel is transparent ([1, 0]: all of it).
-    pub bands: Vec<[f64; 2]>,
+    pub(crate) bands: Vec<[f64; 2]>,
 }
 
 /// Where the ray crosses a prism's boundary, and the map's value there: (b0, b1, b2, w).
