@@ -1,5 +1,6 @@
 //! Where WGSL kernels (and their `#include`s) and the default graphs are read from. Every file
-//! under `wgsl/` and `graphs/` is embedded in the binary (see `build.rs`), so an installed or copied
+//! under `wgsl/` and `graphs/` is embedded in the binary (see `build.rs`; so are the presets'
+//! scene files, `scenes/presets/*.ron`, which `voltex import --preset` reads from here), so an installed or copied
 //! binary needs no source tree; files on disk still win, so kernels and graphs stay editable (and
 //! hot-reloadable) in place. A shader `rel` (a path relative to the WGSL root, e.g.
 //! `shared/types.wgsl`) is looked up, first match wins:
@@ -208,11 +209,14 @@ mod tests {
     }
 
     #[test]
-    fn every_kernel_and_graph_is_embedded_byte_identically() {
+    fn every_kernel_graph_and_preset_is_embedded_byte_identically() {
         let root = Path::new(env!("CARGO_MANIFEST_DIR"));
         let mut files = Vec::new();
         walk(&root.join("wgsl"), "wgsl", &mut files);
         walk(&root.join("graphs"), "graphs", &mut files);
+        let mut presets = Vec::new();
+        walk(&root.join("scenes/presets"), "scenes/presets", &mut presets);
+        files.extend(presets.into_iter().filter(|(r, _)| r.ends_with(".ron")));
         files.sort();
         assert!(files.iter().any(|(r, _)| r == "wgsl/shared/types.wgsl"), "{files:?}");
         assert!(files.iter().any(|(r, _)| r == "graphs/frame.ron"), "{files:?}");

@@ -465,7 +465,7 @@ fn plan_prints_passes_pruning_and_memory_without_a_gpu() {
         "output 64x48",
         "passes (in order):",
         "pruned:",
-        "pass draw_base: no object matches BaseSurface",
+        "pass(es) of methods and object kinds this scene does not use",
         "GPU memory:",
         "total",
     ] {
