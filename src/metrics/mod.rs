@@ -119,6 +119,18 @@ pub fn diff_heatmap(map: &[f32], width: u32, height: u32) -> Vec<[u8; 4]> {
         .collect()
 }
 
+/// The colours of [`diff_heatmap`] at `n` evenly spaced values from 0 to 1 (n >= 2), as
+/// `#rrggbb`: a legend's colour scale.
+pub fn heatmap_scale(n: usize) -> Vec<String> {
+    let lut = nv_flip::magma_lut().to_vec();
+    (0..n.max(2))
+        .map(|i| {
+            let k = (i as f64 / (n.max(2) - 1) as f64 * 255.0).round() as usize * 3;
+            format!("#{:02x}{:02x}{:02x}", lut[k], lut[k + 1], lut[k + 2])
+        })
+        .collect()
+}
+
 /// Largest absolute difference over all pixels and R, G, B, A channels (NaN if any value is
 /// non-finite in a way that differs, e.g. NaN vs a number). Size mismatch is an error.
 pub fn max_abs_diff(actual: &Image, reference: &Image) -> Result<f64> {
@@ -152,6 +164,16 @@ mod tests {
         let e = relative_rmse(&a, &r).unwrap();
         let want = (0.01f64 / 1.01).sqrt();
         assert!((e - want).abs() < 1e-6, "{e} vs {want}");
+    }
+
+    #[test]
+    fn heatmap_scale_matches_the_map() {
+        let scale = heatmap_scale(5);
+        let map = diff_heatmap(&[0.0, 0.25, 0.5, 0.75, 1.0], 5, 1);
+        for (c, px) in scale.iter().zip(&map) {
+            assert_eq!(*c, format!("#{:02x}{:02x}{:02x}", px[0], px[1], px[2]));
+        }
+        assert_ne!(scale[0], scale[4]);
     }
 
     #[test]

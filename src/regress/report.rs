@@ -137,13 +137,32 @@ fn card(h: &mut String, i: usize, f: &Found) {
     h.push_str("<div class=\"images\">\n");
     for name in IMAGES.iter().filter(|n| r.images.iter().any(|i| i == *n)) {
         let link = href(&f.folder.join(name));
-        let caption = name.trim_end_matches(".png").replace("diff", "FLIP heat map");
+        let mut caption = name.trim_end_matches(".png").replace("diff", "FLIP heat map");
+        let mut legend = String::new();
+        if *name == "diff.png" {
+            if let Some(f) = r.flip {
+                caption += &format!(", mean {f:.5}");
+            }
+            legend = heat_legend();
+        }
         let _ = writeln!(
             h,
-            "<figure><a href=\"{link}\"><img src=\"{link}\" alt=\"{caption}\"></a><figcaption>{caption}</figcaption></figure>"
+            "<figure><a href=\"{link}\"><img src=\"{link}\" alt=\"{caption}\"></a><figcaption>{caption}</figcaption>{legend}</figure>"
         );
     }
     h.push_str("</div>\n</section>\n");
+}
+
+/// The heat map's colour scale: per-pixel FLIP from 0 to 1, as a gradient with ticks.
+fn heat_legend() -> String {
+    let stops = crate::metrics::heatmap_scale(9);
+    let gradient: Vec<String> =
+        stops.iter().enumerate().map(|(i, c)| format!("{c} {:.1}%", i as f64 * 100.0 / 8.0)).collect();
+    format!(
+        "<div class=\"scale\" style=\"background: linear-gradient(to right, {})\"></div>\
+         <div class=\"ticks\"><span>0</span><span>0.25</span><span>0.5</span><span>0.75</span><span>1</span></div>",
+        gradient.join(", ")
+    )
 }
 
 fn badge(r: &Record) -> String {
@@ -213,6 +232,8 @@ section { border-top: 1px solid #ccc; margin-top: 1.5em; }
 figure { margin: 0; }
 img { width: 256px; image-rendering: pixelated; border: 1px solid #888; }
 figcaption { text-align: center; }
+.scale { width: 256px; height: 10px; border: 1px solid #888; margin-top: 0.3em; }
+.ticks { width: 258px; display: flex; justify-content: space-between; font-size: 0.8em; }
 pre { white-space: pre-wrap; background: #eee; padding: 0.5em; }
 .badge { padding: 0.1em 0.5em; border-radius: 0.3em; font-size: 0.9em; }
 .ok { color: #060; } .badge.ok { background: #cfc; }

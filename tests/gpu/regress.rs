@@ -154,6 +154,12 @@ fn unchanged_scene_passes() {
     );
     let html = index(&out);
     assert!(html.contains("flat_box.ron") && html.contains("flat_box/diff.png"), "{html}");
+    // The heat map says its mean FLIP and shows its colour scale (issue 32, item 8).
+    let mean = format!("FLIP heat map, mean {:.5}", r.flip.unwrap());
+    assert!(
+        html.contains(&mean) && html.contains("class=\"scale\"") && html.contains("#000004 0.0%"),
+        "{html}"
+    );
     assert_eq!(std::fs::read(reference(&scene)).unwrap(), before, "a passing reference is never rewritten");
 }
 
