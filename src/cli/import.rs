@@ -19,6 +19,9 @@ pub struct ImportArgs {
     /// sphere): grain (the default), moss, grass, fur, pears, cobbles, cloud.
     #[arg(long, value_name = "NAME")]
     pub preset: Option<String>,
+    /// Print nothing but warnings and errors (not the written scene's path).
+    #[arg(short, long)]
+    pub quiet: bool,
 }
 
 pub fn run(args: ImportArgs) -> Result<()> {
@@ -34,6 +37,8 @@ pub fn run(args: ImportArgs) -> Result<()> {
     // What `render` would read back must parse: check before writing.
     voltex::scene::parse(&text, &out)?;
     voltex::io::atomic::write_bytes(&out, text.as_bytes())?;
-    println!("{}", out.display());
+    if !args.quiet {
+        println!("{}", out.display());
+    }
     Ok(())
 }

@@ -30,12 +30,31 @@ pub struct RenderArgs {
     /// ui.perfetto.dev or chrome://tracing).
     #[arg(long)]
     trace: Option<PathBuf>,
+    /// Print nothing but warnings and errors (no written paths, no pass times).
+    #[arg(short, long)]
+    quiet: bool,
+    /// Also print how long planning, building (bakes, pipelines), rendering and writing took.
+    #[arg(short, long, conflicts_with = "quiet")]
+    verbose: bool,
     #[command(flatten)]
     overrides: Overrides,
 }
 
+/// What `render` prints on stdout (`--quiet`, `--verbose`).
+#[derive(Clone, Copy, PartialEq)]
+enum Talk {
+    Quiet,
+    Normal,
+    Verbose,
+}
+
 pub fn run(args: RenderArgs) -> Result<()> {
-    let RenderArgs { scene, output, frames, fps, trace, overrides } = args;
+    let RenderArgs { scene, output, frames, fps, trace, quiet, verbose, overrides } = args;
+    let talk = match (quiet, verbose) {
+        (true, _) => Talk::Quiet,
+        (_, true) => Talk::Verbose,
+        _ => Talk::Normal,
+    };
     if let Some(t) = &trace {
         io::atomic::check_writable_dir(
             t.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new(".")),
@@ -43,8 +62,8 @@ pub fn run(args: RenderArgs) -> Result<()> {
     }
     let mut track = Track { name: format!("render {}", scene.display()), frames: Vec::new() };
     let ctx = match frames {
-        None => render(&scene, output, &overrides, &mut track),
-        Some(frames) => render_frames(&scene, output, frames, fps, &overrides, &mut track),
+        None => render(&scene, output, &overrides, talk, &mut track),
+        Some(frames) => render_frames(&scene, output, frames, fps, &overrides, talk, &mut track),
     }?;
     if let Some(path) = &trace {
         if track.frames.iter().all(|f| f.is_empty()) {
@@ -54,7 +73,9 @@ pub fn run(args: RenderArgs) -> Result<()> {
             );
         }
         voltex::render::trace::write(path, &[track], &ctx.adapter_line())?;
-        println!("trace: {}", path.display());
+        if talk != Talk::Quiet {
+            println!("trace: {}", path.display());
+        }
     }
     Ok(())
 }
@@ -63,13 +84,14 @@ fn render(
     scene_path: &Path,
     output: Option<PathBuf>,
     overrides: &Overrides,
+    talk: Talk,
     track: &mut Track,
 ) -> Result<GpuContext> {
     let opts = overrides.options()?;
     let scene = scene::load(scene_path)?;
     let exr_path = output_path(scene_path, output)?;
     let ctx = GpuContext::new()?;
-    render_one(&ctx, &scene, &opts, &exr_path, &mut GpuCache::default(), None, track)?;
+    render_one(&ctx, &scene, &opts, &exr_path, &mut GpuCache::default(), None, talk, track)?;
     Ok(ctx)
 }
 
@@ -81,6 +103,7 @@ fn render_frames(
     (first, last): (u32, u32),
     fps: f64,
     overrides: &Overrides,
+    talk: Talk,
     track: &mut Track,
 ) -> Result<GpuContext> {
     if !(fps.is_finite() && fps > 0.0) {
@@ -105,7 +128,7 @@ fn render_frames(
         let frame_opts = RenderOptions { time: Some(n as f64 / fps), ..opts.clone() };
         let exr = path.with_file_name(format!("{stem}_{n:04}.exr"));
         cache.begin();
-        render_one(&ctx, &scene, &frame_opts, &exr, &mut cache, Some((n, fps, n == first)), track)?;
+        render_one(&ctx, &scene, &frame_opts, &exr, &mut cache, Some((n, fps, n == first)), talk, track)?;
         if animated {
             cache.retain_used();
         }
@@ -147,6 +170,7 @@ fn output_path(scene_path: &Path, output: Option<PathBuf>) -> Result<PathBuf> {
 
 /// Renders one frame to `exr_path` (and its PNG); `frame`: a sequence's frame number, rate and
 /// whether it is the first (whose warnings are printed).
+#[allow(clippy::too_many_arguments)]
 fn render_one(
     ctx: &GpuContext,
     scene: &scene::Scene,
@@ -154,11 +178,15 @@ fn render_one(
     exr_path: &Path,
     cache: &mut GpuCache,
     frame: Option<(u32, f64, bool)>,
+    talk: Talk,
     track: &mut Track,
 ) -> Result<()> {
     let warn = frame.is_none_or(|f| f.2);
     let png_path = exr_path.with_extension("png");
+    let since = |t: std::time::Instant| t.elapsed().as_secs_f64() * 1e3;
+    let started = std::time::Instant::now();
     let bp = Blueprint::new(scene, opts)?;
+    let planned = since(started);
     for w in scene.warnings.iter().filter(|_| warn) {
         eprintln!("warning: {w}");
     }
@@ -168,9 +196,14 @@ fn render_one(
         }
     }
     // Nothing is evicted: a sequence's frames come back, and a scene's bakes are bounded.
+    let t = std::time::Instant::now();
     let mut renderer = Renderer::with_cache(ctx, bp, cache)?;
+    let built = since(t);
     let sequence = frame;
+    let t = std::time::Instant::now();
     let frame = renderer.render(ctx)?;
+    let rendered = since(t);
+    let t = std::time::Instant::now();
     track.frames.push(frame.spans.clone());
     let mut metadata = renderer.metadata(ctx, &frame);
     if let Some((n, fps, _)) = sequence {
@@ -185,6 +218,10 @@ fn render_one(
     };
     io::exr::write_with(exr_path, &frame.image, &meta, &extras)?;
     io::png::write_tonemapped(&png_path, &frame.image)?;
+    let written = since(t);
+    if talk == Talk::Quiet {
+        return Ok(());
+    }
     let gpu = frame.gpu_ms().map(|t| format!("{t:.2} ms GPU")).unwrap_or_else(|| "no GPU timestamps".into());
     println!(
         "{} and {} ({}x{}, {gpu}, {})",
@@ -201,6 +238,12 @@ fn render_one(
     }
     for (pass, ms) in &frame.pass_times {
         println!("  {pass:<20} {ms:>9.3} ms");
+    }
+    if talk == Talk::Verbose {
+        println!(
+            "  wall: planned {planned:.1} ms, built {built:.1} ms (bakes, pipelines, inputs), rendered {rendered:.1} ms \
+             (read back included), written {written:.1} ms"
+        );
     }
     Ok(())
 }

@@ -40,3 +40,25 @@ fn plan_counts_what_it_pruned_and_verbose_lists_it() {
     let counted: usize = short.iter().filter_map(|l| l.trim().split(' ').next()?.parse::<usize>().ok()).sum();
     assert_eq!(counted, long.len(), "the counts add up to the lines --verbose lists");
 }
+
+/// `render -q` prints nothing on stdout and still writes its images; `-v` adds the wall times of
+/// its stages; `import -q` does not print the written path (issue 32, item 7: `-q` was on bake,
+/// export and regress only).
+#[test]
+fn render_and_import_take_quiet_and_render_verbose() {
+    let dir = crate::common::scratch_dir("voltex-quiet");
+    let scene = root().join("scenes/view_slices/flat_box.ron").display().to_string();
+    let out = dir.join("q.exr");
+    let quiet = voltex(&["render", &scene, "--size", "16x16", "-o", crate::common::s(&out), "-q"]);
+    assert!(quiet.status.success() && quiet.stdout.is_empty(), "{}", String::from_utf8_lossy(&quiet.stdout));
+    assert!(out.exists() && out.with_extension("png").exists());
+    let loud = ok(voltex(&["render", &scene, "--size", "16x16", "-o", crate::common::s(&out), "--verbose"]));
+    assert!(loud.contains("wall: planned") && loud.contains("written"), "{loud}");
+    let both = voltex(&["render", &scene, "-q", "-v"]);
+    assert!(!both.status.success(), "--quiet and --verbose conflict");
+    let mesh = root().join("scenes/view_slices/meshes/dome.glb");
+    let imported = dir.join("dome.ron");
+    let run = voltex(&["import", crate::common::s(&mesh), "-o", crate::common::s(&imported), "-q"]);
+    assert!(run.status.success() && run.stdout.is_empty() && imported.exists());
+    std::fs::remove_dir_all(&dir).unwrap();
+}
