@@ -129,8 +129,15 @@ pub trait MethodPlan: Any + Send {
         Ok(())
     }
 
-    /// GPU work done once per renderer (bakes the plan owns), kept in `cache` across reloads.
-    fn prepare(&self, _ctx: &GpuContext, _cache: &mut GpuCache) -> Result<Option<Box<dyn Any + Send>>> {
+    /// GPU work done once per renderer (bakes the plan owns, what it derives from the frame's
+    /// texel bakes `baked`, whose cache keys are `bake_keys`), kept in `cache` across reloads.
+    fn prepare(
+        &self,
+        _ctx: &GpuContext,
+        _cache: &mut GpuCache,
+        _baked: &[crate::bake::Baked],
+        _bake_keys: &[u64],
+    ) -> Result<Option<Box<dyn Any + Send>>> {
         Ok(None)
     }
 

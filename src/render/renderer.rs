@@ -68,10 +68,10 @@ impl Renderer {
         let sources = Sources::project()?;
         let baker_key = cache::key(&sources.describe());
         let mut baker = cache.take::<Baker>(baker_key).unwrap_or_else(|| Baker::new(&sources));
-        let baked: Vec<bake::Baked> = blueprint
-            .bakes
-            .iter()
-            .map(|b| cache.bake(bake_key(&sources, &b.request)?, || baker.bake(ctx, &b.request)))
+        let bake_keys: Vec<u64> =
+            blueprint.bakes.iter().map(|b| bake_key(&sources, &b.request)).collect::<Result<_>>()?;
+        let baked: Vec<bake::Baked> = (blueprint.bakes.iter().zip(&bake_keys))
+            .map(|(b, &key)| cache.bake(key, || baker.bake(ctx, &b.request)))
             .collect::<Result<_>>()?;
         cache.put(baker_key, baker);
         let sampler = ctx.device.create_sampler(&wgpu::SamplerDescriptor {
@@ -86,7 +86,9 @@ impl Renderer {
             ..Default::default()
         });
         // What plans bake for themselves (mesh grids, splat sets), per instance's plan.
-        let prepare = |plan: &dyn crate::methods::MethodPlan, cache: &mut GpuCache| plan.prepare(ctx, cache);
+        let prepare = |plan: &dyn crate::methods::MethodPlan, cache: &mut GpuCache| {
+            plan.prepare(ctx, cache, &baked, &bake_keys)
+        };
         let mut prepared = Vec::with_capacity(blueprint.instances.len());
         for i in &blueprint.instances {
             prepared.push(prepare(blueprint.plan_of(i), cache)?);

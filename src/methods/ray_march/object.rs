@@ -58,7 +58,13 @@ impl MethodPlan for RayMarchPlan {
 
     /// Mesh grids, splat sets and light volumes, baked once per mesh, grid, lattice, and light
     /// and density while the cache holds them.
-    fn prepare(&self, ctx: &GpuContext, cache: &mut GpuCache) -> Result<Option<Box<dyn Any + Send>>> {
+    fn prepare(
+        &self,
+        ctx: &GpuContext,
+        cache: &mut GpuCache,
+        _baked: &[crate::bake::Baked],
+        _bake_keys: &[u64],
+    ) -> Result<Option<Box<dyn Any + Send>>> {
         let grid = match self.mesh_grid_key() {
             Some(key) => Some(cache.bake(key, || Ok(self.bake_mesh_grid(ctx)?.expect("a mesh object")))?),
             None => None,

@@ -1,18 +1,22 @@
 //! ShellMarch objects of a frame as the renderer sees them: each object's knobs
 //! ([`ShellPlan`]), and the one graph instance that marches them all ([`ShellSet`]).
 
+use std::any::Any;
+use std::sync::Arc;
+
 use glam::{DVec2, DVec3};
 
 use super::knobs::ShellMarch;
 use super::march_shell::{folds, ShellObject};
 use super::tiles::{self, TileLists};
-use crate::bake::occupancy;
+use crate::bake::{occupancy, Baked};
 use crate::cpu::prism_map::PrismCorners;
 use crate::error::{Error, Result};
 use crate::gpu::bindings::shell_march as B;
 use crate::gpu::budget::{Allocation, AllocationKind, Driver};
 use crate::gpu::buffers::{storage, uniform};
-use crate::gpu::Inputs;
+use crate::gpu::cache::GpuCache;
+use crate::gpu::{GpuContext, Inputs};
 use crate::methods::reference::trace_reference::TraceView;
 use crate::methods::reference::{build, default_step, twin_inputs, Member, ReferenceSet};
 use crate::methods::view::View;
@@ -184,14 +188,15 @@ impl ShellSet {
             b.insert(name.into(), empty(name, words * 4, true));
         }
         set.copy_volumes(ctx, inputs, cx.baked);
-        let atlas = ctx.read_buffer(&inputs.buffers[B::TEXEL_ATLAS], 0, set.atlas_words * 4)?;
         let b = &mut inputs.buffers;
+        // Made in `prepare`, once per bake (a camera move plans again, reads nothing back).
+        let occupancy = cx.prepared.and_then(|p| p.downcast_ref::<Vec<Arc<Occupancy>>>());
+        let occupancy = occupancy.ok_or_else(|| Error::Invalid("ShellMarch: no occupancy prepared".into()))?;
         let mut pyramids = Vec::with_capacity(self.occupancy_words as usize);
         let mut columns = Vec::with_capacity(set.table.len());
-        for entry in &set.table {
-            let (pyramid, cols) = occupancy_of(&atlas, entry);
-            pyramids.extend(pyramid);
-            columns.push(cols);
+        for o in occupancy {
+            pyramids.extend_from_slice(&o.0);
+            columns.push(&o.1);
         }
         pyramids.resize(self.occupancy_words as usize, 0);
         b.insert(B::SHELL_OCCUPANCY.into(), storage(ctx, "shell_occupancy", bytemuck::cast_slice(&pyramids)));
@@ -201,7 +206,7 @@ impl ShellSet {
             .iter()
             .map(|p| {
                 let o = p.vertices[3] as usize;
-                let band = prism_band(&columns[o], &set.table[o], [uv(p.uv01, 0), uv(p.uv01, 2), uv(p.uv2, 0)]);
+                let band = prism_band(columns[o], &set.table[o], [uv(p.uv01, 0), uv(p.uv01, 2), uv(p.uv2, 0)]);
                 band.map(|w| w as f32)
             })
             .collect();
@@ -244,11 +249,17 @@ pub fn frame_twin_inputs(
     (view, objects)
 }
 
-/// An object's occupancy pyramid from the texel atlas the kernel reads, and the w extents of
-/// its level-0 columns.
-fn occupancy_of(atlas: &[u8], entry: &ReferenceObject) -> (Vec<u32>, Vec<Option<(u32, u32)>>) {
+/// An object's occupancy pyramid and the w extents of its level-0 columns.
+type Occupancy = (Vec<u32>, Vec<Option<(u32, u32)>>);
+
+/// An object's [`Occupancy`] from the texel atlas the kernel reads.
+fn occupancy_of(atlas: &[u8], entry: &ReferenceObject) -> Occupancy {
     let res = [entry.resolution[0], entry.resolution[1], entry.resolution[2]];
-    let pyramid = occupancy::pyramid(&occupancy::atlas_alpha(atlas, res, entry.atlas[0], entry.atlas[1]), res);
+    occupancy_from_alpha(&occupancy::atlas_alpha(atlas, res, entry.atlas[0], entry.atlas[1]), res)
+}
+
+fn occupancy_from_alpha(alpha: &[u8], res: [u32; 3]) -> Occupancy {
+    let pyramid = occupancy::pyramid(alpha, res);
     let columns = occupancy::columns(&pyramid, res);
     (pyramid, columns)
 }
@@ -327,6 +338,33 @@ impl MethodPlan for ShellSet {
 
     fn constants(&self) -> Vec<(String, f64)> {
         ShellSet::constants(self)
+    }
+
+    /// Per object, its [`Occupancy`] from its bake's volume (level 0 read back), kept in the
+    /// cache under the bake's key: made once per bake, not per frame.
+    fn prepare(
+        &self,
+        ctx: &GpuContext,
+        cache: &mut GpuCache,
+        baked: &[Baked],
+        bake_keys: &[u64],
+    ) -> Result<Option<Box<dyn Any + Send>>> {
+        let mut out: Vec<Arc<Occupancy>> = Vec::with_capacity(self.set.table.len());
+        for (entry, &(bake, _)) in self.set.table.iter().zip(&self.set.copies) {
+            let key = crate::gpu::cache::key(&("shell_march occupancy", bake_keys[bake]));
+            let made = match cache.take::<Arc<Occupancy>>(key) {
+                Some(o) => o,
+                None => {
+                    let res = [entry.resolution[0], entry.resolution[1], entry.resolution[2]];
+                    let rgba = crate::gpu::readback::read_texture(ctx, &baked[bake].volume, 4)?;
+                    let alpha: Vec<u8> = rgba.chunks_exact(4).map(|p| p[3]).collect();
+                    Arc::new(occupancy_from_alpha(&alpha, res))
+                }
+            };
+            cache.put(key, made.clone());
+            out.push(made);
+        }
+        Ok(Some(Box::new(out)))
     }
 
     fn check_limits(&self, _object: &ObjectPlan, limits: &wgpu::Limits) -> Result<()> {

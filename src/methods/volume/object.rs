@@ -47,7 +47,13 @@ impl MethodPlan for VolumePlan {
     }
 
     /// The brick table and atlases, uploaded once per grid while the cache holds them.
-    fn prepare(&self, ctx: &GpuContext, cache: &mut GpuCache) -> Result<Option<Box<dyn Any + Send>>> {
+    fn prepare(
+        &self,
+        ctx: &GpuContext,
+        cache: &mut GpuCache,
+        _baked: &[crate::bake::Baked],
+        _bake_keys: &[u64],
+    ) -> Result<Option<Box<dyn Any + Send>>> {
         let uploaded = cache.bake(self.upload_key(), || Ok(upload(ctx, &self.grid)))?;
         Ok(Some(Box::new(uploaded)))
     }

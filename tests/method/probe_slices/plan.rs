@@ -44,8 +44,14 @@ impl MethodPlan for ProbePlan {
     fn check_limits(&self, object: &ObjectPlan, limits: &wgpu::Limits) -> Result<()> {
         self.inner.check_limits(object, limits)
     }
-    fn prepare(&self, ctx: &GpuContext, cache: &mut GpuCache) -> Result<Option<Box<dyn std::any::Any + Send>>> {
-        self.inner.prepare(ctx, cache)
+    fn prepare(
+        &self,
+        ctx: &GpuContext,
+        cache: &mut GpuCache,
+        baked: &[crate::bake::Baked],
+        bake_keys: &[u64],
+    ) -> Result<Option<Box<dyn std::any::Any + Send>>> {
+        self.inner.prepare(ctx, cache, baked, bake_keys)
     }
     fn kernels(&self) -> Vec<&'static str> {
         self.inner.kernels()
