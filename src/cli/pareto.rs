@@ -70,6 +70,13 @@ pub struct ParetoCmd {
     /// Render every swept setting with N x N samples per pixel, averaged.
     #[arg(long, default_value_t = 1)]
     supersample_methods: u32,
+    /// Print no progress on stderr, only errors (the report still goes to stdout).
+    #[arg(short, long)]
+    quiet: bool,
+    /// Keep every setting's result line above the progress bar on a terminal (without one,
+    /// every line is printed anyway).
+    #[arg(short, long, conflicts_with = "quiet")]
+    verbose: bool,
 }
 
 fn parse_adaptive(s: &str) -> std::result::Result<(f64, f64), String> {
@@ -129,5 +136,6 @@ pub fn run(p: ParetoCmd) -> Result<()> {
         peers: p.peers,
         supersample: p.supersample,
         supersample_methods: p.supersample_methods,
+        verbosity: voltex::progress::Verbosity::from_flags(p.quiet, p.verbose),
     })
 }

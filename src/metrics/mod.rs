@@ -121,7 +121,7 @@ pub fn diff_heatmap(map: &[f32], width: u32, height: u32) -> Vec<[u8; 4]> {
 
 /// The colours of [`diff_heatmap`] at `n` evenly spaced values from 0 to 1 (n >= 2), as
 /// `#rrggbb`: a legend's colour scale.
-pub fn heatmap_scale(n: usize) -> Vec<String> {
+pub(crate) fn heatmap_scale(n: usize) -> Vec<String> {
     let lut = nv_flip::magma_lut().to_vec();
     (0..n.max(2))
         .map(|i| {

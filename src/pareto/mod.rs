@@ -96,6 +96,8 @@ pub struct Args {
     pub supersample: u32,
     /// Samples per pixel side of every swept setting (`--supersample-methods`).
     pub supersample_methods: u32,
+    /// What it says on stderr while it runs (`--quiet`, `--verbose`); the report goes to stdout.
+    pub verbosity: Verbosity,
 }
 
 /// One point of the sweep.
@@ -220,16 +222,19 @@ pub fn run(args: &Args) -> Result<()> {
     let n = settings.len();
     let load = report::load_average();
     let ctx = GpuContext::new()?;
-    eprintln!("truth: {}", args.truth_label());
+    if args.verbosity != Verbosity::Quiet {
+        eprintln!("truth: {}", args.truth_label());
+    }
     let truth = measure::image(&ctx, Blueprint::new(&scene, &args.truth_options())?)?;
     let mut rows = Vec::new();
-    let mut progress = Progress::new(n, Verbosity::Normal);
+    let mut progress = Progress::new(n, args.verbosity);
     for (s, bp) in settings.into_iter().zip(blueprints) {
         let label = format!("{} {}", s.method, s.knobs);
         progress.started(&label);
         match measure_setting(&scene, args, &s, bp, &truth) {
             Ok(row) => {
-                progress.finished(&label, &format!("{label}: {}", row.summary()), true, false);
+                let keep = args.verbosity == Verbosity::Verbose;
+                progress.finished(&label, &format!("{label}: {}", row.summary()), true, keep);
                 rows.push(row);
             }
             Err(e) => {
@@ -297,7 +302,7 @@ fn plan(scene: &Scene, args: &Args) -> Result<Planned> {
                 blueprints.push(bp);
             }
             Err(e) => {
-                if let Some(line) = note(&mut notes, &s, &e) {
+                if let Some(line) = note(&mut notes, &s, &e).filter(|_| args.verbosity != Verbosity::Quiet) {
                     eprintln!("{line}");
                 }
             }

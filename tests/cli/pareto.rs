@@ -70,3 +70,22 @@ fn shell_march_sweeps_its_step_and_its_tolerance() {
     let rmse = |k: &str| rows.iter().find(|r| r.0 == k).unwrap().1["rel_rmse"].clone();
     assert_ne!(rmse("step=1 tolerance=0.25"), rmse("step=1 tolerance=4"), "{csv}");
 }
+
+/// `pareto -q` says nothing on stderr (no truth line, no progress) and still reports on stdout.
+#[test]
+fn quiet_pareto_prints_only_its_report() {
+    let scene = root().join("scenes/view_slices/flat_box.ron").display().to_string();
+    let out = scratch_dir("voltex-pareto-quiet");
+    let args =
+        ["pareto", &scene, "--methods", "view-slices", "--planes", "8", "--size", "16x16", "--frames", "1"];
+    let run = voltex(&[&args[..], &["--out", s(&out), "-q"]].concat());
+    assert!(run.status.success() && run.stderr.is_empty(), "{}", String::from_utf8_lossy(&run.stderr));
+    assert!(String::from_utf8_lossy(&run.stdout).contains("ViewSlices front:"));
+    let loud = voltex(&[&args[..], &["--out", s(&out)]].concat());
+    assert!(
+        String::from_utf8_lossy(&loud.stderr).contains("[1/2"),
+        "{}",
+        String::from_utf8_lossy(&loud.stderr)
+    );
+    std::fs::remove_dir_all(&out).unwrap();
+}
