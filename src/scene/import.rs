@@ -144,7 +144,7 @@ pub fn scene_text(asset: &Path, mesh_path: &str, preset: Option<&str>) -> Result
     Ok(format!(
         r#"// Written by `voltex import` around {file} ({triangles} triangles after welding).
 // Edit freely: the mesh is a base surface under the texel "{texel}" of the preset "{preset}"
-// ({what}), drawn with the preset's method; scenes/presets/{preset}.ron shows it on a sphere.
+// ({what}); scenes/presets/{preset}.ron shows it on a sphere.
 #![enable(implicit_some)]
 Scene(
     output: (width: 512, height: 512),
@@ -186,7 +186,8 @@ Scene(
         preset = look.name,
         what = look.what.trim_end_matches('.'),
         base_color = look.base_color,
-        method = look.method,
+        // Without --preset, the method the registry's knobs name for imports (`MethodKnobs::imported`).
+        method = if preset.is_some() { look.method.as_str() } else { crate::scene::Method::imported(false) },
     ))
 }
 
