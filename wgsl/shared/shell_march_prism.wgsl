@@ -159,10 +159,6 @@ fn line_error(index: u32, shape: ptr<function, PrismShape>, ta: f32, tb: f32, ca
     return err;
 }
 
-fn sample_t(s: u32, k: u32) -> f32 {
-    return iv_t0[s] + (f32(k) + 0.5) * iv_h[s];
-}
-
 // Makes piece j the current piece of interval s: its ends mapped exactly (the interval's own
 // ends from its crossings), the line between them checked unless it is the whole interval.
 // `next`: piece j follows the current one, whose end (the same t, bit for bit) is its start.
