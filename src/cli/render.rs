@@ -4,6 +4,7 @@ use std::path::{Path, PathBuf};
 
 use voltex::gpu::cache::GpuCache;
 use voltex::gpu::GpuContext;
+use voltex::progress::Verbosity;
 use voltex::render::trace::Track;
 use voltex::render::{Blueprint, RenderOptions, Renderer};
 use voltex::{io, scene, Result};
@@ -40,21 +41,9 @@ pub struct RenderArgs {
     overrides: Overrides,
 }
 
-/// What `render` prints on stdout (`--quiet`, `--verbose`).
-#[derive(Clone, Copy, PartialEq)]
-enum Talk {
-    Quiet,
-    Normal,
-    Verbose,
-}
-
 pub fn run(args: RenderArgs) -> Result<()> {
     let RenderArgs { scene, output, frames, fps, trace, quiet, verbose, overrides } = args;
-    let talk = match (quiet, verbose) {
-        (true, _) => Talk::Quiet,
-        (_, true) => Talk::Verbose,
-        _ => Talk::Normal,
-    };
+    let talk = Verbosity::from_flags(quiet, verbose);
     if let Some(t) = &trace {
         io::atomic::check_writable_dir(
             t.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new(".")),
@@ -73,7 +62,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
             );
         }
         voltex::render::trace::write(path, &[track], &ctx.adapter_line())?;
-        if talk != Talk::Quiet {
+        if talk != Verbosity::Quiet {
             println!("trace: {}", path.display());
         }
     }
@@ -84,7 +73,7 @@ fn render(
     scene_path: &Path,
     output: Option<PathBuf>,
     overrides: &Overrides,
-    talk: Talk,
+    talk: Verbosity,
     track: &mut Track,
 ) -> Result<GpuContext> {
     let opts = overrides.options()?;
@@ -103,7 +92,7 @@ fn render_frames(
     (first, last): (u32, u32),
     fps: f64,
     overrides: &Overrides,
-    talk: Talk,
+    talk: Verbosity,
     track: &mut Track,
 ) -> Result<GpuContext> {
     if !(fps.is_finite() && fps > 0.0) {
@@ -178,7 +167,7 @@ fn render_one(
     exr_path: &Path,
     cache: &mut GpuCache,
     frame: Option<(u32, f64, bool)>,
-    talk: Talk,
+    talk: Verbosity,
     track: &mut Track,
 ) -> Result<()> {
     let warn = frame.is_none_or(|f| f.2);
@@ -219,7 +208,7 @@ fn render_one(
     io::exr::write_with(exr_path, &frame.image, &meta, &extras)?;
     io::png::write_tonemapped(&png_path, &frame.image)?;
     let written = since(t);
-    if talk == Talk::Quiet {
+    if talk == Verbosity::Quiet {
         return Ok(());
     }
     let gpu = frame.gpu_ms().map(|t| format!("{t:.2} ms GPU")).unwrap_or_else(|| "no GPU timestamps".into());
@@ -239,7 +228,7 @@ fn render_one(
     for (pass, ms) in &frame.pass_times {
         println!("  {pass:<20} {ms:>9.3} ms");
     }
-    if talk == Talk::Verbose {
+    if talk == Verbosity::Verbose {
         println!(
             "  wall: planned {planned:.1} ms, built {built:.1} ms (bakes, pipelines, inputs), rendered {rendered:.1} ms \
              (read back included), written {written:.1} ms"

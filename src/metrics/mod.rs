@@ -122,12 +122,11 @@ pub fn diff_heatmap(map: &[f32], width: u32, height: u32) -> Vec<[u8; 4]> {
 /// The colours of [`diff_heatmap`] at `n` evenly spaced values from 0 to 1 (n >= 2), as
 /// `#rrggbb`: a legend's colour scale.
 pub(crate) fn heatmap_scale(n: usize) -> Vec<String> {
-    let lut = nv_flip::magma_lut().to_vec();
-    (0..n.max(2))
-        .map(|i| {
-            let k = (i as f64 / (n.max(2) - 1) as f64 * 255.0).round() as usize * 3;
-            format!("#{:02x}{:02x}{:02x}", lut[k], lut[k + 1], lut[k + 2])
-        })
+    let n = n.max(2);
+    let values: Vec<f32> = (0..n).map(|i| i as f32 / (n - 1) as f32).collect();
+    diff_heatmap(&values, n as u32, 1)
+        .iter()
+        .map(|c| format!("#{:02x}{:02x}{:02x}", c[0], c[1], c[2]))
         .collect()
 }
 

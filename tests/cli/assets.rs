@@ -69,19 +69,23 @@ fn broken_gltf_names_the_file_and_writes_nothing() {
     }
 }
 
+/// The dome's glb with TEXCOORD_0 dropped from its primitive, written as `dir/no_uvs.glb`.
+pub(crate) fn uvless_glb(dir: &std::path::Path) -> std::path::PathBuf {
+    let glb = std::fs::read(root().join("scenes/view_slices/meshes/dome.glb")).unwrap();
+    let at = String::from_utf8_lossy(&glb).find("\"TEXCOORD_0\":1,").unwrap();
+    let mut edited = glb.clone();
+    edited.splice(at..at + 15, b"               ".iter().copied());
+    let mesh = dir.join("no_uvs.glb");
+    std::fs::write(&mesh, edited).unwrap();
+    mesh
+}
+
 /// A glTF primitive without uvs takes planar ones, as an OBJ without `vt` does (issue 32: it was
 /// refused), with a warning at its path; `import` and the asset opened directly take it too.
 #[test]
 fn a_base_surface_without_uvs_gets_planar_uvs_and_a_warning_at_its_path() {
     let dir = scratch_dir("voltex-gltf-no-uvs");
-    // The dome's glb with TEXCOORD_0 dropped from its primitive.
-    let glb = std::fs::read(root().join("scenes/view_slices/meshes/dome.glb")).unwrap();
-    let text = String::from_utf8_lossy(&glb).into_owned();
-    let at = text.find("\"TEXCOORD_0\":1,").unwrap();
-    let mut edited = glb.clone();
-    edited.splice(at..at + 15, b"               ".iter().copied());
-    let mesh = dir.join("no_uvs.glb");
-    std::fs::write(&mesh, edited).unwrap();
+    let mesh = uvless_glb(&dir);
     let scene = dir.join("no_uvs.ron");
     let text = dome("dome.glb").replace(s(&root().join("scenes/view_slices/meshes/dome.glb")), s(&mesh));
     let line = text.lines().position(|l| l.contains("no_uvs.glb")).unwrap() + 1;

@@ -1,22 +1,8 @@
 //! `voltex import MESH --preset NAME` (issue 32, item 3): a look from the presets built into the
 //! binary on any mesh, in one command, as a normal editable scene.
 
-use crate::common::{ok, root, s, scratch_dir, voltex};
-
-fn stderr(out: &std::process::Output) -> String {
-    String::from_utf8_lossy(&out.stderr).into_owned()
-}
-
-/// The dome's glb with its TEXCOORD_0 dropped: a mesh without uvs.
-fn uvless_glb(dir: &std::path::Path) -> std::path::PathBuf {
-    let glb = std::fs::read(root().join("scenes/view_slices/meshes/dome.glb")).unwrap();
-    let at = String::from_utf8_lossy(&glb).find("\"TEXCOORD_0\":1,").unwrap();
-    let mut edited = glb.clone();
-    edited.splice(at..at + 15, b"               ".iter().copied());
-    let mesh = dir.join("no_uvs.glb");
-    std::fs::write(&mesh, edited).unwrap();
-    mesh
-}
+use crate::assets::uvless_glb;
+use crate::common::{ok, root, s, scratch_dir, stderr, voltex};
 
 /// Moss on a glb without uvs, in one command: the scene names the preset's texel, parses, plans
 /// and renders something (the mesh under moss), and says where the look comes from.

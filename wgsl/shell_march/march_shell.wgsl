@@ -39,7 +39,7 @@ const DEPTH_SLACK: f32 = 2e-3;
 @group(0) @binding(1) var<uniform> shell_params: ReferenceParams;
 // Per 8x8 tile, row by row: its first entry and count in `shell_tile_prisms` (prism indices, each
 // tile's nearest first); per prism two rows of `shell_bounds`: its corner box's minimum with its
-// least distance from the eye (w), its maximum with its greatest (w).
+// least distance from the eye (w), and its maximum.
 @group(0) @binding(2) var<storage, read> shell_tiles: array<vec2<u32>>;
 @group(0) @binding(15) var<storage, read> shell_tile_prisms: array<u32>;
 @group(0) @binding(16) var<storage, read> shell_bounds: array<vec4<f32>>;

@@ -24,7 +24,7 @@ pub(crate) struct TileLists {
     /// Prism indices, tile after tile, each tile's nearest first (ties by index).
     pub(crate) entries: Vec<u32>,
     /// Per prism, two rows: its corner box's minimum with the least distance from the eye of any
-    /// point in it (w), and its maximum with the greatest (w); camera-relative, as the vertices.
+    /// point in it (w), and its maximum (w unused); camera-relative, as the vertices.
     pub(crate) bounds: Vec<[f32; 4]>,
 }
 
@@ -64,9 +64,8 @@ pub(crate) fn bin(prisms: &[ReferencePrism], vertices: &[ShellVertex], camera: &
         let pad = 1e-5 * (hi - lo).max_element() + 1e-7;
         let (lo, hi) = (lo - DVec3::splat(pad), hi + DVec3::splat(pad));
         let near = DVec3::ZERO.clamp(lo, hi).length();
-        let far = lo.abs().max(hi.abs()).length();
         bounds.push([lo.x as f32, lo.y as f32, lo.z as f32, near as f32]);
-        bounds.push([hi.x as f32, hi.y as f32, hi.z as f32, far as f32]);
+        bounds.push([hi.x as f32, hi.y as f32, hi.z as f32, 0.0]);
         let Some((x0, x1, y0, y1)) = screen_box(&corners, camera, forward, size) else {
             continue;
         };
@@ -158,7 +157,8 @@ mod tests {
         // The third lies near the right edge (sx 0.9: pixel ~60), not in the centre's tiles.
         let edge = lists.tiles[3 * 8 + 7];
         assert_eq!(&lists.entries[edge[0] as usize..(edge[0] + edge[1]) as usize], [2]);
-        assert!(lists.bounds[2][3] < lists.bounds[0][3] && lists.bounds[1][3] > lists.bounds[0][3]);
+        // Least distances: 2 for the second, about 4 for the third (off to the side), 5 for the first.
+        assert!(lists.bounds[2][3] < lists.bounds[4][3] && lists.bounds[4][3] < lists.bounds[0][3]);
         // Leaving the nearest out keeps the others in order.
         let kept = lists.only(&[true, false, true]);
         let centre = kept.tiles[3 * 8 + 3];
