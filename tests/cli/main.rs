@@ -19,4 +19,5 @@ mod presets;
 mod preview_input;
 mod preview_latency;
 mod preview_window;
+mod tutorial;
 mod volumes;
