@@ -68,6 +68,51 @@ impl Error {
     pub fn file(path: impl AsRef<Path>, message: impl fmt::Display) -> Self {
         Error::File { path: path.as_ref().to_path_buf(), message: message.to_string() }
     }
+
+    /// The error as the command line prints it: `error: ` and the error's line, then, for a
+    /// position in a text file that can still be read, its source line with a caret under the
+    /// word at the position (codespan-reporting).
+    pub fn report(&self) -> String {
+        let head = format!("error: {self}\n");
+        let Error::At { loc, .. } = self else { return head };
+        source_snippet(loc).map_or(head.clone(), |snippet| head + &snippet)
+    }
+}
+
+/// Source lines longer than this are not quoted (a minified JSON or a binary file).
+const SNIPPET_MAX_LINE: usize = 400;
+
+/// `loc`'s source line with carets under the word there, or `None` where the file is not a
+/// readable text file or has no such position.
+fn source_snippet(loc: &FileLoc) -> Option<String> {
+    use codespan_reporting::diagnostic::{Diagnostic, Label};
+    use codespan_reporting::files::SimpleFile;
+    use codespan_reporting::term;
+    if !std::fs::metadata(&loc.path).ok()?.is_file() {
+        return None;
+    }
+    let source = std::fs::read_to_string(&loc.path).ok()?;
+    let line = source.lines().nth(loc.line.checked_sub(1)?)?;
+    if line.len() > SNIPPET_MAX_LINE || loc.col == 0 || loc.col > line.len() + 1 {
+        return None;
+    }
+    let start = offset_of(&source, loc.line, loc.col);
+    // The word (name, number, string) at the position, or its one character.
+    let rest = &source[start..];
+    let word = |c: char| c.is_alphanumeric() || matches!(c, '_' | '.' | '-' | '+');
+    let len = match rest.chars().next() {
+        Some('"') => rest[1..].find(['"', '\n']).map_or(1, |n| n + 2),
+        Some(c) if word(c) => rest.find(|c: char| !word(c)).unwrap_or(rest.len()),
+        Some(c) if c != '\n' => c.len_utf8(),
+        _ => 0,
+    };
+    let file = SimpleFile::new(loc.path.display().to_string(), source.as_str());
+    // The header line is ours (printed above); the snippet is the diagnostic's body.
+    let diagnostic = Diagnostic::error().with_label(Label::primary((), start..start + len));
+    let config = term::Config { chars: term::Chars::ascii(), ..term::Config::default() };
+    let text = term::emit_into_string(&config, &file, &diagnostic).ok()?;
+    // Drop codespan's own `error` header line: the position is already in ours.
+    Some(text.split_once('\n')?.1.to_string())
 }
 
 /// `Result` with the library's [`Error`].

@@ -26,7 +26,7 @@ fn main() -> ExitCode {
             return match voltex::regress::command(&args) {
                 Ok(code) => ExitCode::from(code),
                 Err(e) => {
-                    eprintln!("error: {e}");
+                    eprint!("{}", e.report());
                     ExitCode::from(voltex::regress::exit::of_error(&e))
                 }
             }
@@ -35,7 +35,10 @@ fn main() -> ExitCode {
             return match cli::farm::run(args) {
                 Ok(code) => ExitCode::from(code),
                 Err(e) => {
-                    eprintln!("error: {e}");
+                    match &e {
+                        cli::farm::FarmError::Input(e) => eprint!("{}", e.report()),
+                        e => eprintln!("error: {e}"),
+                    }
                     ExitCode::from(e.code())
                 }
             }
@@ -49,7 +52,7 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e}");
+            eprint!("{}", e.report());
             ExitCode::FAILURE
         }
     }

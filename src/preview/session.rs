@@ -210,7 +210,7 @@ impl Session {
     fn failed(&mut self, e: crate::Error) -> Outcome {
         let msg = e.to_string();
         if self.logged.as_deref() != Some(&msg) {
-            eprintln!("error: {msg}");
+            eprint!("{}", e.report());
             self.logged = Some(msg.clone());
         }
         self.error = Some(msg.clone());

@@ -62,3 +62,37 @@ fn render_and_import_take_quiet_and_render_verbose() {
     assert!(run.status.success() && run.stdout.is_empty() && imported.exists());
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// An error at a position shows the source line with carets under the word there, below the
+/// `error: file:line:col: message` line it always had (issue 32, item 4: annotated errors); a
+/// line too long to quote (a minified file) is left out.
+#[test]
+fn errors_show_the_source_line_with_a_caret() {
+    let dir = crate::common::scratch_dir("voltex-caret");
+    let text = std::fs::read_to_string(root().join("scenes/view_slices/flat_box.ron")).unwrap();
+    let bad = text.replacen("opacity_length", "opacity_lenght", 1);
+    let scene = dir.join("typo.ron");
+    std::fs::write(&scene, &bad).unwrap();
+    let out = voltex(&["plan", crate::common::s(&scene)]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = crate::common::stderr(&out);
+    let (line, col) =
+        bad.lines().enumerate().find_map(|(n, l)| l.find("opacity_lenght").map(|c| (n + 1, c + 1))).unwrap();
+    let head = format!("error: {}:{line}:{col}: ", scene.display());
+    assert!(err.starts_with(&head), "{err}");
+    let lines: Vec<&str> = err.lines().collect();
+    let quoted = lines.iter().position(|l| l.ends_with(bad.lines().nth(line - 1).unwrap())).expect(&err);
+    let (gutter, source) = lines[quoted].split_once(" | ").unwrap();
+    assert_eq!(gutter.trim(), line.to_string(), "{err}");
+    let carets = lines[quoted + 1];
+    let at = carets.find('^').expect(&err);
+    assert_eq!(at, gutter.len() + 3 + col - 1, "the caret is under column {col}:\n{err}");
+    assert_eq!(carets[at..].trim_end(), "^".repeat("opacity_lenght".len()), "{err}");
+    assert!(source.contains("opacity_lenght"));
+
+    let long = format!("Scene(output: (width: 64, heigt: 64), {})\n", " ".repeat(500));
+    std::fs::write(&scene, long).unwrap();
+    let err = crate::common::stderr(&voltex(&["plan", crate::common::s(&scene)]));
+    assert!(err.starts_with(&format!("error: {}:1:", scene.display())) && err.lines().count() == 1, "{err}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
