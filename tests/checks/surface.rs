@@ -39,7 +39,7 @@ use crate::layers::rust_files;
 /// (1334: `pareto --supersample` and `--supersample-methods` (`pareto::Args`' two fields, for the
 /// command line) and `RenderOptions::knobs` (the command line builds `RenderOptions` by struct
 /// update, so every field is public), and `pareto::Args::verbosity` (`pareto -q/-v`).)
-const PUB_DECLARATIONS: usize = 1335;
+const PUB_DECLARATIONS: usize = 1336;
 
 /// Whether the declaration on line `n` has a `///` doc above its attributes (one-line ones, or
 /// multi-line ones from `#[` to `)]`).
