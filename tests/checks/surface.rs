@@ -39,6 +39,7 @@ use crate::layers::rust_files;
 /// (1334: `pareto --supersample` and `--supersample-methods` (`pareto::Args`' two fields, for the
 /// command line) and `RenderOptions::knobs` (the command line builds `RenderOptions` by struct
 /// update, so every field is public), and `pareto::Args::verbosity` (`pareto -q/-v`).)
+/// (1336: `Error::report`, the error with its source line quoted, printed by the command line.)
 const PUB_DECLARATIONS: usize = 1336;
 
 /// Whether the declaration on line `n` has a `///` doc above its attributes (one-line ones, or
