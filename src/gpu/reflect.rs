@@ -203,3 +203,21 @@ pub(crate) fn overrides(kernel: &Kernel) -> Vec<(String, bool)> {
 pub(crate) fn workgroup_size(kernel: &Kernel, entry_point: &str) -> Option<[u32; 3]> {
     kernel.module.entry_points.iter().find(|e| e.name == entry_point).map(|e| e.workgroup_size)
 }
+
+/// The values of `kernel`'s `const name: array<u32, N>`, or `None` where it has no such
+/// constant. For tables a kernel indexes by a varying index: uploaded into a storage buffer
+/// instead (llvmpipe copies a const array indexed so into every invocation's private memory).
+pub(crate) fn const_u32_array(kernel: &Kernel, name: &str) -> Option<Vec<u32>> {
+    let module = &kernel.module;
+    let (_, c) = module.constants.iter().find(|(_, c)| c.name.as_deref() == Some(name))?;
+    let naga::Expression::Compose { components, .. } = &module.global_expressions[c.init] else {
+        return None;
+    };
+    components
+        .iter()
+        .map(|&h| match module.global_expressions[h] {
+            naga::Expression::Literal(naga::Literal::U32(v)) => Some(v),
+            _ => None,
+        })
+        .collect()
+}

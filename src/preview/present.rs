@@ -6,7 +6,7 @@ use std::borrow::Cow;
 
 use bytemuck::{Pod, Zeroable};
 
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::gpu::sources::Sources;
 use crate::gpu::{shader, GpuContext};
 
@@ -43,6 +43,8 @@ pub(crate) struct Presenter {
     layout: wgpu::BindGroupLayout,
     params: wgpu::Buffer,
     text: wgpu::Buffer,
+    /// The overlay's glyphs (`FONT` of `wgsl/shared/font.wgsl`), read from the kernel.
+    font: wgpu::Buffer,
     pub(crate) format: wgpu::TextureFormat,
 }
 
@@ -101,7 +103,16 @@ impl Presenter {
             usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        Ok(Self { pipeline, layout, params, text, format })
+        let glyphs = crate::gpu::reflect::const_u32_array(&kernel, "FONT")
+            .ok_or_else(|| Error::Invalid("present.wgsl: expected a `const FONT: array<u32, N>`".into()))?;
+        let font = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("overlay font"),
+            size: (glyphs.len() * 4) as u64,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        ctx.queue.write_buffer(&font, 0, bytemuck::cast_slice(&glyphs));
+        Ok(Self { pipeline, layout, params, text, font, format })
     }
 
     /// Draws `image` (and `reference` for the reference and difference views; the image itself
@@ -154,6 +165,7 @@ impl Presenter {
                     resource: wgpu::BindingResource::TextureView(&reference_view),
                 },
                 wgpu::BindGroupEntry { binding: 3, resource: self.text.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 4, resource: self.font.as_entire_binding() },
             ],
         });
         let mut enc = ctx.device.create_command_encoder(&Default::default());

@@ -134,3 +134,48 @@ fn measure_ui_renders_the_reference_in_steps_and_matches_the_blocking_frame() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// The overlay text the window draws without its panel (`H`) has exactly the glyphs of
+/// `wgsl/shared/font.wgsl`'s `FONT`, which the window uploads into a buffer (read from the
+/// kernel, so that llvmpipe does not copy the table into every pixel's invocation): its last
+/// line, `H: show the panel`, pixel by pixel (white where a glyph's bit is set).
+#[test]
+fn overlay_text_has_the_fonts_glyphs() {
+    let font_src = std::fs::read_to_string(common::root().join("wgsl/shared/font.wgsl")).unwrap();
+    let table = &font_src[font_src.find("const FONT:").unwrap()..];
+    let table = &table[table.find('(').unwrap()..];
+    let words: Vec<u32> =
+        table.split("0x").skip(1).map(|w| u32::from_str_radix(&w[..8], 16).unwrap()).collect();
+    assert_eq!(words.len(), 95 * 3);
+    let bit = |c: char, x: usize, y: usize| {
+        (words[(c as usize - 32) * 3 + y / 4] >> (8 * (y % 4) + 7 - x)) & 1 == 1
+    };
+
+    let dir = common::scratch_dir("voltex-overlay");
+    let scene = common::root().join("scenes/view_slices/flat_box.ron");
+    let mut preview = Preview::start(&scene, "64x64", dir.join("frames"), &[]);
+    preview.frame(0);
+    preview.focus();
+    preview.after(|p| drop(p.xdo(&["key", "h"])));
+    let n = preview.until("the panel hidden", |p, n| p.state(n)["panel"] == false);
+    let (w, _, px) = voltex::io::png::read_rgba8(&preview.record.join(format!("frame-{n}.png"))).unwrap();
+    let err = common::stderr(&preview.stop());
+    let line = "H: show the panel";
+    // Text starts 8 pixels in, lines of 12 pixels, characters 8 wide; which line is the last
+    // depends on the lines above it.
+    let drawn_at = |row: usize| {
+        line.chars().enumerate().all(|(i, c)| {
+            (0..12).all(|y| {
+                (0..8).all(|x| {
+                    let p = px[(8 + row * 12 + y) * w as usize + 8 + i * 8 + x];
+                    bit(c, x, y) == (p == [255, 255, 255, 255])
+                })
+            })
+        })
+    };
+    assert!(
+        (0..8).any(drawn_at),
+        "{line:?} is not drawn with FONT's glyphs on any of the first lines; stderr: {err}"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
