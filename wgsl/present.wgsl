@@ -3,7 +3,7 @@
 #include "shared/fullscreen.wgsl"
 
 struct PresentParams {
-    // 0: image, 1: reference, 2: difference (relative, as a heat map).
+    // 0: image, 1: reference, 2: difference (the image is FLIP's heat map, shown as it is).
     mode: u32,
     // Overlay text: lines of `columns` characters in `text`, drawn `scale` times enlarged.
     lines: u32,
@@ -39,12 +39,6 @@ fn filmic(v: vec3<f32>) -> vec3<f32> {
 
 fn srgb(v: vec3<f32>) -> vec3<f32> {
     return select(1.055 * pow(v, vec3<f32>(1.0 / 2.4)) - 0.055, 12.92 * v, v <= vec3<f32>(0.0031308));
-}
-
-// Black, purple, orange, yellow: a small heat ramp for the difference view.
-fn heat(t: f32) -> vec3<f32> {
-    let x = clamp(t, 0.0, 1.0);
-    return clamp(vec3<f32>(1.8 * x, 1.6 * x * x, 0.6 * sin(3.14159 * x) + 0.2 * x * x * x), vec3<f32>(0.0), vec3<f32>(1.0));
 }
 
 fn overlay(pixel: vec2<u32>) -> vec4<f32> {
@@ -85,10 +79,8 @@ fn fs_main(@builtin(position) position: vec4<f32>) -> @location(0) vec4<f32> {
     if (params.mode == 1u) {
         rgb = filmic(b);
     } else if (params.mode == 2u) {
-        let la = dot(a, vec3<f32>(0.2126, 0.7152, 0.0722));
-        let lb = dot(b, vec3<f32>(0.2126, 0.7152, 0.0722));
-        // Difference relative to the reference's brightness, 25% and more at full scale.
-        rgb = heat(4.0 * abs(la - lb) / max(lb, 0.05));
+        // The difference view: FLIP's heat map (an sRGB texture), shown as it is.
+        rgb = a;
     }
     if (!inside) {
         rgb = vec3<f32>(0.02);

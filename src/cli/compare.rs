@@ -22,6 +22,15 @@ pub fn run(args: CompareArgs) -> Result<()> {
     let (a, _) = voltex::io::exr::read(&actual)?;
     let (r, _) = voltex::io::exr::read(&reference)?;
     let flip = metrics::flip(&a, &r)?;
+    // The heat map is written with --json too (it was silently left out).
+    if let Some(path) = &diff {
+        voltex::io::png::write_rgba8(
+            path,
+            a.width,
+            a.height,
+            &metrics::diff_heatmap(&flip.map, a.width, a.height),
+        )?;
+    }
     if json {
         let v = serde_json::json!({
             "flip": flip.mean,
@@ -37,12 +46,6 @@ pub fn run(args: CompareArgs) -> Result<()> {
     println!("largest difference  {:.3e}", metrics::max_abs_diff(&a, &r)?);
     println!("non-finite pixels   {} / {}", metrics::count_nonfinite(&a), metrics::count_nonfinite(&r));
     if let Some(path) = diff {
-        voltex::io::png::write_rgba8(
-            &path,
-            a.width,
-            a.height,
-            &metrics::diff_heatmap(&flip.map, a.width, a.height),
-        )?;
         println!("heat map            {}", path.display());
     }
     Ok(())

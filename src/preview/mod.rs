@@ -3,6 +3,7 @@
 
 pub(crate) mod camera_file;
 pub(crate) mod curves;
+pub(crate) mod difference;
 pub(crate) mod editor;
 pub(crate) mod gui;
 pub(crate) mod knobs;

@@ -54,6 +54,8 @@ pub(crate) struct PanelView<'a> {
     /// Scene, GPU time, adapter, status.
     pub(crate) lines: &'a [String],
     pub(crate) error: Option<&'a str>,
+    /// The difference view shows FLIP's heat map: draw its colour scale.
+    pub(crate) heat_scale: bool,
     pub(crate) note: Option<&'a str>,
     pub(crate) refused: Option<&'a (Vec<Step>, String)>,
     pub(crate) read_only: bool,
@@ -168,6 +170,9 @@ fn contents(ui: &mut egui::Ui, cx: &mut Cx, view: &PanelView) {
             }
         }
     });
+    if view.heat_scale {
+        heat_scale(ui);
+    }
     ui.horizontal(|ui| {
         if ui.add_enabled(view.can_undo, egui::Button::new("undo")).clicked() {
             cx.actions.push(Action::Undo);
@@ -561,4 +566,32 @@ fn atom(
     }
     ui.label(RichText::new(text).monospace());
     (None, false)
+}
+
+/// The difference view's colour scale: FLIP 0 to 1 in the heat map's colours, with ticks.
+fn heat_scale(ui: &mut egui::Ui) {
+    const STEPS: usize = 64;
+    let (rect, _) = ui.allocate_exact_size(egui::vec2(WIDTH - 40.0, 12.0), egui::Sense::hover());
+    let w = rect.width() / STEPS as f32;
+    for i in 0..STEPS {
+        let [r, g, b, _] = super::difference::colour(i as f32 / (STEPS - 1) as f32);
+        let x = rect.left() + i as f32 * w;
+        let cell =
+            egui::Rect::from_min_max(egui::pos2(x, rect.top()), egui::pos2(x + w + 0.5, rect.bottom()));
+        ui.painter().rect_filled(cell, 0.0, egui::Color32::from_rgb(r, g, b));
+    }
+    // Ticks under the bar, each centred on its value.
+    let (labels, _) = ui.allocate_exact_size(egui::vec2(rect.width(), 14.0), egui::Sense::hover());
+    let colour = ui.visuals().text_color();
+    for (v, text) in [(0.0, "0"), (0.25, "0.25"), (0.5, "0.5"), (0.75, "0.75"), (1.0, "1 FLIP")] {
+        let x = rect.left() + v * rect.width();
+        let align = if v == 0.0 {
+            egui::Align2::LEFT_TOP
+        } else if v == 1.0 {
+            egui::Align2::RIGHT_TOP
+        } else {
+            egui::Align2::CENTER_TOP
+        };
+        ui.painter().text(egui::pos2(x, labels.top()), align, text, egui::FontId::proportional(11.0), colour);
+    }
 }

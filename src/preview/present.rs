@@ -31,7 +31,8 @@ pub enum Mode {
     Image = 0,
     /// The same frame drawn by the ground truth (the exact Reference method): the "reference" view.
     Truth = 1,
-    /// The difference between the render and the reference.
+    /// The difference between the render and the reference: FLIP's heat map (the image given
+    /// is that map, shown as it is).
     Difference = 2,
 }
 

@@ -14,6 +14,7 @@ use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop, EventLoopProxy}
 use winit::keyboard::{Key, ModifiersState, NamedKey};
 use winit::window::{Window, WindowId};
 
+use super::difference::Difference;
 use super::editor::Editor;
 use super::gui::Gui;
 use super::panel::{self, Action};
@@ -128,6 +129,10 @@ struct State {
     /// `--measure-ui`'s measurement, and whether it ended (the window closes).
     measure: Option<super::measure_ui::UiMeasure>,
     measured: bool,
+    /// Frames and reference frames finished so far: which pair `difference` was made from.
+    finished: (u64, u64),
+    /// The difference view's FLIP, made once both frames of a pair are finished.
+    difference: Option<Difference>,
 }
 
 impl ApplicationHandler for App {
@@ -349,6 +354,8 @@ impl State {
             cursor: (0.0, 0.0),
             modifiers: ModifiersState::empty(),
             recorded: 0,
+            finished: (0, 0),
+            difference: None,
             started: Instant::now(),
             trace: crate::render::trace::Track { name: "preview".into(), frames: Vec::new() },
             measure: args
@@ -430,6 +437,7 @@ impl State {
             self.reference = Some(r);
         }
         let fresh = self.run_steps(args)?;
+        self.update_difference()?;
         let actions = self.run_panel();
         let image = match self.inflight {
             Some(_) => self.shown.clone(),
@@ -478,6 +486,7 @@ impl State {
             if let Some(times) = self.session.step(&self.ctx, steps, STEP_MS)? {
                 self.inflight = None;
                 fresh = true;
+                self.finished.0 += 1;
                 self.gpu_ms = (!times.is_empty()).then(|| times.iter().map(|t| t.1).sum());
                 self.keep_shown();
                 if let (Some(path), Some(r)) = (&args.trace, self.session.renderer()) {
@@ -498,6 +507,7 @@ impl State {
             let left = (STEP_MS - start.elapsed().as_secs_f64() * 1e3).max(1.0);
             if r.step(&self.ctx, steps, left)?.is_some() {
                 self.reference_inflight = None;
+                self.finished.1 += 1;
                 self.record_next = true;
             }
         }
@@ -505,6 +515,24 @@ impl State {
             self.window.request_redraw();
         }
         Ok(fresh)
+    }
+
+    /// In the difference view, once a new pair of frames is finished: FLIP between them (both
+    /// read back; `voltex compare`'s metric and heat map).
+    fn update_difference(&mut self) -> Result<()> {
+        let current = self.difference.as_ref().is_some_and(|d| d.key == self.finished);
+        if self.mode != Mode::Difference || current || !self.settled() {
+            return Ok(());
+        }
+        let (Some(r), Some(reference)) =
+            (self.session.renderer_mut(), self.reference.as_mut().and_then(|r| r.renderer_mut()))
+        else {
+            return Ok(());
+        };
+        let image = r.read_frame(&self.ctx)?.image;
+        let truth = reference.read_frame(&self.ctx)?.image;
+        self.difference = Some(Difference::new(&self.ctx, &image, &truth, self.finished));
+        Ok(())
     }
 
     /// No frame is rendering and no reference building: what is shown is the latest.
@@ -559,6 +587,8 @@ impl State {
             mode: self.mode,
             lines: &lines,
             error: self.session.error.as_deref(),
+            heat_scale: self.mode == Mode::Difference
+                && self.difference.as_ref().is_some_and(|d| d.texture.is_some()),
             note: editor.and_then(|e| e.note.as_deref()),
             refused: editor.and_then(|e| e.refused.as_ref()),
             read_only: editor.is_some_and(|e| e.read_only),
@@ -658,10 +688,19 @@ impl State {
             })
         };
         let image = image.unwrap_or_else(blank);
+        // The difference view shows FLIP's heat map as it is, once there is one; the image
+        // until then.
+        let heat = self.difference.as_ref().and_then(|d| d.texture.clone()).filter(|_| reference.is_some());
+        let (image, reference, mode) = match (self.mode, heat) {
+            // (The presenter shows its first image tonemapped unless given a second.)
+            (Mode::Difference, Some(heat)) => (heat.clone(), Some(heat), Mode::Difference),
+            (Mode::Difference, None) => (image, None, Mode::Image),
+            (mode, _) => (image, reference, mode),
+        };
         let size = (self.config.width, self.config.height);
         let area = (self.image_width(), size.1);
         if let (Some(dir), true) = (&args.record, record) {
-            self.record(dir, size, &image, reference.as_ref(), &lines, area)?;
+            self.record(dir, size, (&image, reference.as_ref(), mode), &lines, area)?;
         }
         let frame = match self.surface.get_current_texture() {
             wgpu::CurrentSurfaceTexture::Success(f) | wgpu::CurrentSurfaceTexture::Suboptimal(f) => f,
@@ -674,7 +713,7 @@ impl State {
             _ => return Ok(()),
         };
         let view = frame.texture.create_view(&Default::default());
-        self.presenter.draw(&self.ctx, &view, area, &image, reference.as_ref(), self.mode, &lines);
+        self.presenter.draw(&self.ctx, &view, area, &image, reference.as_ref(), mode, &lines);
         if self.panel {
             self.gui.paint(&self.ctx, &view, size);
         }
@@ -688,8 +727,7 @@ impl State {
         &mut self,
         dir: &std::path::Path,
         size: (u32, u32),
-        image: &wgpu::Texture,
-        reference: Option<&wgpu::Texture>,
+        (image, reference, mode): (&wgpu::Texture, Option<&wgpu::Texture>, Mode),
         lines: &[String],
         area: (u32, u32),
     ) -> Result<()> {
@@ -704,7 +742,7 @@ impl State {
             view_formats: &[],
         });
         let view = target.create_view(&Default::default());
-        self.presenter.draw(&self.ctx, &view, area, image, reference, self.mode, lines);
+        self.presenter.draw(&self.ctx, &view, area, image, reference, mode, lines);
         if self.panel {
             self.gui.paint(&self.ctx, &view, size);
         }
@@ -764,6 +802,7 @@ impl State {
             "read_only": self.editor.as_ref().is_some_and(|e| e.read_only),
             "error": self.session.error,
             "editors": editors,
+            "flip": self.difference.as_ref().filter(|_| self.mode == Mode::Difference).and_then(|d| d.flip.clone().ok()),
         });
         let json = path.with_extension("json");
         crate::io::atomic::write_bytes(&json, state.to_string().as_bytes())?;
@@ -796,6 +835,9 @@ impl State {
             }
             None => format!("{gpu}  {}", self.ctx.info.name),
         });
+        if let Some(d) = self.difference.as_ref().filter(|_| self.mode == Mode::Difference) {
+            lines.push(d.line());
+        }
         if !self.status.is_empty() {
             lines.push(self.status.clone());
         }

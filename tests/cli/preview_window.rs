@@ -179,3 +179,61 @@ fn overlay_text_has_the_fonts_glyphs() {
     );
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// The difference view (`3`, `--view difference`) shows FLIP between the frame and the
+/// reference's frame as `voltex compare` computes it: the same mean (in the panel's lines and
+/// the recorded state) and, pixel by pixel, the heat map `compare --diff` writes, with its colour
+/// scale in the panel (issue 32, item 8).
+#[test]
+fn difference_view_shows_compares_flip_and_heat_map() {
+    let dir = common::scratch_dir("voltex-difference-view");
+    let scene = common::root().join("scenes/view_slices/flat_box.ron");
+    let s = |p: &std::path::Path| p.to_str().unwrap().to_string();
+    let (image, truth, heat) = (dir.join("image.exr"), dir.join("truth.exr"), dir.join("heat.png"));
+    common::ok(common::voltex(&["render", &s(&scene), "--size", "40x40", "-o", &s(&image), "-q"]));
+    common::ok(common::voltex(&[
+        "render",
+        &s(&scene),
+        "--size",
+        "40x40",
+        "--method",
+        "reference",
+        "-o",
+        &s(&truth),
+        "-q",
+    ]));
+    let compare =
+        common::ok(common::voltex(&["compare", &s(&image), &s(&truth), "--json", "--diff", &s(&heat)]));
+    let compare: serde_json::Value = serde_json::from_str(compare.lines().next().unwrap()).unwrap();
+    let want = compare["flip"].as_f64().unwrap();
+
+    let mut preview = Preview::start(&scene, "40x40", dir.join("frames"), &[]);
+    preview.frame(0);
+    preview.focus();
+    preview.after(|p| drop(p.xdo(&["key", "3"])));
+    let n = preview.until("the difference's FLIP", |p, n| p.state(n)["flip"].is_number());
+    let state = preview.state(n);
+    let frame = preview.record.join(format!("frame-{n}.png"));
+    let err = common::stderr(&preview.stop());
+    let got = state["flip"].as_f64().unwrap();
+    assert!((got - want).abs() < 1e-9, "window FLIP {got}, compare {want}; stderr: {err}");
+
+    let (w, h, px) = voltex::io::png::read_rgba8(&frame).unwrap();
+    let (_, _, map) = voltex::io::png::read_rgba8(&heat).unwrap();
+    // The image area is left of the panel (340 pixels under Xvfb); the 40x40 map is scaled
+    // to fit it, centred.
+    let area = (w as f64 - 340.0, h as f64);
+    let scale = (area.0 / 40.0).min(area.1 / 40.0);
+    let origin = (0.5 * (area.0 - 40.0 * scale), 0.5 * (area.1 - 40.0 * scale));
+    let mut worst = 0;
+    for y in 0..40 {
+        for x in 0..40 {
+            let (wx, wy) = (origin.0 + (x as f64 + 0.5) * scale, origin.1 + (y as f64 + 0.5) * scale);
+            let p = px[wy as usize * w as usize + wx as usize];
+            let q = map[y * 40 + x];
+            worst = worst.max((0..3).map(|c| (p[c] as i32 - q[c] as i32).abs()).max().unwrap());
+        }
+    }
+    assert!(worst <= 1, "the window's heat map differs from compare --diff's by {worst}; stderr: {err}");
+    std::fs::remove_dir_all(&dir).ok();
+}
