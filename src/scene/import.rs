@@ -309,8 +309,14 @@ fn ron_string(s: &str) -> String {
 pub fn mesh_path(asset: &Path, scene: &Path) -> PathBuf {
     use std::path::Component;
     let absolute = |p: &Path| std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf());
-    let (asset, dir) = (absolute(asset), absolute(scene.parent().unwrap_or(Path::new(""))));
-    let (a, d): (Vec<Component>, Vec<Component>) = (asset.components().collect(), dir.components().collect());
+    // A bare file name's folder is the current one (`Path::parent` gives "", which has no
+    // absolute form: the asset's absolute path was written).
+    let folder = scene.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    let (asset, dir) = (absolute(asset), absolute(folder));
+    fn parts(p: &Path) -> Vec<std::path::Component<'_>> {
+        p.components().filter(|c| *c != std::path::Component::CurDir).collect()
+    }
+    let (a, d) = (parts(&asset), parts(&dir));
     let shared = a.iter().zip(&d).take_while(|(x, y)| x == y).count();
     if shared == 0 {
         return asset;

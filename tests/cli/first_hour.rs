@@ -96,3 +96,27 @@ fn errors_show_the_source_line_with_a_caret() {
     assert!(err.starts_with(&format!("error: {}:1:", scene.display())) && err.lines().count() == 1, "{err}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// `import mesh.glb -o scene.ron` run in the mesh's folder (bare file names) names the mesh
+/// relative to the scene (issue 32, item 4: the scene's folder was "", which has no absolute
+/// form, and the mesh's absolute path was written, breaking the scene when the folder moves).
+#[test]
+fn import_with_bare_names_writes_a_relative_mesh_path() {
+    let dir = crate::common::scratch_dir("voltex-import-bare");
+    std::fs::copy(root().join("scenes/view_slices/meshes/dome.glb"), dir.join("dome.glb")).unwrap();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_voltex"))
+        .args(["import", "dome.glb", "-o", "dome.ron", "-q"])
+        .current_dir(&dir)
+        .env("VOLTEX_ROOT", root())
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", crate::common::stderr(&out));
+    let text = std::fs::read_to_string(dir.join("dome.ron")).unwrap();
+    assert!(text.contains("surface: Obj(path: \"dome.glb\")"), "{text}");
+    // The pair moves together.
+    let moved = dir.with_extension("moved");
+    let _ = std::fs::remove_dir_all(&moved);
+    std::fs::rename(&dir, &moved).unwrap();
+    ok(voltex(&["plan", crate::common::s(&moved.join("dome.ron"))]));
+    std::fs::remove_dir_all(&moved).unwrap();
+}
