@@ -8,6 +8,7 @@ pub(crate) mod editor;
 pub(crate) mod gui;
 pub(crate) mod knobs;
 pub mod latency;
+pub(crate) mod looks;
 pub(crate) mod measure_ui;
 pub(crate) mod panel;
 pub mod present;

@@ -231,6 +231,9 @@ fn object(ui: &mut egui::Ui, cx: &mut Cx, tree: &Value, node: &Value, path: &[St
             ui.label("method: the default");
         }
     }
+    if node.child(&Step::Field("hypertexture".into()), src).is_none() {
+        looks(ui, cx, tree, node, path);
+    }
     for (key, map) in [("hypertexture", "hypertextures"), ("texel", "texels")] {
         let Some(name) = node.child(&Step::Field(key.into()), src).and_then(|n| st::unquote(n.text(src)))
         else {
@@ -594,4 +597,36 @@ fn heat_scale(ui: &mut egui::Ui) {
         };
         ui.painter().text(egui::pos2(x, labels.top()), align, text, egui::FontId::proportional(11.0), colour);
     }
+}
+
+/// The node's texel, picked from the scene's, and a preset's look to put on it.
+fn looks(ui: &mut egui::Ui, cx: &mut Cx, tree: &Value, node: &Value, path: &[Step]) {
+    let src = cx.src;
+    let current = node.child(&Step::Field("texel".into()), src).and_then(|n| st::unquote(n.text(src)));
+    let names: Vec<String> = match tree.at(&[Step::Field("texels".into())], src).map(|t| &t.kind) {
+        Some(Kind::Map(entries)) => entries.iter().filter_map(|(k, _)| st::unquote(k.text(src))).collect(),
+        _ => Vec::new(),
+    };
+    ui.horizontal(|ui| {
+        ui.label("texel");
+        let id = format!("{} texel", st::show(path));
+        let shown = current.clone().unwrap_or_else(|| "(none)".into());
+        egui::ComboBox::from_id_salt(id).selected_text(shown).show_ui(ui, |ui| {
+            for name in &names {
+                if ui.selectable_label(current.as_ref() == Some(name), name).clicked()
+                    && current.as_ref() != Some(name)
+                {
+                    push_edit(cx, super::looks::pick_texel(src, path, name), false);
+                }
+            }
+        });
+        let id = format!("{} look", st::show(path));
+        egui::ComboBox::from_id_salt(id).selected_text("put a preset").show_ui(ui, |ui| {
+            for preset in super::looks::presets() {
+                if ui.selectable_label(false, preset).clicked() {
+                    push_edit(cx, super::looks::put_preset(src, path, preset), false);
+                }
+            }
+        });
+    });
 }

@@ -31,22 +31,22 @@ pub(crate) fn presets() -> Vec<&'static str> {
 
 /// A preset's look, from its scene file: the text of its `texels` entries and its node's
 /// texel, height, uv tiles, base colour and method, for a sphere of radius 1.
-struct Look {
+pub(crate) struct Look {
     name: String,
     /// What it is: the first comment line's text after the name.
-    what: String,
+    pub(crate) what: String,
     /// The lines inside the file's `texels: { ... }`.
-    texels: String,
-    texel: String,
+    pub(crate) texels: String,
+    pub(crate) texel: String,
     height: f64,
     /// The edge of a uv tile (the sphere's area over its tile count, square rooted).
     tile: f64,
-    base_color: String,
-    method: String,
+    pub(crate) base_color: String,
+    pub(crate) method: String,
 }
 
 /// The preset `name` (see [`presets`]), or an error listing them.
-fn look(name: &str) -> Result<Look> {
+pub(crate) fn look(name: &str) -> Result<Look> {
     let rel = format!("scenes/presets/{name}.ron");
     let Some(text) = crate::gpu::sources::embedded(&rel) else {
         return Err(Error::Invalid(format!("no preset `{name}`: expected one of {}", presets().join(", "))));

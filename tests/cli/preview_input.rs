@@ -265,3 +265,48 @@ fn the_panel_refuses_bad_values_and_yields_to_the_file() {
     assert!(!String::from_utf8_lossy(&out.stderr).contains("panicked"));
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// Moss on a UV-less glb in one command, then edited in the panel without opening the RON file
+/// (issue 32's goal): `import --preset moss`, the preview on the scene, the moss's bright colour
+/// typed into its field; the file gets the value (its comments kept), and the frame changes.
+#[test]
+fn moss_imported_in_one_command_is_edited_in_the_panel() {
+    let dir = common::scratch_dir("voltex-moss-panel");
+    let mesh = crate::assets::uvless_glb(&dir);
+    let scene = dir.join("mossy.ron");
+    common::ok(common::voltex(&[
+        "import",
+        common::s(&mesh),
+        "--preset",
+        "moss",
+        "-o",
+        common::s(&scene),
+        "-q",
+    ]));
+    let original = text(&scene);
+    assert!(original.contains("color_high: (0.45, 0.62, 0.2)"), "{original}");
+    let mut p = Preview::start(&scene, "40x40", dir.join("frames"), &[]);
+    p.frame(0);
+    p.focus();
+    let field = "texels[\"moss\"].source.color_high[0]";
+    let n = p.until("the moss's colour field", |p, n| p.state(n)["editors"][field].is_array());
+    let before = pixels(&p, n);
+    let (x0, y0, x1, y1) = widget(&p, n, field);
+    let (cx, cy) = (format!("{}", (0.5 * (x0 + x1)).round()), format!("{}", (0.5 * (y0 + y1)).round()));
+    p.after(|p| {
+        p.xdo(&["mousemove", &cx, &cy, "click", "1"]);
+        // The field takes the keyboard in the panel's next frame.
+        std::thread::sleep(std::time::Duration::from_millis(1500));
+        p.xdo(&["key", "ctrl+a", "1", "Return"]);
+    });
+    let path = scene.clone();
+    let n = p.until("the edit in the file", move |_, _| text(&path).contains("color_high: (1.0, 0.62, 0.2)"));
+    let after = pixels(&p, n);
+    let out = p.stop();
+    let edited = text(&scene);
+    // Only that value changed: the import's comments and the rest stay.
+    assert_eq!(edited, original.replace("color_high: (0.45, 0.62, 0.2)", "color_high: (1.0, 0.62, 0.2)"));
+    assert!(changed(&before, &after) > 20, "the redder moss changed nothing on screen");
+    assert!(!String::from_utf8_lossy(&out.stderr).contains("panicked"));
+    std::fs::remove_dir_all(&dir).ok();
+}
