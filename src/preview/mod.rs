@@ -6,6 +6,7 @@ pub(crate) mod curves;
 pub(crate) mod difference;
 pub(crate) mod editor;
 pub(crate) mod gui;
+pub(crate) mod items;
 pub(crate) mod knobs;
 pub mod latency;
 pub(crate) mod looks;

@@ -199,6 +199,9 @@ fn contents(ui: &mut egui::Ui, cx: &mut Cx, view: &PanelView) {
         }
     }
     if let Some(o) = view.objects.get(view.selected) {
+        if let Some((Step::Index(i), list)) = o.node.split_last() {
+            item_buttons(ui, cx, list, *i, " object");
+        }
         if let Some(node) = tree.at(&o.node, cx.src) {
             object(ui, cx, tree, node, &o.node);
         }
@@ -340,10 +343,13 @@ fn value(ui: &mut egui::Ui, cx: &mut Cx, name: &str, v: &Value, path: &[Step]) {
                 if matches!(item.kind, Kind::Atom) {
                     field(ui, cx, &label, item, &p);
                 } else {
-                    egui::CollapsingHeader::new(label)
-                        .id_salt(st::show(&p))
-                        .default_open(true)
-                        .show(ui, |ui| value(ui, cx, name, item, &p));
+                    egui::CollapsingHeader::new(label).id_salt(st::show(&p)).default_open(true).show(
+                        ui,
+                        |ui| {
+                            item_buttons(ui, cx, path, i, "");
+                            value(ui, cx, name, item, &p)
+                        },
+                    );
                 }
             }
         }
@@ -628,5 +634,24 @@ fn looks(ui: &mut egui::Ui, cx: &mut Cx, tree: &Value, node: &Value, path: &[Ste
                 }
             }
         });
+    });
+}
+
+/// Buttons that duplicate or remove item `index` of the list at `list` (`what` names it).
+fn item_buttons(ui: &mut egui::Ui, cx: &mut Cx, list: &[Step], index: usize, what: &str) {
+    let src = cx.src;
+    let item = st::show(&[list, &[Step::Index(index)]].concat());
+    ui.horizontal(|ui| {
+        let duplicate = ui.small_button(format!("duplicate{what}"));
+        let remove = ui.small_button(format!("remove{what}"));
+        // Where they are, for the window tests (`--record`'s editors).
+        cx.rects.push((format!("{item} duplicate"), duplicate.rect));
+        cx.rects.push((format!("{item} remove"), remove.rect));
+        if duplicate.clicked() {
+            push_edit(cx, super::items::duplicate(src, list, index), false);
+        }
+        if remove.clicked() {
+            push_edit(cx, super::items::remove(src, list, index), false);
+        }
     });
 }

@@ -310,3 +310,38 @@ fn moss_imported_in_one_command_is_edited_in_the_panel() {
     assert!(!String::from_utf8_lossy(&out.stderr).contains("panicked"));
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// The panel duplicates and removes objects (issue 32, item 2): "duplicate object" writes a
+/// copy of the selected node with a free name after it, undo takes it back, "remove object"
+/// on the copy removes it.
+#[test]
+fn the_panel_duplicates_and_removes_an_object() {
+    let (dir, scene, mut p) = start("voltex-panel-items");
+    let original = text(&scene);
+    let click = |p: &Preview, n: usize, path: &str| {
+        let (x0, y0, x1, y1) = widget(p, n, path);
+        let (cx, cy) = (format!("{}", (0.5 * (x0 + x1)).round()), format!("{}", (0.5 * (y0 + y1)).round()));
+        p.xdo(&["mousemove", &cx, &cy, "click", "1"]);
+    };
+    let n = p.until("the object's buttons", |p, n| p.state(n)["editors"]["nodes[0] duplicate"].is_array());
+    p.after(|p| click(p, n, "nodes[0] duplicate"));
+    let path = scene.clone();
+    p.until("a copy in the file", move |_, _| text(&path).contains("name: \"ground_2\""));
+    let copied = text(&scene);
+    assert_eq!(copied.matches("name: \"ground").count(), 2, "{copied}");
+    p.after(|p| drop(p.xdo(&["key", "ctrl+z"])));
+    let (path, want) = (scene.clone(), original.clone());
+    p.until("undone", move |_, _| text(&path) == want);
+    p.after(|p| drop(p.xdo(&["key", "ctrl+shift+z"])));
+    let (path, want) = (scene.clone(), copied.clone());
+    p.until("redone", move |_, _| text(&path) == want);
+    // The copy is nodes[1]: select it (Tab), remove it.
+    p.after(|p| drop(p.xdo(&["key", "Tab"])));
+    let n = p.until("the copy selected", |p, m| p.state(m)["editors"]["nodes[1] remove"].is_array());
+    p.after(|p| click(p, n, "nodes[1] remove"));
+    let path = scene.clone();
+    p.until("the copy removed", move |_, _| text(&path) == original);
+    let out = p.stop();
+    assert!(!String::from_utf8_lossy(&out.stderr).contains("panicked"));
+    std::fs::remove_dir_all(&dir).ok();
+}
