@@ -108,19 +108,27 @@ fn interact(
     id: egui::Id,
 ) -> Option<Gesture> {
     let at = resp.interact_pointer_pos().or(resp.hover_pos())?;
+    // A drag's point and where it was grabbed from the point's centre: the point moves with the
+    // pointer by as much as the pointer moves (a grab a few pixels off does not make it jump).
+    type Grab = Option<(usize, usize, [f32; 2])>;
     if resp.drag_started() {
         // The point under the press, not under the pointer once it has moved enough to drag.
         let origin = ui.input(|i| i.pointer.press_origin()).unwrap_or(at);
-        ui.data_mut(|d| d.insert_temp(id, pick(r, curves, origin)));
+        let grab: Grab = pick(r, curves, origin).map(|(c, i)| {
+            let p = curves[c].points[i];
+            let off = to_screen(r, p[0], p[1]) - origin;
+            (c, i, [off.x, off.y])
+        });
+        ui.data_mut(|d| d.insert_temp(id, grab));
     }
-    let dragging: Option<Option<(usize, usize)>> = ui.data(|d| d.get_temp(id));
+    let dragging: Option<Grab> = ui.data(|d| d.get_temp(id));
     if resp.drag_stopped() {
-        ui.data_mut(|d| d.remove::<Option<(usize, usize)>>(id));
+        ui.data_mut(|d| d.remove::<Grab>(id));
     }
     // The frame a drag stops in may hold its last move.
     if resp.dragged() || resp.drag_stopped() {
-        if let Some(Some((c, i))) = dragging {
-            let (mut x, y) = from_screen(r, at);
+        if let Some(Some((c, i, off))) = dragging {
+            let (mut x, y) = from_screen(r, at + egui::vec2(off[0], off[1]));
             let pts = &curves[c].points;
             // x stays strictly between the neighbours' (the file's points are sorted by x).
             let lo = if i > 0 { pts[i - 1][0] + 0.001 } else { 0.0 };
