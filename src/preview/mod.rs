@@ -15,6 +15,7 @@ pub(crate) mod panel;
 pub mod present;
 pub mod scene_text;
 pub(crate) mod session;
+pub(crate) mod tooltips;
 pub mod watch;
 pub mod window;
 

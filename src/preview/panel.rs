@@ -71,6 +71,8 @@ pub(crate) struct Cx<'a> {
     pub(crate) actions: Vec<Action>,
     /// Screen rectangles of the curve editors and number fields by path (window tests drive them).
     pub(crate) rects: Vec<(String, egui::Rect)>,
+    /// The type of the struct whose fields are being shown (for the fields' tooltips).
+    owner: Option<String>,
 }
 
 /// Defaults of fields a file may leave out, by the struct's variant name (unnamed structs: the
@@ -146,6 +148,7 @@ pub(crate) fn show(root: &mut egui::Ui, view: &PanelView) -> (Vec<Action>, Vec<(
         refused: view.refused,
         actions: Vec::new(),
         rects: Vec::new(),
+        owner: None,
     };
     egui::Panel::right("voltex-panel").exact_size(WIDTH).resizable(false).show(root, |ui| {
         egui::ScrollArea::vertical().show(ui, |ui| contents(ui, &mut cx, view));
@@ -282,21 +285,29 @@ fn field(ui: &mut egui::Ui, cx: &mut Cx, name: &str, v: &Value, path: &[Step]) {
         && !v.items().is_empty()
         && v.items().len() <= 4
         && v.items().iter().all(|i| i.number(src).is_some());
+    // What the scene-file reference says of the field, on hover.
+    let tip = super::tooltips::tooltip(name, cx.owner.as_deref());
+    let with_tip = |r: egui::Response| match &tip {
+        Some(t) => r.on_hover_text(t),
+        None => r,
+    };
     if small_tuple || matches!(v.kind, Kind::Atom) {
         ui.horizontal(|ui| {
-            ui.label(name);
+            with_tip(ui.label(name));
             value(ui, cx, name, v, path);
         });
         if let Some(msg) = refused_here(cx, path) {
             ui.colored_label(Color32::from_rgb(255, 110, 90), msg);
         }
     } else {
-        egui::CollapsingHeader::new(name).id_salt(st::show(path)).default_open(true).show(ui, |ui| {
-            value(ui, cx, name, v, path);
-            if let Some(msg) = refused_here(cx, path) {
-                ui.colored_label(Color32::from_rgb(255, 110, 90), msg);
-            }
-        });
+        let shown =
+            egui::CollapsingHeader::new(name).id_salt(st::show(path)).default_open(true).show(ui, |ui| {
+                value(ui, cx, name, v, path);
+                if let Some(msg) = refused_here(cx, path) {
+                    ui.colored_label(Color32::from_rgb(255, 110, 90), msg);
+                }
+            });
+        with_tip(shown.header_response);
     }
 }
 
@@ -414,6 +425,7 @@ fn structure(ui: &mut egui::Ui, cx: &mut Cx, v: &Value, path: &[Step]) {
             ui.colored_label(Color32::from_rgb(255, 110, 90), msg);
         }
     }
+    let outer = std::mem::replace(&mut cx.owner, key.map(str::to_string));
     for (i, f) in fields.iter().enumerate() {
         match &f.name {
             Some(n) if n == "enabled" && key == Some("Noise") => {}
@@ -421,6 +433,7 @@ fn structure(ui: &mut egui::Ui, cx: &mut Cx, v: &Value, path: &[Step]) {
             None => field(ui, cx, &format!("{i}"), &f.value, &[path, &[Step::Index(i)]].concat()),
         }
     }
+    cx.owner = outer;
     let Some(defaults) = key.and_then(defaults_of) else { return };
     for (name, default) in defaults {
         if fields.iter().any(|f| f.name.as_deref() == Some(name)) {
