@@ -59,6 +59,21 @@ fn widget(p: &Preview, n: usize, path: &str) -> (f64, f64, f64, f64) {
     (v[0], v[1], v[2], v[3])
 }
 
+/// Clicks the middle of widget `path` of frame `n`.
+fn click(p: &Preview, n: usize, path: &str) {
+    let (x0, y0, x1, y1) = widget(p, n, path);
+    let (cx, cy) = (format!("{}", (0.5 * (x0 + x1)).round()), format!("{}", (0.5 * (y0 + y1)).round()));
+    p.xdo(&["mousemove", &cx, &cy, "click", "1"]);
+}
+
+/// Clicks number field `path` of frame `n`, selects its text and types `value` and Enter.
+fn type_into(p: &Preview, n: usize, path: &str, value: &str) {
+    click(p, n, path);
+    // The field takes the keyboard in the panel's next frame.
+    std::thread::sleep(std::time::Duration::from_millis(1500));
+    p.xdo(&["key", "ctrl+a", value, "Return"]);
+}
+
 fn start(name: &str) -> (std::path::PathBuf, std::path::PathBuf, Preview) {
     let dir = common::scratch_dir(name);
     let scene = dir.join("scene.ron");
@@ -227,16 +242,9 @@ fn keys_and_a_curve_drag_edit_the_scene_file() {
 fn the_panel_refuses_bad_values_and_yields_to_the_file() {
     let (dir, scene, mut p) = start("voltex-panel-bad");
     let planes = "nodes[0].method.planes";
-    let (x0, y0, x1, y1) = widget(&p, 0, planes);
-    let (cx, cy) = (format!("{}", (0.5 * (x0 + x1)).round()), format!("{}", (0.5 * (y0 + y1)).round()));
     let original = text(&scene);
     // Click to type into the field, select its text, type 0, press Enter.
-    p.after(|p| {
-        p.xdo(&["mousemove", &cx, &cy, "click", "1"]);
-        // The field takes the keyboard in the panel's next frame.
-        std::thread::sleep(std::time::Duration::from_millis(1500));
-        p.xdo(&["key", "ctrl+a", "0", "Return"]);
-    });
+    p.after(|p| type_into(p, 0, planes, "0"));
     let n = p.until("refused", |p, n| !p.state(n)["refused"].is_null());
     let s = p.state(n);
     assert_eq!(text(&scene), original, "an out-of-range value was written");
@@ -297,14 +305,7 @@ fn moss_imported_in_one_command_is_edited_in_the_panel() {
     let field = "texels[\"moss\"].source.color_high[0]";
     let n = p.until("the moss's colour field", |p, n| p.state(n)["editors"][field].is_array());
     let before = pixels(&p, n);
-    let (x0, y0, x1, y1) = widget(&p, n, field);
-    let (cx, cy) = (format!("{}", (0.5 * (x0 + x1)).round()), format!("{}", (0.5 * (y0 + y1)).round()));
-    p.after(|p| {
-        p.xdo(&["mousemove", &cx, &cy, "click", "1"]);
-        // The field takes the keyboard in the panel's next frame.
-        std::thread::sleep(std::time::Duration::from_millis(1500));
-        p.xdo(&["key", "ctrl+a", "1", "Return"]);
-    });
+    p.after(|p| type_into(p, n, field, "1"));
     let path = scene.clone();
     let n = p.until("the edit in the file", move |_, _| text(&path).contains("color_high: (1.0, 0.62, 0.2)"));
     let after = pixels(&p, n);
@@ -324,11 +325,6 @@ fn moss_imported_in_one_command_is_edited_in_the_panel() {
 fn the_panel_duplicates_and_removes_an_object() {
     let (dir, scene, mut p) = start("voltex-panel-items");
     let original = text(&scene);
-    let click = |p: &Preview, n: usize, path: &str| {
-        let (x0, y0, x1, y1) = widget(p, n, path);
-        let (cx, cy) = (format!("{}", (0.5 * (x0 + x1)).round()), format!("{}", (0.5 * (y0 + y1)).round()));
-        p.xdo(&["mousemove", &cx, &cy, "click", "1"]);
-    };
     let n = p.until("the object's buttons", |p, n| p.state(n)["editors"]["nodes[0] duplicate"].is_array());
     p.after(|p| click(p, n, "nodes[0] duplicate"));
     let path = scene.clone();
