@@ -12,6 +12,7 @@ pub mod latency;
 pub(crate) mod looks;
 pub(crate) mod measure_ui;
 pub(crate) mod panel;
+pub(crate) mod pick;
 pub mod present;
 pub mod scene_text;
 pub(crate) mod session;

@@ -120,6 +120,8 @@ struct State {
     rects: Vec<(String, egui::Rect)>,
     status: String,
     drag: Option<(MouseButton, (f64, f64))>,
+    /// Where the last press on the image was (a release there is a click).
+    pressed_at: Option<(f64, f64)>,
     cursor: (f64, f64),
     modifiers: ModifiersState,
     recorded: usize,
@@ -198,9 +200,17 @@ impl ApplicationHandler for App {
                 let on_image = !s.panel || s.cursor.0 < s.image_width() as f64;
                 if state == ElementState::Pressed && on_image {
                     s.drag = Some((button, s.cursor));
+                    s.pressed_at = Some(s.cursor);
                     s.session.draft = s.session.draft_scale();
                 } else if state == ElementState::Released {
                     s.drag = None;
+                    // A click (the pointer moved under 3 pixels) selects what is under it.
+                    let at = s.pressed_at.take();
+                    if button == MouseButton::Left
+                        && at.is_some_and(|(x, y)| (x - s.cursor.0).hypot(y - s.cursor.1) < 3.0)
+                    {
+                        s.select_at(s.cursor);
+                    }
                     s.refine();
                 }
             }
@@ -351,6 +361,7 @@ impl State {
             rects: Vec::new(),
             status: String::new(),
             drag: None,
+            pressed_at: None,
             cursor: (0.0, 0.0),
             modifiers: ModifiersState::empty(),
             recorded: 0,
@@ -895,6 +906,32 @@ impl State {
             nodes.into_iter().find(|(n, _)| *n == name).map(|(_, p)| p)
         });
         Some((name, m, node))
+    }
+
+    /// Selects the textured object whose shell is under window position `at`, if any.
+    fn select_at(&mut self, at: (f64, f64)) {
+        let (Some(cam), Some(r)) = (self.session.options.camera.or(self.home), self.session.renderer())
+        else {
+            return;
+        };
+        // The image as the presenter fits it into its area (aspect kept, centred).
+        let (w, h) = (r.blueprint.size.0 as f64, r.blueprint.size.1 as f64);
+        let area = (self.image_width() as f64, self.config.height as f64);
+        let scale = (area.0 / w).min(area.1 / h);
+        let pixel =
+            ((at.0 - 0.5 * (area.0 - w * scale)) / scale, (at.1 - 0.5 * (area.1 - h * scale)) / scale);
+        if !(0.0..w).contains(&pixel.0) || !(0.0..h).contains(&pixel.1) {
+            return;
+        }
+        let objects: Vec<_> = r.blueprint.objects.iter().map(|o| &o.object).collect();
+        let Some(i) = super::pick::pick(&objects, &cam, r.blueprint.size, pixel) else { return };
+        let name = objects[i].name.clone();
+        if let Some(k) = self.methods().iter().position(|(n, _)| *n == name) {
+            self.selected = k;
+            self.status = format!("selected {name}");
+            self.record_next = true;
+            self.window.request_redraw();
+        }
     }
 
     fn set_mode(&mut self, mode: Mode) {

@@ -347,3 +347,42 @@ fn the_panel_duplicates_and_removes_an_object() {
     assert!(!String::from_utf8_lossy(&out.stderr).contains("panicked"));
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// A click on the image selects the textured object under the pointer (issue 32, item 2): with
+/// the ball selected (Tab), a click where the ground's shell is (a point on its top, projected
+/// through the scene's camera) selects the ground.
+#[test]
+fn a_click_in_the_view_selects_the_object_under_it() {
+    let (dir, _scene, mut p) = start("voltex-click-select");
+    let mut n = 0;
+    for _ in 0..4 {
+        p.after(|p| drop(p.xdo(&["key", "Tab"])));
+        if let Ok(m) = p.within(10, "ball selected", |p, n| p.state(n)["selected"] == "ball") {
+            n = m;
+            break;
+        }
+    }
+    assert_eq!(p.state(n)["selected"], "ball");
+    // The ground's top at (0.6, -0.6, 0.3), through the camera of SCENE (a pinhole, 40x40), into
+    // the window: the image fits the area left of the panel (340 pixels), centred.
+    let (eye, target, up) =
+        (glam::DVec3::new(0.0, -3.0, 1.6), glam::DVec3::new(0.0, 0.0, 0.2), glam::DVec3::Z);
+    let f = (target - eye).normalize();
+    let r = f.cross(up).normalize();
+    let u = r.cross(f);
+    let focal = 20.0 / (20f64.to_radians()).tan();
+    let d = glam::DVec3::new(0.6, -0.6, 0.3) - eye;
+    let pixel = (20.0 + focal * d.dot(r) / d.dot(f), 20.0 - focal * d.dot(u) / d.dot(f));
+    let (w, h, _) = voltex::io::png::read_rgba8(&p.record.join(format!("frame-{n}.png"))).unwrap();
+    let area = (w as f64 - 340.0, h as f64);
+    let scale = (area.0 / 40.0).min(area.1 / 40.0);
+    let at =
+        (0.5 * (area.0 - 40.0 * scale) + pixel.0 * scale, 0.5 * (area.1 - 40.0 * scale) + pixel.1 * scale);
+    let (x, y) = (format!("{}", at.0.round()), format!("{}", at.1.round()));
+    p.after(|p| drop(p.xdo(&["mousemove", &x, &y, "click", "1"])));
+    let n = p.until("the ground selected", |p, n| p.state(n)["selected"] == "ground");
+    assert_eq!(p.state(n)["status"], "selected ground");
+    let out = p.stop();
+    assert!(!String::from_utf8_lossy(&out.stderr).contains("panicked"));
+    std::fs::remove_dir_all(&dir).ok();
+}
