@@ -311,7 +311,8 @@ pub(crate) fn color_ramp(ui: &mut egui::Ui, cx: &mut Cx, v: &Value, path: &[Step
 }
 
 /// A 2D shape function (rows by density from 0 at the top, columns by noise value) as an image.
-pub(crate) fn grid_image(ui: &mut egui::Ui, rows: &[Vec<f64>], key: &str) {
+pub(crate) fn grid_image(ui: &mut egui::Ui, cx: &mut Cx, rows: &[Vec<f64>], path: &[Step], paint: bool) {
+    let key = st::show(path);
     let (h, w) = (rows.len(), rows.first().map_or(0, Vec::len));
     if h == 0 || w == 0 {
         return;
@@ -326,20 +327,61 @@ pub(crate) fn grid_image(ui: &mut egui::Ui, rows: &[Vec<f64>], key: &str) {
         (w, h).hash(&mut s);
         s.finish()
     };
-    let id = ui.scope_id().with(("grid", key));
+    let id = ui.scope_id().with(("grid", &key));
     let cached: Option<(u64, egui::TextureHandle)> = ui.data(|d| d.get_temp(id));
     let tex = match cached {
         Some((k, t)) if k == hash => t,
         _ => {
-            let t = ui.ctx().load_texture(key, image, egui::TextureOptions::NEAREST);
+            let t = ui.ctx().load_texture(&key, image, egui::TextureOptions::NEAREST);
             ui.data_mut(|d| d.insert_temp(id, (hash, t.clone())));
             t
         }
     };
+    // The brush's density (a `Grid` is painted as the paper paints its 2D transfer functions).
+    let brush_id = id.with("brush");
+    let mut brush: f64 = ui.data(|d| d.get_temp(brush_id)).unwrap_or(1.0);
+    if paint {
+        ui.horizontal(|ui| {
+            ui.label("brush");
+            if ui.add(egui::Slider::new(&mut brush, 0.0..=1.0).max_decimals(2)).changed() {
+                ui.data_mut(|d| d.insert_temp(brush_id, brush));
+            }
+        });
+    }
     let width = ui.available_width().max(120.0);
     let size = Vec2::new(width, (width * h as f32 / w as f32).clamp(24.0, 160.0));
-    let (resp, painter) = ui.allocate_painter(size, Sense::hover());
+    let sense = if paint { Sense::click_and_drag() } else { Sense::hover() };
+    let (resp, painter) = ui.allocate_painter(size, sense);
     painter.image(tex.id(), resp.rect, Rect::from_min_max(pos2(0.0, 0.0), pos2(1.0, 1.0)), Color32::WHITE);
     painter.rect_stroke(resp.rect, 0.0, Stroke::new(1.0, Color32::from_gray(90)), StrokeKind::Inside);
-    ui.small(format!("{h} densities (top: 0) x {w} noise values (left: 0)"));
+    cx.rects.push((key.clone(), resp.rect));
+    ui.small(if paint {
+        format!("{h} densities (top: 0) x {w} noise values (left: 0): paint with the brush, right button: 0")
+    } else {
+        format!("{h} densities (top: 0) x {w} noise values (left: 0)")
+    });
+    if !paint {
+        return;
+    }
+    // The cell under the pointer takes the brush's value (0 with the right button); a stroke is
+    // one undo step, as a curve drag is.
+    let pressed = resp.dragged() || resp.clicked() || resp.secondary_clicked() || resp.drag_stopped();
+    if let (true, Some(at)) = (pressed, resp.interact_pointer_pos()) {
+        let r = resp.rect;
+        let col = (((at.x - r.left()) / r.width()) * w as f32).floor().clamp(0.0, w as f32 - 1.0) as usize;
+        let row = (((at.y - r.top()) / r.height()) * h as f32).floor().clamp(0.0, h as f32 - 1.0) as usize;
+        let erase = resp.secondary_clicked() || ui.input(|i| i.pointer.secondary_down());
+        let value = if erase { 0.0 } else { brush };
+        if (rows[row][col] - value).abs() > 1e-9 {
+            let cell = [path, &[Step::Index(0), Step::Index(row), Step::Index(col)]].concat();
+            let text = st::format_number(value, "0.0");
+            match st::set(cx.src, &cell, &text) {
+                Ok(edit) => cx.actions.push(Action::Edit { edit, live: resp.dragged() }),
+                Err(e) => cx.actions.push(Action::Note(e.to_string())),
+            }
+        }
+    }
+    if resp.drag_stopped() {
+        cx.actions.push(Action::EndGesture);
+    }
 }

@@ -340,7 +340,8 @@ fn value(ui: &mut egui::Ui, cx: &mut Cx, name: &str, v: &Value, path: &[Step]) {
         Kind::Paren { name: Some(n), .. } if n == "Grid" || n == "Image" => {
             choice(ui, cx, v, path);
             let rows = grid_rows(cx, v, path);
-            super::curves::grid_image(ui, &rows, &st::show(path));
+            // A `Grid` is painted in the panel; an `Image` is its file's.
+            super::curves::grid_image(ui, cx, &rows, path, n == "Grid");
         }
         Kind::Paren { .. } => structure(ui, cx, v, path),
         Kind::List(items) => {

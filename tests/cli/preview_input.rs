@@ -386,3 +386,31 @@ fn a_click_in_the_view_selects_the_object_under_it() {
     assert!(!String::from_utf8_lossy(&out.stderr).contains("panicked"));
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// A 2D shape function (`Grid`) is painted in the panel (Gilet & Dischler's Figure 6; issue 32,
+/// item 2): a click on a cell of its image writes the brush's density (1 by default) into that
+/// cell of the file, and nothing else changes.
+#[test]
+fn a_grid_shape_is_painted_in_the_panel() {
+    let dir = common::scratch_dir("voltex-grid-paint");
+    let scene = dir.join("grid.ron");
+    let original = text(&common::root().join("scenes/hypertextures/fig7_2d_transfer.ron"));
+    std::fs::write(&scene, &original).unwrap();
+    let mut p = Preview::start(&scene, "24x16", dir.join("frames"), &[]);
+    p.frame(0);
+    p.focus();
+    let grid = "hypertextures[\"constant\"].noises[0].shape";
+    let n = p.until("the grid's image", |p, n| p.state(n)["editors"][grid].is_array());
+    // Row 0 (density 0, at the top), column 0 (noise 0, at the left) of a 2 x 5 grid.
+    let (x0, y0, x1, y1) = widget(&p, n, grid);
+    let (x, y) =
+        (format!("{}", (x0 + 0.1 * (x1 - x0)).round()), format!("{}", (y0 + 0.25 * (y1 - y0)).round()));
+    p.after(|p| drop(p.xdo(&["mousemove", &x, &y, "click", "1"])));
+    let (path, before) = (scene.clone(), original.clone());
+    p.until("the cell painted", move |_, _| text(&path) != before);
+    let painted = original.replacen("Grid([[0.0, 0.0, 0.0, 0.5, 1.0]", "Grid([[1.0, 0.0, 0.0, 0.5, 1.0]", 1);
+    assert_eq!(text(&scene), painted);
+    let out = p.stop();
+    assert!(!String::from_utf8_lossy(&out.stderr).contains("panicked"));
+    std::fs::remove_dir_all(&dir).ok();
+}
