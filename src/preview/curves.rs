@@ -14,12 +14,22 @@ use crate::types::{TransferFunction, TransferPoint};
 const PICK: f32 = 8.0;
 /// Height of a curve editor.
 const HEIGHT: f32 = 130.0;
+/// Pixels from a point to its tangent's handle.
+const HANDLE: f32 = 18.0;
+/// The steepest slope a tangent's handle sets (curve units).
+const MAX_SLOPE: f64 = 50.0;
 
 /// One curve of an editor: its control points (x, y) and how the points read and write.
 struct Curve {
     color: Color32,
     points: Vec<[f64; 3]>,
     kind: u32,
+}
+
+/// Where point `p`'s tangent handle is drawn: [`HANDLE`] pixels along its slope, rightwards.
+fn tangent_handle(r: Rect, p: &[f64; 3]) -> Pos2 {
+    let dir = Vec2::new(r.width(), -(p[2] as f32) * r.height()).normalized();
+    to_screen(r, p[0], p[1]) + dir * HANDLE
 }
 
 fn to_screen(r: Rect, x: f64, y: f64) -> Pos2 {
@@ -208,8 +218,41 @@ pub(crate) fn shape_curve(ui: &mut egui::Ui, cx: &mut Cx, v: &Value, path: &[Ste
     let (resp, painter, r) = area(ui);
     cx.rects.push((st::show(path), resp.rect));
     draw(&painter, r, &curves[0]);
+    // Each point's tangent as a handle: dragged, it sets the point's slope.
+    for p in &points {
+        let (at, end) = (to_screen(r, p[0], p[1]), tangent_handle(r, p));
+        painter.line_segment([at, end], Stroke::new(1.0, Color32::from_gray(160)));
+        painter.circle_stroke(end, 3.0, Stroke::new(1.0, Color32::from_gray(200)));
+    }
+    let tangent_id = resp.id.with("tangent");
+    if resp.drag_started() {
+        let origin = ui.input(|i| i.pointer.press_origin()).unwrap_or(r.center());
+        // A handle, unless a point is under the press (points win).
+        let grabbed = (pick(r, &curves, origin).is_none())
+            .then(|| points.iter().position(|p| tangent_handle(r, p).distance(origin) <= PICK))
+            .flatten();
+        ui.data_mut(|d| d.insert_temp(tangent_id, grabbed));
+    }
+    let tangent: Option<usize> = ui.data(|d| d.get_temp(tangent_id)).flatten();
+    if resp.drag_stopped() {
+        ui.data_mut(|d| d.remove::<Option<usize>>(tangent_id));
+    }
     let id = resp.id.with("drag");
-    if let Some(g) = interact(ui, &resp, r, &curves, id) {
+    if let (Some(i), Some(at)) = (tangent, resp.interact_pointer_pos()) {
+        if resp.dragged() || resp.drag_stopped() {
+            let p = points[i];
+            let v = at - to_screen(r, p[0], p[1]);
+            // In the curve's units; a handle pulled to or past the vertical is steep, not reversed.
+            let (dx, dy) = ((v.x / r.width()).max(1e-3) as f64, (-v.y / r.height()) as f64);
+            let slope = (dy / dx).clamp(-MAX_SLOPE, MAX_SLOPE);
+            let text = format!("({}, {}, {})", num(p[0]), num(p[1]), num(slope));
+            let point = [list_path.as_slice(), &[Step::Index(i)]].concat();
+            match st::set(src, &point, &text) {
+                Ok(edit) => cx.actions.push(Action::Edit { edit, live: resp.dragged() }),
+                Err(e) => cx.actions.push(Action::Note(e.to_string())),
+            }
+        }
+    } else if let Some(g) = interact(ui, &resp, r, &curves, id) {
         let slope_text =
             |i: usize| list.items()[i].items().get(2).map_or("0.0".to_string(), |s| s.text(src).to_string());
         act(
@@ -231,7 +274,7 @@ pub(crate) fn shape_curve(ui: &mut egui::Ui, cx: &mut Cx, v: &Value, path: &[Ste
     if resp.drag_stopped() {
         cx.actions.push(Action::EndGesture);
     }
-    ui.small("drag a point; double click: add; right click: delete");
+    ui.small("drag a point or its tangent's handle; double click: add; right click: delete");
 }
 
 /// `Ramp([(density, (r, g, b, a)), ..])` at `path`: one curve per channel.

@@ -74,6 +74,11 @@ fn type_into(p: &Preview, n: usize, path: &str, value: &str) {
     p.xdo(&["key", "ctrl+a", value, "Return"]);
 }
 
+/// A pause between the steps of a drag (the window sees each move).
+fn pause() {
+    std::thread::sleep(std::time::Duration::from_millis(200));
+}
+
 fn start(name: &str) -> (std::path::PathBuf, std::path::PathBuf, Preview) {
     let dir = common::scratch_dir(name);
     let scene = dir.join("scene.ron");
@@ -149,7 +154,6 @@ fn keys_and_a_curve_drag_edit_the_scene_file() {
     // An orbit drag on the image moves the view, not the file; R resets it; C writes it.
     let file = text(&scene);
     // A hand moves over time: events all at once are merged by the X server.
-    let pause = || std::thread::sleep(std::time::Duration::from_millis(200));
     let orbit = |p: &Preview| {
         p.xdo(&["mousemove", "200", "360", "mousedown", "1"]);
         for x in ["230", "260"] {
@@ -410,6 +414,49 @@ fn a_grid_shape_is_painted_in_the_panel() {
     p.until("the cell painted", move |_, _| text(&path) != before);
     let painted = original.replacen("Grid([[0.0, 0.0, 0.0, 0.5, 1.0]", "Grid([[1.0, 0.0, 0.0, 0.5, 1.0]", 1);
     assert_eq!(text(&scene), painted);
+    let out = p.stop();
+    assert!(!String::from_utf8_lossy(&out.stderr).contains("panicked"));
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// A curve point's tangent has a handle (issue 32: new points got slope 0 and slopes could not be
+/// edited): dragging the peak's handle from its right down by as much as across sets the peak's
+/// slope to minus the editor's width over its height (one pixel of rounding aside).
+#[test]
+fn a_tangent_handle_sets_the_slope() {
+    let (dir, scene, mut p) = start("voltex-tangent");
+    let mut n = 0;
+    for _ in 0..4 {
+        p.after(|p| drop(p.xdo(&["key", "Tab"])));
+        if let Ok(m) = p.within(10, "ball selected", |p, n| p.state(n)["selected"] == "ball") {
+            n = m;
+            break;
+        }
+    }
+    let curve = "hypertextures[\"blob\"].noises[0].shape";
+    let n = p.until("the curve editor", |p, m| m >= n && p.state(m)["editors"][curve].is_array());
+    let (x0, y0, x1, y1) = widget(&p, n, curve);
+    // The plot is inset by 6 pixels; the peak (0.5, 1.0, slope 0) is at its top middle and its
+    // handle 18 pixels to its right.
+    let (w, h) = (x1 - x0 - 12.0, y1 - y0 - 12.0);
+    let (hx, hy) = ((x0 + 6.0 + 0.5 * w + 18.0).round(), (y0 + 6.0).round());
+    p.after(|p| {
+        p.xdo(&["mousemove", &format!("{hx}"), &format!("{hy}"), "mousedown", "1"]);
+        for k in 1..=3 {
+            pause();
+            p.xdo(&["mousemove", &format!("{hx}"), &format!("{}", hy + 6.0 * k as f64)]);
+        }
+        pause();
+        p.xdo(&["mouseup", "1"]);
+    });
+    let path = scene.clone();
+    p.until("the slope written", move |_, _| !text(&path).contains("(0.5, 1.0, 0.0)"));
+    let t = text(&scene);
+    let parsed = voltex::scene::parse(&t, &scene).unwrap();
+    let ShapeTransfer::Curve(c) = &parsed.hypertextures["blob"].noises[0].shape else { panic!() };
+    let want = -w / h;
+    assert!((c[1].0 - 0.5).abs() < 1e-9 && (c[1].1 - 1.0).abs() < 1e-9, "the point itself moved: {t}");
+    assert!((c[1].2 - want).abs() < 0.1 * want.abs(), "slope {} against {want}: {t}", c[1].2);
     let out = p.stop();
     assert!(!String::from_utf8_lossy(&out.stderr).contains("panicked"));
     std::fs::remove_dir_all(&dir).ok();
