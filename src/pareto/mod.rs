@@ -228,14 +228,20 @@ pub fn run(args: &Args) -> Result<()> {
     let truth = measure::image(&ctx, Blueprint::new(&scene, &args.truth_options())?)?;
     let mut rows = Vec::new();
     let mut progress = Progress::new(n, args.verbosity);
-    for (s, bp) in settings.into_iter().zip(blueprints) {
+    // Measured in an order that spreads cheap and costly settings (the ETA is the mean time of
+    // those done so far), reported in the sweep's order.
+    let order = spread(&settings.iter().map(|s| s.method).collect::<Vec<_>>());
+    let mut planned: Vec<Option<(Setting, Blueprint)>> =
+        settings.into_iter().zip(blueprints).map(Some).collect();
+    for i in order {
+        let (s, bp) = planned[i].take().expect("each setting once");
         let label = format!("{} {}", s.method, s.knobs);
         progress.started(&label);
         match measure_setting(&scene, args, &s, bp, &truth) {
             Ok(row) => {
                 let keep = args.verbosity == Verbosity::Verbose;
                 progress.finished(&label, &format!("{label}: {}", row.summary()), true, keep);
-                rows.push(row);
+                rows.push((i, row));
             }
             Err(e) => {
                 progress.finished(&label, &format!("{label}: not measured"), true, true);
@@ -246,6 +252,8 @@ pub fn run(args: &Args) -> Result<()> {
         }
     }
     progress.end();
+    rows.sort_by_key(|(i, _)| *i);
+    let mut rows: Vec<Row> = rows.into_iter().map(|(_, r)| r).collect();
     if rows.is_empty() {
         return Err(Error::Invalid(format!("nothing was measured: {}", notes.join("; "))));
     }
@@ -269,6 +277,37 @@ pub fn run(args: &Args) -> Result<()> {
     report::print_report(args, &ctx, &rows, &peer_rows, &notes, load);
     println!("wrote {}, {} and truth.png", csv_path.display(), svg_path.display());
     Ok(())
+}
+
+/// The order to measure settings in, given each one's method (settings of one method are in
+/// the sweep's order, cheapest first): the methods in turn, and within each method its sweep's
+/// ends alternately (first, last, second, second last, ...), so that the settings measured first
+/// are a fair sample of the costs and an ETA from their mean is not fooled by the cheap ones.
+fn spread(methods: &[&str]) -> Vec<usize> {
+    let mut groups: Vec<(&str, Vec<usize>)> = Vec::new();
+    for (i, m) in methods.iter().enumerate() {
+        match groups.iter_mut().find(|(g, _)| g == m) {
+            Some((_, v)) => v.push(i),
+            None => groups.push((m, vec![i])),
+        }
+    }
+    let zigzag: Vec<Vec<usize>> = groups
+        .iter()
+        .map(|(_, v)| {
+            let (mut lo, mut hi, mut out) = (0, v.len(), Vec::new());
+            while lo < hi {
+                out.push(v[lo]);
+                lo += 1;
+                if lo < hi {
+                    hi -= 1;
+                    out.push(v[hi]);
+                }
+            }
+            out
+        })
+        .collect();
+    let longest = zigzag.iter().map(Vec::len).max().unwrap_or(0);
+    (0..longest).flat_map(|k| zigzag.iter().filter_map(move |z| z.get(k).copied())).collect()
 }
 
 /// Times one setting and measures its error. On a fresh device, so that no render pass has run
@@ -333,4 +372,18 @@ fn note(notes: &mut Vec<String>, s: &Setting, e: &Error) -> Option<String> {
     }
     notes.push(line.clone());
     Some(format!("{line} ({})", s.knobs))
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn settings_are_spread_over_methods_and_costs_each_once() {
+        let methods = ["view", "view", "view", "view", "axis", "axis", "shell"];
+        let order = super::spread(&methods);
+        assert_eq!(order, vec![0, 4, 6, 3, 5, 1, 2]);
+        let mut sorted = order.clone();
+        sorted.sort();
+        assert_eq!(sorted, (0..methods.len()).collect::<Vec<_>>());
+        assert!(super::spread(&[]).is_empty());
+    }
 }
