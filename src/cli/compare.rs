@@ -15,10 +15,16 @@ pub struct CompareArgs {
     /// max_difference; for scripts such as tools/peers/).
     #[arg(long)]
     json: bool,
+    /// Print nothing (the heat map is still written; --json still prints its object).
+    #[arg(short, long)]
+    quiet: bool,
+    /// Also print the image size and the FLIP map's percentiles (median, 95th, 99th, largest).
+    #[arg(short, long, conflicts_with = "quiet")]
+    verbose: bool,
 }
 
 pub fn run(args: CompareArgs) -> Result<()> {
-    let CompareArgs { actual, reference, diff, json } = args;
+    let CompareArgs { actual, reference, diff, json, quiet, verbose } = args;
     let (a, _) = voltex::io::exr::read(&actual)?;
     let (r, _) = voltex::io::exr::read(&reference)?;
     let flip = metrics::flip(&a, &r)?;
@@ -41,7 +47,24 @@ pub fn run(args: CompareArgs) -> Result<()> {
         println!("{v}");
         return Ok(());
     }
+    if quiet {
+        return Ok(());
+    }
     println!("FLIP (mean)         {:.5}", flip.mean);
+    if verbose {
+        let mut sorted: Vec<f32> = flip.map.iter().copied().filter(|v| v.is_finite()).collect();
+        sorted.sort_by(f32::total_cmp);
+        let at =
+            |q: f64| sorted.get(((sorted.len() as f64 - 1.0) * q).round() as usize).copied().unwrap_or(0.0);
+        println!("size                {}x{}", a.width, a.height);
+        println!(
+            "FLIP percentiles    median {:.5}, 95th {:.5}, 99th {:.5}, largest {:.5}",
+            at(0.5),
+            at(0.95),
+            at(0.99),
+            at(1.0)
+        );
+    }
     println!("relative RMSE       {:.5}", metrics::relative_rmse(&a, &r)?);
     println!("largest difference  {:.3e}", metrics::max_abs_diff(&a, &r)?);
     println!("non-finite pixels   {} / {}", metrics::count_nonfinite(&a), metrics::count_nonfinite(&r));

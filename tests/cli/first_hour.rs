@@ -120,3 +120,27 @@ fn import_with_bare_names_writes_a_relative_mesh_path() {
     ok(voltex(&["plan", crate::common::s(&moved.join("dome.ron"))]));
     std::fs::remove_dir_all(&moved).unwrap();
 }
+
+/// `compare -q` prints nothing and still writes its heat map; `-v` adds the FLIP map's
+/// percentiles, in order, the largest at least the mean (issue 32, item 7: -q/-v everywhere).
+#[test]
+fn compare_takes_quiet_and_verbose() {
+    let dir = crate::common::scratch_dir("voltex-compare-qv");
+    let scene = root().join("scenes/view_slices/flat_box.ron").display().to_string();
+    let (a, b, heat) = (dir.join("a.exr"), dir.join("b.exr"), dir.join("heat.png"));
+    let s = crate::common::s;
+    ok(voltex(&["render", &scene, "--size", "16x16", "-o", s(&a), "-q"]));
+    ok(voltex(&["render", &scene, "--size", "16x16", "--planes", "8", "-o", s(&b), "-q"]));
+    let quiet = ok(voltex(&["compare", s(&a), s(&b), "-q", "--diff", s(&heat)]));
+    assert!(quiet.is_empty() && heat.exists(), "{quiet}");
+    let loud = ok(voltex(&["compare", s(&a), s(&b), "-v"]));
+    let number = |key: &str| -> f64 {
+        let at = loud.find(key).unwrap_or_else(|| panic!("no {key}: {loud}")) + key.len();
+        loud[at..].trim_start().split([',', '\n']).next().unwrap().trim().parse().unwrap()
+    };
+    let (mean, median, p95, p99, max) =
+        (number("FLIP (mean)"), number("median"), number("95th"), number("99th"), number("largest"));
+    assert!(median <= p95 && p95 <= p99 && p99 <= max && max >= mean && mean > 0.0, "{loud}");
+    assert!(!voltex(&["compare", s(&a), s(&b), "-q", "-v"]).status.success());
+    std::fs::remove_dir_all(&dir).unwrap();
+}
