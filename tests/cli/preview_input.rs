@@ -74,6 +74,19 @@ fn type_into(p: &Preview, n: usize, path: &str, value: &str) {
     p.xdo(&["key", "ctrl+a", value, "Return"]);
 }
 
+/// Tab until the ball is selected: the frame that shows it. The first key after the window's
+/// focus can be lost on a loaded machine (the selection stayed "ground" for 30 s beside two fuzz
+/// campaigns): again, then.
+fn select_ball(p: &mut Preview) -> usize {
+    for _ in 0..4 {
+        let after = p.after(|p| drop(p.xdo(&["key", "Tab"])));
+        if let Ok(m) = p.within(10, "ball selected", |p, n| p.state(n)["selected"] == "ball") {
+            return m.max(after);
+        }
+    }
+    p.until("ball selected", |p, n| p.state(n)["selected"] == "ball")
+}
+
 /// A pause between the steps of a drag (the window sees each move).
 fn pause() {
     std::thread::sleep(std::time::Duration::from_millis(200));
@@ -94,17 +107,8 @@ fn keys_and_a_curve_drag_edit_the_scene_file() {
     let (dir, scene, mut p) = start("voltex-keys");
     let key = |k: &'static str| move |p: &Preview| drop(p.xdo(&["key", k]));
 
-    // Tab: the next object. The first key after the window's focus can be lost on a loaded
-    // machine (the selection stayed "ground" for 30 s beside two fuzz campaigns): again, then.
-    let mut n = None;
-    for _ in 0..4 {
-        let after = p.after(key("Tab"));
-        if let Ok(m) = p.within(10, "ball selected", |p, n| p.state(n)["selected"] == "ball") {
-            n = Some(m.max(after));
-            break;
-        }
-    }
-    let n = n.unwrap_or_else(|| p.until("ball selected", |p, n| p.state(n)["selected"] == "ball"));
+    // Tab: the next object.
+    let n = select_ball(&mut p);
     let before = pixels(&p, n);
 
     // M on a hypertexture: its shading, None to Phong, in the file and the frame.
@@ -358,15 +362,7 @@ fn the_panel_duplicates_and_removes_an_object() {
 #[test]
 fn a_click_in_the_view_selects_the_object_under_it() {
     let (dir, _scene, mut p) = start("voltex-click-select");
-    let mut n = 0;
-    for _ in 0..4 {
-        p.after(|p| drop(p.xdo(&["key", "Tab"])));
-        if let Ok(m) = p.within(10, "ball selected", |p, n| p.state(n)["selected"] == "ball") {
-            n = m;
-            break;
-        }
-    }
-    assert_eq!(p.state(n)["selected"], "ball");
+    let n = select_ball(&mut p);
     // The ground's top at (0.6, -0.6, 0.3), through the camera of SCENE (a pinhole, 40x40), into
     // the window: the image fits the area left of the panel (340 pixels), centred.
     let (eye, target, up) =
@@ -425,14 +421,7 @@ fn a_grid_shape_is_painted_in_the_panel() {
 #[test]
 fn a_tangent_handle_sets_the_slope() {
     let (dir, scene, mut p) = start("voltex-tangent");
-    let mut n = 0;
-    for _ in 0..4 {
-        p.after(|p| drop(p.xdo(&["key", "Tab"])));
-        if let Ok(m) = p.within(10, "ball selected", |p, n| p.state(n)["selected"] == "ball") {
-            n = m;
-            break;
-        }
-    }
+    let n = select_ball(&mut p);
     let curve = "hypertextures[\"blob\"].noises[0].shape";
     let n = p.until("the curve editor", |p, m| m >= n && p.state(m)["editors"][curve].is_array());
     let (x0, y0, x1, y1) = widget(&p, n, curve);
