@@ -29,6 +29,26 @@ pub(crate) fn duplicate(src: &str, list: &[Step], index: usize) -> Result<st::Ed
     st::insert_item(src, list, index + 1, &text)
 }
 
+/// What an empty list named `field` gets from the panel's "add" (a list with items gets copies
+/// of them instead): its first item as a new scene would have it.
+pub(crate) fn first_item(field: &str) -> Option<&'static str> {
+    match field {
+        "lights" => Some("Directional(direction: (-0.5, 0.6, -0.7))"),
+        "noises" => Some("(shape: Curve([(0.0, 0.0, 0.0), (0.5, 1.0, 0.0), (1.0, 0.0, 0.0)]), amplitude: 0.2, frequency: 3.0)"),
+        _ => None,
+    }
+}
+
+/// The edit adding [`first_item`] to the empty list at `list` (its last step names it).
+pub(crate) fn add_first(src: &str, list: &[Step]) -> Result<st::Edit> {
+    let item = match list.last() {
+        Some(Step::Field(f)) => first_item(f),
+        _ => None,
+    };
+    let item = item.ok_or_else(|| Error::Invalid(format!("`{}`: no item to add", st::show(list))))?;
+    st::insert_item(src, list, 0, item)
+}
+
 /// The edit removing item `index` of the list at `list`.
 pub(crate) fn remove(src: &str, list: &[Step], index: usize) -> Result<st::Edit> {
     st::remove_item(src, list, index)
@@ -66,6 +86,28 @@ mod tests {
         assert!(order.windows(2).all(|w| w[0] < w[1]), "{text}");
         let lights = duplicate(SCENE, &path("lights"), 1).unwrap().apply(SCENE).unwrap();
         assert_eq!(lights.matches("Point(position: (1.0, 2.0, 3.0))").count(), 2, "{lights}");
+    }
+
+    #[test]
+    fn an_empty_list_of_lights_or_noises_gets_a_first_item_that_parses() {
+        let src = "Scene(\n    lights: [],\n)";
+        let text = add_first(src, &path("lights")).unwrap().apply(src).unwrap();
+        assert!(text.contains("lights: [Directional(direction: (-0.5, 0.6, -0.7))],"), "{text}");
+        // The noise as a hypertexture's: the scene parser takes it.
+        let scene = std::fs::read_to_string(
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/hypertextures/fig4_holes.ron"),
+        )
+        .unwrap();
+        let root = st::parse(&scene).unwrap();
+        let noises = root.at(&[Step::Field("hypertextures".into())], &scene).unwrap();
+        let st::Kind::Map(entries) = &noises.kind else { panic!() };
+        let key = st::unquote(entries[0].0.text(&scene)).unwrap();
+        let list = vec![Step::Field("hypertextures".into()), Step::Key(key), Step::Field("noises".into())];
+        let emptied = st::set(&scene, &list, "[]").unwrap().apply(&scene).unwrap();
+        let text = add_first(&emptied, &list).unwrap().apply(&emptied).unwrap();
+        let at = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/hypertextures/x.ron");
+        crate::scene::parse(&text, &at).unwrap();
+        assert!(add_first(src, &path("nodes")).is_err());
     }
 
     #[test]

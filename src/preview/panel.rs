@@ -345,6 +345,17 @@ fn value(ui: &mut egui::Ui, cx: &mut Cx, name: &str, v: &Value, path: &[Step]) {
         }
         Kind::Paren { .. } => structure(ui, cx, v, path),
         Kind::List(items) => {
+            let list_name = match path.last() {
+                Some(Step::Field(f)) => f.as_str(),
+                _ => "",
+            };
+            if items.is_empty() && super::items::first_item(list_name).is_some() {
+                let add = ui.small_button("add");
+                cx.rects.push((format!("{} add", st::show(path)), add.rect));
+                if add.clicked() {
+                    push_edit(cx, super::items::add_first(src, path), false);
+                }
+            }
             for (i, item) in items.iter().enumerate() {
                 let p = [path, &[Step::Index(i)]].concat();
                 let label = match (path.last(), item.name(src)) {
