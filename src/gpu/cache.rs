@@ -74,8 +74,14 @@ impl<T: GpuBytes> GpuBytes for Option<T> {
     }
 }
 
+/// Copies an entry's value (see [`Entry::copy`]).
+type CopyValue = fn(&(dyn Any + Send)) -> Box<dyn Any + Send>;
+
 struct Entry {
     value: Box<dyn Any + Send>,
+    /// Copies `value` (a handle: wgpu's objects are shared, not duplicated), for
+    /// [`GpuCache::share`]; `None` for what [`GpuCache::put`] keeps (not `Clone`).
+    copy: Option<CopyValue>,
     /// GPU bytes of a bake; 0 for modules, layouts and pipelines.
     bytes: u64,
     /// The build that last used it.
@@ -122,6 +128,19 @@ impl GpuCache {
     /// Changes how many bytes of unused bakes `retain_used` keeps (see [`GpuCache::with_stale_bytes`]).
     pub(crate) fn set_stale_bytes(&mut self, bytes: u64) {
         self.stale_bytes = bytes;
+    }
+
+    /// A new cache holding this one's modules, layouts, pipelines and bakes (shared handles on
+    /// the same device), with its settings: another session of the same scene (the preview's
+    /// reference view) finds them instead of baking and compiling again.
+    pub(crate) fn share(&self) -> GpuCache {
+        let entries = (self.entries.iter())
+            .filter_map(|(slot, e)| {
+                let copy = e.copy?;
+                Some((*slot, Entry { value: copy(e.value.as_ref()), copy: e.copy, bytes: e.bytes, used: 0 }))
+            })
+            .collect();
+        GpuCache { entries, stale_bytes: self.stale_bytes, ..Default::default() }
     }
 
     /// Drops every entry (made on a device that was lost), keeping the settings.
@@ -176,7 +195,9 @@ impl GpuCache {
             Made::Bake => self.stats.bakes += 1,
             Made::Layout => {}
         }
-        let entry = Entry { value: Box::new(v.clone()), bytes: bytes(&v), used: self.build };
+        let copy: CopyValue = |v| Box::new(v.downcast_ref::<T>().expect("the entry's own type").clone());
+        let entry =
+            Entry { value: Box::new(v.clone()), copy: Some(copy), bytes: bytes(&v), used: self.build };
         self.entries.insert(slot, entry);
         Ok(v)
     }
@@ -210,7 +231,7 @@ impl GpuCache {
 
     /// Keeps `value` under `key`, used by this build.
     pub(crate) fn put<T: Send + 'static>(&mut self, key: u64, value: T) {
-        let entry = Entry { value: Box::new(value), bytes: 0, used: self.build };
+        let entry = Entry { value: Box::new(value), copy: None, bytes: 0, used: self.build };
         self.entries.insert((TypeId::of::<T>(), key), entry);
     }
 
@@ -267,6 +288,18 @@ mod tests {
         // An entry used by the current build never counts against the cap.
         assert_eq!(build(&mut cache, &[500]), 1);
         assert_eq!(build(&mut cache, &[500]), 0);
+    }
+
+    #[test]
+    fn a_shared_cache_finds_the_bakes_and_keeps_what_put_holds_to_itself() {
+        let mut cache = GpuCache::with_stale_bytes(100);
+        build(&mut cache, &[10, 20]);
+        cache.put(5, String::from("the baker"));
+        let mut shared = cache.share();
+        assert_eq!(build(&mut shared, &[10, 20, 30]), 1, "only 30 is baked again");
+        assert_eq!(shared.take::<String>(5), None, "`put` values are not copied");
+        assert_eq!(cache.take::<String>(5).as_deref(), Some("the baker"));
+        assert_eq!(build(&mut cache, &[10, 20]), 0, "the first cache keeps its own");
     }
 
     #[test]

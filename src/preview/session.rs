@@ -81,20 +81,23 @@ pub(crate) const DRAFT_FRAME_MS: f64 = 40.0;
 impl Session {
     /// Builds the first renderer; a failure leaves the session without one and with `error` set.
     pub fn open(ctx: &GpuContext, scene_path: &Path, options: RenderOptions) -> Self {
-        Self::open_with(ctx, scene_path, options, None)
+        Self::open_with(ctx, scene_path, options, None, GpuCache::with_stale_bytes(STALE_BAKE_BYTES))
     }
 
-    /// As [`Session::open`], from `text` instead of the file when given (edits the file lacks).
+    /// As [`Session::open`], from `text` instead of the file when given (edits the file lacks),
+    /// starting from `cache` (another session's, shared: its bakes and pipelines are not made
+    /// again).
     pub(crate) fn open_with(
         ctx: &GpuContext,
         scene_path: &Path,
         options: RenderOptions,
         text: Option<String>,
+        cache: GpuCache,
     ) -> Self {
         let mut s = Session {
             scene_path: scene_path.to_path_buf(),
             options,
-            cache: GpuCache::with_stale_bytes(STALE_BAKE_BYTES),
+            cache,
             scene: None,
             renderer: None,
             error: None,
@@ -215,6 +218,11 @@ impl Session {
         }
         self.error = Some(msg.clone());
         Outcome::Failed(msg)
+    }
+
+    /// This session's bakes and pipelines, for another session of the same scene.
+    pub(crate) fn shared_cache(&self) -> GpuCache {
+        self.cache.share()
     }
 
     /// Renders a frame with the last good renderer (`None` before any build succeeded).

@@ -429,11 +429,13 @@ impl State {
                 }
                 options.method = Some(MethodKind::truth());
                 options.object_methods.clear();
-                // Built on another thread (scene, bakes, pipelines: half a second of llvmpipe for
-                // torus_egg), so the window keeps drawing meanwhile.
+                // Built on another thread, so the window keeps drawing meanwhile, from the
+                // image's bakes and pipelines (torus_egg's texel bake was half a second of
+                // llvmpipe on the device's one queue, which the window's presents wait behind).
                 let (ctx, path, text) =
                     (self.ctx.clone(), self.session.scene_path.clone(), self.unsaved_text());
-                let build = std::thread::spawn(move || Session::open_with(&ctx, &path, options, text));
+                let cache = self.session.shared_cache();
+                let build = std::thread::spawn(move || Session::open_with(&ctx, &path, options, text, cache));
                 self.reference_build = Some((build, Instant::now()));
             }
         }
