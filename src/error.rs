@@ -73,9 +73,14 @@ impl Error {
     /// position in a text file that can still be read, its source line with a caret under the
     /// word at the position (codespan-reporting).
     pub fn report(&self) -> String {
-        let head = format!("error: {self}\n");
-        let Error::At { loc, .. } = self else { return head };
-        source_snippet(loc).map_or(head.clone(), |snippet| head + &snippet)
+        let mut out = format!("error: {self}\n");
+        if let Some(snippet) = match self {
+            Error::At { loc, .. } => source_snippet(loc),
+            _ => None,
+        } {
+            out.push_str(&snippet);
+        }
+        out
     }
 }
 

@@ -1,7 +1,7 @@
-//! The panel's list edits: duplicate or remove an item of any list of the scene file (objects,
+//! The panel's list edits: duplicate an item of any list of the scene file (objects,
 //! lights, noises, implicit shapes, metaballs, ...), as edits of the text. What the result means
 //! is the scene parser's to judge: an edit it refuses (a list that may not be empty, say) is
-//! refused as a typed value is.
+//! refused as a typed value is. (Removing is `scene_text::remove_item`.)
 
 use crate::error::{Error, Result};
 
@@ -10,7 +10,7 @@ use super::scene_text::{self as st, Step};
 /// The edit inserting a copy of item `index` of the list at `list` after it. A named item (an
 /// object) gets a name the list's other items do not have: `name_2`, `name_3`, ...
 pub(crate) fn duplicate(src: &str, list: &[Step], index: usize) -> Result<st::Edit> {
-    let root = st::parse(src).map_err(|e| Error::Invalid(format!("the scene text: {e}")))?;
+    let root = st::tree(src)?;
     let items = root.at(list, src).map(|l| l.items()).unwrap_or_default();
     let item =
         items.get(index).ok_or_else(|| Error::Invalid(format!("no item {index} in `{}`", st::show(list))))?;
@@ -47,11 +47,6 @@ pub(crate) fn add_first(src: &str, list: &[Step]) -> Result<st::Edit> {
     };
     let item = item.ok_or_else(|| Error::Invalid(format!("`{}`: no item to add", st::show(list))))?;
     st::insert_item(src, list, 0, item)
-}
-
-/// The edit removing item `index` of the list at `list`.
-pub(crate) fn remove(src: &str, list: &[Step], index: usize) -> Result<st::Edit> {
-    st::remove_item(src, list, index)
 }
 
 #[cfg(test)]
@@ -112,12 +107,12 @@ mod tests {
 
     #[test]
     fn an_item_is_removed_with_its_separator() {
-        let text = remove(SCENE, &path("lights"), 0).unwrap().apply(SCENE).unwrap();
+        let text = st::remove_item(SCENE, &path("lights"), 0).unwrap().apply(SCENE).unwrap();
         assert!(text.contains("lights: [Point(position: (1.0, 2.0, 3.0))],"), "{text}");
-        let edit = remove(SCENE, &path("nodes"), 1).unwrap();
+        let edit = st::remove_item(SCENE, &path("nodes"), 1).unwrap();
         let text = edit.apply(SCENE).unwrap();
         assert!(!text.contains("ball_2") && text.contains("\"ball\""), "{text}");
         assert_eq!(edit.inverse().apply(&text).unwrap(), SCENE);
-        assert!(remove(SCENE, &path("lights"), 5).is_err());
+        assert!(st::remove_item(SCENE, &path("lights"), 5).is_err());
     }
 }

@@ -18,15 +18,6 @@ fn compound(src: &str, path: &[Step], change: impl FnOnce(String) -> Result<Stri
     Ok(Edit { path: path.to_vec(), before, after })
 }
 
-/// Sets `field` of the struct at `path` to `text`, adding it when the file leaves it out.
-fn set_field(src: &str, path: &[Step], field: &str, text: &str) -> Result<String> {
-    let mut p = path.to_vec();
-    p.push(Step::Field(field.into()));
-    let has = st::parse(src).ok().is_some_and(|t| t.at(&p, src).is_some());
-    let edit = if has { st::set(src, &p, text)? } else { st::add_field(src, path, field, text)? };
-    edit.apply(src)
-}
-
 /// The node's `method` path, with the method written first as `written` when the file has none.
 fn method_path(src: &str, node: &[Step], written: &str) -> Result<(String, Vec<Step>)> {
     let mut m = node.to_vec();
@@ -68,7 +59,7 @@ fn set_knob(src: &str, mp: &[Step], path: &[&str], value: &str) -> Result<String
     let (last, above) = path.split_last().expect("a knob's path names a field");
     let mut at = mp.to_vec();
     at.extend(above.iter().map(|f| Step::Field((*f).into())));
-    set_field(src, &at, last, value)
+    st::set_field(src, &at, last, value)?.apply(src)
 }
 
 /// `+` (finer) and `-`: the knobs the method's plug-in steps (ViewSlices' planes, a ray step

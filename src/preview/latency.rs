@@ -310,7 +310,7 @@ fn frame(ctx: &GpuContext, session: &mut Session) -> Result<(f64, f64)> {
 /// object's quality knob, its first texel's first colour (or number), its first hypertexture's
 /// first noise amplitude.
 fn probes(src: &str, session: &Session) -> Result<Vec<Probe>> {
-    let tree = st::parse(src).map_err(|e| Error::Invalid(format!("the scene text does not parse: {e}")))?;
+    let tree = st::tree(src)?;
     let field = |f: &str| Step::Field(f.into());
     let mut out = Vec::new();
     let scene = session.scene().ok_or_else(|| Error::Invalid("no scene".into()))?;

@@ -18,8 +18,7 @@ pub(crate) fn presets() -> Vec<&'static str> {
 /// fit its mesh (the preset's are for a unit sphere).
 pub(crate) fn put_preset(src: &str, node: &[Step], name: &str) -> Result<st::Edit> {
     let look = import::look(name)?;
-    let parse = |text: &str| st::parse(text).map_err(|e| Error::Invalid(format!("the scene text: {e}")));
-    let root = parse(src)?;
+    let root = st::tree(src)?;
     let texels_path = [Step::Field("texels".into())];
     let texels =
         root.at(&texels_path, src).ok_or_else(|| Error::Invalid("the scene has no `texels`".into()))?;
@@ -28,7 +27,7 @@ pub(crate) fn put_preset(src: &str, node: &[Step], name: &str) -> Result<st::Edi
     };
     let have: Vec<String> = entries.iter().filter_map(|(k, _)| st::unquote(k.text(src))).collect();
     // The preset's entries as its file writes them (comments kept), those the scene lacks.
-    let preset = parse(&format!("{{\n{}\n}}", look.texels))?;
+    let preset = st::tree(&format!("{{\n{}\n}}", look.texels))?;
     let st::Kind::Map(theirs) = &preset.kind else { unreachable!("parsed as a map") };
     let block = format!("{{\n{}\n}}", look.texels);
     let mut add = String::new();
@@ -52,31 +51,19 @@ pub(crate) fn put_preset(src: &str, node: &[Step], name: &str) -> Result<st::Edi
     for (field, value) in
         [("texel", format!("\"{}\"", look.texel)), ("method", look.method), ("base_color", look.base_color)]
     {
-        let path = [node, &[Step::Field(field.into())]].concat();
-        let edit = match parse(&text)?.at(&path, &text) {
-            Some(_) => st::set(&text, &path, &value)?,
-            None => st::add_field(&text, node, field, &value)?,
-        };
-        text = edit.apply(&text)?;
+        text = st::set_field(&text, node, field, &value)?.apply(&text)?;
     }
     whole(src, &text)
 }
 
 /// The edit setting the node's texel to `name` (one of the scene's texels).
 pub(crate) fn pick_texel(src: &str, node: &[Step], name: &str) -> Result<st::Edit> {
-    let path = [node, &[Step::Field("texel".into())]].concat();
-    let value = format!("\"{name}\"");
-    let root = st::parse(src).map_err(|e| Error::Invalid(format!("the scene text: {e}")))?;
-    match root.at(&path, src) {
-        Some(_) => st::set(src, &path, &value),
-        None => st::add_field(src, node, "texel", &value),
-    }
+    st::set_field(src, node, "texel", &format!("\"{name}\""))
 }
 
 /// One edit of the root value from `src` to `text` (several changes, one undo step).
 fn whole(src: &str, text: &str) -> Result<st::Edit> {
-    let root = st::parse(text).map_err(|e| Error::Invalid(format!("the scene text: {e}")))?;
-    st::set(src, &[], root.text(text))
+    st::set(src, &[], st::tree(text)?.text(text))
 }
 
 #[cfg(test)]

@@ -426,12 +426,7 @@ fn structure(ui: &mut egui::Ui, cx: &mut Cx, v: &Value, path: &[Step]) {
             v.child(&Step::Field("enabled".into()), src).map(|e| e.text(src) != "false").unwrap_or(true);
         let mut on = enabled;
         if ui.checkbox(&mut on, "on").changed() {
-            let p = [path, &[Step::Field("enabled".into())]].concat();
-            let edit = match v.child(&Step::Field("enabled".into()), src) {
-                Some(_) => st::set(src, &p, if on { "true" } else { "false" }),
-                None => st::add_field(src, path, "enabled", "false"),
-            };
-            push_edit(cx, edit, false);
+            push_edit(cx, st::set_field(src, path, "enabled", if on { "true" } else { "false" }), false);
         }
         if let Some(msg) = refused_here(cx, &[path, &[Step::Field("enabled".into())]].concat()) {
             ui.colored_label(Color32::from_rgb(255, 110, 90), msg);
@@ -676,7 +671,7 @@ fn item_buttons(ui: &mut egui::Ui, cx: &mut Cx, list: &[Step], index: usize, wha
             push_edit(cx, super::items::duplicate(src, list, index), false);
         }
         if remove.clicked() {
-            push_edit(cx, super::items::remove(src, list, index), false);
+            push_edit(cx, st::remove_item(src, list, index), false);
         }
     });
 }

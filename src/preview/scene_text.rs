@@ -411,8 +411,13 @@ impl Edit {
     }
 }
 
+/// The text's tree, or an error saying it does not parse (for edits, which need it).
+pub(crate) fn tree(src: &str) -> Result<Value> {
+    parse(src).map_err(|e| Error::Invalid(format!("the scene text does not parse: {e}")))
+}
+
 fn locate(src: &str, path: &[Step]) -> Result<Range<usize>> {
-    let root = parse(src).map_err(|e| Error::Invalid(format!("the scene text does not parse: {e}")))?;
+    let root = tree(src)?;
     root.at(path, src)
         .map(|v| v.span.clone())
         .ok_or_else(|| Error::Invalid(format!("no `{}` in the scene text", show(path))))
@@ -444,7 +449,7 @@ fn on_items(
     path: &[Step],
     change: impl FnOnce(&str, &[Range<usize>]) -> Result<String>,
 ) -> Result<Edit> {
-    let root = parse(src).map_err(|e| Error::Invalid(format!("the scene text does not parse: {e}")))?;
+    let root = tree(src)?;
     let v =
         root.at(path, src).ok_or_else(|| Error::Invalid(format!("no `{}` in the scene text", show(path))))?;
     let base = v.span.start;
@@ -495,10 +500,20 @@ pub fn remove_item(src: &str, path: &[Step], index: usize) -> Result<Edit> {
     })
 }
 
+/// The edit setting `field` of the struct at `path` to `text`, adding the field when the text
+/// leaves it out.
+pub(crate) fn set_field(src: &str, path: &[Step], field: &str, text: &str) -> Result<Edit> {
+    let p = [path, &[Step::Field(field.into())]].concat();
+    match tree(src)?.at(&p, src) {
+        Some(_) => set(src, &p, text),
+        None => add_field(src, path, field, text),
+    }
+}
+
 /// The edit adding `name: value` as the last field of the struct at `path`, separated as its
 /// other fields are.
 pub fn add_field(src: &str, path: &[Step], name: &str, value: &str) -> Result<Edit> {
-    let root = parse(src).map_err(|e| Error::Invalid(format!("the scene text does not parse: {e}")))?;
+    let root = tree(src)?;
     let v =
         root.at(path, src).ok_or_else(|| Error::Invalid(format!("no `{}` in the scene text", show(path))))?;
     let Kind::Paren { fields, .. } = &v.kind else {
