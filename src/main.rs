@@ -20,7 +20,10 @@ fn main() -> ExitCode {
         Command::Compare(args) => cli::compare::run(args),
         Command::Plan(args) => cli::plan::run(args),
         Command::Import(args) => cli::import::run(args),
-        Command::Preview(args) => cli::preview::run(args),
+        Command::Preview(args) => {
+            cli::keep_freed_memory();
+            cli::preview::run(args)
+        }
         // regress and farm exit with a status by cause (voltex::regress::exit).
         Command::Regress(args) => {
             return match voltex::regress::command(&args) {

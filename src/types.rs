@@ -14,9 +14,10 @@ pub struct ShellVertex {
     pub top: [f32; 4],
 }
 
-/// One prism: three welded vertex ids (shared edges are recognised by these ids), the texture
-/// coordinates of its corners (per corner, so uv seams need no duplicated positions) and its
-/// bounding sphere for the trivial reject.
+/// One prism: three welded vertex ids (shared edges are recognised by these ids) and the texture
+/// coordinates of its corners (per corner, so uv seams need no duplicated positions). Nothing of
+/// the view: a camera move reuses the prisms and remakes only the camera-relative vertices and
+/// bounding spheres (`mesh::shell::Shell`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
 pub struct Prism {
@@ -26,8 +27,6 @@ pub struct Prism {
     pub uv01: [f32; 4],
     /// uv of corner 2 (xy); zw unused.
     pub uv2: [f32; 4],
-    /// camera-relative centre (xyz) and radius (w) of a sphere holding all six corners.
-    pub sphere: [f32; 4],
 }
 
 /// Per-object, per-frame parameters of view-aligned slicing.

@@ -139,8 +139,7 @@ pub fn run(args: &Args) -> Result<()> {
             let Some(vs) = o.method::<crate::methods::view_slices::ViewSlicesPlan>() else { continue };
             let t = Instant::now();
             let out = crate::methods::view_slices::slice_prisms::emit_slices(
-                &o.shell.vertices,
-                &o.shell.prisms,
+                &o.shell,
                 &vs.sweep,
                 vs.trivial_reject,
             );

@@ -1,18 +1,30 @@
 //! Shells on the GPU side: camera-relative prism corners and bounding spheres, and the opaque
 //! base-surface triangles. Positions are made camera-relative in f64 before they become f32.
 
+use std::sync::Arc;
+
 use glam::DVec3;
 
 use crate::mesh::{prism, BaseSurface};
 use crate::types::{BaseVertex, Prism, ShellVertex, VertexFrame};
 
-/// The prisms of one object, as the kernels read them: shell vertices (camera-relative) and
-/// prisms.
+/// The prisms of one object, as the kernels read them: shell vertices and prisms' bounding
+/// spheres (camera-relative, made per view) and the prisms (shared by every view).
 pub struct Shell {
     /// Bottom and top of each welded vertex, camera-relative.
     pub vertices: Vec<ShellVertex>,
     /// One prism per base triangle.
-    pub prisms: Vec<Prism>,
+    pub prisms: Arc<[Prism]>,
+    /// Each prism's welded vertex ids alone, packed: a camera move's plane ranges read these,
+    /// not the whole prisms.
+    pub(crate) triangles: Arc<[[u32; 3]]>,
+    /// Per prism, the camera-relative centre (xyz) and radius (w) of a sphere holding its six
+    /// corners, for the trivial reject.
+    pub spheres: Vec<[f32; 4]>,
+    /// Per run of [`BOX_VERTICES`] vertices, the least and greatest coordinates of their bottoms
+    /// and tops: bounds of the f32 values themselves (each rounding step is monotonic), so that
+    /// a view's depth range scans only the runs that may hold its ends.
+    boxes: Vec<[[f32; 3]; 2]>,
 }
 
 fn rel(p: DVec3, eye: DVec3) -> [f32; 4] {
@@ -25,8 +37,8 @@ pub(crate) fn prism_spheres(surface: &BaseSurface) -> Vec<(DVec3, f64)> {
     (0..surface.triangles.len()).map(|t| prism::bounding_sphere(surface.prism(t))).collect()
 }
 
-/// Shell vertices per corner box of [`PreparedShell`]: a view scans the corners of the few boxes
-/// that may hold the farthest one.
+/// Shell vertices per corner box of [`PreparedShell`] and [`Shell`]: a view scans the corners of
+/// the few boxes that may hold the farthest (or nearest) one.
 const BOX_VERTICES: usize = 256;
 
 /// What planning a shell needs of its surface that does not depend on the view, made once per
@@ -36,6 +48,9 @@ const BOX_VERTICES: usize = 256;
 pub(crate) struct PreparedShell {
     /// Each prism's world-space bounding sphere ([`prism_spheres`]).
     pub(crate) spheres: Vec<(DVec3, f64)>,
+    /// The prisms ([`prisms`]) and their vertex ids, which a view shares.
+    prisms: Arc<[Prism]>,
+    triangles: Arc<[[u32; 3]]>,
     /// Boxes (min, max) around the bottoms and tops of each run of [`BOX_VERTICES`] vertices.
     boxes: Vec<(DVec3, DVec3)>,
     /// Per-vertex frames for per-pixel lighting ([`vertex_frames`]), made when first asked.
@@ -54,7 +69,13 @@ impl PreparedShell {
                 })
             })
             .collect();
-        Self { spheres: prism_spheres(surface), boxes, frames: Default::default() }
+        Self {
+            spheres: prism_spheres(surface),
+            prisms: prisms(surface),
+            triangles: surface.triangles.as_slice().into(),
+            boxes,
+            frames: Default::default(),
+        }
     }
 
     /// The per-vertex frames of `surface` (the one this was prepared from).
@@ -90,46 +111,112 @@ impl PreparedShell {
     }
 }
 
+/// The prisms of `surface`: vertex ids and corner uvs.
+fn prisms(surface: &BaseSurface) -> Arc<[Prism]> {
+    let corners = surface.triangles.iter().zip(&surface.corner_uvs);
+    corners
+        .map(|(ids, uv)| Prism {
+            vertices: [ids[0], ids[1], ids[2], 0],
+            uv01: [uv[0].x as f32, uv[0].y as f32, uv[1].x as f32, uv[1].y as f32],
+            uv2: [uv[2].x as f32, uv[2].y as f32, 0.0, 0.0],
+        })
+        .collect()
+}
+
 impl Shell {
     /// The shell of `surface` with positions made relative to the camera at `eye` (in f64, then f32).
     pub fn new(surface: &BaseSurface, eye: DVec3) -> Self {
-        Self::with_spheres(surface, &prism_spheres(surface), eye)
+        Self::prepared(surface, &PreparedShell::new(surface), eye)
     }
 
-    /// [`Shell::new`] with the prisms' world-space bounding spheres given ([`prism_spheres`]):
-    /// a new view moves them to the camera, O(prisms) with no square root.
-    pub(crate) fn with_spheres(surface: &BaseSurface, spheres: &[(DVec3, f64)], eye: DVec3) -> Self {
+    /// A shell of the given parts (tests, and prisms in another order): the packed ids and the
+    /// boxes made from them.
+    pub(crate) fn from_parts(vertices: Vec<ShellVertex>, prisms: Vec<Prism>, spheres: Vec<[f32; 4]>) -> Self {
+        let triangles = prisms.iter().map(|p| [p.vertices[0], p.vertices[1], p.vertices[2]]).collect();
+        let boxes = vertices
+            .chunks(BOX_VERTICES)
+            .map(|run| {
+                let mut b = [[f32::INFINITY; 3], [f32::NEG_INFINITY; 3]];
+                for c in run.iter().flat_map(|v| [v.bottom, v.top]) {
+                    for k in 0..3 {
+                        (b[0][k], b[1][k]) = (b[0][k].min(c[k]), b[1][k].max(c[k]));
+                    }
+                }
+                b
+            })
+            .collect();
+        Self { vertices, prisms: prisms.into(), triangles, spheres, boxes }
+    }
+
+    /// [`Shell::new`] from what `prepared` (made from `surface`) holds: a new view shares its
+    /// prisms and moves its spheres and boxes to the camera, O(vertices + prisms) of copying
+    /// with no square root.
+    pub(crate) fn prepared(surface: &BaseSurface, prepared: &PreparedShell, eye: DVec3) -> Self {
         let vertices = (surface.positions.iter().zip(&surface.heights))
             .map(|(&p, &h)| ShellVertex { bottom: rel(p, eye), top: rel(p + h, eye) })
             .collect();
-        let prisms = (0..surface.triangles.len()).map(|t| {
-            let (ids, uv, (centre, radius)) = (surface.triangles[t], surface.corner_uvs[t], spheres[t]);
-            let centre = centre - eye;
-            // Grown by a relative epsilon so that f32 rounding never rejects a touching plane.
-            let radius = radius * (1.0 + 1e-5) + 1e-6;
-            Prism {
-                vertices: [ids[0], ids[1], ids[2], 0],
-                uv01: [uv[0].x as f32, uv[0].y as f32, uv[1].x as f32, uv[1].y as f32],
-                uv2: [uv[2].x as f32, uv[2].y as f32, 0.0, 0.0],
-                sphere: [centre.x as f32, centre.y as f32, centre.z as f32, radius as f32],
-            }
-        });
-        Self { vertices, prisms: prisms.collect() }
+        let spheres = (prepared.spheres.iter())
+            .map(|&(centre, radius)| {
+                let centre = centre - eye;
+                // Grown by a relative epsilon so that f32 rounding never rejects a touching plane.
+                let radius = radius * (1.0 + 1e-5) + 1e-6;
+                [centre.x as f32, centre.y as f32, centre.z as f32, radius as f32]
+            })
+            .collect();
+        let xyz = |p: DVec3| {
+            let r = rel(p, eye);
+            [r[0], r[1], r[2]]
+        };
+        Self {
+            vertices,
+            prisms: prepared.prisms.clone(),
+            triangles: prepared.triangles.clone(),
+            spheres,
+            boxes: prepared.boxes.iter().map(|&(lo, hi)| [xyz(lo), xyz(hi)]).collect(),
+        }
     }
 
-    /// Range of `dot(n, x)` over all corners.
+    /// Whether every corner coordinate lies within `±limit`, an f32 value (exact: through the
+    /// boxes, and every corner only when a box reaches beyond it).
+    pub(crate) fn within(&self, limit: f32) -> bool {
+        let inside = |c: &[f32]| c.iter().all(|x| x.abs() <= limit);
+        self.boxes.iter().all(|b| inside(&b[0]) && inside(&b[1]))
+            || self.vertices.iter().all(|v| inside(&v.bottom[..3]) && inside(&v.top[..3]))
+    }
+
+    /// Range of `dot(n, x)` over all corners, exactly as a scan of every corner finds it (in
+    /// f64), scanning only the boxes that may hold an end.
     pub(crate) fn depth_range(&self, n: [f32; 3]) -> (f64, f64) {
         let depth =
-            |p: [f32; 4]| n[0] as f64 * p[0] as f64 + n[1] as f64 * p[1] as f64 + n[2] as f64 * p[2] as f64;
-        // Four lanes of vertices, so that the comparisons do not wait on each other (min and max
-        // are exact: the order does not change the result).
-        let (mut lo, mut hi) = ([f64::INFINITY; 4], [f64::NEG_INFINITY; 4]);
-        for (i, v) in self.vertices.iter().enumerate() {
-            let (b, t) = (depth(v.bottom), depth(v.top));
-            lo[i % 4] = lo[i % 4].min(b.min(t));
-            hi[i % 4] = hi[i % 4].max(b.max(t));
-        }
-        (lo.into_iter().fold(f64::INFINITY, f64::min), hi.into_iter().fold(f64::NEG_INFINITY, f64::max))
+            |p: &[f32]| n[0] as f64 * p[0] as f64 + n[1] as f64 * p[1] as f64 + n[2] as f64 * p[2] as f64;
+        // A box's least and greatest depth: its corner on each side of the normal. f32 products
+        // are exact in f64 and each sum rounds monotonically, so no corner in the box computes
+        // beyond these.
+        let ends = |b: &[[f32; 3]; 2]| {
+            let pick = |far: bool| -> [f32; 3] {
+                std::array::from_fn(|k| if (n[k] >= 0.0) == far { b[1][k] } else { b[0][k] })
+            };
+            (depth(&pick(false)), depth(&pick(true)))
+        };
+        let bounds: Vec<(f64, f64)> = self.boxes.iter().map(ends).collect();
+        let scan = |far: bool| {
+            let mut order: Vec<usize> = (0..bounds.len()).collect();
+            let key = |k: usize| if far { bounds[k].1 } else { -bounds[k].0 };
+            order.sort_unstable_by(|&a, &b| key(b).total_cmp(&key(a)));
+            let mut best = f64::NEG_INFINITY;
+            for k in order {
+                if key(k) < best {
+                    break;
+                }
+                let run = k * BOX_VERTICES..((k + 1) * BOX_VERTICES).min(self.vertices.len());
+                for v in &self.vertices[run] {
+                    let (b, t) = (depth(&v.bottom), depth(&v.top));
+                    best = best.max(if far { b.max(t) } else { -b.min(t) });
+                }
+            }
+            best
+        };
+        (-scan(false), scan(true))
     }
 }
 
@@ -229,6 +316,64 @@ pub(crate) mod tests {
             h.x += 0.05 * ((i % 5) as f64 - 2.0);
         }
         s
+    }
+
+    /// The depth range found through the boxes is a scan of every corner's, bit for bit, from
+    /// eyes all around and inside the shell and along every axis (zero normal components), for
+    /// prepared shells and shells made of parts; and the range check through the boxes agrees
+    /// with one of every corner.
+    #[test]
+    fn depth_ranges_through_the_boxes_are_exactly_a_full_scans() {
+        let surface = bumpy(40);
+        let prepared = PreparedShell::new(&surface);
+        let scan = |shell: &Shell, n: [f32; 3]| {
+            let depth = |p: [f32; 4]| {
+                n[0] as f64 * p[0] as f64 + n[1] as f64 * p[1] as f64 + n[2] as f64 * p[2] as f64
+            };
+            shell
+                .vertices
+                .iter()
+                .flat_map(|v| [depth(v.bottom), depth(v.top)])
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), d| (lo.min(d), hi.max(d)))
+        };
+        let mut views = 0;
+        for eye in
+            [DVec3::new(0.0, -4.0, 3.0), DVec3::new(5.0, 1.0, -0.5), DVec3::new(1.4, 0.9, 0.2), DVec3::ZERO]
+        {
+            let shell = Shell::prepared(&surface, &prepared, eye);
+            let parts =
+                Shell::from_parts(shell.vertices.clone(), shell.prisms.to_vec(), shell.spheres.clone());
+            for n in [
+                [0.3f32, -0.5, 0.81],
+                [0.0, 0.0, 1.0],
+                [-1.0, 0.0, 0.0],
+                [0.0, -0.6, -0.8],
+                [-0.2, 0.9, -0.39],
+            ] {
+                let expect = scan(&shell, n);
+                for s in [&shell, &parts] {
+                    let found = s.depth_range(n);
+                    assert_eq!(
+                        (found.0.to_bits(), found.1.to_bits()),
+                        (expect.0.to_bits(), expect.1.to_bits()),
+                        "eye {eye}, n {n:?}"
+                    );
+                }
+                views += 1;
+            }
+            let largest = shell
+                .vertices
+                .iter()
+                .flat_map(|v| [v.bottom, v.top])
+                .flat_map(|c| c[..3].to_vec())
+                .fold(0f32, |m, x| m.max(x.abs()));
+            for limit in [largest, largest * 0.999, largest * 1.001] {
+                assert_eq!(shell.within(limit), largest <= limit);
+            }
+        }
+        assert_eq!(views, 20);
+        let empty = Shell::from_parts(Vec::new(), Vec::new(), Vec::new());
+        assert_eq!(empty.depth_range([0.0, 0.0, 1.0]), (f64::INFINITY, f64::NEG_INFINITY));
     }
 
     /// The farthest corner found through the boxes is the one a scan of every corner finds, bit

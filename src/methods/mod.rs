@@ -87,11 +87,9 @@ pub(crate) fn plan_object(
     opts: &options::RenderOptions,
 ) -> Result<ObjectPlan> {
     let eye = cx.view.eye;
-    let shell = crate::mesh::shell::Shell::with_spheres(&object.surface, &object.prepared().spheres, eye);
+    let shell = crate::mesh::shell::Shell::prepared(&object.surface, object.prepared(), eye);
     // Kernels take camera-relative f32 corners and square their distances.
-    let limit = crate::mesh::prism::MAX_COORD as f32;
-    let in_range = |c: &[f32; 4]| c[..3].iter().all(|x| x.abs() <= limit);
-    if !shell.vertices.iter().all(|v| in_range(&v.bottom) && in_range(&v.top)) {
+    if !shell.within(crate::mesh::prism::MAX_COORD as f32) {
         return Err(crate::error::Error::Invalid(format!(
             "{}: object `{}` lies beyond ±{:e} of the camera: move the camera closer",
             cx.scene.path.display(),

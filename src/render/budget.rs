@@ -8,7 +8,8 @@ use crate::graph::{ResourceDecl, TextureSize};
 use crate::render::Blueprint;
 use crate::scene::Scene;
 
-/// Where the values that size allocations are written in the scene file.
+/// Where the values that size allocations are written in the scene file (found when it was
+/// parsed: `scene::Locations`).
 #[derive(Debug, Clone, Default)]
 pub(crate) struct Positions {
     /// The scene's `output` size; `None` when `--size` replaced it.
@@ -19,36 +20,11 @@ pub(crate) struct Positions {
 
 impl Positions {
     pub(crate) fn of(scene: &Scene, size_overridden: bool) -> Self {
-        let src = scene.source();
-        let loc = |at: usize| {
-            let (line, col) = crate::error::line_col(src, at);
-            FileLoc::new(&scene.path, line, col)
-        };
-        let output = if size_overridden { None } else { find_key(src, 0, "output").map(loc) };
-        let texels_at = find_key(src, 0, "texels").unwrap_or(0);
-        let texels = scene
-            .texels
-            .keys()
-            .filter_map(|name| {
-                let key = find_key(src, texels_at, &format!("\"{name}\""))?;
-                Some((name.clone(), loc(find_key(src, key, "resolution").unwrap_or(key))))
-            })
-            .collect();
-        let nodes_at = find_key(src, 0, "nodes").unwrap_or(0);
-        let mut objects = Vec::new();
-        let mut names = Vec::new();
-        collect_names(&scene.nodes, &mut names);
-        for name in names {
-            let needle = format!("\"{name}\"");
-            if let Some(i) = src[nodes_at..].find(&needle) {
-                objects.push((name.to_string(), loc(nodes_at + i)));
-            }
-        }
-        Positions { output, texels, objects }
+        let at = &scene.locations;
+        let output = if size_overridden { None } else { at.output.clone() };
+        Positions { output, texels: at.texels.clone(), objects: at.objects.clone() }
     }
-}
 
-impl Positions {
     /// `e`, a planning error of object `name` without a position, at the node's name (the
     /// method's knobs and surface that sized the work are in that node).
     pub(crate) fn at_object(&self, name: &str, e: Error) -> Error {
@@ -57,29 +33,6 @@ impl Positions {
             (e, _) => e,
         }
     }
-}
-
-fn collect_names<'a>(nodes: &'a [crate::scene::Node], out: &mut Vec<&'a str>) {
-    for n in nodes {
-        out.push(&n.name);
-        collect_names(&n.children, out);
-    }
-}
-
-/// Byte offset of `key` used as a field or map key (followed by `:`) at or after `from`.
-fn find_key(src: &str, from: usize, key: &str) -> Option<usize> {
-    let mut at = from.min(src.len());
-    while let Some(i) = src[at..].find(key) {
-        let start = at + i;
-        let end = start + key.len();
-        let ident = |c: char| c.is_alphanumeric() || c == '_';
-        let before_ok = !key.starts_with(ident) || !src[..start].ends_with(ident);
-        if before_ok && src[end..].trim_start().starts_with(':') {
-            return Some(start);
-        }
-        at = end;
-    }
-    None
 }
 
 fn padded_row(w: u32) -> u64 {

@@ -181,7 +181,7 @@ impl Blueprint {
         let names: Vec<&str> = objects.iter().map(|o| o.object.name.as_str()).collect();
         let requested = match &opts.aovs {
             Some(names) => aov::Requested { names, at: None },
-            None => aov::Requested { names: &scene.aovs, at: scene.locate_key("aovs") },
+            None => aov::Requested { names: &scene.aovs, at: scene.locations.aovs.clone() },
         };
         let aovs = aov::plan(&mut graph, requested, &names)?;
         let groups = crate::methods::gather(&mut objects, &bakes, &view);

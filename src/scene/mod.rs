@@ -13,6 +13,7 @@ mod flatten;
 pub mod hypertexture;
 mod image;
 pub mod import;
+mod locations;
 pub(crate) mod methods;
 mod types;
 mod validate;
@@ -22,6 +23,7 @@ pub use budget::{MAX_NODES, MAX_SHAPE_VOXELS, MAX_TRIANGLES};
 pub(crate) use flatten::{HyperNode, SceneObject, VolumeNode};
 pub(crate) use hypertexture::Hypertexture;
 pub use image::HeightImage;
+pub(crate) use locations::Locations;
 pub use types::*;
 // The registered methods, each with its knob types (from its folder: see `methods`).
 pub use methods::*;
@@ -106,21 +108,6 @@ impl Scene {
     pub(crate) fn source(&self) -> &str {
         &self.source
     }
-
-    /// Where the top-level field `key` is written (`key:` at the start of a line), if it is.
-    pub(crate) fn locate_key(&self, key: &str) -> Option<crate::error::FileLoc> {
-        let mut offset = 0;
-        for line in self.source.split_inclusive('\n') {
-            let t = line.trim_start();
-            if t.strip_prefix(key).is_some_and(|rest| rest.trim_start().starts_with(':')) {
-                let at = offset + line.len() - t.len();
-                let (l, c) = crate::error::line_col(&self.source, at);
-                return Some(crate::error::FileLoc::new(&self.path, l, c));
-            }
-            offset += line.len();
-        }
-        None
-    }
 }
 
 /// Reads, parses and checks a scene file, and loads the files it refers to.
@@ -193,6 +180,7 @@ pub fn parse(source: &str, path: &Path) -> Result<Scene> {
             None => msg,
         })
         .collect();
+    scene.locations = Locations::of(&scene, source);
     scene.source = source.to_string();
     Ok(scene)
 }

@@ -53,6 +53,9 @@ pub struct Scene {
     /// The file's text, to position errors found after parsing (e.g. by the prism checks).
     #[serde(skip)]
     pub(super) source: String,
+    /// Where the file writes what planning may refuse (found when parsed).
+    #[serde(skip)]
+    pub(crate) locations: super::Locations,
     /// What loading found questionable but drew anyway (each names its file), for the user.
     #[serde(skip)]
     pub warnings: Vec<String>,

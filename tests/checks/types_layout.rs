@@ -18,7 +18,7 @@ fn wgsl_structs_match_rust() {
     let kernel = voltex::gpu::shader::load_str(std::path::Path::new("types.wgsl"), &source).unwrap();
     let rust = [
         layout!(ShellVertex; bottom, top),
-        layout!(Prism; vertices, uv01, uv2, sphere),
+        layout!(Prism; vertices, uv01, uv2),
         layout!(SliceParams; plane_normal, first_plane, spacing, plane_count, prism_count, vertex_capacity),
         layout!(SliceVertex; position, uvw),
         layout!(DrawIndirect; vertex_count, instance_count, first_vertex, first_instance),

@@ -99,16 +99,16 @@ pub fn slice_case(input: &SliceInput) -> Result<bool, String> {
         vertices: [input.ids[0], input.ids[1], input.ids[2], 0],
         uv01: [0.0, 0.0, 1.0, 0.0],
         uv2: [0.0, 1.0, 0.0, 0.0],
-        sphere: [centre.x as f32, centre.y as f32, centre.z as f32, radius as f32],
     };
+    let sphere = [centre.x as f32, centre.y as f32, centre.z as f32, radius as f32];
     let (n, d) = (input.normal, input.d);
-    let poly = slice_prisms::slice_prism(&vertices, &prism, 7, n, d, false);
+    let poly = slice_prisms::slice_prism(&vertices, &prism, sphere, 7, n, d, false);
     // The trivial reject (sphere against plane) assumes a unit normal, as the sweep's is.
     let nlen = (dot(n, n) as f64).sqrt();
     if nlen > 0.0 {
         let (un, ud) = (scale(n, (1.0 / nlen) as f32), (d as f64 / nlen) as f32);
-        let kept = slice_prisms::slice_prism(&vertices, &prism, 7, un, ud, false);
-        let rejected = slice_prisms::slice_prism(&vertices, &prism, 7, un, ud, true);
+        let kept = slice_prisms::slice_prism(&vertices, &prism, sphere, 7, un, ud, false);
+        let rejected = slice_prisms::slice_prism(&vertices, &prism, sphere, 7, un, ud, true);
         if format!("{rejected:?}") != format!("{kept:?}") {
             return Err(format!("the trivial reject changed the polygon: {rejected:?} vs {kept:?}"));
         }

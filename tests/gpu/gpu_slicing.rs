@@ -48,7 +48,7 @@ fn gpu_slices(shell: &Shell, params: &SliceParams, trivial_reject: bool) -> Vec<
     // The per-plane draw arguments agree with the CPU twin's scan.
     let bytes = ctx.read_buffer(&inputs.buffers["plane_draws"], 0, params.plane_count as u64 * 16).unwrap();
     let draws: Vec<voltex::types::DrawIndirect> = bytemuck::pod_collect_to_vec(&bytes);
-    let counts = slice_prisms::count_slices(&shell.vertices, &shell.prisms, &params, trivial_reject);
+    let counts = slice_prisms::count_slices(shell, &params, trivial_reject);
     assert_eq!(draws, slice_prisms::plane_draws(&counts, params.vertex_capacity));
     view_slices::read_back(ctx, &inputs, params.plane_count).unwrap()
 }
@@ -67,7 +67,7 @@ fn by_prism(plane: &[SliceVertex]) -> BTreeMap<u32, Vec<SliceVertex>> {
 /// `ambiguous` of the plane (where the GPU's fused multiply-adds may classify it differently).
 fn compare(shell: &Shell, params: &SliceParams, trivial_reject: bool, ambiguous: f32) -> usize {
     let gpu = gpu_slices(shell, params, trivial_reject);
-    let cpu = slice_prisms::emit_slices(&shell.vertices, &shell.prisms, params, trivial_reject);
+    let cpu = slice_prisms::emit_slices(shell, params, trivial_reject);
     assert_eq!(gpu.len(), cpu.len());
     let n = glam::Vec3::from_slice(&params.plane_normal[..3]);
     let mut compared = 0;
@@ -230,7 +230,7 @@ fn hard_cases_match_the_cpu_twin_exactly() {
     for (name, shell, planes) in cases {
         for params in planes {
             let gpu = gpu_slices(&shell, &params, true);
-            let cpu = slice_prisms::emit_slices(&shell.vertices, &shell.prisms, &params, true);
+            let cpu = slice_prisms::emit_slices(&shell, &params, true);
             assert_eq!(gpu.len(), 1);
             assert_eq!(gpu[0].len(), cpu[0].len(), "{name}, d = {}: vertex counts", params.first_plane);
             for (a, b) in gpu[0].iter().zip(&cpu[0]) {

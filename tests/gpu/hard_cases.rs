@@ -634,13 +634,11 @@ mod twins {
     }
 
     fn unit_prism(v: [u32; 3]) -> Prism {
-        Prism {
-            vertices: [v[0], v[1], v[2], 0],
-            uv01: [0.0, 0.0, 1.0, 0.0],
-            uv2: [0.0, 1.0, 0.0, 0.0],
-            sphere: [0.0, 0.0, 0.0, 1e30],
-        }
+        Prism { vertices: [v[0], v[1], v[2], 0], uv01: [0.0, 0.0, 1.0, 0.0], uv2: [0.0, 1.0, 0.0, 0.0] }
     }
+
+    /// A sphere holding everything (the trivial reject is off in these tests anyway).
+    const ALL: [f32; 4] = [0.0, 0.0, 0.0, 1e30];
 
     /// Planes a hair (1e-7 rad) off parallel to the base, through the middle and through the cap
     /// heights, and a prism whose base is a sliver (altitude 1e-6): finite polygons on the plane,
@@ -655,7 +653,7 @@ mod twins {
         let p = unit_prism([0, 1, 2]);
         let n = Vec3::new(1e-7, 0.0, 1.0).normalize();
         for d in [0.0f32, 1e-7, 0.5, 1.0 - 1e-7, 1.0] {
-            let poly = slice_prism(&verts, &p, 0, n.to_array(), d, false);
+            let poly = slice_prism(&verts, &p, ALL, 0, n.to_array(), d, false);
             let pts: Vec<Vec3> = poly
                 .as_slice()
                 .iter()
@@ -678,7 +676,7 @@ mod twins {
             let a = k as f32 * 0.1;
             let n = Vec3::new(a.cos() * 0.7, a.sin() * 0.7, 0.714).normalize();
             for d in [-0.2f32, 0.0, 0.3, 0.6, 1.0] {
-                let poly = slice_prism(&sliver, &p, 0, n.to_array(), d, false);
+                let poly = slice_prism(&sliver, &p, ALL, 0, n.to_array(), d, false);
                 assert!(poly.len <= 5);
                 for v in poly.as_slice() {
                     assert!(v.position.iter().chain(&v.uvw).all(|c| c.is_finite()), "k {k} d {d}: {v:?}");

@@ -17,6 +17,8 @@
 // The shell relative to the anchor voxel's centre (src/mesh/shell.rs).
 @group(0) @binding(3) var<storage, read> shell_vertices: array<ShellVertex>;
 @group(0) @binding(4) var<storage, read> shell_prisms: array<Prism>;
+// Per prism, its bounding sphere (centre relative to the anchor, radius).
+@group(0) @binding(7) var<storage, read> prism_spheres: array<vec4<f32>>;
 // The texel at full precision (rgba32float, premultiplied), read without a sampler.
 @group(0) @binding(5) var texel_volume: texture_3d<f32>;
 // Per voxel (leaf by leaf, 512 each in OpenVDB's x-major order): x the extinction per world unit
@@ -98,8 +100,9 @@ fn main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index
             for (var e = first; e < end; e++) {
                 let index = world_prism_ids[e];
                 let prism = shell_prisms[index];
-                let d = p - prism.sphere.xyz;
-                if (dot(d, d) > prism.sphere.w * prism.sphere.w) {
+                let sphere = prism_spheres[index];
+                let d = p - sphere.xyz;
+                if (dot(d, d) > sphere.w * sphere.w) {
                     continue;
                 }
                 var shape = load_shape(index);

@@ -1,8 +1,8 @@
 // Plane/prism intersection of view-aligned slicing (2002 paper, Sec. 3-4, Fig. 4); CPU twin in
 // src/methods/view_slices/slice_prisms.rs, which mirrors these functions one to one.
-// The including kernel declares `slice_params`, `shell_vertices`, `prisms`, `trivial_reject` and
-// `planes_per_thread`. Corners and polygons go by pointer: by-value copies of their arrays made
-// these kernels 4x slower on lavapipe.
+// The including kernel declares `slice_params`, `shell_vertices`, `prisms`, `prism_spheres`,
+// `trivial_reject` and `planes_per_thread`. Corners and polygons go by pointer: by-value copies
+// of their arrays made these kernels 4x slower on lavapipe.
 
 const EDGE_ABOVE: u32 = 0u; // a: the plane cuts the prolonged normal edge above its top
 const EDGE_WITHIN: u32 = 1u; // b: bottom and top lie on different sides of the plane
@@ -43,7 +43,7 @@ fn load_prism(index: u32) -> PrismCorners {
         c.bottom[i] = v.bottom.xyz;
         c.top[i] = v.top.xyz;
     }
-    c.sphere = p.sphere;
+    c.sphere = prism_spheres[index];
     return c;
 }
 

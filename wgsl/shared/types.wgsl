@@ -9,7 +9,6 @@ struct Prism {
     vertices: vec4<u32>,
     uv01: vec4<f32>,
     uv2: vec4<f32>,
-    sphere: vec4<f32>,
 }
 
 struct SliceParams {

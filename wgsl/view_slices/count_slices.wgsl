@@ -6,6 +6,8 @@
 @group(0) @binding(1) var<storage, read> shell_vertices: array<ShellVertex>;
 @group(0) @binding(2) var<storage, read> prisms: array<Prism>;
 @group(0) @binding(3) var<storage, read_write> plane_cursors: array<atomic<u32>>;
+// Per prism, its camera-relative bounding sphere (centre, radius).
+@group(0) @binding(4) var<storage, read> prism_spheres: array<vec4<f32>>;
 
 // Skip prisms whose bounding sphere misses the plane before classifying their corners.
 override trivial_reject: bool = true;

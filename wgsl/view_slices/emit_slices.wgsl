@@ -7,6 +7,8 @@
 @group(0) @binding(2) var<storage, read> prisms: array<Prism>;
 @group(0) @binding(3) var<storage, read_write> plane_cursors: array<atomic<u32>>;
 @group(0) @binding(4) var<storage, read_write> slice_vertices: array<SliceVertex>;
+// Per prism, its camera-relative bounding sphere (centre, radius).
+@group(0) @binding(5) var<storage, read> prism_spheres: array<vec4<f32>>;
 
 // Skip prisms whose bounding sphere misses the plane before classifying their corners.
 override trivial_reject: bool = true;

@@ -52,6 +52,8 @@ pub struct AxisPlan {
     pub params: AxisParams,
     /// The shell's prisms sorted back to front by centre distance (the draw order of texels).
     pub prisms: Vec<Prism>,
+    /// Their bounding spheres, in that order.
+    spheres: Vec<[f32; 4]>,
     /// Slice-vertex capacity: every prism at its finest level in its largest direction.
     pub capacity: u64,
     pub(crate) blended: bool,
@@ -81,14 +83,15 @@ impl AxisPlan {
             forward: [forward[0], forward[1], forward[2], eye_inside(shell) as u32 as f32],
             flags: [directions, 0, m.occlusion_culling as u32, m.empty_culling as u32],
         };
-        let distance = |p: &Prism| {
-            let c = p.sphere;
+        let distance = |i: usize| {
+            let c = shell.spheres[i];
             c[0] * c[0] + c[1] * c[1] + c[2] * c[2]
         };
-        let mut prisms = shell.prisms.clone();
-        prisms.sort_by(|a, b| distance(b).total_cmp(&distance(a)));
-        let sorted = Shell { vertices: shell.vertices.clone(), prisms: prisms.clone() };
-        let capacity: u64 = (0..prisms.len()).map(|i| finest_vertices(&sorted, i, &params)).sum();
+        let mut order: Vec<usize> = (0..shell.prisms.len()).collect();
+        order.sort_by(|&a, &b| distance(b).total_cmp(&distance(a)));
+        let prisms = order.iter().map(|&i| shell.prisms[i]).collect();
+        let spheres = order.iter().map(|&i| shell.spheres[i]).collect();
+        let capacity: u64 = (0..shell.prisms.len()).map(|i| finest_vertices(shell, i, &params)).sum();
         let bytes = capacity * std::mem::size_of::<AxisVertex>() as u64;
         if bytes > MAX_VERTEX_BYTES {
             return Err(Error::Invalid(format!(
@@ -102,6 +105,7 @@ impl AxisPlan {
         Ok(Self {
             params,
             prisms,
+            spheres,
             capacity: capacity.max(3),
             blended: m.blend == SliceBlend::Blended,
             grouped: m.draw_order == DrawOrder::Slices,
@@ -111,7 +115,7 @@ impl AxisPlan {
 
     /// The prisms in draw order with the shell's vertices (what the kernels read).
     pub fn shell(&self, shell: &Shell) -> Shell {
-        Shell { vertices: shell.vertices.clone(), prisms: self.prisms.clone() }
+        Shell::from_parts(shell.vertices.clone(), self.prisms.clone(), self.spheres.clone())
     }
 }
 
@@ -121,8 +125,8 @@ impl AxisPlan {
 pub(crate) fn eye_inside(shell: &Shell) -> bool {
     use crate::cpu::prism_map::{inverse, PrismCorners};
     use glam::{DVec3, Vec4Swizzles};
-    shell.prisms.iter().any(|p| {
-        let s = glam::Vec4::from(p.sphere);
+    shell.prisms.iter().zip(&shell.spheres).any(|(p, &s)| {
+        let s = glam::Vec4::from(s);
         if s.xyz().length() > s.w {
             return false;
         }

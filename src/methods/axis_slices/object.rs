@@ -50,13 +50,14 @@ impl MethodPlan for AxisPlan {
     }
 
     fn memory(&self, object: &ObjectPlan, _size: (u32, u32)) -> Vec<(String, u64)> {
-        let shell = (object.shell.vertices.len() * 32 + object.shell.prisms.len() * 64) as u64;
+        let prism = std::mem::size_of::<crate::types::Prism>() as u64;
+        let shell = object.shell.vertices.len() as u64 * 32 + object.shell.prisms.len() as u64 * prism;
         vec![(
             format!(
                 "object {}: axis slice vertices (capacity {}) + choices",
                 object.object.name, self.capacity
             ),
-            self.capacity * 48 + self.prisms.len() as u64 * (32 + 64) + shell + 16,
+            self.capacity * 48 + self.prisms.len() as u64 * (32 + prism) + shell + 16,
         )]
     }
 

@@ -175,7 +175,7 @@ pub(crate) fn build(members: &[Member], params: ReferenceParams, bvh: bool) -> R
             Some(frames) => set.frames.extend_from_slice(frames),
             None => set.frames.extend(std::iter::repeat_n(VertexFrame::default(), o.shell.vertices.len())),
         }
-        for p in &o.shell.prisms {
+        for p in o.shell.prisms.iter() {
             let ids = [p.vertices[0], p.vertices[1], p.vertices[2]];
             if bvh {
                 let corners = ids.iter().flat_map(|&v| {

@@ -68,7 +68,7 @@ pub(crate) fn choose(
     // The prism needing the finest level: (log2 of its pixel over its largest voxel, pixel, voxels).
     let mut best: Option<(f64, f64, f64, f64)> = None;
     let mut spacing = f64::INFINITY;
-    for p in &shell.prisms {
+    for p in shell.prisms.iter() {
         let Some(v) = voxel_sizes(shell, p, res) else { continue };
         let depth = p.vertices[..3]
             .iter()
@@ -124,13 +124,12 @@ mod tests {
             vertices: [ids[0], ids[1], ids[2], 0],
             uv01: [uv[0][0], uv[0][1], uv[1][0], uv[1][1]],
             uv2: [uv[2][0], uv[2][1], 0.0, 0.0],
-            sphere: [0.0; 4],
         };
         let prisms = vec![
             prism([0, 1, 2], [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]),
             prism([1, 3, 2], [[1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]),
         ];
-        Shell { vertices, prisms }
+        Shell::from_parts(vertices, prisms, vec![[0.0; 4]; 2])
     }
 
     const RES: [u32; 3] = [64, 64, 16];

@@ -25,6 +25,7 @@ pub(crate) const CONTRIBUTION: super::Contribution = super::Contribution {
         B::SLICE_PARAMS,
         B::SHELL_VERTICES,
         B::PRISMS,
+        B::PRISM_SPHERES,
         B::PLANE_CURSORS,
         B::DRAW_ARGS,
         B::PLANE_DRAWS,
@@ -90,7 +91,7 @@ pub(crate) fn plane_bounds(shell: &Shell, params: &SliceParams) -> Vec<u64> {
     // so that neighbouring prisms (mostly on the same planes) do not wait on each other's sums.
     let mut diff = vec![[0i64; 4]; params.plane_count as usize + 1];
     let planes = PrismPlanes::new(shell, params);
-    for (i, p) in shell.prisms.iter().enumerate() {
+    for (i, p) in shell.triangles.iter().enumerate() {
         if let Some((k_min, k_max)) = planes.of(p) {
             diff[k_min as usize][i % 4] += 9;
             diff[k_max as usize + 1][i % 4] -= 9;
@@ -151,8 +152,8 @@ impl PrismPlanes {
 
     /// The planes `[k_min, k_max]` prism `p` (of the shell this was made for) spans; `None` when
     /// there is none.
-    pub(crate) fn of(&self, p: &crate::types::Prism) -> Option<(u32, u32)> {
-        let v = |i: usize| self.vertices[p.vertices[i] as usize];
+    pub(crate) fn of(&self, ids: &[u32; 3]) -> Option<(u32, u32)> {
+        let v = |i: usize| self.vertices[ids[i] as usize];
         let (a, b, c) = (v(0), v(1), v(2));
         let k_min = a.0.min(b.0).min(c.0).saturating_sub(1).max(0);
         let k_max = a.1.max(b.1).max(c.1).saturating_add(1).min(self.last);
@@ -236,6 +237,7 @@ pub fn add_inputs(
     b.insert(B::SLICE_PARAMS.into(), uniform(ctx, "slice_params", bytemuck::bytes_of(params)));
     b.insert(B::SHELL_VERTICES.into(), storage(ctx, "shell_vertices", bytemuck::cast_slice(&shell.vertices)));
     b.insert(B::PRISMS.into(), storage(ctx, "prisms", bytemuck::cast_slice(&shell.prisms)));
+    b.insert(B::PRISM_SPHERES.into(), storage(ctx, "prism_spheres", bytemuck::cast_slice(&shell.spheres)));
     b.insert(
         "plane_cursors".into(),
         buffer("plane_cursors", params.plane_count as u64 * 4, wgpu::BufferUsages::empty()),
@@ -289,11 +291,11 @@ mod tests {
     use super::*;
 
     /// A prism's planes by their definition: the depth range of its six corners.
-    fn by_corners(shell: &Shell, p: &crate::types::Prism, params: &SliceParams) -> Option<(u32, u32)> {
+    fn by_corners(shell: &Shell, ids: &[u32; 3], params: &SliceParams) -> Option<(u32, u32)> {
         let n = params.plane_normal.map(|x| x as f64);
         let (spacing, first) = (params.spacing as f64, params.first_plane as f64);
         let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
-        for &v in &p.vertices[..3] {
+        for &v in ids {
             let sv = &shell.vertices[v as usize];
             for c in [sv.bottom, sv.top] {
                 let d = n[0] * c[0] as f64 + n[1] * c[1] as f64 + n[2] * c[2] as f64;
@@ -318,7 +320,7 @@ mod tests {
                 let mut params = sweep(&shell, forward, planes, 1e-3);
                 params.first_plane -= k as f32 * 3.0 * params.spacing;
                 let fast = PrismPlanes::new(&shell, &params);
-                for p in &shell.prisms {
+                for p in shell.triangles.iter() {
                     let range = fast.of(p);
                     assert_eq!(range, by_corners(&shell, p, &params), "{planes} planes, prism {p:?}");
                     spanned += range.is_some() as usize;

@@ -8,7 +8,7 @@ use crate::error::{Error, Result};
 use crate::gpu::{buffers, Inputs};
 use crate::methods::{texels, InputCx, MethodPlan, ObjectPlan, PartDecl, PlanCx};
 use crate::scene::{Compositor, Lighting, Lod, Method, ViewSlices, MAX_PLANES};
-use crate::types::{SliceParams, SliceVertex, VertexFrame};
+use crate::types::{Prism, SliceParams, SliceVertex, VertexFrame};
 
 /// One ViewSlices object of a frame: its plane sweep in chunks, and what the renderer asks of it.
 pub struct ViewSlicesPlan {
@@ -193,7 +193,7 @@ impl MethodPlan for ViewSlicesPlan {
         let mut items = vec![
             (
                 format!("object {name}: shell ({} prisms)", shell.prisms.len()),
-                (shell.vertices.len() * 32 + shell.prisms.len() * 64) as u64,
+                (shell.vertices.len() * 32 + shell.prisms.len() * (std::mem::size_of::<Prism>() + 16)) as u64,
             ),
             (
                 format!(

@@ -3,6 +3,7 @@
 //! functions and the same arithmetic in the same order as the WGSL, so results agree up to
 //! the GPU's fused multiply-adds.
 
+use crate::mesh::shell::Shell;
 use crate::types::{DrawIndirect, Prism, ShellVertex, SliceParams, SliceVertex};
 
 /// Below this `|s_a - s_b|` an edge counts as lying in the plane (t = 0.5).
@@ -72,7 +73,7 @@ fn lerp(a: V3, b: V3, t: f32) -> V3 {
 }
 
 /// `None` for vertex ids out of range (the GPU reads clamped garbage there; here it is no slice).
-fn load_prism(vertices: &[ShellVertex], prism: &Prism) -> Option<PrismCorners> {
+fn load_prism(vertices: &[ShellVertex], prism: &Prism, sphere: [f32; 4]) -> Option<PrismCorners> {
     let ids = [prism.vertices[0], prism.vertices[1], prism.vertices[2]];
     let v = |i: usize| vertices.get(ids[i] as usize);
     let (v0, v1, v2) = (v(0)?, v(1)?, v(2)?);
@@ -81,7 +82,7 @@ fn load_prism(vertices: &[ShellVertex], prism: &Prism) -> Option<PrismCorners> {
         top: [xyz(v0.top), xyz(v1.top), xyz(v2.top)],
         uv: [[prism.uv01[0], prism.uv01[1]], [prism.uv01[2], prism.uv01[3]], [prism.uv2[0], prism.uv2[1]]],
         ids,
-        sphere: prism.sphere,
+        sphere,
     })
 }
 
@@ -244,17 +245,18 @@ fn slice_polygon(c: &PrismCorners, n: V3, d: f32, trivial_reject: bool) -> Slice
     poly
 }
 
-/// The slice polygon of `prism` with the plane `dot(normal, x) = d`.
+/// The slice polygon of `prism` (with its bounding `sphere`) with the plane `dot(normal, x) = d`.
 pub fn slice_prism(
     vertices: &[ShellVertex],
     prism: &Prism,
+    sphere: [f32; 4],
     prism_index: u32,
     normal: [f32; 3],
     d: f32,
     trivial_reject: bool,
 ) -> Polygon {
     let mut out = Polygon::default();
-    let Some(corners) = load_prism(vertices, prism) else {
+    let Some(corners) = load_prism(vertices, prism, sphere) else {
         return out;
     };
     let poly = slice_polygon(&corners, normal, d, trivial_reject);
@@ -290,43 +292,32 @@ pub(crate) fn triangulate(polygon: &Polygon) -> Vec<SliceVertex> {
 }
 
 fn planes<'a>(
-    vertices: &'a [ShellVertex],
-    prisms: &'a [Prism],
+    shell: &'a Shell,
     params: &'a SliceParams,
     trivial_reject: bool,
 ) -> impl Iterator<Item = impl Iterator<Item = Polygon> + 'a> + 'a {
     let normal = xyz(params.plane_normal);
+    let prisms = shell.prisms.iter().zip(&shell.spheres);
     let prism_count = prisms.len().min(params.prism_count as usize);
     (0..params.plane_count).map(move |k| {
         let d = plane_offset(params, k);
-        prisms[..prism_count]
-            .iter()
-            .enumerate()
-            .map(move |(i, p)| slice_prism(vertices, p, i as u32, normal, d, trivial_reject))
+        prisms.clone().take(prism_count).enumerate().map(move |(i, (p, &sphere))| {
+            slice_prism(&shell.vertices, p, sphere, i as u32, normal, d, trivial_reject)
+        })
     })
 }
 
 /// Twin of `emit_slices`: triangle-list vertices per plane, back to front (k ascending), prisms
 /// in index order.
-pub fn emit_slices(
-    vertices: &[ShellVertex],
-    prisms: &[Prism],
-    params: &SliceParams,
-    trivial_reject: bool,
-) -> Vec<Vec<SliceVertex>> {
-    planes(vertices, prisms, params, trivial_reject)
+pub fn emit_slices(shell: &Shell, params: &SliceParams, trivial_reject: bool) -> Vec<Vec<SliceVertex>> {
+    planes(shell, params, trivial_reject)
         .map(|plane| plane.flat_map(|p| triangulate(&p)).collect())
         .collect()
 }
 
 /// Twin of `count_slices`: the triangle-list vertex count of each plane.
-pub fn count_slices(
-    vertices: &[ShellVertex],
-    prisms: &[Prism],
-    params: &SliceParams,
-    trivial_reject: bool,
-) -> Vec<u32> {
-    planes(vertices, prisms, params, trivial_reject)
+pub fn count_slices(shell: &Shell, params: &SliceParams, trivial_reject: bool) -> Vec<u32> {
+    planes(shell, params, trivial_reject)
         .map(|plane| plane.map(|p| fan_vertex_count(p.len)).sum())
         .collect()
 }

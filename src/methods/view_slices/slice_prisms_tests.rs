@@ -9,8 +9,26 @@ fn sv(bottom: V3, top: V3) -> ShellVertex {
     ShellVertex { bottom: [bottom[0], bottom[1], bottom[2], 1.0], top: [top[0], top[1], top[2], 1.0] }
 }
 
+/// A prism with the bounding sphere `load_prism` reads beside it.
+struct P {
+    prism: Prism,
+    sphere: [f32; 4],
+}
+
+impl std::ops::Deref for P {
+    type Target = Prism;
+    fn deref(&self) -> &Prism {
+        &self.prism
+    }
+}
+
+/// [`slice_prism`] of a test prism.
+fn slice(v: &[ShellVertex], p: &P, index: u32, n: V3, d: f32, trivial_reject: bool) -> Polygon {
+    slice_prism(v, p, p.sphere, index, n, d, trivial_reject)
+}
+
 /// A prism over `ids` with its corner uvs and a bounding sphere of its six corners.
-fn prism(vertices: &[ShellVertex], ids: [u32; 3], uv: [[f32; 2]; 3]) -> Prism {
+fn prism(vertices: &[ShellVertex], ids: [u32; 3], uv: [[f32; 2]; 3]) -> P {
     let corners: Vec<V3> = ids
         .iter()
         .flat_map(|&i| {
@@ -25,12 +43,12 @@ fn prism(vertices: &[ShellVertex], ids: [u32; 3], uv: [[f32; 2]; 3]) -> Prism {
         }
     }
     let r = corners.iter().map(|p| len(sub(*p, c))).fold(0.0, f32::max);
-    Prism {
+    let prism = Prism {
         vertices: [ids[0], ids[1], ids[2], 0],
         uv01: [uv[0][0], uv[0][1], uv[1][0], uv[1][1]],
         uv2: [uv[2][0], uv[2][1], 0.0, 0.0],
-        sphere: [c[0], c[1], c[2], r * 1.001 + 1e-6],
-    }
+    };
+    P { prism, sphere: [c[0], c[1], c[2], r * 1.001 + 1e-6] }
 }
 
 fn sub(a: V3, b: V3) -> V3 {
@@ -57,7 +75,7 @@ fn normalize(a: V3) -> V3 {
 }
 
 /// Unit right-triangle prism with vertical unit heights; uv = xy.
-fn unit_prism() -> (Vec<ShellVertex>, Prism) {
+fn unit_prism() -> (Vec<ShellVertex>, P) {
     let v = vec![
         sv([0.0, 0.0, 0.0], [0.0, 0.0, 1.0]),
         sv([1.0, 0.0, 0.0], [1.0, 0.0, 1.0]),
@@ -152,7 +170,7 @@ fn plane(n: V3, x: V3) -> (V3, f32) {
 fn plane_parallel_to_base_gives_the_base_triangle_at_that_height() {
     let (v, p) = unit_prism();
     for (n, d, z) in [([0.0, 0.0, 1.0], 0.3, 0.3), ([0.0, 0.0, -1.0], -0.7, 0.7)] {
-        let poly = slice_prism(&v, &p, 7, n, d, true);
+        let poly = slice(&v, &p, 7, n, d, true);
         assert_eq!(poly.len, 3);
         check_on_plane_and_edges(&v, &p, &poly, n, d);
         check_convex(&positions(&poly), n);
@@ -166,12 +184,12 @@ fn plane_parallel_to_base_gives_the_base_triangle_at_that_height() {
     // Planes containing the bottom or the top: a zero distance is the positive side, so each is
     // sliced from exactly one side, never both, and never yields NaN.
     for z in [0.0f32, 1.0] {
-        let up = slice_prism(&v, &p, 0, [0.0, 0.0, 1.0], z, true).len;
-        let down = slice_prism(&v, &p, 0, [0.0, 0.0, -1.0], -z, true).len;
+        let up = slice(&v, &p, 0, [0.0, 0.0, 1.0], z, true).len;
+        let down = slice(&v, &p, 0, [0.0, 0.0, -1.0], -z, true).len;
         assert_eq!(up + down, 3, "z = {z}");
     }
-    assert_eq!(slice_prism(&v, &p, 0, [0.0, 0.0, 1.0], 1.5, true).len, 0);
-    assert_eq!(slice_prism(&v, &p, 0, [0.0, 0.0, 1.0], 1.5, false).len, 0);
+    assert_eq!(slice(&v, &p, 0, [0.0, 0.0, 1.0], 1.5, true).len, 0);
+    assert_eq!(slice(&v, &p, 0, [0.0, 0.0, 1.0], 1.5, false).len, 0);
 }
 
 #[test]
@@ -186,7 +204,7 @@ fn tilted_planes_give_quad_and_pentagon() {
         ([-0.3, -0.2, 1.0], [0.0, 0.0, 0.5], 3),
     ] {
         let (n, d) = plane(n, x);
-        let poly = slice_prism(&v, &p, 0, n, d, true);
+        let poly = slice(&v, &p, 0, n, d, true);
         assert_eq!(poly.len, expect, "{poly:?}");
         check_on_plane_and_edges(&v, &p, &poly, n, d);
         check_convex(&positions(&poly), n);
@@ -237,7 +255,7 @@ fn degenerate_planes_through_vertex_edge_and_normal_edge() {
     ];
     for (n, x, expect) in cases {
         let (n, d) = plane(n, x);
-        let poly = slice_prism(&v, &p, 0, n, d, true);
+        let poly = slice(&v, &p, 0, n, d, true);
         if let Some(e) = expect {
             assert_eq!(poly.len, e, "n {n:?}: {poly:?}");
         }
@@ -247,9 +265,9 @@ fn degenerate_planes_through_vertex_edge_and_normal_edge() {
         }
     }
     let (n, d) = plane([1.0, 0.0, 0.0], [0.25, 0.0, 0.0]);
-    assert!((area(&positions(&slice_prism(&v, &p, 0, n, d, true))) - 0.75).abs() < 1e-6);
+    assert!((area(&positions(&slice(&v, &p, 0, n, d, true))) - 0.75).abs() < 1e-6);
     let (n, d) = plane([1.0, -1.0, 0.0], [0.0, 0.0, 0.0]);
-    let a = area(&positions(&slice_prism(&v, &p, 0, n, d, true)));
+    let a = area(&positions(&slice(&v, &p, 0, n, d, true)));
     assert!((a - 0.5f64.sqrt()).abs() < 1e-6, "{a}");
 }
 
@@ -323,7 +341,7 @@ fn degenerate_prisms_give_no_nan_and_points_on_the_plane() {
             }
         }
         for (n, d) in planes {
-            let poly = slice_prism(v, &p, 3, n, d, false);
+            let poly = slice(v, &p, 3, n, d, false);
             check_on_plane_and_edges(v, &p, &poly, n, d);
             let tris = triangulate(&poly);
             assert_eq!(tris.len() as u32, fan_vertex_count(poly.len));
@@ -372,8 +390,8 @@ fn prisms_sharing_an_edge_get_bit_identical_points() {
                 n = normalize([n[0], n[1], n[2] * 0.05]);
             }
             let d = dot(n, [0.5, 0.5, 0.4]) + rng.range(-0.7, 0.7);
-            let a = slice_prism(&v, &pa, 0, n, d, true);
-            let b = slice_prism(&v, &pb, 1, n, d, true);
+            let a = slice(&v, &pa, 0, n, d, true);
+            let b = slice(&v, &pb, 1, n, d, true);
             // Both must be polygons, and neither clamped (twisted: more than five crossed edges).
             if a.len == 0 || b.len == 0 {
                 continue;
@@ -401,7 +419,7 @@ fn prisms_sharing_an_edge_get_bit_identical_points() {
 }
 
 /// Vertices and prisms of a flat `cells` x `cells` grid over [0, size]^2 at z = 0 with height h.
-fn flat_shell(cells: u32, size: f32, h: f32) -> (Vec<ShellVertex>, Vec<Prism>) {
+fn flat_shell(cells: u32, size: f32, h: f32) -> Shell {
     let m = cells + 1;
     let mut v = Vec::new();
     for j in 0..m {
@@ -419,13 +437,14 @@ fn flat_shell(cells: u32, size: f32, h: f32) -> (Vec<ShellVertex>, Vec<Prism>) {
             prisms.push(prism(&v, [b, d, c], uv));
         }
     }
-    (v, prisms)
+    Shell::from_parts(v, prisms.iter().map(|p| p.prism).collect(), prisms.iter().map(|p| p.sphere).collect())
 }
 
 #[test]
 fn flat_shell_cross_section_area_at_30_degrees() {
     let (size, h) = (4.0f32, 0.5f32);
-    let (v, prisms) = flat_shell(16, size, h);
+    let shell = flat_shell(16, size, h);
+    let v = &shell.vertices;
     // Plane 30 degrees from the base; it crosses the slab over a length h / sin 30 = 2h in the
     // xz-plane, all inside the box, so the cross-section is a 2h x size rectangle.
     let theta = 30f32.to_radians();
@@ -435,22 +454,22 @@ fn flat_shell_cross_section_area_at_30_degrees() {
         first_plane: dot(n, [2.013, 0.0, 0.25]),
         spacing: 0.0,
         plane_count: 1,
-        prism_count: prisms.len() as u32,
+        prism_count: shell.prisms.len() as u32,
         vertex_capacity: u32::MAX,
         _pad: [0; 3],
     };
-    let tris = &emit_slices(&v, &prisms, &params, true)[0];
+    let tris = &emit_slices(&shell, &params, true)[0];
     let total: f64 =
         tris.chunks(3).map(|t| area(&t.iter().map(|q| xyz(q.position)).collect::<Vec<_>>())).sum();
     let expect = (2.0 * h * size) as f64;
     assert!((total - expect).abs() < 1e-4 * expect, "area {total} vs {expect}");
     // The same by polygons, each convex.
     let mut by_poly = 0.0;
-    for (i, p) in prisms.iter().enumerate() {
-        let poly = slice_prism(&v, p, i as u32, n, params.first_plane, true);
+    for (i, (p, &sphere)) in shell.prisms.iter().zip(&shell.spheres).enumerate() {
+        let poly = slice_prism(v, p, sphere, i as u32, n, params.first_plane, true);
         if poly.len > 0 {
             check_convex(&positions(&poly), n);
-            check_on_plane_and_edges(&v, p, &poly, n, params.first_plane);
+            check_on_plane_and_edges(v, p, &poly, n, params.first_plane);
         }
         by_poly += area(&positions(&poly));
     }
@@ -459,7 +478,7 @@ fn flat_shell_cross_section_area_at_30_degrees() {
 
 #[test]
 fn counts_scan_and_slices_agree_and_trivial_reject_changes_nothing() {
-    let (v, prisms) = flat_shell(6, 2.0, 0.3);
+    let shell = flat_shell(6, 2.0, 0.3);
     let n = normalize([0.3, -0.5, 0.8]);
     let (lo, hi) = (dot(n, [0.0, 2.0, 0.0]), dot(n, [2.0, 0.0, 0.3]));
     let params = SliceParams {
@@ -467,13 +486,13 @@ fn counts_scan_and_slices_agree_and_trivial_reject_changes_nothing() {
         first_plane: hi + 0.01,
         spacing: (hi - lo + 0.02) / 63.0,
         plane_count: 64,
-        prism_count: prisms.len() as u32,
+        prism_count: shell.prisms.len() as u32,
         vertex_capacity: 1000,
         _pad: [0; 3],
     };
-    let slices = emit_slices(&v, &prisms, &params, true);
-    assert_eq!(slices, emit_slices(&v, &prisms, &params, false));
-    let counts = count_slices(&v, &prisms, &params, true);
+    let slices = emit_slices(&shell, &params, true);
+    assert_eq!(slices, emit_slices(&shell, &params, false));
+    let counts = count_slices(&shell, &params, true);
     assert_eq!(counts, slices.iter().map(|s| s.len() as u32).collect::<Vec<_>>());
     assert!(counts.iter().filter(|&&c| c > 0).count() > 50);
     let (offsets, args) = scan_plane_offsets(&counts, params.vertex_capacity);
@@ -493,11 +512,14 @@ fn counts_scan_and_slices_agree_and_trivial_reject_changes_nothing() {
 fn kernels_validate_and_declare_the_bound_globals() {
     let root = crate::project_root().join("wgsl");
     for (file, globals) in [
-        ("view_slices/count_slices.wgsl", &["slice_params", "shell_vertices", "prisms", "plane_cursors"][..]),
+        (
+            "view_slices/count_slices.wgsl",
+            &["slice_params", "shell_vertices", "prisms", "prism_spheres", "plane_cursors"][..],
+        ),
         ("view_slices/scan_plane_offsets.wgsl", &["slice_params", "plane_cursors", "draw_args"][..]),
         (
             "view_slices/emit_slices.wgsl",
-            &["slice_params", "shell_vertices", "prisms", "plane_cursors", "slice_vertices"][..],
+            &["slice_params", "shell_vertices", "prisms", "prism_spheres", "plane_cursors", "slice_vertices"][..],
         ),
     ] {
         let kernel = crate::gpu::shader::load(&root, file).unwrap_or_else(|e| panic!("{e}"));

@@ -25,11 +25,11 @@ pub(crate) fn entry_bound(
     let all = (tiles(size.0) * tiles(size.1)) as u64;
     let mut total = 0u64;
     let planes = super::PrismPlanes::new(shell, params);
-    for p in &shell.prisms {
-        let Some((k_min, k_max)) = planes.of(p) else { continue };
+    for ids in shell.triangles.iter() {
+        let Some((k_min, k_max)) = planes.of(ids) else { continue };
         let (mut lo, mut hi) = (glam::Vec2::splat(f32::INFINITY), glam::Vec2::splat(f32::NEG_INFINITY));
         let mut behind = false;
-        for &v in &p.vertices[..3] {
+        for &v in ids {
             let sv = &shell.vertices[v as usize];
             for c in [sv.bottom, sv.top] {
                 let clip = m * glam::Vec4::new(c[0], c[1], c[2], 1.0);

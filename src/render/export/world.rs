@@ -284,6 +284,10 @@ pub(crate) fn resample(ctx: &GpuContext, baker: &mut Baker, shell: &WorldShell) 
         storage(ctx, "shell_vertices", bytemuck::cast_slice(&gpu_shell.vertices)),
     );
     b.insert(B::SHELL_PRISMS.into(), storage(ctx, "shell_prisms", bytemuck::cast_slice(&gpu_shell.prisms)));
+    b.insert(
+        B::PRISM_SPHERES.into(),
+        storage(ctx, "prism_spheres", bytemuck::cast_slice(&gpu_shell.spheres)),
+    );
     inputs.views.insert(B::TEXEL_VOLUME.into(), baked.volume.create_view(&Default::default()));
     let mut out = vec![[0.0; 4]; shell.voxels() as usize];
     for batch in todo.chunks(BATCH_LEAVES) {
