@@ -202,6 +202,13 @@ impl GpuContext {
             .map_err(|e| self.gpu_error(format!("waiting for the GPU: {e}")))
     }
 
+    /// Blocks until the work of `submission` (and all before it) is done, not what came after.
+    pub(crate) fn wait_for(&self, submission: wgpu::SubmissionIndex) -> Result<()> {
+        self.check_alive()?;
+        let poll = wgpu::PollType::Wait { submission_index: Some(submission), timeout: None };
+        self.device.poll(poll).map(|_| ()).map_err(|e| self.gpu_error(format!("waiting for the GPU: {e}")))
+    }
+
     /// Copies a buffer back to the CPU (tests, timestamps, readback of images).
     pub fn read_buffer(&self, buffer: &wgpu::Buffer, offset: u64, size: u64) -> Result<Vec<u8>> {
         let staging = self.device.create_buffer(&wgpu::BufferDescriptor {

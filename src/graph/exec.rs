@@ -383,7 +383,14 @@ impl Executor {
     }
 
     /// For a tiled pass, the units left from `unit` to the end of its tile; `None` otherwise.
-    fn tile_left(plan: &Plan, index: usize, frame: &Inputs, objects: &[Inputs], unit: u64) -> Option<u64> {
+    /// Of a tiled pass, the units left in the tile holding `unit`, and a whole tile's.
+    fn tile_left(
+        plan: &Plan,
+        index: usize,
+        frame: &Inputs,
+        objects: &[Inputs],
+        unit: u64,
+    ) -> Option<(u64, u64)> {
         let pass = &plan.passes[index];
         let PassDecl::Compute { repeat, .. } = &pass.decl else { return None };
         let mut first = 0u64;
@@ -392,17 +399,17 @@ impl Executor {
             let repeats = count(repeat, inst, frame) as u64;
             let units = repeats * t.count();
             if unit < first + units {
-                return Some(repeats - (unit - first) % repeats.max(1));
+                return Some((repeats - (unit - first) % repeats.max(1), repeats));
             }
             first += units;
         }
-        Some(1)
+        Some((1, 1))
     }
 
     /// A frame to be rendered in steps ([`Executor::step`]): what is left of it.
     pub(crate) fn begin_steps(plan: &Plan, frame: &Inputs, objects: &[Inputs]) -> Steps {
         let total = (0..plan.passes.len()).map(|i| Self::units(plan, i, frame, objects).max(1)).sum();
-        Steps { pass: 0, unit: 0, done: 0, total, written: Vec::new() }
+        Steps { pass: 0, unit: 0, done: 0, total, written: Vec::new(), submitted: None, starts_tile: false }
     }
 
     /// Records and submits the next `max_units` units of work of `steps`' frame (at least one),
@@ -431,7 +438,7 @@ impl Executor {
             let units = Self::units(plan, index, frame, objects).max(1);
             // A tiled pass's units set their tile's origin, which one submission holds one of:
             // it takes the units of one tile (its dispatches).
-            let tile_left = Self::tile_left(plan, index, frame, objects, steps.unit);
+            let tile_left = Self::tile_left(plan, index, frame, objects, steps.unit).map(|t| t.0);
             if tile_left.is_some() && recorded_any {
                 break;
             }
@@ -456,9 +463,11 @@ impl Executor {
                 break;
             }
         }
+        steps.starts_tile = steps.pass < plan.passes.len()
+            && Self::tile_left(plan, steps.pass, frame, objects, steps.unit).is_some_and(|(l, w)| l == w);
         timer.resolve(&mut encoder);
         let commands = ctx.scoped("recording a frame step", || encoder.finish())?;
-        ctx.queue.submit([commands]);
+        steps.submitted = Some(ctx.queue.submit([commands]));
         ctx.take_errors()?;
         Ok(steps.pass == plan.passes.len())
     }
@@ -849,12 +858,27 @@ pub struct Steps {
     done: u64,
     total: u64,
     written: Vec<String>,
+    /// The last submission made, to wait for it alone.
+    submitted: Option<wgpu::SubmissionIndex>,
+    /// Whether the next unit starts a tile of a tiled pass (whose units may cost a hundred times
+    /// the last tile's).
+    starts_tile: bool,
 }
 
 impl Steps {
     /// Units of work done and in all (a compute pass counts one per dispatch).
     pub fn progress(&self) -> (u64, u64) {
         (self.done, self.total)
+    }
+
+    /// The submission of the last step (`None` before the first).
+    pub(crate) fn last_submission(&self) -> Option<wgpu::SubmissionIndex> {
+        self.submitted.clone()
+    }
+
+    /// Whether the next unit starts a tile of a tiled pass.
+    pub(crate) fn starts_tile(&self) -> bool {
+        self.starts_tile
     }
 }
 

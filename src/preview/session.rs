@@ -248,10 +248,14 @@ impl Session {
         self.renderer.as_mut().map(|r| r.begin_steps(ctx))
     }
 
-    /// Renders `steps`' frame on for about `budget_ms`: units submitted in batches, each batch
-    /// sized from the time the last units took and waited for, so that the window's own frames
-    /// run between batches. The per-pass GPU times when the frame is finished. The steps' wall
-    /// time times full-quality frames for [`Session::draft_scale`].
+    /// Renders `steps`' frame on for about `budget_ms`, so that the window's own frames run
+    /// between calls: submissions of a batch of units each, waited for one by one (lavapipe's
+    /// submit itself waits for the one before). The batch doubles while one takes under an eighth
+    /// of the budget and halves past a quarter; it starts again from one unit at every tile of a
+    /// tiled pass, whose units may cost a hundred times the last ones (a Reference tile over the
+    /// object after one over the background), so a submission runs past the budget by about one
+    /// unit at most. The per-pass GPU times when the frame is finished.
+    /// The steps' wall time times full-quality frames for [`Session::draft_scale`].
     pub(crate) fn step(
         &mut self,
         ctx: &GpuContext,
@@ -260,31 +264,32 @@ impl Session {
     ) -> Result<Option<Vec<(String, f64)>>> {
         let Some(r) = self.renderer.as_mut() else { return Ok(Some(Vec::new())) };
         let start = Instant::now();
-        let mut finished = false;
-        while !finished {
-            // A batch doubles while it takes under a quarter of the budget and halves past half
-            // of it: units differ (a tile of the Reference against a cheap pass), so it follows
-            // what the last one took rather than predicting.
-            let t = Instant::now();
-            let goal = steps.progress().0 + self.batch as u64;
-            while !finished && steps.progress().0 < goal {
-                finished = r.step(ctx, steps, goal - steps.progress().0)?;
+        loop {
+            if steps.starts_tile() {
+                self.batch = 1;
             }
-            ctx.wait()?;
-            let took = ms(t);
-            if took < budget_ms / 4.0 {
-                self.batch = (self.batch * 2).min(256);
-            } else if took > budget_ms / 2.0 {
-                self.batch = (self.batch / 2).max(1);
+            let t = Instant::now();
+            let finished = r.step(ctx, steps, self.batch as u64)?;
+            if let Some(submission) = steps.last_submission() {
+                ctx.wait_for(submission)?;
+                let took = ms(t);
+                self.batch = if took < budget_ms / 8.0 {
+                    (self.batch * 2).min(256)
+                } else if took > budget_ms / 4.0 {
+                    (self.batch / 2).max(1)
+                } else {
+                    self.batch
+                };
+            }
+            if finished {
+                break;
             }
             if ms(start) >= budget_ms {
-                break;
+                self.step_ms += ms(start);
+                return Ok(None);
             }
         }
         self.step_ms += ms(start);
-        if !finished {
-            return Ok(None);
-        }
         if self.draft == 1 {
             self.frame_ms = Some(self.step_ms);
         }

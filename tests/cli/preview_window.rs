@@ -156,8 +156,18 @@ fn overlay_text_has_the_fonts_glyphs() {
     let mut preview = Preview::start(&scene, "64x64", dir.join("frames"), &[]);
     preview.frame(0);
     preview.focus();
-    preview.after(|p| drop(p.xdo(&["key", "h"])));
-    let n = preview.until("the panel hidden", |p, n| p.state(n)["panel"] == false);
+    // Pressed again while the panel still shows: under a loaded machine a key sent as the window
+    // takes focus can be lost (seen once in a full run).
+    let mut hidden = Err(0);
+    for _ in 0..3 {
+        preview.after(|p| drop(p.xdo(&["key", "h"])));
+        hidden = preview.within(10, "the panel hidden", |p, n| p.state(n)["panel"] == false);
+        if hidden.is_ok() {
+            break;
+        }
+    }
+    let n =
+        hidden.unwrap_or_else(|n| panic!("the panel still shows after 3 presses of H: {}", preview.state(n)));
     let (w, _, px) = voltex::io::png::read_rgba8(&preview.record.join(format!("frame-{n}.png"))).unwrap();
     let err = common::stderr(&preview.stop());
     let line = "H: show the panel";
