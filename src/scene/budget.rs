@@ -25,7 +25,9 @@ fn triangles(surface: &Surface, assets: &Assets) -> Option<u64> {
         Surface::Sphere { segments, .. } | Surface::Torus { segments, .. } => {
             2 * segments[0] as u64 * segments[1] as u64
         }
-        Surface::Obj { ref path } => assets.meshes.get(&assets.dir.join(&path.value))?.triangles.len() as u64,
+        Surface::Mesh { ref path } => {
+            assets.meshes.get(&assets.dir.join(&path.value))?.triangles.len() as u64
+        }
     })
 }
 

@@ -165,7 +165,7 @@ impl Scene {
             Surface::Torus { major, minor, segments, distortion, seed } => {
                 Arc::new(generate::torus(*major, *minor, *segments, *distortion, *seed))
             }
-            Surface::Obj { path } => assets
+            Surface::Mesh { path } => assets
                 .meshes
                 .get(&assets.dir.join(&path.value))
                 .cloned()

@@ -162,7 +162,7 @@ Scene(
             name: "{name}",
             // {up} is y-up; voltex scenes are z-up.
             transform: (rotate: (90.0, 0.0, 0.0)),
-            surface: Obj(path: {mesh}),
+            surface: Mesh(path: {mesh}),
 {height_note}            height: (length: {height}),
             uv_tiling: ({tiles:.0}, {tiles:.0}),
             texel: "{texel}",

@@ -151,6 +151,11 @@ Scene(output: (width: 8, height: 8), camera: (eye: (0, -1, 0), target: (0, 0, 0)
     let o = load(&path).unwrap().objects().unwrap();
     let h: Vec<f64> = o[0].surface.heights.iter().map(|h| h.z).collect();
     assert_eq!(h, vec![2.0, 1.0, 0.0, 0.5]);
+    // `Mesh(path)`, the surface's name, and `Obj(path)`, its first, read as the same surface.
+    std::fs::write(&path, text.replace("Obj(path", "Mesh(path")).unwrap();
+    let m = load(&path).unwrap().objects().unwrap();
+    assert_eq!(m[0].surface.positions, o[0].surface.positions);
+    assert_eq!(m[0].surface.heights, o[0].surface.heights);
     assert_eq!(o[0].report.warnings.len(), 1, "one zero height: {:?}", o[0].report);
     // Plane vertices at u = 0, 0.5, 1: wrapping makes u = 0 and 1 the mean of the end pixels.
     let h: Vec<f64> = o[1].surface.heights.iter().map(|h| h.z).collect();

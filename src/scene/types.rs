@@ -693,8 +693,10 @@ pub enum Surface {
         #[serde(default)]
         seed: u32,
     },
-    /// Wavefront OBJ, path relative to the scene file.
-    Obj {
+    /// A mesh file, path relative to the scene file: Wavefront OBJ, or glTF (`.gltf`, `.glb`).
+    /// `Obj(path)`, its first name, still reads as this.
+    #[serde(alias = "Obj")]
+    Mesh {
         /// The OBJ, `.gltf` or `.glb` file.
         path: Mark<String>,
     },

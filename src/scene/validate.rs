@@ -473,7 +473,7 @@ impl Checker<'_> {
                 Surface::Torus { major, minor, .. } if minor >= major => {
                     self.fail(s, format!("expected a torus minor radius below the major radius ({major})"));
                 }
-                Surface::Obj { path } => {
+                Surface::Mesh { path } => {
                     mesh = self.mesh(path);
                     // Texels tile by uv: corners without them get planar uvs (as an OBJ without
                     // `vt`), which the user should know of.
@@ -492,7 +492,7 @@ impl Checker<'_> {
         if let Some(scale) = &n.height.scale {
             match (&scale.value, n.surface.as_deref()) {
                 (_, None) => self.fail(scale, "a height scale needs a `surface`".into()),
-                (HeightScale::VertexAttribute, Some(Surface::Obj { path })) => {
+                (HeightScale::VertexAttribute, Some(Surface::Mesh { path })) => {
                     if mesh.as_ref().is_some_and(|m| m.attribute.is_none()) {
                         let msg = format!(
                             "{} has no vertex colours: expected `v x y z r g b` lines (OBJ) or COLOR_0 (glTF) for VertexAttribute",
@@ -502,7 +502,7 @@ impl Checker<'_> {
                     }
                 }
                 (HeightScale::VertexAttribute, Some(_)) => {
-                    self.fail(scale, "built-in surfaces have no vertex attribute: expected Texture(path: ..) or an Obj surface".into());
+                    self.fail(scale, "built-in surfaces have no vertex attribute: expected Texture(path: ..) or a Mesh surface".into());
                 }
                 (HeightScale::Texture { path, channel }, Some(_)) => {
                     self.image_channel(path, *channel, scale)

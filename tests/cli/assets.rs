@@ -115,7 +115,7 @@ fn an_asset_opens_directly_and_imports_as_the_same_scene() {
     let text = std::fs::read_to_string(&scene).unwrap();
     assert!(text.contains("Written by `voltex import` around dome.glb"), "{text}");
     // Outside the scene's folder: relative all the same (issue 32), so the pair can move.
-    assert!(text.contains("surface: Obj(path: \"../dome.glb\")"), "{text}");
+    assert!(text.contains("surface: Mesh(path: \"../dome.glb\")"), "{text}");
     let mut images = Vec::new();
     for (input, out) in [(&glb, "direct.exr"), (&scene, "imported.exr")] {
         let out = dir.join(out);
@@ -125,7 +125,7 @@ fn an_asset_opens_directly_and_imports_as_the_same_scene() {
     assert_eq!(images[0].pixels, images[1].pixels);
     // Beside the asset, the path is relative; `plan` reads the asset too.
     ok(voltex(&["import", s(&glb)]));
-    assert!(std::fs::read_to_string(dir.join("dome.ron")).unwrap().contains("Obj(path: \"dome.glb\")"));
+    assert!(std::fs::read_to_string(dir.join("dome.ron")).unwrap().contains("Mesh(path: \"dome.glb\")"));
     assert!(ok(voltex(&["plan", s(&glb)])).contains("ViewSlices planes 256"));
     // Not an asset: a clear error, nothing written.
     let run = voltex(&["import", s(&scene), "-o", s(&dir.join("x.ron"))]);

@@ -112,7 +112,7 @@ fn import_with_bare_names_writes_a_relative_mesh_path() {
         .unwrap();
     assert!(out.status.success(), "{}", crate::common::stderr(&out));
     let text = std::fs::read_to_string(dir.join("dome.ron")).unwrap();
-    assert!(text.contains("surface: Obj(path: \"dome.glb\")"), "{text}");
+    assert!(text.contains("surface: Mesh(path: \"dome.glb\")"), "{text}");
     // The pair moves together.
     let moved = dir.with_extension("moved");
     let _ = std::fs::remove_dir_all(&moved);
