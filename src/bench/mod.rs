@@ -76,6 +76,8 @@ pub struct Args {
     pub trace: Option<PathBuf>,
     /// The compositors to measure (each setting with each).
     pub compositors: Vec<Compositor>,
+    /// What it says on stderr while it measures (the tables go to stdout).
+    pub verbosity: crate::progress::Verbosity,
 }
 
 /// The passes that bring a ViewSlices sweep's slices into the frame, by compositor: the `draw`
@@ -124,7 +126,15 @@ pub fn run(args: &Args) -> Result<()> {
     // Phase 1: the slicing kernels alone, before any render pass runs in this process.
     let slices_only = crate::project_root().join("graphs/slices_only.ron");
     let mut rows: Vec<Row> = Vec::new();
+    // Each setting twice: its slicing alone, then its full frame.
+    let mut progress = crate::progress::Progress::new(2 * settings.len(), args.verbosity);
+    let label = |s: &Setting, what: &str| {
+        let stem = paths[s.scene].file_stem().unwrap_or_default().to_string_lossy();
+        format!("{stem} planes={} reject={} {:?} {what}", s.planes, s.reject, s.compositor)
+    };
+    let keep = args.verbosity == crate::progress::Verbosity::Verbose;
     for s in &settings {
+        progress.started(&label(s, "slicing alone"));
         let bp = Blueprint::new(&scenes[s.scene], &options(s, Some(slices_only.clone())))?;
         let mut r = Renderer::new(&ctx, bp)?;
         let (slicing, _) = timed(&ctx, &mut r, frames, None)?;
@@ -147,12 +157,16 @@ pub fn run(args: &Args) -> Result<()> {
             fragments += covered_pixels(&r.blueprint, &out);
             triangles += out.iter().map(|p| p.len() / 3).sum::<usize>() as f64;
         }
+        let ms: f64 = slicing.iter().map(|p| p.1).sum();
+        let line = format!("{}: {ms:.2} ms", label(s, "slicing alone"));
+        progress.finished(&label(s, "slicing alone"), &line, true, keep);
         rows.push(Row { slicing, cpu_ms: cpu.iter().sum(), fragments, triangles, ..Default::default() });
     }
 
     // Phase 2: full frames, their raster passes and wall time, and the error of each setting.
     let mut references: Vec<Option<Image>> = vec![None; scenes.len()];
     for (s, row) in settings.iter().zip(&mut rows) {
+        progress.started(&label(s, "frame"));
         if references[s.scene].is_none() {
             let opts =
                 RenderOptions { size: Some(size), planes: Some(reference_planes), ..Default::default() };
@@ -172,7 +186,10 @@ pub fn run(args: &Args) -> Result<()> {
             passes.into_iter().filter(|p| draw.contains(&p.0.as_str()) || p.0 == "composite").collect();
         row.wall_ms = wall;
         row.orbit_ms = orbit_ms(&ctx, &scenes[s.scene], &options(s, None), frames)?;
+        let line = format!("{}: {:.1} ms, FLIP {:.4}", label(s, "frame"), row.wall_ms, row.flip);
+        progress.finished(&label(s, "frame"), &line, true, keep);
     }
+    progress.end();
 
     println!("adapter: {}", ctx.adapter_line());
     println!("{}x{}, median of {frames} frames after warm-up; times in ms", size.0, size.1);

@@ -36,10 +36,29 @@ pub struct BenchArgs {
     /// into screen tiles, composited front to back by compute).
     #[arg(long, value_enum, value_delimiter = ',', default_values_t = vec![CompositorArg::Raster])]
     compositor: Vec<CompositorArg>,
+    /// Print no progress on stderr, only errors (the tables still go to stdout).
+    #[arg(short, long)]
+    quiet: bool,
+    /// Keep every setting's result line above the progress bar on a terminal (without one,
+    /// every line is printed anyway).
+    #[arg(short, long, conflicts_with = "quiet")]
+    verbose: bool,
 }
 
 pub fn run(args: BenchArgs) -> Result<()> {
-    let BenchArgs { scenes, planes, size, frames, reference_planes, json, limits, trace, compositor } = args;
+    let BenchArgs {
+        scenes,
+        planes,
+        size,
+        frames,
+        reference_planes,
+        json,
+        limits,
+        trace,
+        compositor,
+        quiet,
+        verbose,
+    } = args;
     voltex::bench::run(&voltex::bench::Args {
         scenes,
         planes,
@@ -50,6 +69,7 @@ pub fn run(args: BenchArgs) -> Result<()> {
         limits,
         trace,
         compositors: compositor.into_iter().map(Into::into).collect(),
+        verbosity: voltex::progress::Verbosity::from_flags(quiet, verbose),
     })
 }
 

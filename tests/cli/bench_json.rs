@@ -77,6 +77,30 @@ fn bench_writes_json_rows_limits_cost_model_and_trace() {
     ]));
     let r = report(&json);
     assert_eq!((r.command.as_str(), r.size, r.frames), ("bench", [32, 32], 1));
+    // Progress on stderr, a line per setting and phase (none with -q); the tables on stdout.
+    let args = |quiet: bool| {
+        let mut a = vec!["bench", common::s(&scene), "--size", "16x16", "--planes", "4", "--frames", "1"];
+        a.extend(["--reference-planes", "16"]);
+        if quiet {
+            a.push("-q");
+        }
+        common::voltex(&a)
+    };
+    let said = args(false);
+    let err = common::stderr(&said);
+    assert!(
+        said.status.success() && String::from_utf8_lossy(&said.stdout).contains("| flat_box | 4 |"),
+        "{err}"
+    );
+    for line in [
+        "[1/4",
+        "planes=4 reject=true Raster slicing alone: ",
+        "[4/4] flat_box planes=4 reject=false Raster frame: ",
+    ] {
+        assert!(err.contains(line), "{line:?} not in {err}");
+    }
+    let quiet = args(true);
+    assert!(quiet.status.success() && quiet.stderr.is_empty(), "{}", common::stderr(&quiet));
     assert!(r.adapter.contains("(") && r.date.len() == 16, "{} {}", r.adapter, r.date);
     assert_eq!(r.rows.len(), 6, "3 plane counts x trivial reject on and off");
     for row in &r.rows {
