@@ -40,7 +40,8 @@ use crate::layers::rust_files;
 /// command line) and `RenderOptions::knobs` (the command line builds `RenderOptions` by struct
 /// update, so every field is public), and `pareto::Args::verbosity` (`pareto -q/-v`).)
 /// (1336: `Error::report`, the error with its source line quoted, printed by the command line.)
-const PUB_DECLARATIONS: usize = 1336;
+/// (1337: `bench::Args::verbosity` (`bench -q/-v`); `Prism::sphere` gave way to `Shell::spheres`.)
+const PUB_DECLARATIONS: usize = 1337;
 
 /// Whether the declaration on line `n` has a `///` doc above its attributes (one-line ones, or
 /// multi-line ones from `#[` to `)]`).
