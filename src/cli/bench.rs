@@ -46,30 +46,17 @@ pub struct BenchArgs {
 }
 
 pub fn run(args: BenchArgs) -> Result<()> {
-    let BenchArgs {
-        scenes,
-        planes,
-        size,
-        frames,
-        reference_planes,
-        json,
-        limits,
-        trace,
-        compositor,
-        quiet,
-        verbose,
-    } = args;
     voltex::bench::run(&voltex::bench::Args {
-        scenes,
-        planes,
-        size,
-        frames,
-        reference_planes,
-        json,
-        limits,
-        trace,
-        compositors: compositor.into_iter().map(Into::into).collect(),
-        verbosity: voltex::progress::Verbosity::from_flags(quiet, verbose),
+        verbosity: voltex::progress::Verbosity::from_flags(args.quiet, args.verbose),
+        compositors: args.compositor.into_iter().map(Into::into).collect(),
+        scenes: args.scenes,
+        planes: args.planes,
+        size: args.size,
+        frames: args.frames,
+        reference_planes: args.reference_planes,
+        json: args.json,
+        limits: args.limits,
+        trace: args.trace,
     })
 }
 
