@@ -50,11 +50,11 @@ pub fn folds(p: &PrismCorners) -> bool {
         let a1 = det(g1, e2, hi_) + det(e1, g2, hi_);
         let a2 = det(g1, g2, hi_);
         let f = |w: f64| a0 + w * (a1 + w * a2);
-        let mut ws = vec![0.0, 1.0];
-        if a2 != 0.0 && (-a1 / (2.0 * a2)) > 0.0 && (-a1 / (2.0 * a2)) < 1.0 {
-            ws.push(-a1 / (2.0 * a2));
-        }
-        for w in ws {
+        // The ends of w's range and the parabola's vertex when it lies inside (no allocation:
+        // a camera move tests every prism of the shell).
+        let vertex = -a1 / (2.0 * a2);
+        let inside = a2 != 0.0 && vertex > 0.0 && vertex < 1.0;
+        for w in [0.0, 1.0].into_iter().chain(inside.then_some(vertex)) {
             lo = lo.min(f(w));
             hi = hi.max(f(w));
         }
