@@ -102,6 +102,13 @@ fn start(name: &str) -> (std::path::PathBuf, std::path::PathBuf, Preview) {
     (dir, scene, p)
 }
 
+/// Stops the preview of [`start`]: it must not have panicked; its folder is removed.
+fn finish(p: Preview, dir: &Path) {
+    let out = p.stop();
+    assert!(!String::from_utf8_lossy(&out.stderr).contains("panicked"));
+    std::fs::remove_dir_all(dir).ok();
+}
+
 #[test]
 fn keys_and_a_curve_drag_edit_the_scene_file() {
     let (dir, scene, mut p) = start("voltex-keys");
@@ -283,9 +290,7 @@ fn the_panel_refuses_bad_values_and_yields_to_the_file() {
     assert_eq!(text(&scene), external, "{s}");
     assert_eq!(s["method"], "ViewSlices(planes: 8, lighting: Baked)", "{s}");
     assert!(s["note"].as_str().unwrap_or("").contains("the file wins"), "{s}");
-    let out = p.stop();
-    assert!(!String::from_utf8_lossy(&out.stderr).contains("panicked"));
-    std::fs::remove_dir_all(&dir).ok();
+    finish(p, &dir);
 }
 
 /// Moss on a UV-less glb in one command, then edited in the panel without opening the RON file
@@ -351,9 +356,7 @@ fn the_panel_duplicates_and_removes_an_object() {
     p.after(|p| click(p, n, "nodes[1] remove"));
     let path = scene.clone();
     p.until("the copy removed", move |_, _| text(&path) == original);
-    let out = p.stop();
-    assert!(!String::from_utf8_lossy(&out.stderr).contains("panicked"));
-    std::fs::remove_dir_all(&dir).ok();
+    finish(p, &dir);
 }
 
 /// A click on the image selects the textured object under the pointer (issue 32, item 2): with
@@ -382,9 +385,7 @@ fn a_click_in_the_view_selects_the_object_under_it() {
     p.after(|p| drop(p.xdo(&["mousemove", &x, &y, "click", "1"])));
     let n = p.until("the ground selected", |p, n| p.state(n)["selected"] == "ground");
     assert_eq!(p.state(n)["status"], "selected ground");
-    let out = p.stop();
-    assert!(!String::from_utf8_lossy(&out.stderr).contains("panicked"));
-    std::fs::remove_dir_all(&dir).ok();
+    finish(p, &dir);
 }
 
 /// A 2D shape function (`Grid`) is painted in the panel (Gilet & Dischler's Figure 6; issue 32,
@@ -410,9 +411,7 @@ fn a_grid_shape_is_painted_in_the_panel() {
     p.until("the cell painted", move |_, _| text(&path) != before);
     let painted = original.replacen("Grid([[0.0, 0.0, 0.0, 0.5, 1.0]", "Grid([[1.0, 0.0, 0.0, 0.5, 1.0]", 1);
     assert_eq!(text(&scene), painted);
-    let out = p.stop();
-    assert!(!String::from_utf8_lossy(&out.stderr).contains("panicked"));
-    std::fs::remove_dir_all(&dir).ok();
+    finish(p, &dir);
 }
 
 /// A curve point's tangent has a handle (issue 32: new points got slope 0 and slopes could not be
@@ -446,7 +445,5 @@ fn a_tangent_handle_sets_the_slope() {
     let want = -w / h;
     assert!((c[1].0 - 0.5).abs() < 1e-9 && (c[1].1 - 1.0).abs() < 1e-9, "the point itself moved: {t}");
     assert!((c[1].2 - want).abs() < 0.1 * want.abs(), "slope {} against {want}: {t}", c[1].2);
-    let out = p.stop();
-    assert!(!String::from_utf8_lossy(&out.stderr).contains("panicked"));
-    std::fs::remove_dir_all(&dir).ok();
+    finish(p, &dir);
 }
