@@ -194,18 +194,19 @@ impl GpuContext {
         }
     }
 
+    /// Blocks until all submitted work is done.
     pub(crate) fn wait(&self) -> Result<()> {
-        self.check_alive()?;
-        self.device
-            .poll(wgpu::PollType::wait_indefinitely())
-            .map(|_| ())
-            .map_err(|e| self.gpu_error(format!("waiting for the GPU: {e}")))
+        self.wait_until(None)
     }
 
     /// Blocks until the work of `submission` (and all before it) is done, not what came after.
     pub(crate) fn wait_for(&self, submission: wgpu::SubmissionIndex) -> Result<()> {
+        self.wait_until(Some(submission))
+    }
+
+    fn wait_until(&self, submission: Option<wgpu::SubmissionIndex>) -> Result<()> {
         self.check_alive()?;
-        let poll = wgpu::PollType::Wait { submission_index: Some(submission), timeout: None };
+        let poll = wgpu::PollType::Wait { submission_index: submission, timeout: None };
         self.device.poll(poll).map(|_| ()).map_err(|e| self.gpu_error(format!("waiting for the GPU: {e}")))
     }
 
