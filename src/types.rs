@@ -321,6 +321,22 @@ pub struct ReferenceObject {
     pub params: [f32; 4],
 }
 
+/// A ShellMarch object's footprint filter (`shell_filters`): where its texel's MIP levels are
+/// and how a footprint picks one.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct ShellFilter {
+    /// Where its levels from 1 on start in `shell_mips` (8-byte words).
+    pub mips: u32,
+    /// MIP levels, level 0 included: 0 or 1 where the object does not filter.
+    pub levels: u32,
+    /// Levels added to every footprint's level.
+    pub bias: f32,
+    /// Words of one occupancy pyramid of its texel: the pyramids of its levels' dilated
+    /// opacity follow its own in `shell_occupancy`, one per level from 1 on.
+    pub occupancy: u32,
+}
+
 /// Per-pixel progress of the reference tracer between its dispatches (`reference_state`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]

@@ -67,6 +67,48 @@ pub(crate) fn pyramid(alpha: &[u8], res: [u32; 3]) -> Vec<u32> {
     out
 }
 
+/// The opacity of a volume of `res` dilated by `radius` voxels in s and t (each voxel the most
+/// within `radius` of it along x, then y, repeating): the pyramid of the result covers samples
+/// that read that much farther than a level-0 one (ShellMarch's footprint filter).
+pub(crate) fn dilate_st(alpha: &[u8], res: [u32; 3], radius: u32) -> Vec<u8> {
+    let shape = res.map(|n| n as usize);
+    let pass = |values: &[u8], axis: usize| -> Vec<u8> {
+        let n = shape[axis];
+        let stride = if axis == 0 { 1 } else { shape[0] };
+        let r = (radius as usize).min(n / 2);
+        let mut out = vec![0u8; values.len()];
+        let mut row = Vec::with_capacity(n);
+        for base in (0..values.len()).filter(|i| (i / stride) % n == 0) {
+            row.clear();
+            row.extend((0..n).map(|k| values[base + k * stride]));
+            for (k, v) in window_max(&row, r).into_iter().enumerate() {
+                out[base + k * stride] = v;
+            }
+        }
+        out
+    };
+    pass(&pass(alpha, 0), 1)
+}
+
+/// Per entry of the repeating `row`, the most within `r` of it (r <= len / 2), in time linear in
+/// the row (van Herk / Gil-Werman: maxima of blocks of the window's width, from either end).
+fn window_max(row: &[u8], r: usize) -> Vec<u8> {
+    let (n, w) = (row.len(), 2 * r + 1);
+    let ext: Vec<u8> = (0..n + 2 * r).map(|i| row[(i + n - r) % n]).collect();
+    let (mut ahead, mut behind) = (ext.clone(), ext.clone());
+    for i in 1..ext.len() {
+        if i % w != 0 {
+            ahead[i] = ahead[i].max(ahead[i - 1]);
+        }
+    }
+    for i in (0..ext.len() - 1).rev() {
+        if (i + 1) % w != 0 {
+            behind[i] = behind[i].max(behind[i + 1]);
+        }
+    }
+    (0..n).map(|i| behind[i].max(ahead[i + w - 1])).collect()
+}
+
 /// Per column of level-0 bricks (x fastest): the first and last occupied brick along w, or
 /// `None` where the column holds nothing. `pyramid`: a [`pyramid`] of a volume of `res`.
 pub(crate) fn columns(pyramid: &[u32], res: [u32; 3]) -> Vec<Option<(u32, u32)>> {
@@ -155,6 +197,29 @@ mod tests {
         // Levels 1 and 2: one brick each, holding it.
         assert_eq!(&p[8..], &[200, 200]);
         assert!(pyramid(&vec![0; 512], res).iter().all(|&v| v == 0));
+    }
+
+    /// Dilation in s and t reaches across the repeat and leaves w alone.
+    #[test]
+    fn dilation_spreads_in_s_and_t_only() {
+        let res = [8, 4, 2];
+        let mut alpha = vec![0u8; 64];
+        alpha[(4 + 1) * 8 + 7] = 9; // (7, 1, 1)
+        let d = dilate_st(&alpha, res, 1);
+        let at = |x: usize, y: usize, z: usize| d[(z * 4 + y) * 8 + x];
+        for (x, y) in [(6, 0), (7, 1), (0, 2), (0, 1)] {
+            assert_eq!(at(x, y, 1), 9, "({x}, {y})");
+        }
+        assert_eq!((at(5, 1, 1), at(1, 1, 1), at(7, 3, 1), at(7, 1, 0)), (0, 0, 0, 0));
+        // A radius past half the size takes the whole row and column.
+        assert!(dilate_st(&alpha, res, 9)[32..].iter().all(|&v| v == 9));
+        // The linear-time window against the plain one, on every radius of a varied row.
+        let row: Vec<u8> = (0..13u32).map(|i| (i * 37 % 11) as u8).collect();
+        for r in 0..=6 {
+            let plain: Vec<u8> =
+                (0..13).map(|i| (0..=2 * r).map(|k| row[(i + 13 - r + k) % 13]).max().unwrap()).collect();
+            assert_eq!(window_max(&row, r), plain, "radius {r}");
+        }
     }
 
     /// The band over a box of s and t is the occupied bricks' w extent, found across the repeat.

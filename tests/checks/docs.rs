@@ -265,7 +265,7 @@ macro_rules! trace {
 fn scene_registry() -> Registry {
     use voltex::scene::hypertexture as h;
     use voltex::scene::*;
-    trace!(Scene; Light, TexelSource, Shape, Surface, HeightScale, Method, Lighting, Compositor, Lod, Quality, Shading,
+    trace!(Scene; Light, TexelSource, Shape, Surface, HeightScale, Method, Lighting, Compositor, Lod, Filter, Quality, Shading,
         Segments, Shadows, SliceDirections, SliceBlend, DrawOrder, h::SoftObject, h::Field, h::Operator,
         h::ShapeTransfer, h::ColorTransfer)
 }

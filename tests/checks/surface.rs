@@ -41,7 +41,10 @@ use crate::layers::rust_files;
 /// update, so every field is public), and `pareto::Args::verbosity` (`pareto -q/-v`).)
 /// (1336: `Error::report`, the error with its source line quoted, printed by the command line.)
 /// (1337: `bench::Args::verbosity` (`bench -q/-v`); `Prism::sphere` gave way to `Shell::spheres`.)
-const PUB_DECLARATIONS: usize = 1337;
+/// (1345: ShellMarch's footprint filter: the scene-file knobs `filter` and `mip_bias` and their
+/// enum `Filter` (public as every knob type, for the scene reference's check), and the GPU struct
+/// `ShellFilter` with its four fields (public as every `types` struct, for the layout check).)
+const PUB_DECLARATIONS: usize = 1345;
 
 /// Whether the declaration on line `n` has a `///` doc above its attributes (one-line ones, or
 /// multi-line ones from `#[` to `)]`).

@@ -38,6 +38,7 @@ fn wgsl_structs_match_rust() {
         layout!(ReferencePrism; vertices, uv01, uv2),
         layout!(ReferenceObject; resolution, atlas, params),
         layout!(ReferenceState; color, resume),
+        layout!(ShellFilter; mips, levels, bias, occupancy),
         layout!(AxisParams; resolution, criteria, forward, flags),
         layout!(AxisChoice; direction, level, first, count, vertex_count, vertex_offset, reverse, culled),
         layout!(AxisVertex; position, texcoord, normal),

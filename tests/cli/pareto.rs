@@ -48,10 +48,11 @@ fn rows_have_orbit_times_and_the_truth_can_be_supersampled() {
     assert!(!out.status.success() && err.contains("--supersample 9: expected 1 to 8"), "{err}");
 }
 
-/// ShellMarch's sweep takes its tolerance too, and the knob reaches the kernel: a looser
-/// tolerance maps fewer pieces exactly, so its image differs.
+/// ShellMarch's sweep takes its tolerance and the footprint filter's MIP bias too, and the knobs
+/// reach the kernel: a looser tolerance maps fewer pieces exactly, and each bias reads other MIP
+/// levels, so their images differ.
 #[test]
-fn shell_march_sweeps_its_step_and_its_tolerance() {
+fn shell_march_sweeps_its_step_tolerance_and_filter() {
     let scene = root().join("scenes/shell_march/torus_egg.ron").display().to_string();
     let (_, csv) = pareto(&scene, "voltex-pareto-shell", &["--methods", "shell-march", "--size", "32x32"]);
     let rows = rows(&csv, "ShellMarch");
@@ -64,11 +65,17 @@ fn shell_march_sweeps_its_step_and_its_tolerance() {
             "step=2 tolerance=0.25",
             "step=4 tolerance=0.25",
             "step=1 tolerance=1",
-            "step=1 tolerance=4"
+            "step=1 tolerance=4",
+            "step=1 tolerance=0.25 filter=footprint mip_bias=-1",
+            "step=1 tolerance=0.25 filter=footprint mip_bias=0",
+            "step=1 tolerance=0.25 filter=footprint mip_bias=1"
         ]
     );
     let rmse = |k: &str| rows.iter().find(|r| r.0 == k).unwrap().1["rel_rmse"].clone();
     assert_ne!(rmse("step=1 tolerance=0.25"), rmse("step=1 tolerance=4"), "{csv}");
+    let filtered = |b: &str| rmse(&format!("step=1 tolerance=0.25 filter=footprint mip_bias={b}"));
+    assert_ne!(rmse("step=1 tolerance=0.25"), filtered("-1"), "{csv}");
+    assert_ne!(filtered("-1"), filtered("1"), "{csv}");
 }
 
 /// `pareto -q` says nothing on stderr (no truth line, no progress) and still reports on stdout.

@@ -142,6 +142,51 @@ fn skipping_changes_no_pixel() {
     assert_eq!(differ.count(), 0, "pixels changed by skipping");
 }
 
+/// `example` drawn with `ShellMarch(knobs)` in place of `ShellMarch()`.
+fn with_knobs(dir: &str, name: &str, knobs: &str) -> scene::Scene {
+    let path = example(dir, name);
+    let text = std::fs::read_to_string(&path).unwrap();
+    let changed = text.replace("method: ShellMarch()", &format!("method: ShellMarch({knobs})"));
+    assert_ne!(text, changed, "{name} is drawn with ShellMarch()");
+    scene::parse(&changed, &path).unwrap()
+}
+
+/// The footprint filter (levels of the bake's layers copied into `shell_mips`, read at the
+/// level of each interval's footprint, steps in the level's voxels) agrees with the twin, which
+/// makes its levels with the twin of the MIP kernel; it changes the image, and skipping (its
+/// bricks and bands widened by the filter's reach) still changes no pixel. At 48x48 the
+/// footprints span levels 1 to 3 (reaches of 2.5 to 23.5 voxels), where bricks still skip.
+#[test]
+fn the_footprint_filter_matches_its_twin_and_skips_exactly() {
+    for (name, bias) in [("torus_egg.ron", -1.0), ("terrain.ron", 0.0)] {
+        let knobs = format!("filter: Footprint, mip_bias: {bias}");
+        let filtered = with_knobs("shell_march", name, &knobs);
+        let m = march(&filtered, &shell_march(48), true);
+        let (max, mean) = differences(&m.gpu, &m.cpu);
+        eprintln!("{name} filtered: GPU vs f64 twin: max {max:.2e}, mean {mean:.2e}; counts {:?}", m.counts);
+        assert!(mean < 2e-3 && max < 0.25, "{name}: max {max}, mean {mean}");
+        assert_eq!((m.unfinished, m.counts[2]), (0, 0), "{name}: unfinished rays, dropped intervals");
+        let plain = march(&load(&example("shell_march", name)), &shell_march(48), false);
+        let (changed, _) = differences(&m.gpu, &plain.gpu);
+        assert!(changed > 0.02, "{name}: filtering changes the image (largest change {changed})");
+        let unskipped = with_knobs("shell_march", name, &format!("{knobs}, skip_empty: false"));
+        let off = march(&unskipped, &shell_march(48), false);
+        assert!(
+            m.counts[1] > 0 && off.counts[1] == 0,
+            "{name}: skipped {} and {}",
+            m.counts[1],
+            off.counts[1]
+        );
+        let differ = m
+            .gpu
+            .pixels
+            .iter()
+            .zip(&off.gpu.pixels)
+            .filter(|(a, b)| a.map(f32::to_bits) != b.map(f32::to_bits));
+        assert_eq!(differ.count(), 0, "{name}: pixels changed by skipping");
+    }
+}
+
 /// A box of uniform fog (a flat shell over a plane): the opacity of every pixel is exactly
 /// `1 - (1 - a)^(path / opacity_length)`, sides and seams between prisms included.
 #[test]

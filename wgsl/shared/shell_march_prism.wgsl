@@ -207,6 +207,17 @@ fn set_piece(s: u32, j: u32, ca_known: vec4<f32>, next: bool) {
     iv_cb[s] = cb;
 }
 
+// The MIP level (fractional, from 0 to the last) that a sample in prism `index` at distance t reads:
+// log2 of the pixel's footprint there in voxels of s and t, plus the bias; 0 without filtering.
+fn footprint_level(index: u32, t: f32) -> f32 {
+    let prism = shell_prisms[index];
+    let footprint = shell_filters[prism.vertices.w];
+    if (footprint.levels <= 1u) {
+        return 0.0;
+    }
+    return clamp(log2(cone * t * prism.uv2.w) + footprint.bias, 0.0, f32(footprint.levels - 1u));
+}
+
 // Holds the ray's stretch [t0, t1] inside prism `index` (map values c0, c1 at its ends, c3 at
 // its first third): its samples, how its interpolation is split, and where it resumes.
 fn add_interval(index: u32, t0: f32, t1: f32, c0: vec4<f32>, c1: vec4<f32>, c3: vec4<f32>, shape: ptr<function, PrismShape>) {
@@ -224,8 +235,12 @@ fn add_interval(index: u32, t0: f32, t1: f32, c0: vec4<f32>, c1: vec4<f32>, c3: 
     let v1 = voxels(index, c1);
     let v0 = select(v3, voxels(index, c0), c0.w >= 0.0);
     let v6 = select(mix(v3, v1, 0.5), voxels(index, c6), c6.w >= 0.0);
+    // Filtered, the samples read the level of the footprint at the interval's middle, whose
+    // voxels are 2^level wide in s and t.
+    let level = footprint_level(index, 0.5 * (t0 + t1));
+    let coarse = vec3<f32>(vec2<f32>(exp2(-floor(level))), 1.0);
     // Samples: the path through (s, t, w) in voxels over `step`, and at least one per w-voxel.
-    let path = max3(abs(v3 - v0)) + max3(abs(v6 - v3)) + max3(abs(v1 - v6));
+    let path = max3(abs(v3 - v0) * coarse) + max3(abs(v6 - v3) * coarse) + max3(abs(v1 - v6) * coarse);
     let path_w = abs(v3.z - v0.z) + abs(v6.z - v3.z) + abs(v1.z - v6.z);
     let n = u32(clamp(ceil(max(path / object.params.y, path_w)), 1.0, MAX_SAMPLES));
     let h = (t1 - t0) / f32(n);
@@ -256,6 +271,7 @@ fn add_interval(index: u32, t0: f32, t1: f32, c0: vec4<f32>, c1: vec4<f32>, c3: 
     iv_next[s] = t0 + (f32(k) + 0.5) * h;
     iv_pieces[s] = pieces;
     iv_c1[s] = c1;
+    iv_level[s] = level;
     var j = 0u;
     if (pieces > 1u) {
         j = min(u32((iv_next[s] - t0) / (t1 - t0) * f32(pieces)), pieces - 1u);

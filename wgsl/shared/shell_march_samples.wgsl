@@ -1,17 +1,27 @@
 // ShellMarch's samples (included by march_shell.wgsl): empty-space runs, trilinear filtering and
 // lighting as the Reference does them, and compositing the held intervals nearest first.
 
+// The occupancy pyramid a sample at MIP level `level` skips by: 0 (the texel's own) at level 0,
+// else the coarser level c it mixes, whose pyramid holds the opacity dilated in s and t by as far
+// as its voxels reach (twin: filter::pyramid).
+fn filter_pyramid(level: f32, levels: u32) -> u32 {
+    if (level <= 0.0) {
+        return 0u;
+    }
+    return min(u32(floor(level)) + 1u, levels - 1u);
+}
+
 // How many samples of an interval in `prism` (of `object`) from map value c on are empty for
 // certain (at most `most`): along the line c + k dc, until it leaves the largest brick around c
-// that holds no opacity.
-fn empty_run(prism: ReferencePrism, object: ReferenceObject, c: vec4<f32>, dc: vec4<f32>, most: u32) -> u32 {
+// that holds no opacity (in the object's occupancy pyramid `pyramid`, `words` words each).
+fn empty_run(prism: ReferencePrism, object: ReferenceObject, c: vec4<f32>, dc: vec4<f32>, most: u32, pyramid: u32, words: u32) -> u32 {
     let res = object.resolution.xyz;
     let resf = vec3<f32>(res);
     let st = c.x * prism.uv01.xy + c.y * prism.uv01.zw + c.z * prism.uv2.xy;
     let x = vec3<f32>(fract(st), c.w) * resf;
     let dx = vec3<f32>(dc.x * prism.uv01.xy + dc.y * prism.uv01.zw + dc.z * prism.uv2.xy, dc.w) * resf;
     var run = 0.0;
-    var offset = object.atlas.w;
+    var offset = object.atlas.w + pyramid * words;
     for (var level = 0u; level < 3u; level++) {
         // Bricks of 4, 16, 64 voxels: shifts, as vector integer division is slow on llvmpipe.
         let shift = 2u + 2u * level;
@@ -83,6 +93,66 @@ fn sample_volume(object: ReferenceObject, uvw: vec3<f32>, normals: bool) -> vec4
     return out;
 }
 
+// The f16 in the low 16 bits of h, exactly (`unpack2x16float` needs a capability that Mesa's
+// Vulkan drivers lack without f16 support). The levels hold no infinity or NaN.
+fn half(h: u32) -> f32 {
+    let e = (h >> 10u) & 0x1fu;
+    let m = h & 0x3ffu;
+    // Subnormal: m 2^-24; normal: the exponent rebiased from 15 to 127.
+    let v = select(bitcast<f32>(((e + 112u) << 23u) | (m << 13u)), f32(m) * 5.9604645e-8, e == 0u);
+    return select(v, -v, (h & 0x8000u) != 0u);
+}
+
+fn half4(v: vec2<u32>) -> vec4<f32> {
+    return vec4<f32>(half(v.x & 0xffffu), half(v.x >> 16u), half(v.y & 0xffffu), half(v.y >> 16u));
+}
+
+// Bilinear in s and t (repeating) and linear in w of MIP level l >= 1 of `object`'s texel.
+fn sample_level(object: ReferenceObject, footprint: ShellFilter, uvw: vec3<f32>, l: u32) -> vec4<f32> {
+    let depth = object.resolution.z;
+    var offset = footprint.mips;
+    for (var k = 1u; k < l; k++) {
+        let n = object.resolution.xy >> vec2<u32>(k);
+        offset += ((n.x + 31u) & ~31u) * n.y * depth;
+    }
+    let n = object.resolution.xy >> vec2<u32>(l);
+    let pitch = (n.x + 31u) & ~31u;
+    let ax = axis(fract(uvw.x), n.x, true);
+    let ay = axis(fract(uvw.y), n.y, true);
+    let az = axis(uvw.z, depth, false);
+    var out = vec4<f32>(0.0);
+    for (var k = 0u; k < 8u; k++) {
+        let x = select(ax.i0, ax.i1, (k & 1u) != 0u);
+        let y = select(ay.i0, ay.i1, (k & 2u) != 0u);
+        let z = select(az.i0, az.i1, (k & 4u) != 0u);
+        let weight = select(1.0 - ax.f, ax.f, (k & 1u) != 0u) * select(1.0 - ay.f, ay.f, (k & 2u) != 0u)
+            * select(1.0 - az.f, az.f, (k & 4u) != 0u);
+        out += half4(shell_mips[offset + (z * n.y + y) * pitch + x]) * weight;
+    }
+    return out;
+}
+
+// The texel at fractional MIP level `level`: level 0 from the atlas, the two levels around it
+// mixed.
+fn sample_filtered(object_index: u32, object: ReferenceObject, uvw: vec3<f32>, level: f32) -> vec4<f32> {
+    if (level <= 0.0) {
+        return sample_volume(object, uvw, false);
+    }
+    let footprint = shell_filters[object_index];
+    let l0 = u32(floor(level));
+    var a: vec4<f32>;
+    if (l0 == 0u) {
+        a = sample_volume(object, uvw, false);
+    } else {
+        a = sample_level(object, footprint, uvw, l0);
+    }
+    let f = level - floor(level);
+    if (f == 0.0) {
+        return a;
+    }
+    return mix(a, sample_level(object, footprint, uvw, l0 + 1u), f);
+}
+
 // Per-pixel lighting as the Reference does it (shared/shading.wgsl), at map value c.
 fn shade(index: u32, object: ReferenceObject, c: vec4<f32>, uvw: vec3<f32>, albedo: vec3<f32>) -> vec3<f32> {
     let shape = load_shape(index);
@@ -100,14 +170,14 @@ fn shade(index: u32, object: ReferenceObject, c: vec4<f32>, uvw: vec3<f32>, albe
 }
 
 // Composites one sample, h apart from the next, of an interval in prism `index` (`prism`, of
-// `object`) at ray distance t and map value c (w < 0: none).
-fn composite(index: u32, prism: ReferencePrism, object: ReferenceObject, h: f32, t: f32, c: vec4<f32>) {
+// `object`) at ray distance t and map value c (w < 0: none), read at MIP level `level`.
+fn composite(index: u32, prism: ReferencePrism, object: ReferenceObject, h: f32, t: f32, c: vec4<f32>, level: f32) {
     taken += 1u;
     if (c.w < 0.0) {
         return;
     }
     let uvw = vec3<f32>(c.x * prism.uv01.xy + c.y * prism.uv01.zw + c.z * prism.uv2.xy, c.w);
-    let texel = sample_volume(object, uvw, false);
+    let texel = sample_filtered(prism.vertices.w, object, uvw, level);
     if (texel.a >= OPAQUE_ALPHA && !opaque_found) {
         opaque_found = true;
         record_opaque_depth(pixel, t * dot(ray, frame.forward.xyz));
@@ -152,6 +222,9 @@ fn run(s: u32, limit: f32) {
     let h = iv_h[s];
     let n = iv_n[s];
     let m = iv_pieces[s];
+    let level = iv_level[s];
+    let footprint = shell_filters[prism.vertices.w];
+    let pyramid = filter_pyramid(level, footprint.levels);
     var piece = iv_piece[s];
     var k = iv_k[s];
     var t = iv_next[s];
@@ -192,12 +265,12 @@ fn run(s: u32, limit: f32) {
             most = end - k;
         }
         var step = 1u;
-        let jump = select(0u, empty_run(prism, object, c, dc, most), skip_empty && c.w >= 0.0);
+        let jump = select(0u, empty_run(prism, object, c, dc, most, pyramid, footprint.occupancy), skip_empty && c.w >= 0.0);
         if (jump > 0u) {
             skipped += jump;
             step = jump;
         } else {
-            composite(index, prism, object, h, t, c);
+            composite(index, prism, object, h, t, c, level);
         }
         k += step;
         t = select(FAR, t0 + (f32(k) + 0.5) * h, k < n);
@@ -254,6 +327,7 @@ fn copy_interval(src: u32, dst: u32) {
     iv_ca[dst] = iv_ca[src];
     iv_cb[dst] = iv_cb[src];
     iv_c1[dst] = iv_c1[src];
+    iv_level[dst] = iv_level[src];
 }
 
 fn next_held() -> f32 {

@@ -166,6 +166,14 @@ struct ReferenceObject {
     params: vec4<f32>,
 }
 
+// ShellMarch's footprint filter of an object (twin: ShellFilter in src/types.rs).
+struct ShellFilter {
+    mips: u32,
+    levels: u32,
+    bias: f32,
+    occupancy: u32,
+}
+
 struct ReferenceState {
     color: vec4<f32>,
     resume: vec4<f32>,

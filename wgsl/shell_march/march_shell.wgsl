@@ -61,6 +61,10 @@ const DEPTH_SLACK: f32 = 2e-3;
 // Samples taken, samples skipped, intervals dropped (a full list), pieces mapped exactly.
 @group(0) @binding(13) var<storage, read_write> shell_march_counts: array<atomic<u32>>;
 @group(0) @binding(14) var<storage, read_write> aov_opaque_depth: array<atomic<u32>>;
+// Per object, its footprint filter; its texel's MIP levels from 1 on (s and t halved a level, w
+// kept), f16 RGBA, each level's rows padded to 32 voxels (copied from the bake's layers).
+@group(0) @binding(18) var<storage, read> shell_filters: array<ShellFilter>;
+@group(0) @binding(19) var<storage, read> shell_mips: array<vec2<u32>>;
 
 #include "shared/aov_depth.wgsl"
 
@@ -90,9 +94,13 @@ var<private> iv_tb: array<f32, MAX_ACTIVE>;
 var<private> iv_ca: array<vec4<f32>, MAX_ACTIVE>;
 var<private> iv_cb: array<vec4<f32>, MAX_ACTIVE>;
 var<private> iv_c1: array<vec4<f32>, MAX_ACTIVE>;
+// The MIP level its samples read (fractional; 0: level 0 alone).
+var<private> iv_level: array<f32, MAX_ACTIVE>;
 var<private> held: u32;
 
 var<private> ray: vec3<f32>;
+// The pixel's cone: its width per unit distance along the ray.
+var<private> cone: f32;
 var<private> t_near: f32;
 var<private> t_resume: f32;
 var<private> t_opaque: f32;
@@ -123,6 +131,12 @@ fn direction(sx: f32, sy: f32) -> vec3<f32> {
     return frame.forward.xyz + shell_params.right.xyz * sx + shell_params.up.xyz * sy;
 }
 
+// A pixel's width per unit distance at the image's centre (the widest of its two sides); off
+// centre the ray is longer by |direction| and the pixel narrower by as much.
+fn pixel_cone() -> f32 {
+    return max(2.0 * length(shell_params.right.xyz) * frame.viewport.z, 2.0 * length(shell_params.up.xyz) * frame.viewport.w);
+}
+
 @compute @workgroup_size(8, 8, 1)
 fn main(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) local: u32, @builtin(workgroup_id) tile: vec3<u32>) {
     let size = vec2<u32>(frame.viewport.xy);
@@ -137,7 +151,9 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_
     var marching = state.resume.z == 0.0;
     let sx = 2.0 * (f32(id.x) + 0.5) * frame.viewport.z - 1.0;
     let sy = 1.0 - 2.0 * (f32(id.y) + 0.5) * frame.viewport.w;
-    ray = normalize(direction(sx, sy));
+    let through = direction(sx, sy);
+    ray = normalize(through);
+    cone = pixel_cone() / length(through);
     let cos_d = dot(ray, frame.forward.xyz);
     let near = shell_params.right.w;
     let far = shell_params.up.w;

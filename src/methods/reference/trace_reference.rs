@@ -59,9 +59,18 @@ pub struct TraceView {
 impl TraceView {
     /// Unit ray direction through the centre of pixel (x, y) (y down).
     pub fn ray(&self, x: u32, y: u32) -> DVec3 {
+        self.direction(x, y).normalize()
+    }
+
+    /// Length of the unnormalised direction through pixel (x, y) (1 at the image's centre).
+    pub(crate) fn through(&self, x: u32, y: u32) -> f64 {
+        self.direction(x, y).length()
+    }
+
+    fn direction(&self, x: u32, y: u32) -> DVec3 {
         let sx = 2.0 * (x as f64 + 0.5) / self.width as f64 - 1.0;
         let sy = 1.0 - 2.0 * (y as f64 + 0.5) / self.height as f64;
-        (self.forward + self.right * sx + self.up * sy).normalize()
+        self.forward + self.right * sx + self.up * sy
     }
 }
 

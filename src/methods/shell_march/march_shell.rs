@@ -13,8 +13,11 @@
 
 use glam::{DVec2, DVec3};
 
+use super::filter;
+use crate::cpu::decoded_texel::DecodedTexel;
 use crate::cpu::prism_map::{self, quadratic_roots, PrismCorners};
 use crate::methods::reference::trace_reference::{shade, TraceObject, TraceView, MAX_ALPHA};
+use crate::types::ShellFilter;
 
 /// Mirrors MAX_PIECES and MAX_SAMPLES in march_shell.wgsl.
 pub(crate) const MAX_PIECES: usize = 8;
@@ -30,6 +33,53 @@ pub struct ShellObject {
     pub tolerance: f64,
     /// Per prism: the band of w outside which its texel is transparent ([1, 0]: all of it).
     pub(crate) bands: Vec<[f64; 2]>,
+    /// The footprint filter, where the object filters.
+    pub(crate) filter: Option<Footprint>,
+}
+
+/// An object's footprint filter as the twin sees it.
+pub(crate) struct Footprint {
+    /// Its texel's levels from 1 on (s and t halved a level), made from level 0 by the twin of
+    /// the bake's MIP kernel.
+    levels: Vec<DecodedTexel>,
+    filter: ShellFilter,
+    /// Per prism: voxels of s and t per world unit (as the kernel reads them).
+    density: Vec<f64>,
+    /// A pixel's width per unit distance at the image's centre.
+    cone: f64,
+}
+
+impl Footprint {
+    pub(crate) fn of(volume: &DecodedTexel, filter: ShellFilter, density: Vec<f64>, cone: f64) -> Footprint {
+        let res = volume.resolution;
+        let mut finer: Vec<[f32; 4]> = volume.texels.iter().map(|t| t.map(|v| v as f32)).collect();
+        let mut levels = Vec::new();
+        for l in 1..filter.levels {
+            finer = crate::cpu::mip_layers::mip_layers(&finer, filter::level_size(res, l - 1), res[2], true);
+            let [w, h] = filter::level_size(res, l);
+            let texels = finer.iter().map(|t| t.map(|v| v as f64)).collect();
+            levels.push(DecodedTexel { resolution: [w, h, res[2]], texels });
+        }
+        Footprint { levels, filter, density, cone }
+    }
+
+    /// The level of prism k's samples on ray `d` (unit; `through`: its unnormalised direction's
+    /// length) at distance t, as `footprint_level`.
+    fn level(&self, k: usize, through: f64, t: f64) -> f64 {
+        filter::level(self.cone / through, t, self.density[k], &self.filter)
+    }
+
+    /// The texel at `uvw` at fractional `level`, as `sample_filtered`.
+    fn sample(&self, level0: &DecodedTexel, uvw: DVec3, level: f64) -> [f64; 4] {
+        let at = |l: usize| if l == 0 { level0.sample(uvw) } else { self.levels[l - 1].sample(uvw) };
+        let l0 = level.floor();
+        let (a, f) = (at(l0 as usize), level - l0);
+        if level <= 0.0 || f == 0.0 {
+            return a;
+        }
+        let b = at(l0 as usize + 1);
+        std::array::from_fn(|c| a[c] + (b[c] - a[c]) * f)
+    }
 }
 
 /// Where the ray crosses a prism's boundary, and the map's value there: (b0, b1, b2, w).
@@ -164,6 +214,8 @@ pub(crate) struct Interval {
     pub(crate) pieces: usize,
     pub(crate) c0: Option<[f64; 4]>,
     pub(crate) c1: [f64; 4],
+    /// The MIP level its samples read (0: level 0 alone).
+    pub(crate) level: f64,
 }
 
 /// How far (voxels) the line from ca to cb strays from the exact map at the thirds of [ta, tb].
@@ -196,14 +248,20 @@ pub(crate) fn piece(d: DVec3, o: &ShellObject, iv: &Interval, j: usize) -> Piece
     Piece { ta, tb, line }
 }
 
-/// Twin of `add_interval`: [t0, t1] inside prism k (c3: the exact map at its first third).
-fn interval(d: DVec3, o: &ShellObject, k: usize, (t0, t1): (f64, f64), c0: Option<[f64; 4]>, c1: [f64; 4], c3: [f64; 4]) -> Interval {
+/// Twin of `add_interval`: [t0, t1] inside prism k (c3: the exact map at its first third), on a
+/// ray whose unnormalised direction is `through` long.
+#[allow(clippy::too_many_arguments)]
+fn interval(d: DVec3, through: f64, o: &ShellObject, k: usize, (t0, t1): (f64, f64), c0: Option<[f64; 4]>, c1: [f64; 4], c3: [f64; 4]) -> Interval {
     let (p, uv, res) = (&o.trace.prisms[k], &o.trace.uvs[k], o.trace.volume.resolution);
     let c6 = exact(d * (t0 + (t1 - t0) * 2.0 / 3.0), p);
     let (v3, v1) = (voxels(uv, res, c3), voxels(uv, res, c1));
     let v0 = c0.map_or(v3, |c| voxels(uv, res, c));
     let v6 = c6.map_or((v3 + v1) * 0.5, |c| voxels(uv, res, c));
-    let path = max3(v3 - v0) + max3(v6 - v3) + max3(v1 - v6);
+    // Filtered, the samples read the footprint's level at the middle, 2^level voxels wide in s, t.
+    let level = o.filter.as_ref().map_or(0.0, |f| f.level(k, through, 0.5 * (t0 + t1)));
+    let st = 0.5f64.powi(level.floor() as i32);
+    let coarse = |v: DVec3| v * DVec3::new(st, st, 1.0);
+    let path = max3(coarse(v3 - v0)) + max3(coarse(v6 - v3)) + max3(coarse(v1 - v6));
     let path_w = (v3.z - v0.z).abs() + (v6.z - v3.z).abs() + (v1.z - v6.z).abs();
     let n = (path / o.step).max(path_w).ceil().clamp(1.0, MAX_SAMPLES);
     let mut pieces = 0;
@@ -211,11 +269,12 @@ fn interval(d: DVec3, o: &ShellObject, k: usize, (t0, t1): (f64, f64), c0: Optio
         let err = max3(v3 - v0.lerp(v1, 1.0 / 3.0)).max(max3(v6 - v0.lerp(v1, 2.0 / 3.0)));
         pieces = (err / o.tolerance).sqrt().ceil().clamp(1.0, MAX_PIECES as f64) as usize;
     }
-    Interval { prism: k, t0, t1, n: n as u64, h: (t1 - t0) / n, pieces, c0, c1 }
+    Interval { prism: k, t0, t1, n: n as u64, h: (t1 - t0) / n, pieces, c0, c1, level }
 }
 
-/// Twin of `expand_prism`: the intervals of ray `d` inside prism k after `t_near`.
-pub(crate) fn intervals(d: DVec3, o: &ShellObject, k: usize, t_near: f64) -> Vec<Interval> {
+/// Twin of `expand_prism`: the intervals of ray `d` (unnormalised, `through` long) inside prism
+/// k after `t_near`.
+pub(crate) fn intervals(d: DVec3, through: f64, o: &ShellObject, k: usize, t_near: f64) -> Vec<Interval> {
     let (p, band) = (&o.trace.prisms[k], o.bands[k]);
     let mut out = Vec::new();
     if band[0] > band[1] {
@@ -231,7 +290,7 @@ pub(crate) fn intervals(d: DVec3, o: &ShellObject, k: usize, t_near: f64) -> Vec
             if at_near {
                 c0 = exact(d * t0, p);
             }
-            out.push(interval(d, o, k, (t0, t1), c0, c1, c3));
+            out.push(interval(d, through, o, k, (t0, t1), c0, c1, c3));
         }
         (t0, c0, at_near) = (t1, Some(c1), false);
     }
@@ -258,13 +317,13 @@ pub fn march_shell(view: &TraceView, objects: &[ShellObject], min_transmittance:
     let mut out = Vec::with_capacity((view.width * view.height) as usize);
     for y in 0..view.height {
         for x in 0..view.width {
-            out.push(march_ray(view, objects, view.ray(x, y), min_transmittance));
+            out.push(march_ray(view, objects, view.ray(x, y), view.through(x, y), min_transmittance));
         }
     }
     out
 }
 
-fn march_ray(view: &TraceView, objects: &[ShellObject], d: DVec3, min_transmittance: f64) -> [f64; 4] {
+fn march_ray(view: &TraceView, objects: &[ShellObject], d: DVec3, through: f64, min_transmittance: f64) -> [f64; 4] {
     let t_near = view.near / d.dot(view.forward);
     let mut t_opaque = f64::INFINITY;
     let mut held = Vec::new();
@@ -278,7 +337,7 @@ fn march_ray(view: &TraceView, objects: &[ShellObject], d: DVec3, min_transmitta
                     }
                 }
             }
-            held.extend(intervals(d, o, k, t_near).into_iter().map(|iv| (i, iv)));
+            held.extend(intervals(d, through, o, k, t_near).into_iter().map(|iv| (i, iv)));
         }
     }
     // Every sample before the first opaque surface, nearest first.
@@ -299,7 +358,10 @@ fn march_ray(view: &TraceView, objects: &[ShellObject], d: DVec3, min_transmitta
         let uv = o.trace.uvs[iv.prism];
         let st = uv[0] * c[0] + uv[1] * c[1] + uv[2] * c[2];
         let uvw = DVec3::new(st.x, st.y, c[3]);
-        let texel = o.trace.volume.sample(uvw);
+        let texel = match &o.filter {
+            Some(f) => f.sample(&o.trace.volume, uvw, iv.level),
+            None => o.trace.volume.sample(uvw),
+        };
         let alpha = texel[3].clamp(0.0, MAX_ALPHA);
         if alpha <= 1e-6 {
             continue;

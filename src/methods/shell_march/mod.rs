@@ -2,11 +2,13 @@
 //! for speed at a measured error. Its objects share the Reference's layout (the prisms of every
 //! ShellMarch object, their shells concatenated, level 0 of their volumes in one storage buffer:
 //! `reference::build`), to which it adds, per prism, whether its map folds, per object an
-//! occupancy pyramid of its texel (`bake::occupancy`) for empty-space skipping, and per frame the
-//! prisms binned into screen tiles (`tiles.rs`).
+//! occupancy pyramid of its texel (`bake::occupancy`) for empty-space skipping, per frame the
+//! prisms binned into screen tiles (`tiles.rs`), and for the footprint filter the texel's MIP
+//! levels in s and t (`filter.rs`).
 
 /// Its scene-file knobs (`knobs.rs`, compiled in the scene layer: `scene::methods`).
 pub(crate) use crate::scene::methods::shell_march as knobs;
+mod filter;
 pub mod march_shell;
 mod object;
 pub(crate) mod plugin;
@@ -35,6 +37,8 @@ pub(crate) const CONTRIBUTION: super::Contribution = super::Contribution {
         B::SHELL_OCCUPANCY,
         B::SHELL_MARCH_STATE,
         B::SHELL_MARCH_COUNTS,
+        B::SHELL_FILTERS,
+        B::SHELL_MIPS,
     ],
     counts: &["shell_march_dispatches"],
     texel_resources: &[B::TEXEL_ATLAS],

@@ -6,8 +6,9 @@ use std::sync::Arc;
 
 use glam::{DVec2, DVec3};
 
-use super::knobs::ShellMarch;
-use super::march_shell::{folds, ShellObject};
+use super::filter;
+use super::knobs::{Filter, ShellMarch};
+use super::march_shell::{folds, Footprint, ShellObject};
 use super::tiles::{self, TileLists};
 use crate::bake::{occupancy, Baked};
 use crate::cpu::prism_map::PrismCorners;
@@ -22,7 +23,7 @@ use crate::methods::reference::{build, default_step, twin_inputs, Member, Refere
 use crate::methods::view::View;
 use crate::methods::{texels, BakePlan, InputCx, MethodPlan, ObjectPlan, PartDecl, PlanCx};
 use crate::scene::{Lighting, Method};
-use crate::types::{FrameParams, ReferenceObject, ReferenceParams, ReferenceState};
+use crate::types::{FrameParams, ReferenceObject, ReferenceParams, ReferenceState, ShellFilter};
 
 /// Mirrors `samples_per_dispatch` and the costs in march_shell.wgsl.
 const BUDGET: f64 = 8192.0;
@@ -46,6 +47,10 @@ pub(crate) fn plan(cx: &mut PlanCx, object: &mut ObjectPlan, m: &ShellMarch) -> 
     let texel = object.object.texel.clone().unwrap_or_default();
     let bake = texels::bake_index(cx.scene, &texel, object.per_pixel, cx.light, cx.time, cx.bakes)?;
     object.bake = Some(bake);
+    // The footprint filter reads the layers' MIP levels (s and t halved, w kept).
+    if m.filter == Filter::Footprint {
+        cx.bakes[bake].request.layers = true;
+    }
     object.methods.push(Box::new(ShellPlan { knobs: *m, dispatches: 0 }));
     Ok(())
 }
@@ -62,6 +67,10 @@ pub struct ShellSet {
     /// Every prism binned into the image's tiles (`tiles::bin`); those whose texel is
     /// transparent over their uvs leave the lists once the atlas is known (`add_inputs`).
     pub(crate) tiles: TileLists,
+    /// Per object its footprint filter (`shell_filters`), and the words of `shell_mips` (at
+    /// least 1). A filtering object's prisms hold their voxel density in `uv2.w`.
+    pub(crate) filters: Vec<ShellFilter>,
+    pub(crate) mip_words: u64,
 }
 
 /// The frame's ShellMarch objects as the Reference's layout takes them.
@@ -123,12 +132,14 @@ pub(super) fn gather(objects: &mut [ObjectPlan], bakes: &[BakePlan], view: &View
     let (list, knobs): (Vec<Member>, Vec<ShellMarch>) = members.into_iter().unzip();
     // No BVH: the kernel walks screen tiles' lists (`tiles.rs`).
     let mut set = build(&list, params, false);
+    let filtering = knobs.iter().map(|k| (k.filter == Filter::Footprint).then_some(k.mip_bias));
+    let (filters, mip_words) = filter::table(list.iter().map(|m| m.resolution).zip(filtering));
     let mut offset = 0u64;
-    for ((entry, k), m) in set.table.iter_mut().zip(&knobs).zip(&list) {
+    for (((entry, k), m), f) in set.table.iter_mut().zip(&knobs).zip(&list).zip(&filters) {
         entry.params[1] = k.step as f32;
         entry.params[2] = k.tolerance as f32;
         entry.atlas[3] = offset as u32;
-        offset += occupancy::words(m.resolution);
+        offset += occupancy::words(m.resolution) * pyramids(f) as u64;
     }
     let v3 = |a: [f32; 4]| DVec3::new(a[0] as f64, a[1] as f64, a[2] as f64);
     for p in &mut set.prisms {
@@ -140,6 +151,13 @@ pub(super) fn gather(objects: &mut [ObjectPlan], bakes: &[BakePlan], view: &View
         };
         p.uv2[2] = folds(&corners) as u32 as f32;
     }
+    for p in &mut set.prisms {
+        let o = p.vertices[3] as usize;
+        if filters[o].levels > 1 {
+            let res = [set.table[o].resolution[0], set.table[o].resolution[1], set.table[o].resolution[2]];
+            p.uv2[3] = filter::density(p, &set.vertices, res);
+        }
+    }
     let work: f64 = list.iter().map(work_bound).sum();
     // Twice the bound: each dispatch walks again to where the last one stopped.
     set.dispatches = ((2.0 * work / BUDGET).ceil() + 1.0).min(u32::MAX as f64) as u32;
@@ -147,10 +165,50 @@ pub(super) fn gather(objects: &mut [ObjectPlan], bakes: &[BakePlan], view: &View
         o.dispatches = set.dispatches;
     }
     let tiles = tiles::bin(&set.prisms, &set.vertices, &camera, view.size);
-    Some(Box::new(ShellSet { set, knobs, occupancy_words: offset.max(1), tiles }))
+    Some(Box::new(ShellSet { set, knobs, occupancy_words: offset.max(1), tiles, filters, mip_words: mip_words.max(1) }))
 }
 
 impl ShellSet {
+    /// Per prism its band (`prism_band`) from the `columns` of its object's pyramid that its
+    /// filtered samples may skip by in a view of `size`.
+    fn bands(&self, occupancy: &[&Occupancy], size: (u32, u32)) -> Vec<[f64; 2]> {
+        let set = &self.set;
+        let cone = filter::pixel_cone(set.params.right, set.params.up, size);
+        let uv = |a: [f32; 4], i: usize| DVec2::new(a[i] as f64, a[i + 1] as f64);
+        (set.prisms.iter())
+            .map(|p| {
+                let o = p.vertices[3] as usize;
+                let pyramid = filter::prism_pyramid(p, &set.vertices, cone, &self.filters[o]) as usize;
+                let columns = &occupancy[o][pyramid].1;
+                prism_band(columns, &set.table[o], [uv(p.uv01, 0), uv(p.uv01, 2), uv(p.uv2, 0)])
+            })
+            .collect()
+    }
+
+    /// `shell_filters`, and `shell_mips` with levels 1.. of each filtering object's texel layers.
+    fn copy_mips(&self, ctx: &GpuContext, inputs: &mut Inputs, baked: &[Baked]) {
+        let b = &mut inputs.buffers;
+        b.insert(B::SHELL_FILTERS.into(), storage(ctx, "shell_filters", bytemuck::cast_slice(&self.filters)));
+        let mips = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("shell_mips"),
+            size: self.mip_words * 8,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        let copies: Vec<_> = (self.filters.iter().zip(&self.set.table).zip(&self.set.copies))
+            .filter(|((f, _), _)| f.levels > 1)
+            .map(|((f, entry), &(bake, _))| {
+                (*f, [entry.resolution[0], entry.resolution[1], entry.resolution[2]], &baked[bake].layers[0])
+            })
+            .collect();
+        if !copies.is_empty() {
+            let mut encoder = ctx.device.create_command_encoder(&Default::default());
+            filter::copy_levels(&mut encoder, &mips, &copies);
+            ctx.queue.submit([encoder.finish()]);
+        }
+        b.insert(B::SHELL_MIPS.into(), mips);
+    }
+
     /// The kernel's override constants: the lowest cutoff of its objects; skipping unless one
     /// turns it off.
     fn constants(&self) -> Vec<(String, f64)> {
@@ -188,28 +246,20 @@ impl ShellSet {
             b.insert(name.into(), empty(name, words * 4, true));
         }
         set.copy_volumes(ctx, inputs, cx.baked);
+        self.copy_mips(ctx, inputs, cx.baked);
         let b = &mut inputs.buffers;
         // Made in `prepare`, once per bake (a camera move plans again, reads nothing back).
         let occupancy = cx.prepared.and_then(|p| p.downcast_ref::<Vec<Arc<Occupancy>>>());
         let occupancy = occupancy.ok_or_else(|| Error::Invalid("ShellMarch: no occupancy prepared".into()))?;
+        let occupancy: Vec<&Occupancy> = occupancy.iter().map(|o| &**o).collect();
         let mut pyramids = Vec::with_capacity(self.occupancy_words as usize);
-        let mut columns = Vec::with_capacity(set.table.len());
-        for o in occupancy {
-            pyramids.extend_from_slice(&o.0);
-            columns.push(&o.1);
+        for (pyramid, _) in occupancy.iter().flat_map(|o| o.iter()) {
+            pyramids.extend_from_slice(pyramid);
         }
         pyramids.resize(self.occupancy_words as usize, 0);
         b.insert(B::SHELL_OCCUPANCY.into(), storage(ctx, "shell_occupancy", bytemuck::cast_slice(&pyramids)));
-        let uv = |a: [f32; 4], i: usize| DVec2::new(a[i] as f64, a[i + 1] as f64);
-        let bands: Vec<[f32; 2]> = set
-            .prisms
-            .iter()
-            .map(|p| {
-                let o = p.vertices[3] as usize;
-                let band = prism_band(columns[o], &set.table[o], [uv(p.uv01, 0), uv(p.uv01, 2), uv(p.uv2, 0)]);
-                band.map(|w| w as f32)
-            })
-            .collect();
+        let bands: Vec<[f32; 2]> =
+            self.bands(&occupancy, cx.size).into_iter().map(|band| band.map(|w| w as f32)).collect();
         // Prisms whose texel is transparent are left out of the lists, but for their opaque bases.
         let listed: Vec<bool> = (set.prisms.iter().zip(&bands))
             .map(|(p, band)| band[0] <= band[1] || set.table[p.vertices[3] as usize].resolution[3] & 2 != 0)
@@ -238,30 +288,57 @@ pub fn frame_twin_inputs(
     normal_atlas: &[u8],
 ) -> (TraceView, Vec<ShellObject>) {
     let (list, knobs): (Vec<Member>, Vec<ShellMarch>) = members(objects, bakes).into_iter().unzip();
+    let size = frame.1;
     let (view, traced) = twin_inputs(&set.set, &list, frame, texel_atlas, normal_atlas);
-    let objects = (traced.into_iter().zip(knobs).zip(&set.set.table))
-        .map(|((trace, k), entry)| {
-            let columns = occupancy_of(texel_atlas, entry).1;
-            let bands = trace.uvs.iter().map(|uv| prism_band(&columns, entry, *uv)).collect();
-            ShellObject { trace, step: k.step, tolerance: k.tolerance, bands }
+    let occupancy: Vec<Occupancy> =
+        (set.set.table.iter().zip(&set.filters)).map(|(entry, f)| occupancy_of(texel_atlas, entry, f)).collect();
+    let mut bands = set.bands(&occupancy.iter().collect::<Vec<_>>(), size).into_iter();
+    let mut prisms = set.set.prisms.iter();
+    let cone = filter::pixel_cone(set.set.params.right, set.set.params.up, size);
+    let objects = (traced.into_iter().zip(knobs).zip(&set.filters))
+        .map(|((trace, k), f)| {
+            let n = trace.prisms.len();
+            let bands = bands.by_ref().take(n).collect();
+            let density = prisms.by_ref().take(n).map(|p| p.uv2[3] as f64).collect();
+            let filter = (f.levels > 1).then(|| Footprint::of(&trace.volume, *f, density, cone));
+            ShellObject { trace, step: k.step, tolerance: k.tolerance, bands, filter }
         })
         .collect();
     (view, objects)
 }
 
-/// An object's occupancy pyramid and the w extents of its level-0 columns.
-type Occupancy = (Vec<u32>, Vec<Option<(u32, u32)>>);
+/// An object's occupancy: per pyramid, its words and the w extents of its level-0 columns. The
+/// texel's own pyramid, then where the object filters one per MIP level c from 1 on, of the
+/// opacity dilated by `filter::radius(c)` in s and t (what a sample mixing level c reads).
+type Occupancy = Vec<(Vec<u32>, Vec<Option<(u32, u32)>>)>;
 
-/// An object's [`Occupancy`] from the texel atlas the kernel reads.
-fn occupancy_of(atlas: &[u8], entry: &ReferenceObject) -> Occupancy {
-    let res = [entry.resolution[0], entry.resolution[1], entry.resolution[2]];
-    occupancy_from_alpha(&occupancy::atlas_alpha(atlas, res, entry.atlas[0], entry.atlas[1]), res)
+/// Pyramids of an object with filter `f` in `shell_occupancy`.
+fn pyramids(f: &ShellFilter) -> u32 {
+    f.levels.max(1)
 }
 
-fn occupancy_from_alpha(alpha: &[u8], res: [u32; 3]) -> Occupancy {
-    let pyramid = occupancy::pyramid(alpha, res);
-    let columns = occupancy::columns(&pyramid, res);
-    (pyramid, columns)
+/// An object's [`Occupancy`] from the texel atlas the kernel reads.
+fn occupancy_of(atlas: &[u8], entry: &ReferenceObject, f: &ShellFilter) -> Occupancy {
+    let res = [entry.resolution[0], entry.resolution[1], entry.resolution[2]];
+    occupancy_from_alpha(&occupancy::atlas_alpha(atlas, res, entry.atlas[0], entry.atlas[1]), res, f)
+}
+
+fn occupancy_from_alpha(alpha: &[u8], res: [u32; 3], f: &ShellFilter) -> Occupancy {
+    (0..pyramids(f))
+        .map(|c| {
+            let dilated;
+            let alpha = match filter::radius(c) {
+                0 => alpha,
+                r => {
+                    dilated = occupancy::dilate_st(alpha, res, r);
+                    &dilated
+                }
+            };
+            let pyramid = occupancy::pyramid(alpha, res);
+            let columns = occupancy::columns(&pyramid, res);
+            (pyramid, columns)
+        })
+        .collect()
 }
 
 /// The band of w of a prism with corner uvs `uv` (its texel repeating) outside which its samples
@@ -291,8 +368,12 @@ impl MethodPlan for ShellPlan {
 
     fn summary(&self, object: &ObjectPlan) -> String {
         let k = &self.knobs;
+        let filter = match k.filter {
+            Filter::Off => String::new(),
+            Filter::Footprint => format!(", filtered over the footprint (MIP bias {})", k.mip_bias),
+        };
         format!(
-            "ShellMarch step {} voxel(s), tolerance {} voxel(s), stop below {}, skipping {}, lighting {:?}, {} dispatch(es) per frame",
+            "ShellMarch step {} voxel(s), tolerance {} voxel(s), stop below {}, skipping {}{filter}, lighting {:?}, {} dispatch(es) per frame",
             k.step,
             k.tolerance,
             k.min_transmittance,
@@ -341,7 +422,7 @@ impl MethodPlan for ShellSet {
     }
 
     /// Per object, its [`Occupancy`] from its bake's volume (level 0 read back), kept in the
-    /// cache under the bake's key: made once per bake, not per frame.
+    /// cache under the bake's key and the filter's levels: made once per bake, not per frame.
     fn prepare(
         &self,
         ctx: &GpuContext,
@@ -350,15 +431,15 @@ impl MethodPlan for ShellSet {
         bake_keys: &[u64],
     ) -> Result<Option<Box<dyn Any + Send>>> {
         let mut out: Vec<Arc<Occupancy>> = Vec::with_capacity(self.set.table.len());
-        for (entry, &(bake, _)) in self.set.table.iter().zip(&self.set.copies) {
-            let key = crate::gpu::cache::key(&("shell_march occupancy", bake_keys[bake]));
+        for ((entry, &(bake, _)), f) in self.set.table.iter().zip(&self.set.copies).zip(&self.filters) {
+            let key = crate::gpu::cache::key(&("shell_march occupancy", bake_keys[bake], pyramids(f)));
             let made = match cache.take::<Arc<Occupancy>>(key) {
                 Some(o) => o,
                 None => {
                     let res = [entry.resolution[0], entry.resolution[1], entry.resolution[2]];
                     let rgba = crate::gpu::readback::read_texture(ctx, &baked[bake].volume, 4)?;
                     let alpha: Vec<u8> = rgba.chunks_exact(4).map(|p| p[3]).collect();
-                    Arc::new(occupancy_from_alpha(&alpha, res))
+                    Arc::new(occupancy_from_alpha(&alpha, res, f))
                 }
             };
             cache.put(key, made.clone());
@@ -412,15 +493,18 @@ impl MethodPlan for ShellSet {
         let s = &self.set;
         vec![(
             format!(
-                "shell march: {} prisms with bounds and bands, {} tile list entries at most, shells, texel atlas{}, \
+                "shell march: {} prisms with bounds and bands, {} tile list entries at most, shells, texel atlas{}{}, \
                  occupancy pyramids, per-pixel state",
                 s.prisms.len(),
                 self.tiles.entries.len(),
-                if s.normal_words > 1 { " + normal atlas" } else { "" }
+                if s.normal_words > 1 { " + normal atlas" } else { "" },
+                if self.mip_words > 1 { " + its s,t MIP levels (f16)" } else { "" }
             ),
             (s.prisms.len() * (48 + 32 + 8) + s.vertices.len() * 32 + s.frames.len() * 32) as u64
                 + (self.tiles.tiles.len() * 8 + self.tiles.entries.len() * 4) as u64
                 + (s.atlas_words + s.normal_words + self.occupancy_words) * 4
+                + self.mip_words * 8
+                + self.filters.len() as u64 * 16
                 + size.0 as u64 * size.1 as u64 * 32,
         )]
     }

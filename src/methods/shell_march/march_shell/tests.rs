@@ -33,7 +33,7 @@ fn object(p: PrismCorners, tolerance: f64) -> ShellObject {
         step: 0.01,
         opaque_base: false,
     };
-    ShellObject { trace, step: 1.0, tolerance, bands: vec![[0.0, 1.0]] }
+    ShellObject { trace, step: 1.0, tolerance, bands: vec![[0.0, 1.0]], filter: None }
 }
 
 /// Base triangle in front of a camera at the origin looking down +y.
@@ -113,7 +113,7 @@ fn interpolation_error(p: PrismCorners, tolerance: f64) -> (f64, f64) {
     let mut rng = Rng(11);
     let (mut worst, mut pieces, mut count): (f64, usize, usize) = (0.0, 0, 0);
     for d in rays(p, &mut rng, 300) {
-        for iv in intervals(d, &o, 0, 0.1) {
+        for iv in intervals(d, 1.0, &o, 0, 0.1) {
             count += 1;
             pieces += iv.pieces;
             for j in 0..iv.pieces {
@@ -160,7 +160,7 @@ fn folded_prisms_are_mapped_exactly() {
     let mut rng = Rng(3);
     let mut seen = 0;
     for d in rays(&o.trace.prisms[0], &mut rng, 100) {
-        for iv in intervals(d, &o, 0, 0.1) {
+        for iv in intervals(d, 1.0, &o, 0, 0.1) {
             assert_eq!(iv.pieces, 0);
             assert!(piece(d, &o, &iv, 0).line.is_none());
             seen += 1;
