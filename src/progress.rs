@@ -1,6 +1,7 @@
-//! Progress of a long command on stderr (regress, pareto, bake, export): a `\r`-updated bar with an ETA when
-//! stderr is a terminal (notable lines printed above it as they come), one line per finished item
-//! otherwise (logs, CI, tests); nothing with `--quiet` but errors.
+//! Progress of a long command on stderr (regress, pareto, bake, export, a render's frame): a
+//! `\r`-updated bar with an ETA when stderr is a terminal (notable lines printed above it as they
+//! come), one line per finished item (or tenth of a frame) otherwise (logs, CI, tests); nothing
+//! with `--quiet` but errors.
 
 use std::io::{IsTerminal, Write};
 use std::time::Instant;
@@ -87,6 +88,25 @@ impl Progress {
             self.draw();
         } else {
             eprintln!("{line}");
+        }
+    }
+
+    /// One piece of work measured in units (a frame's dispatches) is `done` of the `total` units:
+    /// the bar shows `what` on a terminal; otherwise a line at each tenth of the work.
+    pub fn reach(&mut self, done: usize, what: &str) {
+        let tenth = |n: usize| (n * 10).checked_div(self.total).unwrap_or(10);
+        let before = tenth(self.done);
+        self.done = done.min(self.total);
+        self.worked = self.done;
+        if self.verbosity == Verbosity::Quiet {
+            return;
+        }
+        if self.tty {
+            self.running = vec![what.to_string()];
+            self.draw();
+        } else if tenth(self.done) > before {
+            let share = (self.done * 100).checked_div(self.total).unwrap_or(100);
+            eprintln!("[{share}%{}] {what}: {} of {} units", self.eta(), self.done, self.total);
         }
     }
 

@@ -249,12 +249,7 @@ impl Session {
     }
 
     /// Renders `steps`' frame on for about `budget_ms`, so that the window's own frames run
-    /// between calls: submissions of a batch of units each, waited for one by one (lavapipe's
-    /// submit itself waits for the one before). The batch doubles while one takes under an eighth
-    /// of the budget and halves past a quarter; it starts again from one unit at every tile of a
-    /// tiled pass, whose units may cost a hundred times the last ones (a Reference tile over the
-    /// object after one over the background), so a submission runs past the budget by about one
-    /// unit at most. The per-pass GPU times when the frame is finished.
+    /// between calls ([`Renderer::step_for`]). The per-pass GPU times when the frame is finished.
     /// The steps' wall time times full-quality frames for [`Session::draft_scale`].
     pub(crate) fn step(
         &mut self,
@@ -264,32 +259,11 @@ impl Session {
     ) -> Result<Option<Vec<(String, f64)>>> {
         let Some(r) = self.renderer.as_mut() else { return Ok(Some(Vec::new())) };
         let start = Instant::now();
-        loop {
-            if steps.starts_tile() {
-                self.batch = 1;
-            }
-            let t = Instant::now();
-            let finished = r.step(ctx, steps, self.batch as u64)?;
-            if let Some(submission) = steps.last_submission() {
-                ctx.wait_for(submission)?;
-                let took = ms(t);
-                self.batch = if took < budget_ms / 8.0 {
-                    (self.batch * 2).min(256)
-                } else if took > budget_ms / 4.0 {
-                    (self.batch / 2).max(1)
-                } else {
-                    self.batch
-                };
-            }
-            if finished {
-                break;
-            }
-            if ms(start) >= budget_ms {
-                self.step_ms += ms(start);
-                return Ok(None);
-            }
-        }
+        let finished = r.step_for(ctx, steps, budget_ms, &mut self.batch)?;
         self.step_ms += ms(start);
+        if !finished {
+            return Ok(None);
+        }
         if self.draft == 1 {
             self.frame_ms = Some(self.step_ms);
         }

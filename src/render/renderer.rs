@@ -171,6 +171,48 @@ impl Renderer {
         Ok(finished)
     }
 
+    /// Renders `steps`' frame on for about `budget_ms` (a window draws itself between calls, a
+    /// command shows its progress): submissions of `batch` units each, waited for one by one
+    /// (lavapipe's submit itself waits for the one before). The batch doubles while one takes
+    /// under an eighth of the budget and halves past a quarter; it starts again from one unit at
+    /// every tile of a tiled pass, whose units may cost a hundred times the last ones (a
+    /// Reference tile over the object after one over the background), so a submission runs past
+    /// the budget by about one unit at most. Returns whether the frame is finished.
+    pub fn step_for(
+        &mut self,
+        ctx: &GpuContext,
+        steps: &mut Steps,
+        budget_ms: f64,
+        batch: &mut u32,
+    ) -> Result<bool> {
+        let ms = |t: std::time::Instant| t.elapsed().as_secs_f64() * 1e3;
+        let start = std::time::Instant::now();
+        loop {
+            if steps.starts_tile() {
+                *batch = 1;
+            }
+            let t = std::time::Instant::now();
+            let finished = self.step(ctx, steps, *batch as u64)?;
+            if let Some(submission) = steps.last_submission() {
+                ctx.wait_for(submission)?;
+                let took = ms(t);
+                *batch = if took < budget_ms / 8.0 {
+                    (*batch * 2).min(256)
+                } else if took > budget_ms / 4.0 {
+                    (*batch / 2).max(1)
+                } else {
+                    *batch
+                };
+            }
+            if finished {
+                return Ok(true);
+            }
+            if ms(start) >= budget_ms {
+                return Ok(false);
+            }
+        }
+    }
+
     /// Reads back the last frame rendered: the graph's first output, the AOVs and the pass times
     /// (per part of a pass split by [`Renderer::step`]).
     pub fn read_frame(&mut self, ctx: &GpuContext) -> Result<Frame> {

@@ -63,6 +63,30 @@ fn render_and_import_take_quiet_and_render_verbose() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// A long render says how far its frame is (issue 32, item 7: a 20 s render printed nothing):
+/// with `--verbose` (or on a terminal) the frame is rendered in steps, a line at each tenth of
+/// its units of work, and the image is the one a single submission makes, bit for bit; the
+/// printed pass list names each pass once, as without steps.
+#[test]
+fn a_verbose_render_shows_its_progress_and_the_same_image() {
+    let dir = crate::common::scratch_dir("voltex-render-progress");
+    let scene = root().join("scenes/shell_march/torus_egg.ron").display().to_string();
+    let (plain, stepped) = (dir.join("plain.exr"), dir.join("stepped.exr"));
+    let args = ["render", &scene, "--method", "reference", "--size", "48x48", "-o"];
+    let quiet = voltex(&[&args[..], &[crate::common::s(&plain), "-q"]].concat());
+    assert!(quiet.status.success() && quiet.stderr.is_empty(), "{}", crate::common::stderr(&quiet));
+    let loud = voltex(&[&args[..], &[crate::common::s(&stepped), "-v"]].concat());
+    let (out, err) = (ok(loud.clone()), crate::common::stderr(&loud));
+    let lines: Vec<&str> = err.lines().filter(|l| l.contains("] frame: ") && l.contains(" units")).collect();
+    assert!(lines.last().is_some_and(|l| l.starts_with("[100%]")), "{err}");
+    assert_eq!(out.matches("  trace_reference ").count(), 1, "{out}");
+    let read = |p: &std::path::Path| voltex::io::exr::read(p).unwrap().0;
+    let (a, b) = (read(&plain), read(&stepped));
+    let bits = |i: &voltex::io::Image| i.pixels.iter().flat_map(|p| p.map(f32::to_bits)).collect::<Vec<_>>();
+    assert_eq!(bits(&a), bits(&b), "the stepped frame is the single submission's");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 /// An error at a position shows the source line with carets under the word there, below the
 /// `error: file:line:col: message` line it always had (issue 32, item 4: annotated errors); a
 /// line too long to quote (a minified file) is left out.
