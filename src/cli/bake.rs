@@ -30,6 +30,10 @@ pub struct BakeArgs {
     /// No progress on stderr (errors still show).
     #[arg(long, short)]
     quiet: bool,
+    /// Keep every texel's line above the progress bar on a terminal (without one, every line is
+    /// printed anyway).
+    #[arg(long, short, conflicts_with = "quiet")]
+    verbose: bool,
 }
 
 fn parse_depth(s: &str) -> std::result::Result<u32, String> {
@@ -40,7 +44,7 @@ fn parse_depth(s: &str) -> std::result::Result<u32, String> {
 }
 
 pub fn run(args: BakeArgs) -> Result<()> {
-    let BakeArgs { scene: scene_path, texels, out, depth, unlit, quiet } = args;
+    let BakeArgs { scene: scene_path, texels, out, depth, unlit, quiet, verbose } = args;
     let scene = scene::load(&scene_path)?;
     // A sequence is baked as its frames.
     let volumes =
@@ -74,7 +78,7 @@ pub fn run(args: BakeArgs) -> Result<()> {
     let ctx = GpuContext::new()?;
     // f32 volumes, so 16- and 32-bit slices hold more than the render's 8 bits.
     let mut baker = voltex::bake::Baker::full_precision(&Sources::project()?);
-    let verbosity = Verbosity::from_flags(quiet, false);
+    let verbosity = Verbosity::from_flags(quiet, verbose);
     let mut progress = Progress::new(plans.len(), verbosity);
     for plan in plans {
         let start = std::time::Instant::now();
@@ -104,7 +108,7 @@ pub fn run(args: BakeArgs) -> Result<()> {
             &plan.texel,
             &format!("texel \"{}\" {w}x{h}x{d}: {ms:.0} ms", plan.texel),
             true,
-            false,
+            verbose,
         );
         println!("{} ({w}x{h}x{d}, {ms:.0} ms)", dir.display());
     }

@@ -63,6 +63,10 @@ pub struct ExportArgs {
     /// No progress on stderr (errors still show).
     #[arg(long, short)]
     quiet: bool,
+    /// Keep every file's line above the progress bar on a terminal (without one, every line is
+    /// printed anyway).
+    #[arg(long, short, conflicts_with = "quiet")]
+    verbose: bool,
 }
 
 #[derive(clap::ValueEnum, Clone, Copy)]
@@ -121,7 +125,7 @@ pub fn run(args: ExportArgs) -> Result<()> {
         std::fs::create_dir_all(&args.out)
             .map_err(|e| Error::file(&args.out, format!("cannot make the output folder: {e}")))?;
     }
-    let verbosity = Verbosity::from_flags(args.quiet, false);
+    let verbosity = Verbosity::from_flags(args.quiet, args.verbose);
     let view = args.view.then(|| export::view_json(&scene, &plans[0].1));
     let result = write_all(&args.out, &plans, view, opts.compression, args.with_mesh, verbosity);
     if result.is_err() && made {
@@ -186,7 +190,12 @@ fn write_all(
             };
             let [x, y, z] = e.resolution();
             let ms = start.elapsed().as_secs_f64() * 1e3;
-            progress.finished(&name, &format!("{} {x}x{y}x{z}: {ms:.0} ms", e.what), true, false);
+            progress.finished(
+                &name,
+                &format!("{} {x}x{y}x{z}: {ms:.0} ms", e.what),
+                true,
+                verbosity == Verbosity::Verbose,
+            );
             let convention = match &e.source {
                 export::Source::Bake { opacity_length, .. } => {
                     format!("opacity length {}", *opacity_length as f32)

@@ -22,6 +22,10 @@ pub struct PlanArgs {
     /// not use are only counted).
     #[arg(short, long)]
     verbose: bool,
+    /// Print nothing: the exit status (and any error) says whether the scene plans within the
+    /// limits (a check for scripts and CI).
+    #[arg(short, long, conflicts_with = "verbose")]
+    quiet: bool,
 }
 
 pub fn run(args: PlanArgs) -> Result<()> {
@@ -37,6 +41,8 @@ pub fn run(args: PlanArgs) -> Result<()> {
             "the limit `voltex plan` assumes; --adapter checks this machine's",
         )?;
     }
-    print!("{}", bp.describe(args.verbose));
+    if !args.quiet {
+        print!("{}", bp.describe(args.verbose));
+    }
     Ok(())
 }

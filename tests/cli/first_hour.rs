@@ -63,6 +63,28 @@ fn render_and_import_take_quiet_and_render_verbose() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// `plan -q` is a silent check (the exit status says whether the scene plans); `bake` and
+/// `export` take `-v` beside their `-q` (issue 32, item 7: `-q/-v` everywhere).
+#[test]
+fn plan_takes_quiet_and_bake_and_export_take_verbose() {
+    let scene = root().join("scenes/view_slices/flat_box.ron").display().to_string();
+    let quiet = voltex(&["plan", &scene, "-q"]);
+    assert!(quiet.status.success() && quiet.stdout.is_empty(), "{}", String::from_utf8_lossy(&quiet.stdout));
+    let dir = crate::common::scratch_dir("voltex-plan-quiet");
+    let bad = dir.join("bad.ron");
+    std::fs::write(&bad, "Scene(nodes: 3)").unwrap();
+    let failed = voltex(&["plan", crate::common::s(&bad), "-q"]);
+    assert!(!failed.status.success() && crate::common::stderr(&failed).contains("bad.ron"));
+    for cmd in ["bake", "export"] {
+        let out = dir.join(cmd);
+        let run = voltex(&[cmd, &scene, "--out", crate::common::s(&out), "-v"]);
+        assert!(run.status.success(), "{cmd} -v: {}", crate::common::stderr(&run));
+        assert!(crate::common::stderr(&run).contains("[1/1"), "{cmd} -v: {}", crate::common::stderr(&run));
+        assert!(!voltex(&[cmd, &scene, "-q", "-v"]).status.success(), "{cmd}: -q and -v conflict");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 /// A long render says how far its frame is (issue 32, item 7: a 20 s render printed nothing):
 /// with `--verbose` (or on a terminal) the frame is rendered in steps, a line at each tenth of
 /// its units of work, and the image is the one a single submission makes, bit for bit; the
