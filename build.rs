@@ -7,8 +7,11 @@
 //!
 //! It also writes `$OUT_DIR/bindings.rs` (`gpu::bindings`): for each folder of `wgsl/`, one
 //! constant per resource its kernels bind (a `var<uniform>`, `var<storage>` or handle global,
-//! their includes' too), e.g. `view_slices::SLICE_PARAMS = "slice_params"`. Rust code that binds
-//! a resource by one of these names no longer compiles when the WGSL stops declaring it.
+//! their includes' too), e.g. `view_slices::SLICE_PARAMS = "slice_params"`, and in `counts` one
+//! constant per count the built-in graphs' passes dispatch, repeat or draw by (`dispatch:
+//! Threads("planes", ..)`, `repeat: "reference_dispatches"`), e.g. `counts::PLANES = "planes"`. Rust code that binds
+//! a resource or sets a count by one of these names no longer compiles when the WGSL or the graph
+//! stops using it.
 
 use std::path::{Path, PathBuf};
 
@@ -37,7 +40,8 @@ fn main() {
     let dest = out_dir.join("embedded.rs");
     std::fs::write(&dest, out).unwrap_or_else(|e| panic!("cannot write {}: {e}", dest.display()));
     let dest = out_dir.join("bindings.rs");
-    let bindings = bindings(&manifest.join("wgsl"), &files);
+    let mut bindings = bindings(&manifest.join("wgsl"), &files);
+    bindings.push_str(&counts(&files));
     std::fs::write(&dest, bindings).unwrap_or_else(|e| panic!("cannot write {}: {e}", dest.display()));
 }
 
@@ -65,6 +69,32 @@ fn bindings(wgsl: &Path, files: &[(String, String)]) -> String {
         }
         out.push_str("}\n");
     }
+    out
+}
+
+/// The `counts` module text: every count named in a `dispatch`, `repeat` or `draw: Vertices` of a
+/// graph under `graphs/` (quoted names that are not numbers).
+fn counts(files: &[(String, String)]) -> String {
+    let mut names = std::collections::BTreeSet::new();
+    for (rel, abs) in files.iter().filter(|(rel, _)| rel.starts_with("graphs/") && rel.ends_with(".ron")) {
+        let text = std::fs::read_to_string(abs).unwrap_or_else(|e| panic!("cannot read {rel}: {e}"));
+        for line in text.lines().map(|l| l.split("//").next().unwrap_or("")) {
+            let at = ["dispatch:", "repeat:", "Vertices("].iter().find_map(|key| line.find(key));
+            let Some(at) = at else { continue };
+            for (i, quoted) in line[at..].split('"').enumerate() {
+                if i % 2 == 1 && quoted.parse::<u64>().is_err() {
+                    names.insert(quoted.to_string());
+                }
+            }
+        }
+    }
+    let mut out = String::from(
+        "/// Counts the built-in graphs' passes dispatch, repeat or draw by.\npub mod counts {\n",
+    );
+    for n in names {
+        out.push_str(&format!("    /// `{n}`.\n    pub const {}: &str = {n:?};\n", n.to_uppercase()));
+    }
+    out.push_str("}\n");
     out
 }
 

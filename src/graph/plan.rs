@@ -69,7 +69,8 @@ pub struct Plan {
 }
 
 /// Counts known for the whole frame when the graph is planned: graph buffers are sized by them.
-pub(crate) const FRAME_COUNTS: &[&str] = &["width", "height"];
+pub(crate) const FRAME_COUNTS: &[&str] =
+    &[crate::gpu::bindings::counts::WIDTH, crate::gpu::bindings::counts::HEIGHT];
 
 /// Plans `graph` for `objects` and an output of `size` pixels, its shaders looked up in `sources`
 /// (the graph's folder first when the caller put it there: see [`Sources::beside`]), its filters

@@ -1,6 +1,7 @@
 //! The opaque base surface under every textured object, drawn by `base_surface/draw_base.wgsl`.
 
 use super::{InputCx, MethodPlan, ObjectPlan, PartDecl};
+use crate::gpu::bindings::counts as C;
 use crate::gpu::buffers;
 use crate::gpu::Inputs;
 use crate::types::BaseVertex;
@@ -9,7 +10,7 @@ pub(crate) const CONTRIBUTION: super::Contribution = super::Contribution {
     method: "base surface",
     filters: &["BaseSurface"],
     resources: &["base_vertices"],
-    counts: &["base_vertices"],
+    counts: &[C::BASE_VERTICES],
     texel_resources: &[],
     gather: None,
 };
@@ -27,7 +28,7 @@ impl MethodPlan for BaseSurfacePlan {
     fn add_inputs(&self, cx: &InputCx, _object: &ObjectPlan, _part: usize, inputs: &mut Inputs) {
         let bytes = bytemuck::cast_slice(&self.vertices);
         inputs.buffers.insert("base_vertices".into(), buffers::storage(cx.ctx, "base_vertices", bytes));
-        inputs.counts.insert("base_vertices".into(), self.vertices.len() as u32);
+        inputs.counts.insert(C::BASE_VERTICES.into(), self.vertices.len() as u32);
     }
 
     fn summary(&self, _object: &ObjectPlan) -> String {

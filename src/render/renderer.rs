@@ -104,8 +104,8 @@ impl Renderer {
             .insert("frame".into(), buffers::uniform(ctx, "frame", bytemuck::bytes_of(&blueprint.frame)));
         frame.buffers.insert(STEP_ORIGIN.into(), buffers::uniform(ctx, STEP_ORIGIN, &[0; 16]));
         frame.samplers.insert("volume_sampler".into(), sampler);
-        frame.counts.insert("width".into(), blueprint.size.0);
-        frame.counts.insert("height".into(), blueprint.size.1);
+        frame.counts.insert(crate::gpu::bindings::counts::WIDTH.into(), blueprint.size.0);
+        frame.counts.insert(crate::gpu::bindings::counts::HEIGHT.into(), blueprint.size.1);
         let objects = blueprint
             .instances
             .iter()

@@ -11,6 +11,7 @@ pub mod twin;
 
 pub(crate) use object::plan;
 
+use crate::gpu::bindings::counts as C;
 use crate::gpu::bindings::axis_slices as B;
 use slice_images::AxisBaked;
 use crate::error::{Error, Result};
@@ -38,7 +39,7 @@ pub(crate) const CONTRIBUTION: super::Contribution = super::Contribution {
         B::AXIS_SAMPLER,
         B::AXIS_SAMPLER_SIDE,
     ],
-    counts: &["prisms", "axis_triangles"],
+    counts: &[C::PRISMS, C::AXIS_TRIANGLES],
     texel_resources: &[B::AXIS_SLICES_S, B::AXIS_SLICES_T, B::AXIS_SLICES_W],
     gather: None,
 };
@@ -198,7 +199,7 @@ pub(crate) fn add_inputs(
         buffer("axis_layer_counts", 4 * counters, wgpu::BufferUsages::empty()),
     );
     if plan.grouped {
-        inputs.counts.insert("axis_triangles".into(), (plan.capacity / 3) as u32);
+        inputs.counts.insert(C::AXIS_TRIANGLES.into(), (plan.capacity / 3) as u32);
     }
     for (name, t) in ["axis_slices_s", "axis_slices_t", "axis_slices_w"].iter().zip(&baked.arrays) {
         let view = t.create_view(&wgpu::TextureViewDescriptor {
@@ -227,7 +228,7 @@ pub(crate) fn add_inputs(
     inputs
         .samplers
         .insert(B::AXIS_SAMPLER_SIDE.into(), sampler("axis_sampler_side", wgpu::AddressMode::ClampToEdge));
-    inputs.counts.insert(B::PRISMS.into(), plan.prisms.len() as u32);
+    inputs.counts.insert(C::PRISMS.into(), plan.prisms.len() as u32);
     inputs.constants.push(("blended_slices".into(), plan.blended as u32 as f64));
     inputs.constants.push(("grouped_slices".into(), plan.grouped as u32 as f64));
     inputs.constants.push(("mipmapped_slices".into(), plan.method.mipmaps as u32 as f64));

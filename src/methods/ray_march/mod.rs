@@ -15,6 +15,7 @@ pub mod peel_segments;
 pub(crate) mod plugin;
 pub mod splat_segments;
 
+use crate::gpu::bindings::counts as C;
 use crate::gpu::bindings::ray_march as B;
 use glam::{DMat4, DVec3};
 
@@ -448,9 +449,9 @@ impl RayMarchPlan {
             segments.counts[1] = set.counts[1];
             inputs.buffers.insert(B::SURFACE_SPLATS.into(), set.surface.clone());
             inputs.buffers.insert(B::INTERIOR_SPLATS.into(), set.interior.clone());
-            inputs.counts.insert(B::SURFACE_SPLATS.into(), set.counts[0]);
-            inputs.counts.insert("peel_phases".into(), 2 * passes);
-            inputs.counts.insert("peel_blocks".into(), (size.0 * size.1).div_ceil(segments.counts[3].max(1)));
+            inputs.counts.insert(C::SURFACE_SPLATS.into(), set.counts[0]);
+            inputs.counts.insert(C::PEEL_PHASES.into(), 2 * passes);
+            inputs.counts.insert(C::PEEL_BLOCKS.into(), (size.0 * size.1).div_ceil(segments.counts[3].max(1)));
             bounds_bytes = Self::segment_bytes(size, *passes);
         }
         let mut slabs_bytes = 16;
@@ -458,17 +459,17 @@ impl RayMarchPlan {
             segments.counts[0] = set.counts[0];
             segments.counts[1] = set.counts[1];
             inputs.buffers.insert(B::INTERIOR_SPLATS.into(), set.interior.clone());
-            inputs.counts.insert(B::INTERIOR_SPLATS.into(), set.counts[1]);
+            inputs.counts.insert(C::INTERIOR_SPLATS.into(), set.counts[1]);
             let [_, pixels, pieces, _] = segments.splatting;
-            inputs.counts.insert("splat_blocks".into(), splat_blocks(size, pixels, pieces));
+            inputs.counts.insert(C::SPLAT_BLOCKS.into(), splat_blocks(size, pixels, pieces));
             slabs_bytes = slab_bytes(size, *slabs);
         }
         inputs.buffers.insert(B::SEGMENTS.into(), uniform(ctx, "segments", bytemuck::bytes_of(&segments)));
         inputs.buffers.insert(B::PEEL_TICKETS.into(), storage(ctx, "peel_tickets", &[0u8; 16]));
         inputs.buffers.insert(B::MESH_GRID.into(), grid.grid);
         inputs.buffers.insert(B::MESH_DEPTH.into(), grid.depth);
-        inputs.counts.insert("ray_march_dispatches".into(), self.dispatches);
-        inputs.counts.insert(crate::gpu::bindings::bake::TRANSFER_FUNCTIONS.into(), self.packed.functions.len() as u32);
+        inputs.counts.insert(C::RAY_MARCH_DISPATCHES.into(), self.dispatches);
+        inputs.counts.insert(C::TRANSFER_FUNCTIONS.into(), self.packed.functions.len() as u32);
         inputs.constants.extend(self.constants());
         let b = &mut inputs.buffers;
         b.insert(B::HYPER.into(), uniform(ctx, "hyper", bytemuck::bytes_of(&self.params)));

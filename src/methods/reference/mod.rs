@@ -11,6 +11,7 @@ pub mod trace_reference;
 
 pub use object::{frame_twin_inputs, plan, ReferencePlan};
 
+use crate::gpu::bindings::counts as C;
 use crate::gpu::bindings::reference as B;
 use glam::{DVec3, Vec3A};
 use obvhs::aabb::Aabb;
@@ -43,7 +44,7 @@ pub(crate) const CONTRIBUTION: super::Contribution = super::Contribution {
         B::REFERENCE_STATE,
         B::VERTEX_FRAMES,
     ],
-    counts: &["reference_dispatches"],
+    counts: &[C::REFERENCE_DISPATCHES],
     texel_resources: &[B::TEXEL_ATLAS],
     gather: Some(object::gather),
 };
@@ -249,7 +250,7 @@ impl ReferenceSet {
 
     /// Buffers of the reference instance; the atlases are filled from the bakes by `copy_volumes`.
     pub(crate) fn add_inputs(&self, ctx: &GpuContext, inputs: &mut Inputs, size: (u32, u32)) {
-        inputs.counts.insert("reference_dispatches".into(), self.dispatches);
+        inputs.counts.insert(C::REFERENCE_DISPATCHES.into(), self.dispatches);
         let state = ctx.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("reference_state"),
             size: size.0 as u64 * size.1 as u64 * std::mem::size_of::<ReferenceState>() as u64,

@@ -16,6 +16,7 @@ mod tiles;
 
 pub use object::{frame_twin_inputs, ShellSet};
 
+use crate::gpu::bindings::counts as C;
 use crate::gpu::bindings::shell_march as B;
 
 /// What ShellMarch brings to the render graph.
@@ -40,7 +41,7 @@ pub(crate) const CONTRIBUTION: super::Contribution = super::Contribution {
         B::SHELL_FILTERS,
         B::SHELL_MIPS,
     ],
-    counts: &["shell_march_dispatches"],
+    counts: &[C::SHELL_MARCH_DISPATCHES],
     texel_resources: &[B::TEXEL_ATLAS],
     gather: Some(object::gather),
 };

@@ -10,6 +10,7 @@ use super::filter;
 use super::knobs::{Filter, ShellMarch};
 use super::march_shell::{folds, Footprint, ShellObject};
 use super::tiles::{self, TileLists};
+use crate::gpu::bindings::counts as C;
 use crate::bake::{occupancy, Baked};
 use crate::cpu::prism_map::PrismCorners;
 use crate::error::{Error, Result};
@@ -221,7 +222,7 @@ impl ShellSet {
     /// occupancy pyramids (made from the atlas, read back once).
     fn add_inputs(&self, cx: &InputCx, inputs: &mut Inputs) -> Result<()> {
         let (ctx, set) = (cx.ctx, &self.set);
-        inputs.counts.insert("shell_march_dispatches".into(), set.dispatches);
+        inputs.counts.insert(C::SHELL_MARCH_DISPATCHES.into(), set.dispatches);
         inputs.constants.extend(self.constants());
         let pixels = cx.size.0 as u64 * cx.size.1 as u64;
         let empty = |label: &str, bytes: u64, read: bool| {

@@ -12,10 +12,15 @@ pub mod tiles;
 
 pub use object::{plan, ViewSlicesPlan};
 
+use crate::gpu::bindings::counts as C;
 use crate::gpu::bindings::view_slices as B;
 use crate::error::{Error, Result};
 use crate::mesh::shell::Shell;
 use crate::types::{SliceParams, SliceVertex};
+
+/// The planes of the instance's chunk: a count for graphs (no built-in graph dispatches by it,
+/// so `gpu::bindings::counts` has no constant for it).
+const PLANES: &str = "planes";
 
 /// What ViewSlices brings to the render graph.
 pub(crate) const CONTRIBUTION: super::Contribution = super::Contribution {
@@ -42,7 +47,7 @@ pub(crate) const CONTRIBUTION: super::Contribution = super::Contribution {
         B::TILE_ENTRIES,
         B::TILE_LAYER,
     ],
-    counts: &["prisms", "planes", "plane_blocks", "slice_triangles", "tiles_x", "tiles_y"],
+    counts: &[C::PRISMS, PLANES, C::PLANE_BLOCKS, C::SLICE_TRIANGLES, C::TILES_X, C::TILES_Y],
     texel_resources: &[B::VOLUME, B::NORMALS, B::VOLUME_LAYERS, B::NORMAL_LAYERS],
     gather: None,
 };
@@ -250,9 +255,9 @@ pub fn add_inputs(
         .collect();
     let bytes = capacity * std::mem::size_of::<SliceVertex>() as u64;
     b.insert(B::SLICE_VERTICES.into(), buffer("slice_vertices", bytes, wgpu::BufferUsages::empty()));
-    inputs.counts.insert(B::PRISMS.into(), shell.prisms.len() as u32);
-    inputs.counts.insert("planes".into(), params.plane_count);
-    inputs.counts.insert("plane_blocks".into(), params.plane_count.div_ceil(PLANES_PER_THREAD));
+    inputs.counts.insert(C::PRISMS.into(), shell.prisms.len() as u32);
+    inputs.counts.insert(PLANES.into(), params.plane_count);
+    inputs.counts.insert(C::PLANE_BLOCKS.into(), params.plane_count.div_ceil(PLANES_PER_THREAD));
     inputs.constants.push(("planes_per_thread".into(), PLANES_PER_THREAD as f64));
     inputs.constants.push(("trivial_reject".into(), trivial_reject as u32 as f64));
 }

@@ -1,6 +1,7 @@
 //! Buffers and counts of the `Tiles` compositor for one chunk of a ViewSlices sweep (its kernels
 //! and their twins: [`super::tiles`]).
 
+use crate::gpu::bindings::counts as C;
 use crate::gpu::bindings::view_slices as B;
 use super::tiles::{tile_params, MAX_TRIANGLES, TILE_SIZE};
 use crate::gpu::buffers::{uniform, work_buffer};
@@ -91,7 +92,7 @@ pub(crate) fn add_inputs(
         b.insert(name.into(), work_buffer(ctx, name, bytes, wgpu::BufferUsages::empty()));
     }
     let triangles = (vertex_capacity / 3).min(MAX_TRIANGLES - 1) as u32;
-    inputs.counts.insert("slice_triangles".into(), triangles);
-    inputs.counts.insert("tiles_x".into(), params.tiles_x);
-    inputs.counts.insert("tiles_y".into(), params.tiles_y);
+    inputs.counts.insert(C::SLICE_TRIANGLES.into(), triangles);
+    inputs.counts.insert(C::TILES_X.into(), params.tiles_x);
+    inputs.counts.insert(C::TILES_Y.into(), params.tiles_y);
 }

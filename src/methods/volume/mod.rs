@@ -9,6 +9,7 @@
 pub mod march_volume;
 mod object;
 
+use crate::gpu::bindings::counts as C;
 use crate::gpu::bindings::volume as B;
 use std::sync::Arc;
 
@@ -27,7 +28,7 @@ pub(crate) const CONTRIBUTION: super::Contribution = super::Contribution {
     method: "Volume",
     filters: &["Volume"],
     resources: &[B::VOLUME_PARAMS, B::VOLUME_TABLE, B::VOLUME_DENSITY, B::VOLUME_COLOR, B::VOLUME_STATE],
-    counts: &["volume_dispatches"],
+    counts: &[C::VOLUME_DISPATCHES],
     texel_resources: &[],
     gather: None,
 };

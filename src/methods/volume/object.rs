@@ -1,5 +1,6 @@
 //! One volume object of a frame as the renderer sees it.
 
+use crate::gpu::bindings::counts as C;
 use crate::gpu::bindings::volume as B;
 use std::any::Any;
 
@@ -73,7 +74,7 @@ impl MethodPlan for VolumePlan {
             wgpu::BufferUsages::empty(),
         );
         inputs.buffers.insert(B::VOLUME_STATE.into(), state);
-        inputs.counts.insert("volume_dispatches".into(), self.dispatches);
+        inputs.counts.insert(C::VOLUME_DISPATCHES.into(), self.dispatches);
         inputs.constants.extend(self.constants());
     }
 
