@@ -281,7 +281,8 @@ pub struct ReferenceParams {
     pub right: [f32; 4],
     /// xyz: camera up scaled by the half-height at unit distance; w: far plane distance.
     pub up: [f32; 4],
-    /// x: BVH node count; y: prism count; z: object count; w: unused.
+    /// x: BVH node count; y: prism count; z: object count; w: ShellMarch: 1 where empty space
+    /// is skipped.
     pub counts: [u32; 4],
 }
 

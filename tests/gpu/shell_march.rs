@@ -101,8 +101,8 @@ fn kernel_matches_its_f64_twin() {
         let (max, mean) = differences(&m.gpu, &m.cpu);
         let name = path.file_name().unwrap().to_string_lossy();
         eprintln!(
-            "{name}: GPU vs f64 twin: max {max:.2e}, mean {mean:.2e}; samples {} taken, {} skipped; {} exact pieces",
-            m.counts[0], m.counts[1], m.counts[3]
+            "{name}: GPU vs f64 twin: max {max:.2e}, mean {mean:.2e}; samples {} taken, {} skipped; {} exact pieces; unfinished {} dropped {}",
+            m.counts[0], m.counts[1], m.counts[3], m.unfinished, m.counts[2]
         );
         assert!(mean < 2e-3 && max < 0.25, "{name}: max {max}, mean {mean}");
         assert_eq!((m.unfinished, m.counts[2]), (0, 0), "{name}: unfinished rays, dropped intervals");
@@ -142,23 +142,25 @@ fn skipping_changes_no_pixel() {
     assert_eq!(differ.count(), 0, "pixels changed by skipping");
 }
 
-/// `example` drawn with `ShellMarch(knobs)` in place of `ShellMarch()`.
+/// `example` drawn with `knobs` added to its `ShellMarch(...)`.
 fn with_knobs(dir: &str, name: &str, knobs: &str) -> scene::Scene {
     let path = example(dir, name);
     let text = std::fs::read_to_string(&path).unwrap();
-    let changed = text.replace("method: ShellMarch()", &format!("method: ShellMarch({knobs})"));
+    let changed = text
+        .replace("method: ShellMarch()", &format!("method: ShellMarch({knobs})"))
+        .replace("method: ShellMarch(lighting", &format!("method: ShellMarch({knobs}, lighting"));
     assert_ne!(text, changed, "{name} is drawn with ShellMarch()");
     scene::parse(&changed, &path).unwrap()
 }
 
 /// The footprint filter (levels of the bake's layers copied into `shell_mips`, read at the
 /// level of each interval's footprint, steps in the level's voxels) agrees with the twin, which
-/// makes its levels with the twin of the MIP kernel; it changes the image, and skipping (its
-/// bricks and bands widened by the filter's reach) still changes no pixel. At 48x48 the
-/// footprints span levels 1 to 3 (reaches of 2.5 to 23.5 voxels), where bricks still skip.
+/// makes its levels with the twin of the MIP kernel; it changes the image, and skipping (by
+/// pyramids of the opacity dilated by each level's reach) still changes no pixel. sphere_balls
+/// is lit per pixel: its normals are filtered the same way.
 #[test]
 fn the_footprint_filter_matches_its_twin_and_skips_exactly() {
-    for (name, bias) in [("torus_egg.ron", -1.0), ("terrain.ron", 0.0)] {
+    for (name, bias) in [("torus_egg.ron", -1.0), ("terrain.ron", 0.0), ("sphere_balls.ron", 0.0)] {
         let knobs = format!("filter: Footprint, mip_bias: {bias}");
         let filtered = with_knobs("shell_march", name, &knobs);
         let m = march(&filtered, &shell_march(48), true);

@@ -107,14 +107,25 @@ fn half4(v: vec2<u32>) -> vec4<f32> {
     return vec4<f32>(half(v.x & 0xffffu), half(v.x >> 16u), half(v.y & 0xffffu), half(v.y >> 16u));
 }
 
-// Bilinear in s and t (repeating) and linear in w of MIP level l >= 1 of `object`'s texel.
-fn sample_level(object: ReferenceObject, footprint: ShellFilter, uvw: vec3<f32>, l: u32) -> vec4<f32> {
-    let depth = object.resolution.z;
+// Where the two MIP levels the current run's samples mix start in `shell_mips` (and
+// `shell_normal_mips`): found once per run, so that a sample runs no loop of variable length
+// (lavapipe's loop limit counts every iteration of every loop of an invocation).
+var<private> mip_starts: vec2<u32>;
+
+// Where level l >= 1 of `object`'s texel starts in `shell_mips`.
+fn level_start(object: ReferenceObject, footprint: ShellFilter, l: u32) -> u32 {
     var offset = footprint.mips;
     for (var k = 1u; k < l; k++) {
         let n = object.resolution.xy >> vec2<u32>(k);
-        offset += ((n.x + 31u) & ~31u) * n.y * depth;
+        offset += ((n.x + 31u) & ~31u) * n.y * object.resolution.z;
     }
+    return offset;
+}
+
+// Bilinear in s and t (repeating) and linear in w of MIP level l >= 1 of `object`'s texel (or of
+// its normals), which starts at `offset`.
+fn sample_level(object: ReferenceObject, offset: u32, uvw: vec3<f32>, l: u32, normals: bool) -> vec4<f32> {
+    let depth = object.resolution.z;
     let n = object.resolution.xy >> vec2<u32>(l);
     let pitch = (n.x + 31u) & ~31u;
     let ax = axis(fract(uvw.x), n.x, true);
@@ -127,34 +138,39 @@ fn sample_level(object: ReferenceObject, footprint: ShellFilter, uvw: vec3<f32>,
         let z = select(az.i0, az.i1, (k & 4u) != 0u);
         let weight = select(1.0 - ax.f, ax.f, (k & 1u) != 0u) * select(1.0 - ay.f, ay.f, (k & 2u) != 0u)
             * select(1.0 - az.f, az.f, (k & 4u) != 0u);
-        out += half4(shell_mips[offset + (z * n.y + y) * pitch + x]) * weight;
+        let at = offset + (z * n.y + y) * pitch + x;
+        if (normals) {
+            out += half4(shell_normal_mips[at]) * weight;
+        } else {
+            out += half4(shell_mips[at]) * weight;
+        }
     }
     return out;
 }
 
-// The texel at fractional MIP level `level`: level 0 from the atlas, the two levels around it
-// mixed.
-fn sample_filtered(object_index: u32, object: ReferenceObject, uvw: vec3<f32>, level: f32) -> vec4<f32> {
+// The texel (or its normals) at fractional MIP level `level`: level 0 from the atlas, the two
+// levels around it mixed.
+fn sample_filtered(object: ReferenceObject, uvw: vec3<f32>, level: f32, normals: bool) -> vec4<f32> {
     if (level <= 0.0) {
-        return sample_volume(object, uvw, false);
+        return sample_volume(object, uvw, normals);
     }
-    let footprint = shell_filters[object_index];
     let l0 = u32(floor(level));
     var a: vec4<f32>;
     if (l0 == 0u) {
-        a = sample_volume(object, uvw, false);
+        a = sample_volume(object, uvw, normals);
     } else {
-        a = sample_level(object, footprint, uvw, l0);
+        a = sample_level(object, mip_starts.x, uvw, l0, normals);
     }
     let f = level - floor(level);
     if (f == 0.0) {
         return a;
     }
-    return mix(a, sample_level(object, footprint, uvw, l0 + 1u), f);
+    return mix(a, sample_level(object, mip_starts.y, uvw, l0 + 1u, normals), f);
 }
 
-// Per-pixel lighting as the Reference does it (shared/shading.wgsl), at map value c.
-fn shade(index: u32, object: ReferenceObject, c: vec4<f32>, uvw: vec3<f32>, albedo: vec3<f32>) -> vec3<f32> {
+// Per-pixel lighting as the Reference does it (shared/shading.wgsl), at map value c, the normals
+// read at MIP level `level`.
+fn shade(index: u32, object: ReferenceObject, c: vec4<f32>, uvw: vec3<f32>, albedo: vec3<f32>, level: f32) -> vec3<f32> {
     let shape = load_shape(index);
     let fa = vertex_frames[shape.ids[0]];
     let fb = vertex_frames[shape.ids[1]];
@@ -163,7 +179,7 @@ fn shade(index: u32, object: ReferenceObject, c: vec4<f32>, uvw: vec3<f32>, albe
     let dt = c.x * fa.dt.xyz + c.y * fb.dt.xyz + c.z * fc.dt.xyz;
     let dw = c.x * (shape.top[0] - shape.bottom[0]) + c.y * (shape.top[1] - shape.bottom[1]) + c.z * (shape.top[2] - shape.bottom[2]);
     let sign_j = select(-1.0, 1.0, dot(ds, cross(dt, dw)) >= 0.0);
-    let tn = sample_volume(object, uvw, true).xyz;
+    let tn = sample_filtered(object, uvw, level, true).xyz;
     var n = cross(dt, dw) * sign_j * tn.x + cross(dw, ds) * sign_j * tn.y + cross(ds, dt) * sign_j * tn.z;
     n = select(-ray, normalize(n), dot(n, n) > 1e-20);
     return shade_phong(albedo, n, frame.light_dir, -ray, PIXEL_SPECULAR, PIXEL_SHININESS);
@@ -177,7 +193,7 @@ fn composite(index: u32, prism: ReferencePrism, object: ReferenceObject, h: f32,
         return;
     }
     let uvw = vec3<f32>(c.x * prism.uv01.xy + c.y * prism.uv01.zw + c.z * prism.uv2.xy, c.w);
-    let texel = sample_filtered(prism.vertices.w, object, uvw, level);
+    let texel = sample_filtered(object, uvw, level, false);
     if (texel.a >= OPAQUE_ALPHA && !opaque_found) {
         opaque_found = true;
         record_opaque_depth(pixel, t * dot(ray, frame.forward.xyz));
@@ -186,7 +202,7 @@ fn composite(index: u32, prism: ReferencePrism, object: ReferenceObject, h: f32,
     if (alpha > 1e-6) {
         var colour = texel.rgb / alpha;
         if ((object.resolution.w & 1u) != 0u) {
-            colour = shade(index, object, c, uvw, colour);
+            colour = shade(index, object, c, uvw, colour, level);
         }
         // The step-corrected opacity: 1 - (1 - a)^(h / opacity_length).
         let a = 1.0 - exp(log(1.0 - alpha) * h / object.params.x);
@@ -225,6 +241,10 @@ fn run(s: u32, limit: f32) {
     let level = iv_level[s];
     let footprint = shell_filters[prism.vertices.w];
     let pyramid = filter_pyramid(level, footprint.levels);
+    if (level > 0.0) {
+        let l0 = u32(floor(level));
+        mip_starts = vec2<u32>(level_start(object, footprint, l0), level_start(object, footprint, l0 + 1u));
+    }
     var piece = iv_piece[s];
     var k = iv_k[s];
     var t = iv_next[s];
@@ -265,7 +285,7 @@ fn run(s: u32, limit: f32) {
             most = end - k;
         }
         var step = 1u;
-        let jump = select(0u, empty_run(prism, object, c, dc, most, pyramid, footprint.occupancy), skip_empty && c.w >= 0.0);
+        let jump = select(0u, empty_run(prism, object, c, dc, most, pyramid, footprint.occupancy), shell_params.counts.w != 0u && c.w >= 0.0);
         if (jump > 0u) {
             skipped += jump;
             step = jump;

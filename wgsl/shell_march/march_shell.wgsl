@@ -19,7 +19,6 @@
 // typical unit (a few iterations; images bit-identical to 2048 on the example scenes).
 override samples_per_dispatch: u32 = 8192u;
 override min_transmittance: f32 = 1e-3;
-override skip_empty: bool = true;
 const BOUND_COST: i32 = 2;
 const PRISM_COST: i32 = 32;
 const PIECE_COST: i32 = 16;
@@ -36,6 +35,8 @@ const FAR: f32 = 3.4e38;
 const DEPTH_SLACK: f32 = 2e-3;
 
 @group(0) @binding(0) var<uniform> frame: FrameParams;
+// counts.w: 1 where empty space is skipped (a uniform, not an override constant: the same
+// compiled kernel runs with and without it, so skipping is seen to change no pixel, bit for bit).
 @group(0) @binding(1) var<uniform> shell_params: ReferenceParams;
 // Per 8x8 tile, row by row: its first entry and count in `shell_tile_prisms` (prism indices, each
 // tile's nearest first); per prism two rows of `shell_bounds`: its corner box's minimum with its
@@ -65,6 +66,8 @@ const DEPTH_SLACK: f32 = 2e-3;
 // kept), f16 RGBA, each level's rows padded to 32 voxels (copied from the bake's layers).
 @group(0) @binding(18) var<storage, read> shell_filters: array<ShellFilter>;
 @group(0) @binding(19) var<storage, read> shell_mips: array<vec2<u32>>;
+// The same places of the normals' levels, for objects lit per pixel.
+@group(0) @binding(20) var<storage, read> shell_normal_mips: array<vec2<u32>>;
 
 #include "shared/aov_depth.wgsl"
 

@@ -166,7 +166,7 @@ fn sample(view: &TraceView, objects: &[TraceObject], active: &[&Segment], d: DVe
         }
         let mut colour = DVec3::new(texel[0], texel[1], texel[2]) / a;
         if let Some(pp) = &obj.per_pixel {
-            colour = shade(view, pp, s.prism, p, b, uvw, d, colour);
+            colour = shade(view, pp, s.prism, p, b, pp.normals.sample(uvw), d, colour);
         }
         let s_k = -(1.0 - a).ln() / obj.opacity_length;
         sigma += s_k;
@@ -175,7 +175,8 @@ fn sample(view: &TraceView, objects: &[TraceObject], active: &[&Segment], d: DVe
     (sigma, emitted)
 }
 
-/// Phong lighting exactly as `draw_slices.wgsl` does it, with the exact barycentrics.
+/// Phong lighting exactly as `draw_slices.wgsl` does it, with the exact barycentrics; `tn` is the
+/// normal volume's sample there (texture space).
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn shade(
     view: &TraceView,
@@ -183,7 +184,7 @@ pub(crate) fn shade(
     prism: usize,
     p: &PrismCorners,
     b: [f64; 3],
-    uvw: DVec3,
+    tn: [f64; 4],
     ray: DVec3,
     albedo: DVec3,
 ) -> DVec3 {
@@ -192,7 +193,6 @@ pub(crate) fn shade(
     let dt = f[0].1 * b[0] + f[1].1 * b[1] + f[2].1 * b[2];
     let dw = (0..3).map(|i| (p.top[i] - p.bottom[i]) * b[i]).sum::<DVec3>();
     let sign = if ds.dot(dt.cross(dw)) >= 0.0 { 1.0 } else { -1.0 };
-    let tn = pp.normals.sample(uvw);
     let n = dt.cross(dw) * sign * tn[0] + dw.cross(ds) * sign * tn[1] + ds.cross(dt) * sign * tn[2];
     let n = if n.length_squared() > 1e-20 { n.normalize() } else { -ray };
     let l = view.light_dir;

@@ -40,8 +40,9 @@ pub struct ShellObject {
 /// An object's footprint filter as the twin sees it.
 pub(crate) struct Footprint {
     /// Its texel's levels from 1 on (s and t halved a level), made from level 0 by the twin of
-    /// the bake's MIP kernel.
+    /// the bake's MIP kernel; its normals' too, with per-pixel lighting.
     levels: Vec<DecodedTexel>,
+    normal_levels: Vec<DecodedTexel>,
     filter: ShellFilter,
     /// Per prism: voxels of s and t per world unit (as the kernel reads them).
     density: Vec<f64>,
@@ -50,17 +51,30 @@ pub(crate) struct Footprint {
 }
 
 impl Footprint {
-    pub(crate) fn of(volume: &DecodedTexel, filter: ShellFilter, density: Vec<f64>, cone: f64) -> Footprint {
+    pub(crate) fn of(
+        volume: &DecodedTexel,
+        normals: Option<&DecodedTexel>,
+        filter: ShellFilter,
+        density: Vec<f64>,
+        cone: f64,
+    ) -> Footprint {
+        let levels = Self::levels_of(volume, filter.levels);
+        let normal_levels = normals.map_or(Vec::new(), |n| Self::levels_of(n, filter.levels));
+        Footprint { levels, normal_levels, filter, density, cone }
+    }
+
+    /// Levels 1.. of `volume`, each the 2x2 mean of the one above (`cpu::mip_layers`).
+    fn levels_of(volume: &DecodedTexel, levels: u32) -> Vec<DecodedTexel> {
         let res = volume.resolution;
         let mut finer: Vec<[f32; 4]> = volume.texels.iter().map(|t| t.map(|v| v as f32)).collect();
-        let mut levels = Vec::new();
-        for l in 1..filter.levels {
+        let mut out = Vec::new();
+        for l in 1..levels {
             finer = crate::cpu::mip_layers::mip_layers(&finer, filter::level_size(res, l - 1), res[2], true);
             let [w, h] = filter::level_size(res, l);
             let texels = finer.iter().map(|t| t.map(|v| v as f64)).collect();
-            levels.push(DecodedTexel { resolution: [w, h, res[2]], texels });
+            out.push(DecodedTexel { resolution: [w, h, res[2]], texels });
         }
-        Footprint { levels, filter, density, cone }
+        out
     }
 
     /// The level of prism k's samples on ray `d` (unit; `through`: its unnormalised direction's
@@ -71,7 +85,16 @@ impl Footprint {
 
     /// The texel at `uvw` at fractional `level`, as `sample_filtered`.
     fn sample(&self, level0: &DecodedTexel, uvw: DVec3, level: f64) -> [f64; 4] {
-        let at = |l: usize| if l == 0 { level0.sample(uvw) } else { self.levels[l - 1].sample(uvw) };
+        Self::mixed(&self.levels, level0, uvw, level)
+    }
+
+    /// The normals at `uvw` at fractional `level`.
+    fn sample_normals(&self, level0: &DecodedTexel, uvw: DVec3, level: f64) -> [f64; 4] {
+        Self::mixed(&self.normal_levels, level0, uvw, level)
+    }
+
+    fn mixed(levels: &[DecodedTexel], level0: &DecodedTexel, uvw: DVec3, level: f64) -> [f64; 4] {
+        let at = |l: usize| if l == 0 { level0.sample(uvw) } else { levels[l - 1].sample(uvw) };
         let l0 = level.floor();
         let (a, f) = (at(l0 as usize), level - l0);
         if level <= 0.0 || f == 0.0 {
@@ -369,7 +392,11 @@ fn march_ray(view: &TraceView, objects: &[ShellObject], d: DVec3, through: f64, 
         let mut colour = DVec3::new(texel[0], texel[1], texel[2]) / alpha;
         if let Some(pp) = &o.trace.per_pixel {
             let p = &o.trace.prisms[iv.prism];
-            colour = shade(view, pp, iv.prism, p, [c[0], c[1], c[2]], uvw, d, colour);
+            let tn = match &o.filter {
+                Some(f) => f.sample_normals(&pp.normals, uvw, iv.level),
+                None => pp.normals.sample(uvw),
+            };
+            colour = shade(view, pp, iv.prism, p, [c[0], c[1], c[2]], tn, d, colour);
         }
         let a = 1.0 - ((1.0 - alpha).ln() * iv.h / o.trace.opacity_length).exp();
         rgb += colour * a * transmittance;

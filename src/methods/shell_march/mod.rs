@@ -40,6 +40,7 @@ pub(crate) const CONTRIBUTION: super::Contribution = super::Contribution {
         B::SHELL_MARCH_COUNTS,
         B::SHELL_FILTERS,
         B::SHELL_MIPS,
+        B::SHELL_NORMAL_MIPS,
     ],
     counts: &[C::SHELL_MARCH_DISPATCHES],
     texel_resources: &[B::TEXEL_ATLAS],

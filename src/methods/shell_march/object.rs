@@ -133,6 +133,7 @@ pub(super) fn gather(objects: &mut [ObjectPlan], bakes: &[BakePlan], view: &View
     let (list, knobs): (Vec<Member>, Vec<ShellMarch>) = members.into_iter().unzip();
     // No BVH: the kernel walks screen tiles' lists (`tiles.rs`).
     let mut set = build(&list, params, false);
+    set.params.counts[3] = knobs.iter().all(|k| k.skip_empty) as u32;
     let filtering = knobs.iter().map(|k| (k.filter == Filter::Footprint).then_some(k.mip_bias));
     let (filters, mip_words) = filter::table(list.iter().map(|m| m.resolution).zip(filtering));
     let mut offset = 0u64;
@@ -186,36 +187,40 @@ impl ShellSet {
             .collect()
     }
 
-    /// `shell_filters`, and `shell_mips` with levels 1.. of each filtering object's texel layers.
+    /// `shell_filters`; `shell_mips` with levels 1.. of each filtering object's texel layers, and
+    /// `shell_normal_mips` (the same places) with its normals' where it is lit per pixel.
     fn copy_mips(&self, ctx: &GpuContext, inputs: &mut Inputs, baked: &[Baked]) {
         let b = &mut inputs.buffers;
         b.insert(B::SHELL_FILTERS.into(), storage(ctx, "shell_filters", bytemuck::cast_slice(&self.filters)));
-        let mips = ctx.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("shell_mips"),
-            size: self.mip_words * 8,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
-            mapped_at_creation: false,
-        });
-        let copies: Vec<_> = (self.filters.iter().zip(&self.set.table).zip(&self.set.copies))
-            .filter(|((f, _), _)| f.levels > 1)
-            .map(|((f, entry), &(bake, _))| {
-                (*f, [entry.resolution[0], entry.resolution[1], entry.resolution[2]], &baked[bake].layers[0])
-            })
-            .collect();
-        if !copies.is_empty() {
-            let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        let filtering = || {
+            (self.filters.iter().zip(&self.set.table).zip(&self.set.copies))
+                .filter(|((f, _), _)| f.levels > 1)
+                .map(|((f, entry), &(bake, lit))| (*f, [entry.resolution[0], entry.resolution[1], entry.resolution[2]], bake, lit))
+        };
+        let any_lit = filtering().any(|o| o.3);
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        for (name, layer, words) in [(B::SHELL_MIPS, 0, self.mip_words), (B::SHELL_NORMAL_MIPS, 1, if any_lit { self.mip_words } else { 1 })] {
+            let mips = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(name),
+                size: words * 8,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            });
+            let copies: Vec<_> = filtering()
+                .filter(|o| layer == 0 || o.3)
+                .map(|(f, res, bake, _)| (f, res, &baked[bake].layers[layer]))
+                .collect();
             filter::copy_levels(&mut encoder, &mips, &copies);
-            ctx.queue.submit([encoder.finish()]);
+            b.insert(name.into(), mips);
         }
-        b.insert(B::SHELL_MIPS.into(), mips);
+        ctx.queue.submit([encoder.finish()]);
     }
 
-    /// The kernel's override constants: the lowest cutoff of its objects; skipping unless one
-    /// turns it off.
+    /// The kernel's override constants: the lowest cutoff of its objects. (Skipping, on unless
+    /// an object turns it off, is `shell_params.counts.w`.)
     fn constants(&self) -> Vec<(String, f64)> {
         let cutoff = self.knobs.iter().map(|k| k.min_transmittance).fold(1.0, f64::min);
-        let skip = self.knobs.iter().all(|k| k.skip_empty);
-        vec![("min_transmittance".into(), cutoff), ("skip_empty".into(), skip as u32 as f64)]
+        vec![("min_transmittance".into(), cutoff)]
     }
 
     /// Per-pixel state and counters, the tables, the atlases (copied from the bakes) and the
@@ -301,7 +306,8 @@ pub fn frame_twin_inputs(
             let n = trace.prisms.len();
             let bands = bands.by_ref().take(n).collect();
             let density = prisms.by_ref().take(n).map(|p| p.uv2[3] as f64).collect();
-            let filter = (f.levels > 1).then(|| Footprint::of(&trace.volume, *f, density, cone));
+            let normals = trace.per_pixel.as_ref().map(|pp| &pp.normals);
+            let filter = (f.levels > 1).then(|| Footprint::of(&trace.volume, normals, *f, density, cone));
             ShellObject { trace, step: k.step, tolerance: k.tolerance, bands, filter }
         })
         .collect();
@@ -504,7 +510,7 @@ impl MethodPlan for ShellSet {
             (s.prisms.len() * (48 + 32 + 8) + s.vertices.len() * 32 + s.frames.len() * 32) as u64
                 + (self.tiles.tiles.len() * 8 + self.tiles.entries.len() * 4) as u64
                 + (s.atlas_words + s.normal_words + self.occupancy_words) * 4
-                + self.mip_words * 8
+                + self.mip_words * 8 * (1 + s.copies.iter().any(|c| c.1) as u64)
                 + self.filters.len() as u64 * 16
                 + size.0 as u64 * size.1 as u64 * 32,
         )]
