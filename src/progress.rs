@@ -18,6 +18,12 @@ pub enum Verbosity {
 }
 
 impl Verbosity {
+    /// Whether a long frame shows its progress (rendered in steps to do so): on a terminal, or
+    /// when verbose (a line at each tenth).
+    pub fn frame_progress(self) -> bool {
+        self == Verbosity::Verbose || (self == Verbosity::Normal && std::io::stderr().is_terminal())
+    }
+
     /// From the `--quiet` and `--verbose` flags (`--quiet` wins).
     pub fn from_flags(quiet: bool, verbose: bool) -> Self {
         match (quiet, verbose) {
@@ -93,7 +99,7 @@ impl Progress {
 
     /// One piece of work measured in units (a frame's dispatches) is `done` of the `total` units:
     /// the bar shows `what` on a terminal; otherwise a line at each tenth of the work.
-    pub fn reach(&mut self, done: usize, what: &str) {
+    pub(crate) fn reach(&mut self, done: usize, what: &str) {
         let tenth = |n: usize| (n * 10).checked_div(self.total).unwrap_or(10);
         let before = tenth(self.done);
         self.done = done.min(self.total);

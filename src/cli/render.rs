@@ -4,9 +4,9 @@ use std::path::{Path, PathBuf};
 
 use voltex::gpu::cache::GpuCache;
 use voltex::gpu::GpuContext;
-use voltex::progress::{Progress, Verbosity};
+use voltex::progress::Verbosity;
 use voltex::render::trace::Track;
-use voltex::render::{Blueprint, Frame, RenderOptions, Renderer};
+use voltex::render::{Blueprint, RenderOptions, Renderer};
 use voltex::{io, scene, Result};
 
 use super::Overrides;
@@ -194,11 +194,7 @@ fn render_one(
     let built = since(t);
     let sequence = frame;
     let t = std::time::Instant::now();
-    let frame = if shows_progress(talk) {
-        render_in_steps(ctx, &mut renderer, talk)?
-    } else {
-        renderer.render(ctx)?
-    };
+    let frame = renderer.render_showing(ctx, talk, "frame")?;
     let rendered = since(t);
     let t = std::time::Instant::now();
     track.frames.push(frame.spans.clone());
@@ -243,42 +239,4 @@ fn render_one(
         );
     }
     Ok(())
-}
-
-/// Whether a frame shows its progress: on a terminal, or with `--verbose` (a line a tenth).
-fn shows_progress(talk: Verbosity) -> bool {
-    use std::io::IsTerminal;
-    talk == Verbosity::Verbose || (talk == Verbosity::Normal && std::io::stderr().is_terminal())
-}
-
-/// Renders a frame in steps of about a quarter of a second, showing on stderr the share of its
-/// units of work done (a compute pass's dispatches, a tile of a tiled pass, each other pass),
-/// with an ETA: the same frame as one submission makes, bit for bit. Ctrl-C stops it with
-/// nothing written.
-fn render_in_steps(ctx: &GpuContext, renderer: &mut Renderer, talk: Verbosity) -> Result<Frame> {
-    let mut steps = renderer.begin_steps(ctx);
-    let total = steps.progress().1 as usize;
-    let mut progress = Progress::new(total, talk);
-    let mut batch = 1;
-    while !renderer.step_for(ctx, &mut steps, 250.0, &mut batch)? {
-        progress.reach(steps.progress().0 as usize, "frame");
-    }
-    progress.reach(total, "frame");
-    progress.end();
-    let mut frame = renderer.read_frame(ctx)?;
-    frame.pass_times = merged_parts(&frame.pass_times);
-    Ok(frame)
-}
-
-/// Per-pass times with the parts of a pass split by a stepped frame summed, in order (as one
-/// submission times them).
-fn merged_parts(times: &[(String, f64)]) -> Vec<(String, f64)> {
-    let mut out: Vec<(String, f64)> = Vec::new();
-    for (pass, ms) in times {
-        match out.last_mut() {
-            Some(last) if &last.0 == pass => last.1 += ms,
-            _ => out.push((pass.clone(), *ms)),
-        }
-    }
-    out
 }

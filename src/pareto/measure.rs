@@ -135,9 +135,13 @@ pub(crate) fn orbit_ms(
     Ok(median(times))
 }
 
-/// Just the image (the truth).
-pub(crate) fn image(ctx: &GpuContext, bp: Blueprint) -> Result<Image> {
-    Ok(Renderer::new(ctx, bp)?.render(ctx)?.image)
+/// The truth's image, its frame's progress shown as `talk` asks ([`Renderer::render_showing`]).
+pub(crate) fn truth_image(
+    ctx: &GpuContext,
+    bp: Blueprint,
+    talk: crate::progress::Verbosity,
+) -> Result<Image> {
+    Ok(Renderer::new(ctx, bp)?.render_showing(ctx, talk, "truth")?.image)
 }
 
 /// Warm-up frames (`warmed`: the wall ms of one already rendered), then `frames` timed ones:

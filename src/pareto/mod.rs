@@ -225,7 +225,7 @@ pub fn run(args: &Args) -> Result<()> {
     if args.verbosity != Verbosity::Quiet {
         eprintln!("truth: {}", args.truth_label());
     }
-    let truth = measure::image(&ctx, Blueprint::new(&scene, &args.truth_options())?)?;
+    let truth = measure::truth_image(&ctx, Blueprint::new(&scene, &args.truth_options())?, args.verbosity)?;
     let mut rows = Vec::new();
     let mut progress = Progress::new(n, args.verbosity);
     // Measured in an order that spreads cheap and costly settings (the ETA is the mean time of

@@ -10,6 +10,7 @@ use crate::gpu::{buffers, GpuContext};
 use crate::graph::exec::{Executor, Steps, STEP_ORIGIN};
 use crate::io::Image;
 use crate::methods::InputCx;
+use crate::progress::{Progress, Verbosity};
 use crate::render::Blueprint;
 use crate::types::ObjectParams;
 
@@ -146,6 +147,29 @@ impl Renderer {
         self.read_frame(ctx)
     }
 
+    /// Renders one frame as [`Renderer::render`] does, showing its progress on stderr where
+    /// `talk` asks for it ([`Verbosity::frame_progress`]): the share of its units of work done (a
+    /// compute pass's dispatches, a tile of a tiled pass, each other pass) and an ETA, labelled
+    /// `what`. Such a frame is rendered in steps of about a quarter of a second: the same image,
+    /// bit for bit, its split passes' times summed back per pass.
+    pub fn render_showing(&mut self, ctx: &GpuContext, talk: Verbosity, what: &str) -> Result<Frame> {
+        if !talk.frame_progress() {
+            return self.render(ctx);
+        }
+        let mut steps = self.begin_steps(ctx);
+        let total = steps.progress().1 as usize;
+        let mut progress = Progress::new(total, talk);
+        let mut batch = 1;
+        while !self.step_for(ctx, &mut steps, 250.0, &mut batch)? {
+            progress.reach(steps.progress().0 as usize, what);
+        }
+        progress.reach(total, what);
+        progress.end();
+        let mut frame = self.read_frame(ctx)?;
+        frame.pass_times = merged_parts(&frame.pass_times);
+        Ok(frame)
+    }
+
     /// Starts a frame rendered in steps ([`Renderer::step`]) rather than in one submission.
     pub fn begin_steps(&mut self, ctx: &GpuContext) -> Steps {
         let steps = Executor::begin_steps(&self.blueprint.plan, &self.frame, &self.objects);
@@ -178,7 +202,7 @@ impl Renderer {
     /// every tile of a tiled pass, whose units may cost a hundred times the last ones (a
     /// Reference tile over the object after one over the background), so a submission runs past
     /// the budget by about one unit at most. Returns whether the frame is finished.
-    pub fn step_for(
+    pub(crate) fn step_for(
         &mut self,
         ctx: &GpuContext,
         steps: &mut Steps,
@@ -428,4 +452,17 @@ impl Renderer {
             far: v.far as f32,
         }
     }
+}
+
+/// Per-pass times with the parts of a pass split by a stepped frame summed, in order (as one
+/// submission times them).
+fn merged_parts(times: &[(String, f64)]) -> Vec<(String, f64)> {
+    let mut out: Vec<(String, f64)> = Vec::new();
+    for (pass, ms) in times {
+        match out.last_mut() {
+            Some(last) if &last.0 == pass => last.1 += ms,
+            _ => out.push((pass.clone(), *ms)),
+        }
+    }
+    out
 }

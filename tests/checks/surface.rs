@@ -44,7 +44,8 @@ use crate::layers::rust_files;
 /// (1345: ShellMarch's footprint filter: the scene-file knobs `filter` and `mip_bias` and their
 /// enum `Filter` (public as every knob type, for the scene reference's check), and the GPU struct
 /// `ShellFilter` with its four fields (public as every `types` struct, for the layout check).)
-/// (1347: `Renderer::step_for` and `Progress::reach`: `render` shows a frame's progress.)
+/// (1347: `Renderer::render_showing` and `Verbosity::frame_progress`: `render` shows a frame's
+/// progress.)
 const PUB_DECLARATIONS: usize = 1347;
 
 /// Whether the declaration on line `n` has a `///` doc above its attributes (one-line ones, or

@@ -94,5 +94,9 @@ fn quiet_pareto_prints_only_its_report() {
         "{}",
         String::from_utf8_lossy(&loud.stderr)
     );
+    // `-v` also shows the truth's frame as it renders (issue 32, item 10: the ETA left it out).
+    let verbose = voltex(&[&args[..], &["--out", s(&out), "-v"]].concat());
+    let err = String::from_utf8_lossy(&verbose.stderr);
+    assert!(err.lines().any(|l| l.starts_with("[100%] truth: ")), "{err}");
     std::fs::remove_dir_all(&out).unwrap();
 }
