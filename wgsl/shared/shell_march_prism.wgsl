@@ -212,7 +212,7 @@ fn set_piece(s: u32, j: u32, ca_known: vec4<f32>, next: bool) {
 fn footprint_level(index: u32, t: f32) -> f32 {
     let prism = shell_prisms[index];
     let footprint = shell_filters[prism.vertices.w];
-    if (footprint.levels <= 1u) {
+    if (!filtering || footprint.levels <= 1u) {
         return 0.0;
     }
     return clamp(log2(cone * t * prism.uv2.w) + footprint.bias, 0.0, f32(footprint.levels - 1u));

@@ -69,28 +69,22 @@ fn axis(c: f32, n: u32, wrap: bool) -> Axis {
     return Axis(u32(i0), u32(i1), x - fl);
 }
 
-// Trilinear filtering as the volume sampler does it (the Reference's atlas): repeat in s and t,
-// clamp in w, level 0.
-fn sample_volume(object: ReferenceObject, uvw: vec3<f32>, normals: bool) -> vec4<f32> {
-    let ax = axis(fract(uvw.x), object.resolution.x, true);
-    let ay = axis(fract(uvw.y), object.resolution.y, true);
-    let az = axis(uvw.z, object.resolution.z, false);
-    let offset = select(object.atlas.x, object.atlas.z, normals);
-    var out = vec4<f32>(0.0);
-    for (var k = 0u; k < 8u; k++) {
-        let x = select(ax.i0, ax.i1, (k & 1u) != 0u);
-        let y = select(ay.i0, ay.i1, (k & 2u) != 0u);
-        let z = select(az.i0, az.i1, (k & 4u) != 0u);
-        let weight = select(1.0 - ax.f, ax.f, (k & 1u) != 0u) * select(1.0 - ay.f, ay.f, (k & 2u) != 0u)
-            * select(1.0 - az.f, az.f, (k & 4u) != 0u);
-        let at = offset + (z * object.resolution.y + y) * object.atlas.y + x;
-        if (normals) {
-            out += unpack4x8snorm(normal_atlas[at]) * weight;
-        } else {
-            out += unpack4x8unorm(texel_atlas[at]) * weight;
-        }
-    }
-    return out;
+// Corner k (bit 0: x, bit 1: y, bit 2: z) of a trilinear sample between voxels `ax`, `ay`, `az`:
+// its voxel and its weight.
+struct Corner {
+    x: u32,
+    y: u32,
+    z: u32,
+    weight: f32,
+}
+
+fn corner(ax: Axis, ay: Axis, az: Axis, k: u32) -> Corner {
+    let x = select(ax.i0, ax.i1, (k & 1u) != 0u);
+    let y = select(ay.i0, ay.i1, (k & 2u) != 0u);
+    let z = select(az.i0, az.i1, (k & 4u) != 0u);
+    let weight = select(1.0 - ax.f, ax.f, (k & 1u) != 0u) * select(1.0 - ay.f, ay.f, (k & 2u) != 0u)
+        * select(1.0 - az.f, az.f, (k & 4u) != 0u);
+    return Corner(x, y, z, weight);
 }
 
 // The f16 in the low 16 bits of h, exactly (`unpack2x16float` needs a capability that Mesa's
@@ -105,6 +99,37 @@ fn half(h: u32) -> f32 {
 
 fn half4(v: vec2<u32>) -> vec4<f32> {
     return vec4<f32>(half(v.x & 0xffffu), half(v.x >> 16u), half(v.y & 0xffffu), half(v.y >> 16u));
+}
+
+// Trilinear filtering as the volume sampler does it (the Reference's atlas), at MIP level l of
+// `object`'s texel (or of its normals): repeat in s and t, clamp in w. Level 0 is the atlas
+// (8 bits); a level l >= 1 of the footprint filter halves s and t and starts at `start` in
+// `shell_mips` (f16, rows padded to 32 voxels).
+fn sample_volume(object: ReferenceObject, l: u32, start: u32, uvw: vec3<f32>, normals: bool) -> vec4<f32> {
+    let n = object.resolution.xy >> vec2<u32>(l);
+    let ax = axis(fract(uvw.x), n.x, true);
+    let ay = axis(fract(uvw.y), n.y, true);
+    let az = axis(uvw.z, object.resolution.z, false);
+    let atlas = l == 0u;
+    let offset = select(start, select(object.atlas.x, object.atlas.z, normals), atlas);
+    let pitch = select((n.x + 31u) & ~31u, object.atlas.y, atlas);
+    var out = vec4<f32>(0.0);
+    for (var k = 0u; k < 8u; k++) {
+        let c = corner(ax, ay, az, k);
+        let at = offset + (c.z * n.y + c.y) * pitch + c.x;
+        if (atlas) {
+            if (normals) {
+                out += unpack4x8snorm(normal_atlas[at]) * c.weight;
+            } else {
+                out += unpack4x8unorm(texel_atlas[at]) * c.weight;
+            }
+        } else if (normals) {
+            out += half4(shell_normal_mips[at]) * c.weight;
+        } else {
+            out += half4(shell_mips[at]) * c.weight;
+        }
+    }
+    return out;
 }
 
 // Where the two MIP levels the current run's samples mix start in `shell_mips` (and
@@ -122,50 +147,20 @@ fn level_start(object: ReferenceObject, footprint: ShellFilter, l: u32) -> u32 {
     return offset;
 }
 
-// Bilinear in s and t (repeating) and linear in w of MIP level l >= 1 of `object`'s texel (or of
-// its normals), which starts at `offset`.
-fn sample_level(object: ReferenceObject, offset: u32, uvw: vec3<f32>, l: u32, normals: bool) -> vec4<f32> {
-    let depth = object.resolution.z;
-    let n = object.resolution.xy >> vec2<u32>(l);
-    let pitch = (n.x + 31u) & ~31u;
-    let ax = axis(fract(uvw.x), n.x, true);
-    let ay = axis(fract(uvw.y), n.y, true);
-    let az = axis(uvw.z, depth, false);
-    var out = vec4<f32>(0.0);
-    for (var k = 0u; k < 8u; k++) {
-        let x = select(ax.i0, ax.i1, (k & 1u) != 0u);
-        let y = select(ay.i0, ay.i1, (k & 2u) != 0u);
-        let z = select(az.i0, az.i1, (k & 4u) != 0u);
-        let weight = select(1.0 - ax.f, ax.f, (k & 1u) != 0u) * select(1.0 - ay.f, ay.f, (k & 2u) != 0u)
-            * select(1.0 - az.f, az.f, (k & 4u) != 0u);
-        let at = offset + (z * n.y + y) * pitch + x;
-        if (normals) {
-            out += half4(shell_normal_mips[at]) * weight;
-        } else {
-            out += half4(shell_mips[at]) * weight;
-        }
-    }
-    return out;
-}
-
-// The texel (or its normals) at fractional MIP level `level`: level 0 from the atlas, the two
-// levels around it mixed.
+// The texel (or its normals) at fractional MIP level `level` (0: level 0 alone): the two levels
+// around it mixed. Without `filtering` only the first call is compiled: llvmpipe inlines every
+// call of the tap loop, and the filter's two more made the kernel about 10% slower.
 fn sample_filtered(object: ReferenceObject, uvw: vec3<f32>, level: f32, normals: bool) -> vec4<f32> {
-    if (level <= 0.0) {
-        return sample_volume(object, uvw, normals);
+    if (!filtering || level <= 0.0) {
+        return sample_volume(object, 0u, 0u, uvw, normals);
     }
     let l0 = u32(floor(level));
-    var a: vec4<f32>;
-    if (l0 == 0u) {
-        a = sample_volume(object, uvw, normals);
-    } else {
-        a = sample_level(object, mip_starts.x, uvw, l0, normals);
-    }
     let f = level - floor(level);
+    let a = sample_volume(object, l0, mip_starts.x, uvw, normals);
     if (f == 0.0) {
         return a;
     }
-    return mix(a, sample_level(object, mip_starts.y, uvw, l0 + 1u, normals), f);
+    return mix(a, sample_volume(object, l0 + 1u, mip_starts.y, uvw, normals), f);
 }
 
 // Per-pixel lighting as the Reference does it (shared/shading.wgsl), at map value c, the normals
@@ -241,7 +236,7 @@ fn run(s: u32, limit: f32) {
     let level = iv_level[s];
     let footprint = shell_filters[prism.vertices.w];
     let pyramid = filter_pyramid(level, footprint.levels);
-    if (level > 0.0) {
+    if (filtering && level > 0.0) {
         let l0 = u32(floor(level));
         mip_starts = vec2<u32>(level_start(object, footprint, l0), level_start(object, footprint, l0 + 1u));
     }

@@ -19,6 +19,9 @@
 // typical unit (a few iterations; images bit-identical to 2048 on the example scenes).
 override samples_per_dispatch: u32 = 8192u;
 override min_transmittance: f32 = 1e-3;
+// Whether some object filters by footprint (`filter: Footprint`): without, the filter's code is
+// left out of the compiled kernel.
+override filtering: bool = false;
 const BOUND_COST: i32 = 2;
 const PRISM_COST: i32 = 32;
 const PIECE_COST: i32 = 16;

@@ -152,12 +152,10 @@ pub(super) fn gather(objects: &mut [ObjectPlan], bakes: &[BakePlan], view: &View
             ids,
         };
         p.uv2[2] = folds(&corners) as u32 as f32;
-    }
-    for p in &mut set.prisms {
         let o = p.vertices[3] as usize;
         if filters[o].levels > 1 {
-            let res = [set.table[o].resolution[0], set.table[o].resolution[1], set.table[o].resolution[2]];
-            p.uv2[3] = filter::density(p, &set.vertices, res);
+            let [x, y, z, _] = set.table[o].resolution;
+            p.uv2[3] = filter::density(p, &set.vertices, [x, y, z]);
         }
     }
     let work: f64 = list.iter().map(work_bound).sum();
@@ -216,11 +214,13 @@ impl ShellSet {
         ctx.queue.submit([encoder.finish()]);
     }
 
-    /// The kernel's override constants: the lowest cutoff of its objects. (Skipping, on unless
-    /// an object turns it off, is `shell_params.counts.w`.)
+    /// The kernel's override constants: the lowest cutoff of its objects, and whether one
+    /// filters by footprint. (Skipping, on unless an object turns it off, is
+    /// `shell_params.counts.w`.)
     fn constants(&self) -> Vec<(String, f64)> {
         let cutoff = self.knobs.iter().map(|k| k.min_transmittance).fold(1.0, f64::min);
-        vec![("min_transmittance".into(), cutoff)]
+        let filtering = self.filters.iter().any(|f| f.levels > 1);
+        vec![("min_transmittance".into(), cutoff), ("filtering".into(), filtering as u32 as f64)]
     }
 
     /// Per-pixel state and counters, the tables, the atlases (copied from the bakes) and the
