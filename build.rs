@@ -9,9 +9,9 @@
 //! constant per resource its kernels bind (a `var<uniform>`, `var<storage>` or handle global,
 //! their includes' too), e.g. `view_slices::SLICE_PARAMS = "slice_params"`, and in `counts` one
 //! constant per count the built-in graphs' passes dispatch, repeat or draw by (`dispatch:
-//! Threads("planes", ..)`, `repeat: "reference_dispatches"`), e.g. `counts::PLANES = "planes"`. Rust code that binds
-//! a resource or sets a count by one of these names no longer compiles when the WGSL or the graph
-//! stops using it.
+//! Threads("prisms", ..)`, `repeat: "reference_dispatches"`), e.g. `counts::PRISMS = "prisms"`.
+//! Rust code that binds a resource or sets a count by one of these names no longer compiles when
+//! the WGSL or the graph stops using it.
 
 use std::path::{Path, PathBuf};
 

@@ -43,8 +43,8 @@ pub(crate) fn layout(res: [u32; 3], levels: u32) -> (Vec<u64>, u64) {
     (starts, words)
 }
 
-/// Per object the filter (`mips` relative to the buffer's start), and the buffer's words:
-/// `res` and `filtered` per object, with its bias.
+/// Per object (its texel's resolution, and its bias where it filters) its filter, `mips` counted
+/// from the start of `shell_mips`; and the words of `shell_mips`.
 pub(crate) fn table(objects: impl Iterator<Item = ([u32; 3], Option<f64>)>) -> (Vec<ShellFilter>, u64) {
     let mut words = 0u64;
     let table = objects

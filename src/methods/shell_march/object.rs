@@ -185,33 +185,51 @@ impl ShellSet {
             .collect()
     }
 
+    /// The objects that filter by footprint: filter, texel resolution, bake, lit per pixel.
+    fn filtering(&self) -> impl Iterator<Item = (ShellFilter, [u32; 3], usize, bool)> + '_ {
+        (self.filters.iter().zip(&self.set.table).zip(&self.set.copies))
+            .filter(|((f, _), _)| f.levels > 1)
+            .map(|((f, entry), &(bake, lit))| {
+                let [x, y, z, _] = entry.resolution;
+                (*f, [x, y, z], bake, lit)
+            })
+    }
+
+    /// Words of `shell_normal_mips`: the places of `shell_mips` where a filtering object is lit
+    /// per pixel, else 1 (the binding exists).
+    fn normal_mip_words(&self) -> u64 {
+        if self.filtering().any(|o| o.3) {
+            self.mip_words
+        } else {
+            1
+        }
+    }
+
     /// `shell_filters`; `shell_mips` with levels 1.. of each filtering object's texel layers, and
     /// `shell_normal_mips` (the same places) with its normals' where it is lit per pixel.
     fn copy_mips(&self, ctx: &GpuContext, inputs: &mut Inputs, baked: &[Baked]) {
         let b = &mut inputs.buffers;
         b.insert(B::SHELL_FILTERS.into(), storage(ctx, "shell_filters", bytemuck::cast_slice(&self.filters)));
-        let filtering = || {
-            (self.filters.iter().zip(&self.set.table).zip(&self.set.copies))
-                .filter(|((f, _), _)| f.levels > 1)
-                .map(|((f, entry), &(bake, lit))| (*f, [entry.resolution[0], entry.resolution[1], entry.resolution[2]], bake, lit))
-        };
-        let any_lit = filtering().any(|o| o.3);
+        let objects: Vec<_> = self.filtering().collect();
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
-        for (name, layer, words) in [(B::SHELL_MIPS, 0, self.mip_words), (B::SHELL_NORMAL_MIPS, 1, if any_lit { self.mip_words } else { 1 })] {
+        let buffers = [(B::SHELL_MIPS, 0, self.mip_words), (B::SHELL_NORMAL_MIPS, 1, self.normal_mip_words())];
+        for (name, layer, words) in buffers {
             let mips = ctx.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(name),
                 size: words * 8,
                 usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
                 mapped_at_creation: false,
             });
-            let copies: Vec<_> = filtering()
+            let copies: Vec<_> = (objects.iter())
                 .filter(|o| layer == 0 || o.3)
-                .map(|(f, res, bake, _)| (f, res, &baked[bake].layers[layer]))
+                .map(|&(f, res, bake, _)| (f, res, &baked[bake].layers[layer]))
                 .collect();
             filter::copy_levels(&mut encoder, &mips, &copies);
             b.insert(name.into(), mips);
         }
-        ctx.queue.submit([encoder.finish()]);
+        if !objects.is_empty() {
+            ctx.queue.submit([encoder.finish()]);
+        }
     }
 
     /// The kernel's override constants: the lowest cutoff of its objects, and whether one
@@ -510,7 +528,7 @@ impl MethodPlan for ShellSet {
             (s.prisms.len() * (48 + 32 + 8) + s.vertices.len() * 32 + s.frames.len() * 32) as u64
                 + (self.tiles.tiles.len() * 8 + self.tiles.entries.len() * 4) as u64
                 + (s.atlas_words + s.normal_words + self.occupancy_words) * 4
-                + self.mip_words * 8 * (1 + s.copies.iter().any(|c| c.1) as u64)
+                + (self.mip_words + self.normal_mip_words()) * 8
                 + self.filters.len() as u64 * 16
                 + size.0 as u64 * size.1 as u64 * 32,
         )]
