@@ -147,6 +147,15 @@ fn plane_counts() {
     assert_err("planes1e5", &[(14, l)], "scene.ron", 14, 40, "expected a plane count");
 }
 
+/// ShellMarch's footprint filter: a bias out of range, an unknown filter.
+#[test]
+fn shell_march_filter_knobs() {
+    let l = "            method: ShellMarch(filter: Footprint, mip_bias: 9.0),";
+    assert_err("mip_bias9", &[(14, l)], "scene.ron", 14, 61, "expected a MIP bias in [-4, 4] levels");
+    let l = "            method: ShellMarch(filter: Box),";
+    assert_err("filter_box", &[(14, l)], "scene.ron", 14, 40, "Footprint");
+}
+
 #[test]
 fn output_sizes() {
     let l = "    output: (width: 0, height: 64),";
